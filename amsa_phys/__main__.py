@@ -1,0 +1,7 @@
+"""``python -m amsa_phys``."""
+
+import sys
+
+from .cli.main import main
+
+sys.exit(main())

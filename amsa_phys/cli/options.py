@@ -1,0 +1,38 @@
+"""Options shared by several subcommands, defined once."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_scenario_overrides(p: argparse.ArgumentParser) -> None:
+    """--seed, --duration, --set, --log-rate."""
+    p.add_argument("--seed", type=int, help="override the scenario's seed")
+    p.add_argument(
+        "--duration",
+        type=float,
+        metavar="S",
+        help="override the duration (seconds of simulated time)",
+    )
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="Comp.param=V",
+        help="set a parameter at t = 0 (repeatable); V is read as YAML",
+    )
+    p.add_argument(
+        "--log-rate",
+        type=float,
+        metavar="HZ",
+        help="trace rate (default 20 Hz, never below the fastest sensor)",
+    )
+
+
+def add_output(p: argparse.ArgumentParser) -> None:
+    """--out and --force."""
+    p.add_argument(
+        "--out", metavar="DIR", help="run directory (default runs/<scenario>-<YYYYmmdd-HHMMSS>)"
+    )
+    p.add_argument("--force", action="store_true", help="replace an existing --out directory")

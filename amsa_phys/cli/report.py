@@ -1,0 +1,50 @@
+"""Plain-text tables for the terminal."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, TextIO
+
+
+def _fmt(value: Any, digits: int = 2) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float):
+        return f"{value:.{digits}f}"
+    return str(value)
+
+
+def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> None:
+    """Per-phase metrics, the overall line, speed and where the files are."""
+    cols = ("phase", "start", "max", "min", "mean err", "rms err", "settle", "coll", "set")
+    rows = []
+    blocks = [(str(i), p) for i, p in enumerate(metrics["phases"])]
+    blocks.append(("all", {**metrics["overall"], "start": 0.0, "set": {}}))
+    for name, b in blocks:
+        changes = ", ".join(f"{k}={v}" for k, v in b.get("set", {}).items())
+        rows.append(
+            (
+                name,
+                _fmt(b.get("start"), 1),
+                _fmt(b.get("max_distance")),
+                _fmt(b.get("min_distance")),
+                _fmt(b.get("mean_error")),
+                _fmt(b.get("rms_error")),
+                _fmt(b.get("settling_time"), 1),
+                _fmt(b.get("collisions")),
+                changes,
+            )
+        )
+    widths = [max(len(c), *(len(r[i]) for r in rows)) for i, c in enumerate(cols)]
+    line = "  ".join(c.ljust(w) for c, w in zip(cols, widths, strict=True))
+    print(line.rstrip(), file=stream)
+    for r in rows:
+        print("  ".join(v.ljust(w) for v, w in zip(r, widths, strict=True)).rstrip(), file=stream)
+    q = metrics.get("quality")
+    if q:
+        print(f"quality: {q['signal']} vs {q['reference']:g} m ± {q['tolerance']:g} m", file=stream)
+    print(
+        f"simulated {metrics['simulated']:.1f} s in {metrics['wall_time_s']:.2f} s "
+        f"({metrics['real_time_factor']}x real time); outputs in {out_dir}",
+        file=stream,
+    )

@@ -1,0 +1,60 @@
+"""Run one scenario and write its run directory."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+from pathlib import Path
+from types import FrameType
+
+from ..errors import ConfigError
+from ..model.scenario import load_scenario
+from ..runs.rundir import default_run_dir, prepare_run_dir
+from ..runs.single import run_scenario
+from .options import add_output, add_scenario_overrides
+from .report import print_summary
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``amsa-phys run``."""
+    p.add_argument("scenario", help="scenario YAML file")
+    p.add_argument(
+        "--headless",
+        action="store_true",
+        help="no window (the interactive window is not built yet: required)",
+    )
+    add_scenario_overrides(p)
+    add_output(p)
+    p.add_argument("--no-plot", action="store_true", help="skip distance.png")
+    p.add_argument("-q", "--quiet", action="store_true", help="no summary table")
+
+
+def _sigterm(signum: int, frame: FrameType | None) -> None:
+    raise KeyboardInterrupt
+
+
+def run(args: argparse.Namespace) -> int:
+    """Load, run, report."""
+    if not args.headless:
+        raise ConfigError(
+            "the interactive window is not available in this version; run with --headless",
+            key="run",
+        )
+    scenario = load_scenario(
+        args.scenario,
+        overrides=args.overrides,
+        seed=args.seed,
+        duration=args.duration,
+        log_rate=args.log_rate,
+    )
+    out = Path(args.out) if args.out else default_run_dir(scenario.name)
+    prepare_run_dir(out, args.force)
+    previous = signal.signal(signal.SIGTERM, _sigterm)
+    try:
+        outcome = run_scenario(scenario, out, plot=not args.no_plot)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    if not args.quiet:
+        print_summary(outcome.metrics, out, sys.stdout)
+    return 0

@@ -1,0 +1,37 @@
+"""List the template library: kind, ports and parameters of every built-in template."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..model.template import BUILTINS, resolve_template
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``amsa-phys templates``."""
+    p.add_argument("name", nargs="?", help="show one template (built-in name or module:Class)")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print each template."""
+    names = [args.name] if args.name else list(BUILTINS)
+    for name in names:
+        t = resolve_template(name)
+        print(f"{t.name()} ({t.kind.value}): {t.describe()}")
+        for port in t.inputs:
+            print(
+                f"    in  {port.name}"
+                + (f" [{port.unit}]" if port.unit else "")
+                + (f"  {port.description}" if port.description else "")
+            )
+        for port in t.outputs:
+            print(
+                f"    out {port.name}"
+                + (f" [{port.unit}]" if port.unit else "")
+                + (f"  {port.description}" if port.description else "")
+            )
+        for p in t.params:
+            unit = f" {p.unit}" if p.unit else ""
+            rng = f" {p.range_text()}" if p.range_text() else ""
+            print(f"    param {p.name}: {p.type} = {p.default!r}{unit}{rng}  {p.description}")
+    return 0

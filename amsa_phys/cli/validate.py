@@ -1,0 +1,34 @@
+"""Check worlds and scenarios without running them."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..errors import AmsaError
+from .loading import load_any
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``amsa-phys validate``."""
+    p.add_argument("files", nargs="+", help="world or scenario YAML files")
+
+
+def run(args: argparse.Namespace) -> int:
+    """One line per file: ``ok: ...`` or the error. Exit 2 if any file is bad."""
+    bad = 0
+    for path in args.files:
+        try:
+            kind, obj = load_any(path)
+        except AmsaError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            bad += 1
+            continue
+        if kind == "scenario":
+            print(
+                f"ok: {path} (scenario: {len(obj.world.leaves)} components, "
+                f"{len(obj.phases)} phases, {float(obj.duration):g} s)"
+            )
+        else:
+            print(f"ok: {path} (world: {len(obj.leaves)} components)")
+    return 2 if bad else 0

@@ -1,0 +1,1 @@
+"""L2: actuators, controllers and monitors of the MDE challenge."""

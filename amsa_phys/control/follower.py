@@ -1,0 +1,148 @@
+"""FollowerController: the paper's proportional leader-following law.
+
+The error between the follower and its desired place (``distanceRef`` behind the leader on
+the line joining them) is decomposed along and across the follower's heading: with ``alpha``
+the bearing of the leader seen from the follower (from the GPS fixes and the compass) and
+``e = distance - distanceRef``,
+
+* forward power  = (100 * Kv * e + Kff * ff(v_leader)) * cos(alpha)         [%]
+* turning power  = 100 * Kw * alpha                                          [%]
+* left = forward - turning, right = forward + turning.
+
+``Kv`` is in fractions of full power per metre of distance error and ``Kw`` per radian of
+bearing error. The feed-forward term uses the leader's speed estimated from its GPS fixes
+(a least-squares slope over ``speedWindow`` seconds of *new* fixes: a lost fix leaves the
+buffer unchanged and is not mistaken for a stop; a jump faster than twice ``maxSpeed``, such as
+the first real fix after the buffer's initial 0, restarts the estimate). The paper's controller
+"considers the rovers' distance and speed"; without it a proportional law can only hold the
+distance with a standing error proportional to the leader's speed. ``ff(v) = frictionPower + 100 v /
+maxSpeed`` (for v > 0) is the controller's calibrated model of its own rover: the power that
+holds speed ``v`` on flat ground (``frictionPower`` overcomes rolling resistance). Worn motors
+(``motorCoef`` < 100) make that model wrong, which is exactly what the degraded context tests.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Mapping
+from fractions import Fraction
+from typing import Any
+
+from ..model.params import Param
+from ..model.template import Kind, Port, Template
+
+
+class FollowerController(Template):
+    """Proportional follower law: Kv on the distance error, Kw on the bearing error."""
+
+    kind = Kind.CONTROLLER
+    inputs = (
+        Port("xLeader", 0.0, "leader x (GPS)", "m"),
+        Port("yLeader", 0.0, "leader y (GPS)", "m"),
+        Port("xFollower", 0.0, "follower x (GPS)", "m"),
+        Port("yFollower", 0.0, "follower y (GPS)", "m"),
+        Port("headingFollower", 0.0, "follower heading (compass)", "rad"),
+        Port("distanceLeaderFollower", 0.0, "leader-follower distance", "m"),
+    )
+    outputs = (
+        Port("LeftPower", 0.0, "left wheel power", "%"),
+        Port("RightPower", 0.0, "right wheel power", "%"),
+        Port("leaderSpeed", 0.0, "estimated leader speed", "m/s"),
+    )
+    params = (
+        Param(
+            "Kv",
+            "float",
+            "gain on the distance error (power fraction per metre)",
+            0.1,
+            0.0,
+            10.0,
+            "1/m",
+        ),
+        Param(
+            "Kw",
+            "float",
+            "gain on the bearing error (power fraction per radian)",
+            0.04,
+            0.0,
+            10.0,
+            "1/rad",
+        ),
+        Param("distanceRef", "float", "reference distance to the leader", 15.0, 0.0, 1000.0, "m"),
+        Param(
+            "Kff", "float", "weight of the leader-speed feed-forward (0 disables it)", 1.0, 0.0, 2.0
+        ),
+        Param(
+            "maxSpeed",
+            "float",
+            "speed gained per 100 % of power, as the controller believes it",
+            5.5,
+            0.01,
+            100.0,
+            "m/s",
+        ),
+        Param(
+            "frictionPower",
+            "float",
+            "power needed to overcome rolling resistance, as the controller believes it",
+            6.5,
+            0.0,
+            100.0,
+            "%",
+        ),
+        Param(
+            "speedWindow", "float", "time window of the leader-speed estimate", 3.0, 0.1, 600.0, "s"
+        ),
+    )
+
+    def initialize(self, ctx: Any) -> None:
+        """Start with no speed estimate."""
+        self.fixes: deque[tuple[float, float, float]] = deque()
+        self.v_leader = 0.0
+
+    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+        """The paper's doStep: one control update."""
+        p = self.p
+        if inp["distanceLeaderFollower"] <= 0.0:
+            # no distance measured yet (or the rovers touch): command nothing
+            return {"LeftPower": 0.0, "RightPower": 0.0, "leaderSpeed": self.v_leader}
+        xl, yl = inp["xLeader"], inp["yLeader"]
+        self._update_speed(float(t), xl, yl)
+        dx = xl - inp["xFollower"]
+        dy = yl - inp["yFollower"]
+        alpha = math.atan2(dy, dx) - inp["headingFollower"]
+        alpha = (alpha + math.pi) % (2 * math.pi) - math.pi
+        e = inp["distanceLeaderFollower"] - p.distanceRef
+        ff = p.frictionPower + 100.0 * self.v_leader / p.maxSpeed if self.v_leader > 0 else 0.0
+        forward = (100.0 * p.Kv * e + p.Kff * ff) * math.cos(alpha)
+        turn = 100.0 * p.Kw * alpha
+        return {
+            "LeftPower": forward - turn,
+            "RightPower": forward + turn,
+            "leaderSpeed": self.v_leader,
+        }
+
+    def _update_speed(self, t: float, x: float, y: float) -> None:
+        fixes = self.fixes
+        if fixes and fixes[-1][1] == x and fixes[-1][2] == y:
+            return  # no new fix (lost sample): keep the estimate
+        if fixes:
+            lt, lx, ly = fixes[-1]
+            if math.hypot(x - lx, y - ly) > 2 * self.p.maxSpeed * max(t - lt, 0.25):
+                fixes.clear()  # an impossible jump: the first real fix, or a GPS glitch
+        fixes.append((t, x, y))
+        while fixes and fixes[0][0] < t - self.p.speedWindow:
+            fixes.popleft()
+        n = len(fixes)
+        if n < 2:
+            return
+        mt = sum(f[0] for f in fixes) / n
+        mx = sum(f[1] for f in fixes) / n
+        my = sum(f[2] for f in fixes) / n
+        stt = sum((f[0] - mt) ** 2 for f in fixes)
+        if stt <= 0:
+            return
+        vx = sum((f[0] - mt) * (f[1] - mx) for f in fixes) / stt
+        vy = sum((f[0] - mt) * (f[2] - my) for f in fixes) / stt
+        self.v_leader = math.hypot(vx, vy)

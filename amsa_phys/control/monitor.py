@@ -1,0 +1,29 @@
+"""DistanceMonitor: the true leader–follower distance (a sensor in the paper's model)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from fractions import Fraction
+from typing import Any
+
+from ..model.template import Kind, Port, Template
+
+
+class DistanceMonitor(Template):
+    """Euclidean distance between the leader's and the follower's true positions.
+
+    A sensor in the paper (it feeds the controller); also the quality-of-control signal.
+    """
+
+    kind = Kind.SENSOR
+    inputs = (Port("xLeader"), Port("yLeader"), Port("xFollower"), Port("yFollower"))
+    outputs = (Port("distanceFollowerToLeader", 0.0, "true distance", "m"),)
+
+    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+        """The paper's doStep: one distance."""
+        return {
+            "distanceFollowerToLeader": math.hypot(
+                inp["xLeader"] - inp["xFollower"], inp["yLeader"] - inp["yFollower"]
+            )
+        }

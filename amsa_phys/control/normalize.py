@@ -1,0 +1,51 @@
+"""NormalizePower: the actuator stage between the controller and the motors."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from fractions import Fraction
+from typing import Any
+
+from ..model.params import Param
+from ..model.template import Kind, Port, Template
+
+
+class NormalizePower(Template):
+    """Clamp each wheel's power to [powerMin, powerMax], then deliver motorCoef % of it.
+
+    ``motorCoef`` is the paper's context parameter for worn motors: 60 delivers 60 % of the
+    (clamped) power the controller asked for.
+    """
+
+    kind = Kind.ACTUATOR
+    inputs = (
+        Port("powerL", 0.0, "requested left power", "%"),
+        Port("powerR", 0.0, "requested right power", "%"),
+    )
+    outputs = (
+        Port("normalizedPowerL", 0.0, "delivered left power", "%"),
+        Port("normalizedPowerR", 0.0, "delivered right power", "%"),
+    )
+    params = (
+        Param("powerMin", "float", "lowest power", -100.0, -100.0, 100.0, "%"),
+        Param("powerMax", "float", "highest power", 100.0, -100.0, 100.0, "%"),
+        Param("motorCoef", "int", "share of the power actually delivered", 100, 0, 100, "%"),
+    )
+
+    def initialize(self, ctx: Any) -> None:
+        """Refuse an empty range (it would silently pin the motors)."""
+        self.on_param_change("powerMin", self.p.powerMin)
+
+    def on_param_change(self, name: str, value: Any) -> None:
+        """Keep powerMin <= powerMax."""
+        if self.p.powerMin > self.p.powerMax:
+            raise ValueError(f"powerMin {self.p.powerMin:g} is above powerMax {self.p.powerMax:g}")
+
+    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+        """The paper's doStep: clamp, then scale."""
+        lo, hi = self.p.powerMin, self.p.powerMax
+        k = self.p.motorCoef * 0.01
+        return {
+            "normalizedPowerL": min(hi, max(lo, inp["powerL"])) * k,
+            "normalizedPowerR": min(hi, max(lo, inp["powerR"])) * k,
+        }

@@ -1,0 +1,54 @@
+"""The trace: every Data buffer at the log rate, streamed to a temporary file and renamed.
+
+A run that is killed never leaves a half-written ``trace.csv``: rows go to
+``trace.csv.tmp`` and ``os.replace`` gives it its final name only when the run is finalised
+(normally, on a fault or on Ctrl-C). Floats are written with ``repr`` (shortest exact
+round-trip), so the same run gives byte-identical files.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import IO
+
+
+class TraceWriter:
+    """Streams trace rows to ``path`` atomically."""
+
+    def __init__(self, path: Path, columns: Sequence[str]) -> None:
+        self.path = Path(path)
+        self.tmp = self.path.with_name(self.path.name + ".tmp")
+        self.columns = list(columns)
+        self._fh: IO[str] | None = open(self.tmp, "w", encoding="utf-8", newline="\n")  # noqa: SIM115
+        self._fh.write(",".join(["t", *self.columns]) + "\n")
+        self.rows = 0
+
+    def write(self, t_s: float, values: Sequence[float]) -> None:
+        """Append one row (``t`` in seconds, then one value per column)."""
+        assert self._fh is not None, "trace already closed"
+        self._fh.write(repr(t_s) + "," + ",".join(map(repr, values)) + "\n")
+        self.rows += 1
+
+    def close(self) -> Path:
+        """Flush, fsync and rename to the final name; safe to call twice."""
+        if self._fh is not None:
+            self._fh.flush()
+            os.fsync(self._fh.fileno())
+            self._fh.close()
+            self._fh = None
+            os.replace(self.tmp, self.path)
+        return self.path
+
+
+def write_atomic(path: Path, data: str | bytes) -> None:
+    """Write a whole file under a temporary name, then rename it into place."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    mode = "wb" if isinstance(data, bytes) else "w"
+    with open(tmp, mode) as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)

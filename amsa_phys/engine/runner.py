@@ -1,0 +1,332 @@
+"""The simulation loop: components at their own rates on one exact clock.
+
+At every instant the engine does, in this order:
+
+1. apply timeline changes due at that instant (a new phase starts);
+2. run the components due then, in execution order (``model.dataflow``); each reads its
+   inputs at its start and publishes its outputs at its end (run-to-completion);
+3. record a trace row if the log is due;
+4. run the hooks due then (the physics advances from t to t + dt).
+
+So a component due at t sees the world as it is at t. The whole schedule repeats with the
+hyperperiod of all rates and is precomputed once as a table of (offset, actions): the loop
+does no scheduling arithmetic per instant.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from ..errors import RunFault
+from ..model.scenario import Change, Phase, Scenario
+from ..model.template import Template
+from ..model.world import WorldSpec
+from .clock import MAX_EVENTS_PER_CYCLE, TickGrid, hyperperiod
+from .rng import component_rng
+
+Hook = Callable[[], None]
+
+
+@dataclass
+class Event:
+    """Something that happened during the run (a collision, ...), at simulated time ``t``."""
+
+    t: float
+    kind: str
+    detail: str
+
+
+class Context:
+    """What a component's ``initialize`` receives.
+
+    ``rng`` is the component's own stream. ``shared`` returns a per-run service created on
+    first request (the physics world), so templates in different layers can meet without
+    importing each other's modules. ``add_hook`` registers a subsystem step at its own rate.
+    """
+
+    def __init__(self, sim: Simulation, path: str) -> None:
+        self._sim = sim
+        self.path = path
+        self.rng = component_rng(sim.seed, path)
+        self.world = sim.world
+
+    def shared(self, name: str, factory: Callable[[Simulation], Any]) -> Any:
+        """The run's shared service ``name``, created by ``factory(sim)`` the first time."""
+        if name not in self._sim.shared:
+            self._sim.shared[name] = factory(self._sim)
+        return self._sim.shared[name]
+
+    def add_hook(self, rate_hz: Fraction, fn: Hook, name: str) -> None:
+        """Call ``fn()`` at ``rate_hz`` after the components due at the same instant."""
+        self._sim.add_hook(rate_hz, fn, name)
+
+    def record_event(self, kind: str, detail: str) -> None:
+        """Record an event at the current simulated time."""
+        self._sim.record_event(kind, detail)
+
+
+@dataclass
+class _Task:
+    path: str
+    comp: Template
+    period: int
+    inputs: list[tuple[str, str]]
+    outputs: set[str]
+
+
+@dataclass
+class RunResult:
+    """What a finished (or interrupted) run produced, for metrics and reports."""
+
+    t_end: float
+    samples_t: np.ndarray
+    samples_s: np.ndarray
+    events: list[Event] = field(default_factory=list)
+
+
+class Simulation:
+    """One run of a scenario (or of a bare world, for tests)."""
+
+    def __init__(
+        self,
+        world: WorldSpec,
+        *,
+        seed: int = 0,
+        duration: Fraction = Fraction(10),
+        phases: Sequence[Phase] = (),
+        log_rate: Fraction = Fraction(20),
+        quality_signal: str | None = None,
+        trace: Callable[[float, list[float]], None] | None = None,
+    ) -> None:
+        self.world = world
+        self.seed = seed
+        self.duration = Fraction(duration)
+        self.phases = list(phases) or [Phase(Fraction(0), [])]
+        self.log_rate = Fraction(log_rate)
+        self.shared: dict[str, Any] = {}
+        self.events: list[Event] = []
+        self.values: dict[str, float] = {
+            name: float(b.initial) for name, b in world.buffers.items()
+        }
+        self.columns = list(world.buffers)
+        self._trace = trace
+        self._quality = quality_signal
+        self._samples_t: list[float] = []
+        self._samples_s: list[float] = []
+        self._hooks: list[tuple[Fraction, Hook, str]] = []
+        self.components: dict[str, Template] = {}
+        self.now: Fraction = Fraction(0)
+        self.phase_index = 0
+        self.change_log: list[tuple[Fraction, Change]] = []
+        self._initialized = False
+        self._cursor = 0  # next tick to execute
+        self._build()
+
+    @classmethod
+    def from_scenario(cls, scenario: Scenario, **kw: Any) -> Simulation:
+        """A Simulation configured by a loaded scenario."""
+        q = scenario.quality.signal if scenario.quality else None
+        return cls(
+            scenario.world,
+            seed=scenario.seed,
+            duration=scenario.duration,
+            phases=scenario.phases,
+            log_rate=scenario.log_rate,
+            quality_signal=q,
+            **kw,
+        )
+
+    # -- construction -------------------------------------------------------------------
+    def _build(self) -> None:
+        params = {path: dict(leaf.params) for path, leaf in self.world.leaves.items()}
+        for change in self.phases[0].changes:  # phase 0 values are in force at initialize
+            params[change.leaf][change.param] = change.value
+        for path in self.world.order:
+            leaf = self.world.leaves[path]
+            self.components[path] = leaf.template(path, params[path])
+
+    def initialize(self) -> None:
+        """The paper's initialize(): cascades to every Leaf (in execution order)."""
+        if self._initialized:
+            return
+        self._initialized = True
+        for path, comp in self.components.items():
+            try:
+                comp.initialize(Context(self, path))
+            except Exception as exc:  # a component's own bug or bad configuration
+                raise RunFault(self._who(path), 0, f"initialize failed: {exc!r}") from exc
+        self._compile()
+
+    def add_hook(self, rate_hz: Fraction, fn: Hook, name: str) -> None:
+        """See :meth:`Context.add_hook`."""
+        if self._initialized and hasattr(self, "_table"):
+            raise RuntimeError("hooks must be added during initialize")
+        self._hooks.append((Fraction(rate_hz), fn, name))
+
+    def _compile(self) -> None:
+        leaves = self.world.leaves
+        periods = [1 / leaves[p].freq for p in self.world.order]
+        periods += [1 / r for r, _, _ in self._hooks] + [1 / self.log_rate]
+        instants = [p.at for p in self.phases] + [self.duration]
+        self.grid = TickGrid.for_run(periods, instants)
+        g = self.grid
+        self._tasks = []
+        for path in self.world.order:
+            leaf = leaves[path]
+            comp = self.components[path]
+            self._tasks.append(
+                _Task(
+                    path,
+                    comp,
+                    g.ticks(1 / leaf.freq),
+                    list(leaf.inputs.items()),
+                    {p.name for p in leaf.template.outputs},
+                )
+            )
+        self._log_period = g.ticks(1 / self.log_rate)
+        hook_periods = [g.ticks(1 / r) for r, _, _ in self._hooks]
+        all_periods = [t.period for t in self._tasks] + [self._log_period] + hook_periods
+        self._cycle = hyperperiod(all_periods)
+        count = sum(self._cycle // p for p in all_periods)
+        if count > MAX_EVENTS_PER_CYCLE:
+            raise RunFault(
+                "scheduler",
+                0,
+                f"the rates repeat only every "
+                f"{float(g.time(self._cycle)):g} s ({count} events); use "
+                "commensurate frequencies",
+            )
+        table: dict[int, list[tuple[int, Any]]] = {}
+        for task in self._tasks:
+            for off in range(0, self._cycle, task.period):
+                table.setdefault(off, []).append((0, task))
+        for off in range(0, self._cycle, self._log_period):
+            table.setdefault(off, []).append((1, None))
+        for (_, fn, _), period in zip(self._hooks, hook_periods, strict=True):
+            for off in range(0, self._cycle, period):
+                table.setdefault(off, []).append((2, fn))
+        self._table = sorted(table.items())
+        self._end = g.ticks(self.duration)
+        self._phase_ticks = [g.ticks(p.at) for p in self.phases]
+
+    # -- running --------------------------------------------------------------------------
+    def run(self) -> RunResult:
+        """Run to the end of the scenario."""
+        self.advance(self._end_tick())
+        return self.result()
+
+    def _end_tick(self) -> int:
+        self.initialize()
+        return self._end
+
+    @property
+    def finished(self) -> bool:
+        """Whether the run reached its duration."""
+        return self._initialized and self._cursor > self._end
+
+    def advance(self, until_tick: int) -> None:
+        """Execute every instant with tick <= ``until_tick`` (and <= the end)."""
+        self.initialize()
+        until = min(until_tick, self._end)
+        cycle = self._cycle
+        table = self._table
+        tick_s = self.grid.tick
+        end = self._end
+        phase_ticks = self._phase_ticks
+        while self._cursor <= until:
+            base = (self._cursor // cycle) * cycle
+            # entries of this cycle at or after the cursor
+            for off, actions in table:
+                tick = base + off
+                if tick < self._cursor:
+                    continue
+                if tick > until:
+                    self._cursor = tick
+                    return
+                while (
+                    self.phase_index + 1 < len(phase_ticks)
+                    and phase_ticks[self.phase_index + 1] <= tick
+                ):
+                    self.phase_index += 1
+                    self.now = tick_s * phase_ticks[self.phase_index]
+                    for change in self.phases[self.phase_index].changes:
+                        self.apply_change(change)
+                self.now = tick_s * tick
+                for what, obj in actions:
+                    if what == 0:
+                        self._step(obj)
+                    elif what == 1:
+                        self._log()
+                    elif tick < end:
+                        obj()
+                self._cursor = tick + 1
+            self._cursor = max(self._cursor, base + cycle)
+
+    def _step(self, task: _Task) -> None:
+        values = self.values
+        inp = {port: values[buf] for port, buf in task.inputs}
+        try:
+            out = task.comp.do_step(self.now, inp)
+        except RunFault:
+            raise
+        except Exception as exc:
+            raise RunFault(self._who(task.path), self.now, f"do_step raised {exc!r}") from exc
+        if not out:
+            return
+        prefix = task.path + "."
+        for key, value in out.items():
+            if key not in task.outputs:
+                raise RunFault(self._who(task.path), self.now, f"published unknown output {key!r}")
+            try:
+                number = float(value)
+            except (TypeError, ValueError):
+                raise RunFault(
+                    self._who(task.path), self.now, f"output {key} is not a number: {value!r}"
+                ) from None
+            if not math.isfinite(number):
+                raise RunFault(self._who(task.path), self.now, f"output {key} is {number}")
+            values[prefix + key] = number
+
+    def _log(self) -> None:
+        t_s = float(self.now)
+        if self._trace is not None:
+            values = self.values
+            self._trace(t_s, [values[c] for c in self.columns])
+        if self._quality is not None:
+            self._samples_t.append(t_s)
+            self._samples_s.append(self.values[self._quality])
+
+    def apply_change(self, change: Change) -> None:
+        """Set a parameter now (timeline or live); the component is told after."""
+        comp = self.components[change.leaf]
+        setattr(comp.p, change.param, change.value)
+        self.change_log.append((self.now, change))
+        try:
+            comp.on_param_change(change.param, change.value)
+        except Exception as exc:
+            raise RunFault(
+                self._who(change.leaf), self.now, f"rejected {change.param}={change.value!r}: {exc}"
+            ) from exc
+
+    def record_event(self, kind: str, detail: str) -> None:
+        """See :meth:`Context.record_event`."""
+        self.events.append(Event(float(self.now), kind, detail))
+
+    def result(self) -> RunResult:
+        """Samples and events so far."""
+        return RunResult(
+            t_end=float(self.now),
+            samples_t=np.asarray(self._samples_t),
+            samples_s=np.asarray(self._samples_s),
+            events=list(self.events),
+        )
+
+    def _who(self, path: str) -> str:
+        leaf = self.world.leaves.get(path)
+        return f"{path} ({leaf.template.name()})" if leaf else path

@@ -1,0 +1,71 @@
+"""Errors a user can cause, each carrying the exit code the CLI returns for it.
+
+Library code raises these; only ``cli.main`` catches them and prints ``str(err)`` as one
+line. Any other exception is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from pathlib import Path
+
+
+class AmsaError(Exception):
+    """Base of every error a user can cause; ``exit_code`` is what the CLI returns."""
+
+    exit_code = 2
+
+
+class ConfigError(AmsaError):
+    """A world, scenario or command-line value is wrong.
+
+    Printed as ``file:line: key.path: message`` so an editor can jump to it.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        file: str | Path | None = None,
+        line: int | None = None,
+        key: str | None = None,
+    ) -> None:
+        self.message = message
+        self.file = str(file) if file is not None else None
+        self.line = line
+        self.key = key
+        super().__init__(str(self))
+
+    def __str__(self) -> str:
+        where = ""
+        if self.file is not None:
+            where = self.file + (f":{self.line}" if self.line is not None else "") + ": "
+        key = f"{self.key}: " if self.key else ""
+        return f"{where}{key}{self.message}"
+
+
+class RunFault(AmsaError):
+    """A fault during a run (non-finite value, exception in a component, physics blow-up)."""
+
+    exit_code = 3
+
+    def __init__(self, component: str, t: Fraction | float, cause: str) -> None:
+        self.component = component
+        self.t = float(t)
+        self.cause = cause
+        super().__init__(str(self))
+
+    def __str__(self) -> str:
+        return f"run fault at t={self.t:.3f} s in {self.component}: {self.cause}"
+
+
+class ExpectationFailed(AmsaError):
+    """One or more scenario expectations did not hold."""
+
+    exit_code = 1
+
+
+class Interrupted(AmsaError):
+    """The user interrupted a run (Ctrl-C or SIGTERM); outputs so far were finalised."""
+
+    exit_code = 130

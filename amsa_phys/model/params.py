@@ -1,0 +1,132 @@
+"""Typed template parameters: the paper's (name, type, description, default, min, max).
+
+``Param.coerce`` is the one judge of a value: the world loader, the scenario timeline and
+``--set`` all call it, so a value is accepted or refused the same way everywhere.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+#: The parameter types a template may declare, by the name shown to users.
+TYPE_NAMES = ("int", "float", "bool", "str", "enum", "points")
+
+
+@dataclass(frozen=True)
+class Param:
+    """One declared parameter of a template.
+
+    ``type`` is one of :data:`TYPE_NAMES`. ``enum`` parameters take one of ``choices``;
+    ``aliases`` lets a user write a readable name (``behavior: circle``) for an enum value.
+    ``points`` is a list of ``[x, y]`` pairs in metres (waypoints).
+    """
+
+    name: str
+    type: str
+    description: str
+    default: Any
+    min: float | None = None
+    max: float | None = None
+    unit: str = ""
+    choices: tuple[Any, ...] | None = None
+    aliases: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.type not in TYPE_NAMES:
+            raise ValueError(f"parameter {self.name}: unknown type {self.type!r}")
+        if self.type == "enum" and not self.choices:
+            raise ValueError(f"parameter {self.name}: an enum needs choices")
+        # The default must itself be valid: a template author's mistake shows up at import.
+        self.coerce(self.default)
+
+    def range_text(self) -> str:
+        """Human-readable domain, used by ``describe``, ``templates`` and error messages."""
+        if self.type == "enum":
+            names = [f"{v}" for v in self.choices or ()]
+            names += [f"{k}" for k in self.aliases]
+            return "one of " + ", ".join(names)
+        if self.min is not None or self.max is not None:
+            lo = "-inf" if self.min is None else f"{self.min:g}"
+            hi = "inf" if self.max is None else f"{self.max:g}"
+            return f"[{lo}, {hi}]"
+        return ""
+
+    def coerce(self, value: Any) -> Any:
+        """Return ``value`` converted to this parameter's type, or raise ``ValueError``.
+
+        The message says what was expected and what was given; the caller adds file, line
+        and key. Integral floats are accepted for ints (YAML writes ``4.0`` easily); bools
+        are never numbers, and NaN or infinity is never a valid number.
+        """
+        kind = self.type
+        if kind == "bool":
+            if isinstance(value, bool):
+                return value
+            raise ValueError(f"expected true or false, got {_show(value)}")
+        if kind == "str":
+            if isinstance(value, str):
+                return value
+            raise ValueError(f"expected a string, got {_show(value)}")
+        if kind == "enum":
+            if isinstance(value, str) and value in self.aliases:
+                return self.aliases[value]
+            if not isinstance(value, bool) and value in (self.choices or ()):
+                return value
+            raise ValueError(f"expected {self.range_text()}, got {_show(value)}")
+        if kind == "points":
+            return self._coerce_points(value)
+        number = _number(value, integer=kind == "int")
+        if self.min is not None and number < self.min:
+            raise ValueError(
+                f"{number:g} is below the minimum {self.min:g} (range {self.range_text()})"
+            )
+        if self.max is not None and number > self.max:
+            raise ValueError(
+                f"{number:g} is above the maximum {self.max:g} (range {self.range_text()})"
+            )
+        return number
+
+    def _coerce_points(self, value: Any) -> tuple[tuple[float, float], ...]:
+        if not isinstance(value, Sequence) or isinstance(value, str):
+            raise ValueError(f"expected a list of [x, y] points, got {_show(value)}")
+        points = []
+        for item in value:
+            if not isinstance(item, Sequence) or isinstance(item, str) or len(item) != 2:
+                raise ValueError(f"expected an [x, y] pair, got {_show(item)}")
+            points.append((_number(item[0], False), _number(item[1], False)))
+        return tuple(points)
+
+
+def _number(value: Any, integer: bool) -> Any:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        want = "an integer" if integer else "a number"
+        raise ValueError(f"expected {want}, got {_show(value)}")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ValueError(f"expected a finite number, got {value}")
+    if integer:
+        if isinstance(value, float):
+            if not value.is_integer():
+                raise ValueError(f"expected an integer, got {value}")
+            return int(value)
+        return value
+    return float(value)
+
+
+def _show(value: Any) -> str:
+    """Describe a wrong value briefly: its repr (cut) and its YAML-ish type."""
+    names = {
+        bool: "boolean",
+        int: "integer",
+        float: "number",
+        str: "string",
+        list: "list",
+        dict: "mapping",
+        type(None): "null",
+    }
+    text = repr(value)
+    if len(text) > 40:
+        text = text[:37] + "..."
+    return f"{names.get(type(value), type(value).__name__)} {text}"

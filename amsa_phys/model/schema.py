@@ -1,0 +1,290 @@
+"""The shapes of a world and a scenario, checked with jsonschema.
+
+jsonschema (rather than pydantic or a hand-written walker) because the shape is data we can
+print and test, its errors carry the exact key path, and we already keep a line for every key
+path: an error becomes ``file:line: key.path: message`` with no guessing. Values (ranges,
+parameter names, links) are judged afterwards by the world and scenario builders.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import jsonschema
+
+from .suggest import did_you_mean
+from .yamlio import KeyPath, YamlDoc
+
+NAME = r"^[A-Za-z_][A-Za-z0-9_]*$"
+_num = {"type": "number"}
+_pos = {"type": "number", "exclusiveMinimum": 0}
+_nonneg = {"type": "number", "minimum": 0}
+_point = {"type": "array", "items": _num, "minItems": 2, "maxItems": 2}
+
+OBSTACLE = {
+    "type": "object",
+    "required": ["type"],
+    "properties": {"type": {"enum": ["box", "circle", "polyline"]}},
+    "allOf": [
+        {
+            "if": {"properties": {"type": {"const": "box"}}},
+            "then": {
+                "additionalProperties": False,
+                "required": ["x", "y", "width", "height"],
+                "properties": {
+                    "type": {},
+                    "x": _num,
+                    "y": _num,
+                    "width": _pos,
+                    "height": _pos,
+                    "angle": _num,
+                },
+            },
+        },
+        {
+            "if": {"properties": {"type": {"const": "circle"}}},
+            "then": {
+                "additionalProperties": False,
+                "required": ["x", "y", "radius"],
+                "properties": {"type": {}, "x": _num, "y": _num, "radius": _pos},
+            },
+        },
+        {
+            "if": {"properties": {"type": {"const": "polyline"}}},
+            "then": {
+                "additionalProperties": False,
+                "required": ["points"],
+                "properties": {
+                    "type": {},
+                    "points": {"type": "array", "items": _point, "minItems": 2},
+                    "thickness": _pos,
+                },
+            },
+        },
+    ],
+}
+
+PHYSICS = {
+    "type": "object",
+    "additionalProperties": False,
+    "properties": {
+        "rate": _pos,
+        "gravity": _pos,
+        "ground": {
+            "type": "object",
+            "additionalProperties": False,
+            "properties": {"friction": _nonneg, "rolling_resistance": _nonneg},
+        },
+        "walls": {
+            "type": "object",
+            "additionalProperties": False,
+            "required": ["xmin", "xmax", "ymin", "ymax"],
+            "properties": {"xmin": _num, "xmax": _num, "ymin": _num, "ymax": _num},
+        },
+        "obstacles": {"type": "array", "items": OBSTACLE},
+        "max_speed": _pos,
+    },
+}
+
+WORLD: dict[str, Any] = {
+    "type": "object",
+    "additionalProperties": False,
+    "required": ["components"],
+    "properties": {
+        "name": {"type": "string"},
+        "description": {"type": "string"},
+        "physics": PHYSICS,
+        "components": {"$ref": "#/$defs/components"},
+        "schedule": {"type": "array", "items": {"type": "string"}, "uniqueItems": True},
+    },
+    "$defs": {
+        "components": {
+            "type": "object",
+            "minProperties": 1,
+            "propertyNames": {"pattern": NAME},
+            "additionalProperties": {"$ref": "#/$defs/component"},
+        },
+        "component": {
+            "type": "object",
+            "if": {"required": ["components"]},
+            "then": {"$ref": "#/$defs/composite"},
+            "else": {"$ref": "#/$defs/leaf"},
+        },
+        "composite": {
+            "additionalProperties": False,
+            "properties": {
+                "components": {"$ref": "#/$defs/components"},
+                "description": {"type": "string"},
+            },
+        },
+        "leaf": {
+            "additionalProperties": False,
+            "required": ["template"],
+            "properties": {
+                "template": {"type": "string", "minLength": 1},
+                "freq": _pos,
+                "params": {"type": "object"},
+                "inputs": {"type": "object", "additionalProperties": {"type": "string"}},
+                "description": {"type": "string"},
+            },
+        },
+    },
+}
+
+SCENARIO: dict[str, Any] = {
+    "type": "object",
+    "additionalProperties": False,
+    "required": ["world", "duration"],
+    "properties": {
+        "name": {"type": "string"},
+        "description": {"type": "string"},
+        "world": {"type": ["string", "object"]},
+        "duration": _pos,
+        "seed": {"type": "integer", "minimum": 0, "maximum": 2**63 - 1},
+        "log_rate": _pos,
+        "quality": {
+            "type": "object",
+            "additionalProperties": False,
+            "required": ["signal", "reference"],
+            "properties": {"signal": {"type": "string"}, "reference": _num, "tolerance": _pos},
+        },
+        "set": {"type": "object"},
+        "timeline": {
+            "type": "array",
+            "items": {
+                "type": "object",
+                "additionalProperties": False,
+                "required": ["at", "set"],
+                "properties": {
+                    "at": _pos,
+                    "set": {"type": "object", "minProperties": 1},
+                    "label": {"type": "string"},
+                },
+            },
+        },
+        "expect": {
+            "type": "array",
+            "items": {
+                "type": "object",
+                "additionalProperties": False,
+                "required": ["metric"],
+                "anyOf": [{"required": ["below"]}, {"required": ["above"]}],
+                "properties": {
+                    "metric": {"type": "string"},
+                    "phase": {"type": "integer", "minimum": 0},
+                    "below": _num,
+                    "above": _num,
+                },
+            },
+        },
+    },
+}
+
+_TYPE_WORDS = {
+    "object": "a mapping",
+    "array": "a list",
+    "string": "a string",
+    "number": "a number",
+    "integer": "an integer",
+    "boolean": "true or false",
+}
+
+
+def validate(data: Any, schema: dict[str, Any], doc: YamlDoc, prefix: KeyPath = ()) -> None:
+    """Raise the ConfigError of the first shape error (by line), or return."""
+    bad = _first_nonfinite(data, prefix)
+    if bad is not None:
+        raise doc.error(bad, "expected a finite number, got NaN or infinity")
+    validator = jsonschema.Draft202012Validator(schema)
+    errors = list(validator.iter_errors(data))
+    if not errors:
+        return
+    located = [_locate(err, prefix) for err in _leaves(errors)]
+    keypath, message = min(located, key=lambda km: (doc.line(km[0]) or 0, -len(km[0])))
+    raise doc.error(keypath, message)
+
+
+def _leaves(errors: list[jsonschema.ValidationError]) -> list[jsonschema.ValidationError]:
+    """Flatten if/then/anyOf wrappers to the errors that say what is wrong."""
+    out: list[jsonschema.ValidationError] = []
+    for err in errors:
+        if err.validator in ("allOf", "$ref", "if", "then", "else") and err.context:
+            out.extend(_leaves(list(err.context)))
+        else:
+            out.append(err)
+    return out
+
+
+def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, str]:
+    path = (*prefix, *err.absolute_path)
+    inst = err.instance
+    kind = err.validator
+    if kind == "additionalProperties" and isinstance(inst, dict):
+        known = list(err.schema.get("properties", {}))
+        extra = [k for k in inst if k not in known]
+        key = extra[0] if extra else "?"
+        hint = did_you_mean(str(key), known) or (
+            f"; expected one of: {', '.join(known)}" if known else ""
+        )
+        return (*path, key), f"unknown key{hint}"
+    if kind == "required":
+        missing = err.message.split("'")[1] if "'" in err.message else err.message
+        return path, f"missing required key '{missing}'"
+    if kind == "type":
+        want = err.validator_value
+        wants = want if isinstance(want, list) else [want]
+        words = " or ".join(_TYPE_WORDS.get(w, w) for w in wants)
+        return path, f"expected {words}, got {_yaml_type(inst)} {_short(inst)}"
+    if kind in ("exclusiveMinimum", "minimum", "maximum"):
+        sign = {"exclusiveMinimum": ">", "minimum": ">=", "maximum": "<="}[kind]
+        return path, f"must be {sign} {err.validator_value}, got {inst}"
+    if kind in ("enum", "const"):
+        allowed = err.validator_value if kind == "enum" else [err.validator_value]
+        return path, f"expected one of {', '.join(map(str, allowed))}, got {_short(inst)}"
+    if kind == "pattern":
+        return path, (
+            f"{inst!r} is not a valid name (letters, digits and _, not starting with a digit)"
+        )
+    if kind == "anyOf" and isinstance(inst, dict):
+        return path, "needs 'below' or 'above'"
+    if kind == "minProperties":
+        return path, "must not be empty"
+    if kind in ("minItems", "maxItems"):
+        return path, f"wrong number of items ({err.message})"
+    if kind == "uniqueItems":
+        return path, "has repeated entries"
+    return path, err.message
+
+
+def _yaml_type(value: Any) -> str:
+    return {
+        bool: "boolean",
+        int: "integer",
+        float: "number",
+        str: "string",
+        list: "list",
+        dict: "mapping",
+        type(None): "null",
+    }.get(type(value), type(value).__name__)
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _first_nonfinite(data: Any, path: KeyPath) -> KeyPath | None:
+    if isinstance(data, float) and not math.isfinite(data):
+        return path
+    if isinstance(data, dict):
+        for k, v in data.items():
+            found = _first_nonfinite(v, (*path, k))
+            if found is not None:
+                return found
+    if isinstance(data, list):
+        for i, v in enumerate(data):
+            found = _first_nonfinite(v, (*path, i))
+            if found is not None:
+                return found
+    return None

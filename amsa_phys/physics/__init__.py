@@ -1,0 +1,1 @@
+"""L2: rigid-body physics. The only package that imports pymunk."""

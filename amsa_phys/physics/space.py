@@ -1,0 +1,156 @@
+"""The run's pymunk world: ground, walls, obstacles, rovers, collisions, the physics hook.
+
+One ``PhysicsWorld`` per run, created by the first robot template that asks for it
+(``ctx.shared("physics", ...)``) and stepped by an engine hook at ``physics.rate`` Hz after
+the components due at the same instant. The Space is rebuilt for every run and uses one
+thread, so a run is deterministic. Top-down: no gravity in the plane; the ground acts only
+through the wheel model (normal load ``m g / 2`` per wheel).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from fractions import Fraction
+from typing import Any
+
+import pymunk
+
+from ..errors import RunFault
+from .rover import DiffDriveRover
+from .wheel import WheelModel
+
+ROVER = 1
+OBSTACLE = 2
+
+
+class PhysicsWorld:
+    """Owns the pymunk Space for one run."""
+
+    def __init__(self, settings: dict[str, Any], sim: Any) -> None:
+        self.settings = settings
+        self.sim = sim
+        self.rate = Fraction(str(settings["rate"]))
+        self.dt = float(1 / self.rate)
+        self.gravity = float(settings["gravity"])
+        self.ground_friction = float(settings["ground"]["friction"])
+        self.rolling_resistance = float(settings["ground"]["rolling_resistance"])
+        self.max_speed = float(settings["max_speed"])
+        self.space = pymunk.Space(threaded=False)
+        self.space.gravity = (0.0, 0.0)
+        self.space.iterations = 10
+        self.rovers: list[DiffDriveRover] = []
+        self._owner: dict[int, str] = {}
+        self.collisions = 0
+        self._add_obstacles(settings.get("obstacles") or [], settings.get("walls"))
+        self.space.on_collision(ROVER, ROVER, begin=self._on_collision)
+        self.space.on_collision(ROVER, OBSTACLE, begin=self._on_collision)
+        sim.add_hook(self.rate, self.step, "physics")
+
+    def _add_obstacles(self, obstacles: list[dict[str, Any]], walls: dict[str, Any] | None) -> None:
+        static = self.space.static_body
+        shapes: list[pymunk.Shape] = []
+        for i, ob in enumerate(obstacles):
+            kind = ob["type"]
+            if kind == "box":
+                body = pymunk.Body(body_type=pymunk.Body.STATIC)
+                body.position = (ob["x"], ob["y"])
+                body.angle = float(ob.get("angle", 0.0))
+                shape = pymunk.Poly.create_box(body, (ob["width"], ob["height"]))
+                self.space.add(body)
+            elif kind == "circle":
+                shape = pymunk.Circle(static, ob["radius"], (ob["x"], ob["y"]))
+            else:
+                pts = ob["points"]
+                radius = float(ob.get("thickness", 0.1)) / 2
+                for a, b in itertools.pairwise(pts):
+                    seg = pymunk.Segment(static, tuple(a), tuple(b), radius)
+                    self._owner[id(seg)] = f"obstacle[{i}]"
+                    shapes.append(seg)
+                continue
+            self._owner[id(shape)] = f"obstacle[{i}]"
+            shapes.append(shape)
+        if walls:
+            x0, x1, y0, y1 = walls["xmin"], walls["xmax"], walls["ymin"], walls["ymax"]
+            corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)]
+            for a, b in itertools.pairwise(corners):
+                seg = pymunk.Segment(static, a, b, 0.1)
+                self._owner[id(seg)] = "wall"
+                shapes.append(seg)
+        for shape in shapes:
+            shape.friction = 0.6
+            shape.elasticity = 0.1
+            shape.collision_type = OBSTACLE
+        if shapes:
+            self.space.add(*shapes)
+
+    def add_rover(self, name: str, p: Any) -> DiffDriveRover:
+        """Add a rover whose template parameters are ``p`` (see templates.RoverParams)."""
+        load = p.mass * self.gravity / 2  # normal load per wheel
+        mu = self.ground_friction
+        wheel = WheelModel(
+            stall_force_n=p.stallForce,
+            free_speed_mps=p.freeSpeed,
+            efficiency=p.efficiency / 100.0,
+            traction_limit_n=mu * p.tractionCoef * load,
+            rolling_force_n=self.rolling_resistance * p.rollingCoef * load,
+        )
+        rover = DiffDriveRover(
+            self.space,
+            name,
+            mass_kg=p.mass,
+            length_m=p.length,
+            width_m=p.width,
+            track_m=p.track,
+            wheel=wheel,
+            lateral_limit_n=mu * p.lateralCoef * 2 * load,
+            x=p.x,
+            y=p.y,
+            heading=p.heading,
+            collision_type=ROVER,
+        )
+        self._owner[id(rover.shape)] = name
+        self.rovers.append(rover)
+        return rover
+
+    def update_wheel(self, rover: DiffDriveRover, p: Any) -> None:
+        """Rebuild a rover's wheel model after a parameter change (motor wear, ...)."""
+        load = p.mass * self.gravity / 2
+        mu = self.ground_friction
+        rover.wheel = WheelModel(
+            stall_force_n=p.stallForce,
+            free_speed_mps=p.freeSpeed,
+            efficiency=p.efficiency / 100.0,
+            traction_limit_n=mu * p.tractionCoef * load,
+            rolling_force_n=self.rolling_resistance * p.rollingCoef * load,
+        )
+        rover.lateral_limit = mu * p.lateralCoef * 2 * load
+
+    def step(self) -> None:
+        """Advance the world by one physics step (the engine's hook)."""
+        dt = self.dt
+        for rover in self.rovers:
+            rover.apply_forces(dt)
+        self.space.step(dt)
+        limit = self.max_speed
+        for rover in self.rovers:
+            vx, vy = rover.body.velocity
+            speed = math.hypot(vx, vy)
+            if not speed <= limit:  # also catches NaN
+                raise RunFault(
+                    rover.name,
+                    self.sim.now + Fraction(1) / self.rate,
+                    f"body speed {speed:.3g} m/s exceeds physics.max_speed "
+                    f"{limit:g} m/s (physics blow-up?)",
+                )
+
+    def _on_collision(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
+        a, b = arbiter.shapes
+        names = sorted((self._owner.get(id(a), "?"), self._owner.get(id(b), "?")))
+        self.collisions += 1
+        self.sim.record_event("collision", f"{names[0]}-{names[1]}")
+
+
+def physics_of(ctx: Any) -> PhysicsWorld:
+    """The run's PhysicsWorld, created on first use from the world's ``physics:`` settings."""
+    return ctx.shared("physics", lambda sim: PhysicsWorld(sim.world.physics, sim))

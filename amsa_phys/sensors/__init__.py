@@ -1,0 +1,1 @@
+"""L2: sensors. They read Data like any consumer and never import the physics."""

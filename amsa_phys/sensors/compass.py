@@ -1,0 +1,32 @@
+"""Compass: a noisy, biased heading sensor."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from fractions import Fraction
+from typing import Any
+
+from ..model.params import Param
+from ..model.template import Kind, Port, Template
+
+
+class Compass(Template):
+    """Measured heading = true heading + bias + Gaussian noise, wrapped to [-pi, pi)."""
+
+    kind = Kind.SENSOR
+    inputs = (Port("heading", 0.0, "true heading", "rad"),)
+    outputs = (Port("compassHeading", 0.0, "measured heading in [-pi, pi)", "rad"),)
+    params = (
+        Param("noise", "float", "standard deviation of the error", 0.0, 0.0, math.pi, "rad"),
+        Param("bias", "float", "constant offset", 0.0, -math.pi, math.pi, "rad"),
+    )
+
+    def initialize(self, ctx: Any) -> None:
+        """Take this component's own random stream."""
+        self.rng = ctx.rng
+
+    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+        """The paper's doStep: one heading sample."""
+        value = inp["heading"] + self.p.bias + self.p.noise * self.rng.normal()
+        return {"compassHeading": (value + math.pi) % (2 * math.pi) - math.pi}

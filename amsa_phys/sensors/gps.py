@@ -1,0 +1,47 @@
+"""GPS: a noisy, biased, lossy position sensor."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from fractions import Fraction
+from typing import Any
+
+from ..model.params import Param
+from ..model.template import Kind, Port, Template
+
+
+class GPS(Template):
+    """Noisy, biased, lossy position fix; a lost sample publishes nothing.
+
+    Consumers then keep the stale fix, which is what the paper's degraded context (10 % of the
+    leader's fixes lost) relies on. The loss draw and the noise draws happen at every step,
+    lost or not, so a sweep over ``lostDataGPS`` keeps the same noise sequence.
+    """
+
+    kind = Kind.SENSOR
+    inputs = (Port("posX", 0.0, "true x", "m"), Port("posY", 0.0, "true y", "m"))
+    outputs = (Port("gpsPosX", 0.0, "measured x", "m"), Port("gpsPosY", 0.0, "measured y", "m"))
+    params = (
+        Param(
+            "noise", "float", "standard deviation of the error on each axis", 0.0, 0.0, 100.0, "m"
+        ),
+        Param("bias", "float", "constant offset added to both axes", 0.0, -100.0, 100.0, "m"),
+        Param("lostDataGPS", "int", "share of samples lost", 0, 0, 100, "%"),
+    )
+
+    def initialize(self, ctx: Any) -> None:
+        """Take this component's own random stream."""
+        self.rng = ctx.rng
+
+    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+        """The paper's doStep: sample the position, or lose the sample."""
+        ex, ey = self.rng.normal(0.0, 1.0, size=2)
+        lost = self.rng.uniform(0.0, 100.0) < self.p.lostDataGPS
+        if lost:
+            return {}
+        noise = self.p.noise
+        bias = self.p.bias
+        return {
+            "gpsPosX": inp["posX"] + bias + noise * ex,
+            "gpsPosY": inp["posY"] + bias + noise * ey,
+        }
