@@ -1,0 +1,105 @@
+"""Tiny templates for engine tests: they record when they ran and what they saw."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from typing import Any
+
+from amsa_phys.model.params import Param
+from amsa_phys.model.template import Kind, Port, Template
+
+#: (path, t, inputs) of every step, in execution order; reset by each test.
+LOG: list[tuple[str, Fraction, dict[str, Any]]] = []
+
+
+class Source(Template):
+    """Publishes its step count (1, 2, 3, ...) times ``gain``."""
+
+    kind = Kind.ENVIRONMENT
+    outputs = (Port("count", initial=-1.0),)
+    params = (Param("gain", "float", "multiplier", 1.0, -10.0, 10.0),
+              Param("silent", "bool", "publish nothing", False),
+              Param("mode", "enum", "a mode", 1, choices=(1, 2), aliases={"fast": 2}),
+              Param("label", "str", "a label", "x"))
+
+    def initialize(self, ctx: Any) -> None:
+        self.n = 0
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        self.n += 1
+        LOG.append((self.path, t, dict(inp)))
+        return {} if self.p.silent else {"count": self.n * self.p.gain}
+
+
+class Relay(Template):
+    """A sensor that republishes its input."""
+
+    kind = Kind.SENSOR
+    inputs = (Port("x"),)
+    outputs = (Port("y", initial=-2.0),)
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        LOG.append((self.path, t, dict(inp)))
+        return {"y": inp["x"]}
+
+
+class Sink(Template):
+    """An observer that only records."""
+
+    kind = Kind.OBSERVER
+    inputs = (Port("a"), Port("b"))
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        LOG.append((self.path, t, dict(inp)))
+        return {}
+
+
+class Ctl(Template):
+    """A controller with one input and one output (for loops)."""
+
+    kind = Kind.CONTROLLER
+    inputs = (Port("x"),)
+    outputs = (Port("u"),)
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        LOG.append((self.path, t, dict(inp)))
+        return {"u": inp["x"] + 1}
+
+
+class Act(Template):
+    """An actuator."""
+
+    kind = Kind.ACTUATOR
+    inputs = (Port("u"),)
+    outputs = (Port("v"),)
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        LOG.append((self.path, t, dict(inp)))
+        return {"v": inp["u"]}
+
+
+class Plant(Template):
+    """A process whose output is its last input."""
+
+    kind = Kind.PROCESS
+    inputs = (Port("v"),)
+    outputs = (Port("x"),)
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        LOG.append((self.path, t, dict(inp)))
+        return {"x": inp["v"]}
+
+
+class Bad(Template):
+    """A controller that publishes NaN after t = 1 s or raises when ``boom``."""
+
+    kind = Kind.CONTROLLER
+    outputs = (Port("u"),)
+    params = (Param("boom", "bool", "raise instead", False),)
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        if t >= 1:
+            if self.p.boom:
+                raise ZeroDivisionError("division by zero")
+            return {"u": float("nan")}
+        return {"u": 0.0}
