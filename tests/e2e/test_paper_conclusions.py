@@ -1,0 +1,63 @@
+"""The paper's conclusions (section 4.1) read off the metrics of the shipped scenarios.
+
+Like the paper's figures, each Kv is run as its own experiment from the scenario's initial
+state (its timeline removed), for 200 s, and judged on the last 100 s.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from amsa_phys.engine.metrics import block_metrics
+from amsa_phys.engine.runner import Simulation
+from amsa_phys.model.scenario import load_scenario
+
+SCENARIOS = Path(__file__).resolve().parent.parent.parent / "scenarios"
+
+
+def settled_metrics(name: str, kv: float) -> dict[str, Any]:
+    sc = load_scenario(SCENARIOS / name, overrides=[f"MyFollowerController.Kv={kv}"],
+                       duration=200)
+    sc.phases = sc.phases[:1]
+    r = Simulation.from_scenario(sc).run()
+    return block_metrics(r.samples_t, r.samples_s, 100.0, 200.0, 15.0, 1.5,
+                         [e.t for e in r.events], include_end=True)
+
+
+@pytest.fixture(scope="module")
+def nominal() -> dict[float, dict[str, Any]]:
+    return {kv: settled_metrics("scenario1.yaml", kv) for kv in (0.35, 0.15, 0.1, 0.05)}
+
+
+@pytest.fixture(scope="module")
+def degraded() -> dict[float, dict[str, Any]]:
+    return {kv: settled_metrics("scenario2.yaml", kv) for kv in (0.35, 0.05)}
+
+
+def test_nominal_kv_035_does_not_hold_the_distance(nominal: dict[float, Any]) -> None:
+    m = nominal[0.35]
+    assert m["settling_time"] is None  # still outside the ±1.5 m band at the end
+    assert m["max_distance"] > 18.0 and m["min_distance"] < 12.0  # a sustained oscillation
+
+
+def test_nominal_small_kv_is_best(nominal: dict[float, Any]) -> None:
+    best = nominal[0.05]
+    assert best["settling_time"] == 0.0  # within tolerance over the whole judged window
+    assert abs(best["mean_error"]) < 0.2
+    assert best["rms_error"] < nominal[0.35]["rms_error"] / 10
+    assert best["max_distance"] < nominal[0.35]["max_distance"]
+
+
+def test_degraded_kv_035_beats_005(degraded: dict[float, Any]) -> None:
+    assert degraded[0.35]["rms_error"] < degraded[0.05]["rms_error"] / 2
+    assert degraded[0.35]["max_distance"] < degraded[0.05]["max_distance"]
+
+
+def test_degraded_kv_005_settles_too_far_behind(degraded: dict[float, Any]) -> None:
+    m = degraded[0.05]
+    assert m["mean_error"] > 1.5  # standing error beyond the tolerance, behind the leader
+    assert m["min_distance"] > 15.0  # never gets back to the reference
+    assert m["settling_time"] is None
