@@ -17,10 +17,12 @@ class Source(Template):
 
     kind = Kind.ENVIRONMENT
     outputs = (Port("count", initial=-1.0),)
-    params = (Param("gain", "float", "multiplier", 1.0, -10.0, 10.0),
-              Param("silent", "bool", "publish nothing", False),
-              Param("mode", "enum", "a mode", 1, choices=(1, 2), aliases={"fast": 2}),
-              Param("label", "str", "a label", "x"))
+    params = (
+        Param("gain", "float", "multiplier", 1.0, -10.0, 10.0),
+        Param("silent", "bool", "publish nothing", False),
+        Param("mode", "enum", "a mode", 1, choices=(1, 2), aliases={"fast": 2}),
+        Param("label", "str", "a label", "x"),
+    )
 
     def initialize(self, ctx: Any) -> None:
         self.n = 0

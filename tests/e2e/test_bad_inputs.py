@@ -17,7 +17,7 @@ BAD = sorted((Path(__file__).parent.parent / "fixtures" / "bad").glob("*.yaml"))
 def expected(path: Path) -> str:
     first = path.read_bytes().split(b"\n", 1)[0].decode()
     assert first.startswith("# expect: "), f"{path.name} has no '# expect:' line"
-    return first[len("# expect: "):]
+    return first[len("# expect: ") :]
 
 
 def test_corpus_is_large_enough() -> None:
@@ -25,8 +25,9 @@ def test_corpus_is_large_enough() -> None:
 
 
 @pytest.mark.parametrize("path", BAD, ids=[p.stem for p in BAD])
-def test_validate_refuses_with_one_clear_line(path: Path, capsys: pytest.CaptureFixture[str]
-                                              ) -> None:
+def test_validate_refuses_with_one_clear_line(
+    path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     code = main(["validate", str(path)])
     err = capsys.readouterr().err
     assert code == 2
@@ -39,21 +40,45 @@ def test_validate_refuses_with_one_clear_line(path: Path, capsys: pytest.Capture
 
 def test_run_with_bad_scenario_exits_2_without_traceback(tmp_path: Path) -> None:
     bad = Path(__file__).parent.parent / "fixtures" / "bad" / "scenario_set_out_of_range.yaml"
-    proc = subprocess.run([sys.executable, "-m", "amsa_phys", "run", str(bad), "--headless",
-                           "--out", str(tmp_path / "out")], capture_output=True, text=True,
-                          check=False,
-                          env={**os.environ, "PYTHONPATH": str(Path(__file__).parent.parent)})
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "amsa_phys",
+            "run",
+            str(bad),
+            "--headless",
+            "--out",
+            str(tmp_path / "out"),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+        env={**os.environ, "PYTHONPATH": str(Path(__file__).parent.parent)},
+    )
     assert proc.returncode == 2
-    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+    assert proc.stderr.count("\n") == 1
+    assert "Traceback" not in proc.stderr
     assert "timeline[0].set.Src.gain: 99 is above the maximum 10" in proc.stderr
     assert not (tmp_path / "out").exists()  # nothing started, nothing written
 
 
-def test_bad_set_override_names_the_option(tmp_path: Path,
-                                           capsys: pytest.CaptureFixture[str]) -> None:
+def test_bad_set_override_names_the_option(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     scen = Path(__file__).parent.parent.parent / "scenarios" / "scenario1.yaml"
-    code = main(["run", str(scen), "--headless", "--out", str(tmp_path / "o"),
-                 "--set", "MyFollowerController.Kv=abc"])
+    code = main(
+        [
+            "run",
+            str(scen),
+            "--headless",
+            "--out",
+            str(tmp_path / "o"),
+            "--set",
+            "MyFollowerController.Kv=abc",
+        ]
+    )
     assert code == 2
     assert capsys.readouterr().err == (
-        "error: --set MyFollowerController.Kv: expected a number, got string 'abc'\n")
+        "error: --set MyFollowerController.Kv: expected a number, got string 'abc'\n"
+    )

@@ -19,26 +19,53 @@ SCENARIO1 = ROOT / "scenarios" / "scenario1.yaml"
 
 def run(tmp_path: Path, name: str, *extra: str) -> Path:
     out = tmp_path / name
-    assert main(["run", str(SCENARIO1), "--headless", "--out", str(out), "--duration", "30",
-                 "-q", *extra]) == 0
+    assert (
+        main(
+            [
+                "run",
+                str(SCENARIO1),
+                "--headless",
+                "--out",
+                str(out),
+                "--duration",
+                "30",
+                "-q",
+                *extra,
+            ]
+        )
+        == 0
+    )
     return out
 
 
 def test_run_writes_the_run_directory(tmp_path: Path) -> None:
     out = run(tmp_path, "a")
     assert sorted(p.name for p in out.iterdir()) == [
-        "distance.png", "metrics.json", "scenario.yaml", "trace.csv"]
+        "distance.png",
+        "metrics.json",
+        "scenario.yaml",
+        "trace.csv",
+    ]
     header = (out / "trace.csv").read_text().splitlines()[0].split(",")
-    assert header[0] == "t" and "MyDistanceMonitor.distanceFollowerToLeader" in header
-    assert "LeaderGPS.gpsPosX" in header and "Follower.posX" in header
+    assert header[0] == "t"
+    assert "MyDistanceMonitor.distanceFollowerToLeader" in header
+    assert "LeaderGPS.gpsPosX" in header
+    assert "Follower.posX" in header
     rows = (out / "trace.csv").read_text().splitlines()[1:]
     assert len(rows) == 30 * 20 + 1  # 20 Hz, both ends
     metrics = json.loads((out / "metrics.json").read_text())
-    for key in ("max_distance", "min_distance", "mean_error", "rms_error", "settling_time",
-                "collisions"):
+    for key in (
+        "max_distance",
+        "min_distance",
+        "mean_error",
+        "rms_error",
+        "settling_time",
+        "collisions",
+    ):
         assert key in metrics["overall"]
         assert key in metrics["phases"][0]
-    assert metrics["seed"] == 1 and metrics["duration"] == 30.0
+    assert metrics["seed"] == 1
+    assert metrics["duration"] == 30.0
     assert (out / "distance.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
@@ -51,9 +78,24 @@ def test_identical_in_another_process_with_another_hash_seed(tmp_path: Path) -> 
     a = run(tmp_path, "a")
     out = tmp_path / "sub"
     env = {**os.environ, "PYTHONHASHSEED": "12345"}
-    subprocess.run([sys.executable, "-m", "amsa_phys", "run", str(SCENARIO1), "--headless",
-                    "--out", str(out), "--duration", "30", "-q", "--no-plot"],
-                   check=True, env=env)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "amsa_phys",
+            "run",
+            str(SCENARIO1),
+            "--headless",
+            "--out",
+            str(out),
+            "--duration",
+            "30",
+            "-q",
+            "--no-plot",
+        ],
+        check=True,
+        env=env,
+    )
     assert (a / "trace.csv").read_bytes() == (out / "trace.csv").read_bytes()
 
 
@@ -66,8 +108,7 @@ def test_a_different_seed_changes_a_noisy_run(tmp_path: Path) -> None:
 def test_resolved_scenario_replays_exactly(tmp_path: Path) -> None:
     a = run(tmp_path, "a", "--set", "MyFollowerController.Kv=0.2")
     replay = tmp_path / "replay"
-    assert main(["run", str(a / "scenario.yaml"), "--headless", "--out", str(replay),
-                 "-q"]) == 0
+    assert main(["run", str(a / "scenario.yaml"), "--headless", "--out", str(replay), "-q"]) == 0
     assert (a / "trace.csv").read_bytes() == (replay / "trace.csv").read_bytes()
     resolved = yaml.safe_load((a / "scenario.yaml").read_text())
     assert resolved["world"]["components"]["Follower"]["params"]["mass"] == 30.0
@@ -75,27 +116,27 @@ def test_resolved_scenario_replays_exactly(tmp_path: Path) -> None:
 
 
 def test_existing_out_dir_is_not_overwritten_without_force(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = run(tmp_path, "a")
     before = (out / "trace.csv").read_bytes()
     code = main(["run", str(SCENARIO1), "--headless", "--out", str(out), "-q"])
     assert code == 2
-    assert "directory exists and is not empty (use --force to replace it)" in \
-        capsys.readouterr().err
+    assert (
+        "directory exists and is not empty (use --force to replace it)" in capsys.readouterr().err
+    )
     assert (out / "trace.csv").read_bytes() == before
     run(tmp_path, "a", "--force")
 
 
 def test_summary_table_is_printed(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    main(["run", str(SCENARIO1), "--headless", "--out", str(tmp_path / "x"), "--duration",
-          "10"])
+    main(["run", str(SCENARIO1), "--headless", "--out", str(tmp_path / "x"), "--duration", "10"])
     out = capsys.readouterr().out
     assert out.splitlines()[0].split()[:4] == ["phase", "start", "max", "min"]
     assert "real time" in out
 
 
-def test_window_mode_is_refused_clearly(tmp_path: Path,
-                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_window_mode_is_refused_clearly(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["run", str(SCENARIO1), "--out", str(tmp_path / "w")]) == 2
     assert "run with --headless" in capsys.readouterr().err
 
@@ -109,7 +150,12 @@ def test_validate_describe_templates(capsys: pytest.CaptureFixture[str]) -> None
     assert "execution order at a shared instant: Leader -> Follower -> MyNormalizePower" in text
     assert main(["templates"]) == 0
     text = capsys.readouterr().out
-    for name in ("freeRobot (environment)", "controlledRobot (process)", "GPS (sensor)",
-                 "NormalizePower (actuator)", "FollowerController (controller)"):
+    for name in (
+        "freeRobot (environment)",
+        "controlledRobot (process)",
+        "GPS (sensor)",
+        "NormalizePower (actuator)",
+        "FollowerController (controller)",
+    ):
         assert name in text
     assert "param lostDataGPS: int = 0 % [0, 100]" in text

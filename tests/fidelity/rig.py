@@ -13,21 +13,38 @@ from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import load_scenario
 
 
-def drive(tmp_path: Path, left: float, right: float, duration: float, *,
-          robot: dict[str, Any] | None = None, coef: int = 100,
-          physics: dict[str, Any] | None = None,
-          timeline: list[dict[str, Any]] | None = None) -> tuple[dict[str, np.ndarray], Simulation]:
+def drive(
+    tmp_path: Path,
+    left: float,
+    right: float,
+    duration: float,
+    *,
+    robot: dict[str, Any] | None = None,
+    coef: int = 100,
+    physics: dict[str, Any] | None = None,
+    timeline: list[dict[str, Any]] | None = None,
+) -> tuple[dict[str, np.ndarray], Simulation]:
     """Run the rig; return the trace as named columns (50 Hz) and the simulation."""
     world = {
         "physics": {"rate": 100, **(physics or {})},
         "components": {
-            "Ctl": {"template": "ConstantPower", "freq": 50,
-                    "params": {"left": left, "right": right}},
-            "Norm": {"template": "NormalizePower", "freq": 50, "params": {"motorCoef": coef},
-                     "inputs": {"powerL": "Ctl.LeftPower", "powerR": "Ctl.RightPower"}},
-            "Rover": {"template": "controlledRobot", "freq": 50, "params": robot or {},
-                      "inputs": {"powerL": "Norm.normalizedPowerL",
-                                 "powerR": "Norm.normalizedPowerR"}},
+            "Ctl": {
+                "template": "ConstantPower",
+                "freq": 50,
+                "params": {"left": left, "right": right},
+            },
+            "Norm": {
+                "template": "NormalizePower",
+                "freq": 50,
+                "params": {"motorCoef": coef},
+                "inputs": {"powerL": "Ctl.LeftPower", "powerR": "Ctl.RightPower"},
+            },
+            "Rover": {
+                "template": "controlledRobot",
+                "freq": 50,
+                "params": robot or {},
+                "inputs": {"powerL": "Norm.normalizedPowerL", "powerR": "Norm.normalizedPowerR"},
+            },
         },
     }
     scen = {"world": world, "duration": duration, "log_rate": 50}

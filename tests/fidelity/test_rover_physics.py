@@ -45,7 +45,7 @@ def test_unequal_powers_settle_on_a_circle_of_constant_radius(tmp_path: Path) ->
     x, y = tr["Rover.posX"][late], tr["Rover.posY"][late]
     # centre of the circle: least-squares fit of x^2 + y^2 + D x + E y + F = 0
     a = np.column_stack([x, y, np.ones_like(x)])
-    d, e, f = np.linalg.lstsq(a, -(x * x + y * y), rcond=None)[0]
+    d, e, _f = np.linalg.lstsq(a, -(x * x + y * y), rcond=None)[0]
     cx, cy = -d / 2, -e / 2
     radius = np.hypot(x - cx, y - cy)
     assert radius.std() / radius.mean() < 0.005
@@ -71,8 +71,9 @@ def test_lower_motor_coef_gives_lower_top_speed(tmp_path: Path) -> None:
 
 
 def test_zero_power_brings_the_rover_to_rest(tmp_path: Path) -> None:
-    tr, _ = drive(tmp_path, 80, 80, 30,
-                  timeline=[{"at": 10, "set": {"Ctl.left": 0, "Ctl.right": 0}}])
+    tr, _ = drive(
+        tmp_path, 80, 80, 30, timeline=[{"at": 10, "set": {"Ctl.left": 0, "Ctl.right": 0}}]
+    )
     assert tr["Rover.speed"][tr["t"] == 10][0] > 3.0
     assert abs(tr["Rover.speed"][-1]) < 1e-3
     x = tr["Rover.posX"]

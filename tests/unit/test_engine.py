@@ -31,30 +31,43 @@ def steps(path: str) -> list[Fraction]:
 
 
 def test_rates_3_and_7_hz_are_exact_over_a_long_run(tmp_path: Path) -> None:
-    w = load_world(world(tmp_path, """
+    w = load_world(
+        world(
+            tmp_path,
+            """
 components:
   A: {template: "toys:Source", freq: 3}
   B: {template: "toys:Source", freq: 7}
   C: {template: "toys:Source", freq: 0.1}
-"""))
+""",
+        )
+    )
     sim = Simulation(w, duration=Fraction(50000), log_rate=Fraction(1, 10))
     sim.run()
     a, b, c = steps("A"), steps("B"), steps("C")
     assert sim.grid.tick == Fraction(1, 21)
     assert sim.grid.ticks(Fraction(50000)) == 1_050_000  # over 10^6 ticks
     # both ends included: 3 * 50000 + 1 steps, every one exactly k/3 s, no drift
-    assert len(a) == 150_001 and len(b) == 350_001 and len(c) == 5001
+    assert len(a) == 150_001
+    assert len(b) == 350_001
+    assert len(c) == 5001
     assert a == [Fraction(k, 3) for k in range(150_001)]
-    assert b[-1] == Fraction(50000) and b[7 * 41234] == Fraction(41234)
+    assert b[-1] == Fraction(50000)
+    assert b[7 * 41234] == Fraction(41234)
 
 
 def test_same_instant_order_follows_dataflow_not_declaration(tmp_path: Path) -> None:
-    w = load_world(world(tmp_path, """
+    w = load_world(
+        world(
+            tmp_path,
+            """
 components:
   S: {template: "toys:Sink", freq: 1, inputs: {a: R.y, b: Src.count}}
   R: {template: "toys:Relay", freq: 1, inputs: {x: Src.count}}
   Src: {template: "toys:Source", freq: 1}
-"""))
+""",
+        )
+    )
     assert w.order == ["Src", "R", "S"]
     Simulation(w, duration=Fraction(2)).run()
     first = [p for p, t, _ in toys.LOG if t == 0]
@@ -64,11 +77,16 @@ components:
 
 
 def test_writes_overwrite_and_reads_do_not_consume(tmp_path: Path) -> None:
-    w = load_world(world(tmp_path, """
+    w = load_world(
+        world(
+            tmp_path,
+            """
 components:
   Src: {template: "toys:Source", freq: 1}
   S: {template: "toys:Sink", freq: 4, inputs: {a: Src.count, b: Src.count}}
-"""))
+""",
+        )
+    )
     Simulation(w, duration=Fraction(2)).run()
     seen = [inp["a"] for p, t, inp in toys.LOG if p == "S"]
     # four reads per producer write, all the same value; then the next write replaces it
@@ -76,23 +94,34 @@ components:
 
 
 def test_unwritten_buffer_holds_declared_initial_and_silent_producer_keeps_old(
-        tmp_path: Path) -> None:
-    w = load_world(world(tmp_path, """
+    tmp_path: Path,
+) -> None:
+    w = load_world(
+        world(
+            tmp_path,
+            """
 components:
   Src: {template: "toys:Source", freq: 1, params: {silent: true}}
   R: {template: "toys:Relay", freq: 1, inputs: {x: Src.count}}
-"""))
+""",
+        )
+    )
     Simulation(w, duration=Fraction(1)).run()
     assert [inp["x"] for p, _, inp in toys.LOG if p == "R"] == [-1.0, -1.0]
 
 
 def test_consumer_ordered_first_sees_previous_value(tmp_path: Path) -> None:
-    w = load_world(world(tmp_path, """
+    w = load_world(
+        world(
+            tmp_path,
+            """
 components:
   Src: {template: "toys:Source", freq: 1}
   R: {template: "toys:Relay", freq: 1, inputs: {x: Src.count}}
 schedule: [R, Src]
-"""))
+""",
+        )
+    )
     assert w.order == ["R", "Src"]
     Simulation(w, duration=Fraction(2)).run()
     assert [inp["x"] for p, _, inp in toys.LOG if p == "R"] == [-1.0, 1.0, 2.0]
@@ -121,24 +150,31 @@ def test_loop_is_accepted_with_schedule(tmp_path: Path) -> None:
 
 
 def test_forbidden_link_is_refused_naming_the_link(tmp_path: Path) -> None:
-    path = world(tmp_path, """
+    path = world(
+        tmp_path,
+        """
 components:
   Src: {template: "toys:Source", freq: 1}
   Sn: {template: "toys:Relay", freq: 1, inputs: {x: Src.count}}
   P: {template: "toys:Plant", freq: 1, inputs: {v: Sn.y}}
-""")
+""",
+    )
     with pytest.raises(ConfigError) as err:
         load_world(path)
     assert str(err.value) == (
         f"{path}:5: components.P.inputs.v: link Sn (sensor) -> P (process) is not allowed: "
-        "a sensor may feed only controller, observer")
+        "a sensor may feed only controller, observer"
+    )
 
 
 def test_timeline_changes_apply_exactly_at_their_instant(tmp_path: Path) -> None:
-    world(tmp_path, """
+    world(
+        tmp_path,
+        """
 components:
   Src: {template: "toys:Source", freq: 4}
-""")
+""",
+    )
     scen = tmp_path / "s.yaml"
     scen.write_text("""
 world: w.yaml
@@ -157,18 +193,21 @@ timeline:
     values = dict(seen)
     assert values[1.0] == 5.0  # 5th step at gain 1
     assert values[1.25] == 60.0  # 6th step already at gain 10: change before the step
-    assert values[2.25] == 100.0 and values[2.5] == -11.0  # 2.3 s lands between steps
+    assert values[2.25] == 100.0
+    assert values[2.5] == -11.0
     assert [float(at) for at, _ in sim.change_log] == [1.25, 2.3]
 
 
 def test_nan_output_is_a_run_fault_naming_component_and_time(tmp_path: Path) -> None:
     w = load_world(world(tmp_path, "components:\n  B: {template: 'toys:Bad', freq: 4}\n"))
-    with pytest.raises(RunFault, match=re.escape("run fault at t=1.000 s in B (Bad): output u is nan")):
+    message = "run fault at t=1.000 s in B (Bad): output u is nan"
+    with pytest.raises(RunFault, match=re.escape(message)):
         Simulation(w, duration=Fraction(3)).run()
 
 
 def test_exception_in_component_is_a_run_fault(tmp_path: Path) -> None:
-    w = load_world(world(tmp_path, "components:\n  B: {template: 'toys:Bad', freq: 4, "
-                         "params: {boom: true}}\n"))
+    w = load_world(
+        world(tmp_path, "components:\n  B: {template: 'toys:Bad', freq: 4, params: {boom: true}}\n")
+    )
     with pytest.raises(RunFault, match=re.escape("in B (Bad): do_step raised ZeroDivisionError")):
         Simulation(w, duration=Fraction(3)).run()
