@@ -121,7 +121,8 @@ class Simulation:
         self._samples_s: list[float] = []
         self._hooks: list[tuple[Fraction, Hook, str]] = []
         self.components: dict[str, Template] = {}
-        self.now: Fraction = Fraction(0)
+        self._tick = 0  # the instant being executed, in ticks (``now`` derives from it)
+        self._now_override: Fraction | None = None
         self.phase_index = 0
         self.change_log: list[tuple[Fraction, Change]] = []
         self._initialized = False
@@ -168,6 +169,15 @@ class Simulation:
         if self._initialized and hasattr(self, "_table"):
             raise RuntimeError("hooks must be added during initialize")
         self._hooks.append((Fraction(rate_hz), fn, name))
+
+    @property
+    def now(self) -> Fraction:
+        """Exact simulated time of the instant being executed (or last executed)."""
+        if self._now_override is not None:
+            return self._now_override
+        if not hasattr(self, "grid"):
+            return Fraction(0)
+        return self.grid.tick * self._tick
 
     def _compile(self) -> None:
         leaves = self.world.leaves
@@ -236,7 +246,6 @@ class Simulation:
         until = min(until_tick, self._end)
         cycle = self._cycle
         table = self._table
-        tick_s = self.grid.tick
         end = self._end
         phase_ticks = self._phase_ticks
         while self._cursor <= until:
@@ -254,10 +263,13 @@ class Simulation:
                     and phase_ticks[self.phase_index + 1] <= tick
                 ):
                     self.phase_index += 1
-                    self.now = tick_s * phase_ticks[self.phase_index]
-                    for change in self.phases[self.phase_index].changes:
-                        self.apply_change(change)
-                self.now = tick_s * tick
+                    self._now_override = self.grid.time(phase_ticks[self.phase_index])
+                    try:
+                        for change in self.phases[self.phase_index].changes:
+                            self.apply_change(change)
+                    finally:
+                        self._now_override = None
+                self._tick = tick
                 for what, obj in actions:
                     if what == 0:
                         self._step(obj)
@@ -271,8 +283,9 @@ class Simulation:
     def _step(self, task: _Task) -> None:
         values = self.values
         inp = {port: values[buf] for port, buf in task.inputs}
+        now = self.now
         try:
-            out = task.comp.do_step(self.now, inp)
+            out = task.comp.do_step(now, inp)
         except RunFault:
             raise
         except Exception as exc:

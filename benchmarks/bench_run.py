@@ -1,0 +1,81 @@
+"""Headless run speed: scenario1 against a bare pymunk loop in the same process.
+
+Prints the real-time factor of the full engine (all eight components, trace at 20 Hz to a
+file) and of a bare loop that steps the same two rover bodies with the same wheel model at
+the same physics rate — the floor the engine is measured against. Median of N repetitions,
+min and max shown. Run: ``python benchmarks/bench_run.py [--reps 5] [--duration 300]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import tempfile
+import time
+from pathlib import Path
+
+import pymunk
+
+from amsa_phys.engine.recorder import TraceWriter
+from amsa_phys.engine.runner import Simulation
+from amsa_phys.model.scenario import load_scenario
+from amsa_phys.physics.rover import DiffDriveRover
+from amsa_phys.physics.wheel import WheelModel
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def engine_run(duration: float) -> float:
+    """Wall seconds for scenario1 through the engine, trace written to a temp dir."""
+    sc = load_scenario(ROOT / "scenarios" / "scenario1.yaml", duration=duration)
+    with tempfile.TemporaryDirectory() as tmp:
+        trace = TraceWriter(Path(tmp) / "trace.csv", list(sc.world.buffers))
+        t0 = time.perf_counter()
+        Simulation.from_scenario(sc, trace=trace.write).run()
+        trace.close()
+        return time.perf_counter() - t0
+
+
+def bare_loop(duration: float, rate: int = 100) -> float:
+    """Wall seconds to step two rovers with the same wheel model, no engine around them."""
+    space = pymunk.Space()
+    load = 30.0 * 9.81 / 2
+    wheel = WheelModel(45.0, 5.5, 1.0, 0.8 * load, 0.02 * load)
+    rovers = [DiffDriveRover(space, name, mass_kg=30.0, length_m=0.8, width_m=0.6, track_m=0.5,
+                             wheel=wheel, lateral_limit_n=0.8 * 2 * load, x=x, y=0.0,
+                             heading=0.0, collision_type=1)
+              for name, x in (("Leader", 15.0), ("Follower", 0.0))]
+    rovers[0].set_power(22, 22)
+    rovers[1].set_power(30, 28)
+    dt = 1.0 / rate
+    t0 = time.perf_counter()
+    for _ in range(int(duration * rate)):
+        for r in rovers:
+            r.apply_forces(dt)
+        space.step(dt)
+    return time.perf_counter() - t0
+
+
+def main() -> None:
+    """Measure and print."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument("--duration", type=float, default=300.0)
+    args = ap.parse_args()
+    engine, bare = [], []
+    for _ in range(args.reps):
+        engine.append(engine_run(args.duration))
+        bare.append(bare_loop(args.duration))
+    d = args.duration
+    for name, xs in (("engine (scenario1, 8 components, trace)", engine),
+                     ("bare pymunk loop, same bodies and wheels", bare)):
+        med = statistics.median(xs)
+        print(f"{name:45s} median {med:6.3f} s  (min {min(xs):.3f}, max {max(xs):.3f})  "
+              f"{d / med:7.0f}x real time")
+    ratio = statistics.median(engine) / statistics.median(bare)
+    print(f"engine / bare loop time ratio: {ratio:.2f}  ({d:g} s simulated at 100 Hz, "
+          f"{args.reps} repetitions)")
+
+
+if __name__ == "__main__":
+    main()
