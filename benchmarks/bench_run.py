@@ -41,10 +41,23 @@ def bare_loop(duration: float, rate: int = 100) -> float:
     space = pymunk.Space()
     load = 30.0 * 9.81 / 2
     wheel = WheelModel(45.0, 5.5, 1.0, 0.8 * load, 0.02 * load)
-    rovers = [DiffDriveRover(space, name, mass_kg=30.0, length_m=0.8, width_m=0.6, track_m=0.5,
-                             wheel=wheel, lateral_limit_n=0.8 * 2 * load, x=x, y=0.0,
-                             heading=0.0, collision_type=1)
-              for name, x in (("Leader", 15.0), ("Follower", 0.0))]
+    rovers = [
+        DiffDriveRover(
+            space,
+            name,
+            mass_kg=30.0,
+            length_m=0.8,
+            width_m=0.6,
+            track_m=0.5,
+            wheel=wheel,
+            lateral_limit_n=0.8 * 2 * load,
+            x=x,
+            y=0.0,
+            heading=0.0,
+            collision_type=1,
+        )
+        for name, x in (("Leader", 15.0), ("Follower", 0.0))
+    ]
     rovers[0].set_power(22, 22)
     rovers[1].set_power(30, 28)
     dt = 1.0 / rate
@@ -67,14 +80,20 @@ def main() -> None:
         engine.append(engine_run(args.duration))
         bare.append(bare_loop(args.duration))
     d = args.duration
-    for name, xs in (("engine (scenario1, 8 components, trace)", engine),
-                     ("bare pymunk loop, same bodies and wheels", bare)):
+    for name, xs in (
+        ("engine (scenario1, 8 components, trace)", engine),
+        ("bare pymunk loop, same bodies and wheels", bare),
+    ):
         med = statistics.median(xs)
-        print(f"{name:45s} median {med:6.3f} s  (min {min(xs):.3f}, max {max(xs):.3f})  "
-              f"{d / med:7.0f}x real time")
+        print(
+            f"{name:45s} median {med:6.3f} s  (min {min(xs):.3f}, max {max(xs):.3f})  "
+            f"{d / med:7.0f}x real time"
+        )
     ratio = statistics.median(engine) / statistics.median(bare)
-    print(f"engine / bare loop time ratio: {ratio:.2f}  ({d:g} s simulated at 100 Hz, "
-          f"{args.reps} repetitions)")
+    print(
+        f"engine / bare loop time ratio: {ratio:.2f}  ({d:g} s simulated at 100 Hz, "
+        f"{args.reps} repetitions)"
+    )
 
 
 if __name__ == "__main__":

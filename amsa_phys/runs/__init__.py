@@ -1,0 +1,1 @@
+"""L4: one scenario into a run directory; expectations."""

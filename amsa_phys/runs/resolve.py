@@ -1,0 +1,87 @@
+"""The fully resolved scenario: world inlined, every parameter value, enough to replay."""
+
+from __future__ import annotations
+
+import copy
+from fractions import Fraction
+from typing import Any
+
+from ..model.scenario import Change, Scenario
+from ..model.world import LeafSpec
+
+
+def _number(x: Fraction | float) -> float | int:
+    f = float(x)
+    return int(f) if f.is_integer() else f
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    return value
+
+
+def resolved_scenario(
+    scenario: Scenario, extra: list[tuple[Fraction, Change]] | None = None
+) -> dict[str, Any]:
+    """A scenario dict with the world inlined and every Leaf parameter written out.
+
+    ``extra`` adds changes made live (the window), merged into the timeline in time order.
+    """
+    world = copy.deepcopy(scenario.world.data)
+
+    def fill(comps: dict[str, Any], prefix: str) -> None:
+        for name, body in comps.items():
+            path = f"{prefix}.{name}" if prefix else name
+            if "components" in body:
+                fill(body["components"], path)
+                continue
+            leaf: LeafSpec = scenario.world.leaves[path]
+            body["freq"] = _number(leaf.freq)
+            body["params"] = {k: _plain(v) for k, v in leaf.params.items()}
+
+    fill(world["components"], "")
+    world["physics"] = copy.deepcopy(scenario.world.physics)
+    if world["physics"].get("walls") is None:
+        world["physics"].pop("walls", None)
+    timeline: dict[Fraction, dict[str, Any]] = {}
+    labels: dict[Fraction, str] = {}
+    for phase in scenario.phases[1:]:
+        timeline.setdefault(phase.at, {}).update({c.key: _plain(c.value) for c in phase.changes})
+        if phase.label:
+            labels[phase.at] = phase.label
+    for at, change in extra or []:
+        timeline.setdefault(at, {})[change.key] = _plain(change.value)
+    out: dict[str, Any] = {
+        "name": scenario.name,
+        "world": world,
+        "duration": _number(scenario.duration),
+        "seed": scenario.seed,
+        "log_rate": _number(scenario.log_rate),
+        "set": {c.key: _plain(c.value) for c in scenario.phases[0].changes},
+    }
+    if scenario.quality:
+        q = scenario.quality
+        out["quality"] = {"signal": q.signal, "reference": q.reference, "tolerance": q.tolerance}
+    if timeline:
+        out["timeline"] = []
+        for at in sorted(timeline):
+            entry: dict[str, Any] = {"at": _number(at), "set": timeline[at]}
+            if at in labels:
+                entry["label"] = labels[at]
+            out["timeline"].append(entry)
+    if scenario.expect:
+        out["expect"] = [
+            {
+                k: v
+                for k, v in (
+                    ("metric", e.metric),
+                    ("phase", e.phase),
+                    ("below", e.below),
+                    ("above", e.above),
+                )
+                if v is not None
+            }
+            for e in scenario.expect
+        ]
+    return out
