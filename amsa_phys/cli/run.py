@@ -10,6 +10,7 @@ from types import FrameType
 
 from ..errors import ConfigError
 from ..model.scenario import load_scenario
+from ..runs.expect import check_expectations
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
 from .options import add_output, add_scenario_overrides
@@ -57,4 +58,7 @@ def run(args: argparse.Namespace) -> int:
         signal.signal(signal.SIGTERM, previous)
     if not args.quiet:
         print_summary(outcome.metrics, out, sys.stdout)
-    return 0
+    checks = check_expectations(scenario.expect, outcome.metrics)
+    for check in checks:
+        print(f"expect {check.describe()}", file=sys.stdout if check.passed else sys.stderr)
+    return 0 if all(c.passed for c in checks) else 1

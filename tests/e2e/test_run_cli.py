@@ -14,7 +14,7 @@ import yaml
 from amsa_phys.cli.main import main
 
 ROOT = Path(__file__).resolve().parent.parent.parent
-SCENARIO1 = ROOT / "scenarios" / "scenario1.yaml"
+SCENARIO1 = ROOT / "tests" / "fixtures" / "mde_short.yaml"  # scenario1 minus expectations
 
 
 def run(tmp_path: Path, name: str, *extra: str) -> Path:
@@ -141,9 +141,19 @@ def test_window_mode_is_refused_clearly(tmp_path: Path, capsys: pytest.CaptureFi
     assert "run with --headless" in capsys.readouterr().err
 
 
+def test_shipped_scenarios_meet_their_expectations(tmp_path: Path) -> None:
+    for name in ("scenario1", "scenario2"):
+        path = ROOT / "scenarios" / f"{name}.yaml"
+        assert (
+            main(["run", str(path), "--headless", "--out", str(tmp_path / name), "-q", "--no-plot"])
+            == 0
+        )
+
+
 def test_validate_describe_templates(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["validate", str(SCENARIO1), str(ROOT / "worlds" / "mde_challenge.yaml")]) == 0
-    assert main(["describe", str(SCENARIO1)]) == 0
+    shipped = ROOT / "scenarios" / "scenario1.yaml"
+    assert main(["validate", str(shipped), str(ROOT / "worlds" / "mde_challenge.yaml")]) == 0
+    assert main(["describe", str(shipped)]) == 0
     text = capsys.readouterr().out
     assert "MyFollowerController: FollowerController (controller) at 4 Hz" in text
     assert "Kv = 0.35 1/m  [0, 10]" in text or "Kv = 0.05 1/m  [0, 10]" in text
@@ -159,3 +169,62 @@ def test_validate_describe_templates(capsys: pytest.CaptureFixture[str]) -> None
     ):
         assert name in text
     assert "param lostDataGPS: int = 0 % [0, 100]" in text
+
+
+def test_expectations_are_checked_and_reported(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scen = tmp_path / "s.yaml"
+    scen.write_text(
+        f"world: {ROOT / 'worlds' / 'mde_challenge.yaml'}\nduration: 20\n"
+        "quality: {signal: MyDistanceMonitor.distanceFollowerToLeader, "
+        "reference: 15}\nexpect:\n  - {metric: max_distance, below: 1}\n"
+        "  - {metric: min_distance, above: 1}\n"
+    )
+    code = main(["run", str(scen), "--headless", "--out", str(tmp_path / "o"), "-q"])
+    captured = capsys.readouterr()
+    assert code == 1
+    assert "expect min_distance = " in captured.out
+    assert ": pass" in captured.out
+    assert captured.err.startswith("expect max_distance = ")
+    assert "below 1: FAIL" in captured.err
+
+
+def test_sigint_finalises_outputs_and_exits_130(tmp_path: Path) -> None:
+    import signal
+    import time
+
+    out = tmp_path / "int"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "amsa_phys",
+            "run",
+            str(SCENARIO1),
+            "--headless",
+            "--out",
+            str(out),
+            "--duration",
+            "100000",
+            "--no-plot",
+            "-q",
+        ],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 30
+    while not (out / "trace.csv.tmp").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130
+    assert "interrupted at t=" in err
+    assert "Traceback" not in err
+    assert not (out / "trace.csv.tmp").exists()
+    rows = (out / "trace.csv").read_text().splitlines()
+    assert len(rows) > 10
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["status"] == "interrupted"
+    assert 0 < metrics["simulated"] < 100000

@@ -211,3 +211,25 @@ def test_exception_in_component_is_a_run_fault(tmp_path: Path) -> None:
     )
     with pytest.raises(RunFault, match=re.escape("in B (Bad): do_step raised ZeroDivisionError")):
         Simulation(w, duration=Fraction(3)).run()
+
+
+def test_composites_nest_and_inputs_resolve_from_the_inside_out(tmp_path: Path) -> None:
+    w = load_world(
+        world(
+            tmp_path,
+            """
+components:
+  Src: {template: "toys:Source", freq: 1}
+  Team:
+    components:
+      Src: {template: "toys:Source", freq: 1, params: {gain: 10}}
+      R: {template: "toys:Relay", freq: 1, inputs: {x: Src.count}}
+  Outer: {template: "toys:Relay", freq: 1, inputs: {x: Team.Src.count}}
+""",
+        )
+    )
+    assert list(w.leaves) == ["Src", "Team.Src", "Team.R", "Outer"]
+    assert w.leaves["Team.R"].inputs == {"x": "Team.Src.count"}  # its sibling, not the root's
+    assert w.leaves["Outer"].inputs == {"x": "Team.Src.count"}
+    Simulation(w, duration=Fraction(0)).run()
+    assert [inp for p, _, inp in toys.LOG if p == "Team.R"] == [{"x": 10.0}]
