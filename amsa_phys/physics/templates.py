@@ -152,7 +152,8 @@ class FreeRobot(_Robot):
     ``changePeriod`` s; 4 a random trajectory: every ``changePeriod`` s a new heading (within
     ±``randomTurn`` of the current one) and speed (50–120 % of cruise) drawn from the seed;
     5 ``waypoints`` in order, then stop. Headings are held by a proportional steering law
-    (``steerGain`` % of differential power per radian).
+    (``steerGain`` % of differential power per radian, forward power times cos(error)). The
+    circle's wheel powers come from the rover's own wheel model, so the radius is as asked.
     """
 
     template_name = "freeRobot"
@@ -231,9 +232,12 @@ class FreeRobot(_Robot):
         cruise = p.cruisePower
         b = p.behavior
         if b == 2:
-            r = p.circleRadius or 1e9
-            k = self.rover.half_track / r
-            return cruise * (1 - k), cruise * (1 + k)
+            # wheel speeds v (1 -+ h / r) for the cruise speed v, each converted back to the
+            # power that holds it (so rolling resistance does not shrink the circle)
+            wheel = self.rover.wheel
+            v = wheel.steady_speed(cruise)
+            k = self.rover.half_track / (p.circleRadius or 1e9)
+            return wheel.power_for_speed(v * (1 - k)), wheel.power_for_speed(v * (1 + k))
         if b == 1:
             return cruise, cruise
         if t >= self.next_change:
@@ -253,9 +257,12 @@ class FreeRobot(_Robot):
         return self._steer(cruise * self.speed_factor, self.target_heading)
 
     def _steer(self, power: float, heading: float) -> tuple[float, float]:
+        """Hold ``heading``: forward power falls with cos(error), so a large error turns the
+        rover nearly in place instead of orbiting its target."""
         err = wrap_angle(heading - self.rover.body.angle)
         diff = self.p.steerGain * err
-        return power - diff, power + diff
+        forward = power * max(0.0, math.cos(err))
+        return forward - diff, forward + diff
 
     def _waypoints(self, cruise: float) -> tuple[float, float]:
         points = self.p.waypoints

@@ -67,6 +67,20 @@ class WheelModel:
         sign = 1.0 if drive > 0 else -1.0
         return (drive - sign * self.rolling_force_n) * self.free_speed_mps / self.stall_force_n
 
+    def power_for_speed(self, v_wheel: float) -> float:
+        """Power (%) that holds a wheel at ``v_wheel`` against rolling resistance.
+
+        The inverse of :meth:`steady_speed` per wheel: ``F_stall (eta p - v/v_free) = Crr N``.
+        """
+        if v_wheel == 0.0 or self.efficiency == 0.0:
+            return 0.0
+        sign = 1.0 if v_wheel > 0 else -1.0
+        return (
+            100.0
+            * (v_wheel / self.free_speed_mps + sign * self.rolling_force_n / self.stall_force_n)
+            / self.efficiency
+        )
+
 
 def lateral_force(v_lat: float, mass_kg: float, dt_s: float, limit_n: float) -> float:
     """Sideways force (N) that stops a sideways velocity in one step, capped by grip."""
