@@ -115,18 +115,28 @@ def _number(value: Any, integer: bool) -> Any:
     return float(value)
 
 
-def _show(value: Any) -> str:
-    """Describe a wrong value briefly: its repr (cut) and its YAML-ish type."""
-    names = {
-        bool: "boolean",
-        int: "integer",
-        float: "number",
-        str: "string",
-        list: "list",
-        dict: "mapping",
-        type(None): "null",
-    }
+_YAML_TYPES = {
+    bool: "boolean",
+    int: "integer",
+    float: "number",
+    str: "string",
+    list: "list",
+    dict: "mapping",
+    type(None): "null",
+}
+
+
+def yaml_type(value: Any) -> str:
+    """The YAML word for a value's type (``mapping``, ``integer``, ...) for messages."""
+    return _YAML_TYPES.get(type(value), type(value).__name__)
+
+
+def short_repr(value: Any) -> str:
+    """``repr`` cut to 40 characters, for one-line messages."""
     text = repr(value)
-    if len(text) > 40:
-        text = text[:37] + "..."
-    return f"{names.get(type(value), type(value).__name__)} {text}"
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _show(value: Any) -> str:
+    """Describe a wrong value briefly: its YAML type and its (cut) repr."""
+    return f"{yaml_type(value)} {short_repr(value)}"

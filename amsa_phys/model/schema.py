@@ -13,6 +13,7 @@ from typing import Any
 
 import jsonschema
 
+from .params import short_repr, yaml_type
 from .suggest import did_you_mean
 from .yamlio import KeyPath, YamlDoc
 
@@ -235,13 +236,13 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
         want = err.validator_value
         wants = want if isinstance(want, list) else [want]
         words = " or ".join(_TYPE_WORDS.get(w, w) for w in wants)
-        return path, f"expected {words}, got {_yaml_type(inst)} {_short(inst)}"
+        return path, f"expected {words}, got {yaml_type(inst)} {short_repr(inst)}"
     if kind in ("exclusiveMinimum", "minimum", "maximum"):
         sign = {"exclusiveMinimum": ">", "minimum": ">=", "maximum": "<="}[kind]
         return path, f"must be {sign} {err.validator_value}, got {inst}"
     if kind in ("enum", "const"):
         allowed = err.validator_value if kind == "enum" else [err.validator_value]
-        return path, f"expected one of {', '.join(map(str, allowed))}, got {_short(inst)}"
+        return path, f"expected one of {', '.join(map(str, allowed))}, got {short_repr(inst)}"
     if kind == "pattern":
         return path, (
             f"{inst!r} is not a valid name (letters, digits and _, not starting with a digit)"
@@ -255,23 +256,6 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
     if kind == "uniqueItems":
         return path, "has repeated entries"
     return path, err.message
-
-
-def _yaml_type(value: Any) -> str:
-    return {
-        bool: "boolean",
-        int: "integer",
-        float: "number",
-        str: "string",
-        list: "list",
-        dict: "mapping",
-        type(None): "null",
-    }.get(type(value), type(value).__name__)
-
-
-def _short(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def _first_nonfinite(data: Any, path: KeyPath) -> KeyPath | None:
