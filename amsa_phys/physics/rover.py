@@ -59,7 +59,17 @@ class DiffDriveRover:
         self.power_r = min(100.0, max(-100.0, right_pct))
 
     def apply_forces(self, dt: float) -> None:
-        """Set this step's force and torque on the body from the wheel model."""
+        """Set this step's force and torque on the body from the wheel model.
+
+        Lateral grip is a non-holonomic constraint: it must turn the velocity with the body
+        without doing work. pymunk integrates velocity first, then the angle with the new
+        angular velocity, so the heading at the end of the step is ``a + w' dt``. The grip
+        impulse is applied along the normal at the *mid-step* heading and sized so the
+        end-of-step velocity has no sideways component at the *end-of-step* heading: a pure
+        rotation of the velocity (speed kept exactly). Cancelling sideways velocity at the
+        start-of-step heading instead bleeds speed in every turn, by an amount that depends
+        on the physics rate.
+        """
         body = self.body
         angle = body.angle
         c = math.cos(angle)
@@ -67,15 +77,25 @@ class DiffDriveRover:
         vx, vy = body.velocity
         w = body.angular_velocity
         v_fwd = vx * c + vy * s
-        v_lat = -vx * s + vy * c
         h = self.half_track
         wheel = self.wheel
         f_l = wheel.drive_force(self.power_l, v_fwd - w * h)
         f_r = wheel.drive_force(self.power_r, v_fwd + w * h)
-        f_lat = lateral_force(v_lat, self.mass, dt, self.lateral_limit)
         fx = f_l + f_r
-        body.force = (fx * c - f_lat * s, fx * s + f_lat * c)
-        body.torque = (f_r - f_l) * h
+        torque = (f_r - f_l) * h
+        # predicted heading change over this step (semi-implicit Euler, as pymunk does)
+        turn = (w + torque / body.moment * dt) * dt
+        end = angle + turn
+        mid = angle + 0.5 * turn
+        nx_end, ny_end = -math.sin(end), math.cos(end)
+        nx_mid, ny_mid = -math.sin(mid), math.cos(mid)
+        # velocity after the drive force alone, and its sideways part at the end heading
+        px = vx + fx * c / self.mass * dt
+        py = vy + fx * s / self.mass * dt
+        side = px * nx_end + py * ny_end
+        f_lat = lateral_force(side / math.cos(0.5 * turn), self.mass, dt, self.lateral_limit)
+        body.force = (fx * c + f_lat * nx_mid, fx * s + f_lat * ny_mid)
+        body.torque = torque
 
     # -- state, read by the templates ----------------------------------------------------
     @property

@@ -96,6 +96,8 @@ _POSE_OUTPUTS = (
     Port("heading", 0.0, "true heading in [-pi, pi)", "rad"),
     Port("speed", 0.0, "signed speed along the heading", "m/s"),
     Port("yawRate", 0.0, "angular velocity", "rad/s"),
+    Port("wheelSpeedL", 0.0, "left wheel ground speed (what an encoder measures)", "m/s"),
+    Port("wheelSpeedR", 0.0, "right wheel ground speed (what an encoder measures)", "m/s"),
 )
 
 
@@ -114,12 +116,15 @@ class _Robot(Template):
 
     def _pose(self) -> dict[str, float]:
         x, y, heading = self.rover.pose
+        v_l, v_r = self.rover.wheel_speeds()
         return {
             "posX": x,
             "posY": y,
             "heading": heading,
             "speed": self.rover.forward_speed,
             "yawRate": self.rover.body.angular_velocity,
+            "wheelSpeedL": v_l,
+            "wheelSpeedR": v_r,
         }
 
 

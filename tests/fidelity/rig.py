@@ -23,31 +23,32 @@ def drive(
     coef: int = 100,
     physics: dict[str, Any] | None = None,
     timeline: list[dict[str, Any]] | None = None,
+    rate_hz: int = 50,
 ) -> tuple[dict[str, np.ndarray], Simulation]:
-    """Run the rig; return the trace as named columns (50 Hz) and the simulation."""
+    """Run the rig; return the trace as named columns (at ``rate_hz``) and the simulation."""
     world = {
         "physics": {"rate": 100, **(physics or {})},
         "components": {
             "Ctl": {
                 "template": "ConstantPower",
-                "freq": 50,
+                "freq": rate_hz,
                 "params": {"left": left, "right": right},
             },
             "Norm": {
                 "template": "NormalizePower",
-                "freq": 50,
+                "freq": rate_hz,
                 "params": {"motorCoef": coef},
                 "inputs": {"powerL": "Ctl.LeftPower", "powerR": "Ctl.RightPower"},
             },
             "Rover": {
                 "template": "controlledRobot",
-                "freq": 50,
+                "freq": rate_hz,
                 "params": robot or {},
                 "inputs": {"powerL": "Norm.normalizedPowerL", "powerR": "Norm.normalizedPowerR"},
             },
         },
     }
-    scen = {"world": world, "duration": duration, "log_rate": 50}
+    scen: dict[str, Any] = {"world": world, "duration": duration, "log_rate": rate_hz}
     if timeline:
         scen["timeline"] = timeline
     path = tmp_path / "rig.yaml"
