@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from .. import __version__
 from ..errors import AmsaError
 from . import describe, plot, run, templates, validate
+from . import test as test_cmd
 
 COMMANDS = {
     "run": run,
@@ -21,6 +22,7 @@ COMMANDS = {
     "describe": describe,
     "templates": templates,
     "plot": plot,
+    "test": test_cmd,
 }
 
 

@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
         signal.signal(signal.SIGTERM, previous)
     if not args.quiet:
         print_summary(outcome.metrics, out, sys.stdout)
-    checks = check_expectations(scenario.expect, outcome.metrics)
+    checks = check_expectations(scenario.expect, outcome.metrics, out / "trace.csv")
     for check in checks:
         print(f"expect {check.describe()}", file=sys.stdout if check.passed else sys.stderr)
     return 0 if all(c.passed for c in checks) else 1

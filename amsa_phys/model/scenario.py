@@ -69,13 +69,20 @@ class Quality:
 
 @dataclass
 class Expectation:
-    """``metric`` (overall, or of ``phase``) must be ``below`` and/or ``above`` a bound."""
+    """A bound on a run.
 
-    metric: str
+    Either ``metric`` (overall, or of ``phase``) must be ``below`` and/or ``above`` a bound,
+    or every sample of the Data ``trace`` in [``after``, ``before``] must be.
+    """
+
+    metric: str | None
     phase: int | None
     below: float | None
     above: float | None
     line: int | None
+    trace: str | None = None
+    after: float | None = None
+    before: float | None = None
 
 
 @dataclass
@@ -167,25 +174,47 @@ def build_scenario(doc: YamlDoc) -> Scenario:
         )
     expect = []
     for i, e in enumerate(data.get("expect", [])):
+        kp = ("expect", i)
+        if ("metric" in e) == ("trace" in e):
+            raise doc.error(kp, "give exactly one of 'metric' or 'trace'")
+        if "trace" in e:
+            if e["trace"] not in world.buffers:
+                raise doc.error(
+                    (*kp, "trace"),
+                    f"unknown Data {e['trace']!r}" + did_you_mean(e["trace"], world.buffers),
+                )
+            if "phase" in e:
+                raise doc.error((*kp, "phase"), "a trace check takes after/before, not phase")
+            expect.append(
+                Expectation(
+                    None,
+                    None,
+                    e.get("below"),
+                    e.get("above"),
+                    doc.line(kp),
+                    e["trace"],
+                    e.get("after"),
+                    e.get("before"),
+                )
+            )
+            continue
         if e["metric"] not in METRICS:
             raise doc.error(
-                ("expect", i, "metric"),
+                (*kp, "metric"),
                 f"unknown metric {e['metric']!r}"
                 + did_you_mean(e["metric"], METRICS)
                 + f"; known: {', '.join(METRICS)}",
             )
         if "phase" in e and e["phase"] >= len(phases):
             raise doc.error(
-                ("expect", i, "phase"),
+                (*kp, "phase"),
                 f"phase {e['phase']} does not exist "
                 f"(the scenario has {len(phases)} phases, 0..{len(phases) - 1})",
             )
         if quality is None:
-            raise doc.error(("expect", i), "expectations need a quality: section")
+            raise doc.error(kp, "metric expectations need a quality: section")
         expect.append(
-            Expectation(
-                e["metric"], e.get("phase"), e.get("below"), e.get("above"), doc.line(("expect", i))
-            )
+            Expectation(e["metric"], e.get("phase"), e.get("below"), e.get("above"), doc.line(kp))
         )
     return Scenario(
         path=doc.path,

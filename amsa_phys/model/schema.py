@@ -169,11 +169,13 @@ SCENARIO: dict[str, Any] = {
             "items": {
                 "type": "object",
                 "additionalProperties": False,
-                "required": ["metric"],
                 "anyOf": [{"required": ["below"]}, {"required": ["above"]}],
                 "properties": {
                     "metric": {"type": "string"},
+                    "trace": {"type": "string"},
                     "phase": {"type": "integer", "minimum": 0},
+                    "after": _nonneg,
+                    "before": _pos,
                     "below": _num,
                     "above": _num,
                 },

@@ -1,9 +1,12 @@
-"""Checking a run's metrics against the scenario's ``expect`` entries."""
+"""Checking a run against the scenario's ``expect`` entries (metrics and trace windows)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from ..model.scenario import Expectation
 
@@ -17,26 +20,55 @@ class Check:
     passed: bool
     skipped: bool = False
 
+    @property
+    def what(self) -> str:
+        """``max_distance (phase 1)`` or ``Comp.out in [30, end] s``."""
+        e = self.expectation
+        if e.trace is not None:
+            lo = f"{e.after:g}" if e.after is not None else "0"
+            hi = f"{e.before:g}" if e.before is not None else "end"
+            return f"{e.trace} in [{lo}, {hi}] s"
+        return f"{e.metric}" + (f" (phase {e.phase})" if e.phase is not None else "")
+
+    @property
+    def bound(self) -> str:
+        """``below 26 and above 2``."""
+        e = self.expectation
+        parts = []
+        if e.below is not None:
+            parts.append(f"below {e.below:g}")
+        if e.above is not None:
+            parts.append(f"above {e.above:g}")
+        return " and ".join(parts)
+
+    @property
+    def verdict(self) -> str:
+        """pass, FAIL or skipped."""
+        return "skipped" if self.skipped else ("pass" if self.passed else "FAIL")
+
     def describe(self) -> str:
         """``max_distance (phase 1) = 24.3, below 26: pass``."""
-        e = self.expectation
-        where = f" (phase {e.phase})" if e.phase is not None else ""
-        bounds = []
-        if e.below is not None:
-            bounds.append(f"below {e.below:g}")
-        if e.above is not None:
-            bounds.append(f"above {e.above:g}")
         if self.skipped:
-            return f"{e.metric}{where}: skipped (phase not run, --duration cut it)"
+            return f"{self.what}: skipped (phase not run, --duration cut it)"
         value = "none" if self.value is None else f"{self.value:.4g}"
-        verdict = "pass" if self.passed else "FAIL"
-        return f"{e.metric}{where} = {value}, {' and '.join(bounds)}: {verdict}"
+        return f"{self.what} = {value}, {self.bound}: {self.verdict}"
 
 
-def check_expectations(expect: list[Expectation], metrics: dict[str, Any]) -> list[Check]:
-    """Evaluate every expectation; a metric that is null (never settled) fails a bound."""
+def check_expectations(
+    expect: list[Expectation], metrics: dict[str, Any], trace: Path | None = None
+) -> list[Check]:
+    """Evaluate every expectation; a metric that is null (never settled) fails a bound.
+
+    A trace check reports the sample that came closest to breaking (or broke) its bound.
+    """
     checks = []
+    columns: tuple[list[str], np.ndarray] | None = None
     for e in expect:
+        if e.trace is not None:
+            if columns is None:
+                columns = _read(trace)
+            checks.append(_trace_check(e, *columns))
+            continue
         if e.phase is not None and e.phase >= len(metrics["phases"]):
             checks.append(Check(e, None, True, skipped=True))
             continue
@@ -49,3 +81,35 @@ def check_expectations(expect: list[Expectation], metrics: dict[str, Any]) -> li
             ok = value > e.above
         checks.append(Check(e, value, ok))
     return checks
+
+
+def _read(trace: Path | None) -> tuple[list[str], np.ndarray]:
+    if trace is None:
+        raise ValueError("trace checks need the run's trace.csv")
+    with open(trace, encoding="utf-8") as fh:
+        header = fh.readline().strip().split(",")
+    return header, np.loadtxt(trace, delimiter=",", skiprows=1, ndmin=2)
+
+
+def _trace_check(e: Expectation, header: list[str], data: np.ndarray) -> Check:
+    t = data[:, 0]
+    mask = np.ones_like(t, dtype=bool)
+    if e.after is not None:
+        mask &= t >= e.after
+    if e.before is not None:
+        mask &= t <= e.before
+    values = data[mask, header.index(e.trace)]
+    if values.size == 0:
+        return Check(e, None, False)
+    worst: float | None = None
+    ok = True
+    if e.above is not None:
+        low = float(values.min())
+        worst = low
+        ok = ok and low > e.above
+    if e.below is not None:
+        high = float(values.max())
+        if worst is None or high >= e.below:
+            worst = high
+        ok = ok and high < e.below
+    return Check(e, worst, ok)

@@ -71,17 +71,16 @@ def resolved_scenario(
                 entry["label"] = labels[at]
             out["timeline"].append(entry)
     if scenario.expect:
-        out["expect"] = [
-            {
-                k: v
-                for k, v in (
-                    ("metric", e.metric),
-                    ("phase", e.phase),
-                    ("below", e.below),
-                    ("above", e.above),
-                )
-                if v is not None
-            }
-            for e in scenario.expect
-        ]
+        out["expect"] = []
+        for e in scenario.expect:
+            fields = (
+                ("metric", e.metric),
+                ("trace", e.trace),
+                ("phase", e.phase),
+                ("after", e.after),
+                ("before", e.before),
+                ("below", e.below),
+                ("above", e.above),
+            )
+            out["expect"].append({k: v for k, v in fields if v is not None})
     return out

@@ -1,0 +1,80 @@
+"""Run every scenario with expectations; print pass/fail against the bounds."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+from ..errors import ConfigError
+from ..runs.junit import write_junit
+from ..runs.suite import ScenarioResult, find_scenarios, run_scenario_file
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``amsa-phys test``."""
+    p.add_argument(
+        "paths",
+        nargs="*",
+        default=["scenarios"],
+        help="scenario files or folders (default: scenarios)",
+    )
+    p.add_argument("--junit", metavar="FILE", help="also write JUnit XML")
+    p.add_argument(
+        "-j",
+        "--jobs",
+        type=int,
+        default=os.cpu_count() or 1,
+        help="parallel processes (default: all cores)",
+    )
+    p.add_argument("--out", metavar="DIR", help="keep each run's directory under DIR")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Exit 0 if every check passes, 1 if any fails or errors."""
+    files = find_scenarios(args.paths)
+    for f in files:
+        if not f.exists():
+            raise ConfigError("file not found", file=f)
+    if not files:
+        raise ConfigError("no scenario with an expect: section found", key=" ".join(args.paths))
+    if args.jobs < 1:
+        raise ConfigError("must be at least 1", key="--jobs")
+    jobs = min(args.jobs, len(files))
+    out = args.out
+    if jobs == 1:
+        results = [run_scenario_file(str(f), out) for f in files]
+    else:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            results = list(pool.map(run_scenario_file, [str(f) for f in files], [out] * len(files)))
+    print_table(results)
+    if args.junit:
+        write_junit(results, Path(args.junit))
+    return 0 if all(r.passed for r in results) else 1
+
+
+def print_table(results: list[ScenarioResult]) -> None:
+    """One row per check: scenario, check, measured value, bound, verdict."""
+    rows = [("scenario", "check", "measured", "bound", "result")]
+    for r in results:
+        if r.error is not None:
+            rows.append((r.name, "load and run", "-", "-", "ERROR"))
+            continue
+        for c in r.checks:
+            value = "-" if c.value is None else f"{c.value:.4g}"
+            rows.append((r.name, c.what, value, c.bound, c.verdict))
+    widths = [max(len(row[i]) for row in rows) for i in range(5)]
+    for row in rows:
+        print("  ".join(v.ljust(w) for v, w in zip(row, widths, strict=True)).rstrip())
+    for r in results:
+        if r.error is not None:
+            print(f"error: {r.name}: {r.error}", file=sys.stderr)
+    n_checks = sum(len(r.checks) for r in results)
+    n_fail = sum(1 for r in results for c in r.checks if not c.passed)
+    n_err = sum(1 for r in results if r.error is not None)
+    print(
+        f"{len(results)} scenarios, {n_checks} checks: {n_checks - n_fail} passed, "
+        f"{n_fail} failed" + (f", {n_err} errors" if n_err else "")
+    )

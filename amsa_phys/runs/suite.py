@@ -1,0 +1,80 @@
+"""Scenario tests: run every scenario that has ``expect`` and collect the checks.
+
+Used by ``amsa-phys test`` (in parallel, across processes) and by the pytest plugin. Each
+scenario runs into a temporary directory unless an output root is given; a scenario that
+cannot load or faults is an error result, not a crash of the whole suite.
+"""
+
+from __future__ import annotations
+
+import re
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import AmsaError
+from ..model.scenario import load_scenario
+from .expect import Check, check_expectations
+from .rundir import prepare_run_dir
+from .single import run_scenario
+
+_EXPECT = re.compile(r"^expect\s*:", re.MULTILINE)
+
+
+@dataclass
+class ScenarioResult:
+    """The outcome of one scenario file."""
+
+    path: str
+    name: str
+    checks: list[Check] = field(default_factory=list)
+    error: str | None = None
+    wall_s: float = 0.0
+
+    @property
+    def passed(self) -> bool:
+        """No error and every check passed (or was skipped)."""
+        return self.error is None and all(c.passed for c in self.checks)
+
+
+def has_expectations(path: Path) -> bool:
+    """Cheap test: a YAML file with a top-level ``expect:`` key (it is loaded properly later,
+    so a broken scenario surfaces as an error rather than being skipped)."""
+    try:
+        return bool(_EXPECT.search(path.read_text(encoding="utf-8", errors="replace")))
+    except OSError:
+        return False
+
+
+def find_scenarios(paths: list[str]) -> list[Path]:
+    """Scenario files with expectations: files as given, folders searched recursively."""
+    found: list[Path] = []
+    for raw in paths:
+        p = Path(raw)
+        if p.is_dir():
+            found += [f for f in sorted(p.rglob("*.y*ml")) if has_expectations(f)]
+        else:
+            found.append(p)
+    return found
+
+
+def run_scenario_file(path: str, out_root: str | None = None) -> ScenarioResult:
+    """Load, run and check one scenario (safe to call in a worker process)."""
+    t0 = time.perf_counter()
+    result = ScenarioResult(path=path, name=Path(path).stem)
+    try:
+        scenario = load_scenario(path)
+        result.name = scenario.name
+        if not scenario.expect:
+            result.error = "no expect: section"
+            return result
+        with tempfile.TemporaryDirectory(prefix="amsa-test-") as tmp:
+            out = Path(out_root) / result.name if out_root else Path(tmp) / "run"
+            prepare_run_dir(out, force=True)
+            outcome = run_scenario(scenario, out, plot=out_root is not None, progress=False)
+            result.checks = check_expectations(scenario.expect, outcome.metrics, out / "trace.csv")
+    except AmsaError as exc:
+        result.error = str(exc)
+    result.wall_s = time.perf_counter() - t0
+    return result

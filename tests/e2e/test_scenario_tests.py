@@ -1,0 +1,80 @@
+"""``amsa-phys test`` and the pytest plugin on the shipped and a failing scenario."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+from amsa_phys.cli.main import main
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+FAILING = ROOT / "tests" / "fixtures" / "failing_expect.yaml"
+
+
+def test_shipped_scenarios_pass(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["test", str(ROOT / "scenarios"), "-j", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "2 scenarios, 5 checks: 5 passed, 0 failed" in out
+
+
+def test_failing_scenario_gives_exit_1_a_table_and_junit(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    junit = tmp_path / "report.xml"
+    assert main(["test", str(FAILING), "--junit", str(junit), "-j", "1"]) == 1
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].split() == ["scenario", "check", "measured", "bound", "result"]
+    assert any(
+        line.split()[:2] == ["failing_expect", "max_distance"] and line.endswith("FAIL")
+        for line in lines
+    )
+    assert any("collisions" in line and line.endswith("pass") for line in lines)
+    assert lines[-1] == "1 scenarios, 3 checks: 1 passed, 2 failed"
+    root = ET.parse(junit).getroot()
+    suite = root.find("testsuite")
+    assert suite is not None
+    assert suite.get("tests") == "3"
+    assert suite.get("failures") == "2"
+    failures = [f.get("message") for f in root.iter("failure")]
+    assert failures[0].startswith("max_distance = ")
+    assert failures[0].endswith("below 16: FAIL")
+
+
+def test_a_folder_without_scenario_tests_is_a_usage_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["test", str(tmp_path)]) == 2
+    assert "no scenario with an expect: section found" in capsys.readouterr().err
+
+
+def test_pytest_collects_scenarios_in_a_users_project(tmp_path: Path) -> None:
+    project = tmp_path / "proj" / "scenarios"
+    project.mkdir(parents=True)
+    for name in ("scenario2.yaml",):
+        text = (
+            (ROOT / "scenarios" / name)
+            .read_text()
+            .replace("../worlds/mde_challenge.yaml", str(ROOT / "worlds" / "mde_challenge.yaml"))
+        )
+        (project / name).write_text(text)
+    failing = FAILING.read_text().replace(
+        "../../worlds/mde_challenge.yaml", str(ROOT / "worlds" / "mde_challenge.yaml")
+    )
+    (project / "failing.yaml").write_text(failing)
+    shutil.copy(ROOT / "worlds" / "mde_challenge.yaml", project / "not_a_scenario.yaml")
+    proc = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "scenarios"],
+        cwd=project.parent,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert proc.returncode == 1, proc.stdout
+    assert "1 failed, 1 passed" in proc.stdout
+    assert "max_distance = 20.07, below 16: FAIL" in proc.stdout
+    assert "Traceback" not in proc.stdout
