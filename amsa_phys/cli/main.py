@@ -13,7 +13,7 @@ from collections.abc import Sequence
 
 from .. import __version__
 from ..errors import AmsaError
-from . import describe, plot, run, templates, validate
+from . import describe, plot, run, sweep, templates, validate
 from . import test as test_cmd
 
 COMMANDS = {
@@ -23,6 +23,7 @@ COMMANDS = {
     "templates": templates,
     "plot": plot,
     "test": test_cmd,
+    "sweep": sweep,
 }
 
 

@@ -164,6 +164,19 @@ SCENARIO: dict[str, Any] = {
                 },
             },
         },
+        "sweep": {
+            "type": "object",
+            "additionalProperties": False,
+            "properties": {
+                "grid": {
+                    "type": "object",
+                    "additionalProperties": {"type": "array", "minItems": 1},
+                },
+                "contexts": {"type": "object", "additionalProperties": {"type": "object"}},
+                "seeds": {"type": "integer", "minimum": 1},
+                "metric": {"type": "string"},
+            },
+        },
         "expect": {
             "type": "array",
             "items": {

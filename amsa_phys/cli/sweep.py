@@ -1,0 +1,174 @@
+"""Exhaustive exploration: a parameter grid × seeds in parallel, on this machine or Dask."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
+
+from ..engine.recorder import write_atomic
+from ..errors import ConfigError, Interrupted
+from ..model.scenario import load_scenario
+from ..model.yamlio import load_yaml
+from ..plots.summary import plot_summary
+from ..runs.rundir import default_run_dir, prepare_run_dir
+from ..runs.sweep import (
+    METRIC_KEYS,
+    Axis,
+    SweepPlan,
+    check_axes,
+    iter_dask,
+    iter_local,
+    parse_grid,
+    parse_range,
+)
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``amsa-phys sweep``."""
+    p.add_argument("scenario", help="scenario YAML file (its sweep: section gives defaults)")
+    p.add_argument(
+        "--grid",
+        action="append",
+        default=[],
+        metavar="Comp.param=v1,v2,...",
+        help="a grid axis (repeatable); values read as YAML",
+    )
+    p.add_argument(
+        "--range",
+        dest="ranges",
+        action="append",
+        default=[],
+        metavar="Comp.param=start:stop:n",
+        help="n evenly spaced values",
+    )
+    p.add_argument("--seeds", type=int, help="seeds per grid point (default 1)")
+    p.add_argument(
+        "-j",
+        "--jobs",
+        type=int,
+        default=os.cpu_count() or 1,
+        help="local worker processes (default: all cores)",
+    )
+    p.add_argument("--executor", choices=("local", "dask"), default="local")
+    p.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address (tcp://...)")
+    p.add_argument("--metric", help="metric for summary.png (default rms_error)")
+    p.add_argument("--duration", type=float, metavar="S", help="override the duration")
+    p.add_argument("--out", metavar="DIR", help="output (default runs/<scenario>-sweep-...)")
+    p.add_argument("--force", action="store_true", help="replace an existing --out directory")
+
+
+def build_plan(args: argparse.Namespace) -> SweepPlan:
+    """Merge the scenario's ``sweep:`` section with the command line (which wins)."""
+    scenario = load_scenario(args.scenario)
+    doc = load_yaml(args.scenario)
+    section = scenario.data.get("sweep", {})
+    axes: list[Axis] = []
+    contexts: dict[str, dict[str, Any]] = dict(section.get("contexts", {}))
+    if contexts:
+        axes.append(Axis("context", tuple(contexts)))
+    cli_axes = [parse_grid(g) for g in args.grid] + [parse_range(r) for r in args.ranges]
+    cli_keys = {a.key for a in cli_axes}
+    for key, values in section.get("grid", {}).items():
+        if key not in cli_keys:
+            axes.append(Axis(key, tuple(values)))
+    axes += cli_axes
+    if not axes:
+        raise ConfigError("nothing to sweep: give --grid/--range or a sweep: section", key="sweep")
+    try:
+        check_axes([a for a in axes if a.key != "context"], scenario)
+    except ConfigError as exc:
+        if "grid" in section and exc.key and exc.key.removeprefix("--grid ") in section["grid"]:
+            raise doc.error(
+                ("sweep", "grid", exc.key.removeprefix("--grid ")), exc.message
+            ) from None
+        raise
+    from ..model.scenario import resolve_change
+
+    for name, sets in contexts.items():
+        for key, value in sets.items():
+            try:
+                resolve_change(key, value, scenario.world)
+            except ValueError as exc:
+                raise doc.error(("sweep", "contexts", name, key), str(exc)) from None
+    seeds = args.seeds if args.seeds is not None else int(section.get("seeds", 1))
+    if seeds < 1:
+        raise ConfigError("must be at least 1", key="--seeds")
+    return SweepPlan(
+        Path(args.scenario).resolve(),
+        axes,
+        seeds,
+        scenario.seed,
+        contexts,
+        args.metric or section.get("metric", "rms_error"),
+        args.duration,
+    )
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the sweep; results.csv and summary.png; Ctrl-C keeps every finished row."""
+    plan = build_plan(args)
+    if plan.metric not in METRIC_KEYS:
+        raise ConfigError(
+            f"unknown metric {plan.metric!r}; known: {', '.join(METRIC_KEYS)}", key="--metric"
+        )
+    if args.executor == "dask" and not args.scheduler:
+        raise ConfigError("the Dask executor needs --scheduler ADDR", key="--executor")
+    if args.jobs < 1:
+        raise ConfigError("must be at least 1", key="--jobs")
+    name = Path(args.scenario).stem
+    out = Path(args.out) if args.out else default_run_dir(f"{name}-sweep")
+    prepare_run_dir(out, args.force)
+    jobs = plan.jobs()
+    rows: list[dict[str, Any]] = []
+    source = (
+        iter_dask(jobs, args.scheduler)
+        if args.executor == "dask"
+        else iter_local(jobs, min(args.jobs, len(jobs)))
+    )
+    interrupted = False
+    try:
+        with tqdm(total=len(jobs), unit="run", disable=not sys.stderr.isatty()) as bar:
+            for row in source:
+                rows.append(row)
+                bar.update(1)
+    except KeyboardInterrupt:
+        interrupted = True
+    keys = [a.key for a in plan.axes]
+    write_results(rows, keys, out / "results.csv")
+    plot_summary(
+        rows,
+        keys,
+        plan.metric,
+        out / "summary.png",
+        f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})",
+    )
+    failed = [r for r in rows if r["error"]]
+    print(f"{len(rows)} of {len(jobs)} runs done ({len(failed)} failed); results in {out}")
+    for r in failed[:5]:
+        print(f"run {r['run']}: {r['error']}", file=sys.stderr)
+    if interrupted:
+        raise Interrupted(f"sweep interrupted; {len(rows)} finished rows kept in {out}")
+    return 0
+
+
+def write_results(rows: list[dict[str, Any]], axes: list[str], path: Path) -> None:
+    """results.csv sorted by run index, so it never depends on completion order."""
+    rows = sorted(rows, key=lambda r: r["run"])
+    fields = ["run", *axes, "seed_index", "seed", "error"]
+    for r in rows:
+        for k in r:
+            if k not in fields:
+                fields.append(k)
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=fields, lineterminator="\n")
+    writer.writeheader()
+    for r in rows:
+        writer.writerow({k: ("" if r.get(k) is None else r.get(k)) for k in fields})
+    write_atomic(path, buf.getvalue())

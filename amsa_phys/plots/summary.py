@@ -1,0 +1,87 @@
+"""A sweep's summary: a metric against one grid axis (lines, one per other value, with the
+seed spread as error bars) or against two numeric axes (heatmap of the seed mean)."""
+
+from __future__ import annotations
+
+import io
+from collections import defaultdict
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from ..engine.recorder import write_atomic
+
+
+def _numeric(values: list[Any]) -> bool:
+    return all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
+
+
+def plot_summary(
+    rows: list[dict[str, Any]], axes: list[str], metric: str, out: Path, title: str
+) -> Path:
+    """Draw ``metric`` of ``rows`` against the grid ``axes`` into ``out``."""
+    ok = [r for r in rows if r.get(metric) is not None and not r.get("error")]
+    fig, ax = plt.subplots(figsize=(8, 5), dpi=100)
+    numeric_axes = [a for a in axes if _numeric([r[a] for r in ok])]
+    if not ok or not axes:
+        ax.text(0.5, 0.5, "no completed runs to plot", ha="center", transform=ax.transAxes)
+    elif len(axes) == 2 and len(numeric_axes) == 2:
+        xs = sorted({r[axes[0]] for r in ok})
+        ys = sorted({r[axes[1]] for r in ok})
+        grid = np.full((len(ys), len(xs)), np.nan)
+        cells: dict[tuple[Any, Any], list[float]] = defaultdict(list)
+        for r in ok:
+            cells[(r[axes[0]], r[axes[1]])].append(float(r[metric]))
+        for (x, y), vals in cells.items():
+            grid[ys.index(y), xs.index(x)] = float(np.mean(vals))
+        im = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis")
+        ax.set_xticks(range(len(xs)), [f"{x:g}" for x in xs])
+        ax.set_yticks(range(len(ys)), [f"{y:g}" for y in ys])
+        ax.set_xlabel(axes[0])
+        ax.set_ylabel(axes[1])
+        fig.colorbar(im, ax=ax, label=metric)
+    else:
+        x_axis = numeric_axes[0] if numeric_axes else axes[0]
+        others = [a for a in axes if a != x_axis]
+        groups: dict[tuple[Any, ...], dict[Any, list[float]]] = defaultdict(
+            lambda: defaultdict(list)
+        )
+        for r in ok:
+            groups[tuple(r[a] for a in others)][r[x_axis]].append(float(r[metric]))
+        for key, by_x in groups.items():
+            xs = sorted(by_x, key=lambda v: (str(type(v)), v))
+            mean = [float(np.mean(by_x[x])) for x in xs]
+            lo = [m - min(by_x[x]) for m, x in zip(mean, xs, strict=True)]
+            hi = [max(by_x[x]) - m for m, x in zip(mean, xs, strict=True)]
+            label = ", ".join(f"{a}={v}" for a, v in zip(others, key, strict=True)) or metric
+            positions = xs if _numeric(xs) else list(range(len(xs)))
+            ax.errorbar(positions, mean, yerr=[lo, hi], marker="o", capsize=3, label=label)
+            best = int(np.argmin(mean))
+            ax.plot(
+                [positions[best]],
+                [mean[best]],
+                marker="*",
+                ms=14,
+                color="gold",
+                markeredgecolor="k",
+                zorder=5,
+            )
+        if not _numeric([r[x_axis] for r in ok]):
+            labels = sorted({r[x_axis] for r in ok}, key=str)
+            ax.set_xticks(range(len(labels)), [str(v) for v in labels])
+        ax.set_xlabel(x_axis)
+        ax.set_ylabel(metric + " (seed min–max as bars, ★ best)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    ax.set_title(title)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png")
+    plt.close(fig)
+    write_atomic(out, buf.getvalue())
+    return out

@@ -1,0 +1,241 @@
+"""Exhaustive exploration: the Cartesian product of parameter grids × seeds, in parallel.
+
+Each run is a pure function of (scenario file, grid point, seed index), so a result never
+depends on ``-j``, the completion order or the executor. Seed index ``i`` runs with the seed
+derived from (scenario seed, i) — the same for every grid point (common random numbers), so
+two grid points differ by their parameters, not by their noise. Workers load each scenario
+file once per process and copy it per run (no re-parsing per run).
+"""
+
+from __future__ import annotations
+
+import copy
+import functools
+import itertools
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from ..engine.runner import Simulation
+from ..errors import AmsaError, ConfigError
+from ..model.scenario import Scenario, load_scenario, resolve_change
+from .single import compute_metrics
+
+#: Metric columns written for the overall block and each phase.
+METRIC_KEYS = (
+    "max_distance",
+    "min_distance",
+    "mean_error",
+    "rms_error",
+    "settling_time",
+    "final_distance",
+    "collisions",
+)
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One dimension of the grid: a parameter (or ``context``) and its values."""
+
+    key: str
+    values: tuple[Any, ...]
+
+
+@dataclass(frozen=True)
+class Job:
+    """One run of a sweep (picklable: it travels to worker processes and Dask workers)."""
+
+    index: int
+    scenario: str
+    point: tuple[tuple[str, Any], ...]
+    seed_index: int
+    seed: int
+    contexts: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...] = ()
+    duration: float | None = None
+
+
+@dataclass
+class SweepPlan:
+    """Axes, seeds and the jobs they expand to."""
+
+    scenario: Path
+    axes: list[Axis]
+    seeds: int
+    base_seed: int
+    contexts: dict[str, dict[str, Any]] = field(default_factory=dict)
+    metric: str = "rms_error"
+    duration: float | None = None
+
+    def jobs(self) -> list[Job]:
+        """The Cartesian product of the axes, then seeds, in a fixed order."""
+        ctx = tuple((name, tuple(sets.items())) for name, sets in self.contexts.items())
+        out = []
+        values = [a.values for a in self.axes]
+        for n, (combo, s) in enumerate(
+            itertools.product(itertools.product(*values), range(self.seeds))
+        ):
+            point = tuple((a.key, v) for a, v in zip(self.axes, combo, strict=True))
+            out.append(
+                Job(
+                    n,
+                    str(self.scenario),
+                    point,
+                    s,
+                    derive_seed(self.base_seed, s),
+                    ctx,
+                    self.duration,
+                )
+            )
+        return out
+
+
+def derive_seed(base: int, index: int) -> int:
+    """The seed of seed index ``index`` under scenario seed ``base``."""
+    if index == 0:
+        return base
+    state = np.random.SeedSequence(entropy=base, spawn_key=(index,)).generate_state(1)
+    return int(state[0])
+
+
+def parse_values(text: str) -> tuple[Any, ...]:
+    """``0.05,0.1,true,circle`` -> values read as YAML scalars."""
+    out = []
+    for raw in text.split(","):
+        raw = raw.strip()
+        if not raw:
+            raise ValueError("empty value")
+        out.append(yaml.safe_load(raw))
+    return tuple(out)
+
+
+def parse_grid(text: str) -> Axis:
+    """``Comp.param=v1,v2,...``."""
+    key, sep, values = text.partition("=")
+    if not sep or not key.strip():
+        raise ConfigError(f"expected Comp.param=v1,v2,..., got {text!r}", key="--grid")
+    try:
+        return Axis(key.strip(), parse_values(values))
+    except (ValueError, yaml.YAMLError) as exc:
+        raise ConfigError(f"{exc} in {text!r}", key="--grid") from None
+
+
+def parse_range(text: str) -> Axis:
+    """``Comp.param=start:stop:n`` -> n evenly spaced values, both ends included."""
+    key, sep, spec = text.partition("=")
+    parts = spec.split(":")
+    try:
+        if not sep or len(parts) != 3:
+            raise ValueError
+        start, stop, n = float(parts[0]), float(parts[1]), int(parts[2])
+        if n < 1 or not (math.isfinite(start) and math.isfinite(stop)):
+            raise ValueError
+    except ValueError:
+        raise ConfigError(
+            f"expected Comp.param=start:stop:n, got {text!r}", key="--range"
+        ) from None
+    values = np.linspace(start, stop, n) if n > 1 else np.array([start])
+    return Axis(key.strip(), tuple(float(round(v, 12)) for v in values))
+
+
+def check_axes(axes: list[Axis], scenario: Scenario) -> None:
+    """Judge every grid value up front, so a typo fails before any run starts."""
+    seen = set()
+    for axis in axes:
+        if axis.key in seen:
+            raise ConfigError(f"{axis.key} appears twice", key="--grid")
+        seen.add(axis.key)
+        for value in axis.values:
+            try:
+                resolve_change(axis.key, value, scenario.world)
+            except ValueError as exc:
+                raise ConfigError(str(exc), key=f"--grid {axis.key}") from None
+
+
+@functools.lru_cache(maxsize=8)
+def _cached(path: str) -> Scenario:
+    return load_scenario(path)
+
+
+def run_job(job: Job) -> dict[str, Any]:
+    """Run one job and return its result row (errors are reported in the row)."""
+    row: dict[str, Any] = {"run": job.index}
+    for key, value in job.point:
+        row[key] = value
+    row["seed_index"] = job.seed_index
+    row["seed"] = job.seed
+    row["error"] = ""
+    try:
+        scenario = copy.deepcopy(_cached(job.scenario))
+        if job.duration is not None:
+            scenario.duration = type(scenario.duration)(str(job.duration))
+            scenario.phases = [p for p in scenario.phases if p.at < scenario.duration]
+        scenario.seed = job.seed
+        contexts = dict(job.contexts)
+        for key, value in job.point:
+            if key == "context":
+                for k, v in contexts[value]:
+                    scenario.phases[0].changes.append(resolve_change(k, v, scenario.world))
+            else:
+                scenario.phases[0].changes.append(resolve_change(key, value, scenario.world))
+        sim = Simulation.from_scenario(scenario)
+        try:
+            sim.run()
+            status = "completed"
+        except AmsaError as exc:
+            status = f"fault: {exc}"
+            row["error"] = str(exc)
+        metrics = compute_metrics(scenario, sim, sim.result(), 1.0, status)
+    except (AmsaError, ValueError) as exc:
+        row["error"] = str(exc)
+        return row
+    for k in METRIC_KEYS:
+        row[k] = metrics["overall"].get(k)
+    for i, phase in enumerate(metrics["phases"]):
+        for k in METRIC_KEYS:
+            row[f"phase{i}.{k}"] = phase.get(k)
+    return row
+
+
+def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
+    """Rows as they complete, from local worker processes (or in-process for 1 worker)."""
+    if workers <= 1:
+        for job in jobs:
+            yield run_job(job)
+        return
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        futures = [pool.submit(run_job, job) for job in jobs]
+        try:
+            for fut in as_completed(futures):
+                yield fut.result()
+        except BaseException:
+            for fut in futures:
+                fut.cancel()
+            raise
+
+
+def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:
+    """Rows as they complete, from an existing Dask distributed cluster."""
+    try:
+        from distributed import Client, as_completed
+    except ImportError:
+        raise ConfigError(
+            "the Dask executor needs the cluster extra: pip install 'amsa-phys[cluster]'",
+            key="--executor",
+        ) from None
+    try:
+        client = Client(scheduler, timeout="10s")
+    except (OSError, TimeoutError) as exc:
+        raise ConfigError(f"cannot reach the Dask scheduler: {exc}", key="--scheduler") from None
+    try:
+        futures = client.map(run_job, jobs, pure=False)
+        for fut in as_completed(futures):
+            yield fut.result()
+    finally:
+        client.close()

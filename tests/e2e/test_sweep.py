@@ -1,0 +1,109 @@
+"""Sweeps: results independent of -j and of the executor; bad grids refused up front."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+
+from amsa_phys.cli.main import main
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+SCEN = ROOT / "tests" / "fixtures" / "mde_short.yaml"
+GRID = [
+    "--grid",
+    "MyFollowerController.Kv=0.05,0.35",
+    "--grid",
+    "LeaderGPS.noise=0,0.5",
+    "--seeds",
+    "2",
+    "--duration",
+    "20",
+]
+
+
+def rows(out: Path) -> list[dict[str, str]]:
+    with open(out / "results.csv", newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_j1_and_j2_give_identical_results(tmp_path: Path) -> None:
+    assert main(["sweep", str(SCEN), *GRID, "-j", "1", "--out", str(tmp_path / "a")]) == 0
+    assert main(["sweep", str(SCEN), *GRID, "-j", "2", "--out", str(tmp_path / "b")]) == 0
+    a = (tmp_path / "a" / "results.csv").read_bytes()
+    assert a == (tmp_path / "b" / "results.csv").read_bytes()
+    table = rows(tmp_path / "a")
+    assert len(table) == 2 * 2 * 2
+    assert {r["MyFollowerController.Kv"] for r in table} == {"0.05", "0.35"}
+    assert all(r["error"] == "" for r in table)
+    # common random numbers: seed index 1 has the same seed at every grid point
+    assert len({r["seed"] for r in table if r["seed_index"] == "1"}) == 1
+    # noise matters only where there is noise: seed indexes agree when noise is 0
+    quiet = [r for r in table if r["LeaderGPS.noise"] == "0"]
+    assert quiet[0]["rms_error"] == quiet[1]["rms_error"]
+    assert (tmp_path / "a" / "summary.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_dask_local_cluster_gives_the_same_rows(tmp_path: Path) -> None:
+    distributed = pytest.importorskip("distributed")
+    assert main(["sweep", str(SCEN), *GRID, "-j", "1", "--out", str(tmp_path / "local")]) == 0
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        code = main(
+            [
+                "sweep",
+                str(SCEN),
+                *GRID,
+                "--executor",
+                "dask",
+                "--scheduler",
+                cluster.scheduler_address,
+                "--out",
+                str(tmp_path / "dask"),
+            ]
+        )
+    assert code == 0
+    assert rows(tmp_path / "dask") == rows(tmp_path / "local")
+
+
+def test_a_bad_grid_value_is_refused_before_any_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = main(
+        [
+            "sweep",
+            str(SCEN),
+            "--grid",
+            "MyFollowerController.Kv=0.1,99",
+            "--out",
+            str(tmp_path / "x"),
+        ]
+    )
+    assert code == 2
+    assert capsys.readouterr().err == (
+        "error: --grid MyFollowerController.Kv: 99 is above the maximum 10 (range [0, 10])\n"
+    )
+    assert not (tmp_path / "x").exists()
+
+
+def test_range_axis(tmp_path: Path) -> None:
+    assert (
+        main(
+            [
+                "sweep",
+                str(SCEN),
+                "--range",
+                "MyFollowerController.Kv=0.1:0.3:3",
+                "--duration",
+                "5",
+                "-j",
+                "1",
+                "--out",
+                str(tmp_path / "r"),
+            ]
+        )
+        == 0
+    )
+    assert [r["MyFollowerController.Kv"] for r in rows(tmp_path / "r")] == ["0.1", "0.2", "0.3"]
