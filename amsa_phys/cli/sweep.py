@@ -62,6 +62,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=float, metavar="S", help="override the duration")
     p.add_argument("--out", metavar="DIR", help="output (default runs/<scenario>-sweep-...)")
     p.add_argument("--force", action="store_true", help="replace an existing --out directory")
+    p.add_argument(
+        "--keep-runs", action="store_true", help="also write each run's directory under DIR/runs/"
+    )
 
 
 def build_plan(args: argparse.Namespace) -> SweepPlan:
@@ -125,6 +128,8 @@ def run(args: argparse.Namespace) -> int:
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-sweep")
     prepare_run_dir(out, args.force)
+    if args.keep_runs:
+        plan.keep_dir = str((out / "runs").resolve())
     jobs = plan.jobs()
     rows: list[dict[str, Any]] = []
     source = (

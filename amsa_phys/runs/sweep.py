@@ -12,7 +12,9 @@ from __future__ import annotations
 import copy
 import functools
 import itertools
+import json
 import math
+import signal
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,7 +26,8 @@ import yaml
 from ..engine.runner import Simulation
 from ..errors import AmsaError, ConfigError
 from ..model.scenario import Scenario, load_scenario, resolve_change
-from .single import compute_metrics
+from .rundir import prepare_run_dir
+from .single import compute_metrics, run_scenario
 
 #: Metric columns written for the overall block and each phase.
 METRIC_KEYS = (
@@ -57,6 +60,7 @@ class Job:
     seed: int
     contexts: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...] = ()
     duration: float | None = None
+    keep_dir: str | None = None
 
 
 @dataclass
@@ -70,6 +74,7 @@ class SweepPlan:
     contexts: dict[str, dict[str, Any]] = field(default_factory=dict)
     metric: str = "rms_error"
     duration: float | None = None
+    keep_dir: str | None = None
 
     def jobs(self) -> list[Job]:
         """The Cartesian product of the axes, then seeds, in a fixed order."""
@@ -89,6 +94,7 @@ class SweepPlan:
                     derive_seed(self.base_seed, s),
                     ctx,
                     self.duration,
+                    self.keep_dir,
                 )
             )
         return out
@@ -182,14 +188,22 @@ def run_job(job: Job) -> dict[str, Any]:
                     scenario.phases[0].changes.append(resolve_change(k, v, scenario.world))
             else:
                 scenario.phases[0].changes.append(resolve_change(key, value, scenario.world))
-        sim = Simulation.from_scenario(scenario)
-        try:
-            sim.run()
-            status = "completed"
-        except AmsaError as exc:
-            status = f"fault: {exc}"
-            row["error"] = str(exc)
-        metrics = compute_metrics(scenario, sim, sim.result(), 1.0, status)
+        if job.keep_dir is not None:
+            out = prepare_run_dir(Path(job.keep_dir) / f"run-{job.index:05d}", force=True)
+            try:
+                metrics = run_scenario(scenario, out, progress=False).metrics
+            except AmsaError as exc:
+                row["error"] = str(exc)
+                metrics = json.loads((out / "metrics.json").read_text())
+        else:
+            sim = Simulation.from_scenario(scenario)
+            try:
+                sim.run()
+                status = "completed"
+            except AmsaError as exc:
+                status = f"fault: {exc}"
+                row["error"] = str(exc)
+            metrics = compute_metrics(scenario, sim, sim.result(), 1.0, status)
     except (AmsaError, ValueError) as exc:
         row["error"] = str(exc)
         return row
@@ -209,7 +223,9 @@ def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    # workers ignore Ctrl-C: the main process handles it, cancels what has not started and
+    # lets running jobs finish, so every finished row is kept
+    with ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint) as pool:
         futures = [pool.submit(run_job, job) for job in jobs]
         try:
             for fut in as_completed(futures):
@@ -218,6 +234,10 @@ def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
             for fut in futures:
                 fut.cancel()
             raise
+
+
+def _ignore_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:

@@ -107,3 +107,68 @@ def test_range_axis(tmp_path: Path) -> None:
         == 0
     )
     assert [r["MyFollowerController.Kv"] for r in rows(tmp_path / "r")] == ["0.1", "0.2", "0.3"]
+
+
+def test_keep_runs_writes_each_run_directory(tmp_path: Path) -> None:
+    assert (
+        main(
+            [
+                "sweep",
+                str(SCEN),
+                "--grid",
+                "MyFollowerController.Kv=0.1,0.2",
+                "--duration",
+                "5",
+                "-j",
+                "1",
+                "--keep-runs",
+                "--out",
+                str(tmp_path / "k"),
+            ]
+        )
+        == 0
+    )
+    runs = sorted((tmp_path / "k" / "runs").iterdir())
+    assert [r.name for r in runs] == ["run-00000", "run-00001"]
+    assert (runs[1] / "trace.csv").exists()
+    assert "MyFollowerController.Kv: 0.2" in (runs[1] / "scenario.yaml").read_text()
+
+
+def test_ctrl_c_keeps_every_finished_row(tmp_path: Path) -> None:
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "int"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "amsa_phys",
+            "sweep",
+            str(SCEN),
+            "--range",
+            "MyFollowerController.Kv=0.01:0.4:400",
+            "--duration",
+            "30",
+            "-j",
+            "2",
+            "--out",
+            str(out),
+        ],
+        stderr=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    time.sleep(4)
+    import os
+
+    os.killpg(proc.pid, signal.SIGINT)  # like a terminal's Ctrl-C: the whole group
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "sweep interrupted" in err
+    table = rows(out)
+    assert 0 < len(table) < 400
+    assert all(r["error"] == "" for r in table)
