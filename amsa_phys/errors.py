@@ -41,7 +41,16 @@ class ConfigError(AmsaError):
         if self.file is not None:
             where = self.file + (f":{self.line}" if self.line is not None else "") + ": "
         key = f"{self.key}: " if self.key else ""
-        return f"{where}{key}{self.message}"
+        return one_line(f"{where}{key}{self.message}")
+
+
+def one_line(text: str) -> str:
+    """Escape control characters (a key may hold a newline) so a message stays one line."""
+    if text.isprintable():
+        return text
+    return "".join(
+        c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text
+    )
 
 
 class RunFault(AmsaError):

@@ -85,6 +85,7 @@ PHYSICS = {
         },
         "obstacles": {"type": "array", "items": OBSTACLE},
         "max_speed": _pos,
+        "extent": _pos,
     },
 }
 

@@ -30,6 +30,7 @@ PHYSICS_DEFAULTS: dict[str, Any] = {
     "obstacles": [],
     "walls": None,
     "max_speed": 100.0,
+    "extent": 100000.0,
 }
 
 

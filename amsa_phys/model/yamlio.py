@@ -161,8 +161,17 @@ def parse_yaml(raw: bytes | str, path: str | Path) -> YamlDoc:
         line = mark.line + 1 if mark is not None else None
         problem = exc.problem or exc.context or "syntax error"
         raise ConfigError(f"YAML syntax error: {problem}", file=path, line=line) from None
+    except yaml.reader.ReaderError as exc:
+        line = text.count("\n", 0, exc.position) + 1
+        char = exc.character if isinstance(exc.character, str) else chr(exc.character)
+        raise ConfigError(
+            f"not YAML text: control character {ord(char):#06x} is not allowed",
+            file=path,
+            line=line,
+        ) from None
     except yaml.YAMLError as exc:
-        raise ConfigError(f"YAML error: {exc}", file=path) from None
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ConfigError(f"YAML error: {first}", file=path) from None
     except RecursionError:
         raise ConfigError("YAML nesting too deep", file=path) from None
     if node is None:

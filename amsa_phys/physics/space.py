@@ -36,6 +36,7 @@ class PhysicsWorld:
         self.ground_friction = float(settings["ground"]["friction"])
         self.rolling_resistance = float(settings["ground"]["rolling_resistance"])
         self.max_speed = float(settings["max_speed"])
+        self.extent = float(settings["extent"])
         self.space = pymunk.Space(threaded=False)
         self.space.gravity = (0.0, 0.0)
         self.space.iterations = 10
@@ -133,6 +134,7 @@ class PhysicsWorld:
             rover.apply_forces(dt)
         self.space.step(dt)
         limit = self.max_speed
+        extent = self.extent
         for rover in self.rovers:
             vx, vy = rover.body.velocity
             speed = math.hypot(vx, vy)
@@ -142,6 +144,13 @@ class PhysicsWorld:
                     self.sim.now + Fraction(1) / self.rate,
                     f"body speed {speed:.3g} m/s exceeds physics.max_speed "
                     f"{limit:g} m/s (physics blow-up?)",
+                )
+            x, y = rover.body.position
+            if not (abs(x) <= extent and abs(y) <= extent):
+                raise RunFault(
+                    rover.name,
+                    self.sim.now + Fraction(1) / self.rate,
+                    f"body left the world at ({x:.4g}, {y:.4g}) m (physics.extent is {extent:g} m)",
                 )
 
     def _on_collision(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:

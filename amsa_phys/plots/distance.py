@@ -66,7 +66,8 @@ def plot_distance(trace: Path, metrics: dict[str, Any], out: Path) -> Path:
     ax.set_ylabel("distance (m)")
     ax.set_title(f"{metrics.get('scenario', '')} (seed {metrics.get('seed', '')})")
     ax.grid(alpha=0.3)
-    ax.legend(loc="lower right", fontsize=8)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="lower right", fontsize=8)
     fig.tight_layout()
     buf = io.BytesIO()
     fig.savefig(buf, format="png")

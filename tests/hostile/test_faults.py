@@ -1,0 +1,179 @@
+"""Runtime faults and kills: exit 3 naming component and time, outputs kept, no torn files."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from amsa_phys.cli.main import main
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+TESTS = ROOT / "tests"
+ENV = {**os.environ, "PYTHONPATH": str(TESTS)}
+
+
+def scenario(tmp_path: Path, components: str, extra: str = "", duration: float = 5) -> Path:
+    path = tmp_path / "s.yaml"
+    path.write_text(f"world:\n  components:\n{components}\nduration: {duration}\n{extra}")
+    return path
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "amsa_phys", *args],
+        capture_output=True,
+        text=True,
+        env=ENV,
+        check=False,
+    )
+
+
+@pytest.mark.parametrize(
+    ("boom", "cause"),
+    [
+        ("false", "output u is nan"),
+        ("true", "do_step raised ZeroDivisionError('division by zero')"),
+    ],
+)
+def test_controller_nan_or_exception_is_exit_3_with_trace_kept(
+    tmp_path: Path, boom: str, cause: str
+) -> None:
+    scen = scenario(tmp_path, f"    B: {{template: 'toys:Bad', freq: 4, params: {{boom: {boom}}}}}")
+    proc = run_cli("run", str(scen), "--headless", "--out", str(tmp_path / "o"), "-q")
+    assert proc.returncode == 3
+    assert proc.stderr == f"error: run fault at t=1.000 s in B (Bad): {cause}\n"
+    trace = (tmp_path / "o" / "trace.csv").read_text().splitlines()
+    assert trace[-1].startswith("0.95,")  # every row before the fault, nothing after
+    metrics = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert metrics["status"].startswith("fault: run fault at t=1.000 s in B")
+
+
+def test_absurd_speed_is_a_physics_blow_up_fault(tmp_path: Path) -> None:
+    rover = """    Ctl: {template: ConstantPower, freq: 10, params: {left: 100, right: 100}}
+    N: {template: NormalizePower, freq: 10,
+        inputs: {powerL: Ctl.LeftPower, powerR: Ctl.RightPower}}
+    R: {template: controlledRobot, freq: 10,
+        params: {stallForce: 90000, freeSpeed: 100, tractionCoef: 5},
+        inputs: {powerL: N.normalizedPowerL, powerR: N.normalizedPowerR}}"""
+    scen = scenario(tmp_path, rover, "", 20)
+    (tmp_path / "s.yaml").write_text(
+        (tmp_path / "s.yaml")
+        .read_text()
+        .replace("world:\n", "world:\n  physics: {max_speed: 30}\n")
+    )
+    assert main(["run", str(scen), "--headless", "--out", str(tmp_path / "o"), "-q"]) == 3
+    metrics = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert "in R: body speed" in metrics["status"]
+    assert "exceeds physics.max_speed 30 m/s" in metrics["status"]
+
+
+def test_leaving_the_world_is_a_fault(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    leader = "    L: {template: freeRobot, freq: 10, params: {cruisePower: 100}}"
+    scen = scenario(tmp_path, leader, "", 60)
+    (tmp_path / "s.yaml").write_text(
+        (tmp_path / "s.yaml").read_text().replace("world:\n", "world:\n  physics: {extent: 50}\n")
+    )
+    assert main(["run", str(scen), "--headless", "--out", str(tmp_path / "o"), "-q"]) == 3
+    err = capsys.readouterr().err
+    assert "in L: body left the world at (50" in err
+    assert "(physics.extent is 50 m)" in err
+
+
+def test_invalid_value_reached_mid_run_is_exit_3(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    comps = """    Ctl: {template: ConstantPower, freq: 4}
+    N: {template: NormalizePower, freq: 4, inputs: {powerL: Ctl.LeftPower, powerR: Ctl.RightPower}}"""
+    scen = scenario(
+        tmp_path, comps, "timeline:\n  - {at: 2, set: {N.powerMin: 50, N.powerMax: 10}}\n"
+    )
+    assert main(["run", str(scen), "--headless", "--out", str(tmp_path / "o"), "-q"]) == 3
+    assert capsys.readouterr().err == (
+        "error: run fault at t=2.000 s in N (NormalizePower): rejected powerMax=10.0: "
+        "powerMin 50 is above powerMax 10\n"
+    )
+
+
+def test_sigterm_finalises_like_ctrl_c(tmp_path: Path) -> None:
+    out = tmp_path / "t"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "amsa_phys",
+            "run",
+            str(TESTS / "fixtures" / "mde_short.yaml"),
+            "--headless",
+            "--out",
+            str(out),
+            "--duration",
+            "100000",
+            "--no-plot",
+            "-q",
+        ],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 30
+    while not (out / "trace.csv.tmp").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.3)
+    proc.terminate()
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130
+    assert "interrupted at t=" in err
+    assert json.loads((out / "metrics.json").read_text())["status"] == "interrupted"
+
+
+def test_sigkill_never_leaves_a_partial_file_under_a_final_name(tmp_path: Path) -> None:
+    out = tmp_path / "k"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "amsa_phys",
+            "run",
+            str(TESTS / "fixtures" / "mde_short.yaml"),
+            "--headless",
+            "--out",
+            str(out),
+            "--duration",
+            "100000",
+            "--no-plot",
+            "-q",
+        ]
+    )
+    deadline = time.monotonic() + 30
+    while not (out / "trace.csv.tmp").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.3)
+    proc.kill()
+    proc.wait(timeout=30)
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["trace.csv.tmp"]  # the only file is the temporary one
+
+
+def test_unwritable_output_directory_is_refused_before_the_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    code = main(
+        [
+            "run",
+            str(TESTS / "fixtures" / "mde_short.yaml"),
+            "--headless",
+            "--out",
+            str(blocker / "sub"),
+            "-q",
+        ]
+    )
+    assert code == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {blocker / 'sub'}: --out: cannot create directory")
