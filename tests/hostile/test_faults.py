@@ -89,7 +89,8 @@ def test_invalid_value_reached_mid_run_is_exit_3(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     comps = """    Ctl: {template: ConstantPower, freq: 4}
-    N: {template: NormalizePower, freq: 4, inputs: {powerL: Ctl.LeftPower, powerR: Ctl.RightPower}}"""
+    N: {template: NormalizePower, freq: 4,
+        inputs: {powerL: Ctl.LeftPower, powerR: Ctl.RightPower}}"""
     scen = scenario(
         tmp_path, comps, "timeline:\n  - {at: 2, set: {N.powerMin: 50, N.powerMax: 10}}\n"
     )
