@@ -6,6 +6,7 @@ import argparse
 import csv
 import io
 import os
+import signal
 import sys
 from pathlib import Path
 from typing import Any
@@ -138,6 +139,7 @@ def run(args: argparse.Namespace) -> int:
         else iter_local(jobs, min(args.jobs, len(jobs)))
     )
     interrupted = False
+    previous = signal.signal(signal.SIGTERM, _sigterm)
     try:
         with tqdm(total=len(jobs), unit="run", disable=not sys.stderr.isatty()) as bar:
             for row in source:
@@ -145,6 +147,8 @@ def run(args: argparse.Namespace) -> int:
                 bar.update(1)
     except KeyboardInterrupt:
         interrupted = True
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     keys = [a.key for a in plan.axes]
     write_results(rows, keys, out / "results.csv")
     plot_summary(
@@ -161,6 +165,10 @@ def run(args: argparse.Namespace) -> int:
     if interrupted:
         raise Interrupted(f"sweep interrupted; {len(rows)} finished rows kept in {out}")
     return 0
+
+
+def _sigterm(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
 
 
 def write_results(rows: list[dict[str, Any]], axes: list[str], path: Path) -> None:

@@ -134,7 +134,8 @@ def test_keep_runs_writes_each_run_directory(tmp_path: Path) -> None:
     assert "MyFollowerController.Kv: 0.2" in (runs[1] / "scenario.yaml").read_text()
 
 
-def test_ctrl_c_keeps_every_finished_row(tmp_path: Path) -> None:
+@pytest.mark.parametrize("how", ["sigint-group", "sigterm"])
+def test_ctrl_c_keeps_every_finished_row(tmp_path: Path, how: str) -> None:
     import signal
     import subprocess
     import sys
@@ -165,7 +166,10 @@ def test_ctrl_c_keeps_every_finished_row(tmp_path: Path) -> None:
     time.sleep(4)
     import os
 
-    os.killpg(proc.pid, signal.SIGINT)  # like a terminal's Ctrl-C: the whole group
+    if how == "sigterm":
+        proc.terminate()
+    else:
+        os.killpg(proc.pid, signal.SIGINT)  # like a terminal's Ctrl-C: the whole group
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
     assert "sweep interrupted" in err
