@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 from typing import Any
 
@@ -12,7 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..engine.recorder import write_atomic
+from .save import save_png
 
 
 def read_trace(path: Path) -> tuple[list[str], np.ndarray]:
@@ -68,9 +67,4 @@ def plot_distance(trace: Path, metrics: dict[str, Any], out: Path) -> Path:
     ax.grid(alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="lower right", fontsize=8)
-    fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png")
-    plt.close(fig)
-    write_atomic(out, buf.getvalue())
-    return out
+    return save_png(fig, out)

@@ -3,7 +3,6 @@ seed spread as error bars) or against two numeric axes (heatmap of the seed mean
 
 from __future__ import annotations
 
-import io
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
@@ -14,7 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..engine.recorder import write_atomic
+from .save import save_png
 
 
 def _numeric(values: list[Any]) -> bool:
@@ -79,9 +78,4 @@ def plot_summary(
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     ax.set_title(title)
-    fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png")
-    plt.close(fig)
-    write_atomic(out, buf.getvalue())
-    return out
+    return save_png(fig, out)

@@ -192,31 +192,11 @@ def test_expectations_are_checked_and_reported(
 
 def test_sigint_finalises_outputs_and_exits_130(tmp_path: Path) -> None:
     import signal
-    import time
+
+    from longrun import start_long_run
 
     out = tmp_path / "int"
-    proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "amsa_phys",
-            "run",
-            str(SCENARIO1),
-            "--headless",
-            "--out",
-            str(out),
-            "--duration",
-            "100000",
-            "--no-plot",
-            "-q",
-        ],
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    deadline = time.monotonic() + 30
-    while not (out / "trace.csv.tmp").exists() and time.monotonic() < deadline:
-        time.sleep(0.05)
-    time.sleep(0.5)
+    proc = start_long_run(out, stderr=subprocess.PIPE)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == 130

@@ -6,10 +6,10 @@ import json
 import os
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
+from longrun import start_long_run
 
 from amsa_phys.cli.main import main
 
@@ -103,28 +103,7 @@ def test_invalid_value_reached_mid_run_is_exit_3(
 
 def test_sigterm_finalises_like_ctrl_c(tmp_path: Path) -> None:
     out = tmp_path / "t"
-    proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "amsa_phys",
-            "run",
-            str(TESTS / "fixtures" / "mde_short.yaml"),
-            "--headless",
-            "--out",
-            str(out),
-            "--duration",
-            "100000",
-            "--no-plot",
-            "-q",
-        ],
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    deadline = time.monotonic() + 30
-    while not (out / "trace.csv.tmp").exists() and time.monotonic() < deadline:
-        time.sleep(0.05)
-    time.sleep(0.3)
+    proc = start_long_run(out, stderr=subprocess.PIPE)
     proc.terminate()
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == 130
@@ -134,26 +113,7 @@ def test_sigterm_finalises_like_ctrl_c(tmp_path: Path) -> None:
 
 def test_sigkill_never_leaves_a_partial_file_under_a_final_name(tmp_path: Path) -> None:
     out = tmp_path / "k"
-    proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "amsa_phys",
-            "run",
-            str(TESTS / "fixtures" / "mde_short.yaml"),
-            "--headless",
-            "--out",
-            str(out),
-            "--duration",
-            "100000",
-            "--no-plot",
-            "-q",
-        ]
-    )
-    deadline = time.monotonic() + 30
-    while not (out / "trace.csv.tmp").exists() and time.monotonic() < deadline:
-        time.sleep(0.05)
-    time.sleep(0.3)
+    proc = start_long_run(out)
     proc.kill()
     proc.wait(timeout=30)
     names = sorted(p.name for p in out.iterdir())
