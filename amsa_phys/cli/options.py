@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 
 
 def add_scenario_overrides(p: argparse.ArgumentParser) -> None:
@@ -36,3 +37,14 @@ def add_output(p: argparse.ArgumentParser) -> None:
         "--out", metavar="DIR", help="run directory (default runs/<scenario>-<YYYYmmdd-HHMMSS>)"
     )
     p.add_argument("--force", action="store_true", help="replace an existing --out directory")
+
+
+def add_jobs(p: argparse.ArgumentParser) -> None:
+    """-j/--jobs: worker processes, all cores by default."""
+    p.add_argument(
+        "-j",
+        "--jobs",
+        type=int,
+        default=os.cpu_count() or 1,
+        help="parallel worker processes (default: all cores)",
+    )

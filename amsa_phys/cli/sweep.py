@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import csv
 import io
-import os
 import signal
 import sys
 from pathlib import Path
@@ -29,6 +28,7 @@ from ..runs.sweep import (
     parse_grid,
     parse_range,
 )
+from .options import add_jobs
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -50,13 +50,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="n evenly spaced values",
     )
     p.add_argument("--seeds", type=int, help="seeds per grid point (default 1)")
-    p.add_argument(
-        "-j",
-        "--jobs",
-        type=int,
-        default=os.cpu_count() or 1,
-        help="local worker processes (default: all cores)",
-    )
+    add_jobs(p)
     p.add_argument("--executor", choices=("local", "dask"), default="local")
     p.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address (tcp://...)")
     p.add_argument("--metric", help="metric for summary.png (default rms_error)")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -11,6 +10,7 @@ from pathlib import Path
 from ..errors import ConfigError
 from ..runs.junit import write_junit
 from ..runs.suite import ScenarioResult, find_scenarios, run_scenario_file
+from .options import add_jobs
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -22,13 +22,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="scenario files or folders (default: scenarios)",
     )
     p.add_argument("--junit", metavar="FILE", help="also write JUnit XML")
-    p.add_argument(
-        "-j",
-        "--jobs",
-        type=int,
-        default=os.cpu_count() or 1,
-        help="parallel processes (default: all cores)",
-    )
+    add_jobs(p)
     p.add_argument("--out", metavar="DIR", help="keep each run's directory under DIR")
 
 
