@@ -10,6 +10,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 from rig import drive
 
 from amsa_phys.physics.wheel import WheelModel
@@ -56,10 +57,26 @@ def test_unequal_powers_settle_on_a_circle_of_constant_radius(tmp_path: Path) ->
     assert abs(kinematic.mean() - radius.mean()) / radius.mean() < 0.01
 
 
-def test_top_speed_matches_the_motor_and_resistance_closed_form(tmp_path: Path) -> None:
-    tr, _ = drive(tmp_path, 100, 100, 30)
+def top_speed_error(tmp_path: Path, robot: dict[str, float] | None = None) -> float:
+    """Relative gap between the simulated top speed and the default rover's closed form."""
+    tr, _ = drive(tmp_path, 100, 100, 30, robot=robot)
     expected = WHEEL.steady_speed(100)  # 5.5 * (1 - 2.943 / 45) = 5.14 m/s
-    assert abs(tr["Rover.speed"][-1] - expected) / expected < 0.005
+    return abs(tr["Rover.speed"][-1] - expected) / expected
+
+
+def test_top_speed_matches_the_motor_and_resistance_closed_form(tmp_path: Path) -> None:
+    assert top_speed_error(tmp_path) < 0.005
+
+
+@pytest.mark.parametrize(
+    "robot",
+    [{"freeSpeed": 5.3}, {"rollingCoef": 1.5}, {"mass": 40.0}],
+    ids=["motor", "rolling", "mass"],
+)
+def test_mutation_top_speed_check_fails_when_a_parameter_is_perturbed(
+    tmp_path: Path, robot: dict[str, float]
+) -> None:
+    assert top_speed_error(tmp_path, robot) > 0.005
 
 
 def test_lower_motor_coef_gives_lower_top_speed(tmp_path: Path) -> None:
