@@ -13,7 +13,7 @@ from collections.abc import Sequence
 
 from .. import __version__
 from ..errors import AmsaError
-from . import describe, plot, run, sweep, templates, validate
+from . import describe, graph, plot, run, sweep, templates, validate
 from . import test as test_cmd
 
 COMMANDS = {
@@ -24,6 +24,7 @@ COMMANDS = {
     "plot": plot,
     "test": test_cmd,
     "sweep": sweep,
+    "graph": graph,
 }
 
 

@@ -1,0 +1,30 @@
+"""Draw the architecture of a world or scenario, components coloured by kind."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..errors import ConfigError
+from ..plots.graph import draw
+from .loading import load_any
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``amsa-phys graph``."""
+    p.add_argument("file", help="world or scenario YAML file")
+    p.add_argument("-o", "--output", required=True, help="OUT.png, OUT.svg or OUT.dot")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Load and draw."""
+    out = Path(args.output)
+    if out.suffix.lower() not in (".png", ".svg", ".dot"):
+        raise ConfigError("expected a .png, .svg or .dot file name", key="--output", file=out)
+    kind, obj = load_any(args.file)
+    world = obj.world if kind == "scenario" else obj
+    if not out.parent.is_dir():
+        raise ConfigError("directory does not exist", key="--output", file=out.parent)
+    draw(world, out)
+    print(f"wrote {out}")
+    return 0

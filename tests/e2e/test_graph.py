@@ -1,0 +1,41 @@
+"""``amsa-phys graph``: DOT lists every component and link; PNG and SVG are real images."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from amsa_phys.cli.main import main
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+WORLD = ROOT / "worlds" / "mde_challenge.yaml"
+
+
+def test_dot_has_every_component_coloured_by_kind_and_every_link(tmp_path: Path) -> None:
+    out = tmp_path / "a.dot"
+    assert main(["graph", str(ROOT / "scenarios" / "scenario1.yaml"), "-o", str(out)]) == 0
+    dot = out.read_text()
+    assert dot.startswith('digraph "mdeChallenge" {')
+    assert (
+        '"Follower" [label="Follower\\ncontrolledRobot (process, 4 Hz)", fillcolor="#fdb462"]'
+        in dot
+    )
+    assert '"LeaderGPS" -> "MyFollowerController" [label="gpsPosX→xLeader"' in dot
+    assert '"MyNormalizePower" -> "Follower" [label="normalizedPowerL→powerL"' in dot
+    assert dot.count(" -> ") == 19  # every input of the eight components
+
+
+@pytest.mark.parametrize(("suffix", "magic"), [(".png", b"\x89PNG"), (".svg", b"<?xml")])
+def test_images(tmp_path: Path, suffix: str, magic: bytes) -> None:
+    out = tmp_path / f"a{suffix}"
+    assert main(["graph", str(WORLD), "-o", str(out)]) == 0
+    data = out.read_bytes()
+    assert data.startswith(magic)
+    if suffix == ".svg":
+        assert b"MyFollowerController" in data
+
+
+def test_bad_output_name(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["graph", str(WORLD), "-o", str(tmp_path / "a.jpg")]) == 2
+    assert "--output: expected a .png, .svg or .dot file name" in capsys.readouterr().err
