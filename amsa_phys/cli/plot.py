@@ -1,4 +1,4 @@
-"""Redraw a run's distance-vs-time plot from its trace.csv and metrics.json."""
+"""Redraw a run's distance-vs-time and trajectory plots from its trace.csv and metrics.json."""
 
 from __future__ import annotations
 
@@ -8,12 +8,18 @@ from pathlib import Path
 
 from ..errors import ConfigError
 from ..plots.distance import plot_distance
+from ..plots.trajectory import plot_trajectory
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
     """Arguments of ``amsa-phys plot``."""
     p.add_argument("rundir", help="a run directory written by `amsa-phys run`")
-    p.add_argument("-o", "--output", help="output PNG (default RUNDIR/distance.png)")
+    p.add_argument(
+        "-o",
+        "--output",
+        help="distance plot PNG (default RUNDIR/distance.png; the trajectory plot "
+        "goes next to it as <name>-trajectory.png, or RUNDIR/trajectory.png)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -29,6 +35,8 @@ def run(args: argparse.Namespace) -> int:
             f"invalid JSON: {exc.msg}", file=rundir / "metrics.json", line=exc.lineno
         ) from None
     out = Path(args.output) if args.output else rundir / "distance.png"
+    traj = out.with_name(out.stem + "-trajectory.png") if args.output else rundir / "trajectory.png"
     plot_distance(rundir / "trace.csv", metrics, out)
-    print(f"wrote {out}")
+    plot_trajectory(rundir / "trace.csv", metrics, traj)
+    print(f"wrote {out} and {traj}")
     return 0

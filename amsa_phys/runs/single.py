@@ -23,6 +23,7 @@ from ..engine.runner import RunResult, Simulation
 from ..errors import Interrupted, RunFault
 from ..model.scenario import Scenario
 from ..plots.distance import plot_distance
+from ..plots.trajectory import plot_trajectory
 from .resolve import resolved_scenario
 
 
@@ -134,6 +135,7 @@ def run_scenario(
     write_atomic(out_dir / "scenario.yaml", yaml.safe_dump(resolved, sort_keys=False))
     if plot:
         plot_distance(out_dir / "trace.csv", metrics, out_dir / "distance.png")
+        plot_trajectory(out_dir / "trace.csv", metrics, out_dir / "trajectory.png")
     if isinstance(error, KeyboardInterrupt):
         raise Interrupted(
             f"interrupted at t={result.t_end:.2f} s; outputs so far are in {out_dir}"

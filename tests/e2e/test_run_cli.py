@@ -45,6 +45,7 @@ def test_run_writes_the_run_directory(tmp_path: Path) -> None:
         "metrics.json",
         "scenario.yaml",
         "trace.csv",
+        "trajectory.png",
     ]
     header = (out / "trace.csv").read_text().splitlines()[0].split(",")
     assert header[0] == "t"
@@ -208,3 +209,14 @@ def test_sigint_finalises_outputs_and_exits_130(tmp_path: Path) -> None:
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["status"] == "interrupted"
     assert 0 < metrics["simulated"] < 100000
+
+
+def test_plot_redraws_both_figures(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = run(tmp_path, "a")
+    (out / "distance.png").unlink()
+    (out / "trajectory.png").unlink()
+    assert main(["plot", str(out)]) == 0
+    assert (out / "distance.png").read_bytes()[:4] == b"\x89PNG"
+    assert (out / "trajectory.png").read_bytes()[:4] == b"\x89PNG"
+    assert main(["plot", str(tmp_path)]) == 2
+    assert "not a run directory: trace.csv is missing" in capsys.readouterr().err
