@@ -17,24 +17,24 @@ ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO1 = ROOT / "tests" / "fixtures" / "mde_short.yaml"  # scenario1 minus expectations
 
 
+def run_argv(out: Path, *extra: str) -> list[str]:
+    """``amsa-phys run`` of the short scenario for 30 s into ``out``."""
+    return [
+        "run",
+        str(SCENARIO1),
+        "--headless",
+        "--out",
+        str(out),
+        "--duration",
+        "30",
+        "-q",
+        *extra,
+    ]
+
+
 def run(tmp_path: Path, name: str, *extra: str) -> Path:
     out = tmp_path / name
-    assert (
-        main(
-            [
-                "run",
-                str(SCENARIO1),
-                "--headless",
-                "--out",
-                str(out),
-                "--duration",
-                "30",
-                "-q",
-                *extra,
-            ]
-        )
-        == 0
-    )
+    assert main(run_argv(out, *extra)) == 0
     return out
 
 
@@ -80,22 +80,7 @@ def test_identical_in_another_process_with_another_hash_seed(tmp_path: Path) -> 
     out = tmp_path / "sub"
     env = {**os.environ, "PYTHONHASHSEED": "12345"}
     subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "amsa_phys",
-            "run",
-            str(SCENARIO1),
-            "--headless",
-            "--out",
-            str(out),
-            "--duration",
-            "30",
-            "-q",
-            "--no-plot",
-        ],
-        check=True,
-        env=env,
+        [sys.executable, "-m", "amsa_phys", *run_argv(out, "--no-plot")], check=True, env=env
     )
     assert (a / "trace.csv").read_bytes() == (out / "trace.csv").read_bytes()
 
