@@ -82,3 +82,20 @@ def test_bad_set_override_names_the_option(
     assert capsys.readouterr().err == (
         "error: --set MyFollowerController.Kv: expected a number, got string 'abc'\n"
     )
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["run"], ["nope"], ["sweep", "x.yaml", "--seeds", "abc"]],
+    ids=["missing-arg", "unknown-command", "bad-int"],
+)
+def test_usage_errors_are_one_line_exit_2(
+    argv: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert err.startswith("error: amsa-phys")
+    assert "--help)" in err
