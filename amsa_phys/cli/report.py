@@ -48,3 +48,10 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
         f"({metrics['real_time_factor']}x real time); outputs in {out_dir}",
         file=stream,
     )
+    video = metrics.get("video")
+    if video:
+        w, h = video["size"]
+        print(
+            f"video {video['path']}: {video['frames']} frames, {w}x{h} at {video['fps']} fps",
+            file=stream,
+        )

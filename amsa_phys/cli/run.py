@@ -14,6 +14,7 @@ from ..runs.expect import check_expectations
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
 from .options import add_output, add_scenario_overrides
+from .recording import add_recording, recording_options, snapshot_options
 from .report import print_summary
 
 
@@ -23,10 +24,11 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--headless",
         action="store_true",
-        help="no window (the interactive window is not built yet: required)",
+        help="no window: run as fast as possible (default: the interactive window)",
     )
     add_scenario_overrides(p)
     add_output(p)
+    add_recording(p)
     p.add_argument("--no-plot", action="store_true", help="skip distance.png")
     p.add_argument("-q", "--quiet", action="store_true", help="no summary table")
 
@@ -37,11 +39,15 @@ def _sigterm(signum: int, frame: FrameType | None) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Load, run, report."""
+    record = recording_options(args)
+    snapshot = snapshot_options(args)
     if not args.headless:
-        raise ConfigError(
-            "the interactive window is not available in this version; run with --headless",
-            key="run",
-        )
+        from ..view.window import open_display
+
+        try:
+            open_display()
+        except RuntimeError as exc:
+            raise ConfigError(f"{exc}; run with --headless", key="run") from None
     scenario = load_scenario(
         args.scenario,
         overrides=args.overrides,
@@ -53,7 +59,14 @@ def run(args: argparse.Namespace) -> int:
     prepare_run_dir(out, args.force)
     previous = signal.signal(signal.SIGTERM, _sigterm)
     try:
-        outcome = run_scenario(scenario, out, plot=not args.no_plot)
+        outcome = run_scenario(
+            scenario,
+            out,
+            plot=not args.no_plot,
+            record=record,
+            snapshot=snapshot,
+            window=not args.headless,
+        )
     finally:
         signal.signal(signal.SIGTERM, previous)
     if not args.quiet:

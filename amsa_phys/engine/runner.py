@@ -125,6 +125,8 @@ class Simulation:
         self._now_override: Fraction | None = None
         self.phase_index = 0
         self.change_log: list[tuple[Fraction, Change]] = []
+        self.live_changes: list[tuple[Fraction, Change]] = []
+        self._pending_live: list[Change] = []
         self._initialized = False
         self._cursor = 0  # next tick to execute
         self._build()
@@ -270,6 +272,8 @@ class Simulation:
                     finally:
                         self._now_override = None
                 self._tick = tick
+                if self._pending_live:
+                    self._apply_live()
                 for what, obj in actions:
                     if what == 0:
                         self._step(obj)
@@ -326,6 +330,33 @@ class Simulation:
             raise RunFault(
                 self._who(change.leaf), self.now, f"rejected {change.param}={change.value!r}: {exc}"
             ) from exc
+
+    def next_instant(self) -> Fraction:
+        """Time of the next instant at which something runs (where a live change lands)."""
+        self.initialize()
+        base = (self._cursor // self._cycle) * self._cycle
+        for off, _ in self._table:
+            if base + off >= self._cursor:
+                return self.grid.time(base + off)
+        return self.grid.time(base + self._cycle + self._table[0][0])
+
+    def apply_live(self, change: Change) -> Fraction:
+        """Queue a change made by hand (the window); it lands at :meth:`next_instant`.
+
+        It is applied after the timeline changes due at that instant and before the
+        components, exactly where a timeline entry at that time would be, so writing it into
+        the resolved scenario's timeline replays the session. Returns the instant.
+        """
+        at = self.next_instant()
+        self._pending_live.append(change)
+        return at
+
+    def _apply_live(self) -> None:
+        pending, self._pending_live = self._pending_live, []
+        for change in pending:
+            self.apply_change(change)
+            self.live_changes.append((self.now, change))
+            self.record_event("live change", f"{change.key}={change.value}")
 
     def record_event(self, kind: str, detail: str) -> None:
         """See :meth:`Context.record_event`."""

@@ -80,6 +80,9 @@ class Template:
     params: ClassVar[tuple[Any, ...]] = ()  # tuple[Param, ...]
     #: Name used in files; defaults to the class name.
     template_name: ClassVar[str] = ""
+    #: Parameters read only by ``initialize`` (a body's mass, an initial pose): changing them
+    #: once the run has started is refused, so the window's parameter panel does not offer it.
+    fixed_once_running: ClassVar[frozenset[str]] = frozenset()
 
     def __init__(self, path: str, params: Mapping[str, Any]) -> None:
         self.path = path

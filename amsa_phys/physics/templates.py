@@ -103,6 +103,7 @@ _POSE_OUTPUTS = (
 
 class _Robot(Template):
     rover: DiffDriveRover
+    fixed_once_running = frozenset(_BODY_PARAMS)
 
     def initialize(self, ctx: Any) -> None:
         self.physics = physics_of(ctx)

@@ -22,11 +22,15 @@ def _plain(value: Any) -> Any:
 
 
 def resolved_scenario(
-    scenario: Scenario, extra: list[tuple[Fraction, Change]] | None = None
+    scenario: Scenario,
+    extra: list[tuple[Fraction, Change]] | None = None,
+    duration: Fraction | None = None,
 ) -> dict[str, Any]:
     """A scenario dict with the world inlined and every Leaf parameter written out.
 
-    ``extra`` adds changes made live (the window), merged into the timeline in time order.
+    ``extra`` adds changes made live (the window), merged into the timeline in time order;
+    a change made before the first instant ran becomes part of ``set``. ``duration`` cuts
+    the scenario where a window session was closed, so replaying it gives the same trace.
     """
     world = copy.deepcopy(scenario.world.data)
 
@@ -50,15 +54,23 @@ def resolved_scenario(
         timeline.setdefault(phase.at, {}).update({c.key: _plain(c.value) for c in phase.changes})
         if phase.label:
             labels[phase.at] = phase.label
+    initial = {c.key: _plain(c.value) for c in scenario.phases[0].changes}
     for at, change in extra or []:
+        if at == 0:
+            initial[change.key] = _plain(change.value)
+            continue
+        if at not in timeline:
+            labels[at] = "live"
         timeline.setdefault(at, {})[change.key] = _plain(change.value)
+    end = scenario.duration if duration is None else Fraction(duration)
+    timeline = {at: sets for at, sets in timeline.items() if at < end}
     out: dict[str, Any] = {
         "name": scenario.name,
         "world": world,
-        "duration": _number(scenario.duration),
+        "duration": _number(end),
         "seed": scenario.seed,
         "log_rate": _number(scenario.log_rate),
-        "set": {c.key: _plain(c.value) for c in scenario.phases[0].changes},
+        "set": initial,
     }
     if scenario.quality:
         q = scenario.quality

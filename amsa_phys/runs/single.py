@@ -10,9 +10,10 @@ from __future__ import annotations
 import json
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import yaml
 from tqdm import tqdm
@@ -24,7 +25,12 @@ from ..errors import Interrupted, RunFault
 from ..model.scenario import Scenario
 from ..plots.distance import plot_distance
 from ..plots.trajectory import plot_trajectory
+from ..view.drive import FrameSink, advance
+from ..view.encoder import EncoderError
 from .resolve import resolved_scenario
+
+if TYPE_CHECKING:  # pygame is imported only by runs that draw
+    from ..view.recorder import Recorder, RecordOptions, Snapshot, SnapshotOptions
 
 
 @dataclass
@@ -110,28 +116,70 @@ def _jsonable(value: Any) -> Any:
 
 
 def run_scenario(
-    scenario: Scenario, out_dir: Path, *, progress: bool | None = None, plot: bool = True
+    scenario: Scenario,
+    out_dir: Path,
+    *,
+    progress: bool | None = None,
+    plot: bool = True,
+    record: RecordOptions | None = None,
+    snapshot: SnapshotOptions | None = None,
+    window: bool | WindowDriver = False,
 ) -> RunOutcome:
-    """Run ``scenario`` and write its run directory (which must exist and be empty)."""
+    """Run ``scenario`` and write its run directory (which must exist and be empty).
+
+    ``record`` also writes a video, ``snapshot`` a PNG of one instant (in a window session:
+    of the moment it was closed, without trails). ``window`` runs the scenario in the
+    interactive window (until the user closes it) instead of as fast as possible; a callable
+    ``window`` replaces the window's own loop (tests drive it with scripted events and an
+    exact clock).
+    """
     out_dir = Path(out_dir)
     trace = TraceWriter(out_dir / "trace.csv", list(scenario.world.buffers))
     sim = Simulation.from_scenario(scenario, trace=trace.write)
     status = "completed"
     error: BaseException | None = None
+    recorder: Recorder | None = None
+    still: Snapshot | None = None
     t0 = time.perf_counter()
     try:
         sim.initialize()
-        _advance_with_progress(sim, scenario, progress)
+        if record is not None:
+            from ..view.recorder import Recorder
+
+            recorder = Recorder(sim, record, scenario.quality)
+        if snapshot is not None:
+            from ..view.recorder import Snapshot
+
+            still = Snapshot(sim, snapshot, scenario.quality)
+        if window:
+            driver = window if callable(window) else _open_window
+            driver(sim, scenario, recorder)
+            if not sim.finished:
+                status = f"closed in the window at t={float(sim.now):g} s"
+        else:
+            sinks = [s for s in (recorder, still) if s is not None]
+            _advance_with_progress(sim, scenario, progress, sinks)
     except RunFault as exc:
         status, error = f"fault: {exc}", exc
+    except EncoderError as exc:
+        error = RunFault("recorder", sim.now, str(exc))
+        status = f"fault: {error}"
     except KeyboardInterrupt as exc:
         status, error = "interrupted", exc
     wall = time.perf_counter() - t0
     trace.close()
+    video = _finish_video(recorder, error)
     result = sim.result()
     metrics = compute_metrics(scenario, sim, result, wall, status)
+    if video is not None:
+        metrics["video"] = video
+    if still is not None:
+        metrics["snapshot"] = {"path": str(still.close()), "t": float(still.at)}
     write_atomic(out_dir / "metrics.json", json.dumps(metrics, indent=2) + "\n")
-    resolved = resolved_scenario(scenario, extra=None)
+    stopped_early = window and not sim.finished and error is None and sim.now > 0
+    resolved = resolved_scenario(
+        scenario, extra=sim.live_changes, duration=sim.now if stopped_early else None
+    )
     write_atomic(out_dir / "scenario.yaml", yaml.safe_dump(resolved, sort_keys=False))
     if plot:
         plot_distance(out_dir / "trace.csv", metrics, out_dir / "distance.png")
@@ -145,7 +193,40 @@ def run_scenario(
     return RunOutcome(out_dir, metrics, sim)
 
 
-def _advance_with_progress(sim: Simulation, scenario: Scenario, progress: bool | None) -> None:
+WindowDriver = Callable[[Simulation, Scenario, "Recorder | None"], None]
+
+
+def _open_window(sim: Simulation, scenario: Scenario, recorder: Recorder | None) -> None:
+    from ..view.window import Window
+
+    Window(sim, scenario.quality, title=scenario.name, recorder=recorder).run()
+
+
+def _finish_video(recorder: Recorder | None, error: BaseException | None) -> dict[str, Any] | None:
+    """Finalise the video whatever ended the run; what ``metrics.json`` says about it."""
+    if recorder is None:
+        return None
+    opts = recorder.options
+    try:
+        path = recorder.close()
+    except EncoderError as exc:
+        if error is None:
+            raise RunFault("recorder", recorder.sim.now, str(exc)) from None
+        if not (isinstance(error, RunFault) and error.component == "recorder"):
+            print(f"amsa-phys: {exc}", file=sys.stderr)  # besides the run's own error
+        return None
+    return {
+        "path": str(path),
+        "frames": recorder.index,
+        "fps": opts.fps,
+        "size": list(opts.size),
+        "speedup": float(opts.speedup),
+    }
+
+
+def _advance_with_progress(
+    sim: Simulation, scenario: Scenario, progress: bool | None, sinks: list[FrameSink]
+) -> None:
     """Advance in one-second chunks, updating a progress bar on a terminal."""
     total = float(scenario.duration)
     disable = (not sys.stderr.isatty()) if progress is None else not progress
@@ -162,5 +243,5 @@ def _advance_with_progress(sim: Simulation, scenario: Scenario, progress: bool |
         tick = -1
         while tick < end:
             tick = min(end, tick + per_second)
-            sim.advance(tick)
+            advance(sim, tick, sinks)
             bar.update(float(grid.time(tick)) - bar.n)

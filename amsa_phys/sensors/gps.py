@@ -32,12 +32,14 @@ class GPS(Template):
     def initialize(self, ctx: Any) -> None:
         """Take this component's own random stream."""
         self.rng = ctx.rng
+        self.lost = 0  # samples lost so far: the renderer marks them
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
         """The paper's doStep: sample the position, or lose the sample."""
         ex, ey = self.rng.normal(0.0, 1.0, size=2)
         lost = self.rng.uniform(0.0, 100.0) < self.p.lostDataGPS
         if lost:
+            self.lost += 1
             return {}
         noise = self.p.noise
         bias = self.p.bias

@@ -122,11 +122,6 @@ def test_summary_table_is_printed(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert "real time" in out
 
 
-def test_window_mode_is_refused_clearly(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["run", str(SCENARIO1), "--out", str(tmp_path / "w")]) == 2
-    assert "run with --headless" in capsys.readouterr().err
-
-
 def test_shipped_scenarios_meet_their_expectations(tmp_path: Path) -> None:
     for name in ("scenario1", "scenario2"):
         path = ROOT / "scenarios" / f"{name}.yaml"

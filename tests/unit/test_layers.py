@@ -1,4 +1,4 @@
-"""Imports flow one way: model -> engine -> physics|sensors|control -> plots -> runs -> cli."""
+"""Imports flow one way: model -> engine -> physics|sensors|control -> plots|view -> runs -> cli."""
 
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ LAYER = {
     "sensors": 2,
     "control": 2,
     "plots": 3,
+    "view": 3,
     "runs": 4,
     "cli": 5,
 }

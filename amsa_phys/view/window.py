@@ -1,0 +1,270 @@
+"""The interactive window: watch, pause, step, zoom, and change parameters live.
+
+The simulation advances by ``speed x`` the wall-clock time between two displayed frames
+(capped, so a stall does not jump ahead), to the last instant on the run's grid. Every
+parameter change made in the panel goes through ``Simulation.apply_live`` and so lands at
+one exact instant; the run directory's ``scenario.yaml`` lists it as a timeline entry, and
+replaying that file reproduces the session's trace.
+
+``frame(real_dt)`` runs one iteration (events, advance, draw) so that tests can drive the
+window with injected events and an exact clock under SDL's dummy video driver.
+"""
+
+from __future__ import annotations
+
+import os
+from fractions import Fraction
+
+from ..engine.runner import Simulation
+from ..model.scenario import Quality
+from .camera import Camera
+from .draw import INK, LOST, MUTED, Renderer
+from .drive import advance
+from .panel import ParamPanel
+from .pg import pygame
+from .recorder import Recorder
+from .scene import Scene
+
+SPEEDS = (1 / 16, 1 / 8, 1 / 4, 1 / 2, 1, 2, 4, 8, 16, 32, 64, 128, 256)
+MAX_REAL_DT = 0.1  # seconds of wall clock a single frame may cover
+FPS = 60
+
+HELP = [
+    "space  pause / resume      s or .  one instant (pauses)",
+    "] [    faster / slower     c       camera: fit, follow each rover",
+    "z x    zoom in / out       wheel   zoom      drag / arrows  pan",
+    "p      parameter panel:    up/down row, pgup/pgdn component,",
+    "       left/right step (shift: fine), type a number, enter apply, esc drop",
+    "h      this help           q / esc quit (outputs are written)",
+]
+
+
+def open_display() -> None:
+    """Start SDL's video, or raise ``RuntimeError`` saying why no window can be shown.
+
+    With no X11/Wayland display SDL quietly falls back to its ``offscreen`` driver: a window
+    would then run invisibly and never be closed. We refuse that unless the user (or a test)
+    asked for an offscreen driver explicitly with ``SDL_VIDEODRIVER``.
+    """
+    try:
+        pygame.display.init()
+    except pygame.error as exc:
+        raise RuntimeError(f"cannot open a window: {exc}") from None
+    driver = pygame.display.get_driver()
+    if driver in ("offscreen", "dummy") and not os.environ.get("SDL_VIDEODRIVER"):
+        pygame.display.quit()
+        raise RuntimeError("no display to open a window on (no X11 or Wayland session)")
+
+
+class Window:
+    """One interactive session on one Simulation (already initialised)."""
+
+    def __init__(
+        self,
+        sim: Simulation,
+        quality: Quality | None,
+        *,
+        title: str = "amsa-phys",
+        size: tuple[int, int] = (1280, 720),
+        recorder: Recorder | None = None,
+        paused: bool = False,
+    ) -> None:
+        pygame.display.init()
+        pygame.font.init()
+        self.screen = pygame.display.set_mode(size, pygame.RESIZABLE)
+        pygame.display.set_caption(f"amsa-phys: {title}")
+        self.sim = sim
+        self.recorder = recorder
+        self.sinks = [recorder] if recorder is not None else []
+        self.scene = Scene(sim, quality)
+        self.camera = Camera(size)
+        self.renderer = Renderer(size)
+        self.panel = ParamPanel(sim)
+        self.speed_index = SPEEDS.index(1)
+        self.paused = paused
+        self.running = True
+        self.show_help = False
+        self.notice = ""
+        self._owed = 0.0  # simulated seconds the wall clock has earned but not yet run
+        self._drag: tuple[int, int] | None = None
+        self._end = sim.grid.ticks(sim.duration)
+
+    # -- the loop ------------------------------------------------------------------------
+    @property
+    def speed(self) -> float:
+        """Simulated seconds per wall-clock second."""
+        return SPEEDS[self.speed_index]
+
+    @property
+    def finished(self) -> bool:
+        """The run reached its duration."""
+        return self.sim.finished
+
+    def run(self) -> None:
+        """Until the user closes the window."""
+        clock = pygame.time.Clock()
+        try:
+            while self.frame(clock.tick(FPS) / 1000):
+                pass
+        finally:
+            pygame.display.quit()
+
+    def frame(self, real_dt: float) -> bool:
+        """One iteration: events, advance by ``speed * real_dt``, draw. False once closed."""
+        for event in pygame.event.get():
+            self.handle(event)
+        if not self.running:
+            return False
+        if not self.paused and not self.finished:
+            self._owed += self.speed * min(real_dt, MAX_REAL_DT)
+            target = self.sim.now + Fraction(self._owed).limit_denominator(10**6)
+            tick = int(target / self.sim.grid.tick)
+            if tick >= self.sim.grid.ticks(self.sim.now):
+                before = self.sim.now
+                advance(self.sim, min(tick, self._end), self.sinks)
+                self._owed -= float(self.sim.now - before)
+        self.draw()
+        return True
+
+    def step_once(self) -> None:
+        """Run the next instant only (and pause)."""
+        self.paused = True
+        if self.finished:
+            return
+        tick = self.sim.grid.ticks(self.sim.next_instant())
+        advance(self.sim, min(tick, self._end), self.sinks)
+
+    # -- input ---------------------------------------------------------------------------
+    def handle(self, event: pygame.event.Event) -> None:
+        """React to one pygame event."""
+        if event.type == pygame.QUIT:
+            self.running = False
+        elif event.type == pygame.KEYDOWN:
+            self._key(event)
+        elif event.type == pygame.MOUSEWHEEL:
+            self.camera.zoom(1.15**event.y, pygame.mouse.get_pos())
+        elif event.type == pygame.MOUSEBUTTONDOWN and event.button == 1:
+            self._drag = event.pos
+        elif event.type == pygame.MOUSEBUTTONUP and event.button == 1:
+            self._drag = None
+        elif event.type == pygame.MOUSEMOTION and self._drag is not None:
+            self.camera.pan(event.pos[0] - self._drag[0], event.pos[1] - self._drag[1])
+            self._drag = event.pos
+        elif event.type == pygame.VIDEORESIZE:
+            self._resize((event.w, event.h))
+
+    def _key(self, event: pygame.event.Event) -> None:
+        key = event.key
+        shift = bool(event.mod & pygame.KMOD_SHIFT)
+        panel = self.panel
+        if panel.visible and self._panel_key(key, event.unicode, shift):
+            return
+        if key in (pygame.K_q, pygame.K_ESCAPE):
+            self.running = False
+        elif key == pygame.K_SPACE:
+            self.paused = not self.paused
+        elif key in (pygame.K_s, pygame.K_PERIOD):
+            self.step_once()
+        elif key == pygame.K_RIGHTBRACKET or (key in (pygame.K_PLUS, pygame.K_EQUALS)):
+            self.speed_index = min(len(SPEEDS) - 1, self.speed_index + 1)
+        elif key == pygame.K_LEFTBRACKET or key == pygame.K_MINUS:
+            self.speed_index = max(0, self.speed_index - 1)
+        elif key == pygame.K_z:
+            self.camera.zoom(1.25)
+        elif key == pygame.K_x:
+            self.camera.zoom(1 / 1.25)
+        elif key == pygame.K_c:
+            self.notice = "camera: " + self.camera.cycle([r.name for r in self.scene.rovers()])
+        elif key in (pygame.K_LEFT, pygame.K_RIGHT, pygame.K_UP, pygame.K_DOWN):
+            dx = {pygame.K_LEFT: 60, pygame.K_RIGHT: -60}.get(key, 0)
+            dy = {pygame.K_UP: 60, pygame.K_DOWN: -60}.get(key, 0)
+            self.camera.pan(dx, dy)
+        elif key in (pygame.K_p, pygame.K_TAB):
+            panel.visible = True
+        elif key in (pygame.K_h, pygame.K_F1):
+            self.show_help = not self.show_help
+
+    def _panel_key(self, key: int, text: str, shift: bool) -> bool:
+        """Keys the open panel takes; False lets the window have them."""
+        panel = self.panel
+        if key in (pygame.K_p, pygame.K_TAB):
+            panel.visible = False
+            panel.cancel()
+        elif key == pygame.K_UP:
+            panel.move(-1)
+        elif key == pygame.K_DOWN:
+            panel.move(1)
+        elif key == pygame.K_PAGEUP:
+            panel.next_component(-1)
+        elif key == pygame.K_PAGEDOWN:
+            panel.next_component(1)
+        elif key == pygame.K_LEFT:
+            panel.step(-1, fine=shift)
+        elif key == pygame.K_RIGHT:
+            panel.step(1, fine=shift)
+        elif key == pygame.K_BACKSPACE:
+            panel.backspace()
+        elif key == pygame.K_ESCAPE and (panel.pending is not None or panel.text is not None):
+            panel.cancel()
+        elif key in (pygame.K_RETURN, pygame.K_KP_ENTER):
+            self.apply_panel()
+        elif text and (text.isdigit() or text in ".-+e"):
+            panel.type_char(text)
+        else:
+            return False
+        return True
+
+    def apply_panel(self) -> None:
+        """Commit the panel's pending value as a live change at the next instant."""
+        if self.finished:
+            self.panel.message = "the run has ended; nothing more to change"
+            self.panel.cancel()
+            return
+        change = self.panel.commit()
+        if change is not None:
+            at = self.sim.apply_live(change)
+            self.panel.message = f"{change.key} = {change.value} at t = {float(at):.2f} s"
+            self.notice = f"live: {self.panel.message}"
+
+    def _resize(self, size: tuple[int, int]) -> None:
+        size = (max(320, size[0]), max(240, size[1]))
+        self.screen = pygame.display.set_mode(size, pygame.RESIZABLE)
+        cam = self.camera
+        cam.width, cam.height = size
+        self.renderer = Renderer(size)
+
+    # -- drawing -------------------------------------------------------------------------
+    def status(self) -> list[str]:
+        """Top-right lines: run state, speed, camera, recording."""
+        if self.finished:
+            state = "finished (q to close)"
+        elif self.paused:
+            state = "PAUSED"
+        else:
+            state = "running"
+        lines = [f"{state}  x{self.speed:g}", f"camera {self.camera.label()}  h: help"]
+        if self.recorder is not None:
+            lines.append(f"recording {self.recorder.options.path.name}")
+        if self.notice:
+            lines.append(self.notice)
+        return lines
+
+    def draw(self) -> None:
+        """Render the current state to the window."""
+        frame = self.scene.frame()
+        cam = self.camera
+        cam.update([(r.x, r.y, r.name) for r in frame.rovers], 0.0 if self.paused else 0.05)
+        self.renderer.draw(self.screen, frame, cam, self.status())
+        h = self.screen.get_height()
+        if self.panel.visible:
+            lines = ["parameters (p closes)", *self.panel.lines()]
+            colours = [MUTED] + [INK] * (len(lines) - 1)
+            if self.panel.message:
+                lines.append(self.panel.message)
+                colours.append(LOST if "fixed" in self.panel.message else MUTED)
+            self.renderer.panel(self.screen, lines, colours, (10, h // 3), align_right=False)
+        if self.show_help:
+            self.renderer.panel(
+                self.screen, HELP, [INK] * len(HELP), (10, h // 3), align_right=True
+            )
+        pygame.display.flip()
