@@ -36,7 +36,11 @@ def add_output(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--out", metavar="DIR", help="run directory (default runs/<scenario>-<YYYYmmdd-HHMMSS>)"
     )
-    p.add_argument("--force", action="store_true", help="replace an existing --out directory")
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="replace an existing --out directory (and --record, --snapshot files)",
+    )
 
 
 def add_jobs(p: argparse.ArgumentParser) -> None:
