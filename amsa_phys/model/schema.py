@@ -118,6 +118,21 @@ WORLD: dict[str, Any] = {
             "properties": {
                 "components": {"$ref": "#/$defs/components"},
                 "description": {"type": "string"},
+                "count": {"type": "integer", "minimum": 1, "maximum": 10000},
+                "schedule": {"type": "array", "items": {"type": "string"}, "uniqueItems": True},
+                "first": {
+                    "type": "object",
+                    "additionalProperties": {
+                        "type": "object",
+                        "additionalProperties": False,
+                        "properties": {
+                            "inputs": {
+                                "type": "object",
+                                "additionalProperties": {"type": "string"},
+                            }
+                        },
+                    },
+                },
             },
         },
         "leaf": {

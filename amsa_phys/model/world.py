@@ -105,22 +105,60 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
         return doc.error((*prefix, *keypath), message)
 
     leaves: dict[str, LeafSpec] = {}
+    copy_schedule: list[str] = []  # the counted Composites' own schedules, per copy
     raw_inputs: dict[str, tuple[dict[str, str], KeyPath]] = {}
     root = CompositeSpec(path="")
 
-    def walk(comps: dict[str, Any], parent: CompositeSpec, keypath: KeyPath) -> None:
+    def walk(
+        comps: dict[str, Any],
+        parent: CompositeSpec,
+        keypath: KeyPath,
+        copy: Copy | None = None,
+    ) -> None:
         for name, body in comps.items():
             path = f"{parent.path}.{name}" if parent.path else name
             kp = (*keypath, name)
             if "components" in body:
+                if "count" in body:
+                    for leaf_name in body.get("first", {}):
+                        if leaf_name not in body["components"]:
+                            raise err(
+                                (*kp, "first", leaf_name),
+                                f"no component {leaf_name!r} in this Composite"
+                                + did_you_mean(str(leaf_name), body["components"]),
+                            )
+                    for inner, inner_body in body["components"].items():
+                        if "components" in inner_body:
+                            raise err(
+                                (*kp, "components", inner),
+                                "a Composite with count: holds Leaves only",
+                            )
+                    for j, item in enumerate(body.get("schedule", [])):
+                        if item not in body["components"]:
+                            raise err(
+                                (*kp, "schedule", j),
+                                f"no component {item!r} in this Composite"
+                                + did_you_mean(str(item), body["components"]),
+                            )
+                    for i in range(1, body["count"] + 1):
+                        copy_schedule.extend(f"{path}{i}.{x}" for x in body.get("schedule", []))
+                        node = CompositeSpec(path=f"{path}{i}")
+                        parent.children.append(node)
+                        walk(body["components"], node, (*kp, "components"), Copy(i, body, kp))
+                    continue
+                for key in ("first", "schedule"):
+                    if key in body:
+                        raise err((*kp, key), f"only a Composite with count: has {key}:")
                 node = CompositeSpec(path=path)
                 parent.children.append(node)
-                walk(body["components"], node, (*kp, "components"))
+                walk(body["components"], node, (*kp, "components"), copy)
                 continue
-            leaf = _build_leaf(path, body, kp, err)
+            leaf = _build_leaf(path, body, kp, err, copy)
+            if path in leaves:
+                raise err(kp, f"component {path} is defined twice (a counted copy's name?)")
             leaves[path] = leaf
             parent.children.append(leaf)
-            raw_inputs[path] = (body.get("inputs", {}), kp)
+            raw_inputs[path] = (copy.inputs(name, body) if copy else body.get("inputs", {}), kp)
 
     walk(data["components"], root, ("components",))
 
@@ -138,6 +176,7 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
     for i, item in enumerate(schedule):
         if item not in leaves:
             raise err(("schedule", i), f"unknown component {item!r}" + did_you_mean(item, leaves))
+    schedule += [x for x in copy_schedule if x not in schedule]
     physics = _merge(PHYSICS_DEFAULTS, data.get("physics", {}))
     order = execution_order(leaves, schedule, err)
     return WorldSpec(
@@ -154,7 +193,43 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
     )
 
 
-def _build_leaf(path: str, body: dict[str, Any], kp: KeyPath, err: Any) -> LeafSpec:
+@dataclass(frozen=True)
+class Copy:
+    """Copy ``i`` (from 1) of a Composite with ``count: N`` — the platoon's cars.
+
+    Copies are named ``<name>1`` .. ``<name>N``. In their Leaves' ``inputs``, ``{i}`` is the
+    copy's number and ``{i-1}`` the previous one's, so ``Car{i-1}.Robot.posX`` is the car
+    ahead; ``first:`` gives copy 1 other inputs (the car ahead of the first is the leader).
+    A numeric parameter may be ``{from: A, step: B}``: A + B (i - 1) in copy i.
+    """
+
+    i: int
+    body: dict[str, Any]
+    keypath: KeyPath
+
+    def inputs(self, leaf_name: str, leaf_body: dict[str, Any]) -> dict[str, str]:
+        """The leaf's inputs in this copy, placeholders filled in."""
+        inputs = dict(leaf_body.get("inputs", {}))
+        if self.i == 1:
+            inputs.update(self.body.get("first", {}).get(leaf_name, {}).get("inputs", {}))
+        return {port: self.fill(ref) for port, ref in inputs.items()}
+
+    def fill(self, text: str) -> str:
+        """``{i}`` and ``{i-1}`` replaced by this copy's numbers."""
+        return text.replace("{i-1}", str(self.i - 1)).replace("{i}", str(self.i))
+
+    def value(self, value: Any) -> Any:
+        """A ``{from, step}`` parameter's value in this copy; anything else unchanged."""
+        if isinstance(value, dict) and set(value) == {"from", "step"}:
+            a, b = value["from"], value["step"]
+            if all(isinstance(v, int | float) and not isinstance(v, bool) for v in (a, b)):
+                return a + b * (self.i - 1)
+        return value
+
+
+def _build_leaf(
+    path: str, body: dict[str, Any], kp: KeyPath, err: Any, copy: Copy | None = None
+) -> LeafSpec:
     ref = body["template"]
     try:
         template = resolve_template(ref)
@@ -171,6 +246,8 @@ def _build_leaf(path: str, body: dict[str, Any], kp: KeyPath, err: Any) -> LeafS
                 f"unknown parameter of template {template.name()}"
                 + did_you_mean(str(name), declared),
             )
+        if copy is not None:
+            value = copy.value(value)
         try:
             params[name] = declared[name].coerce(value)
         except ValueError as exc:

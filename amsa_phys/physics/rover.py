@@ -9,6 +9,7 @@ teleports the body: sideways sliding is removed by a friction force, not by edit
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import pymunk
 
@@ -51,12 +52,23 @@ class DiffDriveRover:
         space.add(self.body, self.shape)
         self.power_l = 0.0
         self.power_r = 0.0
+        self._slot: tuple[Any, int] | None = None
         self.slipping = False
 
     def set_power(self, left_pct: float, right_pct: float) -> None:
         """Command the wheels; the motor driver saturates at ±100 %."""
         self.power_l = min(100.0, max(-100.0, left_pct))
         self.power_r = min(100.0, max(-100.0, right_pct))
+        if self._slot is not None:
+            powers, i = self._slot
+            powers[0, i] = self.power_l
+            powers[1, i] = self.power_r
+
+    def attach_power_slot(self, powers: Any, index: int) -> None:
+        """Also write the commands into ``powers[:, index]`` (the batch path's arrays)."""
+        self._slot = (powers, index)
+        powers[0, index] = self.power_l
+        powers[1, index] = self.power_r
 
     def apply_forces(self, dt: float) -> None:
         """Set this step's force and torque on the body from the wheel model.

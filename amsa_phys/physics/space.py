@@ -17,6 +17,7 @@ from typing import Any
 import pymunk
 
 from ..errors import RunFault
+from . import fleet
 from .rover import DiffDriveRover
 from .wheel import WheelModel
 
@@ -43,6 +44,8 @@ class PhysicsWorld:
         self.rovers: list[DiffDriveRover] = []
         self._owner: dict[int, str] = {}
         self.collisions = 0
+        self._fleet: fleet.Fleet | None = None
+        self._fleet_checked = False
         self._add_obstacles(settings.get("obstacles") or [], settings.get("walls"))
         self.space.on_collision(ROVER, ROVER, begin=self._on_collision)
         self.space.on_collision(ROVER, OBSTACLE, begin=self._on_collision)
@@ -126,9 +129,14 @@ class PhysicsWorld:
             rolling_force_n=self.rolling_resistance * p.rollingCoef * load,
         )
         rover.lateral_limit = mu * p.lateralCoef * 2 * load
+        if self._fleet is not None:
+            self._fleet.refresh()
 
     def step(self) -> None:
         """Advance the world by one physics step (the engine's hook)."""
+        if len(self.rovers) >= fleet.BATCH_MIN:
+            self._step_batch()
+            return
         dt = self.dt
         for rover in self.rovers:
             rover.apply_forces(dt)
@@ -152,6 +160,19 @@ class PhysicsWorld:
                     self.sim.now + Fraction(1) / self.rate,
                     f"body left the world at ({x:.4g}, {y:.4g}) m (physics.extent is {extent:g} m)",
                 )
+
+    def _step_batch(self) -> None:
+        """The same step for many rovers: forces in one numpy pass (``fleet.py``)."""
+        if self._fleet is None:
+            self._fleet = fleet.Fleet(self.space, self.rovers)
+        state = self._fleet.state()
+        if self._fleet_checked:  # the previous step's result, checked as the scalar path does
+            bad = self._fleet.first_violation(state, self.max_speed, self.extent)
+            if bad is not None:
+                raise RunFault(self.rovers[bad[0]].name, self.sim.now, bad[1])
+        self._fleet_checked = True
+        self._fleet.apply_forces(state, self.dt)
+        self.space.step(self.dt)
 
     def _on_collision(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
         a, b = arbiter.shapes

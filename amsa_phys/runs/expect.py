@@ -49,7 +49,8 @@ class Check:
     def describe(self) -> str:
         """``max_distance (phase 1) = 24.3, below 26: pass``."""
         if self.skipped:
-            return f"{self.what}: skipped (phase not run, --duration cut it)"
+            cut = "window" if self.expectation.trace is not None else "phase"
+            return f"{self.what}: skipped ({cut} not run, --duration cut it)"
         value = "none" if self.value is None else f"{self.value:.4g}"
         return f"{self.what} = {value}, {self.bound}: {self.verdict}"
 
@@ -100,7 +101,10 @@ def _trace_check(e: Expectation, header: list[str], data: np.ndarray) -> Check:
         mask &= t <= e.before
     values = data[mask, header.index(e.trace)]
     if values.size == 0:
-        return Check(e, None, False)
+        ran_until = float(t[-1]) if t.size else 0.0
+        # a window that starts after the run ended was cut off (--duration), like a phase
+        cut = e.after is not None and e.after > ran_until
+        return Check(e, None, cut, skipped=cut)
     worst: float | None = None
     ok = True
     if e.above is not None:

@@ -35,6 +35,9 @@ def resolved_scenario(
     world = copy.deepcopy(scenario.world.data)
 
     def fill(comps: dict[str, Any], prefix: str) -> None:
+        for name in list(comps):
+            if "count" in comps[name]:
+                _expand_copies(comps, name, prefix, scenario)
         for name, body in comps.items():
             path = f"{prefix}.{name}" if prefix else name
             if "components" in body:
@@ -45,6 +48,8 @@ def resolved_scenario(
             body["params"] = {k: _plain(v) for k, v in leaf.params.items()}
 
     fill(world["components"], "")
+    if scenario.world.schedule:
+        world["schedule"] = list(scenario.world.schedule)  # copies' schedules written out
     world["physics"] = copy.deepcopy(scenario.world.physics)
     if world["physics"].get("walls") is None:
         world["physics"].pop("walls", None)
@@ -96,3 +101,24 @@ def resolved_scenario(
             )
             out["expect"].append({k: v for k, v in fields if v is not None})
     return out
+
+
+def _expand_copies(comps: dict[str, Any], name: str, prefix: str, scenario: Scenario) -> None:
+    """Replace a ``count:`` Composite by its copies, written out (names, params, links)."""
+    body = comps[name]
+    items = list(comps.items())
+    comps.clear()
+    for key, value in items:
+        if key != name:
+            comps[key] = value
+            continue
+        for i in range(1, body["count"] + 1):
+            copy_path = f"{prefix}.{name}{i}" if prefix else f"{name}{i}"
+            inner: dict[str, Any] = {}
+            for leaf_name, leaf_body in body["components"].items():
+                leaf: LeafSpec = scenario.world.leaves[f"{copy_path}.{leaf_name}"]
+                out = {k: v for k, v in leaf_body.items() if k in ("template", "description")}
+                if leaf.inputs:
+                    out["inputs"] = dict(leaf.inputs)  # absolute: found from any scope
+                inner[leaf_name] = out
+            comps[f"{name}{i}"] = {"components": inner}

@@ -1,0 +1,219 @@
+"""Every performance target of the project, measured in one go: value, baseline, PASS/MISS.
+
+Run: ``python benchmarks/perf.py [--reps 5] [--only NAME ...]``. Each figure is the median of
+``--reps`` repetitions (min and max shown); each baseline is measured in the same run, in the
+same process where the target says so, because these machines are noisy and only ratios
+compare. Targets (issue "Performance"):
+
+* headless run of scenario1 (300 s, 100 Hz physics, 8 components, trace at 20 Hz):
+  >= 1000x real time in-process, and <= 1.2x the time of a bare loop stepping the same two
+  bodies with the same wheel model;
+* the whole ``amsa-phys run --headless`` process (imports, plots, files) < 1.5 s;
+* platoon: cost per rover-step flat from 2 to 200 rovers (<= 1.2x the 2-rover cost), and
+  >= 50x real time with 200 rovers;
+* recording at 1280x720: >= 150 frames/s, within 1.3x of the encoder alone;
+* sweeps: speed-up from -j 1 to -j N >= 0.9 N;
+* memory: peak RSS of a 1-hour run and of a 1-hour recording within 1.5x of a 1-minute one.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+os.environ.setdefault("MPLBACKEND", "Agg")
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import bench_record
+import bench_run
+import bench_sweep
+import yaml
+
+from amsa_phys.engine.runner import Simulation
+from amsa_phys.model.scenario import load_scenario
+
+ROOT = Path(__file__).resolve().parent.parent
+SCENARIO1 = ROOT / "scenarios" / "scenario1.yaml"
+
+
+def med(xs: list[float]) -> str:
+    """``median (min..max)`` with sensible digits."""
+    return f"{statistics.median(xs):.4g} (min {min(xs):.4g}, max {max(xs):.4g})"
+
+
+def verdict(ok: bool) -> str:
+    return "PASS" if ok else "MISS"
+
+
+def report(name: str, measured: str, target: str, ok: bool) -> None:
+    print(f"{verdict(ok)}  {name:34s} {measured}   target {target}", flush=True)
+
+
+# -- headless run ----------------------------------------------------------------------------
+def headless(reps: int) -> None:
+    engine = [300 / bench_run.engine_run(300) for _ in range(reps)]
+    bare = [300 / bench_run.bare_loop(300) for _ in range(reps)]
+    ratio = [b / e for e, b in zip(engine, bare, strict=True)]  # engine time / bare time
+    report("headless run, x real time", med(engine), ">= 1000", statistics.median(engine) >= 1000)
+    report(
+        "engine time / bare loop time",
+        f"{med(ratio)}; bare loop {statistics.median(bare):.0f}x real time",
+        "<= 1.2",
+        statistics.median(ratio) <= 1.2,
+    )
+
+
+def process(reps: int) -> None:
+    walls = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for i in range(reps):
+            argv = [sys.executable, "-m", "amsa_phys", "run", str(SCENARIO1), "--headless"]
+            argv += ["--duration", "300", "--out", f"{tmp}/r{i}", "-q"]
+            t0 = time.perf_counter()
+            subprocess.run(argv, check=False, capture_output=True)
+            walls.append(time.perf_counter() - t0)
+    report("amsa-phys run process, s", med(walls), "< 1.5", statistics.median(walls) < 1.5)
+
+
+# -- platoon scaling --------------------------------------------------------------------------
+def platoon_world(cars: int, tmp: Path) -> Path:
+    """worlds/platoon.yaml with ``count: cars`` and a scenario around it."""
+    world = yaml.safe_load((ROOT / "worlds" / "platoon.yaml").read_text())
+    world["components"]["Car"]["count"] = cars
+    (tmp / f"platoon{cars}.yaml").write_text(yaml.safe_dump(world))
+    scen = tmp / f"platoon{cars}_scenario.yaml"
+    scen.write_text(f"world: platoon{cars}.yaml\nduration: 10\nseed: 1\n")
+    return scen
+
+
+def platoon_cost(scen: Path, duration: float) -> tuple[float, int]:
+    """(microseconds per rover-step, rovers) for ``duration`` simulated seconds."""
+    sc = load_scenario(scen, duration=duration)
+    sim = Simulation.from_scenario(sc)
+    sim.initialize()
+    rovers = len(sim.shared["physics"].rovers)
+    t0 = time.perf_counter()
+    sim.run()
+    wall = time.perf_counter() - t0
+    steps = duration * 100
+    return wall / (rovers * steps) * 1e6, rovers
+
+
+def platoon(reps: int) -> None:
+    with tempfile.TemporaryDirectory() as d:
+        tmp = Path(d)
+        costs: dict[int, list[float]] = {}
+        for cars in (1, 9, 49, 199):
+            scen = platoon_world(cars, tmp)
+            duration = max(2.0, 200.0 / (cars + 1))
+            for _ in range(reps):
+                cost, rovers = platoon_cost(scen, duration)
+                costs.setdefault(rovers, []).append(cost)
+    base = statistics.median(costs[2])
+    for rovers, xs in costs.items():
+        rt = [1e6 / (c * rovers * 100) for c in xs]
+        print(
+            f"      platoon {rovers:3d} rovers: {med(xs)} us per rover-step, {med(rt)}x real time"
+        )
+    worst = max(statistics.median(xs) for xs in costs.values()) / base
+    report("platoon cost per rover-step vs 2", f"worst {worst:.2f}x", "<= 1.2x", worst <= 1.2)
+    rt200 = [1e6 / (c * 200 * 100) for c in costs[200]]
+    report("platoon 200 rovers, x real time", med(rt200), ">= 50", statistics.median(rt200) >= 50)
+
+
+# -- recording -------------------------------------------------------------------------------
+def recording(reps: int) -> None:
+    fps = bench_record.measure(reps, 30.0, (1280, 720))
+    rec = fps["record"]
+    report("recording 1280x720, frames/s", med(rec), ">= 150", statistics.median(rec) >= 150)
+    ratio = [e / r for r, e in zip(rec, fps["encoder alone"], strict=True)]
+    report(
+        "record time / encoder-alone time",
+        f"{med(ratio)}; render alone {statistics.median(fps['render']):.0f} frames/s",
+        "<= 1.3",
+        statistics.median(ratio) <= 1.3,
+    )
+
+
+# -- sweeps ----------------------------------------------------------------------------------
+def sweeps(reps: int) -> None:
+    cores = os.cpu_count() or 1
+    single = [bench_sweep.one(1) for _ in range(reps)]
+    multi = [bench_sweep.one(cores) for _ in range(reps)]
+    speedup = [m / s for s, m in zip(single, multi, strict=True)]
+    report(
+        f"sweep speed-up -j {cores} / -j 1",
+        f"{med(speedup)}; -j 1 {statistics.median(single):.1f} runs/s",
+        f">= {0.9 * cores:.1f}",
+        statistics.median(speedup) >= 0.9 * cores,
+    )
+
+
+# -- memory ----------------------------------------------------------------------------------
+def peak_rss_mib(argv: list[str]) -> float:
+    """Peak resident memory of a child process (MiB), from the kernel's own accounting."""
+    proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    _, _, usage = os.wait4(proc.pid, 0)
+    return usage.ru_maxrss / 1024
+
+
+def memory(reps: int) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+
+        def run(duration: int, record: bool, i: int) -> float:
+            argv = [sys.executable, "-m", "amsa_phys", "run", str(SCENARIO1), "--headless"]
+            argv += ["--duration", str(duration), "--out", f"{tmp}/m{duration}{record}{i}"]
+            argv += ["-q", "--no-plot"]
+            if record:
+                argv += ["--record", f"{tmp}/v{duration}{i}.mp4", "--size", "320x240"]
+                argv += ["--speedup", "10"]
+            return peak_rss_mib(argv)
+
+        for record, label in ((False, "run"), (True, "recording")):
+            short = [run(60, record, i) for i in range(reps)]
+            long = [run(3600, record, i) for i in range(reps)]
+            ratio = statistics.median(long) / statistics.median(short)
+            report(
+                f"peak RSS 1 h / 1 min {label}",
+                f"{ratio:.2f} ({statistics.median(long):.0f} vs "
+                f"{statistics.median(short):.0f} MiB)",
+                "<= 1.5",
+                ratio <= 1.5,
+            )
+
+
+TARGETS: dict[str, Callable[[int], None]] = {
+    "headless": headless,
+    "process": process,
+    "platoon": platoon,
+    "recording": recording,
+    "sweeps": sweeps,
+    "memory": memory,
+}
+
+
+def main() -> None:
+    """Measure every target (or ``--only`` some) and print PASS/MISS lines."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument("--only", nargs="*", choices=list(TARGETS), default=list(TARGETS))
+    args = ap.parse_args()
+    print(
+        f"# {os.cpu_count()} cores, Python {sys.version.split()[0]}, "
+        f"median of {args.reps} (min, max)",
+        flush=True,
+    )
+    for name in args.only:
+        TARGETS[name](args.reps if name != "memory" else max(1, min(args.reps, 3)))
+
+
+if __name__ == "__main__":
+    main()
