@@ -90,15 +90,7 @@ class PhysicsWorld:
 
     def add_rover(self, name: str, p: Any) -> DiffDriveRover:
         """Add a rover whose template parameters are ``p`` (see templates.RoverParams)."""
-        load = p.mass * self.gravity / 2  # normal load per wheel
-        mu = self.ground_friction
-        wheel = WheelModel(
-            stall_force_n=p.stallForce,
-            free_speed_mps=p.freeSpeed,
-            efficiency=p.efficiency / 100.0,
-            traction_limit_n=mu * p.tractionCoef * load,
-            rolling_force_n=self.rolling_resistance * p.rollingCoef * load,
-        )
+        wheel, lateral_limit = self._wheel_model(p)
         rover = DiffDriveRover(
             self.space,
             name,
@@ -107,7 +99,7 @@ class PhysicsWorld:
             width_m=p.width,
             track_m=p.track,
             wheel=wheel,
-            lateral_limit_n=mu * p.lateralCoef * 2 * load,
+            lateral_limit_n=lateral_limit,
             x=p.x,
             y=p.y,
             heading=p.heading,
@@ -117,18 +109,25 @@ class PhysicsWorld:
         self.rovers.append(rover)
         return rover
 
-    def update_wheel(self, rover: DiffDriveRover, p: Any) -> None:
-        """Rebuild a rover's wheel model after a parameter change (motor wear, ...)."""
+    def _wheel_model(self, p: Any) -> tuple[WheelModel, float]:
+        """A rover's wheel model and lateral grip limit from its template parameters.
+
+        Both scale with the normal load per wheel (``m g / 2``) and the ground's friction.
+        """
         load = p.mass * self.gravity / 2
         mu = self.ground_friction
-        rover.wheel = WheelModel(
+        wheel = WheelModel(
             stall_force_n=p.stallForce,
             free_speed_mps=p.freeSpeed,
             efficiency=p.efficiency / 100.0,
             traction_limit_n=mu * p.tractionCoef * load,
             rolling_force_n=self.rolling_resistance * p.rollingCoef * load,
         )
-        rover.lateral_limit = mu * p.lateralCoef * 2 * load
+        return wheel, mu * p.lateralCoef * 2 * load
+
+    def update_wheel(self, rover: DiffDriveRover, p: Any) -> None:
+        """Rebuild a rover's wheel model after a parameter change (motor wear, ...)."""
+        rover.wheel, rover.lateral_limit = self._wheel_model(p)
         if self._fleet is not None:
             self._fleet.refresh()
 
