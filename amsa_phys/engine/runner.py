@@ -16,7 +16,8 @@ does no scheduling arithmetic per instant.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+import operator
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
@@ -77,7 +78,17 @@ class _Task:
     comp: Template
     period: int
     inputs: list[tuple[str, str]]
-    outputs: set[str]
+    targets: dict[str, str]  # output port -> buffer name ("Component.port")
+
+
+@dataclass
+class _Instant:
+    """What happens at one offset of the repeating cycle, in the order the engine runs it."""
+
+    offset: int
+    tasks: list[_Task] = field(default_factory=list)
+    log: bool = False
+    hooks: list[Hook] = field(default_factory=list)
 
 
 @dataclass
@@ -123,6 +134,7 @@ class Simulation:
         self.components: dict[str, Template] = {}
         self._tick = 0  # the instant being executed, in ticks (``now`` derives from it)
         self._now_override: Fraction | None = None
+        self._now_cache: tuple[int, Fraction] = (0, Fraction(0))
         self.phase_index = 0
         self.change_log: list[tuple[Fraction, Change]] = []
         self.live_changes: list[tuple[Fraction, Change]] = []
@@ -177,9 +189,14 @@ class Simulation:
         """Exact simulated time of the instant being executed (or last executed)."""
         if self._now_override is not None:
             return self._now_override
+        tick, now = self._now_cache
+        if tick == self._tick:
+            return now
         if not hasattr(self, "grid"):
             return Fraction(0)
-        return self.grid.tick * self._tick
+        now = self.grid.tick * self._tick
+        self._now_cache = (self._tick, now)
+        return now
 
     def _compile(self) -> None:
         leaves = self.world.leaves
@@ -198,7 +215,7 @@ class Simulation:
                     comp,
                     g.ticks(1 / leaf.freq),
                     list(leaf.inputs.items()),
-                    {p.name for p in leaf.template.outputs},
+                    {p.name: f"{path}.{p.name}" for p in leaf.template.outputs},
                 )
             )
         self._log_period = g.ticks(1 / self.log_rate)
@@ -214,18 +231,26 @@ class Simulation:
                 f"{float(g.time(self._cycle)):g} s ({count} events); use "
                 "commensurate frequencies",
             )
-        table: dict[int, list[tuple[int, Any]]] = {}
+        table: dict[int, _Instant] = {}
         for task in self._tasks:
             for off in range(0, self._cycle, task.period):
-                table.setdefault(off, []).append((0, task))
+                table.setdefault(off, _Instant(off)).tasks.append(task)
         for off in range(0, self._cycle, self._log_period):
-            table.setdefault(off, []).append((1, None))
+            table.setdefault(off, _Instant(off)).log = True
         for (_, fn, _), period in zip(self._hooks, hook_periods, strict=True):
             for off in range(0, self._cycle, period):
-                table.setdefault(off, []).append((2, fn))
-        self._table = sorted(table.items())
+                table.setdefault(off, _Instant(off)).hooks.append(fn)
+        self._table = [
+            (i.offset, tuple(i.tasks), i.log, tuple(i.hooks)) for _, i in sorted(table.items())
+        ]
         self._end = g.ticks(self.duration)
         self._phase_ticks = [g.ticks(p.at) for p in self.phases]
+        self._next_phase_tick = self._phase_tick_after(self.phase_index)
+        # one row of the trace in column order, gathered in C
+        cols = self.columns
+        self._row: Callable[[dict[str, float]], Sequence[float]] = (
+            operator.itemgetter(*cols) if len(cols) > 1 else lambda v: [v[c] for c in cols]
+        )
 
     # -- running --------------------------------------------------------------------------
     def run(self) -> RunResult:
@@ -243,81 +268,109 @@ class Simulation:
         return self._initialized and self._cursor > self._end
 
     def advance(self, until_tick: int) -> None:
-        """Execute every instant with tick <= ``until_tick`` (and <= the end)."""
+        """Execute every instant with tick <= ``until_tick`` (and <= the end).
+
+        The hot loop of every run: per instant it does two integer compares, then calls what
+        the precomputed table lists. Phase changes are found by comparing with the next phase's
+        tick only; hooks (the physics step) do not run at the final instant, which ends the run.
+        """
         self.initialize()
         until = min(until_tick, self._end)
         cycle = self._cycle
         table = self._table
         end = self._end
-        phase_ticks = self._phase_ticks
-        while self._cursor <= until:
-            base = (self._cursor // cycle) * cycle
-            # entries of this cycle at or after the cursor
-            for off, actions in table:
-                tick = base + off
-                if tick < self._cursor:
-                    continue
-                if tick > until:
-                    self._cursor = tick
-                    return
-                while (
-                    self.phase_index + 1 < len(phase_ticks)
-                    and phase_ticks[self.phase_index + 1] <= tick
-                ):
-                    self.phase_index += 1
-                    self._now_override = self.grid.time(phase_ticks[self.phase_index])
-                    try:
-                        for change in self.phases[self.phase_index].changes:
-                            self.apply_change(change)
-                    finally:
-                        self._now_override = None
-                self._tick = tick
-                if self._pending_live:
-                    self._apply_live()
-                for what, obj in actions:
-                    if what == 0:
-                        self._step(obj)
-                    elif what == 1:
+        step = self._step
+        cursor = self._cursor
+        try:
+            while cursor <= until:
+                base = (cursor // cycle) * cycle
+                for off, tasks, log, hooks in table:
+                    tick = base + off
+                    if tick < cursor:
+                        continue
+                    if tick > until:
+                        cursor = tick
+                        return
+                    if tick >= self._next_phase_tick:
+                        self._enter_phases(tick)
+                    self._tick = tick
+                    if self._pending_live:
+                        self._apply_live()
+                    if tasks:
+                        now = self.now
+                        for task in tasks:
+                            step(task, now)
+                    if log:
                         self._log()
-                    elif tick < end:
-                        obj()
-                self._cursor = tick + 1
-            self._cursor = max(self._cursor, base + cycle)
+                    if tick < end:
+                        for hook in hooks:
+                            hook()
+                    cursor = tick + 1
+                cursor = max(cursor, base + cycle)
+        finally:
+            self._cursor = cursor
 
-    def _step(self, task: _Task) -> None:
+    def _enter_phases(self, tick: int) -> None:
+        """Apply the timeline changes of every phase that starts at or before ``tick``."""
+        phase_ticks = self._phase_ticks
+        while self.phase_index + 1 < len(phase_ticks) and phase_ticks[self.phase_index + 1] <= tick:
+            self.phase_index += 1
+            self._now_override = self.grid.time(phase_ticks[self.phase_index])
+            try:
+                for change in self.phases[self.phase_index].changes:
+                    self.apply_change(change)
+            finally:
+                self._now_override = None
+        self._next_phase_tick = self._phase_tick_after(self.phase_index)
+
+    def _phase_tick_after(self, index: int) -> int | float:
+        i = index + 1
+        return self._phase_ticks[i] if i < len(self._phase_ticks) else math.inf
+
+    def _step(self, task: _Task, now: Fraction) -> None:
+        """Run one component: read its inputs, call ``do_step``, publish its outputs."""
         values = self.values
         inp = {port: values[buf] for port, buf in task.inputs}
-        now = self.now
         try:
             out = task.comp.do_step(now, inp)
         except RunFault:
             raise
         except Exception as exc:
-            raise RunFault(self._who(task.path), self.now, f"do_step raised {exc!r}") from exc
+            raise RunFault(self._who(task.path), now, f"do_step raised {exc!r}") from exc
         if not out:
             return
-        prefix = task.path + "."
+        targets = task.targets
+        try:
+            for key, value in out.items():
+                number = float(value)
+                if number - number != 0.0:  # inf or nan
+                    raise ValueError
+                values[targets[key]] = number
+        except (KeyError, TypeError, ValueError):
+            raise self._bad_output(task, out) from None
+
+    def _bad_output(self, task: _Task, out: Mapping[str, Any]) -> RunFault:
+        """The fault for the first output ``_step`` refused (a slow path: faults are rare)."""
+        who = self._who(task.path)
         for key, value in out.items():
-            if key not in task.outputs:
-                raise RunFault(self._who(task.path), self.now, f"published unknown output {key!r}")
+            if key not in task.targets:
+                return RunFault(who, self.now, f"published unknown output {key!r}")
             try:
                 number = float(value)
             except (TypeError, ValueError):
-                raise RunFault(
-                    self._who(task.path), self.now, f"output {key} is not a number: {value!r}"
-                ) from None
+                return RunFault(who, self.now, f"output {key} is not a number: {value!r}")
             if not math.isfinite(number):
-                raise RunFault(self._who(task.path), self.now, f"output {key} is {number}")
-            values[prefix + key] = number
+                return RunFault(who, self.now, f"output {key} is {number}")
+        return RunFault(who, self.now, f"published invalid outputs {dict(out)!r}")
 
     def _log(self) -> None:
         t_s = float(self.now)
+        values = self.values
         if self._trace is not None:
-            values = self.values
-            self._trace(t_s, [values[c] for c in self.columns])
+            self._trace(t_s, self._row(values))
         if self._quality is not None:
             self._samples_t.append(t_s)
-            self._samples_s.append(self.values[self._quality])
+            self._samples_s.append(values[self._quality])
 
     def apply_change(self, change: Change) -> None:
         """Set a parameter now (timeline or live); the component is told after."""
@@ -335,7 +388,7 @@ class Simulation:
         """Time of the next instant at which something runs (where a live change lands)."""
         self.initialize()
         base = (self._cursor // self._cycle) * self._cycle
-        for off, _ in self._table:
+        for off, *_ in self._table:
             if base + off >= self._cursor:
                 return self.grid.time(base + off)
         return self.grid.time(base + self._cycle + self._table[0][0])

@@ -9,8 +9,9 @@ through the wheel model (normal load ``m g / 2`` per wheel).
 
 from __future__ import annotations
 
+import functools
 import itertools
-import math
+from collections.abc import Sequence
 from fractions import Fraction
 from typing import Any
 
@@ -18,6 +19,8 @@ import pymunk
 
 from ..errors import RunFault
 from . import fleet
+from .bodyio import BodyIO
+from .forces import FewRovers
 from .rover import DiffDriveRover
 from .wheel import WheelModel
 
@@ -44,8 +47,8 @@ class PhysicsWorld:
         self.rovers: list[DiffDriveRover] = []
         self._owner: dict[int, str] = {}
         self.collisions = 0
-        self._fleet: fleet.Fleet | None = None
-        self._fleet_checked = False
+        self._model: FewRovers | fleet.Fleet | None = None
+        self._state: Any = None
         self._add_obstacles(settings.get("obstacles") or [], settings.get("walls"))
         self.space.on_collision(ROVER, ROVER, begin=self._on_collision)
         self.space.on_collision(ROVER, OBSTACLE, begin=self._on_collision)
@@ -107,6 +110,7 @@ class PhysicsWorld:
         )
         self._owner[id(rover.shape)] = name
         self.rovers.append(rover)
+        self._model = None  # the batch layout changed
         return rover
 
     def _wheel_model(self, p: Any) -> tuple[WheelModel, float]:
@@ -128,50 +132,41 @@ class PhysicsWorld:
     def update_wheel(self, rover: DiffDriveRover, p: Any) -> None:
         """Rebuild a rover's wheel model after a parameter change (motor wear, ...)."""
         rover.wheel, rover.lateral_limit = self._wheel_model(p)
-        if self._fleet is not None:
-            self._fleet.refresh()
+        if self._model is not None:
+            self._model.refresh()
 
     def step(self) -> None:
-        """Advance the world by one physics step (the engine's hook)."""
-        if len(self.rovers) >= fleet.BATCH_MIN:
-            self._step_batch()
-            return
-        dt = self.dt
-        for rover in self.rovers:
-            rover.apply_forces(dt)
-        self.space.step(dt)
-        limit = self.max_speed
-        extent = self.extent
-        for rover in self.rovers:
-            vx, vy = rover.body.velocity
-            speed = math.hypot(vx, vy)
-            if not speed <= limit:  # also catches NaN
-                raise RunFault(
-                    rover.name,
-                    self.sim.now + Fraction(1) / self.rate,
-                    f"body speed {speed:.3g} m/s exceeds physics.max_speed "
-                    f"{limit:g} m/s (physics blow-up?)",
-                )
-            x, y = rover.body.position
-            if not (abs(x) <= extent and abs(y) <= extent):
-                raise RunFault(
-                    rover.name,
-                    self.sim.now + Fraction(1) / self.rate,
-                    f"body left the world at ({x:.4g}, {y:.4g}) m (physics.extent is {extent:g} m)",
-                )
+        """Advance the world by one physics step (the engine's hook).
 
-    def _step_batch(self) -> None:
-        """The same step for many rovers: forces in one numpy pass (``fleet.py``)."""
-        if self._fleet is None:
-            self._fleet = fleet.Fleet(self.space, self.rovers)
-        state = self._fleet.state()
-        if self._fleet_checked:  # the previous step's result, checked as the scalar path does
-            bad = self._fleet.first_violation(state, self.max_speed, self.extent)
-            if bad is not None:
-                raise RunFault(self.rovers[bad[0]].name, self.sim.now, bad[1])
-        self._fleet_checked = True
-        self._fleet.apply_forces(state, self.dt)
+        One batch read and one batch write of body state a step (``bodyio.py``). The state
+        read after a step is the next step's input: only the physics step moves bodies.
+        """
+        model = self._model or self._start()
+        model.apply(self._state, self.dt)
+        model.io.write()
         self.space.step(self.dt)
+        state = self._state = model.read()
+        bad = model.first_violation(state, self.max_speed, self.extent)
+        if bad is not None:
+            raise RunFault(self.rovers[bad[0]].name, self.sim.now + 1 / self.rate, bad[1])
+
+    def _start(self) -> FewRovers | fleet.Fleet:
+        """Choose the force model for this many rovers and read the initial state."""
+        io = BodyIO(self.space, [r.body for r in self.rovers])
+        if len(self.rovers) >= fleet.BATCH_MIN:
+            model: FewRovers | fleet.Fleet = fleet.Fleet(io, self.rovers)
+        else:
+            model = FewRovers(io, self.rovers)
+        self._model = model
+        self._state = model.read()
+        for k, rover in enumerate(self.rovers):
+            rover.attach_state(functools.partial(self._kinematics, k))
+        return model
+
+    def _kinematics(self, k: int) -> Sequence[float]:
+        """Rover ``k``'s ``x, y, angle, vx, vy, w`` from the last batch read."""
+        model = self._model or self._start()
+        return model.kinematics(self._state, k)
 
     def _on_collision(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
         a, b = arbiter.shapes

@@ -116,16 +116,17 @@ class _Robot(Template):
             raise ValueError(f"{name} is fixed once the run has started")
 
     def _pose(self) -> dict[str, float]:
-        x, y, heading = self.rover.pose
-        v_l, v_r = self.rover.wheel_speeds()
+        x, y, a, vx, vy, w = self.rover.kinematics()
+        v = vx * math.cos(a) + vy * math.sin(a)
+        h = self.rover.half_track
         return {
             "posX": x,
             "posY": y,
-            "heading": heading,
-            "speed": self.rover.forward_speed,
-            "yawRate": self.rover.body.angular_velocity,
-            "wheelSpeedL": v_l,
-            "wheelSpeedR": v_r,
+            "heading": wrap_angle(a),
+            "speed": v,
+            "yawRate": w,
+            "wheelSpeedL": v - w * h,
+            "wheelSpeedR": v + w * h,
         }
 
 
@@ -252,7 +253,7 @@ class FreeRobot(_Robot):
                 cycle = (1.0, 0.5, 1.5, 1.0)
                 self.speed_factor = cycle[int(t / Fraction(str(p.changePeriod))) % 4]
             elif b == 4:
-                self.target_heading = self.rover.body.angle + self.rng.uniform(
+                self.target_heading = self.rover.kinematics()[2] + self.rng.uniform(
                     -p.randomTurn, p.randomTurn
                 )
                 self.speed_factor = float(self.rng.uniform(0.5, 1.2))
@@ -265,14 +266,14 @@ class FreeRobot(_Robot):
     def _steer(self, power: float, heading: float) -> tuple[float, float]:
         """Hold ``heading``: forward power falls with cos(error), so a large error turns the
         rover nearly in place instead of orbiting its target."""
-        err = wrap_angle(heading - self.rover.body.angle)
+        err = wrap_angle(heading - self.rover.kinematics()[2])
         diff = self.p.steerGain * err
         forward = power * max(0.0, math.cos(err))
         return forward - diff, forward + diff
 
     def _waypoints(self, cruise: float) -> tuple[float, float]:
         points = self.p.waypoints
-        x, y = self.rover.body.position
+        x, y = self.rover.kinematics()[:2]
         while self.waypoint < len(points):
             wx, wy = points[self.waypoint]
             if math.hypot(wx - x, wy - y) > self.p.waypointRadius:

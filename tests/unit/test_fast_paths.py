@@ -1,0 +1,134 @@
+"""The fast paths of issue 8 against the plain code they replace.
+
+Each speed-up keeps a slower, obvious route alive (reference wheel model, documented
+``pymunk.batch`` calls, plain ``repr`` rows); these tests hold the two to the same results.
+"""
+
+from __future__ import annotations
+
+import array
+import math
+import random
+from pathlib import Path
+
+import pymunk
+import pytest
+
+from amsa_phys.engine.recorder import TraceWriter
+from amsa_phys.engine.runner import Simulation
+from amsa_phys.model.scenario import load_scenario
+from amsa_phys.physics import bodyio
+from amsa_phys.physics.bodyio import BodyIO
+from amsa_phys.physics.forces import FewRovers
+from amsa_phys.physics.rover import DiffDriveRover
+from amsa_phys.physics.wheel import WheelModel, lateral_force
+
+ROOT = Path(__file__).resolve().parents[2]
+WHEEL = WheelModel(45.0, 5.5, 0.9, 0.8 * 147.15, 0.02 * 147.15)
+DT = 0.01
+
+
+def make_rovers(n: int) -> tuple[pymunk.Space, list[DiffDriveRover]]:
+    space = pymunk.Space()
+    box = pymunk.Body(body_type=pymunk.Body.STATIC)  # a static body first: rows must map
+    space.add(box, pymunk.Poly.create_box(box, (1, 1)))
+    rovers = [
+        DiffDriveRover(
+            space,
+            f"R{i}",
+            mass_kg=30.0,
+            length_m=0.8,
+            width_m=0.6,
+            track_m=0.5,
+            wheel=WHEEL,
+            lateral_limit_n=0.8 * 2 * 147.15,
+            x=5.0 * i,
+            y=1.0,
+            heading=0.3 * i,
+            collision_type=1,
+        )
+        for i in range(n)
+    ]
+    return space, rovers
+
+
+def reference_forces(r: DiffDriveRover, dt: float) -> tuple[float, float, float]:
+    """The force model written with ``wheel.py``'s reference functions and pymunk properties."""
+    body = r.body
+    a = body.angle
+    c, s = math.cos(a), math.sin(a)
+    vx, vy = body.velocity
+    w = body.angular_velocity
+    v_fwd = vx * c + vy * s
+    f_l = r.wheel.drive_force(r.power_l, v_fwd - w * r.half_track)
+    f_r = r.wheel.drive_force(r.power_r, v_fwd + w * r.half_track)
+    fx = f_l + f_r
+    torque = (f_r - f_l) * r.half_track
+    turn = (w + torque / body.moment * dt) * dt
+    end, mid = a + turn, a + 0.5 * turn
+    px = vx + fx * c / r.mass * dt
+    py = vy + fx * s / r.mass * dt
+    side = px * -math.sin(end) + py * math.cos(end)
+    f_lat = lateral_force(side / math.cos(0.5 * turn), r.mass, dt, r.lateral_limit)
+    return fx * c - f_lat * math.sin(mid), fx * s + f_lat * math.cos(mid), torque
+
+
+def test_inlined_forces_equal_the_reference_wheel_model() -> None:
+    space, rovers = make_rovers(3)
+    rng = random.Random(4)
+    for r in rovers:  # every regime: traction-limited, braking, skidding, at rest
+        r.body.velocity = (rng.uniform(-6, 6), rng.uniform(-6, 6))
+        r.body.angular_velocity = rng.uniform(-3, 3)
+    rovers[0].set_power(100, -100)
+    rovers[1].set_power(0, 0)
+    rovers[2].set_power(37.5, 12.0)
+    model = FewRovers(BodyIO(space, [r.body for r in rovers]), rovers)
+    model.apply(model.read(), DT)
+    for k, r in enumerate(rovers):
+        o = model.rows[k] * bodyio.FORCE
+        got = tuple(model.io.forces[o : o + 3])
+        assert got == pytest.approx(reference_forces(r, DT), rel=1e-12, abs=1e-12)
+
+
+@pytest.mark.parametrize("direct", [True, False], ids=["direct", "documented"])
+def test_batch_io_reads_and_writes_what_pymunk_holds(direct: bool) -> None:
+    space, rovers = make_rovers(2)
+    rovers[1].body.velocity = (1.5, -2.0)
+    rovers[1].body.angular_velocity = 0.25
+    io = BodyIO(space, [r.body for r in rovers], direct=direct)
+    assert io.direct is direct
+    state = io.read()
+    i = io.rows[1] * bodyio.STATE
+    assert state[i : i + 6] == [5.0, 1.0, 0.3, 1.5, -2.0, 0.25]
+    o = io.rows[1] * bodyio.FORCE
+    io.forces[o : o + 3] = array.array("d", [3.0, -4.0, 0.5])
+    io.write()
+    assert tuple(rovers[1].body.force) == (3.0, -4.0)
+    assert rovers[1].body.torque == 0.5
+    assert tuple(rovers[0].body.force) == (0.0, 0.0)
+
+
+def test_documented_batch_route_gives_the_same_run(monkeypatch: pytest.MonkeyPatch) -> None:
+    def final_state() -> list[list[float]]:
+        sc = load_scenario(ROOT / "scenarios" / "scenario1.yaml", duration=20)
+        sim = Simulation.from_scenario(sc)
+        sim.run()
+        return [list(r.kinematics()) for r in sim.shared["physics"].rovers]
+
+    direct = final_state()
+    monkeypatch.setattr(bodyio, "_direct_available", lambda space: False)
+    assert final_state() == direct
+
+
+def test_trace_rows_equal_plain_repr_whatever_changes(tmp_path: Path) -> None:
+    rng = random.Random(1)
+    values = [0.0, 1.0, 2.0, 3.0]
+    writer = TraceWriter(tmp_path / "trace.csv", ["a", "b", "c", "d"])
+    expected = ["t,a,b,c,d"]
+    for k in range(200):
+        j = rng.randrange(4)
+        values[j] = rng.choice([rng.random(), float(k), values[(j + 1) % 4], -0.0])
+        writer.write(k * 0.05, list(values))
+        expected.append(",".join(map(repr, [k * 0.05, *values])))
+    writer.close()
+    assert (tmp_path / "trace.csv").read_text().splitlines() == expected
