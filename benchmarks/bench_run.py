@@ -64,15 +64,16 @@ def bare_loop(duration: float, rate: int = 100) -> float:
     ]
     rovers[0].set_power(22, 22)
     rovers[1].set_power(30, 28)
-    model = FewRovers(BodyIO(space, [r.body for r in rovers]), rovers)
     dt = 1.0 / rate
+    model = FewRovers(BodyIO(space, [r.body for r in rovers]), rovers, dt, (100.0, 1e4))
+    io = model.io
     t0 = time.perf_counter()
-    state = model.read()
+    state = io.read()
     for _ in range(int(duration * rate)):
-        model.apply(state, dt)
-        model.io.write()
-        space.step(dt)
-        state = model.read()
+        model.apply(state)
+        io.write()
+        io.step(dt)
+        state = io.read()
     return time.perf_counter() - t0
 
 

@@ -137,12 +137,20 @@ class FollowerController(Template):
         n = len(fixes)
         if n < 2:
             return
-        mt = sum(f[0] for f in fixes) / n
-        mx = sum(f[1] for f in fixes) / n
-        my = sum(f[2] for f in fixes) / n
-        stt = sum((f[0] - mt) ** 2 for f in fixes)
+        # least-squares slope, two passes (means, then centred sums) in plain loops: the
+        # controller runs every step and generator expressions cost twice as much
+        st = sx = sy = 0.0
+        for ft, fx, fy in fixes:
+            st += ft
+            sx += fx
+            sy += fy
+        mt, mx, my = st / n, sx / n, sy / n
+        stt = stx = sty = 0.0
+        for ft, fx, fy in fixes:
+            d = ft - mt
+            stt += d * d
+            stx += d * (fx - mx)
+            sty += d * (fy - my)
         if stt <= 0:
             return
-        vx = sum((f[0] - mt) * (f[1] - mx) for f in fixes) / stt
-        vy = sum((f[0] - mt) * (f[2] - my) for f in fixes) / stt
-        self.v_leader = math.hypot(vx, vy)
+        self.v_leader = math.hypot(stx / stt, sty / stt)

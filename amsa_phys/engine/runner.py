@@ -101,6 +101,29 @@ class RunResult:
     events: list[Event] = field(default_factory=list)
 
 
+Entry = tuple[int, tuple[_Task, ...], bool, tuple[Hook, ...], int, int]
+
+
+def _runs(instants: list[_Instant]) -> list[Entry]:
+    """The cycle's instants as table entries ``(offset, tasks, log, hooks, last, spacing)``.
+
+    Consecutive instants with only the same hooks (the physics steps between two log rows)
+    become one entry covering ``offset, offset + spacing, ..., last``; any other instant is
+    its own entry with ``last == offset``.
+    """
+    out: list[Entry] = []
+    for i in instants:
+        hooks = tuple(i.hooks)
+        if out and not i.tasks and not i.log:
+            off, tasks, log, prev_hooks, last, spacing = out[-1]
+            hook_only = not tasks and not log and prev_hooks == hooks
+            if hook_only and (last == off or i.offset - last == spacing):
+                out[-1] = (off, tasks, log, hooks, i.offset, i.offset - last)
+                continue
+        out.append((i.offset, tuple(i.tasks), i.log, hooks, i.offset, 1))
+    return out
+
+
 class Simulation:
     """One run of a scenario (or of a bare world, for tests)."""
 
@@ -194,7 +217,8 @@ class Simulation:
             return now
         if not hasattr(self, "grid"):
             return Fraction(0)
-        now = self.grid.tick * self._tick
+        # Fraction(n, d) directly: ``grid.tick * tick`` costs three times as much
+        now = Fraction(self._tick * self._tick_num, self._tick_den)
         self._now_cache = (self._tick, now)
         return now
 
@@ -205,6 +229,7 @@ class Simulation:
         instants = [p.at for p in self.phases] + [self.duration]
         self.grid = TickGrid.for_run(periods, instants)
         g = self.grid
+        self._tick_num, self._tick_den = g.tick.numerator, g.tick.denominator
         self._tasks = []
         for path in self.world.order:
             leaf = leaves[path]
@@ -240,9 +265,7 @@ class Simulation:
         for (_, fn, _), period in zip(self._hooks, hook_periods, strict=True):
             for off in range(0, self._cycle, period):
                 table.setdefault(off, _Instant(off)).hooks.append(fn)
-        self._table = [
-            (i.offset, tuple(i.tasks), i.log, tuple(i.hooks)) for _, i in sorted(table.items())
-        ]
+        self._table = _runs([i for _, i in sorted(table.items())])
         self._end = g.ticks(self.duration)
         self._phase_ticks = [g.ticks(p.at) for p in self.phases]
         self._next_phase_tick = self._phase_tick_after(self.phase_index)
@@ -284,28 +307,48 @@ class Simulation:
         try:
             while cursor <= until:
                 base = (cursor // cycle) * cycle
-                for off, tasks, log, hooks in table:
-                    tick = base + off
-                    if tick < cursor:
+                for off, tasks, log, hooks, last_off, spacing in table:
+                    first = base + off
+                    last = base + last_off
+                    if last < cursor:
                         continue
-                    if tick > until:
-                        cursor = tick
-                        return
-                    if tick >= self._next_phase_tick:
-                        self._enter_phases(tick)
-                    self._tick = tick
-                    if self._pending_live:
-                        self._apply_live()
-                    if tasks:
-                        now = self.now
-                        for task in tasks:
-                            step(task, now)
-                    if log:
-                        self._log()
-                    if tick < end:
-                        for hook in hooks:
-                            hook()
-                    cursor = tick + 1
+                    if (
+                        last_off != off
+                        and first >= cursor
+                        and last <= until
+                        and last < end
+                        and last < self._next_phase_tick
+                        and not self._pending_live
+                    ):
+                        # a whole run of hook-only instants (physics steps between log rows):
+                        # nothing else can happen in between, so no checks per instant
+                        for tick in range(first, last + 1, spacing):
+                            self._tick = tick
+                            for hook in hooks:
+                                hook()
+                        cursor = last + 1
+                        continue
+                    for tick in range(first, last + 1, spacing):
+                        if tick < cursor:
+                            continue
+                        if tick > until:
+                            cursor = tick
+                            return
+                        if tick >= self._next_phase_tick:
+                            self._enter_phases(tick)
+                        self._tick = tick
+                        if self._pending_live:
+                            self._apply_live()
+                        if tasks:
+                            now = self.now
+                            for task in tasks:
+                                step(task, now)
+                        if log:
+                            self._log()
+                        if tick < end:
+                            for hook in hooks:
+                                hook()
+                        cursor = tick + 1
                 cursor = max(cursor, base + cycle)
         finally:
             self._cursor = cursor
@@ -364,7 +407,9 @@ class Simulation:
         return RunFault(who, self.now, f"published invalid outputs {dict(out)!r}")
 
     def _log(self) -> None:
-        t_s = float(self.now)
+        # float(tick * n) without building a Fraction: int / int is correctly rounded, the
+        # same float ``float(Fraction)`` gives
+        t_s = (self._tick * self._tick_num) / self._tick_den
         values = self.values
         if self._trace is not None:
             self._trace(t_s, self._row(values))
@@ -388,9 +433,10 @@ class Simulation:
         """Time of the next instant at which something runs (where a live change lands)."""
         self.initialize()
         base = (self._cursor // self._cycle) * self._cycle
-        for off, *_ in self._table:
-            if base + off >= self._cursor:
-                return self.grid.time(base + off)
+        for off, _, _, _, last_off, spacing in self._table:
+            for tick in range(base + off, base + last_off + 1, spacing):
+                if tick >= self._cursor:
+                    return self.grid.time(tick)
         return self.grid.time(base + self._cycle + self._table[0][0])
 
     def apply_live(self, change: Change) -> Fraction:

@@ -1,4 +1,4 @@
-"""All bodies' state read, and all forces written, in one C call each.
+"""The per-step calls into Chipmunk: all bodies' state read, all forces written, one step.
 
 Reading ``body.angle``, ``body.velocity``, ... and setting ``body.force`` one property at a
 time costs ~0.3-0.8 µs each through pymunk's Python layer: for two rovers that was more
@@ -7,10 +7,11 @@ instead, but its functions allocate a fresh descriptor and re-wrap the buffers o
 call (~2.8 µs each). ``BodyIO`` builds those descriptors once and calls Chipmunk's batch
 iterators directly (~0.9 µs read, ~0.7 µs write for two rovers).
 
-That uses names ``pymunk.batch`` imports but does not document (``lib``, ``ffi``, the
-Space's ``_space`` handle; pymunk is pinned to 7.x). If they are ever missing, ``BodyIO``
-falls back to the documented ``get_space_bodies`` / ``set_space_bodies``: same data,
-slower. Both routes are exercised by the tests.
+``step`` likewise calls ``cpSpaceStep`` without ``Space.step``'s Python layer when that
+layer has nothing to do. That uses names ``pymunk`` has but does not document (``lib``, ``ffi``, the
+Space's ``_space`` handle and step queues; pymunk is pinned to 7.x). If they are ever
+missing, ``BodyIO`` falls back to the documented ``get_space_bodies`` /
+``set_space_bodies`` / ``Space.step``: same results, slower. Both routes are exercised by the tests.
 
 Layout, per body in the Space's own order (``rows`` maps rover index to that order):
 state ``x, y, angle, vx, vy, w``; forces ``fx, fy, torque``.
@@ -45,7 +46,20 @@ def _direct_available(space: pymunk.Space) -> bool:
         return (
             _lib is not None
             and _ffi is not None
-            and hasattr(space, "_space")
+            and all(
+                hasattr(space, name)
+                for name in (
+                    "_space",
+                    "_locked",
+                    "_add_later",
+                    "_remove_later",
+                    "_bodies_to_check",
+                    "_removed_shapes",
+                    "_post_step_callbacks",
+                )
+            )
+            and not space.threaded
+            and hasattr(_lib, "cpSpaceStep")
             and hasattr(_lib, "cpSpaceEachBody")
             and hasattr(_lib, "pmSpaceBodyGetIteratorFuncBatched")
             and hasattr(_lib, "pmSpaceBodySetIteratorFuncBatched")
@@ -79,6 +93,7 @@ class BodyIO:
             assert _ffi is not None
             assert _lib is not None
             self._each = _lib.cpSpaceEachBody
+            self._space_step = _lib.cpSpaceStep
             self._handle = space._space
             self._get_fn = _ffi.addressof(_lib, "pmSpaceBodyGetIteratorFuncBatched")
             self._set_fn = _ffi.addressof(_lib, "pmSpaceBodySetIteratorFuncBatched")
@@ -86,6 +101,11 @@ class BodyIO:
             self._set = self._descriptor(_WRITE, self._out)
             self._in_arr = self._in._float_arr
             self._out_arr = self._out._float_arr
+            # one read sizes the C array; later reads refill it in place (the count is reset
+            # to 0 first, so it never grows and never moves), so one view serves every read
+            self._read_c()
+            self._n_floats = self._in_arr.num
+            self._view = memoryview(_ffi.buffer(self._in_arr.arr, 8 * self._n_floats)).cast("d")
 
     @staticmethod
     def _descriptor(fields: pb.BodyFields, buf: pb.Buffer) -> Any:
@@ -96,32 +116,58 @@ class BodyIO:
         data.intArray = buf._int_arr
         return data
 
-    def read(self) -> list[float]:
-        """Every body's ``x, y, angle, vx, vy, w`` as one flat list of floats."""
+    def _read_c(self) -> None:
+        arr = self._in_arr
+        arr.num = 0
+        self._each(self._handle, self._get_fn, self._get)
+
+    def _read_view(self) -> memoryview:
+        """The read buffer after a fresh read, as doubles (valid until the next read)."""
         if self.direct:
             arr = self._in_arr
             arr.num = 0
             self._each(self._handle, self._get_fn, self._get)
-            return _ffi.unpack(arr.arr, arr.num)  # type: ignore[union-attr]
+            if arr.num != self._n_floats:
+                raise RuntimeError("a body was added to the space after its BodyIO was built")
+            return self._view
         self._in.clear()
         pb.get_space_bodies(self.space, _READ, self._in)
-        return memoryview(self._in.float_buf()).cast("d").tolist()
+        return memoryview(self._in.float_buf()).cast("d")
+
+    def read(self) -> list[float]:
+        """Every body's ``x, y, angle, vx, vy, w`` as one flat list of floats."""
+        return self._read_view().tolist()
 
     def read_array(self) -> np.ndarray:
         """The same state as a (bodies, 6) numpy array viewing the read buffer.
 
         The view is valid until the next read (the many-rover path indexes it at once).
         """
-        if self.direct:
-            arr = self._in_arr
-            arr.num = 0
-            self._each(self._handle, self._get_fn, self._get)
-            raw = _ffi.buffer(arr.arr, 8 * arr.num)  # type: ignore[union-attr]
-        else:
-            self._in.clear()
-            pb.get_space_bodies(self.space, _READ, self._in)
-            raw = self._in.float_buf()
-        return np.frombuffer(raw, dtype=np.float64).reshape(-1, STATE)
+        return np.frombuffer(self._read_view(), dtype=np.float64).reshape(-1, STATE)
+
+    def step(self, dt: float) -> None:
+        """``space.step(dt)`` without pymunk's Python bookkeeping when there is none to do.
+
+        ``Space.step`` wraps ``cpSpaceStep`` with work for bodies, shapes and callbacks queued
+        while the space was locked (~1 µs of Python per step, half of the step for two
+        rovers). Nothing in this project queues any (the collision callback only counts), so
+        when those queues are empty the C step is called directly, locked as pymunk locks it.
+        If a callback ever queued work during the step, it is refused loudly rather than lost.
+        """
+        space = self.space
+        if not self.direct or space._bodies_to_check:  # new bodies: let pymunk validate them
+            space.step(dt)
+            return
+        space._locked = True
+        try:
+            self._space_step(self._handle, dt)
+        finally:
+            space._locked = False
+        # what pymunk would do after the step, refused if there is any (there never is)
+        if space._add_later or space._remove_later or space._post_step_callbacks:
+            raise RuntimeError("a collision callback changed the space during a step")
+        if space._removed_shapes:
+            space._removed_shapes.clear()
 
     def write(self) -> None:
         """Send :attr:`forces` to every body (forces of non-rover bodies stay zero)."""

@@ -22,15 +22,20 @@ BATCH_MIN = 6
 class Fleet:
     """All rovers of one Space as arrays, indexed like ``rovers``."""
 
-    def __init__(self, io: BodyIO, rovers: list[DiffDriveRover]) -> None:
+    def __init__(
+        self, io: BodyIO, rovers: list[DiffDriveRover], dt: float, limits: tuple[float, float]
+    ) -> None:
         self.io = io
         self.rovers = rovers
+        self.dt = dt
+        self.max_speed, self.extent = limits
         self.rows = np.array(io.rows, dtype=np.intp)
         self.powers = np.zeros((2, len(rovers)))
         for i, r in enumerate(rovers):
             r.attach_power_slot(self.powers, i)
         self._out = np.frombuffer(io.forces, dtype=np.float64).reshape(-1, 3)
         self.refresh()
+        self.state = self.read()
 
     def refresh(self) -> None:
         """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
@@ -46,9 +51,17 @@ class Fleet:
         self.inv_moment = 1.0 / k.moment
         self.lateral = k.lateral
 
-    def kinematics(self, state: np.ndarray, k: int) -> list[float]:
-        """Rover ``k``'s six state floats."""
-        return state[k].tolist()
+    def kinematics(self, k: int) -> list[float]:
+        """Rover ``k``'s six state floats after the last step."""
+        return self.state[k].tolist()
+
+    def advance(self) -> tuple[int, str] | None:
+        """One physics step: forces, pymunk's step, the new state; a safety violation or None."""
+        self.apply(self.state, self.dt)
+        self.io.write()
+        self.io.step(self.dt)
+        state = self.state = self.read()
+        return self.first_violation(state, self.max_speed, self.extent)
 
     def read(self) -> np.ndarray:
         """(rovers, 6) array: x, y, angle, vx, vy, w now (a copy)."""

@@ -59,8 +59,9 @@ class DiffDriveRover:
 
     def set_power(self, left_pct: float, right_pct: float) -> None:
         """Command the wheels; the motor driver saturates at ±100 %."""
-        self.power_l = min(100.0, max(-100.0, left_pct))
-        self.power_r = min(100.0, max(-100.0, right_pct))
+        # chained comparisons, not min/max: this runs every control step of every rover
+        self.power_l = left_pct if -100.0 <= left_pct <= 100.0 else _saturate(left_pct)
+        self.power_r = right_pct if -100.0 <= right_pct <= 100.0 else _saturate(right_pct)
         if self._slot is not None:
             powers, i = self._slot
             powers[0, i] = self.power_l
@@ -107,6 +108,11 @@ class DiffDriveRover:
         v = self.forward_speed
         w = self.kinematics()[5]
         return v - w * self.half_track, v + w * self.half_track
+
+
+def _saturate(pct: float) -> float:
+    """The motor driver's limit: ±100 % (NaN gives -100, as ``min(100, max(-100, nan))``)."""
+    return min(100.0, max(-100.0, pct))
 
 
 def wrap_angle(a: float) -> float:

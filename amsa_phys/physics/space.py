@@ -48,7 +48,6 @@ class PhysicsWorld:
         self._owner: dict[int, str] = {}
         self.collisions = 0
         self._model: FewRovers | fleet.Fleet | None = None
-        self._state: Any = None
         self._add_obstacles(settings.get("obstacles") or [], settings.get("walls"))
         self.space.on_collision(ROVER, ROVER, begin=self._on_collision)
         self.space.on_collision(ROVER, OBSTACLE, begin=self._on_collision)
@@ -138,35 +137,30 @@ class PhysicsWorld:
     def step(self) -> None:
         """Advance the world by one physics step (the engine's hook).
 
-        One batch read and one batch write of body state a step (``bodyio.py``). The state
-        read after a step is the next step's input: only the physics step moves bodies.
+        One batch write, one C step and one batch read of body state (``bodyio.py``); the
+        state read after a step is the next step's input, since only the physics step moves
+        bodies.
         """
-        model = self._model or self._start()
-        model.apply(self._state, self.dt)
-        model.io.write()
-        self.space.step(self.dt)
-        state = self._state = model.read()
-        bad = model.first_violation(state, self.max_speed, self.extent)
+        bad = (self._model or self._start()).advance()
         if bad is not None:
             raise RunFault(self.rovers[bad[0]].name, self.sim.now + 1 / self.rate, bad[1])
 
     def _start(self) -> FewRovers | fleet.Fleet:
         """Choose the force model for this many rovers and read the initial state."""
         io = BodyIO(self.space, [r.body for r in self.rovers])
+        limits = (self.max_speed, self.extent)
         if len(self.rovers) >= fleet.BATCH_MIN:
-            model: FewRovers | fleet.Fleet = fleet.Fleet(io, self.rovers)
+            model: FewRovers | fleet.Fleet = fleet.Fleet(io, self.rovers, self.dt, limits)
         else:
-            model = FewRovers(io, self.rovers)
+            model = FewRovers(io, self.rovers, self.dt, limits)
         self._model = model
-        self._state = model.read()
         for k, rover in enumerate(self.rovers):
             rover.attach_state(functools.partial(self._kinematics, k))
         return model
 
     def _kinematics(self, k: int) -> Sequence[float]:
-        """Rover ``k``'s ``x, y, angle, vx, vy, w`` from the last batch read."""
-        model = self._model or self._start()
-        return model.kinematics(self._state, k)
+        """Rover ``k``'s ``x, y, angle, vx, vy, w`` after the last step."""
+        return (self._model or self._start()).kinematics(k)
 
     def _on_collision(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
         a, b = arbiter.shapes

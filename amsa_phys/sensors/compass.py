@@ -7,6 +7,7 @@ from collections.abc import Mapping
 from fractions import Fraction
 from typing import Any
 
+from ..engine.rng import Drawn
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
 
@@ -23,10 +24,10 @@ class Compass(Template):
     )
 
     def initialize(self, ctx: Any) -> None:
-        """Take this component's own random stream."""
-        self.rng = ctx.rng
+        """Take this component's own random stream (drawn in blocks)."""
+        self.noise = Drawn(ctx.rng.standard_normal)
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
         """The paper's doStep: one heading sample."""
-        value = inp["heading"] + self.p.bias + self.p.noise * self.rng.normal()
+        value = inp["heading"] + self.p.bias + self.p.noise * self.noise()
         return {"compassHeading": (value + math.pi) % (2 * math.pi) - math.pi}

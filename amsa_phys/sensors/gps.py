@@ -6,6 +6,7 @@ from collections.abc import Mapping
 from fractions import Fraction
 from typing import Any
 
+from ..engine.rng import Drawn
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
 
@@ -15,7 +16,8 @@ class GPS(Template):
 
     Consumers then keep the stale fix, which is what the paper's degraded context (10 % of the
     leader's fixes lost) relies on. The loss draw and the noise draws happen at every step,
-    lost or not, so a sweep over ``lostDataGPS`` keeps the same noise sequence.
+    lost or not, from two separate streams, so a sweep over ``lostDataGPS`` keeps the same
+    noise sequence.
     """
 
     kind = Kind.SENSOR
@@ -30,14 +32,17 @@ class GPS(Template):
     )
 
     def initialize(self, ctx: Any) -> None:
-        """Take this component's own random stream."""
-        self.rng = ctx.rng
+        """Split this component's random stream: one for the noise, one for the losses."""
+        noise_rng, loss_rng = ctx.rng.spawn(2)
+        self.noise = Drawn(noise_rng.standard_normal)
+        self.draw_loss = Drawn(loss_rng.random)
         self.lost = 0  # samples lost so far: the renderer marks them
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
         """The paper's doStep: sample the position, or lose the sample."""
-        ex, ey = self.rng.normal(0.0, 1.0, size=2)
-        lost = self.rng.uniform(0.0, 100.0) < self.p.lostDataGPS
+        ex = self.noise()
+        ey = self.noise()
+        lost = self.draw_loss() * 100.0 < self.p.lostDataGPS
         if lost:
             self.lost += 1
             return {}

@@ -82,8 +82,8 @@ def test_inlined_forces_equal_the_reference_wheel_model() -> None:
     rovers[0].set_power(100, -100)
     rovers[1].set_power(0, 0)
     rovers[2].set_power(37.5, 12.0)
-    model = FewRovers(BodyIO(space, [r.body for r in rovers]), rovers)
-    model.apply(model.read(), DT)
+    model = FewRovers(BodyIO(space, [r.body for r in rovers]), rovers, DT, (100.0, 1e4))
+    model.apply(model.state)
     for k, r in enumerate(rovers):
         o = model.rows[k] * bodyio.FORCE
         got = tuple(model.io.forces[o : o + 3])
