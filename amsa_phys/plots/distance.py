@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 from typing import Any
 
@@ -15,10 +16,18 @@ from .save import save_png
 
 
 def read_trace(path: Path) -> tuple[list[str], np.ndarray]:
-    """The trace's column names and its values as a 2-D array."""
+    """The trace's column names and its values as a 2-D array (read once per file version:
+    a run draws several plots from the same trace)."""
+    st = Path(path).stat()
+    return _read_trace(str(path), st.st_mtime_ns, st.st_size)
+
+
+@functools.lru_cache(maxsize=2)
+def _read_trace(path: str, mtime_ns: int, size: int) -> tuple[list[str], np.ndarray]:
     with open(path, encoding="utf-8") as fh:
         header = fh.readline().strip().split(",")
     data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    data.flags.writeable = False  # shared between callers
     return header, data
 
 
@@ -67,4 +76,4 @@ def plot_distance(trace: Path, metrics: dict[str, Any], out: Path) -> Path:
     ax.grid(alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="lower right", fontsize=8)
-    return save_png(fig, out)
+    return save_png(fig, out, margins=(0.065, 0.11, 0.985, 0.92))

@@ -11,9 +11,20 @@ from matplotlib.figure import Figure
 from ..engine.recorder import write_atomic
 
 
-def save_png(fig: Figure, out: Path) -> Path:
-    """Render ``fig`` to PNG, write it atomically to ``out`` and close the figure."""
-    fig.tight_layout()
+def save_png(
+    fig: Figure, out: Path, margins: tuple[float, float, float, float] | None = None
+) -> Path:
+    """Render ``fig`` to PNG, write it atomically to ``out`` and close the figure.
+
+    ``margins`` (left, bottom, right, top, in figure fractions) places a single-axes figure
+    directly; without it ``tight_layout`` measures every label first, which costs a full
+    extra layout pass (~60 ms a figure, a tenth of a headless run's process time).
+    """
+    if margins is None:
+        fig.tight_layout()
+    else:
+        left, bottom, right, top = margins
+        fig.subplots_adjust(left=left, bottom=bottom, right=right, top=top)
     buf = io.BytesIO()
     fig.savefig(buf, format="png")
     plt.close(fig)

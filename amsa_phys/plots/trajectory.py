@@ -41,4 +41,4 @@ def plot_trajectory(trace: Path, metrics: dict[str, Any], out: Path) -> Path:
     ax.set_ylabel("y (m)")
     ax.grid(alpha=0.3)
     ax.set_title(f"{metrics.get('scenario', '')}: trajectories (o start, ■ end)")
-    return save_png(fig, out)
+    return save_png(fig, out, margins=(0.12, 0.09, 0.97, 0.93))
