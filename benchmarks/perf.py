@@ -113,7 +113,7 @@ def platoon(reps: int) -> None:
         costs: dict[int, list[float]] = {}
         for cars in (1, 9, 49, 199):
             scen = platoon_world(cars, tmp)
-            duration = max(2.0, 200.0 / (cars + 1))
+            duration = max(10.0, 400.0 / (cars + 1))
             for _ in range(reps):
                 cost, rovers = platoon_cost(scen, duration)
                 costs.setdefault(rovers, []).append(cost)

@@ -23,12 +23,12 @@ class Drawn:
     """Scalars from one random stream, drawn from numpy in blocks.
 
     A sensor needs one or two random numbers a step; asking numpy for each costs ~1 µs (a
-    call and an array), drawing 256 at once costs ~0.02 µs a number. The sequence is fixed by
+    call and an array), drawing 64 at once costs ~0.02 µs a number. The sequence is fixed by
     the stream alone, so it is the same whatever else the component does between draws.
     ``draw(n)`` returns the next ``n`` numbers, e.g. ``rng.standard_normal``.
     """
 
-    def __init__(self, draw: Callable[[int], np.ndarray], block: int = 256) -> None:
+    def __init__(self, draw: Callable[[int], np.ndarray], block: int = 64) -> None:
         self._draw = draw
         self._block = block
         self._it: Iterator[float] = iter(())
