@@ -11,6 +11,7 @@ Run: ``python benchmarks/bench_run.py [--reps 5] [--duration 300]``.
 from __future__ import annotations
 
 import argparse
+import math
 import statistics
 import tempfile
 import time
@@ -24,7 +25,7 @@ from amsa_phys.model.scenario import load_scenario
 from amsa_phys.physics.bodyio import BodyIO
 from amsa_phys.physics.forces import FewRovers
 from amsa_phys.physics.rover import DiffDriveRover
-from amsa_phys.physics.wheel import WheelModel
+from amsa_phys.physics.wheel import WheelModel, lateral_force
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -40,8 +41,8 @@ def engine_run(duration: float) -> float:
         return time.perf_counter() - t0
 
 
-def bare_loop(duration: float, rate: int = 100) -> float:
-    """Wall seconds to step two rovers with the same wheel model, no engine around them."""
+def two_rovers() -> tuple[pymunk.Space, list[DiffDriveRover]]:
+    """The two scenario1 rover bodies (default template parameters) driving in a space."""
     space = pymunk.Space()
     load = 30.0 * 9.81 / 2
     wheel = WheelModel(45.0, 5.5, 1.0, 0.8 * load, 0.02 * load)
@@ -64,6 +65,15 @@ def bare_loop(duration: float, rate: int = 100) -> float:
     ]
     rovers[0].set_power(22, 22)
     rovers[1].set_power(30, 28)
+    return space, rovers
+
+
+def bare_loop(duration: float, rate: int = 100) -> float:
+    """Wall seconds to step two rovers with the same wheel model, no engine around them.
+
+    The floor: the same force code, batch I/O and C step the engine's physics uses.
+    """
+    space, rovers = two_rovers()
     dt = 1.0 / rate
     model = FewRovers(BodyIO(space, [r.body for r in rovers]), rovers, dt, (100.0, 1e4))
     io = model.io
@@ -77,20 +87,55 @@ def bare_loop(duration: float, rate: int = 100) -> float:
     return time.perf_counter() - t0
 
 
+def plain_loop(duration: float, rate: int = 100) -> float:
+    """Wall seconds for the straightforward loop the issue describes (context, not a target).
+
+    Same bodies and wheel model, written the obvious way: pymunk properties read and set per
+    body, ``WheelModel.drive_force`` and ``lateral_force`` called per wheel, ``space.step``.
+    """
+    space, rovers = two_rovers()
+    dt = 1.0 / rate
+    t0 = time.perf_counter()
+    for _ in range(int(duration * rate)):
+        for r in rovers:
+            body = r.body
+            a = body.angle
+            c, s = math.cos(a), math.sin(a)
+            vx, vy = body.velocity
+            w = body.angular_velocity
+            v_fwd = vx * c + vy * s
+            f_l = r.wheel.drive_force(r.power_l, v_fwd - w * r.half_track)
+            f_r = r.wheel.drive_force(r.power_r, v_fwd + w * r.half_track)
+            fx = f_l + f_r
+            torque = (f_r - f_l) * r.half_track
+            turn = (w + torque / body.moment * dt) * dt
+            end, mid = a + turn, a + 0.5 * turn
+            px = vx + fx * c / r.mass * dt
+            py = vy + fx * s / r.mass * dt
+            side = px * -math.sin(end) + py * math.cos(end)
+            f_lat = lateral_force(side / math.cos(0.5 * turn), r.mass, dt, r.lateral_limit)
+            body.force = (fx * c - f_lat * math.sin(mid), fx * s + f_lat * math.cos(mid))
+            body.torque = torque
+        space.step(dt)
+    return time.perf_counter() - t0
+
+
 def main() -> None:
     """Measure and print."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--duration", type=float, default=300.0)
     args = ap.parse_args()
-    engine, bare = [], []
+    engine, bare, plain = [], [], []
     for _ in range(args.reps):
         engine.append(engine_run(args.duration))
         bare.append(bare_loop(args.duration))
+        plain.append(plain_loop(args.duration))
     d = args.duration
     for name, xs in (
         ("engine (scenario1, 8 components, trace)", engine),
         ("bare pymunk loop, same bodies and wheels", bare),
+        ("plain per-property loop (context)", plain),
     ):
         med = statistics.median(xs)
         print(

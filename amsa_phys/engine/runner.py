@@ -322,10 +322,16 @@ class Simulation:
                     ):
                         # a whole run of hook-only instants (physics steps between log rows):
                         # nothing else can happen in between, so no checks per instant
-                        for tick in range(first, last + 1, spacing):
-                            self._tick = tick
-                            for hook in hooks:
+                        if len(hooks) == 1:  # the usual case: the physics step alone
+                            hook = hooks[0]
+                            for tick in range(first, last + 1, spacing):
+                                self._tick = tick
                                 hook()
+                        else:
+                            for tick in range(first, last + 1, spacing):
+                                self._tick = tick
+                                for hook in hooks:
+                                    hook()
                         cursor = last + 1
                         continue
                     for tick in range(first, last + 1, spacing):
