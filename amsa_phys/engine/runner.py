@@ -10,7 +10,9 @@ At every instant the engine does, in this order:
 
 So a component due at t sees the world as it is at t. The whole schedule repeats with the
 hyperperiod of all rates and is precomputed once as a table of (offset, actions): the loop
-does no scheduling arithmetic per instant.
+does no scheduling arithmetic per instant, and a run of instants where only the physics step
+is due (four in five at 100 Hz physics with a 20 Hz trace) is one table entry stepped in a
+tight loop.
 """
 
 from __future__ import annotations
