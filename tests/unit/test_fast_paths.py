@@ -132,3 +132,13 @@ def test_trace_rows_equal_plain_repr_whatever_changes(tmp_path: Path) -> None:
         expected.append(",".join(map(repr, [k * 0.05, *values])))
     writer.close()
     assert (tmp_path / "trace.csv").read_text().splitlines() == expected
+
+
+def test_batch_io_refuses_a_body_added_behind_its_back() -> None:
+    space, rovers = make_rovers(2)
+    io = BodyIO(space, [r.body for r in rovers])
+    extra = pymunk.Body(1.0, 1.0)
+    space.add(extra, pymunk.Circle(extra, 0.1))
+    space.step(0.01)  # pymunk validates the new body
+    with pytest.raises(RuntimeError, match="added to the space after"):
+        io.read()
