@@ -9,14 +9,16 @@ from __future__ import annotations
 import array
 import math
 import random
+from fractions import Fraction
 from pathlib import Path
 
 import pymunk
 import pytest
 
+from amsa_phys.engine import runner
 from amsa_phys.engine.recorder import TraceWriter
 from amsa_phys.engine.runner import Simulation
-from amsa_phys.model.scenario import load_scenario
+from amsa_phys.model.scenario import Change, load_scenario
 from amsa_phys.physics import bodyio
 from amsa_phys.physics.bodyio import BodyIO
 from amsa_phys.physics.forces import FewRovers
@@ -142,3 +144,46 @@ def test_batch_io_refuses_a_body_added_behind_its_back() -> None:
     space.step(0.01)  # pymunk validates the new body
     with pytest.raises(RuntimeError, match="added to the space after"):
         io.read()
+
+
+def scheduled_run(tmp_path: Path, chunks: list[int] | None) -> tuple[list[list[float]], list]:
+    """The MDE world with a timeline change and a live change inside runs of physics-only
+    instants (t = 2.03 s, between two 20 Hz log rows); ``chunks`` advance in uneven steps."""
+    scen = tmp_path / "s.yaml"
+    scen.write_text(
+        f"world: {ROOT / 'worlds' / 'mde_challenge.yaml'}\n"
+        "duration: 6\nseed: 3\n"
+        "timeline:\n  - {at: 2.03, set: {Leader.cruisePower: 60}}\n"
+    )
+    rows: list[list[float]] = []
+    sim = Simulation.from_scenario(load_scenario(scen), trace=lambda t, v: rows.append([t, *v]))
+    sim.initialize()
+    tick = 0
+    for step in chunks or [sim.grid.ticks(Fraction(6))]:
+        tick += step
+        sim.advance(tick)
+        if tick == 311:  # queue a live change between two physics-only instants
+            sim.apply_live(Change("Leader", "cruisePower", 30.0))
+    sim.advance(sim.grid.ticks(Fraction(6)))
+    changes = [(at, c.leaf, c.param, c.value) for at, c in sim.change_log]
+    return rows, [*changes, [tuple(r.kinematics()) for r in sim.shared["physics"].rovers]]
+
+
+def test_runs_of_physics_only_instants_change_nothing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    chunks = [7, 300, 4, 1, 37, 251]  # passes tick 311 and cuts runs in their middle
+    fast = scheduled_run(tmp_path, chunks)
+    assert scheduled_run(tmp_path, [311, 289]) == fast  # whole runs, the tight loop
+    assert fast[1][0][0] == Fraction(203, 100)  # the timeline change, at its exact instant
+    assert fast[1][1][0] == Fraction(312, 100)  # the live change, at the next instant
+    # the same run with every instant its own table entry (no runs)
+    monkeypatch.setattr(
+        runner,
+        "_runs",
+        lambda instants: [
+            (i.offset, tuple(i.tasks), i.log, tuple(i.hooks), i.offset, 1) for i in instants
+        ],
+    )
+    assert scheduled_run(tmp_path, chunks) == fast
+    assert scheduled_run(tmp_path, [1] * 600) == fast
