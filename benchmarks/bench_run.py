@@ -11,7 +11,6 @@ Run: ``python benchmarks/bench_run.py [--reps 5] [--duration 300]``.
 from __future__ import annotations
 
 import argparse
-import math
 import statistics
 import tempfile
 import time
@@ -23,9 +22,9 @@ from amsa_phys.engine.recorder import TraceWriter
 from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.physics.bodyio import BodyIO
-from amsa_phys.physics.forces import FewRovers
+from amsa_phys.physics.forces import FewRovers, reference_forces
 from amsa_phys.physics.rover import DiffDriveRover
-from amsa_phys.physics.wheel import WheelModel, lateral_force
+from amsa_phys.physics.wheel import WheelModel
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -90,32 +89,17 @@ def bare_loop(duration: float, rate: int = 100) -> float:
 def plain_loop(duration: float, rate: int = 100) -> float:
     """Wall seconds for the straightforward loop the issue describes (context, not a target).
 
-    Same bodies and wheel model, written the obvious way: pymunk properties read and set per
-    body, ``WheelModel.drive_force`` and ``lateral_force`` called per wheel, ``space.step``.
+    Same bodies and wheel model, written the obvious way (``forces.reference_forces``: pymunk
+    properties read and set per body, the wheel functions called per wheel), ``space.step``.
     """
     space, rovers = two_rovers()
     dt = 1.0 / rate
     t0 = time.perf_counter()
     for _ in range(int(duration * rate)):
         for r in rovers:
-            body = r.body
-            a = body.angle
-            c, s = math.cos(a), math.sin(a)
-            vx, vy = body.velocity
-            w = body.angular_velocity
-            v_fwd = vx * c + vy * s
-            f_l = r.wheel.drive_force(r.power_l, v_fwd - w * r.half_track)
-            f_r = r.wheel.drive_force(r.power_r, v_fwd + w * r.half_track)
-            fx = f_l + f_r
-            torque = (f_r - f_l) * r.half_track
-            turn = (w + torque / body.moment * dt) * dt
-            end, mid = a + turn, a + 0.5 * turn
-            px = vx + fx * c / r.mass * dt
-            py = vy + fx * s / r.mass * dt
-            side = px * -math.sin(end) + py * math.cos(end)
-            f_lat = lateral_force(side / math.cos(0.5 * turn), r.mass, dt, r.lateral_limit)
-            body.force = (fx * c - f_lat * math.sin(mid), fx * s + f_lat * math.cos(mid))
-            body.torque = torque
+            fx, fy, torque = reference_forces(r, dt)
+            r.body.force = (fx, fy)
+            r.body.torque = torque
         space.step(dt)
     return time.perf_counter() - t0
 

@@ -29,6 +29,7 @@ from typing import NamedTuple
 
 from .bodyio import FORCE, STATE, BodyIO
 from .rover import DiffDriveRover
+from .wheel import lateral_force
 
 
 class RoverConstants(NamedTuple):
@@ -204,6 +205,31 @@ class FewRovers:
             if not (abs(x) <= extent and abs(y) <= extent):
                 return k, outside(x, y, extent)
         return None
+
+
+def reference_forces(rover: DiffDriveRover, dt: float) -> tuple[float, float, float]:
+    """The same model written plainly: pymunk properties, ``wheel.py``'s functions per wheel.
+
+    ``(fx, fy, torque)`` for ``rover`` this step. Slow (~5 µs a rover); it is what the fast
+    paths are tested against and the "plain loop" of the benchmarks.
+    """
+    body = rover.body
+    a = body.angle
+    c, s = math.cos(a), math.sin(a)
+    vx, vy = body.velocity
+    w = body.angular_velocity
+    v_fwd = vx * c + vy * s
+    f_l = rover.wheel.drive_force(rover.power_l, v_fwd - w * rover.half_track)
+    f_r = rover.wheel.drive_force(rover.power_r, v_fwd + w * rover.half_track)
+    fx = f_l + f_r
+    torque = (f_r - f_l) * rover.half_track
+    turn = (w + torque / body.moment * dt) * dt
+    end, mid = a + turn, a + 0.5 * turn
+    px = vx + fx * c / rover.mass * dt
+    py = vy + fx * s / rover.mass * dt
+    side = px * -math.sin(end) + py * math.cos(end)
+    f_lat = lateral_force(side / math.cos(0.5 * turn), rover.mass, dt, rover.lateral_limit)
+    return fx * c - f_lat * math.sin(mid), fx * s + f_lat * math.cos(mid), torque
 
 
 def too_fast(speed: float, max_speed: float) -> str:

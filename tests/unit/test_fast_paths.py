@@ -7,7 +7,6 @@ Each speed-up keeps a slower, obvious route alive (reference wheel model, docume
 from __future__ import annotations
 
 import array
-import math
 import random
 from fractions import Fraction
 from pathlib import Path
@@ -21,9 +20,9 @@ from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import Change, load_scenario
 from amsa_phys.physics import bodyio
 from amsa_phys.physics.bodyio import BodyIO
-from amsa_phys.physics.forces import FewRovers
+from amsa_phys.physics.forces import FewRovers, reference_forces
 from amsa_phys.physics.rover import DiffDriveRover
-from amsa_phys.physics.wheel import WheelModel, lateral_force
+from amsa_phys.physics.wheel import WheelModel
 
 ROOT = Path(__file__).resolve().parents[2]
 WHEEL = WheelModel(45.0, 5.5, 0.9, 0.8 * 147.15, 0.02 * 147.15)
@@ -52,27 +51,6 @@ def make_rovers(n: int) -> tuple[pymunk.Space, list[DiffDriveRover]]:
         for i in range(n)
     ]
     return space, rovers
-
-
-def reference_forces(r: DiffDriveRover, dt: float) -> tuple[float, float, float]:
-    """The force model written with ``wheel.py``'s reference functions and pymunk properties."""
-    body = r.body
-    a = body.angle
-    c, s = math.cos(a), math.sin(a)
-    vx, vy = body.velocity
-    w = body.angular_velocity
-    v_fwd = vx * c + vy * s
-    f_l = r.wheel.drive_force(r.power_l, v_fwd - w * r.half_track)
-    f_r = r.wheel.drive_force(r.power_r, v_fwd + w * r.half_track)
-    fx = f_l + f_r
-    torque = (f_r - f_l) * r.half_track
-    turn = (w + torque / body.moment * dt) * dt
-    end, mid = a + turn, a + 0.5 * turn
-    px = vx + fx * c / r.mass * dt
-    py = vy + fx * s / r.mass * dt
-    side = px * -math.sin(end) + py * math.cos(end)
-    f_lat = lateral_force(side / math.cos(0.5 * turn), r.mass, dt, r.lateral_limit)
-    return fx * c - f_lat * math.sin(mid), fx * s + f_lat * math.cos(mid), torque
 
 
 def test_inlined_forces_equal_the_reference_wheel_model() -> None:
