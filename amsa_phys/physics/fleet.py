@@ -64,7 +64,7 @@ class Fleet:
 
     def advance(self) -> tuple[int, str] | None:
         """One physics step: forces, pymunk's step, the new state; a safety violation or None."""
-        self.apply(self.state, self.dt)
+        self.apply(self.state)
         self.io.write()
         self.io.step(self.dt)
         state = self.state = self.read()
@@ -93,8 +93,9 @@ class Fleet:
         motor -= ratio
         return motor
 
-    def apply(self, state: np.ndarray, dt: float) -> None:
+    def apply(self, state: np.ndarray) -> None:
         """Write every rover's force and torque for this step into the batch buffer."""
+        dt = self.dt
         angle, vx, vy, w = state[:, 2], state[:, 3], state[:, 4], state[:, 5]
         c = np.cos(angle)
         s = np.sin(angle)
