@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 from typing import Any
+
+import numpy as np
 
 from amsa_phys.model.params import Param
 from amsa_phys.model.template import Kind, Port, Template
@@ -105,3 +108,21 @@ class Bad(Template):
                 raise ZeroDivisionError("division by zero")
             return {"u": float("nan")}
         return {"u": 0.0}
+
+
+class Divider(Template):
+    """A sensor publishing ``1 / (k x)``, one copy at a time or many at once (``step_many``)."""
+
+    kind = Kind.SENSOR
+    inputs = (Port("x"),)
+    outputs = (Port("y"),)
+    params = (Param("k", "float", "factor", 1.0, -10.0, 10.0),)
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        k = inp["x"] * self.p.k
+        return {"y": 1.0 / k if k else math.inf}
+
+    @classmethod
+    def step_many(cls, comps: Any, t: Fraction, inp: Any, p: Any, state: Any) -> Any:
+        with np.errstate(divide="ignore"):
+            return {"y": 1.0 / (inp["x"] * p.k)}, None

@@ -25,9 +25,11 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from fractions import Fraction
 from typing import Any
+
+import numpy as np
 
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
@@ -154,3 +156,88 @@ class FollowerController(Template):
         if stt <= 0:
             return
         self.v_leader = math.hypot(stx / stt, sty / stt)
+
+    @classmethod
+    def step_many(
+        cls,
+        comps: Sequence[FollowerController],
+        t: Fraction,
+        inp: Mapping[str, Any],
+        p: Any,
+        state: dict[str, Any],
+    ) -> tuple[Mapping[str, Any], None]:
+        """``do_step`` for many copies at once (``engine/batch.py``).
+
+        The fixes of every copy live in a (copies, slots) array, newest in the last column,
+        with a mask of the slots in use; the update follows ``_update_speed`` step by step
+        (skip a repeated fix, restart after an impossible jump, append, drop old fixes) and
+        the slope is the same two-pass least squares, summed along the rows.
+        """
+        n = len(comps)
+        ts = float(t)
+        if "fixes" not in state:
+            state["fixes"] = _grow(None, n, 16)
+            state["v"] = np.zeros(n)
+        v_leader = state["v"]
+        xl, yl, d = inp["xLeader"], inp["yLeader"], inp["distanceLeaderFollower"]
+        active = d > 0.0
+        # _update_speed, for the active copies whose leader fix is new
+        T, X, Y, used = state["fixes"]
+        has = used[:, -1]
+        same = has & (X[:, -1] == xl) & (Y[:, -1] == yl)
+        upd = active & ~same
+        if upd.any():
+            jump = np.hypot(xl - X[:, -1], yl - Y[:, -1]) > 2 * p.maxSpeed * np.maximum(
+                ts - T[:, -1], 0.25
+            )
+            used[upd & has & jump] = False
+            rows = np.flatnonzero(upd)
+            if used[rows, 0].any():  # a window longer than the slots: double them
+                state["fixes"] = _grow(state["fixes"], n, 2 * T.shape[1])
+                T, X, Y, used = state["fixes"]
+            for arr, new in ((T, ts), (X, xl[rows]), (Y, yl[rows])):
+                arr[rows, :-1] = arr[rows, 1:]
+                arr[rows, -1] = new
+            used[rows, :-1] = used[rows, 1:]
+            used[rows, -1] = True
+            used[rows] &= T[rows] >= (ts - p.speedWindow[rows])[:, None]
+            k = used[rows].sum(axis=1)
+            m = used[rows]
+            mt = np.where(m, T[rows], 0.0).sum(axis=1) / np.maximum(k, 1)
+            mx = np.where(m, X[rows], 0.0).sum(axis=1) / np.maximum(k, 1)
+            my = np.where(m, Y[rows], 0.0).sum(axis=1) / np.maximum(k, 1)
+            dt = np.where(m, T[rows] - mt[:, None], 0.0)
+            stt = (dt * dt).sum(axis=1)
+            stx = (dt * (X[rows] - mx[:, None])).sum(axis=1)
+            sty = (dt * (Y[rows] - my[:, None])).sum(axis=1)
+            ok = (k >= 2) & (stt > 0)
+            safe = np.where(ok, stt, 1.0)
+            v_leader[rows[ok]] = np.hypot(stx / safe, sty / safe)[ok]
+        dx = xl - inp["xFollower"]
+        dy = yl - inp["yFollower"]
+        alpha = np.arctan2(dy, dx) - inp["headingFollower"]
+        alpha = (alpha + math.pi) % (2 * math.pi) - math.pi
+        e = d - p.distanceRef
+        moving = v_leader > 0
+        ff = np.where(moving, p.frictionPower + 100.0 * v_leader / p.maxSpeed, 0.0)
+        forward = (100.0 * p.Kv * e + p.Kff * ff) * np.cos(alpha)
+        turn = 100.0 * p.Kw * alpha
+        zero = np.zeros(n)
+        return {
+            "LeftPower": np.where(active, forward - turn, zero),
+            "RightPower": np.where(active, forward + turn, zero),
+            "leaderSpeed": v_leader.copy(),
+        }, None
+
+
+def _grow(
+    fix: tuple[np.ndarray, ...] | None, n: int, slots: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The fix arrays with ``slots`` columns, the newest fixes kept in the last ones."""
+    T, X, Y = (np.zeros((n, slots)) for _ in range(3))
+    used = np.zeros((n, slots), dtype=bool)
+    if fix is not None:
+        w = fix[0].shape[1]
+        for new, old in zip((T, X, Y, used), fix, strict=True):
+            new[:, slots - w :] = old
+    return T, X, Y, used

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from fractions import Fraction
 from typing import Any
+
+import numpy as np
 
 from ..model.template import Kind, Port, Template
 
@@ -27,3 +29,12 @@ class DistanceMonitor(Template):
                 inp["xLeader"] - inp["xFollower"], inp["yLeader"] - inp["yFollower"]
             )
         }
+
+    @classmethod
+    def step_many(
+        cls, comps: Sequence[Any], t: Fraction, inp: Mapping[str, Any], p: Any, state: Any
+    ) -> tuple[Mapping[str, Any], None]:
+        """``do_step`` for many copies at once (``engine/batch.py``)."""
+        dx = inp["xLeader"] - inp["xFollower"]
+        dy = inp["yLeader"] - inp["yFollower"]
+        return {"distanceFollowerToLeader": np.hypot(dx, dy)}, None

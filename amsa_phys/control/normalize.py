@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from fractions import Fraction
 from typing import Any
+
+import numpy as np
 
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
@@ -49,3 +51,15 @@ class NormalizePower(Template):
             "normalizedPowerL": min(hi, max(lo, inp["powerL"])) * k,
             "normalizedPowerR": min(hi, max(lo, inp["powerR"])) * k,
         }
+
+    @classmethod
+    def step_many(
+        cls, comps: Sequence[Any], t: Fraction, inp: Mapping[str, Any], p: Any, state: Any
+    ) -> tuple[Mapping[str, Any], None]:
+        """``do_step`` for many copies at once (``engine/batch.py``)."""
+        k = p.motorCoef * 0.01
+        lo, hi = p.powerMin, p.powerMax
+        return {
+            "normalizedPowerL": np.minimum(hi, np.maximum(lo, inp["powerL"])) * k,
+            "normalizedPowerR": np.minimum(hi, np.maximum(lo, inp["powerR"])) * k,
+        }, None

@@ -8,7 +8,7 @@ every other component's random numbers unchanged.
 from __future__ import annotations
 
 import zlib
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 
 import numpy as np
 
@@ -32,6 +32,7 @@ class Drawn:
         self._draw = draw
         self._block = block
         self._it: Iterator[float] = iter(())
+        self._unused = self._it  # replaced at the first draw
 
     def __call__(self) -> float:
         """The next number."""
@@ -40,3 +41,35 @@ class Drawn:
         except StopIteration:
             self._it = iter(self._draw(self._block).tolist())
             return next(self._it)
+
+    @property
+    def fresh(self) -> bool:
+        """Whether nothing was drawn yet (a group may then take the stream over)."""
+        return self._it is self._unused
+
+
+class DrawnMany:
+    """The next number of each of many streams at once, as an array.
+
+    The group form of :class:`Drawn` (``engine/batch.py``): every stream fills its row of a
+    (streams, block) array in one numpy call, and each call returns the next column, so
+    every stream yields exactly the numbers it would one at a time. It takes over fresh
+    ``Drawn`` streams (a leaf is stepped in its group always or never).
+    """
+
+    def __init__(self, streams: Sequence[Drawn], block: int = 64) -> None:
+        if not all(d.fresh for d in streams):
+            raise RuntimeError("a stream was drawn from before its group took it over")
+        self._draws = [d._draw for d in streams]
+        self._block = block
+        self._pos = block
+        self._buf = np.empty((len(streams), 0))
+
+    def __call__(self) -> np.ndarray:
+        """The next number of every stream."""
+        if self._pos >= self._block:
+            self._buf = np.array([draw(self._block) for draw in self._draws])
+            self._pos = 0
+        col = self._buf[:, self._pos]
+        self._pos += 1
+        return col

@@ -22,6 +22,7 @@ import operator
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
+from itertools import compress
 from typing import Any
 
 import numpy as np
@@ -30,6 +31,7 @@ from ..errors import RunFault
 from ..model.scenario import Change, Phase, Scenario
 from ..model.template import Template
 from ..model.world import WorldSpec
+from . import batch
 from .clock import MAX_EVENTS_PER_CYCLE, TickGrid, hyperperiod
 from .rng import component_rng
 
@@ -267,7 +269,23 @@ class Simulation:
         for (_, fn, _), period in zip(self._hooks, hook_periods, strict=True):
             for off in range(0, self._cycle, period):
                 table.setdefault(off, _Instant(off)).hooks.append(fn)
-        self._table = _runs([i for _, i in sorted(table.items())])
+        instants = [i for _, i in sorted(table.items())]
+        # like components of repeated Composites step as arrays where that changes no read
+        keys = {t.path: batch.group_key(t, leaves[t.path].freq) for t in self._tasks}
+        planned = batch.plan([i.tasks for i in instants], keys)
+        self._groups_of: dict[str, list[batch.Group]] = {}
+        for inst, seq in zip(instants, planned, strict=True):
+            inst.tasks = [
+                (self._step_group, item) if isinstance(item, batch.Group) else (self._step, item)
+                for item in seq
+            ]
+            for item in seq:
+                if isinstance(item, batch.Group):
+                    for path in item.paths:
+                        groups = self._groups_of.setdefault(path, [])
+                        if item not in groups:
+                            groups.append(item)
+        self._table = _runs(instants)
         self._end = g.ticks(self.duration)
         self._phase_ticks = [g.ticks(p.at) for p in self.phases]
         self._next_phase_tick = self._phase_tick_after(self.phase_index)
@@ -304,7 +322,6 @@ class Simulation:
         cycle = self._cycle
         table = self._table
         end = self._end
-        step = self._step
         cursor = self._cursor
         try:
             while cursor <= until:
@@ -349,8 +366,8 @@ class Simulation:
                             self._apply_live()
                         if tasks:
                             now = self.now
-                            for task in tasks:
-                                step(task, now)
+                            for run, task in tasks:
+                                run(task, now)
                         if log:
                             self._log()
                         if tick < end:
@@ -400,6 +417,33 @@ class Simulation:
         except (KeyError, TypeError, ValueError):
             raise self._bad_output(task, out) from None
 
+    def _step_group(self, group: batch.Group, now: Fraction) -> None:
+        """Run a group of like components in one call (``engine/batch.py``)."""
+        values = self.values
+        inp = {port: np.array(get(values), dtype=np.float64) for port, get in group.inputs}
+        try:
+            out, published = group.template.step_many(
+                group.comps, now, inp, group.params, group.state
+            )
+        except RunFault:
+            raise
+        except Exception as exc:
+            who = self._who(group.paths[0])
+            raise RunFault(who, now, f"do_step raised {exc!r}") from exc
+        n = len(group.paths)
+        mask = None if published is None else published.tolist()
+        for port, arr in out.items():
+            bufs = group.outputs.get(port)
+            if bufs is None:
+                who = self._who(group.paths[0])
+                raise RunFault(who, now, f"published unknown output {port!r}")
+            arr = np.broadcast_to(np.asarray(arr, dtype=np.float64), (n,))
+            k = batch.first_bad(arr, published)
+            if k is not None:
+                raise RunFault(self._who(group.paths[k]), now, f"output {port} is {arr[k]}")
+            pairs = zip(bufs, arr.tolist(), strict=True)
+            values.update(pairs if mask is None else compress(pairs, mask))
+
     def _bad_output(self, task: _Task, out: Mapping[str, Any]) -> RunFault:
         """The fault for the first output ``_step`` refused (a slow path: faults are rare)."""
         who = self._who(task.path)
@@ -429,6 +473,8 @@ class Simulation:
         """Set a parameter now (timeline or live); the component is told after."""
         comp = self.components[change.leaf]
         setattr(comp.p, change.param, change.value)
+        for group in getattr(self, "_groups_of", {}).get(change.leaf, ()):
+            group.params.invalidate()
         self.change_log.append((self.now, change))
         try:
             comp.on_param_change(change.param, change.value)

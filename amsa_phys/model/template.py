@@ -72,6 +72,13 @@ class Template:
     ``do_step`` takes the inputs read at the start of the step and returns the outputs to
     publish at its end (run-to-completion); a missing key publishes nothing, so consumers
     keep the previous value.
+
+    A template may also define a classmethod ``step_many(comps, t, inputs, p, state)`` that
+    steps many copies of itself at once (``engine/batch.py``): ``inputs`` maps each input
+    port to an array with one value per copy, ``p`` gives each parameter as such an array,
+    ``state`` is a dict kept for the group; it returns ``(outputs, published)`` with one
+    array per output port and a boolean mask of the copies that publish (``None``: all).
+    A leaf is stepped either always through ``step_many`` or always through ``do_step``.
     """
 
     kind: ClassVar[Kind]

@@ -27,6 +27,8 @@ import math
 from collections.abc import Sequence
 from typing import NamedTuple
 
+import numpy as np
+
 from .bodyio import FORCE, STATE, BodyIO
 from .rover import DiffDriveRover
 from .wheel import lateral_force
@@ -112,6 +114,11 @@ class FewRovers:
         """Rover ``k``'s six state floats after the last step."""
         i = self._offsets[k]
         return self.state[i : i + STATE]
+
+    def kinematics_array(self, index: np.ndarray) -> np.ndarray:
+        """(n, 6) state of the rovers at ``index`` after the last step."""
+        rows = np.asarray(self.rows)[index]
+        return np.array(self.state).reshape(-1, STATE)[rows]
 
     def advance(self) -> tuple[int, str] | None:
         """One physics step: forces, pymunk's step, the new state; a safety violation or None."""

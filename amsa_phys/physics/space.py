@@ -15,6 +15,7 @@ from collections.abc import Sequence
 from fractions import Fraction
 from typing import Any
 
+import numpy as np
 import pymunk
 
 from ..errors import RunFault
@@ -157,6 +158,15 @@ class PhysicsWorld:
         for k, rover in enumerate(self.rovers):
             rover.attach_state(functools.partial(self._kinematics, k))
         return model
+
+    def index_of(self, rovers: Sequence[DiffDriveRover]) -> np.ndarray:
+        """Positions of ``rovers`` in this world (for :meth:`kinematics_array`)."""
+        where = {id(r): k for k, r in enumerate(self.rovers)}
+        return np.array([where[id(r)] for r in rovers], dtype=np.intp)
+
+    def kinematics_array(self, index: np.ndarray) -> np.ndarray:
+        """(n, 6) ``x, y, angle, vx, vy, w`` of the rovers at ``index`` after the last step."""
+        return (self._model or self._start()).kinematics_array(index)
 
     def _kinematics(self, k: int) -> Sequence[float]:
         """Rover ``k``'s ``x, y, angle, vx, vy, w`` after the last step."""

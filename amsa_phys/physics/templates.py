@@ -10,9 +10,11 @@ the physics advances between steps at ``physics.rate``.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from fractions import Fraction
 from typing import Any
+
+import numpy as np
 
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
@@ -146,6 +148,36 @@ class ControlledRobot(_Robot):
         """The paper's doStep: apply the commanded powers, publish the pose."""
         self.rover.set_power(inp["powerL"], inp["powerR"])
         return self._pose()
+
+    @classmethod
+    def step_many(
+        cls,
+        comps: Sequence[ControlledRobot],
+        t: Fraction,
+        inp: Mapping[str, Any],
+        p: Any,
+        state: dict[str, Any],
+    ) -> tuple[Mapping[str, Any], None]:
+        """``do_step`` for many copies at once (``engine/batch.py``)."""
+        physics = comps[0].physics
+        if "index" not in state:
+            state["index"] = physics.index_of([c.rover for c in comps])
+            state["half_track"] = np.array([c.rover.half_track for c in comps])
+        powers = zip(comps, inp["powerL"].tolist(), inp["powerR"].tolist(), strict=True)
+        for c, left, right in powers:
+            c.rover.set_power(left, right)
+        x, y, a, vx, vy, w = physics.kinematics_array(state["index"]).T
+        v = vx * np.cos(a) + vy * np.sin(a)
+        wh = w * state["half_track"]
+        return {
+            "posX": x,
+            "posY": y,
+            "heading": (a + math.pi) % (2 * math.pi) - math.pi,
+            "speed": v,
+            "yawRate": w,
+            "wheelSpeedL": v - wh,
+            "wheelSpeedR": v + wh,
+        }, None
 
 
 BEHAVIORS = {"straight": 1, "circle": 2, "speedChanges": 3, "random": 4, "waypoints": 5}

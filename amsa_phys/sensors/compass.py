@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from fractions import Fraction
 from typing import Any
 
-from ..engine.rng import Drawn
+from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
 
@@ -31,3 +31,14 @@ class Compass(Template):
         """The paper's doStep: one heading sample."""
         value = inp["heading"] + self.p.bias + self.p.noise * self.noise()
         return {"compassHeading": (value + math.pi) % (2 * math.pi) - math.pi}
+
+    @classmethod
+    def step_many(
+        cls, comps: Sequence[Any], t: Fraction, inp: Mapping[str, Any], p: Any, state: Any
+    ) -> tuple[Mapping[str, Any], None]:
+        """``do_step`` for many copies at once, each from its own stream (``engine/batch.py``)."""
+        if "noise" not in state:
+            state["noise"] = DrawnMany([c.noise for c in comps])
+        draws = state["noise"]()
+        value = inp["heading"] + p.bias + p.noise * draws
+        return {"compassHeading": (value + math.pi) % (2 * math.pi) - math.pi}, None

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from fractions import Fraction
 from typing import Any
 
-from ..engine.rng import Drawn
+import numpy as np
+
+from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
 
@@ -52,3 +54,26 @@ class GPS(Template):
             "gpsPosX": inp["posX"] + bias + noise * ex,
             "gpsPosY": inp["posY"] + bias + noise * ey,
         }
+
+    @classmethod
+    def step_many(
+        cls, comps: Sequence[Any], t: Fraction, inp: Mapping[str, Any], p: Any, state: Any
+    ) -> tuple[Mapping[str, Any], np.ndarray]:
+        """``do_step`` for many copies at once (``engine/batch.py``).
+
+        Each copy draws from its own streams in the scalar order (x noise, y noise, loss);
+        the lost copies publish nothing (the mask returned).
+        """
+        if "noise" not in state:
+            state["noise"] = DrawnMany([c.noise for c in comps])
+            state["loss"] = DrawnMany([c.draw_loss for c in comps])
+        ex = state["noise"]()
+        ey = state["noise"]()
+        lost = state["loss"]() * 100.0 < p.lostDataGPS
+        for k in np.flatnonzero(lost).tolist():
+            comps[k].lost += 1
+        noise, bias = p.noise, p.bias
+        return {
+            "gpsPosX": inp["posX"] + bias + noise * ex,
+            "gpsPosY": inp["posY"] + bias + noise * ey,
+        }, ~lost
