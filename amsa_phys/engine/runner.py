@@ -376,7 +376,9 @@ class Simulation:
                         cursor = tick + 1
                 cursor = max(cursor, base + cycle)
         finally:
-            self._cursor = cursor
+            # after a fault inside a run of physics-only instants ``cursor`` is still the
+            # run's start; the instant that failed is ``_tick``, as on the general path
+            self._cursor = max(cursor, self._tick)
 
     def _enter_phases(self, tick: int) -> None:
         """Apply the timeline changes of every phase that starts at or before ``tick``."""
