@@ -201,11 +201,12 @@ class FollowerController(Template):
             used[rows, :-1] = used[rows, 1:]
             used[rows, -1] = True
             used[rows] &= T[rows] >= (ts - p.speedWindow[rows])[:, None]
-            k = used[rows].sum(axis=1)
             m = used[rows]
-            mt = np.where(m, T[rows], 0.0).sum(axis=1) / np.maximum(k, 1)
-            mx = np.where(m, X[rows], 0.0).sum(axis=1) / np.maximum(k, 1)
-            my = np.where(m, Y[rows], 0.0).sum(axis=1) / np.maximum(k, 1)
+            k = m.sum(axis=1)
+            count = np.maximum(k, 1)  # rows with no fix are masked out below
+            mt = np.where(m, T[rows], 0.0).sum(axis=1) / count
+            mx = np.where(m, X[rows], 0.0).sum(axis=1) / count
+            my = np.where(m, Y[rows], 0.0).sum(axis=1) / count
             dt = np.where(m, T[rows] - mt[:, None], 0.0)
             stt = (dt * dt).sum(axis=1)
             stx = (dt * (X[rows] - mx[:, None])).sum(axis=1)

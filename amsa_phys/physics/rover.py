@@ -105,8 +105,8 @@ class DiffDriveRover:
 
     def wheel_speeds(self) -> tuple[float, float]:
         """Ground speed of the left and right wheel contact points (m/s)."""
-        v = self.forward_speed
-        w = self.kinematics()[5]
+        _, _, a, vx, vy, w = self.kinematics()
+        v = vx * math.cos(a) + vy * math.sin(a)
         return v - w * self.half_track, v + w * self.half_track
 
 
