@@ -14,6 +14,7 @@ import argparse
 import statistics
 import tempfile
 import time
+from fractions import Fraction
 from pathlib import Path
 
 import pymunk
@@ -84,6 +85,48 @@ def bare_loop(duration: float, rate: int = 100) -> float:
         io.step(dt)
         state = io.read()
     return time.perf_counter() - t0
+
+
+def fused_loop(duration: float, trace: bool = True) -> float:
+    """Wall seconds for scenario1 hand-fused: the least any scheduler could add (context).
+
+    The same component objects, physics hook and trace writer as :func:`engine_run`, called
+    from one hand-written loop: no table, no run-length instants, no output checks, no phase
+    or live-change tests. What it costs beyond :func:`bare_loop` is the components' and the
+    trace's own Python, which no engine can remove. It reads the engine's compiled task list
+    (private names) on purpose, so that it calls exactly what the engine calls.
+    """
+    sc = load_scenario(ROOT / "scenarios" / "scenario1.yaml", duration=duration)
+    with tempfile.TemporaryDirectory() as tmp:
+        writer = TraceWriter(Path(tmp) / "trace.csv", list(sc.world.buffers))
+        sim = Simulation.from_scenario(sc, trace=writer.write)
+        sim.initialize()
+        values = sim.values
+        row = sim._row
+        write = writer.write if trace else (lambda t, v: None)
+        (hook,) = [fn for _, fn, _ in sim._hooks]
+        cycle, log_period = sim._cycle, sim._log_period
+        num, den = sim._tick_num, sim._tick_den
+        due: list[list] = [[] for _ in range(cycle)]
+        for task in sim._tasks:
+            for off in range(0, cycle, task.period):
+                due[off].append((task.comp.do_step, task.inputs, task.targets))
+        end = int(duration * den / num)
+        t0 = time.perf_counter()
+        for tick in range(end):
+            tasks = due[tick % cycle]
+            if tasks:
+                now = Fraction(tick * num, den)
+                for do_step, inputs, targets in tasks:
+                    out = do_step(now, {port: values[buf] for port, buf in inputs})
+                    if out:
+                        for key, value in out.items():
+                            values[targets[key]] = float(value)
+            if tick % log_period == 0:
+                write(tick * num / den, row(values))
+            hook()
+        writer.close()
+        return time.perf_counter() - t0
 
 
 def plain_loop(duration: float, rate: int = 100) -> float:

@@ -2,7 +2,7 @@
 
 A run that is killed never leaves a half-written ``trace.csv``: rows go to
 ``trace.csv.tmp`` and ``os.replace`` gives it its final name only when the run is finalised
-(normally, on a fault or on Ctrl-C). Floats are written with ``repr`` (shortest exact
+(normally, on a fault or on Ctrl-C). Floats are spelled as ``repr`` spells them (shortest exact
 round-trip), so the same run gives byte-identical files.
 """
 
@@ -10,56 +10,79 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
-from itertools import compress
-from operator import is_not
 from pathlib import Path
 from typing import IO
 
-#: Rows collected before one write to the file.
-_CHUNK = 128
+import orjson
+
+#: Rows collected before they are formatted and written in one go.
+_CHUNK = 256
+
+
+def format_rows(rows: Sequence[Sequence[float]]) -> bytes:
+    """CSV lines for ``rows`` of floats, each float spelled exactly as ``repr`` spells it.
+
+    ``repr`` of a float costs ~0.5 µs, a trace row holds ~25 of them, so formatting was a
+    sixth of a headless run. orjson formats a whole chunk in C (~0.04 µs a float) with the
+    same shortest round-trip digits; it spells some exponents differently (``1e-7`` for
+    ``1e-07``, ``0.00001`` for ``1e-05``, and versions differ), so lines that may hold such
+    a number (an ``e``, or ``0.0000``) are re-spelled with ``repr``. The file is therefore
+    byte-identical to the plain ``repr`` one whatever the orjson version. NaN and infinity
+    (orjson writes ``null``; the engine never logs them) also take the ``repr`` path.
+    """
+    if not rows:
+        return b""
+    blob = orjson.dumps(rows, default=float)
+    if b"n" in blob:  # null: a non-finite value
+        return "".join(",".join(map(repr, row)) + "\n" for row in rows).encode()
+    body = blob.replace(b"],[", b"\n")
+    if b"e" in body or b"0.0000" in body:
+        body = b"[[" + _respell(body[2:-2]) + b"]]"
+    return body[2:-2] + b"\n"
+
+
+def _respell(body: bytes) -> bytes:
+    """Re-spell with ``repr`` the numbers of ``body`` whose orjson spelling may differ."""
+    lines = body.split(b"\n")
+    for k, line in enumerate(lines):
+        if b"e" in line or b"0.0000" in line:
+            lines[k] = b",".join(
+                repr(float(tok)).encode() if b"e" in tok or b"0.0000" in tok else tok
+                for tok in line.split(b",")
+            )
+    return b"\n".join(lines)
 
 
 class TraceWriter:
     """Streams trace rows to ``path`` atomically.
 
-    Most buffers change at a lower rate than the log (a 4 Hz sensor in a 20 Hz trace), and
-    ``repr`` of a float costs ~0.3 µs, so the writer keeps the last value *object* of each
-    column with its text and formats only the columns holding a new object (found in C with
-    ``map``/``compress``). Floats are immutable: the same object always has the same text,
-    and identity keeps ``-0.0`` and ``0.0`` apart. Rows reach the file a chunk at a time.
+    Rows are kept as tuples and formatted a chunk at a time (:func:`format_rows`), so a row
+    costs the run about a microsecond instead of ~8. Values must be floats (the engine's
+    buffers hold nothing else).
     """
 
     def __init__(self, path: Path, columns: Sequence[str]) -> None:
         self.path = Path(path)
         self.tmp = self.path.with_name(self.path.name + ".tmp")
         self.columns = list(columns)
-        self._fh: IO[str] | None = open(self.tmp, "w", encoding="utf-8", newline="\n")  # noqa: SIM115
-        self._fh.write(",".join(["t", *self.columns]) + "\n")
+        self._fh: IO[bytes] | None = open(self.tmp, "wb")  # noqa: SIM115
+        self._fh.write((",".join(["t", *self.columns]) + "\n").encode())
         self.rows = 0
-        self._last: list[object] = [None] * len(self.columns)
-        self._text: list[str] = [""] * len(self.columns)
-        self._index = range(len(self.columns))
-        self._rows: list[str] = []  # formatted rows not yet written
+        self._rows: list[tuple[float, ...]] = []  # rows not yet written
 
     def write(self, t_s: float, values: Sequence[float]) -> None:
         """Append one row (``t`` in seconds, then one value per column)."""
         assert self._fh is not None, "trace already closed"
-        last = self._last
-        text = self._text
-        for i in compress(self._index, map(is_not, values, last)):
-            v = values[i]
-            last[i] = v
-            text[i] = repr(v)
         rows = self._rows
-        rows.append(repr(t_s) + "," + ",".join(text) + "\n")
+        rows.append((t_s, *values))
         self.rows += 1
         if len(rows) >= _CHUNK:
             self._flush_rows()
 
     def _flush_rows(self) -> None:
-        """Hand the collected rows to the file in one call (a write per row costs ~2 µs)."""
+        """Format the collected rows and hand them to the file in one call."""
         if self._rows and self._fh is not None:
-            self._fh.write("".join(self._rows))
+            self._fh.write(format_rows(self._rows))
             self._rows.clear()
 
     def close(self) -> Path:

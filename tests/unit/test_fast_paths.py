@@ -7,7 +7,9 @@ Each speed-up keeps a slower, obvious route alive (reference wheel model, docume
 from __future__ import annotations
 
 import array
+import math
 import random
+import struct
 from fractions import Fraction
 from pathlib import Path
 
@@ -15,7 +17,7 @@ import pymunk
 import pytest
 
 from amsa_phys.engine import runner
-from amsa_phys.engine.recorder import TraceWriter
+from amsa_phys.engine.recorder import TraceWriter, format_rows
 from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import Change, load_scenario
 from amsa_phys.physics import bodyio
@@ -105,13 +107,33 @@ def test_trace_rows_equal_plain_repr_whatever_changes(tmp_path: Path) -> None:
     values = [0.0, 1.0, 2.0, 3.0]
     writer = TraceWriter(tmp_path / "trace.csv", ["a", "b", "c", "d"])
     expected = ["t,a,b,c,d"]
-    for k in range(200):
+    for k in range(700):  # several chunks, the last one partial
         j = rng.randrange(4)
-        values[j] = rng.choice([rng.random(), float(k), values[(j + 1) % 4], -0.0])
+        tiny_or_huge = rng.uniform(-9.9, 9.9) * 10.0 ** rng.randint(-30, 30)
+        values[j] = rng.choice(
+            [rng.random(), float(k), values[(j + 1) % 4], -0.0, tiny_or_huge, 1e-05, 1e16]
+        )
         writer.write(k * 0.05, list(values))
         expected.append(",".join(map(repr, [k * 0.05, *values])))
     writer.close()
     assert (tmp_path / "trace.csv").read_text().splitlines() == expected
+
+
+def test_trace_spelling_is_repr_for_any_float() -> None:
+    """orjson's spelling of exponents differs from repr's (and between its versions);
+    format_rows must give repr's bytes for every finite float, and NaN/inf must not
+    become JSON's null."""
+    rng = random.Random(7)
+    floats = [
+        struct.unpack("<d", rng.getrandbits(64).to_bytes(8, "little"))[0] for _ in range(6000)
+    ]
+    floats = [v for v in floats if math.isfinite(v)]
+    floats += [5e-324, 1.7976931348623157e308, 9999999999999998.0, 1e16, 1e-4, 9.9e-05, 0.0]
+    rows = [tuple(floats[i : i + 7]) for i in range(0, len(floats) - 7, 7)]
+    expected = "".join(",".join(map(repr, row)) + "\n" for row in rows).encode()
+    assert format_rows(rows) == expected
+    assert format_rows([(0.5, math.nan, -math.inf)]) == b"0.5,nan,-inf\n"
+    assert format_rows([]) == b""
 
 
 def test_batch_io_refuses_a_body_added_behind_its_back() -> None:
