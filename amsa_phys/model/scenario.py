@@ -137,6 +137,8 @@ def build_scenario(doc: YamlDoc) -> Scenario:
     else:
         world = build_world(world_ref, doc, ("world",))
     duration = Fraction(str(data["duration"]))
+    if duration <= 0:
+        raise doc.error(("duration",), f"must be > 0, got {data['duration']}")
     phases = [Phase(Fraction(0), _changes(data.get("set", {}), ("set",), doc, world))]
     last = Fraction(0)
     for i, entry in enumerate(data.get("timeline", [])):

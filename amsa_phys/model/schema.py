@@ -22,6 +22,10 @@ _num = {"type": "number"}
 _pos = {"type": "number", "exclusiveMinimum": 0}
 _nonneg = {"type": "number", "minimum": 0}
 _point = {"type": "array", "items": _num, "minItems": 2, "maxItems": 2}
+#: A time: seconds as a number, or an exact fraction "7/3" (an instant of a 3 Hz component,
+#: which no decimal writes exactly; the resolved scenario writes such instants this way).
+FRACTION = r"^[0-9]+/[1-9][0-9]*$"
+_time = {"anyOf": [_pos, {"type": "string", "pattern": FRACTION}]}
 
 OBSTACLE = {
     "type": "object",
@@ -157,7 +161,7 @@ SCENARIO: dict[str, Any] = {
         "name": {"type": "string"},
         "description": {"type": "string"},
         "world": {"type": ["string", "object"]},
-        "duration": _pos,
+        "duration": _time,
         "seed": {"type": "integer", "minimum": 0, "maximum": 2**63 - 1},
         "log_rate": _pos,
         "quality": {
@@ -174,7 +178,7 @@ SCENARIO: dict[str, Any] = {
                 "additionalProperties": False,
                 "required": ["at", "set"],
                 "properties": {
-                    "at": _pos,
+                    "at": _time,
                     "set": {"type": "object", "minProperties": 1},
                     "label": {"type": "string"},
                 },
@@ -277,6 +281,13 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
     if kind == "pattern":
         return path, (
             f"{inst!r} is not a valid name (letters, digits and _, not starting with a digit)"
+        )
+    if kind == "anyOf" and err.validator_value == _time["anyOf"]:
+        if isinstance(inst, int | float) and not isinstance(inst, bool):
+            return path, f"must be > 0, got {inst}"
+        return path, (
+            'expected a positive number of seconds or an exact fraction such as "7/3", '
+            f"got {yaml_type(inst)} {short_repr(inst)}"
         )
     if kind == "anyOf" and isinstance(inst, dict):
         return path, "needs 'below' or 'above'"

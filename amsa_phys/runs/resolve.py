@@ -15,6 +15,21 @@ def _number(x: Fraction | float) -> float | int:
     return int(f) if f.is_integer() else f
 
 
+def _time(t: Fraction) -> float | int | str:
+    """An instant written so that loading it gives ``t`` back exactly.
+
+    A float when its shortest repr is ``t`` itself (0.25, 2.51); otherwise the fraction
+    ``"7/3"`` — an instant of a 3 Hz component has no exact decimal, and a float near it
+    would replay the change just *after* the components due at ``t`` instead of before.
+    """
+    t = Fraction(t)
+    if t.denominator == 1:
+        return int(t)
+    if Fraction(repr(float(t))) == t:
+        return float(t)
+    return f"{t.numerator}/{t.denominator}"
+
+
 def _plain(value: Any) -> Any:
     if isinstance(value, tuple):
         return [_plain(v) for v in value]
@@ -72,7 +87,7 @@ def resolved_scenario(
     out: dict[str, Any] = {
         "name": scenario.name,
         "world": world,
-        "duration": _number(end),
+        "duration": _time(end),
         "seed": scenario.seed,
         "log_rate": _number(scenario.log_rate),
         "set": initial,
@@ -83,7 +98,7 @@ def resolved_scenario(
     if timeline:
         out["timeline"] = []
         for at in sorted(timeline):
-            entry: dict[str, Any] = {"at": _number(at), "set": timeline[at]}
+            entry: dict[str, Any] = {"at": _time(at), "set": timeline[at]}
             if at in labels:
                 entry["label"] = labels[at]
             out["timeline"].append(entry)

@@ -233,3 +233,34 @@ components:
     assert w.leaves["Outer"].inputs == {"x": "Team.Src.count"}
     Simulation(w, duration=Fraction(0)).run()
     assert [inp for p, _, inp in toys.LOG if p == "Team.R"] == [{"x": 10.0}]
+
+
+def test_an_instant_with_no_exact_decimal_replays_exactly(tmp_path: Path) -> None:
+    """A live change at t = 7/3 (a 3 Hz instant) is written as "7/3", not 2.3333333333333335:
+    the float would land just after the 3 Hz step at 7/3 and the replay would differ."""
+    import yaml
+
+    from amsa_phys.engine.recorder import TraceWriter
+    from amsa_phys.model.scenario import Change
+    from amsa_phys.runs.resolve import resolved_scenario
+
+    world(tmp_path, 'components:\n  Src: {template: "toys:Source", freq: 3}\n')
+    scen = tmp_path / "s.yaml"
+    scen.write_text("world: w.yaml\nduration: 4\n")
+
+    sc = load_scenario(scen)
+    first = TraceWriter(tmp_path / "a.csv", sc.world.buffers)
+    live = Simulation.from_scenario(sc, trace=first.write)
+    live.initialize()
+    live.advance(live.grid.ticks(Fraction(7, 3)) - 1)
+    assert live.apply_live(Change("Src", "gain", 10.0)) == Fraction(7, 3)
+    live.run()
+    resolved = resolved_scenario(sc, extra=live.live_changes, duration=Fraction(10, 3))
+    assert resolved["timeline"][0]["at"] == "7/3"
+    assert resolved["duration"] == "10/3"
+    (tmp_path / "r.yaml").write_text(yaml.safe_dump({**resolved, "duration": 4}))
+    again = TraceWriter(tmp_path / "b.csv", sc.world.buffers)
+    Simulation.from_scenario(load_scenario(tmp_path / "r.yaml"), trace=again.write).run()
+    assert again.close().read_bytes() == first.close().read_bytes()
+    # decimals stay numbers
+    assert resolved_scenario(sc, duration=Fraction(5, 2))["duration"] == 2.5
