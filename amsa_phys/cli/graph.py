@@ -6,7 +6,6 @@ import argparse
 from pathlib import Path
 
 from ..errors import ConfigError
-from ..plots.graph import draw
 from .loading import load_any
 
 
@@ -25,6 +24,8 @@ def run(args: argparse.Namespace) -> int:
     world = obj.world if kind == "scenario" else obj
     if not out.parent.is_dir():
         raise ConfigError("directory does not exist", key="--output", file=out.parent)
+    from ..plots.graph import draw  # matplotlib: imported by the commands that draw
+
     draw(world, out)
     print(f"wrote {out}")
     return 0

@@ -7,8 +7,7 @@ import json
 from pathlib import Path
 
 from ..errors import ConfigError
-from ..plots.distance import plot_distance
-from ..plots.trajectory import plot_trajectory
+from ..runs.plotjob import draw_run_plots
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -36,7 +35,6 @@ def run(args: argparse.Namespace) -> int:
         ) from None
     out = Path(args.output) if args.output else rundir / "distance.png"
     traj = out.with_name(out.stem + "-trajectory.png") if args.output else rundir / "trajectory.png"
-    plot_distance(rundir / "trace.csv", metrics, out)
-    plot_trajectory(rundir / "trace.csv", metrics, traj)
+    draw_run_plots(rundir / "trace.csv", metrics, out, traj)
     print(f"wrote {out} and {traj}")
     return 0

@@ -7,15 +7,20 @@ import signal
 import sys
 from pathlib import Path
 from types import FrameType
+from typing import TYPE_CHECKING
 
 from ..errors import ConfigError
 from ..model.scenario import load_scenario
 from ..runs.expect import check_expectations
+from ..runs.plotjob import PlotJob
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
 from .options import add_output, add_scenario_overrides
 from .recording import add_recording, recording_options, snapshot_options
 from .report import print_summary
+
+if TYPE_CHECKING:  # pygame is imported only by runs that draw
+    from ..view.recorder import RecordOptions, SnapshotOptions
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -41,6 +46,21 @@ def run(args: argparse.Namespace) -> int:
     """Load, run, report."""
     record = recording_options(args)
     snapshot = snapshot_options(args)
+    # a headless run's plots: a child imports matplotlib while we load and simulate
+    plotter = PlotJob.start() if args.headless and not args.no_plot else None
+    try:
+        return _run(args, record, snapshot, plotter)
+    finally:
+        if plotter is not None:
+            plotter.close()
+
+
+def _run(
+    args: argparse.Namespace,
+    record: RecordOptions | None,
+    snapshot: SnapshotOptions | None,
+    plotter: PlotJob | None,
+) -> int:
     if not args.headless:
         from ..view.window import open_display
 
@@ -66,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
             record=record,
             snapshot=snapshot,
             window=not args.headless,
+            plotter=plotter,
         )
     finally:
         signal.signal(signal.SIGTERM, previous)

@@ -16,7 +16,6 @@ from ..engine.recorder import write_atomic
 from ..errors import ConfigError, Interrupted
 from ..model.scenario import load_scenario
 from ..model.yamlio import load_yaml
-from ..plots.summary import plot_summary
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.sweep import (
     METRIC_KEYS,
@@ -145,6 +144,8 @@ def run(args: argparse.Namespace) -> int:
         signal.signal(signal.SIGTERM, previous)
     keys = [a.key for a in plan.axes]
     write_results(rows, keys, out / "results.csv")
+    from ..plots.summary import plot_summary  # matplotlib: only once the rows are in
+
     plot_summary(
         rows,
         keys,

@@ -23,10 +23,9 @@ from ..engine.recorder import TraceWriter, write_atomic
 from ..engine.runner import RunResult, Simulation
 from ..errors import Interrupted, RunFault
 from ..model.scenario import Scenario
-from ..plots.distance import plot_distance
-from ..plots.trajectory import plot_trajectory
 from ..view.drive import FrameSink, advance
 from ..view.encoder import EncoderError
+from .plotjob import PlotJob
 from .resolve import resolved_scenario
 
 if TYPE_CHECKING:  # pygame is imported only by runs that draw
@@ -124,6 +123,7 @@ def run_scenario(
     record: RecordOptions | None = None,
     snapshot: SnapshotOptions | None = None,
     window: bool | WindowDriver = False,
+    plotter: PlotJob | None = None,
 ) -> RunOutcome:
     """Run ``scenario`` and write its run directory (which must exist and be empty).
 
@@ -131,7 +131,8 @@ def run_scenario(
     of the moment it was closed, without trails). ``window`` runs the scenario in the
     interactive window (until the user closes it) instead of as fast as possible; a callable
     ``window`` replaces the window's own loop (tests drive it with scripted events and an
-    exact clock).
+    exact clock). ``plotter`` draws the plots (a child started early, ``runs/plotjob.py``);
+    without one they are drawn in-process.
     """
     out_dir = Path(out_dir)
     trace = TraceWriter(out_dir / "trace.csv", list(scenario.world.buffers))
@@ -181,9 +182,12 @@ def run_scenario(
         scenario, extra=sim.live_changes, duration=sim.now if stopped_early else None
     )
     write_atomic(out_dir / "scenario.yaml", yaml.safe_dump(resolved, sort_keys=False))
+    plotter = plotter or PlotJob()
     if plot:
-        plot_distance(out_dir / "trace.csv", metrics, out_dir / "distance.png")
-        plot_trajectory(out_dir / "trace.csv", metrics, out_dir / "trajectory.png")
+        plotter.draw(
+            out_dir / "trace.csv", metrics, out_dir / "distance.png", out_dir / "trajectory.png"
+        )
+    plotter.close()
     if isinstance(error, KeyboardInterrupt):
         raise Interrupted(
             f"interrupted at t={result.t_end:.2f} s; outputs so far are in {out_dir}"

@@ -1,0 +1,128 @@
+"""A run's two plots, drawn by a child process that imports matplotlib while the run runs.
+
+Importing matplotlib costs ~0.6 s on the project's machines — as much as simulating 300 s of
+scenario1 — and a headless run needs it only at its very end. ``amsa-phys run --headless``
+therefore forks a child as it starts: the child imports matplotlib on the other core while
+the parent loads the scenario and simulates, then waits for one job (the finished trace and
+metrics), draws ``distance.png`` and ``trajectory.png`` (written atomically by the plotting
+code itself) and exits. A headless run's process is ~0.4 s shorter.
+
+Decisions:
+
+* ``fork`` only (Linux): a spawned child would re-import the whole package and gain little;
+  elsewhere, or when the child cannot be started, plots are drawn in-process as before.
+* The child ignores SIGINT: Ctrl-C in a terminal reaches the whole process group, and the
+  parent still draws the plots of an interrupted run. It exits when the parent goes away
+  (end of file on its pipe), so it never outlives a killed parent for long.
+* Whatever goes wrong in the child — it died, hung for :data:`TIMEOUT_S`, or plotting raised —
+  the parent draws the plots itself, so errors surface exactly as for an in-process draw.
+* Sweeps and ``amsa-phys test`` do not use it: their workers already keep every core busy.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import signal
+import sys
+from multiprocessing.connection import Connection
+from pathlib import Path
+from typing import Any
+
+#: How long the parent waits for the child's plots before drawing them itself.
+TIMEOUT_S = 60.0
+
+
+def draw_run_plots(trace: Path, metrics: dict[str, Any], distance: Path, trajectory: Path) -> None:
+    """The distance and trajectory plots of a run (imports matplotlib on first use)."""
+    from ..plots.distance import plot_distance
+    from ..plots.trajectory import plot_trajectory
+
+    plot_distance(trace, metrics, distance)
+    plot_trajectory(trace, metrics, trajectory)
+
+
+def _child(jobs: Connection, parent_end: Connection) -> None:
+    """The child's life: import, wait for one job, draw it, report."""
+    parent_end.close()  # so that the parent's exit is an end of file here
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    with contextlib.suppress(Exception):  # on failure the parent draws (and reports)
+        import matplotlib.pyplot  # noqa: F401  the import this process exists for
+
+        from ..plots import distance, trajectory  # noqa: F401
+    try:
+        job = jobs.recv()
+    except EOFError:
+        return
+    if job is None:
+        return
+    try:
+        draw_run_plots(*job)
+        jobs.send("ok")
+    except BaseException as exc:  # reported to the parent, which redraws
+        jobs.send(f"failed: {exc!r}")
+
+
+class PlotJob:
+    """The run's plots in a child process, or in-process when that is not possible."""
+
+    def __init__(self) -> None:
+        self._conn: Connection | None = None
+        self._proc: multiprocessing.process.BaseProcess | None = None
+
+    @classmethod
+    def start(cls) -> PlotJob:
+        """Fork the child now (it starts importing matplotlib at once)."""
+        job = cls()
+        if not sys.platform.startswith("linux"):
+            return job
+        for stream in (sys.stdout, sys.stderr):  # else the child re-flushes their buffers
+            stream.flush()
+        try:
+            ctx = multiprocessing.get_context("fork")
+            parent_end, child_end = ctx.Pipe()
+            proc = ctx.Process(target=_child, args=(child_end, parent_end), daemon=True)
+            proc.start()
+        except (OSError, ValueError):
+            return job
+        child_end.close()
+        job._conn, job._proc = parent_end, proc
+        return job
+
+    @property
+    def background(self) -> bool:
+        """Whether a child is standing by."""
+        return self._conn is not None
+
+    def draw(self, trace: Path, metrics: dict[str, Any], distance: Path, trajectory: Path) -> None:
+        """Draw the plots: by the child if it answers in time, else here."""
+        args = (Path(trace), metrics, Path(distance), Path(trajectory))
+        if self._handoff(args):
+            return
+        draw_run_plots(*args)
+
+    def _handoff(self, args: tuple[Path, dict[str, Any], Path, Path]) -> bool:
+        conn = self._conn
+        if conn is None:
+            return False
+        try:
+            conn.send(args)
+            done = conn.poll(TIMEOUT_S) and conn.recv() == "ok"
+        except (OSError, EOFError, ValueError):
+            done = False
+        self.close()
+        return done
+
+    def close(self) -> None:
+        """Dismiss the child (no plots wanted, or they are done); safe to call twice."""
+        conn, proc = self._conn, self._proc
+        self._conn = self._proc = None
+        if conn is not None:
+            with contextlib.suppress(OSError, ValueError):  # the child may be gone
+                conn.send(None)
+            conn.close()
+        if proc is not None:
+            proc.join(1.0)
+            if proc.is_alive():
+                proc.kill()
+                proc.join()
