@@ -34,7 +34,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     add_scenario_overrides(p)
     add_output(p)
     add_recording(p)
-    p.add_argument("--no-plot", action="store_true", help="skip the plots (distance.png, trajectory.png)")
+    p.add_argument(
+        "--no-plot", action="store_true", help="skip the plots (distance.png, trajectory.png)"
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="no summary table")
 
 
