@@ -192,25 +192,29 @@ class FollowerController(Template):
             )
             used[upd & has & jump] = False
             rows = np.flatnonzero(upd)
-            if used[rows, 0].any():  # a window longer than the slots: double them
+            # all copies at once (the usual case: their fixes arrive together) use views, a
+            # subset gathers copies; the arithmetic is the same either way
+            sel: slice | np.ndarray = slice(None) if len(rows) == n else rows
+            if used[sel, 0].any():  # a window longer than the slots: double them
                 state["fixes"] = _grow(state["fixes"], n, 2 * T.shape[1])
                 T, X, Y, used = state["fixes"]
-            for arr, new in ((T, ts), (X, xl[rows]), (Y, yl[rows])):
-                arr[rows, :-1] = arr[rows, 1:]
-                arr[rows, -1] = new
-            used[rows, :-1] = used[rows, 1:]
-            used[rows, -1] = True
-            used[rows] &= T[rows] >= (ts - p.speedWindow[rows])[:, None]
-            m = used[rows]
+            for arr, new in ((T, ts), (X, xl[sel]), (Y, yl[sel])):
+                arr[sel, :-1] = arr[sel, 1:]
+                arr[sel, -1] = new
+            used[sel, :-1] = used[sel, 1:]
+            used[sel, -1] = True
+            used[sel] &= T[sel] >= (ts - p.speedWindow[sel])[:, None]
+            m = used[sel]
+            t_, x_, y_ = T[sel], X[sel], Y[sel]
             k = m.sum(axis=1)
             count = np.maximum(k, 1)  # rows with no fix are masked out below
-            mt = np.where(m, T[rows], 0.0).sum(axis=1) / count
-            mx = np.where(m, X[rows], 0.0).sum(axis=1) / count
-            my = np.where(m, Y[rows], 0.0).sum(axis=1) / count
-            dt = np.where(m, T[rows] - mt[:, None], 0.0)
+            mt = np.where(m, t_, 0.0).sum(axis=1) / count
+            mx = np.where(m, x_, 0.0).sum(axis=1) / count
+            my = np.where(m, y_, 0.0).sum(axis=1) / count
+            dt = np.where(m, t_ - mt[:, None], 0.0)
             stt = (dt * dt).sum(axis=1)
-            stx = (dt * (X[rows] - mx[:, None])).sum(axis=1)
-            sty = (dt * (Y[rows] - my[:, None])).sum(axis=1)
+            stx = (dt * (x_ - mx[:, None])).sum(axis=1)
+            sty = (dt * (y_ - my[:, None])).sum(axis=1)
             ok = (k >= 2) & (stt > 0)
             safe = np.where(ok, stt, 1.0)
             v_leader[rows[ok]] = np.hypot(stx / safe, sty / safe)[ok]

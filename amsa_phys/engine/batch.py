@@ -171,6 +171,8 @@ def _breaks(
 
 def first_bad(arr: np.ndarray, published: np.ndarray | None) -> int | None:
     """Index of the first published member whose value is not finite, or None."""
+    if published is None and np.isfinite(arr).all():  # the usual case, in two calls
+        return None
     bad = ~np.isfinite(arr)
     if published is not None:
         bad &= published

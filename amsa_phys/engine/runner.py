@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 import operator
+from array import array
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -422,7 +423,8 @@ class Simulation:
     def _step_group(self, group: batch.Group, now: Fraction) -> None:
         """Run a group of like components in one call (``engine/batch.py``)."""
         values = self.values
-        inp = {port: np.array(get(values), dtype=np.float64) for port, get in group.inputs}
+        # array('d', tuple) then a view: a third cheaper than np.array on a tuple of floats
+        inp = {port: np.frombuffer(array("d", get(values))) for port, get in group.inputs}
         try:
             out, published = group.template.step_many(
                 group.comps, now, inp, group.params, group.state
@@ -439,7 +441,8 @@ class Simulation:
             if bufs is None:
                 who = self._who(group.paths[0])
                 raise RunFault(who, now, f"published unknown output {port!r}")
-            arr = np.broadcast_to(np.asarray(arr, dtype=np.float64), (n,))
+            if not (type(arr) is np.ndarray and arr.shape == (n,) and arr.dtype == np.float64):
+                arr = np.broadcast_to(np.asarray(arr, dtype=np.float64), (n,))
             k = batch.first_bad(arr, published)
             if k is not None:
                 raise RunFault(self._who(group.paths[k]), now, f"output {port} is {arr[k]}")

@@ -164,6 +164,30 @@ class PhysicsWorld:
         where = {id(r): k for k, r in enumerate(self.rovers)}
         return np.array([where[id(r)] for r in rovers], dtype=np.intp)
 
+    def set_powers(
+        self,
+        rovers: Sequence[DiffDriveRover],
+        index: np.ndarray,
+        left: np.ndarray,
+        right: np.ndarray,
+    ) -> None:
+        """Command many rovers at once, as ``rover.set_power`` would one by one.
+
+        The grouped controlled robots of a platoon (``step_many``) command 200 rovers at
+        4 Hz; one by one that is ~0.8 µs a rover. Saturation is the motor driver's (±100 %,
+        NaN to -100 as :func:`rover._saturate`); the rovers' ``power_l``/``power_r`` (which the
+        per-rover force model and the renderer read) and the batch model's arrays both follow.
+        """
+        left = np.where(np.isnan(left), -100.0, np.clip(left, -100.0, 100.0))
+        right = np.where(np.isnan(right), -100.0, np.clip(right, -100.0, 100.0))
+        for rover, lp, rp in zip(rovers, left.tolist(), right.tolist(), strict=True):
+            rover.power_l = lp
+            rover.power_r = rp
+        model = self._model
+        if isinstance(model, fleet.Fleet):
+            model.powers[0, index] = left
+            model.powers[1, index] = right
+
     def kinematics_array(self, index: np.ndarray) -> np.ndarray:
         """(n, 6) ``x, y, angle, vx, vy, w`` of the rovers at ``index`` after the last step."""
         return (self._model or self._start()).kinematics_array(index)

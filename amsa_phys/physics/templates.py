@@ -163,9 +163,9 @@ class ControlledRobot(_Robot):
         if "index" not in state:
             state["index"] = physics.index_of([c.rover for c in comps])
             state["half_track"] = np.array([c.rover.half_track for c in comps])
-        powers = zip(comps, inp["powerL"].tolist(), inp["powerR"].tolist(), strict=True)
-        for c, left, right in powers:
-            c.rover.set_power(left, right)
+        if "rovers" not in state:
+            state["rovers"] = [c.rover for c in comps]
+        physics.set_powers(state["rovers"], state["index"], inp["powerL"], inp["powerR"])
         x, y, a, vx, vy, w = physics.kinematics_array(state["index"]).T
         v = vx * np.cos(a) + vy * np.sin(a)
         wh = w * state["half_track"]

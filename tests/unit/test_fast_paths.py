@@ -187,3 +187,37 @@ def test_runs_of_physics_only_instants_change_nothing(
     )
     assert scheduled_run(tmp_path, chunks) == fast
     assert scheduled_run(tmp_path, [1] * 600) == fast
+
+
+@pytest.mark.parametrize("cars", [5, 45], ids=["float path", "fleet"])
+def test_commanding_many_rovers_equals_one_by_one(tmp_path: Path, cars: int) -> None:
+    """``PhysicsWorld.set_powers`` (the grouped controlled robots) saturates like
+    ``set_power`` and reaches whatever force model the world runs."""
+    import numpy as np
+    import yaml
+
+    world = yaml.safe_load((ROOT / "worlds" / "platoon.yaml").read_text())
+    world["components"]["Car"]["count"] = cars
+    (tmp_path / "w.yaml").write_text(yaml.safe_dump(world))
+    (tmp_path / "s.yaml").write_text("world: w.yaml\nduration: 2\n")
+    sims = []
+    for _ in range(2):
+        sim = Simulation.from_scenario(load_scenario(tmp_path / "s.yaml"))
+        sim.initialize()
+        sim.advance(10)
+        sims.append(sim)
+    rng = np.random.default_rng(3)
+    left = rng.uniform(-150, 150, cars)
+    right = rng.uniform(-150, 150, cars)
+    left[0], right[1] = np.nan, 100.0
+    many, one = (s.shared["physics"] for s in sims)
+    chosen = many.rovers[1:]  # the cars, not the leader
+    many.set_powers(chosen, many.index_of(chosen), left, right)
+    for rover, lp, rp in zip(one.rovers[1:], left.tolist(), right.tolist(), strict=True):
+        rover.set_power(lp, rp)
+    for a, b in zip(many.rovers, one.rovers, strict=True):
+        assert (a.power_l, a.power_r) == (b.power_l, b.power_r)
+    for sim in sims:
+        sim.run()
+    finals = [[list(r.kinematics()) for r in s.shared["physics"].rovers] for s in sims]
+    assert finals[0] == finals[1]
