@@ -77,7 +77,8 @@ class PlotJob:
         if not sys.platform.startswith("linux"):
             return job
         for stream in (sys.stdout, sys.stderr):  # else the child re-flushes their buffers
-            stream.flush()
+            if stream is not None:
+                stream.flush()
         try:
             ctx = multiprocessing.get_context("fork")
             parent_end, child_end = ctx.Pipe()
