@@ -35,10 +35,10 @@ def format_rows(rows: Sequence[Sequence[float]]) -> bytes:
     blob = orjson.dumps(rows, default=float)
     if b"n" in blob:  # null: a non-finite value
         return "".join(",".join(map(repr, row)) + "\n" for row in rows).encode()
-    body = blob.replace(b"],[", b"\n")
+    body = blob[2:-2].replace(b"],[", b"\n")  # [[a,b],[c,d]] -> a,b\nc,d
     if b"e" in body or b"0.0000" in body:
-        body = b"[[" + _respell(body[2:-2]) + b"]]"
-    return body[2:-2] + b"\n"
+        body = _respell(body)
+    return body + b"\n"
 
 
 def _respell(body: bytes) -> bytes:
