@@ -32,6 +32,11 @@ if TYPE_CHECKING:  # pygame is imported only by runs that draw
     from ..view.recorder import Recorder, RecordOptions, Snapshot, SnapshotOptions
 
 
+#: libyaml's emitter when PyYAML has it: the same text as ``yaml.safe_dump``, 3-4x faster (a
+#: 200-car platoon's resolved scenario: 0.66 s -> 0.19 s).
+_YAML_DUMPER = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+
+
 @dataclass
 class RunOutcome:
     """What a finished run wrote and measured."""
@@ -181,7 +186,8 @@ def run_scenario(
     resolved = resolved_scenario(
         scenario, extra=sim.live_changes, duration=sim.now if stopped_early else None
     )
-    write_atomic(out_dir / "scenario.yaml", yaml.safe_dump(resolved, sort_keys=False))
+    text = yaml.dump(resolved, Dumper=_YAML_DUMPER, sort_keys=False)
+    write_atomic(out_dir / "scenario.yaml", text)
     plotter = plotter or PlotJob()
     if plot:
         plotter.draw(
