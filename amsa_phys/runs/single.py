@@ -227,7 +227,7 @@ def _finish_video(recorder: Recorder | None, error: BaseException | None) -> dic
         return None
     return {
         "path": str(path),
-        "frames": recorder.index,
+        "frames": recorder.encoder.written,  # what the file holds, even after Ctrl-C
         "fps": opts.fps,
         "size": list(opts.size),
         "speedup": float(opts.speedup),

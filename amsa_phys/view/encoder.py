@@ -107,7 +107,10 @@ class VideoEncoder:
             raise ValueError(f"video size {size[0]}x{size[1]} must be even (yuv420p)")
         self.path = Path(path)
         self.size = size
-        self.frames = 0
+        #: frames written whole to ffmpeg, counted by the writer thread: Ctrl-C interrupts only
+        #: the main thread, possibly between handing a frame over and counting it, so this is
+        #: the count that matches the finished file
+        self.written = 0
         self.tmp = self.path.with_name(self.path.name + ".tmp")
         self._log = tempfile.TemporaryFile()  # noqa: SIM115 (lives as long as ffmpeg)
         self._proc = subprocess.Popen(
@@ -135,6 +138,7 @@ class VideoEncoder:
             try:
                 if self._error is None:
                     self._write_all(buf)
+                    self.written += 1
             except OSError as exc:  # ffmpeg died (disk full, bad argument)
                 self._error = exc
             finally:
@@ -160,7 +164,6 @@ class VideoEncoder:
         if self._error is not None:
             raise EncoderError(self._failure())
         self._queue.put(pixels)
-        self.frames += 1
 
     def wait_written(self) -> None:
         """Block until the oldest submitted frame has been written to the pipe."""
