@@ -203,12 +203,17 @@ def test_ctrl_c_during_a_recording_leaves_a_playable_video(tmp_path: Path) -> No
     )
     tmp = video.with_name(video.name + ".tmp")
     deadline = time.monotonic() + 60
-    while not (tmp.exists() and tmp.stat().st_size > 20_000):
-        assert proc.poll() is None, proc.stderr.read() if proc.stderr else ""
-        assert time.monotonic() < deadline, "recording never started"
-        time.sleep(0.05)
-    os.killpg(proc.pid, signal.SIGINT)
-    _, err = proc.communicate(timeout=60)
+    try:
+        while not (tmp.exists() and tmp.stat().st_size > 20_000):
+            assert proc.poll() is None, proc.stderr.read() if proc.stderr else ""
+            assert time.monotonic() < deadline, "recording never started"
+            time.sleep(0.05)
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:  # a failed or hung run must not outlive the test (its ffmpeg follows it)
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
     assert proc.returncode == 130, err
     assert not tmp.exists()
     _, frames = decode(video)
