@@ -2,7 +2,10 @@
 
 import os
 import sys
+from collections.abc import Iterator
 from pathlib import Path
+
+import pytest
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("MPLBACKEND", "Agg")
@@ -13,3 +16,12 @@ ROOT = Path(__file__).resolve().parent.parent
 
 # broken and deliberately failing scenario files are inputs of tests, not tests themselves
 collect_ignore_glob = ["fixtures/*", "golden/*.yaml"]
+
+
+@pytest.fixture(autouse=True)
+def _no_leftover_long_runs() -> Iterator[None]:
+    """A test that fails mid-way must not leave its 100 000 s run burning a core."""
+    yield
+    from longrun import stop_leftovers
+
+    stop_leftovers()

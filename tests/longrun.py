@@ -9,6 +9,18 @@ from pathlib import Path
 
 FIXTURE = Path(__file__).resolve().parent / "fixtures" / "mde_short.yaml"
 
+#: Every long run started, so that ``conftest.py`` can stop any a failed test left running.
+STARTED: list[subprocess.Popen[str]] = []
+
+
+def stop_leftovers() -> None:
+    """Kill the long runs still alive (a test failed before it ended its run)."""
+    while STARTED:
+        proc = STARTED.pop()
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
 
 def start_long_run(out: Path, **popen: object) -> subprocess.Popen[str]:
     """A 100 000 s run into ``out``, returned once ``trace.csv.tmp`` exists (plus 0.3 s)."""
@@ -30,6 +42,7 @@ def start_long_run(out: Path, **popen: object) -> subprocess.Popen[str]:
         text=True,
         **popen,
     )  # type: ignore[call-overload]
+    STARTED.append(proc)
     deadline = time.monotonic() + 30
     while not (out / "trace.csv.tmp").exists() and time.monotonic() < deadline:
         time.sleep(0.05)

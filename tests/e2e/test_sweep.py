@@ -166,11 +166,16 @@ def test_ctrl_c_keeps_every_finished_row(tmp_path: Path, how: str) -> None:
     time.sleep(4)
     import os
 
-    if how == "sigterm":
-        proc.terminate()
-    else:
-        os.killpg(proc.pid, signal.SIGINT)  # like a terminal's Ctrl-C: the whole group
-    _, err = proc.communicate(timeout=60)
+    try:
+        if how == "sigterm":
+            proc.terminate()
+        else:
+            os.killpg(proc.pid, signal.SIGINT)  # like a terminal's Ctrl-C: the whole group
+        _, err = proc.communicate(timeout=60)
+    finally:  # a hung sweep must not outlive the test with its workers
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
     assert proc.returncode == 130, err
     assert "sweep interrupted" in err
     table = rows(out)
