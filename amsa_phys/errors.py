@@ -74,7 +74,11 @@ class ExpectationFailed(AmsaError):
     exit_code = 1
 
 
-class Interrupted(AmsaError):
-    """The user interrupted a run (Ctrl-C or SIGTERM); outputs so far were finalised."""
+class Interrupted(KeyboardInterrupt):
+    """The user interrupted a run (Ctrl-C or SIGTERM); outputs so far were finalised.
+
+    A KeyboardInterrupt, not an :class:`AmsaError`: code that records a run's error and goes
+    on (a sweep's row, a suite's scenario) must not swallow the user's Ctrl-C.
+    """
 
     exit_code = 130

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import os
+import signal
 from fractions import Fraction
 from typing import Any
 
@@ -126,3 +128,28 @@ class Divider(Template):
     def step_many(cls, comps: Any, t: Fraction, inp: Any, p: Any, state: Any) -> Any:
         with np.errstate(divide="ignore"):
             return {"y": 1.0 / (inp["x"] * p.k)}, None
+
+
+class CtrlC(Template):
+    """Publishes its step count and sends its own process ``signals`` signals at ``at`` s.
+
+    Stands in for a user's Ctrl-C (or ``kill``) landing in the middle of an instant.
+    """
+
+    kind = Kind.CONTROLLER
+    outputs = (Port("u"),)
+    params = (
+        Param("at", "float", "when to signal", 2.5, 0.0, 1e6),
+        Param("signals", "int", "how many signals", 1, 1, 2),
+        Param("term", "bool", "SIGTERM instead of SIGINT", False),
+    )
+
+    def initialize(self, ctx: Any) -> None:
+        self.n = 0
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        self.n += 1
+        if t == Fraction(self.p.at):
+            for _ in range(self.p.signals):
+                os.kill(os.getpid(), signal.SIGTERM if self.p.term else signal.SIGINT)
+        return {"u": float(self.n)}

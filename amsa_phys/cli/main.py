@@ -62,6 +62,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except AmsaError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return exc.exit_code
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:  # Interrupted says where; a bare one during loading
+        print(f"error: {exc}" if str(exc) else "interrupted", file=sys.stderr)
         return 130

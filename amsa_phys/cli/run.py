@@ -6,9 +6,9 @@ import argparse
 import signal
 import sys
 from pathlib import Path
-from types import FrameType
 from typing import TYPE_CHECKING
 
+from ..engine import interrupt
 from ..errors import ConfigError
 from ..model.scenario import load_scenario
 from ..runs.expect import check_expectations
@@ -38,10 +38,6 @@ def add_args(p: argparse.ArgumentParser) -> None:
         "--no-plot", action="store_true", help="skip the plots (distance.png, trajectory.png)"
     )
     p.add_argument("-q", "--quiet", action="store_true", help="no summary table")
-
-
-def _sigterm(signum: int, frame: FrameType | None) -> None:
-    raise KeyboardInterrupt
 
 
 def run(args: argparse.Namespace) -> int:
@@ -79,7 +75,7 @@ def _run(
     )
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
     prepare_run_dir(out, args.force)
-    previous = signal.signal(signal.SIGTERM, _sigterm)
+    previous = signal.signal(signal.SIGTERM, interrupt.request)
     try:
         outcome = run_scenario(
             scenario,

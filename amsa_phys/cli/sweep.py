@@ -12,6 +12,7 @@ from typing import Any
 
 from tqdm import tqdm
 
+from ..engine import interrupt
 from ..engine.recorder import write_atomic
 from ..errors import ConfigError, Interrupted
 from ..model.scenario import load_scenario
@@ -132,7 +133,7 @@ def run(args: argparse.Namespace) -> int:
         else iter_local(jobs, min(args.jobs, len(jobs)))
     )
     interrupted = False
-    previous = signal.signal(signal.SIGTERM, _sigterm)
+    previous = signal.signal(signal.SIGTERM, interrupt.request)
     try:
         with tqdm(total=len(jobs), unit="run", disable=not sys.stderr.isatty()) as bar:
             for row in source:
@@ -160,10 +161,6 @@ def run(args: argparse.Namespace) -> int:
     if interrupted:
         raise Interrupted(f"sweep interrupted; {len(rows)} finished rows kept in {out}")
     return 0
-
-
-def _sigterm(signum: int, frame: object) -> None:
-    raise KeyboardInterrupt
 
 
 def write_results(rows: list[dict[str, Any]], axes: list[str], path: Path) -> None:

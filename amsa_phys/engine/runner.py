@@ -32,7 +32,7 @@ from ..errors import RunFault
 from ..model.scenario import Change, Phase, Scenario
 from ..model.template import Template
 from ..model.world import WorldSpec
-from . import batch
+from . import batch, interrupt
 from .clock import MAX_EVENTS_PER_CYCLE, TickGrid, hyperperiod
 from .rng import component_rng
 
@@ -316,6 +316,16 @@ class Simulation:
     def advance(self, until_tick: int) -> None:
         """Execute every instant with tick <= ``until_tick`` (and <= the end).
 
+        A Ctrl-C noted meanwhile (:mod:`.interrupt`) is raised here, once every instant up
+        to ``until_tick`` has run whole.
+        """
+        self._advance(until_tick)
+        if interrupt.requested():
+            raise KeyboardInterrupt
+
+    def _advance(self, until_tick: int) -> None:
+        """:meth:`advance` without the interrupt check.
+
         The hot loop of every run: per instant it does two integer compares, then calls what
         the precomputed table lists. Phase changes are found by comparing with the next phase's
         tick only; hooks (the physics step) do not run at the final instant, which ends the run.
@@ -524,10 +534,12 @@ class Simulation:
 
     def result(self) -> RunResult:
         """Samples and events so far."""
+        # equal lengths even if a second Ctrl-C (raised at once) fell between the two appends
+        n = min(len(self._samples_t), len(self._samples_s))
         return RunResult(
             t_end=float(self.now),
-            samples_t=np.array(self._samples_t, dtype=np.float64),
-            samples_s=np.array(self._samples_s, dtype=np.float64),
+            samples_t=np.array(self._samples_t[:n], dtype=np.float64),
+            samples_s=np.array(self._samples_s[:n], dtype=np.float64),
             events=list(self.events),
         )
 

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import yaml
 from tqdm import tqdm
 
+from ..engine import interrupt
 from ..engine.metrics import block_metrics
 from ..engine.recorder import TraceWriter, write_atomic
 from ..engine.runner import RunResult, Simulation
@@ -138,8 +139,35 @@ def run_scenario(
     ``window`` replaces the window's own loop (tests drive it with scripted events and an
     exact clock). ``plotter`` draws the plots (a child started early, ``runs/plotjob.py``);
     without one they are drawn in-process.
+
+    Ctrl-C (SIGINT, and SIGTERM from the CLI) during the run stops it between two instants
+    (``engine/interrupt.py``): the outputs describe whole instants, then
+    :class:`~amsa_phys.errors.Interrupted` is raised. A second Ctrl-C stops at once.
     """
-    out_dir = Path(out_dir)
+    with interrupt.deferred():
+        return _run_scenario(
+            scenario,
+            Path(out_dir),
+            progress=progress,
+            plot=plot,
+            record=record,
+            snapshot=snapshot,
+            window=window,
+            plotter=plotter,
+        )
+
+
+def _run_scenario(
+    scenario: Scenario,
+    out_dir: Path,
+    *,
+    progress: bool | None,
+    plot: bool,
+    record: RecordOptions | None,
+    snapshot: SnapshotOptions | None,
+    window: bool | WindowDriver,
+    plotter: PlotJob | None,
+) -> RunOutcome:
     trace = TraceWriter(out_dir / "trace.csv", list(scenario.world.buffers))
     sim = Simulation.from_scenario(scenario, trace=trace.write)
     status = "completed"
@@ -200,6 +228,11 @@ def run_scenario(
         ) from None
     if error is not None:
         raise error
+    if interrupt.requested():  # Ctrl-C after the last instant: the outputs are complete
+        raise Interrupted(
+            f"interrupted after the run ended at t={result.t_end:.2f} s; "
+            f"its outputs are complete in {out_dir}"
+        )
     return RunOutcome(out_dir, metrics, sim)
 
 
@@ -250,7 +283,7 @@ def _advance_with_progress(
         leave=False,
         bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} s [{elapsed}<{remaining}]",
     ) as bar:
-        tick = -1
+        tick = 0  # chunks end on whole seconds: a Ctrl-C stops at t=3.0, not 2.95
         while tick < end:
             tick = min(end, tick + per_second)
             advance(sim, tick, sinks)

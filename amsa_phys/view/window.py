@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 from fractions import Fraction
 
+from ..engine import interrupt
 from ..engine.runner import Simulation
 from ..model.scenario import Quality
 from .camera import Camera
@@ -111,6 +112,7 @@ class Window:
 
     def frame(self, real_dt: float) -> bool:
         """One iteration: events, advance by ``speed * real_dt``, draw. False once closed."""
+        interrupt.check()  # Ctrl-C in the terminal, also while paused (advance checks too)
         for event in pygame.event.get():
             self.handle(event)
         if not self.running:

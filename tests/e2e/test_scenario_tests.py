@@ -78,3 +78,20 @@ def test_pytest_collects_scenarios_in_a_users_project(tmp_path: Path) -> None:
     assert "1 failed, 1 passed" in proc.stdout
     assert "max_distance = 20.07, below 16: FAIL" in proc.stdout
     assert "Traceback" not in proc.stdout
+
+
+def test_ctrl_c_stops_the_whole_suite_not_just_one_scenario(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # an interrupted scenario is not a failed one: the suite must not go on to the next file
+    text = (
+        "world:\n  components:\n    K: {template: 'toys:CtrlC', freq: 4}\n"
+        "duration: 100\nquality: {signal: K.u, reference: 0}\n"
+        "expect:\n  - {metric: max_distance, below: 1000}\n"
+    )
+    (tmp_path / "a.yaml").write_text(text)
+    (tmp_path / "b.yaml").write_text(text)
+    assert main(["test", str(tmp_path), "-j", "1"]) == 130
+    captured = capsys.readouterr()
+    assert captured.err.startswith("error: interrupted at t=3.00 s")
+    assert "scenarios," not in captured.out  # no table: nothing was reported as run

@@ -152,3 +152,30 @@ def test_a_window_without_a_display_is_refused_clearly(
     assert "no display to open a window on" in err
     assert "run with --headless" in err
     assert not (tmp_path / "w").exists()
+
+
+def test_ctrl_c_in_the_terminal_stops_a_paused_window(tmp_path: Path) -> None:
+    import json
+    import os
+    import signal
+
+    from amsa_phys.errors import Interrupted
+
+    def ctrl_c_while_paused(sim: Simulation, scenario: Scenario, rec: Recorder | None) -> None:
+        w = Window(sim, scenario.quality, size=(320, 240))
+        while sim.now < 2:
+            w.frame(0.1)
+        press(pygame.K_SPACE)
+        w.frame(0.1)
+        os.kill(os.getpid(), signal.SIGINT)  # only noted: the state stays whole
+        for _ in range(3):
+            w.frame(0.1)  # paused: nothing advances, yet the next frame stops the session
+        raise AssertionError("the window kept running after Ctrl-C")
+
+    out = tmp_path / "w"
+    out.mkdir()
+    with pytest.raises(Interrupted, match=r"interrupted at t=2\.0"):
+        run_scenario(load_scenario(SCENARIO), out, window=ctrl_c_while_paused, plot=False)
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["status"] == "interrupted"
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # handler restored

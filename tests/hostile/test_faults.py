@@ -111,6 +111,35 @@ def test_sigterm_finalises_like_ctrl_c(tmp_path: Path) -> None:
     assert json.loads((out / "metrics.json").read_text())["status"] == "interrupted"
 
 
+@pytest.mark.parametrize("term", ["false", "true"], ids=["ctrl-c", "sigterm"])
+def test_interrupt_inside_an_instant_stops_after_whole_instants(tmp_path: Path, term: str) -> None:
+    # the signal arrives inside a component's doStep at t=2.5; the run ends at the end of that
+    # simulated second, every instant up to it whole (CI once caught a Ctrl-C between the
+    # quality sample's time and value: IndexError and a traceback instead of exit 130)
+    comps = f"    K: {{template: 'toys:CtrlC', freq: 4, params: {{term: {term}}}}}"
+    quality = "quality: {signal: K.u, reference: 0}\n"
+    scen = scenario(tmp_path, comps, quality, duration=100)
+    proc = run_cli("run", str(scen), "--headless", "--out", str(tmp_path / "o"), "-q")
+    assert proc.returncode == 130
+    assert proc.stderr.startswith("error: interrupted at t=3.00 s; outputs so far are in ")
+    trace = (tmp_path / "o" / "trace.csv").read_text().splitlines()
+    assert trace[-1] == "3.0,13.0"  # K ran at 0, 0.25, ..., 3.0: 13 steps, all logged
+    metrics = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert (metrics["status"], metrics["simulated"]) == ("interrupted", 3.0)
+    assert metrics["overall"]["max_distance"] == 13.0  # the quality samples are whole too
+
+
+def test_second_ctrl_c_stops_at_once_and_still_finalises(tmp_path: Path) -> None:
+    comps = "    K: {template: 'toys:CtrlC', freq: 4, params: {signals: 2}}"
+    scen = scenario(tmp_path, comps, "quality: {signal: K.u, reference: 0}\n", duration=100)
+    proc = run_cli("run", str(scen), "--headless", "--out", str(tmp_path / "o"), "-q")
+    assert proc.returncode == 130
+    assert proc.stderr.startswith("error: interrupted at t=2.50 s; outputs so far are in ")
+    metrics = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert (metrics["status"], metrics["simulated"]) == ("interrupted", 2.5)
+    assert (tmp_path / "o" / "trace.csv").read_text().splitlines()[-1].startswith("2.45,")
+
+
 def test_sigkill_never_leaves_a_partial_file_under_a_final_name(tmp_path: Path) -> None:
     out = tmp_path / "k"
     proc = start_long_run(out)

@@ -1,0 +1,74 @@
+"""Ctrl-C and SIGTERM stop a run *between* two calls of ``Simulation.advance``, never inside one.
+
+Why: Python raises KeyboardInterrupt wherever the main thread happens to be. Inside an
+instant it can land between two statements that belong together -- CI caught one between
+appending a quality sample's time and its value, and the metrics then failed with an
+IndexError and a traceback instead of exit 130 -- or half-way through a component's
+``doStep``, so the outputs finalised afterwards describe a state no instant ever had.
+
+So while a run is going (:class:`deferred`), the signal handler only notes the request and
+``Simulation.advance`` raises KeyboardInterrupt when it returns: every simulated second in a
+headless run, every frame in the window and in a recording, which is well under a
+wall-clock second for any world this project ships. A second signal raises at once: the user
+insists (a component stuck in an endless loop never returns from ``advance``).
+
+Only the main thread can own signal handlers, and a handler somebody else installed (a sweep
+worker ignores SIGINT; a host application has its own) is left alone: :class:`deferred` is
+then a no-op and nothing is ever requested.
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from types import FrameType
+
+_installed = 0  # deferrals whose handler is in place (nested runs share one request)
+_requested = False
+
+
+def request(signum: int | None = None, frame: FrameType | None = None) -> None:
+    """Signal handler: note a stop request, or raise at once.
+
+    At once when no run defers interrupts, or when a request is already pending (the
+    second Ctrl-C). Also the CLI's SIGTERM handler, so ``kill`` behaves like Ctrl-C.
+    """
+    global _requested
+    if not _installed or _requested:
+        raise KeyboardInterrupt
+    _requested = True
+
+
+def requested() -> bool:
+    """Whether a stop was requested during the current run (and not yet ended)."""
+    return _requested
+
+
+def check() -> None:
+    """Raise KeyboardInterrupt if a stop was requested: call where the state is whole."""
+    if _requested:
+        raise KeyboardInterrupt
+
+
+@contextmanager
+def deferred() -> Iterator[None]:
+    """While active, SIGINT (if Python's default handler has it) only requests a stop."""
+    global _installed, _requested
+    if threading.current_thread() is not threading.main_thread() or signal.getsignal(
+        signal.SIGINT
+    ) not in (signal.default_int_handler, request):
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, request)
+    if not _installed:
+        _requested = False
+    _installed += 1
+    try:
+        yield
+    finally:
+        _installed -= 1
+        signal.signal(signal.SIGINT, previous)
+        if not _installed:
+            _requested = False
