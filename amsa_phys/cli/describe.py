@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..model.world import WorldSpec
+from ..runs.expect import describe_bound, describe_what
 from .loading import load_any
 
 
@@ -53,8 +54,7 @@ def run(args: argparse.Namespace) -> int:
             changes = ", ".join(f"{c.key}={c.value!r}" for c in phase.changes) or "-"
             print(f"phase {i} at {float(phase.at):g} s: {changes}")
         for e in obj.expect:
-            where = f" phase {e.phase}" if e.phase is not None else ""
-            print(f"expect {e.metric}{where}: below {e.below} above {e.above}")
+            print(f"expect {describe_what(e)} {describe_bound(e)}")
         world = obj.world
     else:
         world = obj

@@ -23,23 +23,12 @@ class Check:
     @property
     def what(self) -> str:
         """``max_distance (phase 1)`` or ``Comp.out in [30, end] s``."""
-        e = self.expectation
-        if e.trace is not None:
-            lo = f"{e.after:g}" if e.after is not None else "0"
-            hi = f"{e.before:g}" if e.before is not None else "end"
-            return f"{e.trace} in [{lo}, {hi}] s"
-        return f"{e.metric}" + (f" (phase {e.phase})" if e.phase is not None else "")
+        return describe_what(self.expectation)
 
     @property
     def bound(self) -> str:
         """``below 26 and above 2``."""
-        e = self.expectation
-        parts = []
-        if e.below is not None:
-            parts.append(f"below {e.below:g}")
-        if e.above is not None:
-            parts.append(f"above {e.above:g}")
-        return " and ".join(parts)
+        return describe_bound(self.expectation)
 
     @property
     def verdict(self) -> str:
@@ -53,6 +42,25 @@ class Check:
             return f"{self.what}: skipped ({cut} not run, --duration cut it)"
         value = "none" if self.value is None else f"{self.value:.4g}"
         return f"{self.what} = {value}, {self.bound}: {self.verdict}"
+
+
+def describe_what(e: Expectation) -> str:
+    """What an expectation measures: ``max_distance (phase 1)`` or ``Comp.out in [30, end] s``."""
+    if e.trace is not None:
+        lo = f"{e.after:g}" if e.after is not None else "0"
+        hi = f"{e.before:g}" if e.before is not None else "end"
+        return f"{e.trace} in [{lo}, {hi}] s"
+    return f"{e.metric}" + (f" (phase {e.phase})" if e.phase is not None else "")
+
+
+def describe_bound(e: Expectation) -> str:
+    """An expectation's bounds: ``below 26 and above 2``."""
+    parts = []
+    if e.below is not None:
+        parts.append(f"below {e.below:g}")
+    if e.above is not None:
+        parts.append(f"above {e.above:g}")
+    return " and ".join(parts)
 
 
 def check_expectations(

@@ -139,6 +139,7 @@ def test_validate_describe_templates(capsys: pytest.CaptureFixture[str]) -> None
     assert "MyFollowerController: FollowerController (controller) at 4 Hz" in text
     assert "Kv = 0.35 1/m  [0, 10]" in text or "Kv = 0.05 1/m  [0, 10]" in text
     assert "execution order at a shared instant: Leader -> Follower -> MyNormalizePower" in text
+    assert "expect rms_error (phase 0) above 2\nexpect rms_error (phase 3) below 0.1\n" in text
     assert main(["templates"]) == 0
     text = capsys.readouterr().out
     for name in (
