@@ -1,4 +1,4 @@
-"""Redraw a run's distance-vs-time and trajectory plots from its trace.csv and metrics.json."""
+"""Redraw a run's plots from its trace and metrics, or a sweep's summary from results.csv."""
 
 from __future__ import annotations
 
@@ -8,22 +8,34 @@ from pathlib import Path
 
 from ..errors import ConfigError
 from ..runs.plotjob import draw_run_plots
+from ..runs.sweep import read_results, unknown_metric
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
     """Arguments of ``amsa-phys plot``."""
-    p.add_argument("rundir", help="a run directory written by `amsa-phys run`")
+    p.add_argument(
+        "rundir", help="a run directory (`amsa-phys run`) or a sweep directory (`amsa-phys sweep`)"
+    )
     p.add_argument(
         "-o",
         "--output",
         help="distance plot PNG (default RUNDIR/distance.png; the trajectory plot "
-        "goes next to it as <name>-trajectory.png, or RUNDIR/trajectory.png)",
+        "goes next to it as <name>-trajectory.png, or RUNDIR/trajectory.png); "
+        "for a sweep: the summary PNG (default DIR/summary.png)",
+    )
+    p.add_argument(
+        "--metric",
+        help="sweep only: the metric to plot, overall or phase<i>.<metric> (default rms_error)",
     )
 
 
 def run(args: argparse.Namespace) -> int:
     """Draw the plot."""
     rundir = Path(args.rundir)
+    if (rundir / "results.csv").is_file() and not (rundir / "trace.csv").exists():
+        return _plot_sweep(rundir, args)
+    if args.metric is not None:
+        raise ConfigError("only for a sweep directory (with results.csv)", key="--metric")
     for name in ("trace.csv", "metrics.json"):
         if not (rundir / name).is_file():
             raise ConfigError(f"not a run directory: {name} is missing", file=rundir)
@@ -37,4 +49,22 @@ def run(args: argparse.Namespace) -> int:
     traj = out.with_name(out.stem + "-trajectory.png") if args.output else rundir / "trajectory.png"
     draw_run_plots(rundir / "trace.csv", metrics, out, traj)
     print(f"wrote {out} and {traj}")
+    return 0
+
+
+def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
+    """summary.png again, for any metric column: no need to rerun the sweep to see another."""
+    from ..plots.summary import plot_summary  # matplotlib: only once the rows are read
+
+    rows, axes = read_results(sweepdir / "results.csv")
+    metric = args.metric or "rms_error"
+    phases = sum(1 for key in rows[0] if key.endswith(".rms_error")) if rows else 0
+    why = unknown_metric(metric, phases)
+    if why is not None:
+        raise ConfigError(why, key="--metric")
+    seeds = len({r["seed_index"] for r in rows})
+    out = Path(args.output) if args.output else sweepdir / "summary.png"
+    title = f"{sweepdir.name}: {metric} ({seeds} seed{'s' if seeds != 1 else ''})"
+    plot_summary(rows, axes, metric, out, title)
+    print(f"wrote {out}")
     return 0

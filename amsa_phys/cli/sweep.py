@@ -19,7 +19,6 @@ from ..model.scenario import load_scenario
 from ..model.yamlio import load_yaml
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.sweep import (
-    METRIC_KEYS,
     Axis,
     SweepPlan,
     check_axes,
@@ -27,6 +26,7 @@ from ..runs.sweep import (
     iter_local,
     parse_grid,
     parse_range,
+    unknown_metric,
 )
 from .options import add_jobs
 
@@ -98,13 +98,20 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
     seeds = args.seeds if args.seeds is not None else int(section.get("seeds", 1))
     if seeds < 1:
         raise ConfigError("must be at least 1", key="--seeds")
+    metric = args.metric or section.get("metric", "rms_error")
+    end = args.duration if args.duration is not None else scenario.duration
+    why = unknown_metric(metric, sum(1 for p in scenario.phases if p.at < end))
+    if why is not None:
+        if args.metric is None:
+            raise doc.error(("sweep", "metric"), why)
+        raise ConfigError(why, key="--metric")
     return SweepPlan(
         Path(args.scenario).resolve(),
         axes,
         seeds,
         scenario.seed,
         contexts,
-        args.metric or section.get("metric", "rms_error"),
+        metric,
         args.duration,
     )
 
@@ -112,10 +119,6 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
 def run(args: argparse.Namespace) -> int:
     """Run the sweep; results.csv and summary.png; Ctrl-C keeps every finished row."""
     plan = build_plan(args)
-    if plan.metric not in METRIC_KEYS:
-        raise ConfigError(
-            f"unknown metric {plan.metric!r}; known: {', '.join(METRIC_KEYS)}", key="--metric"
-        )
     if args.executor == "dask" and not args.scheduler:
         raise ConfigError("the Dask executor needs --scheduler ADDR", key="--executor")
     if args.jobs < 1:

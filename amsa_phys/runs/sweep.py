@@ -10,6 +10,7 @@ file once per process and copy it per run (no re-parsing per run).
 from __future__ import annotations
 
 import copy
+import csv
 import functools
 import itertools
 import json
@@ -39,6 +40,53 @@ METRIC_KEYS = (
     "final_distance",
     "collisions",
 )
+
+
+def metric_names(n_phases: int) -> list[str]:
+    """The metric columns of ``results.csv``: overall, then ``phase<i>.<metric>``."""
+    return [*METRIC_KEYS, *(f"phase{i}.{k}" for i in range(n_phases) for k in METRIC_KEYS)]
+
+
+def unknown_metric(metric: str, n_phases: int) -> str | None:
+    """Why ``metric`` names no column of a sweep with ``n_phases`` phases (None if it does)."""
+    if metric in metric_names(n_phases):
+        return None
+    phases = (
+        f"; or phase<i>.<metric> for i in 0..{n_phases - 1}"
+        if n_phases > 1
+        else "; or phase0.<metric>" * n_phases
+    )
+    return f"unknown metric {metric!r}; known: {', '.join(METRIC_KEYS)}{phases}"
+
+
+def read_results(path: Path) -> tuple[list[dict[str, Any]], list[str]]:
+    """``results.csv`` back as rows and the grid axes (the columns between run and seed_index).
+
+    Axis values that read as numbers become floats (so a numeric axis plots as one), metrics
+    become floats or None (an empty cell: never settled, or the run failed).
+    """
+    with open(path, newline="") as fh:
+        reader = csv.DictReader(fh)
+        fields = list(reader.fieldnames or [])
+        if fields[:1] != ["run"] or "seed_index" not in fields:
+            raise ConfigError("not a sweep's results.csv (no run/seed_index columns)", file=path)
+        axes = fields[1 : fields.index("seed_index")]
+        rows = []
+        for raw in reader:
+            row: dict[str, Any] = dict(raw)
+            for key in axes:
+                row[key] = _number_or_text(raw[key])
+            for key in fields[fields.index("error") + 1 :]:
+                row[key] = float(raw[key]) if raw[key] else None
+            rows.append(row)
+    return rows, axes
+
+
+def _number_or_text(text: str) -> Any:
+    try:
+        return float(text)
+    except ValueError:
+        return text
 
 
 @dataclass(frozen=True)

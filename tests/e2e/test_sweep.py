@@ -181,3 +181,46 @@ def test_ctrl_c_keeps_every_finished_row(tmp_path: Path, how: str) -> None:
     table = rows(out)
     assert 0 < len(table) < 400
     assert all(r["error"] == "" for r in table)
+
+
+def test_phase_metrics_and_replotting_a_sweep(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from amsa_phys.runs.sweep import read_results
+
+    out = tmp_path / "s"
+    args = ["sweep", str(SCEN), "--range", "MyFollowerController.Kv=0.1:0.3:3", "-j", "1"]
+    # the timeline changes Kv at 125 s: phase 1 exists only in runs that reach it
+    phase1 = ["--metric", "phase1.rms_error", "--out", str(out)]
+    assert main([*args, "--duration", "20", *phase1]) == 2
+    assert capsys.readouterr().err.startswith(
+        "error: --metric: unknown metric 'phase1.rms_error'; known: max_distance, "
+    )
+    assert not out.exists()
+    assert main([*args, "--duration", "130", *phase1]) == 0
+    table, axes = read_results(out / "results.csv")
+    assert axes == ["MyFollowerController.Kv"]
+    assert [r["MyFollowerController.Kv"] for r in table] == [0.1, 0.2, 0.3]
+    assert all(isinstance(r["phase1.rms_error"], float) for r in table)
+    assert [r["rms_error"] for r in table] == [float(r["rms_error"]) for r in rows(out)]
+
+    (out / "summary.png").unlink()
+    capsys.readouterr()
+    assert main(["plot", str(out), "--metric", "phase0.max_distance"]) == 0
+    assert capsys.readouterr().out == f"wrote {out / 'summary.png'}\n"
+    assert (out / "summary.png").read_bytes()[:4] == b"\x89PNG"
+    assert main(["plot", str(out), "--metric", "phase2.rms_error"]) == 2
+    assert capsys.readouterr().err.endswith("or phase<i>.<metric> for i in 0..1\n")
+
+
+def test_a_bad_sweep_metric_in_the_file_names_its_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scen = tmp_path / "s.yaml"
+    text = SCEN.read_text().replace("../../worlds/", f"{ROOT}/worlds/")
+    scen.write_text(text + "sweep:\n  grid: {MyFollowerController.Kv: [0.1]}\n  metric: rms\n")
+    line = len(text.splitlines()) + 3
+    assert main(["sweep", str(scen), "--out", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err.startswith(
+        f"error: {scen}:{line}: sweep.metric: unknown metric 'rms'; known: "
+    )
