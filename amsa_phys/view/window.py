@@ -13,6 +13,7 @@ window with injected events and an exact clock under SDL's dummy video driver.
 from __future__ import annotations
 
 import os
+import sys
 from fractions import Fraction
 
 from ..engine import interrupt
@@ -45,8 +46,18 @@ def open_display() -> None:
 
     With no X11/Wayland display SDL quietly falls back to its ``offscreen`` driver: a window
     would then run invisibly and never be closed. We refuse that unless the user (or a test)
-    asked for an offscreen driver explicitly with ``SDL_VIDEODRIVER``.
+    asked for an offscreen driver explicitly with ``SDL_VIDEODRIVER``. On Linux with neither
+    ``DISPLAY`` nor ``WAYLAND_DISPLAY`` set we refuse before asking SDL: its Wayland probe
+    would print its own ``error: XDG_RUNTIME_DIR ...`` line above ours.
     """
+    env = os.environ
+    if (
+        sys.platform.startswith("linux")
+        and not env.get("SDL_VIDEODRIVER")
+        and not env.get("DISPLAY")
+        and not env.get("WAYLAND_DISPLAY")
+    ):
+        raise RuntimeError("no display to open a window on (no X11 or Wayland session)")
     try:
         pygame.display.init()
     except pygame.error as exc:
