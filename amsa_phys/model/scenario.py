@@ -131,6 +131,8 @@ def build_scenario(doc: YamlDoc) -> Scenario:
     world_ref = data["world"]
     if isinstance(world_ref, str):
         world_path = doc.path.parent / world_ref
+        if world_path.is_dir():
+            raise doc.error(("world",), f"{world_path} is a directory, expected a world file")
         if not world_path.is_file():
             raise doc.error(("world",), f"world file not found: {world_path}")
         world = load_world(world_path)
