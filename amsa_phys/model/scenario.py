@@ -20,15 +20,16 @@ from .template import Kind
 from .world import WorldSpec, build_world, load_world
 from .yamlio import KeyPath, YamlDoc, load_yaml
 
-#: Metrics an ``expect`` entry may name (see engine/metrics.py).
+#: Metrics an ``expect`` entry may name (see engine/metrics.py), in the order of the columns
+#: of a sweep's ``results.csv``.
 METRICS = (
     "max_distance",
     "min_distance",
     "mean_error",
     "rms_error",
     "settling_time",
-    "collisions",
     "final_distance",
+    "collisions",
 )
 
 DEFAULT_LOG_RATE_HZ = 20

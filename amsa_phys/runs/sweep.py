@@ -26,20 +26,12 @@ import yaml
 
 from ..engine.runner import Simulation
 from ..errors import AmsaError, ConfigError
-from ..model.scenario import Scenario, load_scenario, resolve_change
+from ..model.scenario import METRICS, Scenario, load_scenario, resolve_change
 from .rundir import prepare_run_dir
 from .single import compute_metrics, run_scenario
 
 #: Metric columns written for the overall block and each phase.
-METRIC_KEYS = (
-    "max_distance",
-    "min_distance",
-    "mean_error",
-    "rms_error",
-    "settling_time",
-    "final_distance",
-    "collisions",
-)
+METRIC_KEYS = METRICS
 
 
 def metric_names(n_phases: int) -> list[str]:
