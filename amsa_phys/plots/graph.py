@@ -4,6 +4,12 @@ Layout: a component's column is its depth in the dataflow, counting only edges t
 in the execution order (a loop's back edge is drawn but does not push columns); rows keep
 declaration order. DOT output is for Graphviz users; PNG and SVG are drawn with matplotlib so
 no Graphviz install is needed.
+
+Labels are placed, not just drawn: each link's label (one line per Data buffer) goes at the
+first point along its arrow where its measured extent overlaps no component and no label
+placed before it; the gap after a column is as wide as the longest label leaving it. An
+earlier version put every label just after its source box, where labels of one source sat on
+top of each other and of the next column's names.
 """
 
 from __future__ import annotations
@@ -14,7 +20,9 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from matplotlib.figure import Figure
 from matplotlib.patches import FancyBboxPatch
+from matplotlib.transforms import Bbox
 
 from ..engine.recorder import write_atomic
 from ..model.world import WorldSpec
@@ -88,87 +96,201 @@ def _columns(world: WorldSpec) -> dict[str, int]:
     return col
 
 
+BOX_W, BOX_H = 3.0, 0.9  # a component, in data units (0.9 inch each)
+ROW_STEP = 1.6
+LABEL_PT = 6
+CHAR_W = 0.055  # data units per label character at LABEL_PT, for sizing column gaps
+ARC_RISE = 1.4  # how far a feedback arc rises above the boxes it joins
+MARGINS = (0.01, 0.01, 0.99, 0.92)  # fixed: labels are placed against the final transform
+#: where along an arrow a label is tried, in order (0 = source end, 1 = target end)
+ALONG = (0.5, 0.35, 0.65, 0.22, 0.78, 0.12, 0.88)
+
+
 def draw(world: WorldSpec, out: Path) -> Path:
     """Write the diagram to ``out`` (.png, .svg or .dot)."""
     suffix = out.suffix.lower()
     if suffix == ".dot":
         write_atomic(out, to_dot(world))
         return out
-    col = _columns(world)
-    rows: dict[int, int] = {}
-    pos = {}
-    for path in world.leaves:
-        c = col[path]
-        pos[path] = (c * 4.2, -rows.get(c, 0) * 1.6)
-        rows[c] = rows.get(c, 0) + 1
-    width = max(x for x, _ in pos.values()) + 4
-    height = max(-y for _, y in pos.values()) + 2
-    fig, ax = plt.subplots(figsize=(max(6, width * 0.9), max(3, height * 0.9)), dpi=100)
-    w, h = 3.0, 0.9
+    fig, _, _ = diagram(world)
+    if suffix == ".png":
+        return save_png(fig, out, MARGINS)
+    import io
+
+    buf = io.StringIO()
+    fig.savefig(buf, format="svg")
+    plt.close(fig)
+    write_atomic(out, buf.getvalue())
+    return out
+
+
+def diagram(world: WorldSpec) -> tuple[Figure, list[Bbox], list[Bbox]]:
+    """The figure, and the display extents of its components and of its link labels."""
+    pos = _positions(world)
     merged: dict[tuple[str, str], list[str]] = {}
     for a, b, label in edges(world):
         merged.setdefault((a, b), []).append(label)
-    for (a, b), labels in merged.items():
-        label = ", ".join(labels)
-        (x0, y0), (x1, y1) = pos[a], pos[b]
-        back = x1 <= x0
+    curves = {ab: _curve(pos[ab[0]], pos[ab[1]]) for ab in merged}
+    xs = [x for x, _ in pos.values()]
+    ys = [y for _, y in pos.values()]
+    top = max(ys) + BOX_H / 2 + 0.6
+    for p0, c, p2 in curves.values():
+        top = max(top, (p0[1] + 2 * c[1] + p2[1]) / 4 + 0.5)
+    x_lo, x_hi = min(xs) - BOX_W / 2 - 0.3, max(xs) + BOX_W / 2 + 0.3
+    y_lo = min(ys) - BOX_H / 2 - 1.0  # room for the legend
+    fig = plt.figure(figsize=(max(6.0, (x_hi - x_lo) * 0.9), max(3.0, (top - y_lo) * 0.9)), dpi=100)
+    ax = fig.add_subplot()
+    fig.subplots_adjust(*MARGINS)
+    ax.set_xlim(x_lo, x_hi)
+    ax.set_ylim(y_lo, top)
+    ax.set_aspect("equal")
+    ax.axis("off")
+    ax.set_title(f"{world.name}: {len(world.leaves)} components")
+    ax.apply_aspect()
+    renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
+    boxes = [_draw_box(ax, path, leaf, pos[path]) for path, leaf in world.leaves.items()]
+    box_extents = [b.get_window_extent(renderer) for b in boxes]
+    placed: list[Bbox] = []
+    for ab, labels in merged.items():
+        p0, c, p2 = curves[ab]
         ax.annotate(
             "",
-            xy=(x1 - w / 2 if not back else x1, y1 + (0 if not back else h / 2)),
-            xytext=(x0 + w / 2 if not back else x0, y0 + (0 if not back else h / 2)),
+            xy=p2,
+            xytext=p0,
             arrowprops={
                 "arrowstyle": "-|>",
                 "color": "0.35",
                 "lw": 0.9,
-                "connectionstyle": "arc3,rad=0.35" if back else "arc3,rad=0.05",
+                "shrinkA": 0,
+                "shrinkB": 0,
+                "connectionstyle": f"arc3,rad={_rad(p0, c, p2):.6f}",
             },
         )
-        lx = x0 + w / 2 + 0.15 if not back else (x0 + x1) / 2
-        ly = (
-            y0 + 0.08 + 0.28 * (y1 - y0) / max(abs(x1 - x0), 1.0)
-            if not back
-            else (max(y0, y1) + 1.0)
-        )
-        ax.text(lx, ly, label, fontsize=6, ha="left" if not back else "center", color="0.25")
-    for path, leaf in world.leaves.items():
-        x, y = pos[path]
-        kind = leaf.kind.value
-        ax.add_patch(
-            FancyBboxPatch(
-                (x - w / 2, y - h / 2),
-                w,
-                h,
-                boxstyle="round,pad=0.05,rounding_size=0.15",
-                fc=KIND_COLOURS[kind],
-                ec="0.2",
-                lw=1,
-            )
-        )
-        ax.text(x, y + 0.12, path, ha="center", va="center", fontsize=8.5, weight="bold")
-        ax.text(
-            x,
-            y - 0.2,
-            f"{leaf.template.name()} · {float(leaf.freq):g} Hz",
-            ha="center",
-            va="center",
-            fontsize=7,
+        placed.append(
+            _place_label(ax, renderer, "\n".join(labels), (p0, c, p2), box_extents, placed)
         )
     handles = [
         FancyBboxPatch((0, 0), 1, 1, fc=c, ec="0.2", label=k) for k, c in KIND_COLOURS.items()
     ]
     ax.legend(handles=handles, loc="lower right", fontsize=7, ncol=3)
-    ax.set_xlim(-2.5, width)
-    ax.set_ylim(-height, 2.8)
-    ax.set_aspect("equal")
-    ax.axis("off")
-    ax.set_title(f"{world.name}: {len(world.leaves)} components")
-    if suffix == ".png":
-        return save_png(fig, out)
-    import io
+    return fig, box_extents, placed
 
-    buf = io.StringIO()
-    fig.tight_layout()
-    fig.savefig(buf, format="svg")
-    plt.close(fig)
-    write_atomic(out, buf.getvalue())
-    return out
+
+def _positions(world: WorldSpec) -> dict[str, tuple[float, float]]:
+    """Box centres: columns by dataflow depth, each gap as wide as its longest label."""
+    col = _columns(world)
+    longest = dict.fromkeys(range(max(col.values()) + 1), 0)
+    for a, b, label in edges(world):
+        if col[b] > col[a]:
+            longest[col[a]] = max(longest[col[a]], len(label))
+    x_of, x = {}, 0.0
+    for c in sorted(longest):
+        x_of[c] = x
+        x += BOX_W + min(6.0, max(2.0, CHAR_W * longest[c] + 0.8))
+    rows: dict[int, int] = {}
+    pos = {}
+    for path in world.leaves:
+        c = col[path]
+        pos[path] = (x_of[c], -rows.get(c, 0) * ROW_STEP)
+        rows[c] = rows.get(c, 0) + 1
+    return pos
+
+
+Point = tuple[float, float]
+
+
+def _curve(a: Point, b: Point) -> tuple[Point, Point, Point]:
+    """Start, control point and end of the quadratic arrow from box ``a`` to box ``b``.
+
+    Forward links are straight, right side to left side; a link back (into a process: the
+    loop's feedback) arcs over the boxes from top to top.
+    """
+    (x0, y0), (x1, y1) = a, b
+    if x1 > x0:
+        p0, p2 = (x0 + BOX_W / 2, y0), (x1 - BOX_W / 2, y1)
+        return p0, ((p0[0] + p2[0]) / 2, (p0[1] + p2[1]) / 2), p2
+    p0, p2 = (x0, y0 + BOX_H / 2), (x1, y1 + BOX_H / 2)
+    peak = max(p0[1], p2[1]) + ARC_RISE  # the curve's midpoint; the control point is twice as high
+    mid = ((p0[0] + p2[0]) / 2, (p0[1] + p2[1]) / 2)
+    return p0, (mid[0], 2 * peak - mid[1]), p2
+
+
+def _rad(p0: Point, c: Point, p2: Point) -> float:
+    """matplotlib's ``arc3`` rad that puts the control point at ``c`` (0 for a straight line)."""
+    dx, dy = p2[0] - p0[0], p2[1] - p0[1]
+    mid = ((p0[0] + p2[0]) / 2, (p0[1] + p2[1]) / 2)
+    length2 = dx * dx + dy * dy
+    if length2 == 0:
+        return 0.0
+    # arc3: c = mid + rad * (dy, -dx)
+    return ((c[0] - mid[0]) * dy - (c[1] - mid[1]) * dx) / length2
+
+
+def _place_label(
+    ax: plt.Axes,
+    renderer: object,
+    text: str,
+    curve: tuple[Point, Point, Point],
+    boxes: list[Bbox],
+    placed: list[Bbox],
+) -> Bbox:
+    """Put ``text`` at the first point of the curve where it overlaps nothing; its extent."""
+    p0, c, p2 = curve
+    label = ax.text(
+        0,
+        0,
+        text,
+        fontsize=LABEL_PT,
+        ha="center",
+        va="center",
+        color="0.2",
+        bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
+        zorder=4,
+    )
+    best: tuple[int, Bbox] | None = None
+    for t in ALONG:
+        u = 1 - t
+        label.set_position(
+            (
+                u * u * p0[0] + 2 * u * t * c[0] + t * t * p2[0],
+                u * u * p0[1] + 2 * u * t * c[1] + t * t * p2[1],
+            )
+        )
+        extent = label.get_window_extent(renderer).expanded(1.08, 1.15)
+        hits = sum(extent.overlaps(o) for o in (*boxes, *placed))
+        if best is None or hits < best[0]:
+            best = (hits, extent)
+            spot = label.get_position()
+        if hits == 0:
+            break
+    assert best is not None
+    label.set_position(spot)
+    return best[1]
+
+
+def _draw_box(ax: plt.Axes, path: str, leaf: object, centre: Point) -> FancyBboxPatch:
+    """One component: name, template and frequency on its kind's colour."""
+    x, y = centre
+    kind = leaf.kind.value  # type: ignore[attr-defined]
+    box = FancyBboxPatch(
+        (x - BOX_W / 2, y - BOX_H / 2),
+        BOX_W,
+        BOX_H,
+        boxstyle="round,pad=0.05,rounding_size=0.15",
+        fc=KIND_COLOURS[kind],
+        ec="0.2",
+        lw=1,
+        zorder=2,
+    )
+    ax.add_patch(box)
+    ax.text(x, y + 0.12, path, ha="center", va="center", fontsize=8.5, weight="bold", zorder=3)
+    ax.text(
+        x,
+        y - 0.2,
+        f"{leaf.template.name()} · {float(leaf.freq):g} Hz",  # type: ignore[attr-defined]
+        ha="center",
+        va="center",
+        fontsize=7,
+        zorder=3,
+    )
+    return box

@@ -39,3 +39,24 @@ def test_images(tmp_path: Path, suffix: str, magic: bytes) -> None:
 def test_bad_output_name(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["graph", str(WORLD), "-o", str(tmp_path / "a.jpg")]) == 2
     assert "--output: expected a .png, .svg or .dot file name" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["mde_challenge", "platoon"])
+def test_every_link_label_is_readable(name: str) -> None:
+    # each label overlaps no component and no other label, and lies inside the picture
+    import matplotlib.pyplot as plt
+
+    from amsa_phys.model.world import load_world
+    from amsa_phys.plots.graph import diagram, edges
+
+    world = load_world(ROOT / "worlds" / f"{name}.yaml")
+    fig, boxes, labels = diagram(world)
+    try:
+        assert len(labels) == len({(a, b) for a, b, _ in edges(world)})
+        for i, label in enumerate(labels):
+            assert not any(label.overlaps(box) for box in boxes), i
+            assert not any(label.overlaps(other) for other in labels[:i]), i
+            assert fig.bbox.contains(label.x0, label.y0)
+            assert fig.bbox.contains(label.x1, label.y1)
+    finally:
+        plt.close(fig)
