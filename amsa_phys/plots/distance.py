@@ -11,6 +11,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.figure import Figure
 
 from .save import save_png
 
@@ -31,12 +32,59 @@ def _read_trace(path: str, mtime_ns: int, size: int) -> tuple[list[str], np.ndar
     return header, data
 
 
+NOTE_PT = 7.5  # phase notes' font size
+MAX_NOTE_LINES = 5
+FIG_H_IN = 4.5
+MARGINS = (0.065, 0.11, 0.985, 0.92)  # left, bottom, right, top: fixed, so the band is known
+AXES_HEIGHT_PT = FIG_H_IN * (MARGINS[3] - MARGINS[1]) * 72
+
+
+def _phase_notes(ax: plt.Axes, phases: list[dict[str, Any]]) -> list[str]:
+    """Mark each phase's start and write what it set, one change a line, at the top.
+
+    One change a line keeps a note as narrow as its longest change, so it fits in its phase
+    (a one-line note ran past the next phase's line and over its note). Returns the lines of
+    the tallest note (the band the caller keeps free above the data).
+    """
+    tallest: list[str] = []
+    for phase in phases:
+        start = phase["start"]
+        if start > 0:
+            ax.axvline(start, color="0.4", lw=0.8, ls=":")
+        lines = [f"{k.split('.')[-1]}={v}" for k, v in phase["set"].items()]
+        if len(lines) > MAX_NOTE_LINES:
+            lines = [*lines[: MAX_NOTE_LINES - 1], f"+{len(lines) - MAX_NOTE_LINES + 1} more"]
+        if phase.get("label"):
+            lines.insert(0, str(phase["label"]))
+        if not lines:
+            continue
+        ax.annotate(
+            "\n".join(lines),
+            (start, 1.0),
+            xycoords=("data", "axes fraction"),
+            xytext=(3, -3),
+            textcoords="offset points",
+            va="top",
+            fontsize=NOTE_PT,
+            color="0.25",
+            linespacing=1.1,
+        )
+        tallest = max(tallest, lines, key=len)
+    return tallest
+
+
 def plot_distance(trace: Path, metrics: dict[str, Any], out: Path) -> Path:
     """Draw the quality signal of ``trace`` with the phases of ``metrics`` into ``out``."""
+    fig = distance_figure(trace, metrics)
+    return save_png(fig, out, margins=MARGINS)
+
+
+def distance_figure(trace: Path, metrics: dict[str, Any]) -> Figure:
+    """The figure :func:`plot_distance` saves, laid out with its final margins."""
     header, data = read_trace(trace)
     quality = metrics.get("quality") or {}
     signal = quality.get("signal")
-    fig, ax = plt.subplots(figsize=(10, 4.5), dpi=100)
+    fig, ax = plt.subplots(figsize=(10, FIG_H_IN), dpi=100)
     if signal in header and data.size:
         t = data[:, 0]
         s = data[:, header.index(signal)]
@@ -53,21 +101,10 @@ def plot_distance(trace: Path, metrics: dict[str, Any], out: Path) -> Path:
         ax.axhline(ref, color="tab:green", lw=1.2, ls="--", label=f"reference {ref:g} m")
         ax.plot(t, s, color="tab:blue", lw=1.2, label=signal)
         top = max(float(np.max(s)), ref + tol)
-        for i, phase in enumerate(metrics.get("phases", [])):
-            start = phase["start"]
-            if start > 0:
-                ax.axvline(start, color="0.4", lw=0.8, ls=":")
-            text = ", ".join(f"{k.split('.')[-1]}={v}" for k, v in phase["set"].items())
-            ax.annotate(
-                text,
-                (start, top),
-                xytext=(3, -2 - 11 * (i % 2)),
-                textcoords="offset points",
-                va="top",
-                fontsize=8,
-                color="0.25",
-            )
-        ax.set_ylim(bottom=0, top=top * 1.15)
+        lines = _phase_notes(ax, metrics.get("phases", []))
+        # the notes get a band of their own above the data: the curve never runs through them
+        band = (len(lines) * NOTE_PT * 1.25 + 8) / AXES_HEIGHT_PT if lines else 0.05
+        ax.set_ylim(bottom=0, top=top * 1.05 / max(0.4, 1 - band))
     else:
         ax.text(0.5, 0.5, "no quality signal", ha="center", transform=ax.transAxes)
     ax.set_xlabel("time (s)")
@@ -76,4 +113,5 @@ def plot_distance(trace: Path, metrics: dict[str, Any], out: Path) -> Path:
     ax.grid(alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="lower right", fontsize=8)
-    return save_png(fig, out, margins=(0.065, 0.11, 0.985, 0.92))
+    fig.subplots_adjust(*MARGINS)
+    return fig
