@@ -31,13 +31,19 @@ SPEEDS = (1 / 16, 1 / 8, 1 / 4, 1 / 2, 1, 2, 4, 8, 16, 32, 64, 128, 256)
 MAX_REAL_DT = 0.1  # seconds of wall clock a single frame may cover
 FPS = 60
 
-HELP = [
-    "space  pause / resume      s or .  one instant (pauses)",
-    "] [    faster / slower     c       camera: fit, follow each rover",
-    "z x    zoom in / out       wheel   zoom      drag / arrows  pan",
-    "p      parameter panel:    up/down row, pgup/pgdn component,",
-    "       left/right step (shift: fine), type a number, enter apply, esc drop",
-    "h      this help           q / esc quit (outputs are written)",
+HELP = [  # every key _key and _panel_key handle
+    "space         pause / resume",
+    "s or .        one instant (pauses)",
+    "] [ or + -    faster / slower",
+    "c             camera: fit, then follow each rover",
+    "z x, wheel    zoom in / out",
+    "drag, arrows  pan",
+    "p or tab      parameter panel (open / close)",
+    "  up down     row; pgup pgdn: component",
+    "  left right  step the value (shift: fine)",
+    "  0-9 . - e   type a value; enter applies, esc drops",
+    "h or F1       this help",
+    "q or esc      quit (the outputs are written)",
 ]
 
 
