@@ -153,3 +153,22 @@ class CtrlC(Template):
             for _ in range(self.p.signals):
                 os.kill(os.getpid(), signal.SIGTERM if self.p.term else signal.SIGINT)
         return {"u": float(self.n)}
+
+
+class Picky(Template):
+    """A controller that refuses parameter changes after its fourth step (a state rule)."""
+
+    kind = Kind.CONTROLLER
+    outputs = (Port("u"),)
+    params = (Param("gain", "float", "output", 1.0, -10.0, 10.0),)
+
+    def initialize(self, ctx: Any) -> None:
+        self.n = 0
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        self.n += 1
+        return {"u": self.p.gain}
+
+    def on_param_change(self, name: str, value: Any) -> None:
+        if self.n > 4:
+            raise ValueError(f"too late to change {name} after 4 steps")

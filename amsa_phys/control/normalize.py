@@ -34,14 +34,21 @@ class NormalizePower(Template):
         Param("motorCoef", "int", "share of the power actually delivered", 100, 0, 100, "%"),
     )
 
-    def initialize(self, ctx: Any) -> None:
+    @classmethod
+    def check_params(cls, values: Mapping[str, Any]) -> None:
         """Refuse an empty range (it would silently pin the motors)."""
-        self.on_param_change("powerMin", self.p.powerMin)
+        if values["powerMin"] > values["powerMax"]:
+            raise ValueError(
+                f"powerMin {values['powerMin']:g} is above powerMax {values['powerMax']:g}"
+            )
+
+    def initialize(self, ctx: Any) -> None:
+        """Check the range once more (a world built in code skips the loader)."""
+        self.check_params(self.p.as_dict())
 
     def on_param_change(self, name: str, value: Any) -> None:
         """Keep powerMin <= powerMax."""
-        if self.p.powerMin > self.p.powerMax:
-            raise ValueError(f"powerMin {self.p.powerMin:g} is above powerMax {self.p.powerMax:g}")
+        self.check_params(self.p.as_dict())
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
         """The paper's doStep: clamp, then scale."""

@@ -119,8 +119,11 @@ def load_scenario(
         scenario.phases = [p for p in scenario.phases if p.at < scenario.duration]
     if log_rate is not None:
         scenario.log_rate = _positive_fraction(log_rate, "--log-rate")
+    in_file = len(scenario.phases[0].changes)
     for text in overrides or []:
         scenario.phases[0].changes.append(parse_override(text, scenario.world))
+    if overrides:
+        check_phases(scenario, doc, in_file)
     scenario.log_rate = _effective_log_rate(scenario.log_rate, scenario.world)
     return scenario
 
@@ -221,7 +224,7 @@ def build_scenario(doc: YamlDoc) -> Scenario:
         expect.append(
             Expectation(e["metric"], e.get("phase"), e.get("below"), e.get("above"), doc.line(kp))
         )
-    return Scenario(
+    scenario = Scenario(
         path=doc.path,
         name=str(data.get("name", doc.path.stem)),
         world=world,
@@ -233,6 +236,47 @@ def build_scenario(doc: YamlDoc) -> Scenario:
         expect=expect,
         data=data,
     )
+    check_phases(scenario, doc)
+    return scenario
+
+
+def check_phases(scenario: Scenario, doc: YamlDoc, in_file: int | None = None) -> None:
+    """Refuse a scenario whose phases would break a template's rules, before anything runs.
+
+    Each leaf's values are followed through the phases: after every phase, a leaf it changed
+    must pass its template's ``check_params`` (powerMin <= powerMax, ...), and a timeline
+    entry must not change a parameter read only by ``initialize`` (a rover's mass: the
+    change would fault mid-run). Only the first ``in_file`` changes of phase 0 come from the
+    file's ``set``; later ones are ``--set`` overrides and are named as such.
+    """
+    world = scenario.world
+    values = {path: dict(leaf.params) for path, leaf in world.leaves.items()}
+
+    def error(phase: int, index: int, change: Change, message: str) -> ConfigError:
+        if phase == 0 and in_file is not None and index >= in_file:
+            return ConfigError(message, key=f"--set {change.key}")
+        where = ("set",) if phase == 0 else ("timeline", phase - 1, "set")
+        return doc.error((*where, change.key), message)
+
+    for i, phase in enumerate(scenario.phases):
+        last: dict[str, tuple[int, Change]] = {}
+        for j, change in enumerate(phase.changes):
+            template = world.leaves[change.leaf].template
+            if i > 0 and change.param in template.fixed_once_running:
+                raise error(
+                    i,
+                    j,
+                    change,
+                    f"{change.param} is read only when the run starts; "
+                    "set it in set: or in the world",
+                )
+            values[change.leaf][change.param] = change.value
+            last[change.leaf] = (j, change)
+        for leaf, (j, change) in last.items():
+            try:
+                world.leaves[leaf].template.check_params(values[leaf])
+            except ValueError as exc:
+                raise error(i, j, change, str(exc)) from None
 
 
 def _changes(sets: dict[str, Any], kp: KeyPath, doc: YamlDoc, world: WorldSpec) -> list[Change]:

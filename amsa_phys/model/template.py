@@ -124,6 +124,17 @@ class Template:
     def on_param_change(self, name: str, value: Any) -> None:
         """Called after the timeline or the user changed a parameter (``self.p`` is updated)."""
 
+    @classmethod
+    def check_params(cls, values: Mapping[str, Any]) -> None:
+        """Rules *between* parameters (each one's type and range is its Param's job).
+
+        Raise ValueError saying what is wrong. Called on every leaf's values at load time --
+        after the world, after ``set`` and after each timeline entry -- so ``validate`` and
+        ``run`` refuse a scenario that would break a rule (exit 2, naming the key), and by
+        the window's panel before a live change is queued. ``initialize`` and
+        ``on_param_change`` should call it too, for changes made from code.
+        """
+
 
 #: Built-in templates: name -> "module:Class", imported on first use.
 BUILTINS: dict[str, str] = {

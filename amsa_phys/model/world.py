@@ -252,6 +252,10 @@ def _build_leaf(
             params[name] = declared[name].coerce(value)
         except ValueError as exc:
             raise err((*kp, "params", name), str(exc)) from None
+    try:
+        template.check_params(params)
+    except ValueError as exc:
+        raise err((*kp, "params"), str(exc)) from None
     return LeafSpec(
         path=path,
         template=template,

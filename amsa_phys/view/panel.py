@@ -174,8 +174,11 @@ class ParamPanel:
         if raw is None:
             self.message = "change the value first (arrows or type a number), then Enter"
             return None
+        comp = self.sim.components[row.leaf]
         try:
             value = row.param.coerce(raw)
+            # the template's rules between parameters: refused here, the run goes on
+            comp.check_params({**comp.p.as_dict(), row.param.name: value})
         except ValueError as exc:
             self.message = f"{row.key}: {exc}"
             self.cancel()

@@ -12,6 +12,7 @@ import pytest
 from amsa_phys.cli.main import main
 
 BAD = sorted((Path(__file__).parent.parent / "fixtures" / "bad").glob("*.yaml"))
+SCENARIO = Path(__file__).parent.parent.parent / "scenarios" / "scenario1.yaml"
 
 
 def expected(path: Path) -> str:
@@ -82,6 +83,18 @@ def test_bad_set_override_names_the_option(
     assert capsys.readouterr().err == (
         "error: --set MyFollowerController.Kv: expected a number, got string 'abc'\n"
     )
+
+
+def test_overrides_that_break_a_rule_name_the_override(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["run", str(SCENARIO), "--headless", "--out", str(tmp_path / "o")]
+    argv += ["--set", "MyNormalizePower.powerMin=80", "--set", "MyNormalizePower.powerMax=20"]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        "error: --set MyNormalizePower.powerMax: powerMin 80 is above powerMax 20\n"
+    )
+    assert not (tmp_path / "o").exists()
 
 
 @pytest.mark.parametrize(

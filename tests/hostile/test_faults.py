@@ -85,20 +85,36 @@ def test_leaving_the_world_is_a_fault(tmp_path: Path, capsys: pytest.CaptureFixt
     assert "(physics.extent is 50 m)" in err
 
 
-def test_invalid_value_reached_mid_run_is_exit_3(
+def test_a_timeline_that_breaks_a_rule_is_refused_before_running(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    # each value is in range, the pair is not: found at load time, not 2 s into the run
     comps = """    Ctl: {template: ConstantPower, freq: 4}
     N: {template: NormalizePower, freq: 4,
         inputs: {powerL: Ctl.LeftPower, powerR: Ctl.RightPower}}"""
     scen = scenario(
         tmp_path, comps, "timeline:\n  - {at: 2, set: {N.powerMin: 50, N.powerMax: 10}}\n"
     )
-    assert main(["run", str(scen), "--headless", "--out", str(tmp_path / "o"), "-q"]) == 3
+    assert main(["run", str(scen), "--headless", "--out", str(tmp_path / "o"), "-q"]) == 2
     assert capsys.readouterr().err == (
-        "error: run fault at t=2.000 s in N (NormalizePower): rejected powerMax=10.0: "
-        "powerMin 50 is above powerMax 10\n"
+        f"error: {scen}:8: timeline[0].set.N.powerMax: powerMin 50 is above powerMax 10\n"
     )
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_change_a_component_rejects_mid_run_is_exit_3(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a rule that depends on the run's state can only be checked when the change lands
+    comps = "    P: {template: 'toys:Picky', freq: 4}"
+    scen = scenario(tmp_path, comps, "timeline:\n  - {at: 2, set: {P.gain: 2}}\n")
+    proc = run_cli("run", str(scen), "--headless", "--out", str(tmp_path / "o"), "-q")
+    assert proc.returncode == 3
+    assert proc.stderr == (
+        "error: run fault at t=2.000 s in P (Picky): rejected gain=2.0: "
+        "too late to change gain after 4 steps\n"
+    )
+    assert (tmp_path / "o" / "trace.csv").read_text().splitlines()[-1].startswith("1.95,")
 
 
 def test_sigterm_finalises_like_ctrl_c(tmp_path: Path) -> None:

@@ -95,6 +95,20 @@ def test_panel_typed_values_are_checked_like_a_scenario_file(sim: Simulation) ->
     assert panel.pending == 2  # next behaviour
 
 
+def test_panel_refuses_a_value_that_breaks_a_rule_and_the_run_goes_on(sim: Simulation) -> None:
+    # powerMin above powerMax is in range on its own; queued, it would end the session
+    panel = ParamPanel(sim)
+    panel.index = [r.key for r in panel.rows].index("MyNormalizePower.powerMin")
+    for ch in "-5":
+        panel.type_char(ch)
+    assert panel.commit() is not None  # -5 <= powerMax 100: fine
+    sim.components["MyNormalizePower"].p.powerMax = 10.0
+    for ch in "20":
+        panel.type_char(ch)
+    assert panel.commit() is None
+    assert panel.message == "MyNormalizePower.powerMin: powerMin 20 is above powerMax 10"
+
+
 def test_live_change_lands_at_the_next_instant_after_the_timeline(sim: Simulation) -> None:
     panel = ParamPanel(sim)
     sim.advance(sim.grid.ticks(sim.duration) // 2)
