@@ -240,19 +240,22 @@ def build_scenario(doc: YamlDoc) -> Scenario:
     return scenario
 
 
-def check_phases(scenario: Scenario, doc: YamlDoc, in_file: int | None = None) -> None:
+def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = None) -> None:
     """Refuse a scenario whose phases would break a template's rules, before anything runs.
 
     Each leaf's values are followed through the phases: after every phase, a leaf it changed
     must pass its template's ``check_params`` (powerMin <= powerMax, ...), and a timeline
     entry must not change a parameter read only by ``initialize`` (a rover's mass: the
     change would fault mid-run). Only the first ``in_file`` changes of phase 0 come from the
-    file's ``set``; later ones are ``--set`` overrides and are named as such.
+    file's ``set``; later ones are ``--set`` overrides and are named as such. Without a
+    ``doc`` (a sweep's grid point) the error names the change only.
     """
     world = scenario.world
     values = {path: dict(leaf.params) for path, leaf in world.leaves.items()}
 
     def error(phase: int, index: int, change: Change, message: str) -> ConfigError:
+        if doc is None:
+            return ConfigError(message, key=change.key)
         if phase == 0 and in_file is not None and index >= in_file:
             return ConfigError(message, key=f"--set {change.key}")
         where = ("set",) if phase == 0 else ("timeline", phase - 1, "set")

@@ -26,7 +26,7 @@ import yaml
 
 from ..engine.runner import Simulation
 from ..errors import AmsaError, ConfigError
-from ..model.scenario import METRICS, Scenario, load_scenario, resolve_change
+from ..model.scenario import METRICS, Scenario, check_phases, load_scenario, resolve_change
 from .rundir import prepare_run_dir
 from .single import compute_metrics, run_scenario
 
@@ -228,6 +228,7 @@ def run_job(job: Job) -> dict[str, Any]:
                     scenario.phases[0].changes.append(resolve_change(k, v, scenario.world))
             else:
                 scenario.phases[0].changes.append(resolve_change(key, value, scenario.world))
+        check_phases(scenario, None)  # this point's combination may break a template's rule
         if job.keep_dir is not None:
             out = prepare_run_dir(Path(job.keep_dir) / f"run-{job.index:05d}", force=True)
             try:

@@ -224,3 +224,18 @@ def test_a_bad_sweep_metric_in_the_file_names_its_line(
     assert capsys.readouterr().err.startswith(
         f"error: {scen}:{line}: sweep.metric: unknown metric 'rms'; known: "
     )
+
+
+def test_a_grid_point_that_breaks_a_rule_is_a_row_error_and_the_rest_run(tmp_path: Path) -> None:
+    out = tmp_path / "r"
+    argv = ["sweep", str(SCEN), "--grid", "MyNormalizePower.powerMin=0,50"]
+    argv += ["--grid", "MyNormalizePower.powerMax=30,100", "--duration", "5", "-j", "1"]
+    assert main([*argv, "--out", str(out)]) == 0
+    table = rows(out)
+    assert [r["error"] for r in table] == [
+        "",
+        "",
+        "MyNormalizePower.powerMax: powerMin 50 is above powerMax 30",
+        "",
+    ]
+    assert table[3]["rms_error"] != ""
