@@ -32,13 +32,20 @@ def add_args(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Draw the plot."""
     rundir = Path(args.rundir)
+    if not rundir.is_dir():
+        raise ConfigError(
+            "no such directory" if not rundir.exists() else "not a directory", file=rundir
+        )
     if (rundir / "results.csv").is_file() and not (rundir / "trace.csv").exists():
         return _plot_sweep(rundir, args)
     if args.metric is not None:
         raise ConfigError("only for a sweep directory (with results.csv)", key="--metric")
     for name in ("trace.csv", "metrics.json"):
         if not (rundir / name).is_file():
-            raise ConfigError(f"not a run directory: {name} is missing", file=rundir)
+            raise ConfigError(
+                f"not a run directory: {name} is missing (nor a sweep's: no results.csv)",
+                file=rundir,
+            )
     try:
         metrics = json.loads((rundir / "metrics.json").read_text())
     except json.JSONDecodeError as exc:
