@@ -68,6 +68,15 @@ class RunFault(AmsaError):
         return f"run fault at t={self.t:.3f} s in {self.component}: {self.cause}"
 
 
+class WorkerLost(AmsaError):
+    """A worker process died under a sweep or a suite (killed, out of memory, a native crash).
+
+    What had finished is kept (a sweep writes its rows); the message says how much.
+    """
+
+    exit_code = 3
+
+
 class ExpectationFailed(AmsaError):
     """One or more scenario expectations did not hold."""
 

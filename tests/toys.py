@@ -172,3 +172,17 @@ class Picky(Template):
     def on_param_change(self, name: str, value: Any) -> None:
         if self.n > 4:
             raise ValueError(f"too late to change {name} after 4 steps")
+
+
+class Die(Template):
+    """Publishes ``gain``; its process dies at once when ``gain`` is 2 (a native crash, an OOM
+    kill: nothing Python can catch)."""
+
+    kind = Kind.CONTROLLER
+    outputs = (Port("u"),)
+    params = (Param("gain", "float", "output", 1.0, -10.0, 10.0),)
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        if self.p.gain == 2:
+            os._exit(9)
+        return {"u": self.p.gain}

@@ -6,11 +6,13 @@ import argparse
 import itertools
 import sys
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
-from ..errors import ConfigError, Interrupted
+from ..errors import ConfigError, Interrupted, WorkerLost
 from ..runs.junit import write_junit
 from ..runs.suite import ScenarioResult, find_scenarios, run_scenario_file
+from ..runs.sweep import WORKER_LOST
 from .options import add_jobs
 
 
@@ -61,6 +63,11 @@ def _run_all(files: list[Path], jobs: int, out: str | None) -> list[ScenarioResu
     except KeyboardInterrupt:
         raise Interrupted(
             f"test interrupted after {len(done)} of {len(files)} scenarios; nothing reported"
+        ) from None
+    except BrokenProcessPool:
+        raise WorkerLost(
+            f"test stopped: {WORKER_LOST}, after {len(done)} of {len(files)} scenarios; "
+            "nothing reported"
         ) from None
     return [done[i] for i in range(len(files))]
 

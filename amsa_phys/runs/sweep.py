@@ -25,7 +25,7 @@ import numpy as np
 import yaml
 
 from ..engine.runner import Simulation
-from ..errors import AmsaError, ConfigError
+from ..errors import AmsaError, ConfigError, WorkerLost
 from ..model.scenario import METRICS, Scenario, check_phases, load_scenario, resolve_change
 from .rundir import prepare_run_dir
 from .single import compute_metrics, run_scenario
@@ -207,14 +207,20 @@ def _cached(path: str) -> Scenario:
     return load_scenario(path)
 
 
-def run_job(job: Job) -> dict[str, Any]:
-    """Run one job and return its result row (errors are reported in the row)."""
+def job_row(job: Job, error: str = "") -> dict[str, Any]:
+    """A result row's leading columns: run number, grid point, seed; no metrics yet."""
     row: dict[str, Any] = {"run": job.index}
     for key, value in job.point:
         row[key] = value
     row["seed_index"] = job.seed_index
     row["seed"] = job.seed
-    row["error"] = ""
+    row["error"] = error
+    return row
+
+
+def run_job(job: Job) -> dict[str, Any]:
+    """Run one job and return its result row (errors are reported in the row)."""
+    row = job_row(job)
     try:
         scenario = copy.deepcopy(_cached(job.scenario))
         if job.duration is not None:
@@ -263,6 +269,7 @@ def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
             yield run_job(job)
         return
     from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures.process import BrokenProcessPool
 
     # workers ignore Ctrl-C: the main process handles it, cancels what has not started and
     # lets running jobs finish, so every finished row is kept
@@ -271,10 +278,15 @@ def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
         try:
             for fut in as_completed(futures):
                 yield fut.result()
+        except BrokenProcessPool:
+            raise WorkerLost(WORKER_LOST) from None
         except BaseException:
             for fut in futures:
                 fut.cancel()
             raise
+
+
+WORKER_LOST = "a worker process died (killed, out of memory, or a crash in native code)"
 
 
 def _ignore_sigint() -> None:
@@ -294,9 +306,15 @@ def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:
         client = Client(scheduler, timeout="10s")
     except (OSError, TimeoutError) as exc:
         raise ConfigError(f"cannot reach the Dask scheduler: {exc}", key="--scheduler") from None
+    from distributed import KilledWorker
+
     try:
         futures = client.map(run_job, jobs, pure=False)
+        job_of = dict(zip(futures, jobs, strict=True))
         for fut in as_completed(futures):
-            yield fut.result()
+            try:
+                yield fut.result()
+            except KilledWorker:  # Dask retried it on other workers and they died too
+                yield job_row(job_of[fut], f"{WORKER_LOST}, on every worker that ran it")
     finally:
         client.close()

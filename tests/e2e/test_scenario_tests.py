@@ -132,3 +132,18 @@ def test_ctrl_c_stops_a_parallel_suite_promptly(tmp_path: Path) -> None:
     assert err == "error: test interrupted after 0 of 4 scenarios; nothing reported\n"
     assert stdout == ""
     assert sorted(p.name for p in out.iterdir()) == ["a", "b"]  # c and d never started
+
+
+def test_a_worker_that_dies_stops_the_suite_with_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    for name, gain in (("a", 1), ("b", 2)):
+        (tmp_path / f"{name}.yaml").write_text(
+            f"world:\n  components:\n    D: {{template: 'toys:Die', freq: 4, params: "
+            f"{{gain: {gain}}}}}\nduration: 1\nexpect:\n  - {{trace: D.u, below: 5}}\n"
+        )
+    assert main(["test", str(tmp_path), "-j", "2"]) == 3
+    err = capsys.readouterr().err
+    assert err.startswith("error: test stopped: a worker process died (killed, out of memory")
+    assert err.endswith("scenarios; nothing reported\n")
+    assert err.count("\n") == 1

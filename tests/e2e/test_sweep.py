@@ -68,6 +68,31 @@ def test_dask_local_cluster_gives_the_same_rows(tmp_path: Path) -> None:
     assert rows(tmp_path / "dask") == rows(tmp_path / "local")
 
 
+def test_on_dask_a_job_that_kills_its_workers_is_a_row_error(tmp_path: Path) -> None:
+    distributed = pytest.importorskip("distributed")
+    import dask
+
+    scen = tmp_path / "s.yaml"
+    scen.write_text("world:\n  components:\n    D: {template: 'toys:Die', freq: 4}\nduration: 1\n")
+    argv = ["sweep", str(scen), "--grid", "D.gain=1,2,3", "--executor", "dask"]
+    # no retries on other workers: the test needs one death, not four
+    with (
+        dask.config.set({"distributed.scheduler.allowed-failures": 0}),
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+    ):
+        code = main([*argv, "--scheduler", cluster.scheduler_address, "--out", str(tmp_path / "o")])
+    assert code == 0
+    table = rows(tmp_path / "o")
+    assert [r["error"] for r in table] == [
+        "",
+        "a worker process died (killed, out of memory, or a crash in native code), "
+        "on every worker that ran it",
+        "",
+    ]
+
+
 def test_a_bad_grid_value_is_refused_before_any_run(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -239,3 +264,21 @@ def test_a_grid_point_that_breaks_a_rule_is_a_row_error_and_the_rest_run(tmp_pat
         "",
     ]
     assert table[3]["rms_error"] != ""
+
+
+def test_a_worker_that_dies_keeps_the_finished_rows(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scen = tmp_path / "s.yaml"
+    scen.write_text("world:\n  components:\n    D: {template: 'toys:Die', freq: 4}\nduration: 1\n")
+    out = tmp_path / "o"
+    # gain 2 kills the worker process running it; the rows finished before are kept
+    argv = ["sweep", str(scen), "--grid", "D.gain=1,1.5,2,3", "-j", "2", "--out", str(out)]
+    assert main(argv) == 3
+    err = capsys.readouterr().err
+    assert err.startswith("error: sweep stopped: a worker process died (killed, out of memory")
+    assert f"finished rows kept in {out}" in err
+    table = rows(out)
+    assert all(r["error"] == "" for r in table)
+    assert {r["D.gain"] for r in table} <= {"1", "1.5", "3"}
+    assert (out / "summary.png").exists()
