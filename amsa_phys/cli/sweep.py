@@ -14,7 +14,7 @@ from tqdm import tqdm
 
 from ..engine import interrupt
 from ..engine.recorder import write_atomic
-from ..errors import ConfigError, Interrupted, WorkerLost
+from ..errors import ConfigError, Interrupted
 from ..model.scenario import load_scenario
 from ..model.yamlio import load_yaml
 from ..runs.rundir import default_run_dir, prepare_run_dir
@@ -136,7 +136,6 @@ def run(args: argparse.Namespace) -> int:
         else iter_local(jobs, min(args.jobs, len(jobs)))
     )
     interrupted = False
-    lost: WorkerLost | None = None
     previous = signal.signal(signal.SIGTERM, interrupt.request)
     try:
         with tqdm(total=len(jobs), unit="run", disable=not sys.stderr.isatty()) as bar:
@@ -145,8 +144,6 @@ def run(args: argparse.Namespace) -> int:
                 bar.update(1)
     except KeyboardInterrupt:
         interrupted = True
-    except WorkerLost as exc:  # the rows so far are written all the same
-        lost = exc
     finally:
         signal.signal(signal.SIGTERM, previous)
     keys = [a.key for a in plan.axes]
@@ -166,8 +163,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"run {r['run']}: {r['error']}", file=sys.stderr)
     if interrupted:
         raise Interrupted(f"sweep interrupted; {len(rows)} finished rows kept in {out}")
-    if lost is not None:
-        raise WorkerLost(f"sweep stopped: {lost}; {len(rows)} finished rows kept in {out}")
     return 0
 
 

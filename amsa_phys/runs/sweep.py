@@ -16,7 +16,8 @@ import itertools
 import json
 import math
 import signal
-from collections.abc import Iterator
+from collections import deque
+from collections.abc import Generator, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -25,7 +26,7 @@ import numpy as np
 import yaml
 
 from ..engine.runner import Simulation
-from ..errors import AmsaError, ConfigError, WorkerLost
+from ..errors import AmsaError, ConfigError
 from ..model.scenario import METRICS, Scenario, check_phases, load_scenario, resolve_change
 from .rundir import prepare_run_dir
 from .single import compute_metrics, run_scenario
@@ -263,27 +264,67 @@ def run_job(job: Job) -> dict[str, Any]:
 
 
 def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
-    """Rows as they complete, from local worker processes (or in-process for 1 worker)."""
+    """Rows as they complete, from local worker processes (or in-process for 1 worker).
+
+    A worker process that dies (killed, out of memory, a crash in native code) breaks the
+    whole pool and every job it held. Those jobs -- at most two per worker are handed out at a
+    time, so few -- run again one at a time, each in a fresh process: a job that kills its
+    process a second time becomes a row error, the others give their rows, and the sweep goes
+    on with a new pool. Hours of finished runs are never lost to one bad point.
+    """
     if workers <= 1:
         for job in jobs:
             yield run_job(job)
         return
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    todo = deque(jobs)
+    while todo:
+        suspects = yield from _pool_pass(todo, workers)
+        for job in suspects:
+            yield _run_alone(job)
+
+
+def _pool_pass(todo: deque[Job], workers: int) -> Generator[dict[str, Any], None, list[Job]]:
+    """Run jobs from ``todo`` until it is empty or the pool breaks; the jobs the break took."""
+    from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
     from concurrent.futures.process import BrokenProcessPool
 
     # workers ignore Ctrl-C: the main process handles it, cancels what has not started and
     # lets running jobs finish, so every finished row is kept
     with ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint) as pool:
-        futures = [pool.submit(run_job, job) for job in jobs]
+        running: dict[Future[dict[str, Any]], Job] = {}
         try:
-            for fut in as_completed(futures):
-                yield fut.result()
-        except BrokenProcessPool:
-            raise WorkerLost(WORKER_LOST) from None
+            while todo or running:
+                while todo and len(running) < 2 * workers:
+                    job = todo.popleft()
+                    running[pool.submit(run_job, job)] = job
+                finished, _ = wait(running, return_when=FIRST_COMPLETED)
+                rows, broken = [], False
+                for fut in sorted(finished, key=lambda f: running[f].index):
+                    try:
+                        rows.append(fut.result())
+                        del running[fut]
+                    except BrokenProcessPool:
+                        broken = True
+                yield from rows
+                if broken:  # what the pool still held, finished or not, is lost with it
+                    return sorted(running.values(), key=lambda j: j.index)
         except BaseException:
-            for fut in futures:
+            for fut in running:
                 fut.cancel()
             raise
+    return []
+
+
+def _run_alone(job: Job) -> dict[str, Any]:
+    """``job`` in a process of its own: its row, or a row error if it kills that process too."""
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
+
+    with ProcessPoolExecutor(max_workers=1, initializer=_ignore_sigint) as pool:
+        try:
+            return pool.submit(run_job, job).result()
+        except BrokenProcessPool:
+            return job_row(job, f"{WORKER_LOST}, twice, running this job")
 
 
 WORKER_LOST = "a worker process died (killed, out of memory, or a crash in native code)"
