@@ -69,9 +69,10 @@ class RunFault(AmsaError):
 
 
 class WorkerLost(AmsaError):
-    """A worker process died under a sweep or a suite (killed, out of memory, a native crash).
+    """A worker process of ``amsa-phys test -j`` died (killed, out of memory, a native crash).
 
-    What had finished is kept (a sweep writes its rows); the message says how much.
+    The message says how many scenarios had finished. (A sweep does not stop for it: it
+    reruns the lost jobs one at a time, ``runs/sweep.py``.)
     """
 
     exit_code = 3
