@@ -68,16 +68,6 @@ class RunFault(AmsaError):
         return f"run fault at t={self.t:.3f} s in {self.component}: {self.cause}"
 
 
-class WorkerLost(AmsaError):
-    """A worker process of ``amsa-phys test -j`` died (killed, out of memory, a native crash).
-
-    The message says how many scenarios had finished. (A sweep does not stop for it: it
-    reruns the lost jobs one at a time, ``runs/sweep.py``.)
-    """
-
-    exit_code = 3
-
-
 class ExpectationFailed(AmsaError):
     """One or more scenario expectations did not hold."""
 

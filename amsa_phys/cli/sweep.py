@@ -138,10 +138,15 @@ def run(args: argparse.Namespace) -> int:
     interrupted = False
     previous = signal.signal(signal.SIGTERM, interrupt.request)
     try:
-        with tqdm(total=len(jobs), unit="run", disable=not sys.stderr.isatty()) as bar:
+        # Ctrl-C is raised between completions, never inside concurrent.futures or Dask
+        with (
+            interrupt.deferred(),
+            tqdm(total=len(jobs), unit="run", disable=not sys.stderr.isatty()) as bar,
+        ):
             for row in source:
                 rows.append(row)
                 bar.update(1)
+            interrupt.check()  # a Ctrl-C noted after the last row still counts
     except KeyboardInterrupt:
         interrupted = True
     finally:

@@ -3,16 +3,15 @@
 from __future__ import annotations
 
 import argparse
-import itertools
+import functools
 import sys
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
-from ..errors import ConfigError, Interrupted, WorkerLost
+from ..engine import interrupt
+from ..errors import ConfigError, Interrupted
 from ..runs.junit import write_junit
+from ..runs.pool import WORKER_LOST, imap_resilient
 from ..runs.suite import ScenarioResult, find_scenarios, run_scenario_file
-from ..runs.sweep import WORKER_LOST
 from .options import add_jobs
 
 
@@ -51,50 +50,43 @@ def _run_all(files: list[Path], jobs: int, out: str | None) -> list[ScenarioResu
 
     A suite cut short reports nothing (a partial table would read as a smaller suite that
     passed): scenarios not started never start, running ones stop at their next simulated
-    second (workers get the terminal's Ctrl-C too), and :class:`Interrupted` says how far it got.
+    second (workers get the terminal's Ctrl-C too), and :class:`Interrupted` says how far it
+    got. A scenario that kills its worker process twice is an ERROR row (``runs/pool.py``).
     """
     done: dict[int, ScenarioResult] = {}
+    paths = [str(f) for f in files]
     try:
-        if jobs == 1:
-            for i, f in enumerate(files):
-                done[i] = run_scenario_file(str(f), out)
-        else:
-            _run_in_pool(files, jobs, out, done)
+        with interrupt.deferred():  # Ctrl-C raised between completions, not in a pool's locks
+            _run_each(paths, jobs, out, done)
+            interrupt.check()  # a Ctrl-C noted after the last completion still stops it
     except KeyboardInterrupt:
         raise Interrupted(
             f"test interrupted after {len(done)} of {len(files)} scenarios; nothing reported"
         ) from None
-    except BrokenProcessPool:
-        raise WorkerLost(
-            f"test stopped: {WORKER_LOST}, after {len(done)} of {len(files)} scenarios; "
-            "nothing reported"
-        ) from None
     return [done[i] for i in range(len(files))]
 
 
-def _run_in_pool(
-    files: list[Path], jobs: int, out: str | None, done: dict[int, ScenarioResult]
+def _run_each(
+    paths: list[str], jobs: int, out: str | None, done: dict[int, ScenarioResult]
 ) -> None:
-    """Fill ``done`` from ``jobs`` worker processes.
+    if jobs == 1:
+        for i, path in enumerate(paths):
+            done[i] = run_scenario_file(path, out)
+            interrupt.check()
+        return
+    # at most ``jobs`` handed out: anything queued would still run after Ctrl-C
+    # (measured before: six 3 s scenarios on two workers went on for 5.4 s)
+    run = functools.partial(_run_file, out)
+    for i, result in imap_resilient(run, paths, jobs, _lost, in_flight=jobs):
+        done[i] = result
 
-    At most ``jobs`` scenarios are handed to the pool at a time: the pool moves submitted work
-    into its workers' queue at once, where Ctrl-C can no longer cancel it (measured: six 3 s
-    scenarios on two workers went on for 5.4 s after Ctrl-C; now they stop within a second).
-    """
-    pending = iter(enumerate(files))
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
 
-        def submit(n: int) -> None:
-            for i, f in itertools.islice(pending, n):
-                running[pool.submit(run_scenario_file, str(f), out)] = i
+def _run_file(out: str | None, path: str) -> ScenarioResult:
+    return run_scenario_file(path, out)
 
-        running: dict[Future[ScenarioResult], int] = {}
-        submit(jobs)
-        while running:
-            finished, _ = wait(running, return_when=FIRST_COMPLETED)
-            for fut in finished:
-                done[running.pop(fut)] = fut.result()
-            submit(len(finished))
+
+def _lost(path: str) -> ScenarioResult:
+    return ScenarioResult(path=path, name=Path(path).stem, error=f"{WORKER_LOST}, twice")
 
 
 def print_table(results: list[ScenarioResult]) -> None:

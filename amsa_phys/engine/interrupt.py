@@ -6,7 +6,7 @@ appending a quality sample's time and its value, and the metrics then failed wit
 IndexError and a traceback instead of exit 130 -- or half-way through a component's
 ``doStep``, so the outputs finalised afterwards describe a state no instant ever had.
 
-So while a run is going (:class:`deferred`), the signal handler only notes the request and
+So while a run is going (:func:`deferred`), the signal handler only notes the request and
 ``Simulation.advance`` raises KeyboardInterrupt when it returns: every simulated second in a
 headless run, every frame in the window and in a recording, which is well under a
 wall-clock second for any world this project ships. A second signal raises at once: the user
@@ -15,6 +15,10 @@ insists (a component stuck in an endless loop never returns from ``advance``).
 Only the main thread can own signal handlers, and a handler somebody else installed (a sweep
 worker ignores SIGINT; a host application has its own) is left alone: :class:`deferred` is
 then a no-op and nothing is ever requested.
+
+Sweeps and ``amsa-phys test -j`` defer interrupts in the main process too: Ctrl-C raised inside
+``concurrent.futures`` (holding one of its locks) could hang the pool's shutdown. Their
+loops wait with a timeout and call :func:`check` between completions.
 """
 
 from __future__ import annotations
@@ -44,6 +48,13 @@ def request(signum: int | None = None, frame: FrameType | None = None) -> None:
 def requested() -> bool:
     """Whether a stop was requested during the current run (and not yet ended)."""
     return _requested
+
+
+def forget() -> None:
+    """In a freshly forked worker process: no deferral, no request (they were the parent's)."""
+    global _installed, _requested
+    _installed = 0
+    _requested = False
 
 
 def check() -> None:

@@ -15,9 +15,8 @@ import functools
 import itertools
 import json
 import math
-import signal
-from collections import deque
-from collections.abc import Generator, Iterator
+import time
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -25,9 +24,11 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ..engine import interrupt
 from ..engine.runner import Simulation
 from ..errors import AmsaError, ConfigError
 from ..model.scenario import METRICS, Scenario, check_phases, load_scenario, resolve_change
+from .pool import WORKER_LOST, imap_resilient
 from .rundir import prepare_run_dir
 from .single import compute_metrics, run_scenario
 
@@ -266,72 +267,24 @@ def run_job(job: Job) -> dict[str, Any]:
 def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
     """Rows as they complete, from local worker processes (or in-process for 1 worker).
 
-    A worker process that dies (killed, out of memory, a crash in native code) breaks the
-    whole pool and every job it held. Those jobs -- at most two per worker are handed out at a
-    time, so few -- run again one at a time, each in a fresh process: a job that kills its
-    process a second time becomes a row error, the others give their rows, and the sweep goes
-    on with a new pool. Hours of finished runs are never lost to one bad point.
+    Workers ignore Ctrl-C: the main process handles it, cancels what has not started and
+    keeps every row finished so far. A worker that dies costs one row, not the sweep
+    (``runs/pool.py``): a job that kills its process twice becomes a row error.
     """
     if workers <= 1:
         for job in jobs:
             yield run_job(job)
+            interrupt.check()
         return
-    todo = deque(jobs)
-    while todo:
-        suspects = yield from _pool_pass(todo, workers)
-        for job in suspects:
-            yield _run_alone(job)
+    lost = functools.partial(_lost_row, f"{WORKER_LOST}, twice, running this job")
+    for _, row in imap_resilient(
+        run_job, jobs, workers, lost, in_flight=2 * workers, ignore_sigint=True
+    ):
+        yield row
 
 
-def _pool_pass(todo: deque[Job], workers: int) -> Generator[dict[str, Any], None, list[Job]]:
-    """Run jobs from ``todo`` until it is empty or the pool breaks; the jobs the break took."""
-    from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-    from concurrent.futures.process import BrokenProcessPool
-
-    # workers ignore Ctrl-C: the main process handles it, cancels what has not started and
-    # lets running jobs finish, so every finished row is kept
-    with ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint) as pool:
-        running: dict[Future[dict[str, Any]], Job] = {}
-        try:
-            while todo or running:
-                while todo and len(running) < 2 * workers:
-                    job = todo.popleft()
-                    running[pool.submit(run_job, job)] = job
-                finished, _ = wait(running, return_when=FIRST_COMPLETED)
-                rows, broken = [], False
-                for fut in sorted(finished, key=lambda f: running[f].index):
-                    try:
-                        rows.append(fut.result())
-                        del running[fut]
-                    except BrokenProcessPool:
-                        broken = True
-                yield from rows
-                if broken:  # what the pool still held, finished or not, is lost with it
-                    return sorted(running.values(), key=lambda j: j.index)
-        except BaseException:
-            for fut in running:
-                fut.cancel()
-            raise
-    return []
-
-
-def _run_alone(job: Job) -> dict[str, Any]:
-    """``job`` in a process of its own: its row, or a row error if it kills that process too."""
-    from concurrent.futures import ProcessPoolExecutor
-    from concurrent.futures.process import BrokenProcessPool
-
-    with ProcessPoolExecutor(max_workers=1, initializer=_ignore_sigint) as pool:
-        try:
-            return pool.submit(run_job, job).result()
-        except BrokenProcessPool:
-            return job_row(job, f"{WORKER_LOST}, twice, running this job")
-
-
-WORKER_LOST = "a worker process died (killed, out of memory, or a crash in native code)"
-
-
-def _ignore_sigint() -> None:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+def _lost_row(error: str, job: Job) -> dict[str, Any]:
+    return job_row(job, error)
 
 
 def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:
@@ -352,10 +305,16 @@ def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:
     try:
         futures = client.map(run_job, jobs, pure=False)
         job_of = dict(zip(futures, jobs, strict=True))
-        for fut in as_completed(futures):
-            try:
-                yield fut.result()
-            except KilledWorker:  # Dask retried it on other workers and they died too
-                yield job_row(job_of[fut], f"{WORKER_LOST}, on every worker that ran it")
+        pending = as_completed(futures)
+        while not pending.is_empty():
+            batch = pending.next_batch(block=False)
+            if not batch:  # poll, so that a noted Ctrl-C is raised here, not in Dask's locks
+                interrupt.check()
+                time.sleep(0.05)
+            for fut in batch:
+                try:
+                    yield fut.result()
+                except KilledWorker:  # Dask retried it on other workers and they died too
+                    yield job_row(job_of[fut], f"{WORKER_LOST}, on every worker that ran it")
     finally:
         client.close()
