@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import functools
+import signal
 import sys
 from pathlib import Path
 
@@ -38,7 +39,11 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("no scenario with an expect: section found", key=" ".join(args.paths))
     if args.jobs < 1:
         raise ConfigError("must be at least 1", key="--jobs")
-    results = _run_all(files, min(args.jobs, len(files)), args.out)
+    previous = signal.signal(signal.SIGTERM, interrupt.request)  # kill: like Ctrl-C
+    try:
+        results = _run_all(files, min(args.jobs, len(files)), args.out)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     print_table(results)
     if args.junit:
         write_junit(results, Path(args.junit))

@@ -28,9 +28,11 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from types import FrameType
+from typing import Any
 
 _installed = 0  # deferrals whose handler is in place (nested runs share one request)
 _requested = False
+_external: Any = None  # a worker process's stop flag, set by its parent (multiprocessing.Event)
 
 
 def request(signum: int | None = None, frame: FrameType | None = None) -> None:
@@ -46,20 +48,27 @@ def request(signum: int | None = None, frame: FrameType | None = None) -> None:
 
 
 def requested() -> bool:
-    """Whether a stop was requested during the current run (and not yet ended)."""
-    return _requested
+    """Whether a stop was requested during the current run (or by this worker's parent)."""
+    return _requested or (_external is not None and _external.is_set())
 
 
-def forget() -> None:
-    """In a freshly forked worker process: no deferral, no request (they were the parent's)."""
-    global _installed, _requested
+def follow(stop: Any) -> None:
+    """In a worker process: forget the parent's deferral state, and stop when ``stop`` is set.
+
+    Workers ignore SIGINT themselves (one idle between two jobs would die of it); their
+    parent owns Ctrl-C and sets ``stop`` (a ``multiprocessing.Event``), which
+    :func:`requested` reads, so a running job ends at its next whole instant however the
+    parent was told (a terminal's Ctrl-C, ``kill -INT`` or SIGTERM to the parent alone).
+    """
+    global _installed, _requested, _external
     _installed = 0
     _requested = False
+    _external = stop
 
 
 def check() -> None:
     """Raise KeyboardInterrupt if a stop was requested: call where the state is whole."""
-    if _requested:
+    if requested():
         raise KeyboardInterrupt
 
 

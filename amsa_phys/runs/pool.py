@@ -11,12 +11,13 @@ fresh process, so the job that kills its process a second time is found and repo
 from __future__ import annotations
 
 import functools
+import multiprocessing
 import signal
 from collections import deque
 from collections.abc import Callable, Generator, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from ..engine import interrupt
 
@@ -33,7 +34,6 @@ def imap_resilient(
     lost: Callable[[T], R],
     *,
     in_flight: int,
-    ignore_sigint: bool = False,
 ) -> Iterator[tuple[int, R]]:
     """``(index, fn(item))`` as jobs complete; ``(index, lost(item))`` for a job that kills
     its worker process twice.
@@ -42,15 +42,19 @@ def imap_resilient(
     Ctrl-C (the pool moves it to its workers' queue at once), and it is what a break costs.
     On any other exception (Ctrl-C included) the jobs not started are cancelled and it
     propagates. Ctrl-C noted by :func:`interrupt.deferred` is raised between completions
-    (checked every 0.2 s). Workers start with Python's own signal handling, SIGINT ignored
-    when ``ignore_sigint`` (a sweep: its running jobs finish and give their rows).
+    (checked every 0.2 s). Workers ignore SIGINT; on the way out the parent sets their stop
+    flag (:func:`interrupt.follow`), so running jobs end at their next whole instant.
     """
-    initializer = functools.partial(_worker_init, ignore_sigint)
+    stop = multiprocessing.get_context().Event()
+    initializer = functools.partial(_worker_init, stop)
     todo = deque(enumerate(items))
-    while todo:
-        suspects = yield from _pass(fn, todo, workers, in_flight, initializer)
-        for index, item in suspects:
-            yield index, _alone(fn, item, lost, initializer)
+    try:
+        while todo:
+            suspects = yield from _pass(fn, todo, workers, in_flight, initializer, stop)
+            for index, item in suspects:
+                yield index, _alone(fn, item, lost, initializer)
+    finally:
+        stop.set()  # also when the caller stops consuming: nothing keeps running for nobody
 
 
 def _pass(
@@ -59,6 +63,7 @@ def _pass(
     workers: int,
     in_flight: int,
     initializer: Callable[[], None],
+    stop: Any,
 ) -> Generator[tuple[int, R], None, list[tuple[int, T]]]:
     """Run jobs from ``todo`` until it is empty or the pool breaks; the jobs the break took."""
     with ProcessPoolExecutor(max_workers=workers, initializer=initializer) as pool:
@@ -81,17 +86,22 @@ def _pass(
                 if broken:  # what the pool still held, finished or not, went with it
                     return sorted(running.values(), key=lambda job: job[0])
         except BaseException:
+            stop.set()  # before the pool's shutdown waits for the jobs still running
             for fut in running:
                 fut.cancel()
             raise
     return []
 
 
-def _worker_init(ignore_sigint: bool) -> None:
-    """A forked worker inherits the parent's handlers and deferral state: start clean."""
-    interrupt.forget()
+def _worker_init(stop: Any) -> None:
+    """A forked worker inherits the parent's handlers and deferral state: start clean.
+
+    SIGINT is ignored (the terminal sends it to the workers too; an idle one would die of
+    it and break the pool); the parent stops running jobs through ``stop`` instead.
+    """
+    interrupt.follow(stop)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    signal.signal(signal.SIGINT, signal.SIG_IGN if ignore_sigint else signal.default_int_handler)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _alone(

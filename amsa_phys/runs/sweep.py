@@ -267,9 +267,9 @@ def run_job(job: Job) -> dict[str, Any]:
 def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
     """Rows as they complete, from local worker processes (or in-process for 1 worker).
 
-    Workers ignore Ctrl-C: the main process handles it, cancels what has not started and
-    keeps every row finished so far. A worker that dies costs one row, not the sweep
-    (``runs/pool.py``): a job that kills its process twice becomes a row error.
+    Workers ignore Ctrl-C: the main process handles it, cancels what has not started, stops
+    what is running and keeps every row finished so far. A worker that dies costs one row,
+    not the sweep (``runs/pool.py``): a job that kills its process twice becomes a row error.
     """
     if workers <= 1:
         for job in jobs:
@@ -277,9 +277,7 @@ def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
             interrupt.check()
         return
     lost = functools.partial(_lost_row, f"{WORKER_LOST}, twice, running this job")
-    for _, row in imap_resilient(
-        run_job, jobs, workers, lost, in_flight=2 * workers, ignore_sigint=True
-    ):
+    for _, row in imap_resilient(run_job, jobs, workers, lost, in_flight=2 * workers):
         yield row
 
 

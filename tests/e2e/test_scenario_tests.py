@@ -97,7 +97,10 @@ def test_ctrl_c_stops_the_whole_suite_not_just_one_scenario(
     assert "scenarios," not in captured.out  # no table: nothing was reported as run
 
 
-def test_ctrl_c_stops_a_parallel_suite_promptly(tmp_path: Path) -> None:
+@pytest.mark.parametrize("how", ["ctrl-c", "kill-int-parent", "kill-term-parent"])
+def test_ctrl_c_stops_a_parallel_suite_promptly(tmp_path: Path, how: str) -> None:
+    # a terminal's Ctrl-C reaches every process; kill reaches the parent only, which must
+    # stop its workers itself
     import os
     import signal
     import time
@@ -122,7 +125,10 @@ def test_ctrl_c_stops_a_parallel_suite_promptly(tmp_path: Path) -> None:
         deadline = time.monotonic() + 30
         while len(list(out.glob("*/trace.csv.tmp"))) < 2 and time.monotonic() < deadline:
             time.sleep(0.05)
-        os.killpg(proc.pid, signal.SIGINT)  # like a terminal's Ctrl-C: the whole group
+        if how == "ctrl-c":
+            os.killpg(proc.pid, signal.SIGINT)  # the whole group
+        else:
+            proc.send_signal(signal.SIGINT if how == "kill-int-parent" else signal.SIGTERM)
         stdout, err = proc.communicate(timeout=30)
     finally:  # a suite that ignored Ctrl-C must not outlive the test with its workers
         if proc.poll() is None:
