@@ -13,6 +13,11 @@ def add_args(p: argparse.ArgumentParser) -> None:
     """Arguments of ``amsa-phys graph``."""
     p.add_argument("file", help="world or scenario YAML file")
     p.add_argument("-o", "--output", required=True, help="OUT.png, OUT.svg or OUT.dot")
+    p.add_argument(
+        "--expand",
+        action="store_true",
+        help="draw every copy of a repeated Composite (default: Car{i}.Robot once, ×N)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -26,6 +31,6 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("directory does not exist", key="--output", file=out.parent)
     from ..plots.graph import draw  # matplotlib: imported by the commands that draw
 
-    draw(world, out)
+    draw(world, out, collapse=not args.expand)
     print(f"wrote {out}")
     return 0

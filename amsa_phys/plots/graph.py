@@ -14,6 +14,8 @@ top of each other and of the next column's names.
 
 from __future__ import annotations
 
+import re
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import matplotlib
@@ -48,32 +50,121 @@ def edges(world: WorldSpec) -> list[tuple[str, str, str]]:
     return out
 
 
-def to_dot(world: WorldSpec) -> str:
+@dataclass(frozen=True)
+class Node:
+    """A box of the diagram: one component, or every copy of a repeated one (``count``)."""
+
+    name: str
+    template: str
+    kind: str
+    freq: float
+    count: int = 1
+
+    @property
+    def subtitle(self) -> str:
+        """``controlledRobot · 4 Hz``, with ``· ×10`` for copies."""
+        copies = f" · ×{self.count}" if self.count > 1 else ""
+        return f"{self.template} · {self.freq:g} Hz{copies}"
+
+
+@dataclass
+class Structure:
+    """What the diagram shows: boxes and labelled links (``Node.name`` to ``Node.name``)."""
+
+    nodes: dict[str, Node]
+    links: list[tuple[str, str, str]]
+
+
+_COPY = re.compile(r"^(.*?)(\d+)$")
+
+
+def structure(world: WorldSpec, collapse: bool = True) -> Structure:
+    """The world's components and links; with ``collapse``, copies drawn once.
+
+    Copies are leaves of Composites whose names differ only in a trailing number (``count:``
+    makes Car1 .. Car10) with the same template: ``Car{i}.Robot`` stands for all of them. A
+    link between different copies says so (``posX (from i-1)``), and a link that only some
+    copies have names them (``(i=1)``, ``(i=2..10)``).
+    """
+    copy_of: dict[str, tuple[str, int]] = {}  # leaf path -> (node name, copy number)
+    if collapse:
+        members: dict[tuple[str, str, str], list[tuple[int, str]]] = {}
+        for path, leaf in world.leaves.items():
+            parent, _, name = path.rpartition(".")
+            m = _COPY.match(parent)
+            if m:
+                key = (m.group(1), name, leaf.template_ref)
+                members.setdefault(key, []).append((int(m.group(2)), path))
+        for (prefix, name, _), group in members.items():
+            if len(group) > 1:
+                for number, path in group:
+                    copy_of[path] = (f"{prefix}{{i}}.{name}", number)
+    nodes: dict[str, Node] = {}
+    for path, leaf in world.leaves.items():
+        name = copy_of[path][0] if path in copy_of else path
+        if name in nodes:
+            nodes[name] = replace(nodes[name], count=nodes[name].count + 1)
+        else:
+            kind = leaf.kind.value
+            nodes[name] = Node(name, leaf.template.name(), kind, float(leaf.freq))
+    numbers: dict[str, set[int]] = {}
+    for name, number in copy_of.values():
+        numbers.setdefault(name, set()).add(number)
+    # (from, to, label, copy offset) -> the copy numbers it holds for (of the copy side)
+    held: dict[tuple[str, str, str, int], set[int]] = {}
+    for a, b, label in edges(world):
+        na, ia = copy_of.get(a, (a, None))
+        nb, ib = copy_of.get(b, (b, None))
+        offset = ia - ib if ia is not None and ib is not None else 0
+        side = ib if ib is not None else ia
+        held.setdefault((na, nb, label, offset), set()).update(() if side is None else (side,))
+    links = []
+    for (na, nb, label, offset), which in held.items():
+        notes = [f"from i{offset:+d}"] if offset else []
+        copy_side = nb if nb in numbers else na
+        if which and which != numbers.get(copy_side, which):
+            notes.append(f"i={_numbers_text(which)}")
+        links.append((na, nb, f"{label} ({', '.join(notes)})" if notes else label))
+    return Structure(nodes, links)
+
+
+def _numbers_text(which: set[int]) -> str:
+    """``1``, ``2..10`` or ``1, 3, 5``."""
+    low, high = min(which), max(which)
+    if len(which) == 1:
+        return str(low)
+    if which == set(range(low, high + 1)):
+        return f"{low}..{high}"
+    return ", ".join(str(n) for n in sorted(which))
+
+
+def to_dot(world: WorldSpec, collapse: bool = True) -> str:
     """The architecture as Graphviz DOT text."""
+    st = structure(world, collapse)
     lines = [
         f'digraph "{world.name}" {{',
         "  rankdir=LR;",
         '  node [shape=box, style="rounded,filled", fontname="Helvetica"];',
     ]
-    for path, leaf in world.leaves.items():
-        kind = leaf.kind.value
-        label = f"{path}\\n{leaf.template.name()} ({kind}, {float(leaf.freq):g} Hz)"
-        lines.append(f'  "{path}" [label="{label}", fillcolor="{KIND_COLOURS[kind]}"];')
-    for a, b, label in edges(world):
+    for name, node in st.nodes.items():
+        copies = f", ×{node.count}" if node.count > 1 else ""
+        label = f"{name}\\n{node.template} ({node.kind}, {node.freq:g} Hz{copies})"
+        lines.append(f'  "{name}" [label="{label}", fillcolor="{KIND_COLOURS[node.kind]}"];')
+    for a, b, label in st.links:
         lines.append(f'  "{a}" -> "{b}" [label="{label}", fontsize=9];')
     lines.append("}")
     return "\n".join(lines) + "\n"
 
 
-def _columns(world: WorldSpec) -> dict[str, int]:
+def _columns(st: Structure) -> dict[str, int]:
     """Dataflow depth, with edges into a process or environment treated as the feedback that
     closes a control loop (drawn, but not pushing columns), and any remaining back edge of a
     depth-first walk ignored."""
-    succ: dict[str, list[str]] = {p: [] for p in world.leaves}
-    for a, b, _ in edges(world):
-        if a != b and world.leaves[b].kind.value not in ("process", "environment"):
+    succ: dict[str, list[str]] = {p: [] for p in st.nodes}
+    for a, b, _ in st.links:
+        if a != b and st.nodes[b].kind not in ("process", "environment"):
             succ[a].append(b)
-    col = dict.fromkeys(world.leaves, 0)
+    col = dict.fromkeys(st.nodes, 0)
     state: dict[str, int] = {}
 
     def visit(node: str) -> None:
@@ -85,10 +176,10 @@ def _columns(world: WorldSpec) -> dict[str, int]:
             visit(nxt)
         state[node] = 2
 
-    for _ in range(len(world.leaves)):  # relax until stable (small graphs)
+    for _ in range(len(st.nodes)):  # relax until stable (small graphs)
         state.clear()
         before = dict(col)
-        for node in world.leaves:
+        for node in st.nodes:
             if node not in state:
                 visit(node)
         if col == before:
@@ -103,16 +194,16 @@ CHAR_W = 0.055  # data units per label character at LABEL_PT, for sizing column 
 ARC_RISE = 1.4  # how far a feedback arc rises above the boxes it joins
 MARGINS = (0.01, 0.01, 0.99, 0.92)  # fixed: labels are placed against the final transform
 #: where along an arrow a label is tried, in order (0 = source end, 1 = target end)
-ALONG = (0.5, 0.35, 0.65, 0.22, 0.78, 0.12, 0.88)
+ALONG = (0.5, 0.35, 0.65, 0.22, 0.78, 0.12, 0.88, 0.42, 0.58, 0.28, 0.72, 0.17, 0.83)
 
 
-def draw(world: WorldSpec, out: Path) -> Path:
-    """Write the diagram to ``out`` (.png, .svg or .dot)."""
+def draw(world: WorldSpec, out: Path, collapse: bool = True) -> Path:
+    """Write the diagram to ``out`` (.png, .svg or .dot); copies once unless not ``collapse``."""
     suffix = out.suffix.lower()
     if suffix == ".dot":
-        write_atomic(out, to_dot(world))
+        write_atomic(out, to_dot(world, collapse))
         return out
-    fig, _, _ = diagram(world)
+    fig, _, _ = diagram(world, collapse)
     if suffix == ".png":
         return save_png(fig, out, MARGINS)
     import io
@@ -124,11 +215,26 @@ def draw(world: WorldSpec, out: Path) -> Path:
     return out
 
 
-def diagram(world: WorldSpec) -> tuple[Figure, list[Bbox], list[Bbox]]:
-    """The figure, and the display extents of its components and of its link labels."""
-    pos = _positions(world)
+def diagram(world: WorldSpec, collapse: bool = True) -> tuple[Figure, list[Bbox], list[Bbox]]:
+    """The figure, and the display extents of its components and of its link labels.
+
+    Where some label finds no free place, the columns move apart and it is laid out again
+    (a few times at most: a crowded gap has more arrows than room).
+    """
+    st = structure(world, collapse)
+    for widen in (0.0, 1.5, 3.0, 4.5):
+        fig, boxes, labels = _layout(world, st, widen)
+        crowded = any(a.overlaps(b) for i, a in enumerate(labels) for b in (*labels[:i], *boxes))
+        if not crowded or widen == 4.5:
+            return fig, boxes, labels
+        plt.close(fig)
+    raise AssertionError("unreachable")
+
+
+def _layout(world: WorldSpec, st: Structure, widen: float) -> tuple[Figure, list[Bbox], list[Bbox]]:
+    pos = _positions(st, widen)
     merged: dict[tuple[str, str], list[str]] = {}
-    for a, b, label in edges(world):
+    for a, b, label in st.links:
         merged.setdefault((a, b), []).append(label)
     curves = {ab: _curve(pos[ab[0]], pos[ab[1]]) for ab in merged}
     xs = [x for x, _ in pos.values()]
@@ -148,7 +254,7 @@ def diagram(world: WorldSpec) -> tuple[Figure, list[Bbox], list[Bbox]]:
     ax.set_title(f"{world.name}: {len(world.leaves)} components")
     ax.apply_aspect()
     renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
-    boxes = [_draw_box(ax, path, leaf, pos[path]) for path, leaf in world.leaves.items()]
+    boxes = [_draw_box(ax, node, pos[name]) for name, node in st.nodes.items()]
     box_extents = [b.get_window_extent(renderer) for b in boxes]
     placed: list[Bbox] = []
     for ab, labels in merged.items():
@@ -176,20 +282,21 @@ def diagram(world: WorldSpec) -> tuple[Figure, list[Bbox], list[Bbox]]:
     return fig, box_extents, placed
 
 
-def _positions(world: WorldSpec) -> dict[str, tuple[float, float]]:
-    """Box centres: columns by dataflow depth, each gap as wide as its longest label."""
-    col = _columns(world)
+def _positions(st: Structure, widen: float = 0.0) -> dict[str, tuple[float, float]]:
+    """Box centres: columns by dataflow depth, each gap as wide as its longest label
+    (plus ``widen``)."""
+    col = _columns(st)
     longest = dict.fromkeys(range(max(col.values()) + 1), 0)
-    for a, b, label in edges(world):
+    for a, b, label in st.links:
         if col[b] > col[a]:
             longest[col[a]] = max(longest[col[a]], len(label))
     x_of, x = {}, 0.0
     for c in sorted(longest):
         x_of[c] = x
-        x += BOX_W + min(6.0, max(2.0, CHAR_W * longest[c] + 0.8))
+        x += BOX_W + min(6.0, max(2.0, CHAR_W * longest[c] + 0.8)) + widen
     rows: dict[int, int] = {}
     pos = {}
-    for path in world.leaves:
+    for path in st.nodes:
         c = col[path]
         pos[path] = (x_of[c], -rows.get(c, 0) * ROW_STEP)
         rows[c] = rows.get(c, 0) + 1
@@ -268,29 +375,20 @@ def _place_label(
     return best[1]
 
 
-def _draw_box(ax: plt.Axes, path: str, leaf: object, centre: Point) -> FancyBboxPatch:
-    """One component: name, template and frequency on its kind's colour."""
+def _draw_box(ax: plt.Axes, node: Node, centre: Point) -> FancyBboxPatch:
+    """One component (or its copies): name, template and frequency on its kind's colour."""
     x, y = centre
-    kind = leaf.kind.value  # type: ignore[attr-defined]
     box = FancyBboxPatch(
         (x - BOX_W / 2, y - BOX_H / 2),
         BOX_W,
         BOX_H,
         boxstyle="round,pad=0.05,rounding_size=0.15",
-        fc=KIND_COLOURS[kind],
+        fc=KIND_COLOURS[node.kind],
         ec="0.2",
         lw=1,
         zorder=2,
     )
     ax.add_patch(box)
-    ax.text(x, y + 0.12, path, ha="center", va="center", fontsize=8.5, weight="bold", zorder=3)
-    ax.text(
-        x,
-        y - 0.2,
-        f"{leaf.template.name()} · {float(leaf.freq):g} Hz",  # type: ignore[attr-defined]
-        ha="center",
-        va="center",
-        fontsize=7,
-        zorder=3,
-    )
+    ax.text(x, y + 0.12, node.name, ha="center", va="center", fontsize=8.5, weight="bold", zorder=3)
+    ax.text(x, y - 0.2, node.subtitle, ha="center", va="center", fontsize=7, zorder=3)
     return box

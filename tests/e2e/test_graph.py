@@ -47,12 +47,12 @@ def test_every_link_label_is_readable(name: str) -> None:
     import matplotlib.pyplot as plt
 
     from amsa_phys.model.world import load_world
-    from amsa_phys.plots.graph import diagram, edges
+    from amsa_phys.plots.graph import diagram, structure
 
     world = load_world(ROOT / "worlds" / f"{name}.yaml")
     fig, boxes, labels = diagram(world)
     try:
-        assert len(labels) == len({(a, b) for a, b, _ in edges(world)})
+        assert len(labels) == len({(a, b) for a, b, _ in structure(world).links})
         for i, label in enumerate(labels):
             assert not any(label.overlaps(box) for box in boxes), i
             assert not any(label.overlaps(other) for other in labels[:i]), i
@@ -60,3 +60,22 @@ def test_every_link_label_is_readable(name: str) -> None:
             assert fig.bbox.contains(label.x1, label.y1)
     finally:
         plt.close(fig)
+
+
+def test_copies_of_a_counted_composite_are_drawn_once(tmp_path: Path) -> None:
+    out = tmp_path / "p.dot"
+    assert main(["graph", str(ROOT / "worlds" / "platoon.yaml"), "-o", str(out)]) == 0
+    dot = out.read_text()
+    assert dot.count("[label=") - dot.count(" -> ") == 8  # Leader and Car{i}'s seven parts
+    assert '"Car{i}.Robot" [label="Car{i}.Robot\\ncontrolledRobot (process, 4 Hz, ×10)"' in dot
+    # car 1 follows the Leader, car i the car ahead: both links say so
+    assert '"Leader" -> "Car{i}.AheadGps" [label="posX (i=1)"' in dot
+    assert '"Car{i}.Robot" -> "Car{i}.AheadGps" [label="posX (from i-1, i=2..10)"' in dot
+    assert '"Car{i}.Robot" -> "Car{i}.Gps" [label="posX"' in dot  # every copy: no note
+    expanded = tmp_path / "e.dot"
+    argv = ["graph", str(ROOT / "worlds" / "platoon.yaml"), "-o", str(expanded), "--expand"]
+    assert main(argv) == 0
+    assert '"Car7.Robot" -> "Car8.AheadGps" [label="posX"' in expanded.read_text()
+    png = tmp_path / "p.png"
+    assert main(["graph", str(ROOT / "worlds" / "platoon.yaml"), "-o", str(png)]) == 0
+    assert png.read_bytes()[:4] == b"\x89PNG"
