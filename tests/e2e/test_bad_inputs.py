@@ -112,3 +112,15 @@ def test_usage_errors_are_one_line_exit_2(
     assert err.count("\n") == 1
     assert err.startswith("error: amsa-phys")
     assert "--help)" in err
+
+
+def test_a_set_override_can_repair_a_rule_the_file_breaks(tmp_path: Path) -> None:
+    scen = tmp_path / "s.yaml"
+    world = Path(__file__).parent.parent.parent / "worlds" / "mde_challenge.yaml"
+    scen.write_text(
+        f"world: {world}\nduration: 2\nset: {{MyNormalizePower.powerMin: 50}}\n"
+        "timeline:\n  - {at: 1, set: {MyNormalizePower.powerMax: 40}}\n"
+    )
+    assert main(["validate", str(scen)]) == 2  # the file alone breaks powerMin <= powerMax
+    argv = ["run", str(scen), "--headless", "-q", "--no-plot", "--out", str(tmp_path / "o")]
+    assert main([*argv, "--set", "MyNormalizePower.powerMin=-10"]) == 0
