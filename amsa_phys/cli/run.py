@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -75,8 +74,7 @@ def _run(
     )
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
     prepare_run_dir(out, args.force)
-    previous = signal.signal(signal.SIGTERM, interrupt.request)
-    try:
+    with interrupt.sigterm_as_ctrl_c():
         outcome = run_scenario(
             scenario,
             out,
@@ -86,8 +84,6 @@ def _run(
             window=not args.headless,
             plotter=plotter,
         )
-    finally:
-        signal.signal(signal.SIGTERM, previous)
     if not args.quiet:
         print_summary(outcome.metrics, out, sys.stdout)
     checks = check_expectations(scenario.expect, outcome.metrics, out / "trace.csv")

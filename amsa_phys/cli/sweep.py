@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import csv
 import io
-import signal
 import sys
 from pathlib import Path
 from typing import Any
@@ -136,10 +135,10 @@ def run(args: argparse.Namespace) -> int:
         else iter_local(jobs, min(args.jobs, len(jobs)))
     )
     interrupted = False
-    previous = signal.signal(signal.SIGTERM, interrupt.request)
     try:
         # Ctrl-C is raised between completions, never inside concurrent.futures or Dask
         with (
+            interrupt.sigterm_as_ctrl_c(),
             interrupt.deferred(),
             tqdm(total=len(jobs), unit="run", disable=not sys.stderr.isatty()) as bar,
         ):
@@ -149,8 +148,6 @@ def run(args: argparse.Namespace) -> int:
             interrupt.check()  # a Ctrl-C noted after the last row still counts
     except KeyboardInterrupt:
         interrupted = True
-    finally:
-        signal.signal(signal.SIGTERM, previous)
     keys = [a.key for a in plan.axes]
     write_results(rows, keys, out / "results.csv")
     from ..plots.summary import plot_summary  # matplotlib: only once the rows are in

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import functools
-import signal
 import sys
 from pathlib import Path
 
@@ -39,11 +38,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("no scenario with an expect: section found", key=" ".join(args.paths))
     if args.jobs < 1:
         raise ConfigError("must be at least 1", key="--jobs")
-    previous = signal.signal(signal.SIGTERM, interrupt.request)  # kill: like Ctrl-C
-    try:
+    with interrupt.sigterm_as_ctrl_c():
         results = _run_all(files, min(args.jobs, len(files)), args.out)
-    finally:
-        signal.signal(signal.SIGTERM, previous)
     print_table(results)
     if args.junit:
         write_junit(results, Path(args.junit))
@@ -55,7 +51,7 @@ def _run_all(files: list[Path], jobs: int, out: str | None) -> list[ScenarioResu
 
     A suite cut short reports nothing (a partial table would read as a smaller suite that
     passed): scenarios not started never start, running ones stop at their next simulated
-    second (workers get the terminal's Ctrl-C too), and :class:`Interrupted` says how far it
+    second (the pool sets its workers' stop flag), and :class:`Interrupted` says how far it
     got. A scenario that kills its worker process twice is an ERROR row (``runs/pool.py``).
     """
     done: dict[int, ScenarioResult] = {}
@@ -81,13 +77,9 @@ def _run_each(
         return
     # at most ``jobs`` handed out: anything queued would still run after Ctrl-C
     # (measured before: six 3 s scenarios on two workers went on for 5.4 s)
-    run = functools.partial(_run_file, out)
+    run = functools.partial(run_scenario_file, out_root=out)
     for i, result in imap_resilient(run, paths, jobs, _lost, in_flight=jobs):
         done[i] = result
-
-
-def _run_file(out: str | None, path: str) -> ScenarioResult:
-    return run_scenario_file(path, out)
 
 
 def _lost(path: str) -> ScenarioResult:

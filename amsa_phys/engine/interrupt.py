@@ -92,3 +92,13 @@ def deferred() -> Iterator[None]:
         signal.signal(signal.SIGINT, previous)
         if not _installed:
             _requested = False
+
+
+@contextmanager
+def sigterm_as_ctrl_c() -> Iterator[None]:
+    """While a command runs, ``kill`` (SIGTERM) is handled like Ctrl-C (:func:`request`)."""
+    previous = signal.signal(signal.SIGTERM, request)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

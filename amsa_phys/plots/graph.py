@@ -222,13 +222,12 @@ def diagram(world: WorldSpec, collapse: bool = True) -> tuple[Figure, list[Bbox]
     (a few times at most: a crowded gap has more arrows than room).
     """
     st = structure(world, collapse)
-    for widen in (0.0, 1.5, 3.0, 4.5):
+    for widen in (0.0, 1.5, 3.0):
         fig, boxes, labels = _layout(world, st, widen)
-        crowded = any(a.overlaps(b) for i, a in enumerate(labels) for b in (*labels[:i], *boxes))
-        if not crowded or widen == 4.5:
+        if not any(a.overlaps(b) for i, a in enumerate(labels) for b in (*labels[:i], *boxes)):
             return fig, boxes, labels
         plt.close(fig)
-    raise AssertionError("unreachable")
+    return _layout(world, st, 4.5)
 
 
 def _layout(world: WorldSpec, st: Structure, widen: float) -> tuple[Figure, list[Bbox], list[Bbox]]:

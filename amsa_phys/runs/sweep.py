@@ -276,13 +276,9 @@ def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
             yield run_job(job)
             interrupt.check()
         return
-    lost = functools.partial(_lost_row, f"{WORKER_LOST}, twice, running this job")
+    lost = functools.partial(job_row, error=f"{WORKER_LOST}, twice, running this job")
     for _, row in imap_resilient(run_job, jobs, workers, lost, in_flight=2 * workers):
         yield row
-
-
-def _lost_row(error: str, job: Job) -> dict[str, Any]:
-    return job_row(job, error)
 
 
 def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:
