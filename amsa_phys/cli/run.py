@@ -14,6 +14,7 @@ from ..runs.expect import check_expectations
 from ..runs.plotjob import PlotJob
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
+from ..runs.suite import input_files
 from .options import add_output, add_scenario_overrides
 from .recording import add_recording, recording_options, snapshot_options
 from .report import print_summary
@@ -73,7 +74,7 @@ def _run(
         log_rate=args.log_rate,
     )
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
-    prepare_run_dir(out, args.force)
+    prepare_run_dir(out, args.force, inputs=input_files(scenario))
     with interrupt.sigterm_as_ctrl_c():
         outcome = run_scenario(
             scenario,

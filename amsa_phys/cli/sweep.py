@@ -17,6 +17,7 @@ from ..errors import ConfigError, Interrupted
 from ..model.scenario import load_scenario
 from ..model.yamlio import load_yaml
 from ..runs.rundir import default_run_dir, prepare_run_dir
+from ..runs.suite import input_files
 from ..runs.sweep import (
     Axis,
     SweepPlan,
@@ -112,6 +113,7 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
         contexts,
         metric,
         args.duration,
+        inputs=tuple(input_files(scenario)),
     )
 
 
@@ -124,7 +126,7 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("must be at least 1", key="--jobs")
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-sweep")
-    prepare_run_dir(out, args.force)
+    prepare_run_dir(out, args.force, inputs=plan.inputs)
     if args.keep_runs:
         plan.keep_dir = str((out / "runs").resolve())
     jobs = plan.jobs()

@@ -1,4 +1,14 @@
-"""Choosing and preparing a run's output directory.
+"""Choosing and preparing a run's output directory, safely.
+
+Three rules keep a run from ever destroying a user's files:
+
+* a scenario's ``name`` reaches the file system only through :func:`safe_name`, which makes
+  it one harmless path component (``..``, ``/etc`` or a control character can never
+  name a directory outside the output root);
+* every directory amsa-phys creates for its outputs holds a marker file (:data:`MARKER`);
+  ``--force`` replaces only such a directory, never one the user made or filled;
+* a directory that holds the run's own inputs (the scenario or its world), or the current
+  directory or one of its parents, is refused outright, with or without ``--force``.
 
 An existing directory is never overwritten without ``force``; an unwritable location is
 reported before the run starts, not after minutes of simulation.
@@ -7,44 +17,131 @@ reported before the run starts, not after minutes of simulation.
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import time
+from collections.abc import Iterable
 from pathlib import Path
 
 from ..errors import ConfigError
+
+#: The file that says "amsa-phys made this directory": ``--force`` replaces nothing else.
+MARKER = ".amsa-phys-run"
+#: Longest name a scenario contributes to a directory name (file systems allow 255 bytes).
+MAX_NAME = 80
+_UNSAFE = re.compile(r"[^A-Za-z0-9_.+=-]")
+
+
+def safe_name(name: str) -> str:
+    """``name`` as one safe path component: no separator, no ``.``/``..``, no control chars.
+
+    Characters outside ``[A-Za-z0-9_.+=-]`` become ``_`` and leading dots become ``_``
+    (so ``..`` is ``__`` and ``/some/dir`` is ``_some_dir``); an empty name is ``scenario``.
+    """
+    text = _UNSAFE.sub("_", name)[:MAX_NAME]
+    stripped = text.lstrip(".")
+    text = "_" * (len(text) - len(stripped)) + stripped
+    return text or "scenario"
 
 
 def default_run_dir(scenario_name: str, root: Path = Path("runs")) -> Path:
     """``runs/<scenario>-<YYYYmmdd-HHMMSS>`` (a suffix is added if it exists already)."""
     stamp = time.strftime("%Y%m%d-%H%M%S")
-    base = root / f"{scenario_name}-{stamp}"
+    base = root / f"{safe_name(scenario_name)}-{stamp}"
     out = base
     n = 1
-    while out.exists():
+    while out.exists() or out.is_symlink():
         n += 1
         out = base.with_name(f"{base.name}-{n}")
     return out
 
 
-def prepare_run_dir(out: Path, force: bool) -> Path:
-    """Create ``out`` (refusing to reuse a non-empty one unless ``force``)."""
+def unique_names(names: Iterable[str]) -> list[str]:
+    """Safe, distinct directory names for ``names`` in order (``a``, ``a-2``, ``a-3``...).
+
+    Two scenarios with the same ``name`` in one ``test --out`` must not share (or delete)
+    each other's directory; the comparison ignores case, for case-insensitive file systems.
+    """
+    taken: set[str] = set()
+    out: list[str] = []
+    for raw in names:
+        base = safe_name(raw)
+        name, n = base, 1
+        while name.lower() in taken:
+            n += 1
+            name = f"{base}-{n}"
+        taken.add(name.lower())
+        out.append(name)
+    return out
+
+
+def is_ours(path: Path) -> bool:
+    """True if amsa-phys created ``path`` as an output directory (it holds the marker)."""
+    return (path / MARKER).is_file() and not (path / MARKER).is_symlink()
+
+
+def _inside(child: Path, parent: Path) -> bool:
+    return child == parent or parent in child.parents
+
+
+def _refuse_inputs(out: Path, inputs: Iterable[Path], flag: str) -> None:
+    """Refuse a non-empty output directory that holds an input, the working directory or a
+    parent of it: replacing it (or mixing outputs into it) would destroy what the user has."""
+    real = out.resolve()
+    cwd = Path.cwd().resolve()
+    if _inside(cwd, real):
+        what = "the current directory" if real == cwd else "a parent of the current directory"
+        raise ConfigError(f"is {what}; choose a new directory for the outputs", key=flag, file=out)
+    for given in inputs:
+        source = Path(given).resolve()
+        if _inside(source, real):
+            raise ConfigError(
+                f"holds the input {given}; choose a directory that does not contain it",
+                key=flag,
+                file=out,
+            )
+
+
+def prepare_run_dir(
+    out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "--out"
+) -> Path:
+    """Create ``out`` for a run's outputs and mark it as ours.
+
+    A non-empty ``out`` is refused unless ``force``, and even then only replaced if amsa-phys
+    made it (:func:`is_ours`) and it holds none of ``inputs``. Symbolic links are never
+    followed into a removal.
+    """
+    inputs = list(inputs)
+    if out.is_symlink() and (force or out.exists()):
+        raise ConfigError(
+            "is a symbolic link; give the real directory (amsa-phys does not replace links)",
+            key=flag,
+            file=out,
+        )
     if out.exists():
         if not out.is_dir():
-            raise ConfigError("exists and is not a directory", key="--out", file=out)
+            raise ConfigError("exists and is not a directory", key=flag, file=out)
         if any(out.iterdir()):
+            _refuse_inputs(out, inputs, flag)
             if not force:
                 raise ConfigError(
                     "directory exists and is not empty (use --force to replace it)",
-                    key="--out",
+                    key=flag,
+                    file=out,
+                )
+            if not is_ours(out):
+                raise ConfigError(
+                    f"directory exists and was not made by amsa-phys (no {MARKER} in it); "
+                    "--force replaces only run directories: choose a new one",
+                    key=flag,
                     file=out,
                 )
             shutil.rmtree(out)
     try:
         out.mkdir(parents=True, exist_ok=True)
+        (out / MARKER).write_text("amsa-phys output directory; --force may replace it\n")
     except OSError as exc:
-        raise ConfigError(
-            f"cannot create directory: {exc.strerror}", key="--out", file=out
-        ) from None
+        raise ConfigError(f"cannot create directory: {exc.strerror}", key=flag, file=out) from None
     if not os.access(out, os.W_OK):
-        raise ConfigError("directory is not writable", key="--out", file=out)
+        raise ConfigError("directory is not writable", key=flag, file=out)
     return out

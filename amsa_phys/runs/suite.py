@@ -14,9 +14,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import AmsaError
-from ..model.scenario import load_scenario
+from ..model.scenario import Scenario, load_scenario
+from ..model.yamlio import load_yaml
 from .expect import Check, check_expectations
-from .rundir import prepare_run_dir
+from .rundir import prepare_run_dir, unique_names
 from .single import run_scenario
 
 _EXPECT = re.compile(r"^expect\s*:", re.MULTILINE)
@@ -59,8 +60,39 @@ def find_scenarios(paths: list[str]) -> list[Path]:
     return found
 
 
-def run_scenario_file(path: str, out_root: str | None = None) -> ScenarioResult:
-    """Load, run and check one scenario (safe to call in a worker process)."""
+def run_dir_names(paths: list[str]) -> list[str]:
+    """One distinct, safe directory name per scenario file for ``test --out``.
+
+    Named after each scenario's ``name:`` (the file's stem where it has none or cannot be
+    read; loading reports that later), made safe and unique *before* any run starts, so two
+    scenarios with the same name in parallel workers never share or delete one directory.
+    """
+    names = []
+    for path in paths:
+        name = Path(path).stem
+        try:
+            data = load_yaml(path).data
+            if isinstance(data, dict) and isinstance(data.get("name"), str):
+                name = data["name"]
+        except (AmsaError, OSError):
+            pass
+        names.append(name)
+    return unique_names(names)
+
+
+def input_files(scenario: Scenario) -> list[Path]:
+    """The files a run of ``scenario`` reads: its output directory must not hold them."""
+    return [scenario.path, scenario.world.source.path]
+
+
+def run_scenario_file(
+    path: str, out_root: str | None = None, dir_name: str | None = None
+) -> ScenarioResult:
+    """Load, run and check one scenario (safe to call in a worker process).
+
+    With ``out_root`` the run goes to ``out_root/dir_name`` (``dir_name`` from
+    :func:`run_dir_names`); nothing outside ``out_root`` is created or removed.
+    """
     t0 = time.perf_counter()
     result = ScenarioResult(path=path, name=Path(path).stem)
     try:
@@ -70,11 +102,20 @@ def run_scenario_file(path: str, out_root: str | None = None) -> ScenarioResult:
             result.error = "no expect: section"
             return result
         with tempfile.TemporaryDirectory(prefix="amsa-test-") as tmp:
-            out = Path(out_root) / result.name if out_root else Path(tmp) / "run"
-            prepare_run_dir(out, force=True)
+            if out_root:
+                sub = dir_name or run_dir_names([path])[0]
+                out = Path(out_root) / sub
+            else:
+                out = Path(tmp) / "run"
+            prepare_run_dir(out, force=True, inputs=input_files(scenario))
             outcome = run_scenario(scenario, out, plot=out_root is not None, progress=False)
             result.checks = check_expectations(scenario.expect, outcome.metrics, out / "trace.csv")
     except AmsaError as exc:
         result.error = str(exc)
     result.wall_s = time.perf_counter() - t0
     return result
+
+
+def run_scenario_job(job: tuple[str, str | None], out_root: str | None) -> ScenarioResult:
+    """:func:`run_scenario_file` for a ``(path, dir_name)`` pair (a pool maps one argument)."""
+    return run_scenario_file(job[0], out_root, job[1])

@@ -117,6 +117,7 @@ class SweepPlan:
     metric: str = "rms_error"
     duration: float | None = None
     keep_dir: str | None = None
+    inputs: tuple[Path, ...] = ()  # files the sweep reads: its --out must not hold them
 
     def jobs(self) -> list[Job]:
         """The Cartesian product of the axes, then seeds, in a fixed order."""

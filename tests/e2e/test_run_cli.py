@@ -41,6 +41,7 @@ def run(tmp_path: Path, name: str, *extra: str) -> Path:
 def test_run_writes_the_run_directory(tmp_path: Path) -> None:
     out = run(tmp_path, "a")
     assert sorted(p.name for p in out.iterdir()) == [
+        ".amsa-phys-run",
         "distance.png",
         "metrics.json",
         "scenario.yaml",

@@ -162,7 +162,7 @@ def test_sigkill_never_leaves_a_partial_file_under_a_final_name(tmp_path: Path) 
     proc.kill()
     proc.wait(timeout=30)
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["trace.csv.tmp"]  # the only file is the temporary one
+    assert names == [".amsa-phys-run", "trace.csv.tmp"]  # no output under a final name
 
 
 def test_unwritable_output_directory_is_refused_before_the_run(

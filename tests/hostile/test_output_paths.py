@@ -1,0 +1,189 @@
+"""Output directories can never reach outside ``--out`` nor destroy a user's files.
+
+The critical case of the hostile audit: a scenario's ``name:`` joined to ``test --out`` used
+to be removed with ``rmtree`` (``name: ".."`` deleted the parent of ``--out``, an absolute
+name deleted that directory). Every test here snapshots a temporary root and asserts that
+nothing outside the output directory changed.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from amsa_phys.cli.main import main
+from amsa_phys.runs.rundir import MARKER, safe_name, unique_names
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+WORLD = ROOT / "worlds" / "mde_challenge.yaml"
+
+
+def _scenario(path: Path, name: str, duration: float = 2) -> Path:
+    path.write_text(
+        f"name: {name!r}\n"
+        f"world: {WORLD}\n"
+        f"duration: {duration}\n"
+        "seed: 1\n"
+        "quality: {signal: MyDistanceMonitor.distanceFollowerToLeader, reference: 15,"
+        " tolerance: 1.5}\n"
+        "expect:\n  - {metric: collisions, below: 1}\n",
+        encoding="utf-8",
+    )
+    return path
+
+
+def _snapshot(root: Path, skip: Path | None = None) -> dict[str, bytes | None]:
+    """Every file and directory under ``root`` (outside ``skip``) with its content."""
+    seen: dict[str, bytes | None] = {}
+    for dirpath, dirnames, filenames in os.walk(root):
+        here = Path(dirpath)
+        if skip is not None and (here == skip or skip in here.parents):
+            dirnames[:] = []
+            continue
+        for d in dirnames:
+            if skip is None or here / d != skip:
+                seen[str(here / d)] = None
+        for f in filenames:
+            seen[str(here / f)] = (here / f).read_bytes()
+    return seen
+
+
+def _plant(root: Path) -> None:
+    """User files that a bad name or --force must never touch."""
+    (root / "precious").mkdir()
+    (root / "precious" / "thesis.tex").write_text("years of work")
+    (root / "notes.txt").write_text("keep me")
+
+
+@pytest.mark.parametrize("name", ["..", ".", "../..", "/ABS", "a/../../b", "\x1b[2J\n", ""])
+def test_test_out_never_touches_anything_outside_out(
+    tmp_path: Path, name: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    root = tmp_path / "root"
+    root.mkdir()
+    _plant(root)
+    if name == "/ABS":  # an absolute path under the temporary root, pointing at user files
+        name = str(root / "precious")
+    out = root / "out"
+    out.mkdir()
+    scen = _scenario(root / "s.yaml", name)
+    before = _snapshot(root, skip=out)
+    main(["test", str(scen), "--out", str(out), "-j", "1"])
+    assert _snapshot(root, skip=out) == before
+    made = [p for p in out.iterdir()]
+    assert len(made) == 1
+    assert made[0].parent == out
+    assert (made[0] / "metrics.json").is_file()
+    assert (made[0] / MARKER).is_file()
+    capsys.readouterr()
+
+
+def test_run_default_directory_stays_under_runs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    _plant(tmp_path)
+    scen = _scenario(tmp_path / "s.yaml", "../precious")
+    before = _snapshot(tmp_path, skip=tmp_path / "runs")
+    assert main(["run", str(scen), "--headless", "--no-plot", "-q"]) == 0
+    assert _snapshot(tmp_path, skip=tmp_path / "runs") == before
+    (made,) = (tmp_path / "runs").iterdir()
+    assert made.name.startswith("___precious-")
+    capsys.readouterr()
+
+
+def test_same_name_twice_in_parallel_gets_two_directories(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    a = _scenario(tmp_path / "a.yaml", "twin")
+    b = _scenario(tmp_path / "b.yaml", "twin")
+    out = tmp_path / "out"
+    assert main(["test", str(a), str(b), "--out", str(out), "-j", "2"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["twin", "twin-2"]
+    for d in out.iterdir():
+        assert (d / "metrics.json").is_file()
+    capsys.readouterr()
+
+
+def test_force_refuses_a_directory_amsa_phys_did_not_make(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scen = _scenario(tmp_path / "s.yaml", "s")
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "data.csv").write_text("1,2,3")
+    code = main(["run", str(scen), "--headless", "--out", str(mine), "--force", "-q"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1
+    assert "--out" in err[0]
+    assert "not made by amsa-phys" in err[0]
+    assert (mine / "data.csv").read_text() == "1,2,3"
+
+
+def test_force_replaces_a_run_directory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scen = _scenario(tmp_path / "s.yaml", "s")
+    out = tmp_path / "run"
+    args = ["run", str(scen), "--headless", "--no-plot", "--out", str(out), "-q"]
+    assert main(args) == 0
+    (out / "metrics.json").write_text("stale")
+    assert main(args) == 2  # without --force an existing run directory is kept
+    assert main([*args, "--force"]) == 0
+    assert (out / "metrics.json").read_text() != "stale"
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize("where", ["scenario_dir", "parent", "cwd"])
+def test_force_onto_the_inputs_or_cwd_is_refused(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    where: str,
+) -> None:
+    proj = tmp_path / "proj"
+    (proj / "scenarios").mkdir(parents=True)
+    scen = _scenario(proj / "scenarios" / "s.yaml", "s")
+    # make the directory look like ours too: the input rule must hold regardless
+    for d in (proj, proj / "scenarios"):
+        (d / MARKER).write_text("planted")
+    monkeypatch.chdir(proj)
+    out = {"scenario_dir": proj / "scenarios", "parent": proj, "cwd": Path(".")}[where]
+    before = _snapshot(tmp_path)
+    code = main(["run", str(scen), "--headless", "--out", str(out), "--force", "-q"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1
+    assert "--out" in err[0]
+    assert _snapshot(tmp_path) == before
+
+
+def test_force_does_not_follow_a_symlink(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scen = _scenario(tmp_path / "s.yaml", "s")
+    target = tmp_path / "target"
+    target.mkdir()
+    (target / MARKER).write_text("x")
+    (target / "keep.txt").write_text("keep")
+    link = tmp_path / "link"
+    link.symlink_to(target)
+    code = main(["run", str(scen), "--headless", "--out", str(link), "--force", "-q"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2
+    assert len(err) == 1
+    assert "symbolic link" in err[0]
+    assert (target / "keep.txt").read_text() == "keep"
+
+
+def test_safe_name_is_one_harmless_component() -> None:
+    assert safe_name("..") == "__"
+    assert safe_name(".") == "_"
+    assert safe_name("/etc") == "_etc"
+    assert safe_name("a/b\\c") == "a_b_c"
+    assert safe_name("\x1b[2J") == "__2J"
+    assert safe_name("") == "scenario"
+    assert safe_name("scenario1") == "scenario1"
+    assert len(safe_name("x" * 1000)) == 80
+    assert unique_names(["a", "A", "a", "b"]) == ["a", "A-2", "a-3", "b"]
