@@ -110,7 +110,18 @@ def load_scenario(
     log_rate: float | None = None,
 ) -> Scenario:
     """Load a scenario; command-line overrides are judged like file values."""
-    doc = load_yaml(path)
+    return configure_scenario(load_yaml(path), overrides, seed, duration, log_rate)
+
+
+def configure_scenario(
+    doc: YamlDoc,
+    overrides: list[str] | None = None,
+    seed: int | None = None,
+    duration: float | None = None,
+    log_rate: float | None = None,
+) -> Scenario:
+    """:func:`load_scenario` of a document already parsed (a file, or a mapping given in
+    Python: ``amsa_phys.run``), so both judge the options the same way."""
     # with overrides, the rules are checked once they are in: a --set may repair the file
     scenario = build_scenario(doc, check_rules=not overrides)
     if seed is not None:

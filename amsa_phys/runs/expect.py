@@ -64,11 +64,14 @@ def describe_bound(e: Expectation) -> str:
 
 
 def check_expectations(
-    expect: list[Expectation], metrics: dict[str, Any], trace: Path | None = None
+    expect: list[Expectation],
+    metrics: dict[str, Any],
+    trace: Path | tuple[list[str], np.ndarray] | None = None,
 ) -> list[Check]:
     """Evaluate every expectation; a metric that is null (never settled) fails a bound.
 
-    A trace check reports the sample that came closest to breaking (or broke) its bound.
+    ``trace`` is the run's ``trace.csv``, or its header and rows already in memory. A trace
+    check reports the sample that came closest to breaking (or broke) its bound.
     """
     checks = []
     columns: tuple[list[str], np.ndarray] | None = None
@@ -92,7 +95,9 @@ def check_expectations(
     return checks
 
 
-def _read(trace: Path | None) -> tuple[list[str], np.ndarray]:
+def _read(trace: Path | tuple[list[str], np.ndarray] | None) -> tuple[list[str], np.ndarray]:
+    if isinstance(trace, tuple):
+        return trace
     if trace is None:
         raise ValueError("trace checks need the run's trace.csv")
     with open(trace, encoding="utf-8") as fh:

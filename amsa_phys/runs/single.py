@@ -10,10 +10,10 @@ from __future__ import annotations
 import json
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import yaml
 from tqdm import tqdm
@@ -169,6 +169,68 @@ def _run_scenario(
     plotter: PlotJob | None,
 ) -> RunOutcome:
     trace = TraceWriter(out_dir / "trace.csv", list(scenario.world.buffers))
+    ended = execute(
+        scenario, trace, progress=progress, record=record, snapshot=snapshot, window=window
+    )
+    write_run_files(out_dir, ended.metrics, ended.resolved, plot=plot, plotter=plotter)
+    error = ended.error
+    t_end = ended.metrics["simulated"]
+    if isinstance(error, KeyboardInterrupt):
+        raise Interrupted(
+            f"interrupted at t={t_end:.2f} s; outputs so far are in {out_dir}"
+        ) from None
+    if error is not None:
+        raise error
+    if interrupt.requested():  # Ctrl-C after the last instant: the outputs are complete
+        raise Interrupted(
+            f"interrupted after the run ended at t={t_end:.2f} s; "
+            f"its outputs are complete in {out_dir}"
+        )
+    return RunOutcome(out_dir, ended.metrics, ended.simulation)
+
+
+class TraceSink(Protocol):
+    """Where the trace rows go: a file (:class:`TraceWriter`) or memory (``TraceMemory``)."""
+
+    def write(self, t_s: float, values: Sequence[float]) -> None:
+        """Take one row (``t`` in seconds, then one value per Data buffer)."""
+
+    def close(self) -> object:
+        """Finalise (the file is renamed into place); called once the run has ended."""
+
+
+@dataclass
+class Ended:
+    """A run that has ended (completed, faulted, interrupted or closed), in memory.
+
+    What a run directory is written from (:func:`write_run_files`), and what
+    ``amsa_phys.run`` keeps without writing anything: the two cannot drift apart. ``error``
+    is the fault or interrupt that ended the run, for the caller to raise once the outputs
+    so far are safe.
+    """
+
+    scenario: Scenario
+    simulation: Simulation
+    metrics: dict[str, Any]
+    resolved: dict[str, Any]
+    error: BaseException | None
+
+
+def execute(
+    scenario: Scenario,
+    trace: TraceSink,
+    *,
+    progress: bool | None = None,
+    record: RecordOptions | None = None,
+    snapshot: SnapshotOptions | None = None,
+    window: bool | WindowDriver = False,
+) -> Ended:
+    """Run ``scenario``, streaming its trace to ``trace``; measure it, resolve it.
+
+    A fault or an interrupt ends the run and is returned in :attr:`Ended.error` (the trace
+    holds every instant up to it); only a failure to finish the video with no other error
+    is raised here. Call inside :func:`interrupt.deferred` so Ctrl-C stops between instants.
+    """
     sim = Simulation.from_scenario(scenario, trace=trace.write)
     status = "completed"
     error: BaseException | None = None
@@ -209,11 +271,24 @@ def _run_scenario(
         metrics["video"] = video
     if still is not None:
         metrics["snapshot"] = {"path": str(still.close()), "t": float(still.at)}
-    write_atomic(out_dir / "metrics.json", json.dumps(metrics, indent=2) + "\n")
     stopped_early = window and not sim.finished and error is None and sim.now > 0
     resolved = resolved_scenario(
         scenario, extra=sim.live_changes, duration=sim.now if stopped_early else None
     )
+    return Ended(scenario, sim, metrics, resolved, error)
+
+
+def write_run_files(
+    out_dir: Path,
+    metrics: dict[str, Any],
+    resolved: dict[str, Any],
+    *,
+    plot: bool = True,
+    plotter: PlotJob | None = None,
+) -> None:
+    """``metrics.json``, ``scenario.yaml`` and (with ``plot``) the two plots of a run whose
+    ``trace.csv`` is already in ``out_dir``; each file is written atomically."""
+    write_atomic(out_dir / "metrics.json", json.dumps(metrics, indent=2) + "\n")
     text = yaml.dump(resolved, Dumper=_YAML_DUMPER, sort_keys=False)
     write_atomic(out_dir / "scenario.yaml", text)
     plotter = plotter or PlotJob()
@@ -222,18 +297,6 @@ def _run_scenario(
             out_dir / "trace.csv", metrics, out_dir / "distance.png", out_dir / "trajectory.png"
         )
     plotter.close()
-    if isinstance(error, KeyboardInterrupt):
-        raise Interrupted(
-            f"interrupted at t={result.t_end:.2f} s; outputs so far are in {out_dir}"
-        ) from None
-    if error is not None:
-        raise error
-    if interrupt.requested():  # Ctrl-C after the last instant: the outputs are complete
-        raise Interrupted(
-            f"interrupted after the run ended at t={result.t_end:.2f} s; "
-            f"its outputs are complete in {out_dir}"
-        )
-    return RunOutcome(out_dir, metrics, sim)
 
 
 WindowDriver = Callable[[Simulation, Scenario, "Recorder | None"], None]

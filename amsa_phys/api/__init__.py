@@ -1,0 +1,11 @@
+"""The Python API: run a scenario and get its metrics, trace and events in memory.
+
+``import amsa_phys as ap; run = ap.run("scenarios/scenario2.yaml", seed=3)`` (the package
+exposes these names lazily, so ``import amsa_phys`` stays cheap). See the README's
+"From Python".
+"""
+
+from .result import Run, run
+from .source import MAPPING, load, validate
+
+__all__ = ["MAPPING", "Run", "load", "run", "validate"]

@@ -1,0 +1,137 @@
+"""``amsa_phys.run``: one scenario run in memory, saved as a run directory only on request.
+
+The run goes through ``runs.single.execute``, the function behind ``amsa-phys run
+--headless``, with the trace kept in memory instead of streamed to a file; :meth:`Run.save`
+writes the same files through the same writers (``write_run_files``, ``TraceWriter``) and the
+same output-directory rules (``runs/rundir.py``). So a saved run is what the CLI writes, and
+its ``trace.csv`` is byte-identical.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..engine import interrupt
+from ..engine.runner import Event
+from ..engine.tracemem import TraceMemory
+from ..errors import Interrupted
+from ..model.scenario import Scenario
+from ..runs.expect import Check, check_expectations
+from ..runs.rundir import default_run_dir, prepare_run_dir
+from ..runs.single import Ended, execute, write_run_files
+from ..runs.suite import input_files
+from .source import Source, load
+
+
+class Run:
+    """A finished run of a scenario, in memory.
+
+    Attributes:
+        metrics: the ``metrics.json`` document (a dict: ``overall``, ``phases``, ``status``...).
+        trace: every Data buffer at the log rate, a numpy structured array with one field per
+            ``trace.csv`` column (``run.trace["t"]``, ``run.trace["Follower.posX"]``).
+        columns: the trace's column names, ``"t"`` first, as in ``trace.csv``.
+        events: every event of the run (collisions, ...) as ``Event(t, kind, detail)``.
+        scenario: the resolved scenario (world inlined, every value) as ``scenario.yaml``
+            holds it; ``amsa_phys.run(run.scenario)`` replays the run.
+        checks: the scenario's ``expect`` entries, evaluated (``check.passed``, ``.value``).
+    """
+
+    def __init__(self, ended: Ended, memory: TraceMemory) -> None:
+        self._loaded: Scenario = ended.scenario
+        self._memory = memory
+        self.metrics: dict[str, Any] = ended.metrics
+        self.scenario: dict[str, Any] = ended.resolved
+        self.events: list[Event] = list(ended.simulation.events)
+        self.trace: np.ndarray = memory.structured()
+        self.columns: list[str] = ["t", *memory.columns]
+        self.checks: list[Check] = check_expectations(
+            ended.scenario.expect, self.metrics, (self.columns, memory.matrix())
+        )
+
+    @property
+    def status(self) -> str:
+        """``completed``, ``interrupted`` or ``fault: ...`` (as in ``metrics.json``)."""
+        return str(self.metrics["status"])
+
+    @property
+    def passed(self) -> bool:
+        """Whether every ``expect`` check passed (True for a scenario without any)."""
+        return all(c.passed for c in self.checks)
+
+    def save(
+        self, out: str | os.PathLike[str] | None = None, *, force: bool = False, plot: bool = True
+    ) -> Path:
+        """Write the run directory ``amsa-phys run --headless --out OUT`` writes; returns it.
+
+        ``out`` defaults to ``runs/<scenario>-<YYYYmmdd-HHMMSS>``. The CLI's rules apply: a
+        non-empty directory is refused unless ``force`` (and then only one amsa-phys made),
+        one holding the scenario or its world, the current directory or a parent never.
+        ``plot=False`` skips the two plots (``--no-plot``).
+        """
+        path = Path(out) if out is not None else default_run_dir(self._loaded.name)
+        inputs = [p for p in input_files(self._loaded) if p.is_file()]  # a mapping has none
+        prepare_run_dir(path, force, inputs=inputs)
+        self._memory.save(path / "trace.csv")
+        write_run_files(path, self.metrics, self.scenario, plot=plot)
+        return path
+
+    def __repr__(self) -> str:
+        overall = self.metrics.get("overall", {})
+        rms = overall.get("rms_error")
+        shown = f", rms_error={rms:.3g}" if isinstance(rms, float) else ""
+        return (
+            f"<Run {self._loaded.name!r} seed={self.metrics['seed']} "
+            f"{self.metrics['simulated']:g}/{self.metrics['duration']:g} s {self.status}"
+            f"{shown}, {len(self.trace)} trace rows>"
+        )
+
+
+def run(
+    source: Source,
+    *,
+    seed: int | None = None,
+    duration: float | Fraction | None = None,
+    set: Mapping[str, Any] | None = None,  # the CLI's --set, by its name
+    log_rate: float | None = None,
+    base_dir: str | os.PathLike[str] | None = None,
+    progress: bool = False,
+) -> Run:
+    """Run a scenario (a file path or a mapping) as ``amsa-phys run --headless`` does.
+
+    Nothing is written (call :meth:`Run.save` for the run directory). Options are the CLI's
+    (see :func:`~amsa_phys.api.source.load`); ``progress=True`` shows the progress bar.
+    Errors are the CLI's, raised: :class:`~amsa_phys.errors.ConfigError` for bad input and
+    :class:`~amsa_phys.errors.RunFault` for a fault during the run, with the CLI's one-line
+    message; Ctrl-C stops the run between two instants and raises
+    :class:`~amsa_phys.errors.Interrupted`. A fault or an interrupt carries the run up to
+    that instant as the exception's ``run`` attribute (inspect it, or ``save`` it).
+    """
+    scenario = load(
+        source, seed=seed, duration=duration, set=set, log_rate=log_rate, base_dir=base_dir
+    )
+    memory = TraceMemory(list(scenario.world.buffers))
+    with interrupt.deferred():
+        ended = execute(scenario, memory, progress=progress)
+        late_stop = interrupt.requested()  # Ctrl-C after the last instant
+    result = Run(ended, memory)
+    error = ended.error
+    t_end = result.metrics["simulated"]
+    if isinstance(error, KeyboardInterrupt):
+        error = Interrupted(f"interrupted at t={t_end:.2f} s; the run so far is the error's .run")
+    elif error is None and late_stop:
+        error = Interrupted(
+            f"interrupted after the run ended at t={t_end:.2f} s; the error's .run is complete"
+        )
+    if error is None:
+        return result
+    error.run = result  # type: ignore[attr-defined]
+    if isinstance(error, Interrupted):
+        raise error from None
+    raise error  # a RunFault keeps its cause: a user template's own traceback

@@ -1,0 +1,182 @@
+"""A scenario from Python: a file path or a mapping, with the CLI's options as arguments.
+
+Everything goes through the loader the CLI uses (``model.scenario.configure_scenario``), so
+a value is judged the same way and an error is the same one-line message. Two choices:
+
+* ``set={"Comp.param": value}`` is turned into the CLI's ``--set Comp.param=value`` text
+  (the value written as a one-line YAML scalar or list, which reads back as the same value)
+  and parsed by the CLI's own code: the API's overrides cannot drift from ``--set``.
+* A mapping has no file: its errors name ``<mapping>`` (no line), and a relative ``world:``
+  path is resolved against ``base_dir`` (default: the current directory when the call is
+  made). Python values that YAML has no word for are converted first: tuples become lists,
+  numpy scalars numbers, paths strings and fractions exact ``"n/d"`` times.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+import os
+from collections.abc import Mapping
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from ..errors import ConfigError
+from ..model.scenario import Scenario, build_scenario, configure_scenario, load_scenario
+from ..model.world import build_world
+from ..model.yamlio import KeyPath, YamlDoc, dotted, load_yaml
+
+#: What errors in a scenario given as a mapping name instead of a file.
+MAPPING = "<mapping>"
+
+Source = str | os.PathLike[str] | Mapping[str, Any]
+
+
+class MappingDoc(YamlDoc):
+    """A scenario given as a Python mapping: errors name ``<mapping>`` and the key path."""
+
+    def error(self, keypath: KeyPath, message: str) -> ConfigError:
+        """A ConfigError at ``keypath`` of the mapping (there is no line to give)."""
+        return ConfigError(message, file=MAPPING, key=dotted(keypath))
+
+
+def load(
+    source: Source,
+    *,
+    seed: int | None = None,
+    duration: float | Fraction | None = None,
+    set: Mapping[str, Any] | None = None,  # the CLI's --set, by its name
+    log_rate: float | None = None,
+    base_dir: str | os.PathLike[str] | None = None,
+) -> Scenario:
+    """Load and check a scenario as ``amsa-phys run`` would, without running it.
+
+    ``source`` is a scenario file or a mapping of the same shape; the keyword arguments are
+    the CLI's ``--seed``, ``--duration``, ``--set`` and ``--log-rate`` (errors name those
+    options, exactly as the CLI prints them). Raises :class:`~amsa_phys.errors.ConfigError`.
+    """
+    overrides = [override_text(key, value) for key, value in (set or {}).items()]
+    seed = _seed(seed)
+    dur = None if duration is None else _number(duration, "--duration")
+    rate = None if log_rate is None else _number(log_rate, "--log-rate")
+    if isinstance(source, Mapping):
+        doc = mapping_doc(source, base_dir)
+        return configure_scenario(doc, overrides, seed, dur, rate)
+    if isinstance(source, (str, os.PathLike)):
+        if base_dir is not None:
+            raise TypeError(
+                "base_dir= is for a scenario given as a mapping; "
+                "a file's relative paths resolve against the file"
+            )
+        return load_scenario(source, overrides, seed, dur, rate)
+    raise TypeError(f"expected a scenario file path or a mapping, got {type(source).__name__}")
+
+
+def validate(source: Source, *, base_dir: str | os.PathLike[str] | None = None) -> str:
+    """Check a world or a scenario (file or mapping) as ``amsa-phys validate`` does.
+
+    Returns ``"scenario"`` or ``"world"`` (a document with a ``world:`` key is a scenario);
+    raises the :class:`~amsa_phys.errors.ConfigError` the CLI would print.
+    """
+    if isinstance(source, Mapping):
+        doc: YamlDoc = mapping_doc(source, base_dir)
+    elif isinstance(source, (str, os.PathLike)):
+        if base_dir is not None:
+            raise TypeError("base_dir= is for a scenario given as a mapping")
+        doc = load_yaml(source)
+    else:
+        raise TypeError(f"expected a file path or a mapping, got {type(source).__name__}")
+    if isinstance(doc.data, dict) and "world" in doc.data:
+        build_scenario(doc)
+        return "scenario"
+    build_world(doc.data, doc, ())
+    return "world"
+
+
+def mapping_doc(source: Mapping[str, Any], base_dir: str | os.PathLike[str] | None) -> MappingDoc:
+    """``source`` as a document of plain YAML values; relative paths against ``base_dir``."""
+    data = _plain(source, ())
+    if not isinstance(data, dict):  # pragma: no cover - a Mapping always gives a dict
+        raise ConfigError("expected a mapping", file=MAPPING)
+    data.setdefault("name", "mapping")
+    base = Path(base_dir) if base_dir is not None else Path()
+    return MappingDoc(path=base / MAPPING, data=data)
+
+
+def override_text(key: Any, value: Any) -> str:
+    """``--set`` text for one override: ``Comp.param=<value as one line of YAML>``."""
+    if not isinstance(key, str) or "=" in key:
+        raise ConfigError(f"expected Component.parameter, got {key!r}", key="--set")
+    text = yaml.safe_dump(
+        _plain(value, (key,)), default_flow_style=True, width=math.inf, allow_unicode=True
+    )
+    if text.endswith("\n...\n"):  # a bare scalar document
+        text = text[: -len("\n...\n")]
+    return f"{key}={text.strip()}"
+
+
+def _seed(seed: Any) -> int | None:
+    if seed is None:
+        return None
+    try:
+        if isinstance(seed, bool):
+            raise TypeError
+        return operator.index(seed)
+    except TypeError:
+        raise ConfigError(f"expected an integer, got {seed!r}", key="--seed") from None
+
+
+def _number(value: Any, option: str) -> Any:
+    """A time or rate for the loader, which judges it as it judges the CLI's option (a
+    Fraction is kept: ``duration=Fraction(7, 3)`` is exactly 7/3 s)."""
+    if isinstance(value, Fraction):
+        return value
+    if isinstance(value, bool) or not (isinstance(value, (int, float)) or _is_numpy(value)):
+        raise ConfigError(f"expected a number, got {value!r}", key=option)
+    return float(value)
+
+
+def _is_numpy(value: Any) -> bool:
+    return type(value).__module__ == "numpy" and hasattr(value, "item")
+
+
+def _plain(value: Any, keypath: KeyPath) -> Any:
+    """``value`` with only the types a YAML file can give (dict, list, str, numbers, bool)."""
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, int):
+        return int(value)  # an IntEnum is written as its number
+    if isinstance(value, float):
+        return float(value)
+    if isinstance(value, Mapping):
+        out = {}
+        for key, item in value.items():
+            if not isinstance(key, str):
+                raise ConfigError(
+                    f"keys must be strings, got {key!r}", file=MAPPING, key=dotted(keypath)
+                )
+            out[key] = _plain(item, (*keypath, key))
+        return out
+    if isinstance(value, (list, tuple)):
+        return [_plain(v, (*keypath, i)) for i, v in enumerate(value)]
+    if isinstance(value, Fraction):
+        if value.denominator == 1:
+            return int(value)
+        if Fraction(repr(float(value))) == value:
+            return float(value)
+        return f"{value.numerator}/{value.denominator}"
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    if _is_numpy(value):
+        if getattr(value, "ndim", 0):
+            return _plain(value.tolist(), keypath)
+        return _plain(value.item(), keypath)
+    raise ConfigError(
+        f"a {type(value).__name__} cannot be written in a scenario "
+        "(use numbers, strings, booleans, lists and mappings)",
+        file=MAPPING,
+        key=dotted(keypath),
+    )

@@ -1,0 +1,62 @@
+"""The trace kept in memory (``amsa_phys.run``): rows as packed doubles, written on request.
+
+A run from Python writes no file unless asked, so its rows go to one flat ``array('d')``
+(8 bytes a value, no float objects: a 1-hour run of the MDE world is ~15 MiB) instead of a
+file. :meth:`TraceMemory.save` replays them through the very :class:`TraceWriter` the CLI
+streams to, so the saved ``trace.csv`` is byte-identical to ``amsa-phys run --headless``.
+"""
+
+from __future__ import annotations
+
+from array import array
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from .recorder import TraceWriter
+
+
+class TraceMemory:
+    """Collects trace rows (``t``, then one value per Data buffer) in memory."""
+
+    def __init__(self, columns: Sequence[str]) -> None:
+        self.columns = list(columns)
+        self.width = len(self.columns) + 1
+        self._flat = array("d")
+        self._closed = False
+
+    def write(self, t_s: float, values: Sequence[float]) -> None:
+        """Append one row (the engine's trace callback)."""
+        flat = self._flat
+        flat.append(t_s)
+        flat.extend(values)
+
+    def close(self) -> None:
+        """No more rows: the arrays handed out from now on are views, not copies."""
+        self._closed = True
+
+    @property
+    def rows(self) -> int:
+        """Rows recorded so far."""
+        return len(self._flat) // self.width
+
+    def matrix(self) -> np.ndarray:
+        """The rows as a read-only ``(rows, 1 + columns)`` float64 array (``t`` first)."""
+        # a view while rows may still come would pin the array: ``extend`` then fails
+        data = np.frombuffer(self._flat, dtype=np.float64) if self._closed else np.array(self._flat)
+        data = data.reshape(-1, self.width)
+        data.flags.writeable = False
+        return data
+
+    def structured(self) -> np.ndarray:
+        """The rows as a structured array: ``trace["t"]``, ``trace["Follower.posX"]``, ..."""
+        dtype = np.dtype([(name, np.float64) for name in ("t", *self.columns)])
+        return self.matrix().view(dtype).reshape(-1)
+
+    def save(self, path: Path) -> Path:
+        """Write ``trace.csv`` exactly as the CLI writes it (same writer, atomically)."""
+        writer = TraceWriter(path, self.columns)
+        for row in self.matrix().tolist():  # on an error only ``trace.csv.tmp`` is left
+            writer.write(row[0], row[1:])
+        return writer.close()
