@@ -1,4 +1,5 @@
-"""Imports flow one way: model -> engine -> physics|sensors|control -> plots|view -> runs -> cli."""
+"""Imports flow one way: model -> engine -> physics|sensors|control -> plots|view -> runs ->
+cli|api -> gym."""
 
 from __future__ import annotations
 
@@ -18,6 +19,8 @@ LAYER = {
     "view": 3,
     "runs": 4,
     "cli": 5,
+    "api": 5,
+    "gym": 6,
 }
 MODULES = sorted(p for p in PKG.rglob("*.py") if p.parent != PKG)
 

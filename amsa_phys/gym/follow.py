@@ -1,0 +1,260 @@
+"""``amsa_phys/Follow-v0``: an agent in place of a scenario's controller.
+
+The agent *is* the component: its observation is what the component reads (its connected
+inputs, in the template's port order), its action is what it publishes, and it acts at the
+component's own frequency, where the component would run in each instant; the engine runs
+everything in between (``gym/episode.py``). Reward per step, from the scenario's quality
+signal ``s`` (reference ``r``, tolerance ``tol``) at the agent's next instant::
+
+    reward = -|s - r| / tol - collision_penalty * (new collisions during the step)
+
+so a step inside the tolerance band costs at most 1 and a perfect follower earns 0.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from collections.abc import Mapping, Sequence
+from fractions import Fraction
+from typing import Any
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+from ..api.source import Source, load
+from ..engine.tracemem import TraceMemory
+from ..errors import ConfigError
+from ..model.scenario import Scenario
+from ..model.suggest import did_you_mean
+from ..model.template import Kind
+from .episode import Episode
+
+
+class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
+    """A scenario as a Gymnasium environment whose agent replaces one component.
+
+    Args:
+        scenario: a scenario file or mapping (as ``amsa_phys.run`` takes).
+        controller: the Leaf the agent replaces (default: the scenario's only controller).
+        actions: the outputs the agent sets (default: those another component reads).
+        action_scale: an action ``a`` in [-1, 1] publishes ``a * action_scale`` (default 100:
+            the MDE controllers' outputs are percent of power). Not clipped: the actuator
+            downstream clamps, as it clamps the replaced controller.
+        collision_penalty: subtracted from the reward per new collision.
+        duration, set, log_rate, base_dir: as for ``amsa_phys.run`` (the CLI's options).
+        render_mode: ``None`` or ``"rgb_array"``; render_size: (width, height) in pixels.
+        record_trace: keep the episode's trace in memory (:meth:`trace`), as ``run`` does.
+    """
+
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 4}  # noqa: RUF012
+
+    def __init__(
+        self,
+        scenario: Source,
+        *,
+        controller: str | None = None,
+        actions: Sequence[str] | None = None,
+        action_scale: float = 100.0,
+        collision_penalty: float = 10.0,
+        duration: float | Fraction | None = None,
+        set: Mapping[str, Any] | None = None,  # the CLI's --set, by its name
+        log_rate: float | None = None,
+        base_dir: str | os.PathLike[str] | None = None,
+        render_mode: str | None = None,
+        render_size: tuple[int, int] = (640, 360),
+        record_trace: bool = False,
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ConfigError(
+                f"unknown render mode {render_mode!r}; amsa_phys/Follow-v0 renders 'rgb_array'",
+                key="render_mode",
+            )
+        self._source = scenario
+        self._options = {"duration": duration, "set": dict(set or {}), "log_rate": log_rate}
+        self._base_dir = base_dir
+        self._scenario = self._load({})
+        world = self._scenario.world
+        if self._scenario.quality is None:
+            raise ConfigError(
+                "the scenario has no quality: section; the reward is computed from it",
+                key="scenario",
+            )
+        self.quality = self._scenario.quality
+        self.path = controller if controller is not None else _default_controller(self._scenario)
+        if self.path not in world.leaves:
+            raise ConfigError(
+                f"unknown component {self.path!r}" + did_you_mean(self.path, world.leaves),
+                key="controller",
+            )
+        leaf = world.leaves[self.path]
+        self.observed = [p.name for p in leaf.template.inputs if p.name in leaf.inputs]
+        if not self.observed:
+            raise ConfigError(
+                f"{self.path} reads no input: the agent would observe nothing", key="controller"
+            )
+        outputs = [p.name for p in leaf.template.outputs]
+        self.acted = list(actions) if actions is not None else _read_outputs(world, self.path)
+        for name in self.acted:
+            if name not in outputs:
+                raise ConfigError(
+                    f"{self.path} has no output {name!r}" + did_you_mean(name, outputs),
+                    key="actions",
+                )
+        if not self.acted:
+            raise ConfigError(f"{self.path} has no output to act on", key="actions")
+        self.action_scale = float(action_scale)
+        self.collision_penalty = float(collision_penalty)
+        self.period = 1 / leaf.freq
+        self.metadata = {**self.metadata, "render_fps": float(leaf.freq)}
+        self.observation_space = spaces.Box(-np.inf, np.inf, (len(self.observed),), np.float64)
+        self.action_space = spaces.Box(-1.0, 1.0, (len(self.acted),), np.float64)
+        self.render_mode = render_mode
+        self.render_size = (int(render_size[0]), int(render_size[1]))
+        self.record_trace = record_trace
+        self._episode: Episode | None = None
+        self._memory: TraceMemory | None = None
+        self._frames: Any = None
+        self._collisions = 0
+        self._seen_events = 0
+
+    # -- Gymnasium API ---------------------------------------------------------------------
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Start an episode: the scenario from t = 0 with scenario seed ``seed``.
+
+        Without ``seed`` the scenario seed is drawn from the environment's generator (seeded
+        by the last ``reset(seed=...)``). ``options={"set": {"Comp.param": v}}`` changes
+        parameters at t = 0 for this episode (on top of the constructor's ``set``).
+        """
+        super().reset(seed=seed)
+        episode_seed = seed if seed is not None else int(self.np_random.integers(0, 2**31 - 1))
+        scenario = self._scenario
+        extra = dict((options or {}).get("set") or {})
+        unknown = sorted(set((options or {}).keys()) - {"set"})
+        if unknown:
+            raise ConfigError(f"unknown reset option {unknown[0]!r}; known: set", key="options")
+        if extra:
+            scenario = self._load(extra)
+        scenario = dataclasses.replace(scenario, seed=episode_seed)
+        self.close()
+        self._memory = TraceMemory(list(scenario.world.buffers)) if self.record_trace else None
+        trace = self._memory.write if self._memory is not None else None
+        self._episode = Episode(scenario, self.path, trace)
+        self._collisions = 0
+        self._seen_events = 0
+        if self.render_mode == "rgb_array":
+            from .render import FrameSource
+
+            self._frames = FrameSource(self._episode.sim, self.quality, self.render_size)
+        info = self._info()
+        info["seed"] = episode_seed
+        return self._observation(), info
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """Publish ``action * action_scale`` as the component's outputs; run one period."""
+        episode = self._episode
+        if episode is None or episode.done:
+            raise gymnasium.error.ResetNeeded("call reset() before step(): the episode has ended")
+        a = np.asarray(action, dtype=np.float64).reshape(-1)
+        if a.shape != (len(self.acted),):
+            raise ValueError(f"expected an action of shape ({len(self.acted)},), got {a.shape}")
+        scale = self.action_scale
+        episode.step({name: float(v) * scale for name, v in zip(self.acted, a, strict=True)})
+        if self._frames is not None:
+            self._frames.sample()
+        events = episode.sim.events
+        new = sum(1 for e in events[self._seen_events :] if e.kind == "collision")
+        self._seen_events = len(events)
+        self._collisions += new
+        signal = episode.sim.values[self.quality.signal]
+        reward = -abs(signal - self.quality.reference) / self.quality.tolerance
+        reward -= self.collision_penalty * new
+        if episode.done and self._memory is not None:
+            self._memory.close()
+        return self._observation(), float(reward), False, episode.done, self._info()
+
+    def render(self) -> np.ndarray | None:  # type: ignore[override]
+        """The current picture (``render_mode="rgb_array"``), ``(height, width, 3)`` uint8."""
+        if self._frames is None or self._episode is None:
+            return None
+        status = [f"agent: {self.path}"]
+        return self._frames.draw(status)  # type: ignore[no-any-return]
+
+    def close(self) -> None:
+        """Stop the episode's worker thread (safe to call twice)."""
+        if self._episode is not None:
+            self._episode.close()
+        self._frames = None
+
+    def __del__(self) -> None:
+        episode = getattr(self, "_episode", None)
+        if episode is not None:
+            episode.close()
+
+    # -- extras ----------------------------------------------------------------------------
+    @property
+    def t(self) -> float:
+        """Simulated time of the agent's current instant (the duration once ended)."""
+        return float(self._episode.t) if self._episode is not None else 0.0
+
+    def trace(self) -> np.ndarray:
+        """The episode's trace so far (``record_trace=True``), as ``amsa_phys.Run.trace``."""
+        if self._memory is None:
+            raise RuntimeError("make the environment with record_trace=True to keep the trace")
+        return self._memory.structured()
+
+    # -- helpers ---------------------------------------------------------------------------
+    def _load(self, extra_set: Mapping[str, Any]) -> Scenario:
+        opts = self._options
+        return load(
+            self._source,
+            duration=opts["duration"],
+            set={**opts["set"], **extra_set},
+            log_rate=opts["log_rate"],
+            base_dir=self._base_dir,
+        )
+
+    def _observation(self) -> np.ndarray:
+        episode = self._episode
+        assert episode is not None
+        if episode.done:  # the end: what the component would read now
+            leaf = episode.sim.world.leaves[self.path]
+            values = episode.sim.values
+            return np.array([values[leaf.inputs[p]] for p in self.observed], dtype=np.float64)
+        return np.array([episode.inputs[p] for p in self.observed], dtype=np.float64)
+
+    def _info(self) -> dict[str, Any]:
+        episode = self._episode
+        assert episode is not None
+        return {
+            "t": float(episode.t),
+            "signal": float(episode.sim.values[self.quality.signal]),
+            "collisions": self._collisions,
+        }
+
+
+def _default_controller(scenario: Scenario) -> str:
+    controllers = [p for p, leaf in scenario.world.leaves.items() if leaf.kind is Kind.CONTROLLER]
+    if len(controllers) == 1:
+        return controllers[0]
+    if not controllers:
+        raise ConfigError(
+            "the world has no controller; name the component the agent replaces",
+            key="controller",
+        )
+    shown = ", ".join(controllers[:5]) + (", ..." if len(controllers) > 5 else "")
+    raise ConfigError(
+        f"the world has {len(controllers)} controllers ({shown}); choose one", key="controller"
+    )
+
+
+def _read_outputs(world: Any, path: str) -> list[str]:
+    """The outputs of ``path`` that another component reads, in port order."""
+    read = {
+        buf for other, leaf in world.leaves.items() if other != path for buf in leaf.inputs.values()
+    }
+    outputs = [p.name for p in world.leaves[path].template.outputs]
+    return [name for name in outputs if f"{path}.{name}" in read]
