@@ -15,6 +15,8 @@ from enum import Enum
 from fractions import Fraction
 from typing import Any, ClassVar, Protocol
 
+from .suggest import did_you_mean
+
 
 class Kind(str, Enum):
     """The six kinds of component of the AMSA architectural style."""
@@ -170,8 +172,23 @@ def resolve_template(ref: str) -> type[Template]:
     except ImportError as exc:
         raise TemplateNotFound(f"cannot import module {module_name!r}: {exc}") from None
     cls = getattr(module, attr, None)
+    if cls is None:
+        found = [
+            n for n, v in vars(module).items() if isinstance(v, type) and issubclass(v, Template)
+        ]
+        raise TemplateNotFound(
+            f"module {module_name!r} has no {attr!r}" + did_you_mean(attr, found)
+        )
     if not (isinstance(cls, type) and issubclass(cls, Template)):
-        raise TemplateNotFound(f"{target!r} is not a Template subclass")
-    if not isinstance(getattr(cls, "kind", None), Kind):
-        raise TemplateNotFound(f"template {target!r} declares no valid kind")
+        raise TemplateNotFound(
+            f"{target!r} is not a Template subclass (from amsa_phys import Template)"
+        )
+    kind = getattr(cls, "kind", None)
+    if not isinstance(kind, Kind):
+        got = "none" if kind is None else repr(kind)
+        raise TemplateNotFound(
+            f"template {target!r} declares no valid kind (got {got}); valid kinds: "
+            f"{', '.join(k.value for k in Kind)} (e.g. kind = Kind.CONTROLLER, "
+            "from amsa_phys import Kind)"
+        )
     return cls
