@@ -172,6 +172,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         signal = episode.sim.values[self.quality.signal]
         reward = -abs(signal - self.quality.reference) / self.quality.tolerance
         reward -= self.collision_penalty * new
+        reward += 0.0  # -0.0 (no error at all) reads as 0.0
         if episode.done and self._memory is not None:
             self._memory.close()
         return self._observation(), float(reward), False, episode.done, self._info()
