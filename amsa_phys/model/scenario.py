@@ -51,12 +51,30 @@ class Change:
 
 
 @dataclass
+class Step:
+    """Changes made inside a phase without starting a new one, at ``at``.
+
+    A timeline entry with ``new_phase: false`` and a change made live in the window are
+    steps: the phase structure (and so what ``expect: {phase: i}`` means) stays the one the
+    scenario's author wrote, however many changes land inside a phase.
+    """
+
+    at: Fraction
+    changes: list[Change]
+    label: str = ""
+    entry: int | None = None  # index in the file's ``timeline`` (None: made live)
+
+
+@dataclass
 class Phase:
     """A phase of the scenario: from ``at`` (phase 0 at 0) with the changes made then."""
 
     at: Fraction
     changes: list[Change]
     label: str = ""
+    #: changes inside this phase after its start (``new_phase: false``), in time order
+    within: list[Step] = field(default_factory=list)
+    entry: int | None = None  # index in the file's ``timeline`` (None: phase 0)
 
 
 @dataclass
@@ -100,6 +118,24 @@ class Scenario:
     phases: list[Phase]
     expect: list[Expectation] = field(default_factory=list)
     data: dict[str, Any] = field(default_factory=dict)
+    #: when ``--duration`` shortened the run: the file's phase starts followed by its
+    #: duration. The phase the run stops in (and the run as a whole) is then cut short: its
+    #: metrics are partial and its checks skipped, not judged as if it were complete.
+    planned_bounds: list[Fraction] | None = None
+
+
+def shorten(scenario: Scenario, duration: Fraction) -> None:
+    """Run ``scenario`` until ``duration`` instead (``--duration``): later changes drop out.
+
+    A shorter run remembers the file's duration, so the phase it stops in is reported as
+    cut short (partial) rather than judged as if it were complete.
+    """
+    if duration < scenario.duration and scenario.planned_bounds is None:
+        scenario.planned_bounds = [p.at for p in scenario.phases] + [scenario.duration]
+    scenario.duration = duration
+    scenario.phases = [p for p in scenario.phases if p.at < duration]
+    for phase in scenario.phases:
+        phase.within = [s for s in phase.within if s.at < duration]
 
 
 def load_scenario(
@@ -116,8 +152,7 @@ def load_scenario(
     if seed is not None:
         scenario.seed = seed
     if duration is not None:
-        scenario.duration = _positive_fraction(duration, "--duration")
-        scenario.phases = [p for p in scenario.phases if p.at < scenario.duration]
+        shorten(scenario, _positive_fraction(duration, "--duration"))
     if log_rate is not None:
         scenario.log_rate = _positive_fraction(log_rate, "--log-rate")
     in_file = len(scenario.phases[0].changes)
@@ -167,13 +202,11 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
                 f"the scenario (duration {float(duration):g} s)",
             )
         last = at
-        phases.append(
-            Phase(
-                at,
-                _changes(entry["set"], ("timeline", i, "set"), doc, world),
-                entry.get("label", ""),
-            )
-        )
+        changes = _changes(entry["set"], ("timeline", i, "set"), doc, world)
+        if entry.get("new_phase", True):
+            phases.append(Phase(at, changes, entry.get("label", ""), entry=i))
+        else:
+            phases[-1].within.append(Step(at, changes, entry.get("label", ""), entry=i))
     quality = None
     if "quality" in data:
         q = data["quality"]
@@ -259,21 +292,25 @@ def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = 
     world = scenario.world
     values = {path: dict(leaf.params) for path, leaf in world.leaves.items()}
 
-    def error(phase: int, index: int, change: Change, message: str) -> ConfigError:
+    def error(entry: int | None, index: int, change: Change, message: str) -> ConfigError:
         if doc is None:
             return ConfigError(message, key=change.key)
-        if phase == 0 and in_file is not None and index >= in_file:
+        if entry is None and in_file is not None and index >= in_file:
             return ConfigError(message, key=f"--set {change.key}")
-        where = ("set",) if phase == 0 else ("timeline", phase - 1, "set")
+        where = ("set",) if entry is None else ("timeline", entry, "set")
         return doc.error((*where, change.key), message)
 
+    steps: list[tuple[bool, int | None, list[Change]]] = []  # (at t = 0, entry, changes)
     for i, phase in enumerate(scenario.phases):
+        steps.append((i == 0, phase.entry, phase.changes))
+        steps += [(False, s.entry, s.changes) for s in phase.within]
+    for initial, entry, changes in steps:
         last: dict[str, tuple[int, Change]] = {}
-        for j, change in enumerate(phase.changes):
+        for j, change in enumerate(changes):
             template = world.leaves[change.leaf].template
-            if i > 0 and change.param in template.fixed_once_running:
+            if not initial and change.param in template.fixed_once_running:
                 raise error(
-                    i,
+                    entry,
                     j,
                     change,
                     f"{change.param} is read only when the run starts; "
@@ -285,7 +322,7 @@ def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = 
             try:
                 world.leaves[leaf].template.check_params(values[leaf])
             except ValueError as exc:
-                raise error(i, j, change, str(exc)) from None
+                raise error(entry, j, change, str(exc)) from None
 
 
 def _changes(sets: dict[str, Any], kp: KeyPath, doc: YamlDoc, world: WorldSpec) -> list[Change]:

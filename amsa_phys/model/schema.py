@@ -181,6 +181,7 @@ SCENARIO: dict[str, Any] = {
                     "at": _time,
                     "set": {"type": "object", "minProperties": 1},
                     "label": {"type": "string"},
+                    "new_phase": {"type": "boolean"},
                 },
             },
         },

@@ -12,6 +12,7 @@ import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -23,9 +24,10 @@ from ..engine.metrics import block_metrics
 from ..engine.recorder import TraceWriter, write_atomic
 from ..engine.runner import RunResult, Simulation
 from ..errors import Interrupted, RunFault
-from ..model.scenario import Scenario
+from ..model.scenario import Change, Expectation, Scenario
 from ..view.drive import FrameSink, advance
 from ..view.encoder import EncoderError
+from .expect import describe_bound, describe_what, skip_reason
 from .plotjob import PlotJob
 from .resolve import resolved_scenario
 
@@ -50,28 +52,49 @@ class RunOutcome:
 def compute_metrics(
     scenario: Scenario, sim: Simulation, result: RunResult, wall_s: float, status: str
 ) -> dict[str, Any]:
-    """The ``metrics.json`` document (design.md) for a run that reached ``result.t_end``."""
-    end = result.t_end
+    """The ``metrics.json`` document (design.md) for a run that reached ``result.t_end``.
+
+    A run that stopped before its planned end (``--duration`` shorter than the file's, the
+    window closed, a fault, Ctrl-C) lists only the phases it entered; the phase it stopped
+    in, and the overall block, are marked ``partial``: their checks are skipped, not failed.
+    Changes made inside a phase (``new_phase: false`` entries, live changes from the
+    window) are listed in that phase's ``changes``; they never start a phase of their own,
+    so a session and its replay have the same phases.
+    """
+    completed = status == "completed"
+    end = float(scenario.duration) if completed else result.t_end
+    bounds = [float(b) for b in scenario.planned_bounds or []] or [
+        *(float(p.at) for p in scenario.phases),
+        float(scenario.duration),
+    ]
     q = scenario.quality
     collisions = [e.t for e in result.events if e.kind == "collision"]
-    starts = [float(p.at) for p in scenario.phases]
+    inner = _changes_within(scenario, sim.live_changes)
+    kept = [p for i, p in enumerate(scenario.phases) if i == 0 or float(p.at) < end]
     phases = []
-    for i, phase in enumerate(scenario.phases):
-        p_end = starts[i + 1] if i + 1 < len(starts) else float(scenario.duration)
+    for i, phase in enumerate(kept):
+        last = i + 1 == len(kept)
+        planned_end = bounds[i + 1]
+        p_end = min(planned_end, end) if last else planned_end
+        start = float(phase.at)
         block: dict[str, Any] = {
-            "start": starts[i],
+            "start": start,
             "end": p_end,
             "set": {c.key: _jsonable(c.value) for c in phase.changes},
         }
         if phase.label:
             block["label"] = phase.label
+        changes = [c for c in inner if start <= c["at"] < p_end or (last and c["at"] == p_end)]
+        if changes:
+            block["changes"] = changes
+        if p_end < planned_end:
+            block["partial"] = True
         if q is not None and result.samples_t.size:
-            last = i + 1 == len(scenario.phases)
             block.update(
                 block_metrics(
                     result.samples_t,
                     result.samples_s,
-                    starts[i],
+                    start,
                     p_end,
                     q.reference,
                     q.tolerance,
@@ -80,14 +103,16 @@ def compute_metrics(
                 )
             )
         else:
-            block["collisions"] = sum(1 for t in collisions if starts[i] <= t < p_end)
+            block["collisions"] = sum(
+                1 for t in collisions if start <= t and (t <= p_end if last else t < p_end)
+            )
         phases.append(block)
     if q is not None and result.samples_t.size:
         overall = block_metrics(
             result.samples_t,
             result.samples_s,
             0.0,
-            float(scenario.duration),
+            end,
             q.reference,
             q.tolerance,
             collisions,
@@ -95,11 +120,13 @@ def compute_metrics(
         )
     else:
         overall = {"collisions": len(collisions)}
+    if end < bounds[-1]:
+        overall["partial"] = True
     return {
         "scenario": scenario.name,
         "seed": scenario.seed,
         "duration": float(scenario.duration),
-        "simulated": end,
+        "simulated": result.t_end,
         "status": status,
         "quality": (
             {"signal": q.signal, "reference": q.reference, "tolerance": q.tolerance} if q else None
@@ -108,8 +135,25 @@ def compute_metrics(
         "phases": phases,
         "events": [{"t": e.t, "kind": e.kind, "detail": e.detail} for e in result.events[:1000]],
         "wall_time_s": round(wall_s, 3),
-        "real_time_factor": round(end / wall_s, 1) if wall_s > 0 else None,
+        "real_time_factor": round(result.t_end / wall_s, 1) if wall_s > 0 else None,
     }
+
+
+def _changes_within(
+    scenario: Scenario, live: list[tuple[Fraction, Change]]
+) -> list[dict[str, Any]]:
+    """Changes made inside phases (timeline ``new_phase: false`` and live), in time order."""
+    out: dict[Fraction, dict[str, Any]] = {}
+    for phase in scenario.phases:
+        for step in phase.within:
+            entry = out.setdefault(step.at, {"at": float(step.at), "set": {}})
+            entry["set"].update({c.key: _jsonable(c.value) for c in step.changes})
+            if step.label:
+                entry["label"] = step.label
+    for at, change in live:
+        entry = out.setdefault(at, {"at": float(at), "set": {}, "label": "live"})
+        entry["set"][change.key] = _jsonable(change.value)
+    return [out[at] for at in sorted(out)]
 
 
 def _jsonable(value: Any) -> Any:
@@ -211,10 +255,14 @@ def _run_scenario(
         metrics["snapshot"] = {"path": str(still.close()), "t": float(still.at)}
     write_atomic(out_dir / "metrics.json", json.dumps(metrics, indent=2) + "\n")
     stopped_early = window and not sim.finished and error is None and sim.now > 0
+    drop = [e for e in scenario.expect if skip_reason(e, metrics) is not None]
     resolved = resolved_scenario(
-        scenario, extra=sim.live_changes, duration=sim.now if stopped_early else None
+        scenario,
+        extra=sim.live_changes,
+        duration=sim.now if stopped_early else None,
+        drop=drop,
     )
-    text = yaml.dump(resolved, Dumper=_YAML_DUMPER, sort_keys=False)
+    text = _cut_note(metrics, drop) + yaml.dump(resolved, Dumper=_YAML_DUMPER, sort_keys=False)
     write_atomic(out_dir / "scenario.yaml", text)
     plotter = plotter or PlotJob()
     if plot:
@@ -234,6 +282,17 @@ def _run_scenario(
             f"its outputs are complete in {out_dir}"
         )
     return RunOutcome(out_dir, metrics, sim)
+
+
+def _cut_note(metrics: dict[str, Any], dropped: list[Expectation]) -> str:
+    """A comment heading a cut run's resolved scenario: what was left out, and why."""
+    if not dropped:
+        return ""
+    names = "; ".join(f"{describe_what(e)} {describe_bound(e)}" for e in dropped)
+    return (
+        f"# this run stopped at t={metrics['simulated']:g} s, so these checks were not "
+        f"judged and are left out: {names}\n"
+    )
 
 
 WindowDriver = Callable[[Simulation, Scenario, "Recorder | None"], None]

@@ -18,6 +18,7 @@ import math
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -27,7 +28,14 @@ import yaml
 from ..engine import interrupt
 from ..engine.runner import Simulation
 from ..errors import AmsaError, ConfigError
-from ..model.scenario import METRICS, Scenario, check_phases, load_scenario, resolve_change
+from ..model.scenario import (
+    METRICS,
+    Scenario,
+    check_phases,
+    load_scenario,
+    resolve_change,
+    shorten,
+)
 from .pool import WORKER_LOST, imap_resilient
 from .rundir import prepare_run_dir
 from .single import compute_metrics, run_scenario
@@ -227,8 +235,7 @@ def run_job(job: Job) -> dict[str, Any]:
     try:
         scenario = copy.deepcopy(_cached(job.scenario))
         if job.duration is not None:
-            scenario.duration = type(scenario.duration)(str(job.duration))
-            scenario.phases = [p for p in scenario.phases if p.at < scenario.duration]
+            shorten(scenario, Fraction(str(job.duration)))
         scenario.seed = job.seed
         contexts = dict(job.contexts)
         for key, value in job.point:
