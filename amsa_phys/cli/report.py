@@ -52,9 +52,11 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
     q = metrics.get("quality")
     if q:
         print(f"quality: {q['signal']} vs {q['reference']:g} m ± {q['tolerance']:g} m", file=stream)
+    paused = metrics.get("paused_s")
     print(
-        f"simulated {metrics['simulated']:.1f} s in {metrics['wall_time_s']:.2f} s "
-        f"({metrics['real_time_factor']}x real time); outputs in {out_dir}",
+        f"simulated {metrics['simulated']:.1f} s in {metrics['wall_time_s']:.2f} s"
+        + (f", {paused:.2f} s of it paused" if paused else "")
+        + f" ({metrics['real_time_factor']}x real time); outputs in {out_dir}",
         file=stream,
     )
     video = metrics.get("video")

@@ -161,6 +161,7 @@ class Simulation:
         self._samples_t = array("d")
         self._samples_s = array("d")
         self._hooks: list[tuple[Fraction, Hook, str]] = []
+        self._log_listeners: list[Callable[[float, dict[str, float]], None]] = []
         self.components: dict[str, Template] = {}
         self._tick = 0  # the instant being executed, in ticks (``now`` derives from it)
         self._now_override: Fraction | None = None
@@ -499,6 +500,23 @@ class Simulation:
         if self._quality is not None:
             self._samples_t.append(t_s)
             self._samples_s.append(values[self._quality])
+        if self._log_listeners:
+            for listener in self._log_listeners:
+                listener(t_s, values)
+
+    def add_log_listener(self, fn: Callable[[float, dict[str, float]], None]) -> None:
+        """Call ``fn(t_s, values)`` at every logged instant, after the trace row.
+
+        The window and the video sample trails, GPS fixes and live metrics here: per
+        simulated instant, the very samples ``metrics.json`` is computed from, whatever the
+        frame rate or speed-up (at x256 a frame spans seconds of simulated time).
+        """
+        self._log_listeners.append(fn)
+
+    @property
+    def pending_live(self) -> list[Change]:
+        """Live changes queued for the next instant, not yet applied."""
+        return list(self._pending_live)
 
     def apply_change(self, change: Change) -> None:
         """Set a parameter now (timeline or live); the component is told after."""

@@ -50,7 +50,12 @@ class RunOutcome:
 
 
 def compute_metrics(
-    scenario: Scenario, sim: Simulation, result: RunResult, wall_s: float, status: str
+    scenario: Scenario,
+    sim: Simulation,
+    result: RunResult,
+    wall_s: float,
+    status: str,
+    idle_s: float = 0.0,
 ) -> dict[str, Any]:
     """The ``metrics.json`` document (design.md) for a run that reached ``result.t_end``.
 
@@ -59,7 +64,8 @@ def compute_metrics(
     in, and the overall block, are marked ``partial``: their checks are skipped, not failed.
     Changes made inside a phase (``new_phase: false`` entries, live changes from the
     window) are listed in that phase's ``changes``; they never start a phase of their own,
-    so a session and its replay have the same phases.
+    so a session and its replay have the same phases. ``idle_s`` is wall-clock time the
+    window spent paused (or finished, waiting to be closed): not part of the run's speed.
     """
     completed = status == "completed"
     end = float(scenario.duration) if completed else result.t_end
@@ -122,6 +128,7 @@ def compute_metrics(
         overall = {"collisions": len(collisions)}
     if end < bounds[-1]:
         overall["partial"] = True
+    busy = wall_s - idle_s
     return {
         "scenario": scenario.name,
         "seed": scenario.seed,
@@ -135,7 +142,8 @@ def compute_metrics(
         "phases": phases,
         "events": [{"t": e.t, "kind": e.kind, "detail": e.detail} for e in result.events[:1000]],
         "wall_time_s": round(wall_s, 3),
-        "real_time_factor": round(result.t_end / wall_s, 1) if wall_s > 0 else None,
+        **({"paused_s": round(idle_s, 3)} if idle_s > 0 else {}),
+        "real_time_factor": round(result.t_end / busy, 1) if busy > 0 else None,
     }
 
 
@@ -219,6 +227,7 @@ def _run_scenario(
     recorder: Recorder | None = None
     still: Snapshot | None = None
     t0 = time.perf_counter()
+    idle = 0.0
     try:
         sim.initialize()
         if record is not None:
@@ -231,7 +240,7 @@ def _run_scenario(
             still = Snapshot(sim, snapshot, scenario.quality)
         if window:
             driver = window if callable(window) else _open_window
-            driver(sim, scenario, recorder)
+            idle = driver(sim, scenario, recorder) or 0.0
             if not sim.finished:
                 status = f"closed in the window at t={float(sim.now):g} s"
         else:
@@ -248,7 +257,7 @@ def _run_scenario(
     trace.close()
     video = _finish_video(recorder, error)
     result = sim.result()
-    metrics = compute_metrics(scenario, sim, result, wall, status)
+    metrics = compute_metrics(scenario, sim, result, wall, status, idle_s=idle)
     if video is not None:
         metrics["video"] = video
     if still is not None:
@@ -295,13 +304,14 @@ def _cut_note(metrics: dict[str, Any], dropped: list[Expectation]) -> str:
     )
 
 
-WindowDriver = Callable[[Simulation, Scenario, "Recorder | None"], None]
+#: Runs a window session; returns the wall-clock seconds it was paused (None: never).
+WindowDriver = Callable[[Simulation, Scenario, "Recorder | None"], "float | None"]
 
 
-def _open_window(sim: Simulation, scenario: Scenario, recorder: Recorder | None) -> None:
+def _open_window(sim: Simulation, scenario: Scenario, recorder: Recorder | None) -> float:
     from ..view.window import Window
 
-    Window(sim, scenario.quality, title=scenario.name, recorder=recorder).run()
+    return Window(sim, scenario.quality, title=scenario.name, recorder=recorder).run()
 
 
 def _finish_video(recorder: Recorder | None, error: BaseException | None) -> dict[str, Any] | None:
