@@ -52,6 +52,8 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
     q = metrics.get("quality")
     if q:
         print(f"quality: {q['signal']} vs {q['reference']:g} m ± {q['tolerance']:g} m", file=stream)
+    else:
+        print("no quality: section, so no metrics of control and no distance.png", file=stream)
     paused = metrics.get("paused_s")
     print(
         f"simulated {metrics['simulated']:.1f} s in {metrics['wall_time_s']:.2f} s"

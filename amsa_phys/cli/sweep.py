@@ -6,6 +6,7 @@ import argparse
 import csv
 import io
 import sys
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +27,7 @@ from ..runs.sweep import (
     iter_local,
     parse_grid,
     parse_range,
+    timeline_overlaps,
     unknown_metric,
 )
 from .options import add_jobs
@@ -51,7 +53,13 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--seeds", type=int, help="seeds per grid point (default 1)")
     add_jobs(p)
-    p.add_argument("--executor", choices=("local", "dask"), default="local")
+    p.add_argument(
+        "--executor",
+        choices=("local", "dask"),
+        default="local",
+        help="where the runs go: local worker processes (default, -j of them) or an "
+        "existing Dask cluster (needs --scheduler and the cluster extra)",
+    )
     p.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address (tcp://...)")
     p.add_argument("--metric", help="metric for summary.png (default rms_error)")
     p.add_argument("--duration", type=float, metavar="S", help="override the duration")
@@ -105,6 +113,8 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
         if args.metric is None:
             raise doc.error(("sweep", "metric"), why)
         raise ConfigError(why, key="--metric")
+    swept = [a.key for a in axes if a.key != "context"]
+    swept += [k for sets in contexts.values() for k in sets]
     return SweepPlan(
         Path(args.scenario).resolve(),
         axes,
@@ -114,12 +124,15 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
         metric,
         args.duration,
         inputs=tuple(input_files(scenario)),
+        warnings=tuple(timeline_overlaps(swept, scenario, Fraction(str(end)))),
     )
 
 
 def run(args: argparse.Namespace) -> int:
     """Run the sweep; results.csv and summary.png; Ctrl-C keeps every finished row."""
     plan = build_plan(args)
+    for warning in plan.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
     if args.executor == "dask" and not args.scheduler:
         raise ConfigError("the Dask executor needs --scheduler ADDR", key="--executor")
     if args.jobs < 1:

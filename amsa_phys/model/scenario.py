@@ -6,6 +6,8 @@ Every value is judged by the parameter's own ``Param.coerce``, with file, line a
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
@@ -157,6 +159,9 @@ def load_scenario(
         scenario.log_rate = _positive_fraction(log_rate, "--log-rate")
     in_file = len(scenario.phases[0].changes)
     for text in overrides or []:
+        if text.strip().startswith(PHYSICS_PREFIX):
+            scenario.world = with_physics(scenario.world, parse_physics_override(text))
+            continue
         scenario.phases[0].changes.append(parse_override(text, scenario.world))
     if overrides:
         check_phases(scenario, doc, in_file)
@@ -182,6 +187,8 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
         world = load_world(world_path)
     else:
         world = build_world(world_ref, doc, ("world",))
+    if "physics" in data:
+        world = with_physics(world, data["physics"])
     duration = Fraction(str(data["duration"]))
     if duration <= 0:
         raise doc.error(("duration",), f"must be > 0, got {data['duration']}")
@@ -364,6 +371,62 @@ def parse_override(text: str, world: WorldSpec) -> Change:
         return resolve_change(key.strip(), value, world)
     except ValueError as exc:
         raise ConfigError(str(exc), key=f"--set {key.strip()}") from None
+
+
+PHYSICS_PREFIX = "physics."
+
+
+def with_physics(world: WorldSpec, over: dict[str, Any]) -> WorldSpec:
+    """``world`` with a scenario's ``physics:`` (or ``--set physics.…``) merged over its own.
+
+    Mappings merge key by key (``ground: {friction: 0.5}`` keeps the world's rolling
+    resistance); ``obstacles`` are *added* to the world's, so a scenario can put a box in
+    the leader's way without restating the arena; any other value replaces the world's.
+    The world itself is not changed: a WorldSpec may be shared.
+    """
+    merged = copy.deepcopy(world.physics)
+    for key, value in over.items():
+        if key == "obstacles":
+            merged["obstacles"] = [*merged.get("obstacles", []), *copy.deepcopy(value)]
+        elif isinstance(value, dict) and isinstance(merged.get(key), dict):
+            merged[key] = {**merged[key], **copy.deepcopy(value)}
+        else:
+            merged[key] = copy.deepcopy(value)
+    return dataclasses.replace(world, physics=merged)
+
+
+def parse_physics_override(text: str) -> dict[str, Any]:
+    """``physics.ground.friction=0.5`` -> ``{"ground": {"friction": 0.5}}``, shape-checked
+    like a file's ``physics:`` (unknown keys named, with a suggestion)."""
+    key, sep, raw = text.partition("=")
+    key = key.strip()
+    if not sep:
+        raise ConfigError(f"expected physics.key=value, got {text!r}", key="--set")
+    try:
+        value = yaml.safe_load(raw) if raw.strip() else raw
+    except yaml.YAMLError:
+        value = raw
+    return physics_setting(key, value, option=f"--set {key}")
+
+
+def physics_setting(key: str, value: Any, option: str) -> dict[str, Any]:
+    """``physics.a.b`` and a value as the nested mapping ``{a: {b: value}}``, shape-checked;
+    a ConfigError names ``option`` (a ``--set`` or ``--grid`` axis)."""
+    parts = key.split(".")[1:]
+    if not parts or not all(parts):
+        raise ConfigError("expected physics.<setting>, e.g. physics.ground.friction", key=option)
+    nested: dict[str, Any] = {}
+    inner = nested
+    for part in parts[:-1]:
+        inner = inner.setdefault(part, {})
+    inner[parts[-1]] = value
+    doc = YamlDoc(Path(option), nested)
+    try:
+        schema.validate(nested, schema.PHYSICS, doc)
+    except ConfigError as exc:
+        where = f"physics.{exc.key}" if exc.key else key
+        raise ConfigError(exc.message, key=f"{option.split(' ')[0]} {where}") from None
+    return nested
 
 
 def _positive_fraction(value: float, option: str) -> Fraction:

@@ -170,6 +170,7 @@ SCENARIO: dict[str, Any] = {
             "required": ["signal", "reference"],
             "properties": {"signal": {"type": "string"}, "reference": _num, "tolerance": _pos},
         },
+        "physics": PHYSICS,  # merged over the world's (model/scenario.py: with_physics)
         "set": {"type": "object"},
         "timeline": {
             "type": "array",

@@ -28,7 +28,7 @@ from ..model.scenario import Change, Expectation, Scenario
 from ..view.drive import FrameSink, advance
 from ..view.encoder import EncoderError
 from .expect import describe_bound, describe_what, skip_reason
-from .plotjob import PlotJob
+from .plotjob import PlotJob, plot_context
 from .resolve import resolved_scenario
 
 if TYPE_CHECKING:  # pygame is imported only by runs that draw
@@ -276,7 +276,11 @@ def _run_scenario(
     plotter = plotter or PlotJob()
     if plot:
         plotter.draw(
-            out_dir / "trace.csv", metrics, out_dir / "distance.png", out_dir / "trajectory.png"
+            out_dir / "trace.csv",
+            metrics,
+            out_dir / "distance.png",
+            out_dir / "trajectory.png",
+            plot_context(scenario.world),
         )
     plotter.close()
     if isinstance(error, KeyboardInterrupt):

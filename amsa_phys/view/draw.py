@@ -14,6 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..palette import ALERT, rover_colour
 from .camera import Camera
 from .pg import font, pygame
 from .scene import Frame, RoverPose
@@ -25,27 +26,11 @@ INK = (32, 32, 36)
 MUTED = (110, 110, 116)
 OBSTACLE = (120, 116, 108)
 WHEEL = (40, 40, 44)
-LOST = (214, 39, 40)
+LOST = ALERT
 OK = (44, 160, 44)
 WARN = (240, 170, 30)
 BAD = (214, 39, 40)
-ROVER_COLOURS = [
-    (230, 120, 30),  # leader: orange
-    (31, 119, 180),  # follower: blue
-    (44, 160, 44),
-    (148, 103, 189),
-    (140, 86, 75),
-    (227, 119, 194),
-    (127, 127, 127),
-    (188, 189, 34),
-    (23, 190, 207),
-]
 MIN_ROVER_PX = 5.0
-
-
-def rover_colour(index: int) -> tuple[int, int, int]:
-    """Colour of the index-th rover (leader first, as in the plots)."""
-    return ROVER_COLOURS[index % len(ROVER_COLOURS)]
 
 
 def error_colour(error: float, tolerance: float) -> tuple[int, int, int]:

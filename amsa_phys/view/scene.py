@@ -14,7 +14,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..engine.runner import Simulation
+from ..model.geometry import Obstacle, static_obstacles
 from ..model.scenario import Quality
+from ..palette import rover_names
 
 #: Trail and GPS history kept per rover: bounded, so a long run draws in constant time.
 TRAIL_POINTS = 1500
@@ -37,15 +39,6 @@ class RoverPose:
     power_l: float
     power_r: float
     speed: float
-
-
-@dataclass(frozen=True)
-class Obstacle:
-    """Static geometry in world metres: ``poly`` (closed), ``circle`` or ``line`` (open)."""
-
-    kind: str
-    points: tuple[tuple[float, float], ...]
-    radius: float = 0.0
 
 
 @dataclass
@@ -93,31 +86,6 @@ class Frame:
     duration: float
 
 
-def static_obstacles(physics: dict[str, Any]) -> list[Obstacle]:
-    """Obstacles and walls from the world's ``physics:`` settings (the same data pymunk got)."""
-    out: list[Obstacle] = []
-    for ob in physics.get("obstacles") or []:
-        if ob["type"] == "box":
-            w, h = ob["width"] / 2, ob["height"] / 2
-            a = float(ob.get("angle", 0.0))
-            c, s = math.cos(a), math.sin(a)
-            pts = tuple(
-                (ob["x"] + c * dx - s * dy, ob["y"] + s * dx + c * dy)
-                for dx, dy in ((-w, -h), (w, -h), (w, h), (-w, h))
-            )
-            out.append(Obstacle("poly", pts))
-        elif ob["type"] == "circle":
-            out.append(Obstacle("circle", ((ob["x"], ob["y"]),), ob["radius"]))
-        else:
-            pts = tuple((float(p[0]), float(p[1])) for p in ob["points"])
-            out.append(Obstacle("line", pts, float(ob.get("thickness", 0.1)) / 2))
-    walls = physics.get("walls")
-    if walls:
-        x0, x1, y0, y1 = walls["xmin"], walls["xmax"], walls["ymin"], walls["ymax"]
-        out.append(Obstacle("line", ((x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)), 0.1))
-    return out
-
-
 def describe_phase(sim: Simulation) -> str:
     """``phase 2/4 from 125 s: Kv=0.15`` — what the HUD prints about the current phase."""
     phase = sim.phases[sim.phase_index]
@@ -157,6 +125,8 @@ class Scene:
                 self.gps.append(GpsTrack(path, source.rpartition(".")[0] or None))
         self.metrics = LiveMetrics()
         self._last_fix: dict[str, tuple[float, float]] = {}
+        # rovers in declaration order: the i-th has the i-th colour, as in the plots
+        self._rank = {name: i for i, name in enumerate(rover_names(list(sim.world.buffers)))}
         sim.add_log_listener(self._sample)
 
     def _physics(self) -> Any:
@@ -184,6 +154,7 @@ class Scene:
                     r.forward_speed,
                 )
             )
+        out.sort(key=lambda r: self._rank.get(r.name, len(self._rank)))
         return out
 
     def _sample(self, t_s: float, values: dict[str, float]) -> None:
