@@ -16,6 +16,7 @@ from ..engine import interrupt
 from ..engine.recorder import write_atomic
 from ..errors import ConfigError, Interrupted
 from ..model.scenario import load_scenario
+from ..model.wording import plural
 from ..model.yamlio import load_yaml
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.suite import input_files
@@ -175,11 +176,13 @@ def run(args: argparse.Namespace) -> int:
         f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})",
     )
     failed = [r for r in rows if r["error"]]
-    print(f"{len(rows)} of {len(jobs)} runs done ({len(failed)} failed); results in {out}")
+    print(
+        f"{len(rows)} of {plural(len(jobs), 'run')} done ({len(failed)} failed); results in {out}"
+    )
     for r in failed[:5]:
         print(f"run {r['run']}: {r['error']}", file=sys.stderr)
     if interrupted:
-        raise Interrupted(f"sweep interrupted; {len(rows)} finished rows kept in {out}")
+        raise Interrupted(f"sweep interrupted; {plural(len(rows), 'finished row')} kept in {out}")
     return 0
 
 

@@ -19,6 +19,7 @@ from ..errors import ConfigError
 from . import schema
 from .suggest import did_you_mean
 from .template import Kind
+from .wording import plural
 from .world import WorldSpec, build_world, load_world
 from .yamlio import KeyPath, YamlDoc, load_yaml
 
@@ -183,7 +184,9 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
         if world_path.is_dir():
             raise doc.error(("world",), f"{world_path} is a directory, expected a world file")
         if not world_path.is_file():
-            raise doc.error(("world",), f"world file not found: {world_path}")
+            raise doc.error(
+                ("world",), f"world file not found: {world_path}" + _nearby_file(world_path)
+            )
         world = load_world(world_path)
     else:
         world = build_world(world_ref, doc, ("world",))
@@ -262,7 +265,8 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
             raise doc.error(
                 (*kp, "phase"),
                 f"phase {e['phase']} does not exist "
-                f"(the scenario has {len(phases)} phases, 0..{len(phases) - 1})",
+                f"(the scenario has {plural(len(phases), 'phase')}, "
+                + (f"0..{len(phases) - 1})" if len(phases) > 1 else "only phase 0)"),
             )
         if quality is None:
             raise doc.error(kp, "metric expectations need a quality: section")
@@ -284,6 +288,17 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
     if check_rules:
         check_phases(scenario, doc)
     return scenario
+
+
+def _nearby_file(path: Path) -> str:
+    """`` (did you mean x.yaml?)`` for a YAML file beside ``path`` with a close name
+    (``x.yml`` for ``x.yaml``, a typo in the stem); empty if there is none."""
+    try:
+        names = [p.name for p in path.parent.iterdir() if p.suffix in (".yaml", ".yml")]
+    except OSError:
+        return ""
+    same_stem = [n for n in names if Path(n).stem == path.stem]
+    return f" (did you mean {same_stem[0]}?)" if same_stem else did_you_mean(path.name, names)
 
 
 def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = None) -> None:

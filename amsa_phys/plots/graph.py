@@ -29,6 +29,7 @@ from matplotlib.path import Path as MplPath
 from matplotlib.transforms import Bbox
 
 from ..engine.recorder import write_atomic
+from ..model.wording import plural
 from ..model.world import WorldSpec
 from .save import save_png
 
@@ -259,7 +260,7 @@ def _layout(
     ax.set_ylim(y_lo, top)
     ax.set_aspect("equal")
     ax.axis("off")
-    ax.set_title(f"{world.name}: {len(world.leaves)} components")
+    ax.set_title(f"{world.name}: {plural(len(world.leaves), 'component')}")
     ax.apply_aspect()
     renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
     names = list(st.nodes)

@@ -8,8 +8,9 @@ static layer (terrain zones) is a few more lines there.
 A long, nearly straight run (scenario 1: a 420 m straight line) drawn to scale is a
 hairline in a square of empty metres. When every true path stays within 5 % of its length
 of one straight line, and the world has no obstacles or walls (an arena is drawn to scale,
-it is what the paths are read against), the plot turns into a *lateral-offset view*: distance along that line
-against the offset across it, the offset axis stretched (and labelled so). We chose this
+it is what the paths are read against), the plot turns into a *lateral-offset view*:
+distance along that line against the offset across it, the offset axis stretched (and
+labelled so). We chose this
 over a to-scale plot with an auto-aspect inset because the inset would get a fraction of
 the figure while the to-scale panel shows only a line; the rotated, stretched view gives
 the whole figure to what varies, works for a straight run in any direction, and keeps
@@ -113,7 +114,7 @@ def plot_trajectory(
     """
     world = world or {}
     header, data = read_trace(trace)
-    rovers = rover_names(header)
+    rovers = rover_names(header) if len(data) else []  # a run that faulted at t = 0 has none
     paths = {r: data[:, [header.index(f"{r}.posX"), header.index(f"{r}.posY")]] for r in rovers}
     physics = world.get("physics")
     arena = bool(static_obstacles(physics or {}))  # obstacles or walls: show them to scale
