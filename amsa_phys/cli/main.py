@@ -72,9 +72,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except AmsaError as exc:
-        cause = _root_cause(exc)
         if args.debug:
+            cause = _root_cause(exc, hidden=True)
             traceback.print_exception(cause or exc, chain=False, file=sys.stderr)
+        cause = _root_cause(exc)  # raised *from* code: a component's exception, not a message
         user = cause is not None and _in_user_code(cause)
         hint = " (amsa-phys --debug shows its traceback)" if user and not args.debug else ""
         print(f"error: {exc}{hint}", file=sys.stderr)
@@ -84,18 +85,19 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
 
 
-def _root_cause(exc: BaseException) -> BaseException | None:
+def _root_cause(exc: BaseException, hidden: bool = False) -> BaseException | None:
     """The exception in code (not an AmsaError) that ``exc`` was raised from, if any.
 
     A component's own exception reaches the user as one line (``do_step raised
-    NameError(...)``); its traceback is kept on the chain (``__cause__``, or the context a
-    ``raise ... from None`` hides) for ``--debug`` to show.
+    NameError(...)``); its traceback is kept on the chain (``raise ... from exc``). With
+    ``hidden``, the context a ``raise ... from None`` hides counts too (``--debug`` shows
+    everything it can find: a rejected change, a module that failed to import).
     """
     seen: list[BaseException] = []
     e: BaseException | None = exc
     while e is not None and e not in seen:
         seen.append(e)
-        e = e.__cause__ or e.__context__
+        e = e.__cause__ or (e.__context__ if hidden else None)
     code = [e for e in seen if not isinstance(e, AmsaError | LookupError)]
     return code[-1] if code else None
 

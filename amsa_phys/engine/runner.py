@@ -530,7 +530,7 @@ class Simulation:
         except Exception as exc:
             raise RunFault(
                 self._who(change.leaf), self.now, f"rejected {change.param}={change.value!r}: {exc}"
-            ) from exc
+            ) from None  # a rejection is a message, not a crash (--debug still finds it)
 
     def next_instant(self) -> Fraction:
         """Time of the next instant at which something runs (where a live change lands)."""
