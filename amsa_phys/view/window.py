@@ -301,13 +301,20 @@ class Window:
         h = self.screen.get_height()
         below = max(box.bottom for box in self.renderer.boxes.values()) + 6
         top = max(h // 3, below)  # under the HUD and status, however they were laid out
+        line_px = self.renderer.font.get_linesize()
+
+        def fitting(n_lines: int) -> int:  # a panel too tall for the room below moves up
+            return max(10, min(top, h - n_lines * line_px - 22))
+
         if self.panel.visible:
             lines = ["parameters (p closes)", *self.panel.lines()]
             colours = [MUTED] + [INK] * (len(lines) - 1)
             if self.panel.message:
                 lines.append(self.panel.message)
                 colours.append(LOST if "fixed" in self.panel.message else MUTED)
-            self.renderer.panel(self.screen, lines, colours, (10, top), align_right=False)
+            at = (10, fitting(len(lines)))
+            self.renderer.panel(self.screen, lines, colours, at, align_right=False)
         if self.show_help:
-            self.renderer.panel(self.screen, HELP, [INK] * len(HELP), (10, top), align_right=True)
+            at = (10, fitting(len(HELP)))
+            self.renderer.panel(self.screen, HELP, [INK] * len(HELP), at, align_right=True)
         pygame.display.flip()
