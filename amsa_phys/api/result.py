@@ -45,6 +45,7 @@ class Run:
 
     def __init__(self, ended: Ended, memory: TraceMemory) -> None:
         self._loaded: Scenario = ended.scenario
+        self._ended = ended
         self._memory = memory
         self.metrics: dict[str, Any] = ended.metrics
         self.scenario: dict[str, Any] = ended.resolved
@@ -79,7 +80,7 @@ class Run:
         inputs = [p for p in input_files(self._loaded) if p.is_file()]  # a mapping has none
         prepare_run_dir(path, force, inputs=inputs)
         self._memory.save(path / "trace.csv")
-        write_run_files(path, self.metrics, self.scenario, plot=plot)
+        write_run_files(path, self._ended, plot=plot)
         return path
 
     def __repr__(self) -> str:

@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
-from ..model.world import WorldSpec
+from ..errors import ConfigError
+from ..model.scenario import PHYSICS_PREFIX, Scenario, load_scenario
+from ..model.wording import plural
+from ..model.world import LeafSpec, WorldSpec
 from ..runs.expect import describe_bound, describe_what
 from .loading import load_any
 
@@ -12,23 +16,63 @@ from .loading import load_any
 def add_args(p: argparse.ArgumentParser) -> None:
     """Arguments of ``amsa-phys describe``."""
     p.add_argument("file", help="world or scenario YAML file")
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="Comp.param=V",
+        help="scenario only: show the values as `run --set` would start them",
+    )
 
 
-def describe_world(world: WorldSpec) -> list[str]:
-    """Human-readable lines describing a world."""
+#: where a value in force at t = 0 comes from
+Source = str
+
+
+def raw_params(world: WorldSpec, leaf: LeafSpec) -> dict[str, Any]:
+    """The parameters a world file writes for ``leaf`` (not the template's defaults)."""
+    body: Any = world.data
+    for part in leaf.keypath:
+        body = body.get(part, {}) if isinstance(body, dict) else {}
+    params = body.get("params", {}) if isinstance(body, dict) else {}
+    return params if isinstance(params, dict) else {}
+
+
+def describe_world(
+    world: WorldSpec,
+    start: dict[str, dict[str, tuple[Any, Source]]] | None = None,
+    physics_from: dict[str, Source] | None = None,
+) -> list[str]:
+    """Human-readable lines describing a world.
+
+    Every parameter is shown with the value it starts with and where that comes from: the
+    template's default, the world file, or (``start``, for a scenario) the scenario's
+    ``set:`` or a ``--set``, with the world's value it replaced.
+    """
+    start = start or {}
     lines = [
-        f"world {world.name}: {len(world.leaves)} components, physics "
+        f"world {world.name}: {plural(len(world.leaves), 'component')}, physics "
         f"{float(world.physics['rate']):g} Hz"
     ]
+    lines += _physics_lines(world, physics_from or {})
     for path in world.leaves:
         leaf = world.leaves[path]
         t = leaf.template
+        written = raw_params(world, leaf)
         lines.append(f"  {path}: {t.name()} ({t.kind.value}) at {float(leaf.freq):g} Hz")
         for p in t.params:
-            value = leaf.params[p.name]
+            world_value = leaf.params[p.name]
+            source = "world" if p.name in written else "default"
+            value = world_value
+            if p.name in start.get(path, {}):
+                value, source = start[path][p.name]
+                if value != world_value:
+                    source += f"; world {_short(world_value)}"
             rng = p.range_text()
             unit = f" {p.unit}" if p.unit else ""
-            lines.append(f"      {p.name} = {value!r}{unit}" + (f"  {rng}" if rng else ""))
+            text = f"      {p.name} = {value!r}{unit}" + (f"  {rng}" if rng else "")
+            lines.append(f"{text}  ({source})")
         for port, buf in leaf.inputs.items():
             lines.append(f"      <- {port}: {buf}")
         outs = ", ".join(p.name for p in t.outputs)
@@ -39,10 +83,56 @@ def describe_world(world: WorldSpec) -> list[str]:
     return lines
 
 
+def _physics_lines(world: WorldSpec, physics_from: dict[str, Source]) -> list[str]:
+    """The physics settings in force, each with its source (default, world, scenario)."""
+    written = world.data.get("physics", {}) if isinstance(world.data, dict) else {}
+    parts = []
+    for key, value in world.physics.items():
+        if key in ("obstacles", "walls"):
+            continue
+        items = value.items() if isinstance(value, dict) else [(None, value)]
+        for sub, v in items:
+            name = f"{key}.{sub}" if sub else key
+            in_world = (key in written) if sub is None else sub in written.get(key, {})
+            source = physics_from.get(name, "world" if in_world else "default")
+            parts.append(f"{name} {_short(v)} ({source})")
+    obstacles = len(world.physics.get("obstacles") or [])
+    walls = "walls" if world.physics.get("walls") else "no walls"
+    return [f"  physics: {', '.join(parts)}; {obstacles} obstacles, {walls}"]
+
+
+def _short(value: Any) -> str:
+    return f"{value:g}" if isinstance(value, float) else repr(value)
+
+
+def scenario_start(scenario: Scenario, in_file: int) -> dict[str, dict[str, tuple[Any, Source]]]:
+    """Each parameter phase 0 sets, with its source: the first ``in_file`` changes are the
+    scenario's ``set:``, the rest ``--set``."""
+    start: dict[str, dict[str, tuple[Any, Source]]] = {}
+    for i, change in enumerate(scenario.phases[0].changes):
+        source = "scenario set" if i < in_file else "--set"
+        start.setdefault(change.leaf, {})[change.param] = (change.value, source)
+    return start
+
+
 def run(args: argparse.Namespace) -> int:
     """Print the description."""
     kind, obj = load_any(args.file)
+    if kind == "world" and args.overrides:
+        raise ConfigError("only for a scenario: a world has no t = 0 to set", key="--set")
     if kind == "scenario":
+        in_file = len(obj.phases[0].changes)
+        physics_from = {
+            f"{k}.{sub}" if isinstance(v, dict) else k: "scenario physics"
+            for k, v in (obj.data.get("physics") or {}).items()
+            for sub in (v if isinstance(v, dict) else [None])
+        }
+        if args.overrides:
+            obj = load_scenario(args.file, overrides=args.overrides)
+            for text in args.overrides:
+                key = text.partition("=")[0].strip()
+                if key.startswith(PHYSICS_PREFIX):
+                    physics_from[key.removeprefix(PHYSICS_PREFIX)] = "--set"
         print(
             f"scenario {obj.name}: {float(obj.duration):g} s, seed {obj.seed}, "
             f"trace at {float(obj.log_rate):g} Hz"
@@ -53,10 +143,17 @@ def run(args: argparse.Namespace) -> int:
         for i, phase in enumerate(obj.phases):
             changes = ", ".join(f"{c.key}={c.value!r}" for c in phase.changes) or "-"
             print(f"phase {i} at {float(phase.at):g} s: {changes}")
+            for step in phase.within:
+                inner = ", ".join(f"{c.key}={c.value!r}" for c in step.changes)
+                print(f"  change at {float(step.at):g} s (same phase): {inner}")
         for e in obj.expect:
             print(f"expect {describe_what(e)} {describe_bound(e)}")
-        world = obj.world
+        print(
+            "values in force at t = 0, each with where it comes from: default (the "
+            "template's), world, scenario set, --set"
+        )
+        lines = describe_world(obj.world, scenario_start(obj, in_file), physics_from)
     else:
-        world = obj
-    print("\n".join(describe_world(world)))
+        lines = describe_world(obj)
+    print("\n".join(lines))
     return 0

@@ -9,7 +9,10 @@ from __future__ import annotations
 
 import argparse
 import sys
+import sysconfig
+import traceback
 from collections.abc import Sequence
+from pathlib import Path
 from typing import NoReturn
 
 from .. import __version__
@@ -44,10 +47,19 @@ def build_parser() -> argparse.ArgumentParser:
         description="Physics-backed 2D rover testbed implementing the AMSA framework.",
     )
     parser.add_argument("--version", action="version", version=f"amsa-phys {__version__}")
+    debug_help = (
+        "on an error caused by code (a user template's exception), print its traceback "
+        "before the one-line message"
+    )
+    parser.add_argument("--debug", action="store_true", help=debug_help)
+    # also accepted after the command (`amsa-phys run x.yaml --debug`); SUPPRESS keeps the
+    # subcommand from resetting a --debug given before it
+    shared = argparse.ArgumentParser(add_help=False)
+    shared.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=debug_help)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, module in COMMANDS.items():
         doc = (module.__doc__ or "").strip().splitlines()[0]
-        p = sub.add_parser(name, help=doc, description=doc)
+        p = sub.add_parser(name, help=doc, description=doc, parents=[shared])
         module.add_args(p)
         p.set_defaults(func=module.run)
     return parser
@@ -60,8 +72,43 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except AmsaError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        if args.debug:
+            cause = _root_cause(exc, hidden=True)
+            traceback.print_exception(cause or exc, chain=False, file=sys.stderr)
+        cause = _root_cause(exc)  # raised *from* code: a component's exception, not a message
+        user = cause is not None and _in_user_code(cause)
+        hint = " (amsa-phys --debug shows its traceback)" if user and not args.debug else ""
+        print(f"error: {exc}{hint}", file=sys.stderr)
         return exc.exit_code
     except KeyboardInterrupt as exc:  # Interrupted says where; a bare one during loading
         print(f"error: {exc}" if str(exc) else "interrupted", file=sys.stderr)
         return 130
+
+
+def _root_cause(exc: BaseException, hidden: bool = False) -> BaseException | None:
+    """The exception in code (not an AmsaError) that ``exc`` was raised from, if any.
+
+    A component's own exception reaches the user as one line (``do_step raised
+    NameError(...)``); its traceback is kept on the chain (``raise ... from exc``). With
+    ``hidden``, the context a ``raise ... from None`` hides counts too (``--debug`` shows
+    everything it can find: a rejected change, a module that failed to import).
+    """
+    seen: list[BaseException] = []
+    e: BaseException | None = exc
+    while e is not None and e not in seen:
+        seen.append(e)
+        e = e.__cause__ or (e.__context__ if hidden else None)
+    code = [e for e in seen if not isinstance(e, AmsaError | LookupError)]
+    return code[-1] if code else None
+
+
+def _in_user_code(exc: BaseException) -> bool:
+    """Whether ``exc`` went through code outside amsa-phys (a user template's module)."""
+    ours = (
+        str(Path(__file__).resolve().parent.parent),  # amsa_phys
+        sysconfig.get_paths()["stdlib"],  # importlib, when a module cannot be found
+        "<frozen",
+    )
+    return any(
+        not frame.filename.startswith(ours) for frame in traceback.extract_tb(exc.__traceback__)
+    )

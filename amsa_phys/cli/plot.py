@@ -5,9 +5,11 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import Any
 
-from ..errors import ConfigError
-from ..runs.plotjob import draw_run_plots
+from ..errors import AmsaError, ConfigError
+from ..model.scenario import load_scenario
+from ..runs.plotjob import draw_run_plots, plot_context
 from ..runs.sweep import read_results, unknown_metric
 
 
@@ -54,9 +56,20 @@ def run(args: argparse.Namespace) -> int:
         ) from None
     out = Path(args.output) if args.output else rundir / "distance.png"
     traj = out.with_name(out.stem + "-trajectory.png") if args.output else rundir / "trajectory.png"
-    draw_run_plots(rundir / "trace.csv", metrics, out, traj)
-    print(f"wrote {out} and {traj}")
+    written = draw_run_plots(rundir / "trace.csv", metrics, out, traj, _world_of(rundir))
+    print("wrote " + " and ".join(str(p) for p in written))
+    if out not in written:
+        print(f"no {out.name}: the scenario has no quality: section (no signal to plot)")
     return 0
+
+
+def _world_of(rundir: Path) -> dict[str, Any] | None:
+    """The arena and GPS links from the run's resolved scenario.yaml (None if unreadable:
+    the paths are then drawn without the static world)."""
+    try:
+        return plot_context(load_scenario(rundir / "scenario.yaml").world)
+    except (AmsaError, OSError):
+        return None
 
 
 def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
@@ -74,4 +87,11 @@ def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
     title = f"{sweepdir.name}: {metric} ({seeds} seed{'s' if seeds != 1 else ''})"
     plot_summary(rows, axes, metric, out, title)
     print(f"wrote {out}")
+    failed = sum(1 for r in rows if r.get("error"))
+    empty = sum(1 for r in rows if not r.get("error") and r.get(metric) is None)
+    if failed or empty:
+        print(
+            f"left out {failed + empty} of {len(rows)} runs: {empty} with no {metric} value"
+            f" (null: e.g. never settled), {failed} failed"
+        )
     return 0

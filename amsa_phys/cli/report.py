@@ -22,9 +22,12 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
     blocks.append(("all", {**metrics["overall"], "start": 0.0, "set": {}}))
     for name, b in blocks:
         changes = ", ".join(f"{k}={v}" for k, v in b.get("set", {}).items())
+        for c in b.get("changes", []):  # changes inside the phase (live, new_phase: false)
+            inner = ", ".join(f"{k}={v}" for k, v in c["set"].items())
+            changes += f"{'; ' if changes else ''}at {c['at']:g} s: {inner}"
         rows.append(
             (
-                name,
+                name + (" (cut)" if b.get("partial") else ""),
                 _fmt(b.get("start"), 1),
                 _fmt(b.get("max_distance")),
                 _fmt(b.get("min_distance")),
@@ -40,12 +43,22 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
     print(line.rstrip(), file=stream)
     for r in rows:
         print("  ".join(v.ljust(w) for v, w in zip(r, widths, strict=True)).rstrip(), file=stream)
+    if metrics["overall"].get("partial"):
+        print(
+            f"(cut): the run stopped at t={metrics['simulated']:g} s, inside this block; "
+            "its checks are skipped",
+            file=stream,
+        )
     q = metrics.get("quality")
     if q:
         print(f"quality: {q['signal']} vs {q['reference']:g} m ± {q['tolerance']:g} m", file=stream)
+    else:
+        print("no quality: section, so no metrics of control and no distance.png", file=stream)
+    paused = metrics.get("paused_s")
     print(
-        f"simulated {metrics['simulated']:.1f} s in {metrics['wall_time_s']:.2f} s "
-        f"({metrics['real_time_factor']}x real time); outputs in {out_dir}",
+        f"simulated {metrics['simulated']:.1f} s in {metrics['wall_time_s']:.2f} s"
+        + (f", {paused:.2f} s of it paused" if paused else "")
+        + f" ({metrics['real_time_factor']}x real time); outputs in {out_dir}",
         file=stream,
     )
     video = metrics.get("video")

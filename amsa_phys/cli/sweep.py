@@ -6,6 +6,7 @@ import argparse
 import csv
 import io
 import sys
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +16,7 @@ from ..engine import interrupt
 from ..engine.recorder import write_atomic
 from ..errors import ConfigError, Interrupted
 from ..model.scenario import load_scenario
+from ..model.wording import plural
 from ..model.yamlio import load_yaml
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.suite import input_files
@@ -26,6 +28,7 @@ from ..runs.sweep import (
     iter_local,
     parse_grid,
     parse_range,
+    timeline_overlaps,
     unknown_metric,
 )
 from .options import add_jobs
@@ -51,7 +54,13 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--seeds", type=int, help="seeds per grid point (default 1)")
     add_jobs(p)
-    p.add_argument("--executor", choices=("local", "dask"), default="local")
+    p.add_argument(
+        "--executor",
+        choices=("local", "dask"),
+        default="local",
+        help="where the runs go: local worker processes (default, -j of them) or an "
+        "existing Dask cluster (needs --scheduler and the cluster extra)",
+    )
     p.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address (tcp://...)")
     p.add_argument("--metric", help="metric for summary.png (default rms_error)")
     p.add_argument("--duration", type=float, metavar="S", help="override the duration")
@@ -105,6 +114,8 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
         if args.metric is None:
             raise doc.error(("sweep", "metric"), why)
         raise ConfigError(why, key="--metric")
+    swept = [a.key for a in axes if a.key != "context"]
+    swept += [k for sets in contexts.values() for k in sets]
     return SweepPlan(
         Path(args.scenario).resolve(),
         axes,
@@ -114,12 +125,15 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
         metric,
         args.duration,
         inputs=tuple(input_files(scenario)),
+        warnings=tuple(timeline_overlaps(swept, scenario, Fraction(str(end)))),
     )
 
 
 def run(args: argparse.Namespace) -> int:
     """Run the sweep; results.csv and summary.png; Ctrl-C keeps every finished row."""
     plan = build_plan(args)
+    for warning in plan.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
     if args.executor == "dask" and not args.scheduler:
         raise ConfigError("the Dask executor needs --scheduler ADDR", key="--executor")
     if args.jobs < 1:
@@ -162,11 +176,13 @@ def run(args: argparse.Namespace) -> int:
         f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})",
     )
     failed = [r for r in rows if r["error"]]
-    print(f"{len(rows)} of {len(jobs)} runs done ({len(failed)} failed); results in {out}")
+    print(
+        f"{len(rows)} of {plural(len(jobs), 'run')} done ({len(failed)} failed); results in {out}"
+    )
     for r in failed[:5]:
         print(f"run {r['run']}: {r['error']}", file=sys.stderr)
     if interrupted:
-        raise Interrupted(f"sweep interrupted; {len(rows)} finished rows kept in {out}")
+        raise Interrupted(f"sweep interrupted; {plural(len(rows), 'finished row')} kept in {out}")
     return 0
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from ..engine import interrupt
 from ..errors import ConfigError, Interrupted
+from ..model.wording import plural
 from ..runs.junit import write_junit
 from ..runs.pool import WORKER_LOST, imap_resilient
 from ..runs.suite import ScenarioResult, find_scenarios, run_dir_names, run_scenario_job
@@ -30,7 +31,14 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Exit 0 if every check passes, 1 if any fails or errors."""
-    files = find_scenarios(args.paths)
+    skipped: list[Path] = []
+    files = find_scenarios(args.paths, skipped)
+    if skipped:
+        print(
+            f"skipped {plural(len(skipped), 'resolved scenario')} in run directories "
+            f"(e.g. {skipped[0]}); name a file to run it",
+            file=sys.stderr,
+        )
     for f in files:
         if not f.exists():
             raise ConfigError("file not found", file=f)
@@ -111,7 +119,10 @@ def print_table(results: list[ScenarioResult]) -> None:
     n_checks = sum(len(r.checks) for r in results)
     n_fail = sum(1 for r in results for c in r.checks if not c.passed)
     n_err = sum(1 for r in results if r.error is not None)
+    n_skip = sum(1 for r in results for c in r.checks if c.skipped)
     print(
-        f"{len(results)} scenarios, {n_checks} checks: {n_checks - n_fail} passed, "
-        f"{n_fail} failed" + (f", {n_err} errors" if n_err else "")
+        f"{plural(len(results), 'scenario')}, {plural(n_checks, 'check')}: "
+        f"{n_checks - n_fail - n_skip} passed, {n_fail} failed"
+        + (f", {n_skip} skipped" if n_skip else "")
+        + (f", {plural(n_err, 'error')}" if n_err else "")
     )

@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from ..errors import AmsaError
+from ..model.wording import plural
 from .loading import load_any
 
 
@@ -26,9 +27,9 @@ def run(args: argparse.Namespace) -> int:
             continue
         if kind == "scenario":
             print(
-                f"ok: {path} (scenario: {len(obj.world.leaves)} components, "
-                f"{len(obj.phases)} phases, {float(obj.duration):g} s)"
+                f"ok: {path} (scenario: {plural(len(obj.world.leaves), 'component')}, "
+                f"{plural(len(obj.phases), 'phase')}, {float(obj.duration):g} s)"
             )
         else:
-            print(f"ok: {path} (world: {len(obj.leaves)} components)")
+            print(f"ok: {path} (world: {plural(len(obj.leaves), 'component')})")
     return 2 if bad else 0

@@ -161,6 +161,7 @@ class Simulation:
         self._samples_t = array("d")
         self._samples_s = array("d")
         self._hooks: list[tuple[Fraction, Hook, str]] = []
+        self._log_listeners: list[Callable[[float, dict[str, float]], None]] = []
         self.components: dict[str, Template] = {}
         self._tick = 0  # the instant being executed, in ticks (``now`` derives from it)
         self._now_override: Fraction | None = None
@@ -233,7 +234,7 @@ class Simulation:
         leaves = self.world.leaves
         periods = [1 / leaves[p].freq for p in self.world.order]
         periods += [1 / r for r, _, _ in self._hooks] + [1 / self.log_rate]
-        instants = [p.at for p in self.phases] + [self.duration]
+        instants = [at for at, _, _ in self._change_points()] + [self.duration]
         self.grid = TickGrid.for_run(periods, instants)
         g = self.grid
         self._tick_num, self._tick_den = g.tick.numerator, g.tick.denominator
@@ -290,8 +291,9 @@ class Simulation:
                             groups.append(item)
         self._table = _runs(instants)
         self._end = g.ticks(self.duration)
-        self._phase_ticks = [g.ticks(p.at) for p in self.phases]
-        self._next_phase_tick = self._phase_tick_after(self.phase_index)
+        self._points = [(g.ticks(at), i, changes) for at, i, changes in self._change_points()]
+        self._point_index = 0
+        self._next_phase_tick = self._points[0][0] if self._points else math.inf
         # one row of the trace in column order, gathered in C
         cols = self.columns
         self._row: Callable[[dict[str, float]], Sequence[float]] = (
@@ -393,22 +395,35 @@ class Simulation:
             # run's start; the instant that failed is ``_tick``, as on the general path
             self._cursor = max(cursor, self._tick)
 
+    def _change_points(self) -> list[tuple[Fraction, int, list[Change]]]:
+        """Every timeline change after t = 0 in time order: (at, phase it belongs to, changes).
+
+        A phase's start and the changes made inside it (``Phase.within``) are applied the
+        same way; only a phase's start moves :attr:`phase_index`.
+        """
+        points = []
+        for i, phase in enumerate(self.phases):
+            if i > 0:
+                points.append((phase.at, i, phase.changes))
+            points += [(step.at, i, step.changes) for step in phase.within]
+        points.sort(key=lambda p: p[0])
+        return points
+
     def _enter_phases(self, tick: int) -> None:
-        """Apply the timeline changes of every phase that starts at or before ``tick``."""
-        phase_ticks = self._phase_ticks
-        while self.phase_index + 1 < len(phase_ticks) and phase_ticks[self.phase_index + 1] <= tick:
-            self.phase_index += 1
-            self._now_override = self.grid.time(phase_ticks[self.phase_index])
+        """Apply the timeline changes due at or before ``tick`` (new phases and in-phase)."""
+        points = self._points
+        while self._point_index < len(points) and points[self._point_index][0] <= tick:
+            at, phase, changes = points[self._point_index]
+            self._point_index += 1
+            self.phase_index = phase
+            self._now_override = self.grid.time(at)
             try:
-                for change in self.phases[self.phase_index].changes:
+                for change in changes:
                     self.apply_change(change)
             finally:
                 self._now_override = None
-        self._next_phase_tick = self._phase_tick_after(self.phase_index)
-
-    def _phase_tick_after(self, index: int) -> int | float:
-        i = index + 1
-        return self._phase_ticks[i] if i < len(self._phase_ticks) else math.inf
+        i = self._point_index
+        self._next_phase_tick = points[i][0] if i < len(points) else math.inf
 
     def _step(self, task: _Task, now: Fraction) -> None:
         """Run one component: read its inputs, call ``do_step``, publish its outputs."""
@@ -485,6 +500,23 @@ class Simulation:
         if self._quality is not None:
             self._samples_t.append(t_s)
             self._samples_s.append(values[self._quality])
+        if self._log_listeners:
+            for listener in self._log_listeners:
+                listener(t_s, values)
+
+    def add_log_listener(self, fn: Callable[[float, dict[str, float]], None]) -> None:
+        """Call ``fn(t_s, values)`` at every logged instant, after the trace row.
+
+        The window and the video sample trails, GPS fixes and live metrics here: per
+        simulated instant, the very samples ``metrics.json`` is computed from, whatever the
+        frame rate or speed-up (at x256 a frame spans seconds of simulated time).
+        """
+        self._log_listeners.append(fn)
+
+    @property
+    def pending_live(self) -> list[Change]:
+        """Live changes queued for the next instant, not yet applied."""
+        return list(self._pending_live)
 
     def apply_change(self, change: Change) -> None:
         """Set a parameter now (timeline or live); the component is told after."""
@@ -498,7 +530,7 @@ class Simulation:
         except Exception as exc:
             raise RunFault(
                 self._who(change.leaf), self.now, f"rejected {change.param}={change.value!r}: {exc}"
-            ) from exc
+            ) from None  # a rejection is a message, not a crash (--debug still finds it)
 
     def next_instant(self) -> Fraction:
         """Time of the next instant at which something runs (where a live change lands)."""

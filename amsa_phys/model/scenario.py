@@ -6,6 +6,8 @@ Every value is judged by the parameter's own ``Param.coerce``, with file, line a
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
@@ -17,6 +19,7 @@ from ..errors import ConfigError
 from . import schema
 from .suggest import did_you_mean
 from .template import Kind
+from .wording import plural
 from .world import WorldSpec, build_world, load_world
 from .yamlio import KeyPath, YamlDoc, load_yaml
 
@@ -51,12 +54,30 @@ class Change:
 
 
 @dataclass
+class Step:
+    """Changes made inside a phase without starting a new one, at ``at``.
+
+    A timeline entry with ``new_phase: false`` and a change made live in the window are
+    steps: the phase structure (and so what ``expect: {phase: i}`` means) stays the one the
+    scenario's author wrote, however many changes land inside a phase.
+    """
+
+    at: Fraction
+    changes: list[Change]
+    label: str = ""
+    entry: int | None = None  # index in the file's ``timeline`` (None: made live)
+
+
+@dataclass
 class Phase:
     """A phase of the scenario: from ``at`` (phase 0 at 0) with the changes made then."""
 
     at: Fraction
     changes: list[Change]
     label: str = ""
+    #: changes inside this phase after its start (``new_phase: false``), in time order
+    within: list[Step] = field(default_factory=list)
+    entry: int | None = None  # index in the file's ``timeline`` (None: phase 0)
 
 
 @dataclass
@@ -100,6 +121,24 @@ class Scenario:
     phases: list[Phase]
     expect: list[Expectation] = field(default_factory=list)
     data: dict[str, Any] = field(default_factory=dict)
+    #: when ``--duration`` shortened the run: the file's phase starts followed by its
+    #: duration. The phase the run stops in (and the run as a whole) is then cut short: its
+    #: metrics are partial and its checks skipped, not judged as if it were complete.
+    planned_bounds: list[Fraction] | None = None
+
+
+def shorten(scenario: Scenario, duration: Fraction) -> None:
+    """Run ``scenario`` until ``duration`` instead (``--duration``): later changes drop out.
+
+    A shorter run remembers the file's duration, so the phase it stops in is reported as
+    cut short (partial) rather than judged as if it were complete.
+    """
+    if duration < scenario.duration and scenario.planned_bounds is None:
+        scenario.planned_bounds = [p.at for p in scenario.phases] + [scenario.duration]
+    scenario.duration = duration
+    scenario.phases = [p for p in scenario.phases if p.at < duration]
+    for phase in scenario.phases:
+        phase.within = [s for s in phase.within if s.at < duration]
 
 
 def load_scenario(
@@ -127,12 +166,14 @@ def configure_scenario(
     if seed is not None:
         scenario.seed = seed
     if duration is not None:
-        scenario.duration = _positive_fraction(duration, "--duration")
-        scenario.phases = [p for p in scenario.phases if p.at < scenario.duration]
+        shorten(scenario, _positive_fraction(duration, "--duration"))
     if log_rate is not None:
         scenario.log_rate = _positive_fraction(log_rate, "--log-rate")
     in_file = len(scenario.phases[0].changes)
     for text in overrides or []:
+        if text.strip().startswith(PHYSICS_PREFIX):
+            scenario.world = with_physics(scenario.world, parse_physics_override(text))
+            continue
         scenario.phases[0].changes.append(parse_override(text, scenario.world))
     if overrides:
         check_phases(scenario, doc, in_file)
@@ -154,10 +195,14 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
         if world_path.is_dir():
             raise doc.error(("world",), f"{world_path} is a directory, expected a world file")
         if not world_path.is_file():
-            raise doc.error(("world",), f"world file not found: {world_path}")
+            raise doc.error(
+                ("world",), f"world file not found: {world_path}" + _nearby_file(world_path)
+            )
         world = load_world(world_path)
     else:
         world = build_world(world_ref, doc, ("world",))
+    if "physics" in data:
+        world = with_physics(world, data["physics"])
     duration = Fraction(str(data["duration"]))
     if duration <= 0:
         raise doc.error(("duration",), f"must be > 0, got {data['duration']}")
@@ -178,13 +223,11 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
                 f"the scenario (duration {float(duration):g} s)",
             )
         last = at
-        phases.append(
-            Phase(
-                at,
-                _changes(entry["set"], ("timeline", i, "set"), doc, world),
-                entry.get("label", ""),
-            )
-        )
+        changes = _changes(entry["set"], ("timeline", i, "set"), doc, world)
+        if entry.get("new_phase", True):
+            phases.append(Phase(at, changes, entry.get("label", ""), entry=i))
+        else:
+            phases[-1].within.append(Step(at, changes, entry.get("label", ""), entry=i))
     quality = None
     if "quality" in data:
         q = data["quality"]
@@ -233,7 +276,8 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
             raise doc.error(
                 (*kp, "phase"),
                 f"phase {e['phase']} does not exist "
-                f"(the scenario has {len(phases)} phases, 0..{len(phases) - 1})",
+                f"(the scenario has {plural(len(phases), 'phase')}, "
+                + (f"0..{len(phases) - 1})" if len(phases) > 1 else "only phase 0)"),
             )
         if quality is None:
             raise doc.error(kp, "metric expectations need a quality: section")
@@ -257,6 +301,17 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
     return scenario
 
 
+def _nearby_file(path: Path) -> str:
+    """`` (did you mean x.yaml?)`` for a YAML file beside ``path`` with a close name
+    (``x.yml`` for ``x.yaml``, a typo in the stem); empty if there is none."""
+    try:
+        names = [p.name for p in path.parent.iterdir() if p.suffix in (".yaml", ".yml")]
+    except OSError:
+        return ""
+    same_stem = [n for n in names if Path(n).stem == path.stem]
+    return f" (did you mean {same_stem[0]}?)" if same_stem else did_you_mean(path.name, names)
+
+
 def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = None) -> None:
     """Refuse a scenario whose phases would break a template's rules, before anything runs.
 
@@ -270,21 +325,25 @@ def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = 
     world = scenario.world
     values = {path: dict(leaf.params) for path, leaf in world.leaves.items()}
 
-    def error(phase: int, index: int, change: Change, message: str) -> ConfigError:
+    def error(entry: int | None, index: int, change: Change, message: str) -> ConfigError:
         if doc is None:
             return ConfigError(message, key=change.key)
-        if phase == 0 and in_file is not None and index >= in_file:
+        if entry is None and in_file is not None and index >= in_file:
             return ConfigError(message, key=f"--set {change.key}")
-        where = ("set",) if phase == 0 else ("timeline", phase - 1, "set")
+        where = ("set",) if entry is None else ("timeline", entry, "set")
         return doc.error((*where, change.key), message)
 
+    steps: list[tuple[bool, int | None, list[Change]]] = []  # (at t = 0, entry, changes)
     for i, phase in enumerate(scenario.phases):
+        steps.append((i == 0, phase.entry, phase.changes))
+        steps += [(False, s.entry, s.changes) for s in phase.within]
+    for initial, entry, changes in steps:
         last: dict[str, tuple[int, Change]] = {}
-        for j, change in enumerate(phase.changes):
+        for j, change in enumerate(changes):
             template = world.leaves[change.leaf].template
-            if i > 0 and change.param in template.fixed_once_running:
+            if not initial and change.param in template.fixed_once_running:
                 raise error(
-                    i,
+                    entry,
                     j,
                     change,
                     f"{change.param} is read only when the run starts; "
@@ -296,7 +355,7 @@ def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = 
             try:
                 world.leaves[leaf].template.check_params(values[leaf])
             except ValueError as exc:
-                raise error(i, j, change, str(exc)) from None
+                raise error(entry, j, change, str(exc)) from None
 
 
 def _changes(sets: dict[str, Any], kp: KeyPath, doc: YamlDoc, world: WorldSpec) -> list[Change]:
@@ -338,6 +397,62 @@ def parse_override(text: str, world: WorldSpec) -> Change:
         return resolve_change(key.strip(), value, world)
     except ValueError as exc:
         raise ConfigError(str(exc), key=f"--set {key.strip()}") from None
+
+
+PHYSICS_PREFIX = "physics."
+
+
+def with_physics(world: WorldSpec, over: dict[str, Any]) -> WorldSpec:
+    """``world`` with a scenario's ``physics:`` (or ``--set physics.…``) merged over its own.
+
+    Mappings merge key by key (``ground: {friction: 0.5}`` keeps the world's rolling
+    resistance); ``obstacles`` are *added* to the world's, so a scenario can put a box in
+    the leader's way without restating the arena; any other value replaces the world's.
+    The world itself is not changed: a WorldSpec may be shared.
+    """
+    merged = copy.deepcopy(world.physics)
+    for key, value in over.items():
+        if key == "obstacles":
+            merged["obstacles"] = [*merged.get("obstacles", []), *copy.deepcopy(value)]
+        elif isinstance(value, dict) and isinstance(merged.get(key), dict):
+            merged[key] = {**merged[key], **copy.deepcopy(value)}
+        else:
+            merged[key] = copy.deepcopy(value)
+    return dataclasses.replace(world, physics=merged)
+
+
+def parse_physics_override(text: str) -> dict[str, Any]:
+    """``physics.ground.friction=0.5`` -> ``{"ground": {"friction": 0.5}}``, shape-checked
+    like a file's ``physics:`` (unknown keys named, with a suggestion)."""
+    key, sep, raw = text.partition("=")
+    key = key.strip()
+    if not sep:
+        raise ConfigError(f"expected physics.key=value, got {text!r}", key="--set")
+    try:
+        value = yaml.safe_load(raw) if raw.strip() else raw
+    except yaml.YAMLError:
+        value = raw
+    return physics_setting(key, value, option=f"--set {key}")
+
+
+def physics_setting(key: str, value: Any, option: str) -> dict[str, Any]:
+    """``physics.a.b`` and a value as the nested mapping ``{a: {b: value}}``, shape-checked;
+    a ConfigError names ``option`` (a ``--set`` or ``--grid`` axis)."""
+    parts = key.split(".")[1:]
+    if not parts or not all(parts):
+        raise ConfigError("expected physics.<setting>, e.g. physics.ground.friction", key=option)
+    nested: dict[str, Any] = {}
+    inner = nested
+    for part in parts[:-1]:
+        inner = inner.setdefault(part, {})
+    inner[parts[-1]] = value
+    doc = YamlDoc(Path(option), nested)
+    try:
+        schema.validate(nested, schema.PHYSICS, doc)
+    except ConfigError as exc:
+        where = f"physics.{exc.key}" if exc.key else key
+        raise ConfigError(exc.message, key=f"{option.split(' ')[0]} {where}") from None
+    return nested
 
 
 def _positive_fraction(value: float, option: str) -> Fraction:

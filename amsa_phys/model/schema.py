@@ -170,6 +170,7 @@ SCENARIO: dict[str, Any] = {
             "required": ["signal", "reference"],
             "properties": {"signal": {"type": "string"}, "reference": _num, "tolerance": _pos},
         },
+        "physics": PHYSICS,  # merged over the world's (model/scenario.py: with_physics)
         "set": {"type": "object"},
         "timeline": {
             "type": "array",
@@ -181,6 +182,7 @@ SCENARIO: dict[str, Any] = {
                     "at": _time,
                     "set": {"type": "object", "minProperties": 1},
                     "label": {"type": "string"},
+                    "new_phase": {"type": "boolean"},
                 },
             },
         },

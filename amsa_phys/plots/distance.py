@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -27,7 +28,9 @@ def read_trace(path: Path) -> tuple[list[str], np.ndarray]:
 def _read_trace(path: str, mtime_ns: int, size: int) -> tuple[list[str], np.ndarray]:
     with open(path, encoding="utf-8") as fh:
         header = fh.readline().strip().split(",")
-    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    with warnings.catch_warnings():  # a run that faulted at t = 0 has a header only
+        warnings.simplefilter("ignore", UserWarning)
+        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     data.flags.writeable = False  # shared between callers
     return header, data
 
@@ -73,6 +76,46 @@ def _phase_notes(ax: plt.Axes, phases: list[dict[str, Any]]) -> list[str]:
     return tallest
 
 
+def _inner_changes(ax: plt.Axes, phases: list[dict[str, Any]]) -> None:
+    """Mark changes made inside a phase (live in the window, ``new_phase: false``): a dashed
+    line and what was set, upright along the bottom so it never meets the phase notes."""
+    for phase in phases:
+        for change in phase.get("changes", []):
+            at = change["at"]
+            ax.axvline(at, color="tab:purple", lw=0.8, ls="--", alpha=0.8)
+            what = ", ".join(f"{k.split('.')[-1]}={v}" for k, v in change["set"].items())
+            label = change.get("label")
+            ax.annotate(
+                f"{label}: {what}" if label else what,
+                (at, 0.0),
+                xycoords=("data", "axes fraction"),
+                xytext=(-2, 4),
+                textcoords="offset points",
+                rotation=90,
+                ha="right",
+                va="bottom",
+                fontsize=NOTE_PT - 0.5,
+                color="tab:purple",
+            )
+
+
+def _collisions(ax: plt.Axes, events: list[dict[str, Any]], t: np.ndarray, s: np.ndarray) -> None:
+    """A red cross on the curve at every collision (its detail names who touched)."""
+    at = np.array([e["t"] for e in events if e.get("kind") == "collision"], dtype=float)
+    if not at.size:
+        return
+    ax.plot(
+        at,
+        np.interp(at, t, s),
+        "x",
+        color="#d62728",
+        ms=9,
+        mew=2,
+        zorder=5,
+        label=f"collision ({at.size})",
+    )
+
+
 def plot_distance(trace: Path, metrics: dict[str, Any], out: Path) -> Path:
     """Draw the quality signal of ``trace`` with the phases of ``metrics`` into ``out``."""
     fig = distance_figure(trace, metrics)
@@ -99,9 +142,12 @@ def distance_figure(trace: Path, metrics: dict[str, Any]) -> Figure:
             label=f"tolerance ±{tol:g} m",
         )
         ax.axhline(ref, color="tab:green", lw=1.2, ls="--", label=f"reference {ref:g} m")
-        ax.plot(t, s, color="tab:blue", lw=1.2, label=signal)
+        # near-black: blue and orange are the rovers' colours in every other picture
+        ax.plot(t, s, color="0.15", lw=1.2, label=signal)
         top = max(float(np.max(s)), ref + tol)
         lines = _phase_notes(ax, metrics.get("phases", []))
+        _inner_changes(ax, metrics.get("phases", []))
+        _collisions(ax, metrics.get("events", []), t, s)
         # the notes get a band of their own above the data: the curve never runs through them
         band = (len(lines) * NOTE_PT * 1.25 + 8) / AXES_HEIGHT_PT if lines else 0.05
         ax.set_ylim(bottom=0, top=top * 1.05 / max(0.4, 1 - band))

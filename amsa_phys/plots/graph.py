@@ -22,11 +22,14 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+import numpy as np
 from matplotlib.figure import Figure
-from matplotlib.patches import FancyBboxPatch
+from matplotlib.patches import FancyArrowPatch, FancyBboxPatch
+from matplotlib.path import Path as MplPath
 from matplotlib.transforms import Bbox
 
 from ..engine.recorder import write_atomic
+from ..model.wording import plural
 from ..model.world import WorldSpec
 from .save import save_png
 
@@ -192,9 +195,13 @@ ROW_STEP = 1.6
 LABEL_PT = 6
 CHAR_W = 0.055  # data units per label character at LABEL_PT, for sizing column gaps
 ARC_RISE = 1.4  # how far a feedback arc rises above the boxes it joins
+LANE_STEP = 0.35  # between two feedback links routed around the boxes
+CORNER = 0.3  # radius of a routed link's corners
 MARGINS = (0.01, 0.01, 0.99, 0.92)  # fixed: labels are placed against the final transform
-#: where along an arrow a label is tried, in order (0 = source end, 1 = target end)
-ALONG = (0.5, 0.35, 0.65, 0.22, 0.78, 0.12, 0.88, 0.42, 0.58, 0.28, 0.72, 0.17, 0.83)
+#: where along an arrow a label is tried (0 = source end, 1 = target end): middle first
+ALONG = tuple(sorted((k / 40 for k in range(4, 37)), key=lambda t: (abs(t - 0.5), t)))
+#: a label on a component or on another label costs this many line crossings
+OVERLAP_COST = 100
 
 
 def draw(world: WorldSpec, out: Path, collapse: bool = True) -> Path:
@@ -218,29 +225,32 @@ def draw(world: WorldSpec, out: Path, collapse: bool = True) -> Path:
 def diagram(world: WorldSpec, collapse: bool = True) -> tuple[Figure, list[Bbox], list[Bbox]]:
     """The figure, and the display extents of its components and of its link labels.
 
-    Where some label finds no free place, the columns move apart and it is laid out again
-    (a few times at most: a crowded gap has more arrows than room).
+    Where some label finds no free place (off every component, every other label and every
+    other link's line), the columns move apart and it is laid out again (a few times at
+    most: a crowded gap has more arrows than room).
     """
     st = structure(world, collapse)
     for widen in (0.0, 1.5, 3.0):
-        fig, boxes, labels = _layout(world, st, widen)
-        if not any(a.overlaps(b) for i, a in enumerate(labels) for b in (*labels[:i], *boxes)):
+        fig, boxes, labels, conflicts = _layout(world, st, widen)
+        if not conflicts:
             return fig, boxes, labels
         plt.close(fig)
-    return _layout(world, st, 4.5)
+    fig, boxes, labels, _ = _layout(world, st, 4.5)
+    return fig, boxes, labels
 
 
-def _layout(world: WorldSpec, st: Structure, widen: float) -> tuple[Figure, list[Bbox], list[Bbox]]:
+def _layout(
+    world: WorldSpec, st: Structure, widen: float
+) -> tuple[Figure, list[Bbox], list[Bbox], int]:
     pos = _positions(st, widen)
     merged: dict[tuple[str, str], list[str]] = {}
     for a, b, label in st.links:
         merged.setdefault((a, b), []).append(label)
-    curves = {ab: _curve(pos[ab[0]], pos[ab[1]]) for ab in merged}
-    xs = [x for x, _ in pos.values()]
+    routes = _routes(pos, list(merged))
+    pts = [p for line in routes.values() for p in line]
+    xs = [x for x, _ in pos.values()] + [x for x, _ in pts]
     ys = [y for _, y in pos.values()]
-    top = max(ys) + BOX_H / 2 + 0.6
-    for p0, c, p2 in curves.values():
-        top = max(top, (p0[1] + 2 * c[1] + p2[1]) / 4 + 0.5)
+    top = max([max(ys) + BOX_H / 2 + 0.6, *(y + 0.5 for _, y in pts)])
     x_lo, x_hi = min(xs) - BOX_W / 2 - 0.3, max(xs) + BOX_W / 2 + 0.3
     y_lo = min(ys) - BOX_H / 2 - 1.0  # room for the legend
     fig = plt.figure(figsize=(max(6.0, (x_hi - x_lo) * 0.9), max(3.0, (top - y_lo) * 0.9)), dpi=100)
@@ -250,35 +260,44 @@ def _layout(world: WorldSpec, st: Structure, widen: float) -> tuple[Figure, list
     ax.set_ylim(y_lo, top)
     ax.set_aspect("equal")
     ax.axis("off")
-    ax.set_title(f"{world.name}: {len(world.leaves)} components")
+    ax.set_title(f"{world.name}: {plural(len(world.leaves), 'component')}")
     ax.apply_aspect()
     renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
-    boxes = [_draw_box(ax, node, pos[name]) for name, node in st.nodes.items()]
+    names = list(st.nodes)
+    boxes = [_draw_box(ax, st.nodes[name], pos[name]) for name in names]
     box_extents = [b.get_window_extent(renderer) for b in boxes]
+    shown = {ab: ax.transData.transform(routes[ab]) for ab in merged}
+    for ab in merged:
+        ax.add_patch(
+            FancyArrowPatch(
+                path=MplPath(routes[ab]),
+                arrowstyle="-|>",
+                color="0.35",
+                lw=0.9,
+                mutation_scale=10,
+                shrinkA=0,
+                shrinkB=0,
+                zorder=1,
+            )
+        )
     placed: list[Bbox] = []
+    conflicts = 0
     for ab, labels in merged.items():
-        p0, c, p2 = curves[ab]
-        ax.annotate(
-            "",
-            xy=p2,
-            xytext=p0,
-            arrowprops={
-                "arrowstyle": "-|>",
-                "color": "0.35",
-                "lw": 0.9,
-                "shrinkA": 0,
-                "shrinkB": 0,
-                "connectionstyle": f"arc3,rad={_rad(p0, c, p2):.6f}",
-            },
+        ends = {names.index(ab[0]), names.index(ab[1])}
+        others = [line for other, line in shown.items() if other != ab]
+        extent, cost = _place_label(
+            ax, renderer, "\n".join(labels), routes[ab], box_extents, placed, others
         )
-        placed.append(
-            _place_label(ax, renderer, "\n".join(labels), (p0, c, p2), box_extents, placed)
-        )
+        placed.append(extent)
+        conflicts += cost
+        for i, box in enumerate(box_extents):  # a line through a component is a conflict too
+            if i not in ends and _crosses(shown[ab], box.expanded(0.98, 0.9)):
+                conflicts += OVERLAP_COST
     handles = [
         FancyBboxPatch((0, 0), 1, 1, fc=c, ec="0.2", label=k) for k, c in KIND_COLOURS.items()
     ]
     ax.legend(handles=handles, loc="lower right", fontsize=7, ncol=3)
-    return fig, box_extents, placed
+    return fig, box_extents, placed, conflicts
 
 
 def _positions(st: Structure, widen: float = 0.0) -> dict[str, tuple[float, float]]:
@@ -305,43 +324,161 @@ def _positions(st: Structure, widen: float = 0.0) -> dict[str, tuple[float, floa
 Point = tuple[float, float]
 
 
-def _curve(a: Point, b: Point) -> tuple[Point, Point, Point]:
-    """Start, control point and end of the quadratic arrow from box ``a`` to box ``b``.
+def _routes(
+    pos: dict[str, Point], links: list[tuple[str, str]]
+) -> dict[tuple[str, str], list[Point]]:
+    """Every link as a polyline in data units, from its source box to its target box.
 
-    Forward links are straight, right side to left side; a link back (into a process: the
-    loop's feedback) arcs over the boxes from top to top.
+    Forward links are straight, right side to left side; the links leaving (entering) one
+    box start (end) at points spread along its side in the order of the boxes they go to,
+    so a fan of links does not meet in one point. A link back (into a process: the loop's
+    feedback) arcs over the boxes from top to top where that arc crosses no other box;
+    otherwise it is routed around them: up from the source, along a lane above every box,
+    down beside the target and into its left side.
     """
-    (x0, y0), (x1, y1) = a, b
-    if x1 > x0:
-        p0, p2 = (x0 + BOX_W / 2, y0), (x1 - BOX_W / 2, y1)
-        return p0, ((p0[0] + p2[0]) / 2, (p0[1] + p2[1]) / 2), p2
-    p0, p2 = (x0, y0 + BOX_H / 2), (x1, y1 + BOX_H / 2)
-    peak = max(p0[1], p2[1]) + ARC_RISE  # the curve's midpoint; the control point is twice as high
-    mid = ((p0[0] + p2[0]) / 2, (p0[1] + p2[1]) / 2)
-    return p0, (mid[0], 2 * peak - mid[1]), p2
+    forward = [(a, b) for a, b in links if pos[b][0] > pos[a][0]]
+    start: dict[tuple[str, str], float] = {}
+    end: dict[tuple[str, str], float] = {}
+    for name in pos:
+        outs = sorted((ab for ab in forward if ab[0] == name), key=lambda ab: -pos[ab[1]][1])
+        ins = sorted((ab for ab in forward if ab[1] == name), key=lambda ab: -pos[ab[0]][1])
+        for group, side in ((outs, start), (ins, end)):
+            for k, ab in enumerate(group):
+                side[ab] = 0.3 * BOX_H * (1 - 2 * k / (len(group) - 1)) if len(group) > 1 else 0
+    out: dict[tuple[str, str], list[Point]] = {}
+    lanes = 0
+    top = max(y for _, y in pos.values()) + BOX_H / 2
+    for a, b in links:
+        (x0, y0), (x1, y1) = pos[a], pos[b]
+        if (a, b) in start:
+            out[(a, b)] = [(x0 + BOX_W / 2, y0 + start[(a, b)]), (x1 - BOX_W / 2, y1 + end[(a, b)])]
+            continue
+        p0, p2 = (x0, y0 + BOX_H / 2), (x1, y1 + BOX_H / 2)
+        peak = max(p0[1], p2[1]) + ARC_RISE  # the curve's midpoint; the control is twice as high
+        mid = ((p0[0] + p2[0]) / 2, (p0[1] + p2[1]) / 2)
+        arc = _quadratic(p0, (mid[0], 2 * peak - mid[1]), p2)
+        if not any(_hits_box(arc, pos[n]) for n in pos if n not in (a, b)):
+            out[(a, b)] = arc
+            continue
+        lane = top + ARC_RISE + LANE_STEP * lanes
+        lanes += 1
+        side = x1 - BOX_W / 2 - 0.5 - LANE_STEP * (lanes - 1)
+        corners = [p0, (x0, lane), (side, lane), (side, y1), (x1 - BOX_W / 2, y1)]
+        out[(a, b)] = _rounded(corners, CORNER)
+    return out
 
 
-def _rad(p0: Point, c: Point, p2: Point) -> float:
-    """matplotlib's ``arc3`` rad that puts the control point at ``c`` (0 for a straight line)."""
-    dx, dy = p2[0] - p0[0], p2[1] - p0[1]
-    mid = ((p0[0] + p2[0]) / 2, (p0[1] + p2[1]) / 2)
-    length2 = dx * dx + dy * dy
-    if length2 == 0:
-        return 0.0
-    # arc3: c = mid + rad * (dy, -dx)
-    return ((c[0] - mid[0]) * dy - (c[1] - mid[1]) * dx) / length2
+def _quadratic(p0: Point, c: Point, p2: Point, n: int = 40) -> list[Point]:
+    """The quadratic Bezier from ``p0`` to ``p2`` with control ``c`` as ``n + 1`` points."""
+    pts = []
+    for k in range(n + 1):
+        t = k / n
+        u = 1 - t
+        pts.append(
+            (
+                u * u * p0[0] + 2 * u * t * c[0] + t * t * p2[0],
+                u * u * p0[1] + 2 * u * t * c[1] + t * t * p2[1],
+            )
+        )
+    return pts
+
+
+def _rounded(corners: list[Point], r: float) -> list[Point]:
+    """A polyline through ``corners`` with each inner corner rounded (radius about ``r``)."""
+    out = [corners[0]]
+    for prev, here, nxt in zip(corners, corners[1:], corners[2:], strict=False):
+        d_in = max(abs(here[0] - prev[0]), abs(here[1] - prev[1]))
+        d_out = max(abs(nxt[0] - here[0]), abs(nxt[1] - here[1]))
+        k = min(r, d_in / 2, d_out / 2)
+        a = _toward(here, prev, k)
+        b = _toward(here, nxt, k)
+        out += _quadratic(a, here, b, 8)
+    out.append(corners[-1])
+    return out
+
+
+def _toward(p: Point, q: Point, k: float) -> Point:
+    """The point ``k`` from ``p`` toward ``q`` (axis-aligned segments)."""
+    dx, dy = q[0] - p[0], q[1] - p[1]
+    length = max(abs(dx), abs(dy)) or 1.0
+    return (p[0] + dx * k / length, p[1] + dy * k / length)
+
+
+def _hits_box(line: list[Point], centre: Point) -> bool:
+    """Whether the polyline passes through, or within 0.3 of, the box centred at ``centre``.
+
+    The margin keeps an arc from threading the gap between two rows of boxes.
+    """
+    x, y = centre
+    w, h = BOX_W / 2 + 0.3, BOX_H / 2 + 0.3
+    box = Bbox.from_extents(x - w, y - h, x + w, y + h)
+    return _crosses(np.asarray(line), box)
+
+
+def _crosses(line: np.ndarray, box: Bbox) -> bool:
+    """Whether any segment of the polyline ``line`` (N x 2) meets the rectangle ``box``."""
+    a, b = line[:-1], line[1:]
+    near = (  # segments whose own bounding box meets the rectangle: the only candidates
+        (np.minimum(a[:, 0], b[:, 0]) <= box.x1)
+        & (np.maximum(a[:, 0], b[:, 0]) >= box.x0)
+        & (np.minimum(a[:, 1], b[:, 1]) <= box.y1)
+        & (np.maximum(a[:, 1], b[:, 1]) >= box.y0)
+    )
+    return any(_segment_meets(*a[k], *b[k], box) for k in np.flatnonzero(near).tolist())
+
+
+def _segment_meets(x0: float, y0: float, x1: float, y1: float, box: Bbox) -> bool:
+    """Liang-Barsky: does the segment (x0, y0)-(x1, y1) meet ``box``?"""
+    lo, hi = 0.0, 1.0
+    dx, dy = x1 - x0, y1 - y0
+    for p, q in (
+        (-dx, x0 - box.x0),
+        (dx, box.x1 - x0),
+        (-dy, y0 - box.y0),
+        (dy, box.y1 - y0),
+    ):
+        if p == 0:
+            if q < 0:
+                return False
+            continue
+        t = q / p
+        if p < 0:
+            lo = max(lo, t)
+        else:
+            hi = min(hi, t)
+        if lo > hi:
+            return False
+    return True
+
+
+def _along(line: list[Point], t: float) -> Point:
+    """The point a fraction ``t`` of the way along the polyline, by length."""
+    arr = np.asarray(line)
+    seg = np.hypot(*np.diff(arr, axis=0).T)
+    goal = t * seg.sum()
+    k = int(np.searchsorted(np.cumsum(seg), goal))
+    k = min(k, len(seg) - 1)
+    before = seg[:k].sum()
+    f = (goal - before) / seg[k] if seg[k] > 0 else 0.0
+    x, y = arr[k] + f * (arr[k + 1] - arr[k])
+    return (float(x), float(y))
 
 
 def _place_label(
     ax: plt.Axes,
     renderer: object,
     text: str,
-    curve: tuple[Point, Point, Point],
+    line: list[Point],
     boxes: list[Bbox],
     placed: list[Bbox],
-) -> Bbox:
-    """Put ``text`` at the first point of the curve where it overlaps nothing; its extent."""
-    p0, c, p2 = curve
+    others: list[np.ndarray],
+) -> tuple[Bbox, int]:
+    """Put ``text`` on its link where it covers nothing; its extent and what it still covers.
+
+    A place is judged by what the label would cover: a component or a label placed before
+    (:data:`OVERLAP_COST` each) and another link's line (1 each: a label on a crossing
+    hides which line goes where). The first free place from the middle outwards wins.
+    """
     label = ax.text(
         0,
         0,
@@ -353,25 +490,20 @@ def _place_label(
         bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
         zorder=4,
     )
-    best: tuple[int, Bbox] | None = None
+    best: tuple[int, Bbox, Point] | None = None
     for t in ALONG:
-        u = 1 - t
-        label.set_position(
-            (
-                u * u * p0[0] + 2 * u * t * c[0] + t * t * p2[0],
-                u * u * p0[1] + 2 * u * t * c[1] + t * t * p2[1],
-            )
-        )
+        spot = _along(line, t)
+        label.set_position(spot)
         extent = label.get_window_extent(renderer).expanded(1.08, 1.15)
-        hits = sum(extent.overlaps(o) for o in (*boxes, *placed))
-        if best is None or hits < best[0]:
-            best = (hits, extent)
-            spot = label.get_position()
-        if hits == 0:
+        cost = OVERLAP_COST * sum(extent.overlaps(o) for o in (*boxes, *placed))
+        cost += sum(_crosses(o, extent) for o in others)
+        if best is None or cost < best[0]:
+            best = (cost, extent, spot)
+        if cost == 0:
             break
     assert best is not None
-    label.set_position(spot)
-    return best[1]
+    label.set_position(best[2])
+    return best[1], best[0]
 
 
 def _draw_box(ax: plt.Axes, node: Node, centre: Point) -> FancyBboxPatch:

@@ -12,6 +12,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.patches import Rectangle
 
 from .save import save_png
 
@@ -30,20 +31,30 @@ def plot_summary(
     if not ok or not axes:
         ax.text(0.5, 0.5, "no completed runs to plot", ha="center", transform=ax.transAxes)
     elif len(axes) == 2 and len(numeric_axes) == 2:
-        xs = sorted({r[axes[0]] for r in ok})
-        ys = sorted({r[axes[1]] for r in ok})
+        # every grid point gets a cell, those without a value too (drawn grey, "none")
+        xs = sorted({r[axes[0]] for r in rows if _numeric([r[axes[0]]])})
+        ys = sorted({r[axes[1]] for r in rows if _numeric([r[axes[1]]])})
         grid = np.full((len(ys), len(xs)), np.nan)
         cells: dict[tuple[Any, Any], list[float]] = defaultdict(list)
         for r in ok:
             cells[(r[axes[0]], r[axes[1]])].append(float(r[metric]))
         for (x, y), vals in cells.items():
             grid[ys.index(y), xs.index(x)] = float(np.mean(vals))
-        im = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis")
+        cmap = plt.get_cmap("viridis").with_extremes(bad="0.88")
+        im = ax.imshow(np.ma.masked_invalid(grid), origin="lower", aspect="auto", cmap=cmap)
+        _cell_values(ax, grid, im.norm)
+        if np.isfinite(grid).any():
+            j, i = np.unravel_index(int(np.nanargmin(grid)), grid.shape)
+            ax.add_patch(  # the best cell framed in gold (its value starred below)
+                Rectangle((i - 0.5, j - 0.5), 1, 1, fill=False, ec="gold", lw=3.5, zorder=3)
+            )
+            ax.plot(i, j - 0.25, marker="*", ms=13, color="gold", mec="k", ls="none", zorder=4)
+            ax.set_title(f"★ best: {axes[0]}={xs[i]:g}, {axes[1]}={ys[j]:g}", fontsize=9)
         ax.set_xticks(range(len(xs)), [f"{x:g}" for x in xs])
         ax.set_yticks(range(len(ys)), [f"{y:g}" for y in ys])
         ax.set_xlabel(axes[0])
         ax.set_ylabel(axes[1])
-        fig.colorbar(im, ax=ax, label=metric)
+        fig.colorbar(im, ax=ax, label=f"{metric} (seed mean; lowest ★)")
     else:
         x_axis = numeric_axes[0] if numeric_axes else axes[0]
         others = [a for a in axes if a != x_axis]
@@ -77,5 +88,26 @@ def plot_summary(
         ax.set_ylabel(metric + " (seed min–max as bars, ★ best)")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    ax.set_title(title)
+    dropped = len(rows) - len(ok)
+    if dropped:  # runs with no value (failed, or e.g. never settled) are not in the picture
+        title += f"\n{dropped} of {len(rows)} runs have no {metric} and are left out"
+    if ax.get_title():  # the heatmap's best cell
+        title += "\n" + ax.get_title()
+    ax.set_title(title, fontsize=10)
     return save_png(fig, out)
+
+
+def _cell_values(ax: plt.Axes, grid: np.ndarray, norm: Any) -> None:
+    """Each heatmap cell's value, in black on light cells and white on dark ones."""
+    for (j, i), value in np.ndenumerate(grid):
+        finite = bool(np.isfinite(value))
+        dark = finite and norm(value) < 0.5  # viridis is dark at its low end
+        ax.text(
+            i,
+            j,
+            f"{value:.3g}" if finite else "none",
+            ha="center",
+            va="center",
+            fontsize=8,
+            color="white" if dark else ("black" if finite else "0.4"),
+        )

@@ -19,6 +19,7 @@ class Check:
     value: float | None
     passed: bool
     skipped: bool = False
+    why: str = ""  # why it was skipped
 
     @property
     def what(self) -> str:
@@ -38,8 +39,7 @@ class Check:
     def describe(self) -> str:
         """``max_distance (phase 1) = 24.3, below 26: pass``."""
         if self.skipped:
-            cut = "window" if self.expectation.trace is not None else "phase"
-            return f"{self.what}: skipped ({cut} not run, --duration cut it)"
+            return f"{self.what}: skipped ({self.why})"
         value = "none" if self.value is None else f"{self.value:.4g}"
         return f"{self.what} = {value}, {self.bound}: {self.verdict}"
 
@@ -81,8 +81,9 @@ def check_expectations(
                 columns = _read(trace)
             checks.append(_trace_check(e, *columns))
             continue
-        if e.phase is not None and e.phase >= len(metrics["phases"]):
-            checks.append(Check(e, None, True, skipped=True))
+        why = skip_reason(e, metrics)
+        if why is not None:
+            checks.append(Check(e, None, True, skipped=True, why=why))
             continue
         block = metrics["overall"] if e.phase is None else metrics["phases"][e.phase]
         value = block.get(e.metric)
@@ -93,6 +94,25 @@ def check_expectations(
             ok = value > e.above
         checks.append(Check(e, value, ok))
     return checks
+
+
+def skip_reason(e: Expectation, metrics: dict[str, Any]) -> str | None:
+    """Why a metric check cannot be judged on this run, or None if it can.
+
+    A phase the run never reached, or a block the run stopped inside (``--duration`` shorter
+    than the file's, the window closed early), is not judged: the bound is about the whole
+    phase, and half a phase would fail (or pass) for the wrong reason.
+    """
+    if e.trace is not None:
+        return None
+    reached = metrics.get("simulated", 0.0)
+    if e.phase is not None and e.phase >= len(metrics["phases"]):
+        return f"phase {e.phase} not reached: the run ended at t={reached:g} s"
+    block = metrics["overall"] if e.phase is None else metrics["phases"][e.phase]
+    if block.get("partial"):
+        what = "the run" if e.phase is None else f"phase {e.phase}"
+        return f"{what} was cut short at t={reached:g} s"
+    return None
 
 
 def _read(trace: Path | tuple[list[str], np.ndarray] | None) -> tuple[list[str], np.ndarray]:
@@ -117,7 +137,8 @@ def _trace_check(e: Expectation, header: list[str], data: np.ndarray) -> Check:
         ran_until = float(t[-1]) if t.size else 0.0
         # a window that starts after the run ended was cut off (--duration), like a phase
         cut = e.after is not None and e.after > ran_until
-        return Check(e, None, cut, skipped=cut)
+        why = f"window not reached: the run ended at t={ran_until:g} s" if cut else ""
+        return Check(e, None, cut, skipped=cut, why=why)
     worst: float | None = None
     ok = True
     if e.above is not None:

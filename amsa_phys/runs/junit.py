@@ -1,4 +1,10 @@
-"""JUnit XML for CI systems: one testcase per expectation, one suite per scenario."""
+"""JUnit XML for CI systems: one testcase per expectation, one suite per scenario.
+
+Each test case is named by its check and bound (``max_distance (phase 1) below 26``), its
+class is the scenario file's path (two scenarios may share a name, never a path), and every
+case records the measured value as a property (a pass also as ``system-out``), so a CI's
+history shows how close a passing check came to its bound.
+"""
 
 from __future__ import annotations
 
@@ -25,15 +31,23 @@ def write_junit(results: list[ScenarioResult], path: Path) -> None:
             time=f"{r.wall_s:.3f}",
         )
         if r.error is not None:
-            case = ET.SubElement(suite, "testcase", classname=r.name, name="load and run")
+            case = ET.SubElement(suite, "testcase", classname=r.path, name="load and run")
             ET.SubElement(case, "error", message=r.error).text = r.error
             continue
         for c in r.checks:
-            case = ET.SubElement(suite, "testcase", classname=r.name, name=c.what)
+            # the bound is part of the name: two checks on one metric (below 26, above 2)
+            # are two distinct test cases in a CI's history
+            case = ET.SubElement(suite, "testcase", classname=r.path, name=f"{c.what} {c.bound}")
+            props = ET.SubElement(case, "properties")
+            value = "none" if c.value is None else repr(c.value)
+            ET.SubElement(props, "property", name="measured", value=value)
+            ET.SubElement(props, "property", name="bound", value=c.bound)
             if c.skipped:
                 ET.SubElement(case, "skipped", message=c.describe())
             elif not c.passed:
                 ET.SubElement(case, "failure", message=c.describe()).text = c.describe()
+            else:  # a pass records what was measured too, not only that it passed
+                ET.SubElement(case, "system-out").text = c.describe()
     tree = ET.ElementTree(root)
     ET.indent(tree)
     write_atomic(path, ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n")

@@ -27,19 +27,47 @@ import signal
 import sys
 from multiprocessing.connection import Connection
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from ..model.world import WorldSpec
 
 #: How long the parent waits for the child's plots before drawing them itself.
 TIMEOUT_S = 60.0
 
 
-def draw_run_plots(trace: Path, metrics: dict[str, Any], distance: Path, trajectory: Path) -> None:
-    """The distance and trajectory plots of a run (imports matplotlib on first use)."""
+def draw_run_plots(
+    trace: Path,
+    metrics: dict[str, Any],
+    distance: Path,
+    trajectory: Path,
+    world: dict[str, Any] | None = None,
+) -> list[Path]:
+    """The distance and trajectory plots of a run (imports matplotlib on first use).
+
+    A run without a quality signal has no distance to plot: ``distance.png`` is not drawn
+    (rather than left blank), and the caller says so. ``world`` is :func:`plot_context`.
+    Returns the files written.
+    """
     from ..plots.distance import plot_distance
     from ..plots.trajectory import plot_trajectory
 
-    plot_distance(trace, metrics, distance)
-    plot_trajectory(trace, metrics, trajectory)
+    written = []
+    if metrics.get("quality"):
+        written.append(plot_distance(trace, metrics, distance))
+    written.append(plot_trajectory(trace, metrics, trajectory, world))
+    return written
+
+
+def plot_context(world: WorldSpec) -> dict[str, Any]:
+    """What the trajectory plot needs from the world: its static arena (``physics``) and
+    which rover each GPS measures (``gps_of``: GPS path -> rover path), plain data."""
+    gps_of = {}
+    for path, leaf in world.leaves.items():
+        source = leaf.inputs.get("posX", "")
+        if leaf.template.name() == "GPS" and source.endswith(".posX"):
+            gps_of[path] = source[: -len(".posX")]
+    return {"physics": world.physics, "gps_of": gps_of}
 
 
 def _child(jobs: Connection, parent_end: Connection) -> None:
@@ -95,14 +123,21 @@ class PlotJob:
         """Whether a child is standing by."""
         return self._conn is not None
 
-    def draw(self, trace: Path, metrics: dict[str, Any], distance: Path, trajectory: Path) -> None:
+    def draw(
+        self,
+        trace: Path,
+        metrics: dict[str, Any],
+        distance: Path,
+        trajectory: Path,
+        world: dict[str, Any] | None = None,
+    ) -> None:
         """Draw the plots: by the child if it answers in time, else here."""
-        args = (Path(trace), metrics, Path(distance), Path(trajectory))
+        args = (Path(trace), metrics, Path(distance), Path(trajectory), world)
         if self._handoff(args):
             return
         draw_run_plots(*args)
 
-    def _handoff(self, args: tuple[Path, dict[str, Any], Path, Path]) -> bool:
+    def _handoff(self, args: tuple[Any, ...]) -> bool:
         conn = self._conn
         if conn is None:
             return False

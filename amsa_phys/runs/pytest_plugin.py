@@ -14,7 +14,7 @@ from typing import Any
 
 import pytest
 
-from .suite import has_expectations, run_scenario_file
+from .suite import has_expectations, in_run_directory, run_scenario_file
 
 
 class ScenarioFailed(Exception):
@@ -23,7 +23,11 @@ class ScenarioFailed(Exception):
 
 def pytest_collect_file(parent: pytest.Collector, file_path: Path) -> pytest.File | None:
     """Collect ``*.yaml`` / ``*.yml`` scenario files that declare expectations."""
-    if file_path.suffix in (".yaml", ".yml") and has_expectations(file_path):
+    if (
+        file_path.suffix in (".yaml", ".yml")
+        and has_expectations(file_path)
+        and not in_run_directory(file_path)  # a run's resolved scenario, not a test
+    ):
         return ScenarioFile.from_parent(parent, path=file_path)
     return None
 

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import copy
+from collections.abc import Sequence
 from fractions import Fraction
 from typing import Any
 
-from ..model.scenario import Change, Scenario
+from ..model.scenario import Change, Expectation, Scenario
 from ..model.world import LeafSpec
 
 
@@ -40,12 +41,17 @@ def resolved_scenario(
     scenario: Scenario,
     extra: list[tuple[Fraction, Change]] | None = None,
     duration: Fraction | None = None,
+    drop: Sequence[Expectation] = (),
 ) -> dict[str, Any]:
     """A scenario dict with the world inlined and every Leaf parameter written out.
 
-    ``extra`` adds changes made live (the window), merged into the timeline in time order;
-    a change made before the first instant ran becomes part of ``set``. ``duration`` cuts
-    the scenario where a window session was closed, so replaying it gives the same trace.
+    ``extra`` adds changes made live (the window): each becomes a timeline entry labelled
+    ``live`` with ``new_phase: false`` — a change inside the phase it landed in, so the
+    replay has the session's phases and ``expect: {phase: i}`` judges the same phase. A
+    change made before the first instant ran becomes part of ``set``. ``duration`` cuts the
+    scenario where a window session was closed, so replaying it gives the same trace.
+    ``drop`` lists the expectations the run could not judge (a phase cut short or never
+    reached): they are left out, so the replay judges what the run judged.
     """
     world = copy.deepcopy(scenario.world.data)
 
@@ -68,22 +74,29 @@ def resolved_scenario(
     world["physics"] = copy.deepcopy(scenario.world.physics)
     if world["physics"].get("walls") is None:
         world["physics"].pop("walls", None)
-    timeline: dict[Fraction, dict[str, Any]] = {}
-    labels: dict[Fraction, str] = {}
-    for phase in scenario.phases[1:]:
-        timeline.setdefault(phase.at, {}).update({c.key: _plain(c.value) for c in phase.changes})
-        if phase.label:
-            labels[phase.at] = phase.label
+    entries: dict[Fraction, dict[str, Any]] = {}
+
+    def entry(at: Fraction, label: str, new_phase: bool) -> dict[str, Any]:
+        if at not in entries:
+            entries[at] = {"set": {}, "label": label, "new_phase": new_phase}
+        return entries[at]
+
+    for i, phase in enumerate(scenario.phases):
+        if i > 0:
+            entry(phase.at, phase.label, True)["set"].update(
+                {c.key: _plain(c.value) for c in phase.changes}
+            )
+        for step in phase.within:
+            entry(step.at, step.label, False)["set"].update(
+                {c.key: _plain(c.value) for c in step.changes}
+            )
     initial = {c.key: _plain(c.value) for c in scenario.phases[0].changes}
     for at, change in extra or []:
         if at == 0:
             initial[change.key] = _plain(change.value)
-            continue
-        if at not in timeline:
-            labels[at] = "live"
-        timeline.setdefault(at, {})[change.key] = _plain(change.value)
+        else:
+            entry(at, "live", False)["set"][change.key] = _plain(change.value)
     end = scenario.duration if duration is None else Fraction(duration)
-    timeline = {at: sets for at, sets in timeline.items() if at < end}
     out: dict[str, Any] = {
         "name": scenario.name,
         "world": world,
@@ -95,16 +108,21 @@ def resolved_scenario(
     if scenario.quality:
         q = scenario.quality
         out["quality"] = {"signal": q.signal, "reference": q.reference, "tolerance": q.tolerance}
+    timeline = [at for at in sorted(entries) if at < end]
     if timeline:
         out["timeline"] = []
-        for at in sorted(timeline):
-            entry: dict[str, Any] = {"at": _time(at), "set": timeline[at]}
-            if at in labels:
-                entry["label"] = labels[at]
-            out["timeline"].append(entry)
-    if scenario.expect:
+        for at in timeline:
+            e = entries[at]
+            item: dict[str, Any] = {"at": _time(at), "set": e["set"]}
+            if e["label"]:
+                item["label"] = e["label"]
+            if not e["new_phase"]:
+                item["new_phase"] = False
+            out["timeline"].append(item)
+    kept = [e for e in scenario.expect if not any(e is d for d in drop)]
+    if kept:
         out["expect"] = []
-        for e in scenario.expect:
+        for e in kept:
             fields = (
                 ("metric", e.metric),
                 ("trace", e.trace),

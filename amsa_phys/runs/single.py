@@ -12,6 +12,7 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -23,10 +24,11 @@ from ..engine.metrics import block_metrics
 from ..engine.recorder import TraceWriter, write_atomic
 from ..engine.runner import RunResult, Simulation
 from ..errors import Interrupted, RunFault
-from ..model.scenario import Scenario
+from ..model.scenario import Change, Expectation, Scenario
 from ..view.drive import FrameSink, advance
 from ..view.encoder import EncoderError
-from .plotjob import PlotJob
+from .expect import describe_bound, describe_what, skip_reason
+from .plotjob import PlotJob, plot_context
 from .resolve import resolved_scenario
 
 if TYPE_CHECKING:  # pygame is imported only by runs that draw
@@ -48,30 +50,57 @@ class RunOutcome:
 
 
 def compute_metrics(
-    scenario: Scenario, sim: Simulation, result: RunResult, wall_s: float, status: str
+    scenario: Scenario,
+    sim: Simulation,
+    result: RunResult,
+    wall_s: float,
+    status: str,
+    idle_s: float = 0.0,
 ) -> dict[str, Any]:
-    """The ``metrics.json`` document (design.md) for a run that reached ``result.t_end``."""
-    end = result.t_end
+    """The ``metrics.json`` document (design.md) for a run that reached ``result.t_end``.
+
+    A run that stopped before its planned end (``--duration`` shorter than the file's, the
+    window closed, a fault, Ctrl-C) lists only the phases it entered; the phase it stopped
+    in, and the overall block, are marked ``partial``: their checks are skipped, not failed.
+    Changes made inside a phase (``new_phase: false`` entries, live changes from the
+    window) are listed in that phase's ``changes``; they never start a phase of their own,
+    so a session and its replay have the same phases. ``idle_s`` is wall-clock time the
+    window spent paused (or finished, waiting to be closed): not part of the run's speed.
+    """
+    completed = status == "completed"
+    end = float(scenario.duration) if completed else result.t_end
+    bounds = [float(b) for b in scenario.planned_bounds or []] or [
+        *(float(p.at) for p in scenario.phases),
+        float(scenario.duration),
+    ]
     q = scenario.quality
     collisions = [e.t for e in result.events if e.kind == "collision"]
-    starts = [float(p.at) for p in scenario.phases]
+    inner = _changes_within(scenario, sim.live_changes)
+    kept = [p for i, p in enumerate(scenario.phases) if i == 0 or float(p.at) < end]
     phases = []
-    for i, phase in enumerate(scenario.phases):
-        p_end = starts[i + 1] if i + 1 < len(starts) else float(scenario.duration)
+    for i, phase in enumerate(kept):
+        last = i + 1 == len(kept)
+        planned_end = bounds[i + 1]
+        p_end = min(planned_end, end) if last else planned_end
+        start = float(phase.at)
         block: dict[str, Any] = {
-            "start": starts[i],
+            "start": start,
             "end": p_end,
             "set": {c.key: _jsonable(c.value) for c in phase.changes},
         }
         if phase.label:
             block["label"] = phase.label
+        changes = [c for c in inner if start <= c["at"] < p_end or (last and c["at"] == p_end)]
+        if changes:
+            block["changes"] = changes
+        if p_end < planned_end:
+            block["partial"] = True
         if q is not None and result.samples_t.size:
-            last = i + 1 == len(scenario.phases)
             block.update(
                 block_metrics(
                     result.samples_t,
                     result.samples_s,
-                    starts[i],
+                    start,
                     p_end,
                     q.reference,
                     q.tolerance,
@@ -80,14 +109,16 @@ def compute_metrics(
                 )
             )
         else:
-            block["collisions"] = sum(1 for t in collisions if starts[i] <= t < p_end)
+            block["collisions"] = sum(
+                1 for t in collisions if start <= t and (t <= p_end if last else t < p_end)
+            )
         phases.append(block)
     if q is not None and result.samples_t.size:
         overall = block_metrics(
             result.samples_t,
             result.samples_s,
             0.0,
-            float(scenario.duration),
+            end,
             q.reference,
             q.tolerance,
             collisions,
@@ -95,11 +126,14 @@ def compute_metrics(
         )
     else:
         overall = {"collisions": len(collisions)}
+    if end < bounds[-1]:
+        overall["partial"] = True
+    busy = wall_s - idle_s
     return {
         "scenario": scenario.name,
         "seed": scenario.seed,
         "duration": float(scenario.duration),
-        "simulated": end,
+        "simulated": result.t_end,
         "status": status,
         "quality": (
             {"signal": q.signal, "reference": q.reference, "tolerance": q.tolerance} if q else None
@@ -108,8 +142,26 @@ def compute_metrics(
         "phases": phases,
         "events": [{"t": e.t, "kind": e.kind, "detail": e.detail} for e in result.events[:1000]],
         "wall_time_s": round(wall_s, 3),
-        "real_time_factor": round(end / wall_s, 1) if wall_s > 0 else None,
+        **({"paused_s": round(idle_s, 3)} if idle_s > 0 else {}),
+        "real_time_factor": round(result.t_end / busy, 1) if busy > 0 else None,
     }
+
+
+def _changes_within(
+    scenario: Scenario, live: list[tuple[Fraction, Change]]
+) -> list[dict[str, Any]]:
+    """Changes made inside phases (timeline ``new_phase: false`` and live), in time order."""
+    out: dict[Fraction, dict[str, Any]] = {}
+    for phase in scenario.phases:
+        for step in phase.within:
+            entry = out.setdefault(step.at, {"at": float(step.at), "set": {}})
+            entry["set"].update({c.key: _jsonable(c.value) for c in step.changes})
+            if step.label:
+                entry["label"] = step.label
+    for at, change in live:
+        entry = out.setdefault(at, {"at": float(at), "set": {}, "label": "live"})
+        entry["set"][change.key] = _jsonable(change.value)
+    return [out[at] for at in sorted(out)]
 
 
 def _jsonable(value: Any) -> Any:
@@ -172,7 +224,7 @@ def _run_scenario(
     ended = execute(
         scenario, trace, progress=progress, record=record, snapshot=snapshot, window=window
     )
-    write_run_files(out_dir, ended.metrics, ended.resolved, plot=plot, plotter=plotter)
+    write_run_files(out_dir, ended, plot=plot, plotter=plotter)
     error = ended.error
     t_end = ended.metrics["simulated"]
     if isinstance(error, KeyboardInterrupt):
@@ -214,6 +266,7 @@ class Ended:
     metrics: dict[str, Any]
     resolved: dict[str, Any]
     error: BaseException | None
+    note: str = ""  # a comment heading scenario.yaml (checks a cut run left out)
 
 
 def execute(
@@ -237,6 +290,7 @@ def execute(
     recorder: Recorder | None = None
     still: Snapshot | None = None
     t0 = time.perf_counter()
+    idle = 0.0
     try:
         sim.initialize()
         if record is not None:
@@ -249,7 +303,7 @@ def execute(
             still = Snapshot(sim, snapshot, scenario.quality)
         if window:
             driver = window if callable(window) else _open_window
-            driver(sim, scenario, recorder)
+            idle = driver(sim, scenario, recorder) or 0.0
             if not sim.finished:
                 status = f"closed in the window at t={float(sim.now):g} s"
         else:
@@ -266,46 +320,62 @@ def execute(
     trace.close()
     video = _finish_video(recorder, error)
     result = sim.result()
-    metrics = compute_metrics(scenario, sim, result, wall, status)
+    metrics = compute_metrics(scenario, sim, result, wall, status, idle_s=idle)
     if video is not None:
         metrics["video"] = video
     if still is not None:
         metrics["snapshot"] = {"path": str(still.close()), "t": float(still.at)}
     stopped_early = window and not sim.finished and error is None and sim.now > 0
+    drop = [e for e in scenario.expect if skip_reason(e, metrics) is not None]
     resolved = resolved_scenario(
-        scenario, extra=sim.live_changes, duration=sim.now if stopped_early else None
+        scenario,
+        extra=sim.live_changes,
+        duration=sim.now if stopped_early else None,
+        drop=drop,
     )
-    return Ended(scenario, sim, metrics, resolved, error)
+    return Ended(scenario, sim, metrics, resolved, error, _cut_note(metrics, drop))
 
 
 def write_run_files(
-    out_dir: Path,
-    metrics: dict[str, Any],
-    resolved: dict[str, Any],
-    *,
-    plot: bool = True,
-    plotter: PlotJob | None = None,
+    out_dir: Path, ended: Ended, *, plot: bool = True, plotter: PlotJob | None = None
 ) -> None:
     """``metrics.json``, ``scenario.yaml`` and (with ``plot``) the two plots of a run whose
     ``trace.csv`` is already in ``out_dir``; each file is written atomically."""
+    metrics = ended.metrics
     write_atomic(out_dir / "metrics.json", json.dumps(metrics, indent=2) + "\n")
-    text = yaml.dump(resolved, Dumper=_YAML_DUMPER, sort_keys=False)
+    text = ended.note + yaml.dump(ended.resolved, Dumper=_YAML_DUMPER, sort_keys=False)
     write_atomic(out_dir / "scenario.yaml", text)
     plotter = plotter or PlotJob()
     if plot:
         plotter.draw(
-            out_dir / "trace.csv", metrics, out_dir / "distance.png", out_dir / "trajectory.png"
+            out_dir / "trace.csv",
+            metrics,
+            out_dir / "distance.png",
+            out_dir / "trajectory.png",
+            plot_context(ended.scenario.world),
         )
     plotter.close()
 
 
-WindowDriver = Callable[[Simulation, Scenario, "Recorder | None"], None]
+def _cut_note(metrics: dict[str, Any], dropped: list[Expectation]) -> str:
+    """A comment heading a cut run's resolved scenario: what was left out, and why."""
+    if not dropped:
+        return ""
+    names = "; ".join(f"{describe_what(e)} {describe_bound(e)}" for e in dropped)
+    return (
+        f"# this run stopped at t={metrics['simulated']:g} s, so these checks were not "
+        f"judged and are left out: {names}\n"
+    )
 
 
-def _open_window(sim: Simulation, scenario: Scenario, recorder: Recorder | None) -> None:
+#: Runs a window session; returns the wall-clock seconds it was paused (None: never).
+WindowDriver = Callable[[Simulation, Scenario, "Recorder | None"], "float | None"]
+
+
+def _open_window(sim: Simulation, scenario: Scenario, recorder: Recorder | None) -> float:
     from ..view.window import Window
 
-    Window(sim, scenario.quality, title=scenario.name, recorder=recorder).run()
+    return Window(sim, scenario.quality, title=scenario.name, recorder=recorder).run()
 
 
 def _finish_video(recorder: Recorder | None, error: BaseException | None) -> dict[str, Any] | None:

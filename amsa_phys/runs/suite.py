@@ -17,7 +17,7 @@ from ..errors import AmsaError
 from ..model.scenario import Scenario, load_scenario
 from ..model.yamlio import load_yaml
 from .expect import Check, check_expectations
-from .rundir import prepare_run_dir, unique_names
+from .rundir import MARKER, prepare_run_dir, unique_names
 from .single import run_scenario
 
 _EXPECT = re.compile(r"^expect\s*:", re.MULTILINE)
@@ -48,13 +48,37 @@ def has_expectations(path: Path) -> bool:
         return False
 
 
-def find_scenarios(paths: list[str]) -> list[Path]:
-    """Scenario files with expectations: files as given, folders searched recursively."""
+def in_run_directory(path: Path) -> bool:
+    """Whether ``path`` is an output of a run (a run directory's resolved ``scenario.yaml``).
+
+    A folder search skips those: ``test runs/`` would otherwise rerun every old run as a
+    test. A run directory holds amsa-phys's marker file, or (made before the marker) a
+    ``metrics.json`` beside its ``scenario.yaml``.
+    """
+    parent = path.parent
+    if (parent / MARKER).is_file():
+        return True
+    return path.name == "scenario.yaml" and (parent / "metrics.json").is_file()
+
+
+def find_scenarios(paths: list[str], skipped: list[Path] | None = None) -> list[Path]:
+    """Scenario files with expectations: files as given, folders searched recursively.
+
+    A folder's run directories are skipped (see :func:`in_run_directory`) and listed in
+    ``skipped``; a file given by name always runs (that is how a run is replayed as a test).
+    """
     found: list[Path] = []
     for raw in paths:
         p = Path(raw)
         if p.is_dir():
-            found += [f for f in sorted(p.rglob("*.y*ml")) if has_expectations(f)]
+            for f in sorted(p.rglob("*.y*ml")):
+                if not has_expectations(f):
+                    continue
+                if in_run_directory(f):
+                    if skipped is not None:
+                        skipped.append(f)
+                    continue
+                found.append(f)
         else:
             found.append(p)
     return found

@@ -18,6 +18,7 @@ import math
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -27,7 +28,17 @@ import yaml
 from ..engine import interrupt
 from ..engine.runner import Simulation
 from ..errors import AmsaError, ConfigError
-from ..model.scenario import METRICS, Scenario, check_phases, load_scenario, resolve_change
+from ..model.scenario import (
+    METRICS,
+    PHYSICS_PREFIX,
+    Scenario,
+    check_phases,
+    load_scenario,
+    physics_setting,
+    resolve_change,
+    shorten,
+    with_physics,
+)
 from .pool import WORKER_LOST, imap_resilient
 from .rundir import prepare_run_dir
 from .single import compute_metrics, run_scenario
@@ -118,6 +129,7 @@ class SweepPlan:
     duration: float | None = None
     keep_dir: str | None = None
     inputs: tuple[Path, ...] = ()  # files the sweep reads: its --out must not hold them
+    warnings: tuple[str, ...] = ()  # said once before the sweep starts
 
     def jobs(self) -> list[Job]:
         """The Cartesian product of the axes, then seeds, in a fixed order."""
@@ -199,10 +211,59 @@ def check_axes(axes: list[Axis], scenario: Scenario) -> None:
             raise ConfigError(f"{axis.key} appears twice", key="--grid")
         seen.add(axis.key)
         for value in axis.values:
+            if axis.key.startswith(PHYSICS_PREFIX):
+                physics_setting(axis.key, value, option=f"--grid {axis.key}")
+                continue
             try:
                 resolve_change(axis.key, value, scenario.world)
             except ValueError as exc:
                 raise ConfigError(str(exc), key=f"--grid {axis.key}") from None
+
+
+def apply_setting(scenario: Scenario, key: str, value: Any) -> None:
+    """Put one grid value into ``scenario``: a parameter at t = 0, or a physics setting."""
+    if key.startswith(PHYSICS_PREFIX):
+        nested = physics_setting(key, value, option=f"--grid {key}")
+        scenario.world = with_physics(scenario.world, nested)
+    else:
+        scenario.phases[0].changes.append(resolve_change(key, value, scenario.world))
+
+
+def timeline_overlaps(keys: list[str], scenario: Scenario, end: Fraction) -> list[str]:
+    """A warning for each swept parameter the scenario's timeline also changes before ``end``.
+
+    The grid sets its value at t = 0; a timeline entry then overrides it, so the axis only
+    shapes the run until that entry (often phase 0 alone) and the overall metrics mix in
+    phases where every run has the same value.
+    """
+    out = []
+    for key in dict.fromkeys(keys):  # once per key, in order
+        times = []
+        for i, phase in enumerate(scenario.phases):
+            steps = [(phase.at, phase.changes)] if i > 0 else []
+            steps += [(step.at, step.changes) for step in phase.within]
+            times += [
+                at for at, changes in steps if at < end and any(c.key == key for c in changes)
+            ]
+        if times:
+            when = ", ".join(f"{float(t):g}" for t in sorted(times))
+            first = min(times)
+            starts = [p.at for p in scenario.phases]
+            reach = (
+                (
+                    "phase 0 only"
+                    if starts.index(first) == 1
+                    else f"phases 0-{starts.index(first) - 1}"
+                )
+                if first in starts
+                else f"the first {float(first):g} s only"
+            )
+            out.append(
+                f"{key} is swept, but the timeline also sets it (at {when} s): each run's "
+                f"value holds only until {float(first):g} s, so the axis affects {reach}; "
+                "compare phase-0 metrics (--metric phase0.rms_error) or drop those entries"
+            )
+    return out
 
 
 @functools.lru_cache(maxsize=8)
@@ -227,16 +288,15 @@ def run_job(job: Job) -> dict[str, Any]:
     try:
         scenario = copy.deepcopy(_cached(job.scenario))
         if job.duration is not None:
-            scenario.duration = type(scenario.duration)(str(job.duration))
-            scenario.phases = [p for p in scenario.phases if p.at < scenario.duration]
+            shorten(scenario, Fraction(str(job.duration)))
         scenario.seed = job.seed
         contexts = dict(job.contexts)
         for key, value in job.point:
             if key == "context":
                 for k, v in contexts[value]:
-                    scenario.phases[0].changes.append(resolve_change(k, v, scenario.world))
+                    apply_setting(scenario, k, v)
             else:
-                scenario.phases[0].changes.append(resolve_change(key, value, scenario.world))
+                apply_setting(scenario, key, value)
         check_phases(scenario, None)  # this point's combination may break a template's rule
         if job.keep_dir is not None:
             out = prepare_run_dir(Path(job.keep_dir) / f"run-{job.index:05d}", force=True)

@@ -14,6 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..palette import ALERT, rover_colour
 from .camera import Camera
 from .pg import font, pygame
 from .scene import Frame, RoverPose
@@ -25,27 +26,11 @@ INK = (32, 32, 36)
 MUTED = (110, 110, 116)
 OBSTACLE = (120, 116, 108)
 WHEEL = (40, 40, 44)
-LOST = (214, 39, 40)
+LOST = ALERT
 OK = (44, 160, 44)
 WARN = (240, 170, 30)
 BAD = (214, 39, 40)
-ROVER_COLOURS = [
-    (230, 120, 30),  # leader: orange
-    (31, 119, 180),  # follower: blue
-    (44, 160, 44),
-    (148, 103, 189),
-    (140, 86, 75),
-    (227, 119, 194),
-    (127, 127, 127),
-    (188, 189, 34),
-    (23, 190, 207),
-]
 MIN_ROVER_PX = 5.0
-
-
-def rover_colour(index: int) -> tuple[int, int, int]:
-    """Colour of the index-th rover (leader first, as in the plots)."""
-    return ROVER_COLOURS[index % len(ROVER_COLOURS)]
 
 
 def error_colour(error: float, tolerance: float) -> tuple[int, int, int]:
@@ -73,13 +58,22 @@ def nice_step(target_m: float) -> float:
 
 
 class Renderer:
-    """Draws frames at one size; the HUD's font scales with the height."""
+    """Draws frames at one size; the HUD's font and layout scale with the frame.
+
+    The text size follows the smaller of height / 48 and width / 85 (at least 9 px), HUD
+    lines wrap to the room they have, and the status box moves below the HUD when the two
+    would not fit side by side: nothing is clipped or overlaps from 320x240 up.
+    """
+
+    MARGIN = 10
 
     def __init__(self, size: tuple[int, int]) -> None:
         self.size = size
-        self.text_px = max(11, round(size[1] / 48))
+        self.text_px = max(9, round(min(size[1] / 48, size[0] / 85)))
         self.font = font(self.text_px)
-        self.small = font(max(9, self.text_px - 3))
+        self.small = font(max(8, self.text_px - 3))
+        #: the text boxes of the last frame drawn (``hud``, ``status``), in pixels
+        self.boxes: dict[str, pygame.Rect] = {}
 
     def draw(
         self,
@@ -227,9 +221,27 @@ class Renderer:
         else:
             lines.append(f"collisions {m.collisions}")
             colours.append(INK)
-        self.panel(surface, lines, colours, (10, 10), align_right=False)
+        w = self.size[0]
+        gap = self.MARGIN
+        full = w - 2 * gap
+        status_w = self.text_width(status) if status else 0
+        hud_w = self.text_width(lines)
+        beside = full - status_w - gap  # room left of the status box
+        if not status or hud_w <= beside or beside >= 0.55 * full:
+            hud = self.panel(surface, lines, colours, (gap, gap), align_right=False, width=beside)
+            top = gap
+        else:  # too narrow for both on one row: the status goes under the HUD
+            hud = self.panel(surface, lines, colours, (gap, gap), align_right=False, width=full)
+            top = hud.bottom + gap // 2
+        self.boxes = {"hud": hud}
         if status:
-            self.panel(surface, list(status), [INK] * len(status), (10, 10), align_right=True)
+            self.boxes["status"] = self.panel(
+                surface, list(status), [INK] * len(status), (gap, top), align_right=True
+            )
+
+    def text_width(self, lines: Sequence[str]) -> int:
+        """Width of a panel holding ``lines`` unwrapped, padding included."""
+        return max(self.font.size(t)[0] for t in lines) + 12
 
     def panel(
         self,
@@ -239,20 +251,53 @@ class Renderer:
         at: tuple[int, int],
         *,
         align_right: bool,
-    ) -> None:
-        """Text lines on a translucent box, from the top-left or top-right corner."""
-        rendered = [self.font.render(t, True, c) for t, c in zip(lines, colours, strict=True)]
+        width: int | None = None,
+    ) -> pygame.Rect:
+        """Text lines on a translucent box, from the top-left or top-right corner.
+
+        Lines longer than ``width`` (default: the frame less the margins) wrap at spaces.
+        Returns the box drawn.
+        """
         pad = 6
-        width = max(r.get_width() for r in rendered) + 2 * pad
-        height = sum(r.get_height() for r in rendered) + 2 * pad
-        x = self.size[0] - width - at[0] if align_right else at[0]
-        box = pygame.Surface((width, height), pygame.SRCALPHA)
+        room = max(40, (width if width is not None else self.size[0] - 2 * at[0]) - 2 * pad)
+        rendered = [
+            self.font.render(part, True, c)
+            for t, c in zip(lines, colours, strict=True)
+            for part in _wrap(t, self.font, room)
+        ]
+        box_w = max(r.get_width() for r in rendered) + 2 * pad
+        box_h = sum(r.get_height() for r in rendered) + 2 * pad
+        x = self.size[0] - box_w - at[0] if align_right else at[0]
+        box = pygame.Surface((box_w, box_h), pygame.SRCALPHA)
         box.fill((255, 255, 255, 215))
         surface.blit(box, (x, at[1]))
         y = at[1] + pad
         for r in rendered:
             surface.blit(r, (x + pad, y))
             y += r.get_height()
+        return pygame.Rect(x, at[1], box_w, box_h)
+
+
+def _wrap(text: str, fnt: pygame.font.Font, room: int) -> list[str]:
+    """``text`` split at spaces into lines at most ``room`` pixels wide (words cut if need be)."""
+    if fnt.size(text)[0] <= room:
+        return [text]
+    out: list[str] = []
+    line = ""
+    for word in text.split(" "):
+        trial = f"{line} {word}" if line else word
+        if fnt.size(trial)[0] <= room:
+            line = trial
+            continue
+        if line:
+            out.append(line)
+        while fnt.size(word)[0] > room and len(word) > 1:  # a word wider than the box
+            cut = max(1, int(len(word) * room / fnt.size(word)[0]))
+            out.append(word[:cut])
+            word = word[cut:]
+        line = word
+    out.append(line)
+    return out
 
 
 def _screen(camera: Camera, points: Sequence[tuple[float, float]]) -> list[list[float]]:

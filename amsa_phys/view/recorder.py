@@ -96,11 +96,9 @@ class SnapshotOptions:
 class Snapshot:
     """One still frame at simulated time ``at``, saved as PNG (the README's pictures).
 
-    The scene is sampled every :attr:`SAMPLE` simulated seconds before the picture so the
-    trails and GPS history look as they do in the video at that instant.
+    Its scene samples the history (trails, GPS fixes) at every logged instant before the
+    picture, so the trails look as they do in the video at that instant.
     """
-
-    SAMPLE = Fraction(1, 10)
 
     def __init__(
         self, sim: Simulation, options: SnapshotOptions, quality: Quality | None = None
@@ -109,23 +107,15 @@ class Snapshot:
         self.options = options
         self.at = min(options.at if options.at is not None else sim.duration, sim.duration)
         self.scene = Scene(sim, quality)
-        self.index = 0
         self.written: Path | None = None
 
     def next_time(self) -> Fraction | None:
-        """The next history sample, then the picture's time."""
-        if self.written is not None:
-            return None
-        return min(self.SAMPLE * self.index, self.at)
+        """The picture's time (None once it is taken)."""
+        return None if self.written is not None else self.at
 
     def capture(self) -> None:
-        """Sample the history, or take the picture when its time has come."""
-        t = min(self.SAMPLE * self.index, self.at)
-        self.index += 1
-        if t < self.at:
-            self.scene.frame(t=float(t))
-        else:
-            self.write(t)
+        """Take the picture: its time has come."""
+        self.write(self.at)
 
     def write(self, t: Fraction | None = None) -> Path:
         """Render now and save (atomically: a temporary name, then a rename)."""

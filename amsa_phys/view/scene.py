@@ -14,7 +14,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..engine.runner import Simulation
+from ..model.geometry import Obstacle, static_obstacles
 from ..model.scenario import Quality
+from ..palette import rover_names
 
 #: Trail and GPS history kept per rover: bounded, so a long run draws in constant time.
 TRAIL_POINTS = 1500
@@ -39,15 +41,6 @@ class RoverPose:
     speed: float
 
 
-@dataclass(frozen=True)
-class Obstacle:
-    """Static geometry in world metres: ``poly`` (closed), ``circle`` or ``line`` (open)."""
-
-    kind: str
-    points: tuple[tuple[float, float], ...]
-    radius: float = 0.0
-
-
 @dataclass
 class GpsTrack:
     """A GPS sensor's recent fixes and the true positions where fixes were lost."""
@@ -61,7 +54,7 @@ class GpsTrack:
 
 @dataclass
 class LiveMetrics:
-    """Quality of control over the frames seen so far (the trace-based metrics come at the end)."""
+    """Quality of control over the logged instants so far: ``metrics.json``'s samples."""
 
     value: float | None = None
     max: float = -math.inf
@@ -93,31 +86,6 @@ class Frame:
     duration: float
 
 
-def static_obstacles(physics: dict[str, Any]) -> list[Obstacle]:
-    """Obstacles and walls from the world's ``physics:`` settings (the same data pymunk got)."""
-    out: list[Obstacle] = []
-    for ob in physics.get("obstacles") or []:
-        if ob["type"] == "box":
-            w, h = ob["width"] / 2, ob["height"] / 2
-            a = float(ob.get("angle", 0.0))
-            c, s = math.cos(a), math.sin(a)
-            pts = tuple(
-                (ob["x"] + c * dx - s * dy, ob["y"] + s * dx + c * dy)
-                for dx, dy in ((-w, -h), (w, -h), (w, h), (-w, h))
-            )
-            out.append(Obstacle("poly", pts))
-        elif ob["type"] == "circle":
-            out.append(Obstacle("circle", ((ob["x"], ob["y"]),), ob["radius"]))
-        else:
-            pts = tuple((float(p[0]), float(p[1])) for p in ob["points"])
-            out.append(Obstacle("line", pts, float(ob.get("thickness", 0.1)) / 2))
-    walls = physics.get("walls")
-    if walls:
-        x0, x1, y0, y1 = walls["xmin"], walls["xmax"], walls["ymin"], walls["ymax"]
-        out.append(Obstacle("line", ((x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)), 0.1))
-    return out
-
-
 def describe_phase(sim: Simulation) -> str:
     """``phase 2/4 from 125 s: Kv=0.15`` — what the HUD prints about the current phase."""
     phase = sim.phases[sim.phase_index]
@@ -136,7 +104,14 @@ def _short(value: Any) -> str:
 
 
 class Scene:
-    """Builds :class:`Frame` s from one Simulation, remembering trails and GPS history."""
+    """Builds :class:`Frame` s from one Simulation, remembering trails and GPS history.
+
+    History is sampled at every logged instant (:meth:`Simulation.add_log_listener`), not
+    per frame: at x256 a frame spans seconds of simulated time, so per-frame sampling drew
+    trails as chords, missed GPS fixes and put lost-fix marks where the rover was at the
+    next frame. The live metrics use the same samples as ``metrics.json``, so they stand
+    still while the run is paused and end equal to its overall block.
+    """
 
     def __init__(self, sim: Simulation, quality: Quality | None = None) -> None:
         self.sim = sim
@@ -150,6 +125,9 @@ class Scene:
                 self.gps.append(GpsTrack(path, source.rpartition(".")[0] or None))
         self.metrics = LiveMetrics()
         self._last_fix: dict[str, tuple[float, float]] = {}
+        # rovers in declaration order: the i-th has the i-th colour, as in the plots
+        self._rank = {name: i for i, name in enumerate(rover_names(list(sim.world.buffers)))}
+        sim.add_log_listener(self._sample)
 
     def _physics(self) -> Any:
         return self.sim.shared.get("physics")
@@ -176,48 +154,60 @@ class Scene:
                     r.forward_speed,
                 )
             )
+        out.sort(key=lambda r: self._rank.get(r.name, len(self._rank)))
         return out
 
-    def frame(self, t: float | None = None) -> Frame:
-        """Sample the simulation now and return what to draw.
-
-        ``t`` is the time the picture stands for (a video frame's time); by default the
-        simulation's current instant.
-        """
+    def _sample(self, t_s: float, values: dict[str, float]) -> None:
+        """One logged instant: extend trails, note new and lost GPS fixes, update metrics."""
+        physics = self._physics()
+        where: dict[str, tuple[float, float]] = {}
+        for r in physics.rovers if physics is not None else ():
+            x, y, _ = r.pose
+            where[r.name] = (x, y)
+            trail = self.trails.get(r.name)
+            if trail is None:
+                trail = self.trails[r.name] = deque(maxlen=TRAIL_POINTS)
+            if not trail or math.dist(trail[-1], (x, y)) >= TRAIL_STEP_M:
+                trail.append((x, y))
         sim = self.sim
-        rovers = self.rovers()
-        for r in rovers:
-            trail = self.trails.setdefault(r.name, deque(maxlen=TRAIL_POINTS))
-            if not trail or math.dist(trail[-1], (r.x, r.y)) >= TRAIL_STEP_M:
-                trail.append((r.x, r.y))
-        by_name = {r.name: r for r in rovers}
-        values = sim.values
         for track in self.gps:
             fix = (values[f"{track.path}.gpsPosX"], values[f"{track.path}.gpsPosY"])
             if self._last_fix.get(track.path) != fix:
                 self._last_fix[track.path] = fix
                 track.fixes.append(fix)
-            comp = sim.components.get(track.path)
-            lost = int(getattr(comp, "lost", 0))
+            lost = int(getattr(sim.components.get(track.path), "lost", 0))
             if lost > track.lost_total:
-                rover = by_name.get(track.rover or "")
-                if rover is not None:
-                    track.lost.append((rover.x, rover.y))
+                pos = where.get(track.rover or "")
+                if pos is not None:
+                    track.lost.append(pos)  # where the rover really was when it was lost
                 track.lost_total = lost
-        m = self.metrics
-        if self.quality is not None and sim.now > 0:  # before t = 0 runs, buffers hold 0
+        if self.quality is not None:
             v = values[self.quality.signal]
+            m = self.metrics
             m.value = v
             m.max = max(m.max, v)
             m.min = min(m.min, v)
             m.sum_sq += (v - self.quality.reference) ** 2
             m.count += 1
+
+    def frame(self, t: float | None = None) -> Frame:
+        """What to draw now: the history sampled so far, and every rover where it is now.
+
+        ``t`` is the time the picture stands for (a video frame's time); by default the
+        simulation's current instant. A trail ends at the rover's current position.
+        """
+        sim = self.sim
+        rovers = self.rovers()
+        trails = {k: list(v) for k, v in self.trails.items()}
+        for r in rovers:
+            trails.setdefault(r.name, []).append((r.x, r.y))
+        m = self.metrics
         physics = self._physics()
         m.collisions = physics.collisions if physics is not None else 0
         return Frame(
             t=float(sim.now) if t is None else t,
             rovers=rovers,
-            trails={k: list(v) for k, v in self.trails.items()},
+            trails=trails,
             gps=self.gps,
             obstacles=self.obstacles,
             metrics=m,

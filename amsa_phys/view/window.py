@@ -43,7 +43,8 @@ HELP = [  # every key _key and _panel_key handle
     "  left right  step the value (shift: fine)",
     "  0-9 . - e   type a value; enter applies, esc drops",
     "h or F1       this help",
-    "q or esc      quit (the outputs are written)",
+    "q or esc      quit (the outputs are written;",
+    "              esc first closes the panel)",
 ]
 
 
@@ -104,6 +105,8 @@ class Window:
         self.show_help = False
         self.notice = ""
         self._owed = 0.0  # simulated seconds the wall clock has earned but not yet run
+        self.idle_s = 0.0  # wall-clock seconds paused or finished: not part of the run's speed
+        self._quit_asked = False  # q pressed once with a live change still queued
         self._drag: tuple[int, int] | None = None
         self._end = sim.grid.ticks(sim.duration)
 
@@ -118,14 +121,15 @@ class Window:
         """The run reached its duration."""
         return self.sim.finished
 
-    def run(self) -> None:
-        """Until the user closes the window."""
+    def run(self) -> float:
+        """Until the user closes the window; returns the wall-clock seconds spent idle."""
         clock = pygame.time.Clock()
         try:
             while self.frame(clock.tick(FPS) / 1000):
                 pass
         finally:
             pygame.display.quit()
+        return self.idle_s
 
     def frame(self, real_dt: float) -> bool:
         """One iteration: events, advance by ``speed * real_dt``, draw. False once closed."""
@@ -134,7 +138,9 @@ class Window:
             self.handle(event)
         if not self.running:
             return False
-        if not self.paused and not self.finished:
+        if self.paused or self.finished:
+            self.idle_s += real_dt
+        else:
             self._owed += self.speed * min(real_dt, MAX_REAL_DT)
             target = self.sim.now + Fraction(self._owed).limit_denominator(10**6)
             tick = int(target / self.sim.grid.tick)
@@ -178,8 +184,9 @@ class Window:
         panel = self.panel
         if panel.visible and self._panel_key(key, event.unicode, shift):
             return
+        quit_asked, self._quit_asked = self._quit_asked, False
         if key in (pygame.K_q, pygame.K_ESCAPE):
-            self.running = False
+            self.quit(confirmed=quit_asked)
         elif key == pygame.K_SPACE:
             self.paused = not self.paused
         elif key in (pygame.K_s, pygame.K_PERIOD):
@@ -223,8 +230,11 @@ class Window:
             panel.step(1, fine=shift)
         elif key == pygame.K_BACKSPACE:
             panel.backspace()
-        elif key == pygame.K_ESCAPE and (panel.pending is not None or panel.text is not None):
-            panel.cancel()
+        elif key == pygame.K_ESCAPE:  # drops an edit, else closes the panel: never quits
+            if panel.pending is not None or panel.text is not None:
+                panel.cancel()
+            else:
+                panel.visible = False
         elif key in (pygame.K_RETURN, pygame.K_KP_ENTER):
             self.apply_panel()
         elif text and (text.isdigit() or text in ".-+e"):
@@ -232,6 +242,20 @@ class Window:
         else:
             return False
         return True
+
+    def quit(self, *, confirmed: bool = False) -> None:
+        """Stop the session, asking once more if a live change is queued but not yet applied.
+
+        A change queued while paused lands only at the next instant; quitting before then
+        would drop it silently (it would be missing from the run and its scenario.yaml).
+        """
+        pending = self.sim.pending_live
+        if pending and not confirmed and not self.finished:
+            changes = ", ".join(f"{c.key}={c.value}" for c in pending)
+            self.notice = f"{changes} is queued, not applied yet: q again quits without it"
+            self._quit_asked = True
+            return
+        self.running = False
 
     def apply_panel(self) -> None:
         """Commit the panel's pending value as a live change at the next instant."""
@@ -275,15 +299,22 @@ class Window:
         cam.update([(r.x, r.y, r.name) for r in frame.rovers], 0.0 if self.paused else 0.05)
         self.renderer.draw(self.screen, frame, cam, self.status())
         h = self.screen.get_height()
+        below = max(box.bottom for box in self.renderer.boxes.values()) + 6
+        top = max(h // 3, below)  # under the HUD and status, however they were laid out
+        line_px = self.renderer.font.get_linesize()
+
+        def fitting(n_lines: int) -> int:  # a panel too tall for the room below moves up
+            return max(10, min(top, h - n_lines * line_px - 22))
+
         if self.panel.visible:
             lines = ["parameters (p closes)", *self.panel.lines()]
             colours = [MUTED] + [INK] * (len(lines) - 1)
             if self.panel.message:
                 lines.append(self.panel.message)
                 colours.append(LOST if "fixed" in self.panel.message else MUTED)
-            self.renderer.panel(self.screen, lines, colours, (10, h // 3), align_right=False)
+            at = (10, fitting(len(lines)))
+            self.renderer.panel(self.screen, lines, colours, at, align_right=False)
         if self.show_help:
-            self.renderer.panel(
-                self.screen, HELP, [INK] * len(HELP), (10, h // 3), align_right=True
-            )
+            at = (10, fitting(len(HELP)))
+            self.renderer.panel(self.screen, HELP, [INK] * len(HELP), at, align_right=True)
         pygame.display.flip()

@@ -34,7 +34,7 @@ def test_failing_scenario_gives_exit_1_a_table_and_junit(
         for line in lines
     )
     assert any("collisions" in line and line.endswith("pass") for line in lines)
-    assert lines[-1] == "1 scenarios, 3 checks: 1 passed, 2 failed"
+    assert lines[-1] == "1 scenario, 3 checks: 1 passed, 2 failed"
     root = ET.parse(junit).getroot()
     suite = root.find("testsuite")
     assert suite is not None
@@ -152,7 +152,7 @@ def test_a_scenario_that_kills_its_worker_is_an_error_row(
     captured = capsys.readouterr()
     rows = [line.split() for line in captured.out.splitlines()[1:-1]]
     assert [(r[0], r[-1]) for r in rows] == [("a", "pass"), ("b", "ERROR"), ("c", "pass")]
-    assert captured.out.splitlines()[-1].endswith("1 errors")
+    assert captured.out.splitlines()[-1].endswith("1 error")
     assert (
         "b: a worker process died (killed, out of memory, or a crash in native code), twice"
         in captured.err

@@ -97,7 +97,9 @@ def test_live_change_lands_in_the_resolved_scenario(
     assert session.applied_at == Fraction(251, 100)
     doc = yaml.safe_load((out / "scenario.yaml").read_text())
     entries = [e for e in doc["timeline"] if e.get("label") == "live"]
-    assert entries == [{"at": 2.51, "set": {"MyFollowerController.Kv": 0.12}, "label": "live"}]
+    assert entries == [
+        {"at": 2.51, "set": {"MyFollowerController.Kv": 0.12}, "label": "live", "new_phase": False}
+    ]
     assert doc["duration"] == 20
 
 

@@ -38,7 +38,11 @@ def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
     ("boom", "cause"),
     [
         ("false", "output u is nan"),
-        ("true", "do_step raised ZeroDivisionError('division by zero')"),
+        (  # a user template's own exception: --debug would show where it was raised
+            "true",
+            "do_step raised ZeroDivisionError('division by zero') "
+            "(amsa-phys --debug shows its traceback)",
+        ),
     ],
 )
 def test_controller_nan_or_exception_is_exit_3_with_trace_kept(
