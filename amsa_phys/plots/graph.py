@@ -26,7 +26,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import FancyBboxPatch
 from matplotlib.transforms import Bbox
 
-from ..engine.recorder import write_atomic
+from ..atomic import write_atomic
 from ..model.world import WorldSpec
 from .save import save_png
 

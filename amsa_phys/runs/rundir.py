@@ -145,3 +145,28 @@ def prepare_run_dir(
     if not os.access(out, os.W_OK):
         raise ConfigError("directory is not writable", key=flag, file=out)
     return out
+
+
+def check_output(path: Path, flag: str, make_parent: bool = False) -> Path:
+    """An output file's path, checked before any work (exit 2 naming ``flag``).
+
+    Refused: a directory (or a link to one) where the file should go, a directory that does
+    not exist (created with ``make_parent``), one that is not writable (a read-only file
+    system). A write that still fails later (a full disk) is an OutputError naming the file.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise ConfigError("is a directory; give a file name", key=flag, file=path)
+    parent = path.parent
+    if make_parent and not parent.exists():
+        try:
+            parent.mkdir(parents=True)
+        except OSError as exc:
+            raise ConfigError(
+                f"cannot create directory: {exc.strerror}", key=flag, file=parent
+            ) from None
+    if not parent.is_dir():
+        raise ConfigError("directory does not exist", key=flag, file=parent)
+    if not os.access(parent, os.W_OK):
+        raise ConfigError("directory is not writable", key=flag, file=parent)
+    return path

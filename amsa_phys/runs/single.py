@@ -8,6 +8,7 @@ directory never holds a half-written file under its final name.
 from __future__ import annotations
 
 import json
+import math
 import sys
 import time
 from collections.abc import Callable
@@ -15,14 +16,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
 import yaml
 from tqdm import tqdm
 
+from ..atomic import write_atomic
 from ..engine import interrupt
 from ..engine.metrics import block_metrics
-from ..engine.recorder import TraceWriter, write_atomic
+from ..engine.recorder import TraceWriter
 from ..engine.runner import RunResult, Simulation
-from ..errors import Interrupted, RunFault
+from ..errors import Interrupted, OutputError, RunFault, one_line
 from ..model.scenario import Scenario
 from ..view.drive import FrameSink, advance
 from ..view.encoder import EncoderError
@@ -50,7 +53,32 @@ class RunOutcome:
 def compute_metrics(
     scenario: Scenario, sim: Simulation, result: RunResult, wall_s: float, status: str
 ) -> dict[str, Any]:
-    """The ``metrics.json`` document (design.md) for a run that reached ``result.t_end``."""
+    """The ``metrics.json`` document (design.md) for a run that reached ``result.t_end``.
+
+    Always valid JSON: a metric that is not a finite number (a signal near the float limit
+    overflows ``rms_error``) is written as ``null`` and named in ``nonfinite``.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
+        metrics = _metrics(scenario, result, wall_s, status)
+    return _finite(metrics)
+
+
+def _finite(metrics: dict[str, Any]) -> dict[str, Any]:
+    """Replace non-finite metric values by None and list where they were."""
+    bad: list[str] = []
+    blocks = [("overall", metrics["overall"])]
+    blocks += [(f"phases[{i}]", p) for i, p in enumerate(metrics["phases"])]
+    for where, block in blocks:
+        for key, value in block.items():
+            if isinstance(value, float) and not math.isfinite(value):
+                block[key] = None
+                bad.append(f"{where}.{key}")
+    if bad:
+        metrics["nonfinite"] = bad
+    return metrics
+
+
+def _metrics(scenario: Scenario, result: RunResult, wall_s: float, status: str) -> dict[str, Any]:
     end = result.t_end
     q = scenario.quality
     collisions = [e.t for e in result.events if e.kind == "collision"]
@@ -193,7 +221,7 @@ def _run_scenario(
         else:
             sinks = [s for s in (recorder, still) if s is not None]
             _advance_with_progress(sim, scenario, progress, sinks)
-    except RunFault as exc:
+    except (RunFault, OutputError) as exc:  # OutputError: the trace's disk is full
         status, error = f"fault: {exc}", exc
     except EncoderError as exc:
         error = RunFault("recorder", sim.now, str(exc))
@@ -201,37 +229,64 @@ def _run_scenario(
     except KeyboardInterrupt as exc:
         status, error = "interrupted", exc
     wall = time.perf_counter() - t0
-    trace.close()
+    # Each output is written even if another could not be (a full disk): metrics.json
+    # above all. The first failure is raised once the run's own error, if any, is.
+    unwritten: list[OutputError] = []
+
+    def keep(write: Callable[..., Any], *args: Any) -> Any:
+        try:
+            return write(*args)
+        except OutputError as exc:
+            unwritten.append(exc)
+            return None
+
+    has_trace = keep(trace.close) is not None
     video = _finish_video(recorder, error)
     result = sim.result()
     metrics = compute_metrics(scenario, sim, result, wall, status)
     if video is not None:
         metrics["video"] = video
     if still is not None:
-        metrics["snapshot"] = {"path": str(still.close()), "t": float(still.at)}
-    write_atomic(out_dir / "metrics.json", json.dumps(metrics, indent=2) + "\n")
+        picture = keep(still.close)
+        if picture is not None:
+            metrics["snapshot"] = {"path": str(picture), "t": float(still.at)}
+    text = json.dumps(metrics, indent=2, allow_nan=False) + "\n"
+    keep(write_atomic, out_dir / "metrics.json", text)
     stopped_early = window and not sim.finished and error is None and sim.now > 0
     resolved = resolved_scenario(
         scenario, extra=sim.live_changes, duration=sim.now if stopped_early else None
     )
     text = yaml.dump(resolved, Dumper=_YAML_DUMPER, sort_keys=False)
-    write_atomic(out_dir / "scenario.yaml", text)
+    keep(write_atomic, out_dir / "scenario.yaml", text)
     plotter = plotter or PlotJob()
-    if plot:
-        plotter.draw(
-            out_dir / "trace.csv", metrics, out_dir / "distance.png", out_dir / "trajectory.png"
+    if plot and has_trace:
+        keep(
+            plotter.draw,
+            out_dir / "trace.csv",
+            metrics,
+            out_dir / "distance.png",
+            out_dir / "trajectory.png",
         )
     plotter.close()
+    if error is None and unwritten:
+        error, unwritten = unwritten[0], unwritten[1:]
+    named = {error.path} if isinstance(error, OutputError) else set()
+    for exc in unwritten:  # besides the error raised below, each file once
+        if exc.path not in named:
+            named.add(exc.path)
+            print(one_line(f"amsa-phys: {exc}"), file=sys.stderr)
     if isinstance(error, KeyboardInterrupt):
         raise Interrupted(
-            f"interrupted at t={result.t_end:.2f} s; outputs so far are in {out_dir}"
+            one_line(f"interrupted at t={result.t_end:.2f} s; outputs so far are in {out_dir}")
         ) from None
     if error is not None:
         raise error
     if interrupt.requested():  # Ctrl-C after the last instant: the outputs are complete
         raise Interrupted(
-            f"interrupted after the run ended at t={result.t_end:.2f} s; "
-            f"its outputs are complete in {out_dir}"
+            one_line(
+                f"interrupted after the run ended at t={result.t_end:.2f} s; "
+                f"its outputs are complete in {out_dir}"
+            )
         )
     return RunOutcome(out_dir, metrics, sim)
 
@@ -256,7 +311,7 @@ def _finish_video(recorder: Recorder | None, error: BaseException | None) -> dic
         if error is None:
             raise RunFault("recorder", recorder.sim.now, str(exc)) from None
         if not (isinstance(error, RunFault) and error.component == "recorder"):
-            print(f"amsa-phys: {exc}", file=sys.stderr)  # besides the run's own error
+            print(one_line(f"amsa-phys: {exc}"), file=sys.stderr)  # besides the run's own
         return None
     return {
         "path": str(path),
