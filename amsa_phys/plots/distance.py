@@ -13,23 +13,64 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
+from ..errors import ConfigError
+from ..model.params import short_repr
 from .save import save_png
+
+#: Values beyond this are not drawn (NaN): matplotlib's limits overflow near the float limit.
+PLOTTABLE = 1e200
 
 
 def read_trace(path: Path) -> tuple[list[str], np.ndarray]:
     """The trace's column names and its values as a 2-D array (read once per file version:
-    a run draws several plots from the same trace)."""
+    a run draws several plots from the same trace).
+
+    A file that is not a whole trace -- binary junk, a row cut short (no end of line, as a
+    killed writer would leave), rows wider or narrower than the header -- is refused with
+    one line naming the file and line (ConfigError), never plotted as if it were one.
+    """
     st = Path(path).stat()
     return _read_trace(str(path), st.st_mtime_ns, st.st_size)
 
 
 @functools.lru_cache(maxsize=2)
 def _read_trace(path: str, mtime_ns: int, size: int) -> tuple[list[str], np.ndarray]:
-    with open(path, encoding="utf-8") as fh:
-        header = fh.readline().strip().split(",")
-    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    try:
+        with open(path, encoding="utf-8", newline="") as fh:
+            text = fh.read()
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"not a trace: not UTF-8 text (byte {exc.start})", file=path) from None
+    lines = text.split("\n")
+    header = lines[0].split(",")
+    if header[0] != "t" or not text.endswith("\n"):
+        problem = "no header line starting with t" if header[0] != "t" else "cut short"
+        where = 1 if header[0] != "t" else len(lines)
+        raise ConfigError(f"not a whole trace: {problem}", file=path, line=where)
+    rows = lines[1:-1]
+    try:
+        data = np.loadtxt(rows, delimiter=",", ndmin=2) if rows else np.empty((0, len(header)))
+    except ValueError:
+        data = np.empty((0, 0))  # found below, with its line
+    if data.shape[1:] != (len(header),):
+        line, problem = _bad_row(rows, len(header))
+        raise ConfigError(f"not a whole trace: {problem}", file=path, line=line)
+    data[~(np.abs(data) < PLOTTABLE)] = np.nan  # inf, nan and the unplottable
     data.flags.writeable = False  # shared between callers
     return header, data
+
+
+def _bad_row(rows: list[str], width: int) -> tuple[int, str]:
+    """The first row (as a file line) that is not ``width`` numbers, and what is wrong."""
+    for i, row in enumerate(rows):
+        cells = row.split(",")
+        if len(cells) != width:
+            return i + 2, f"{len(cells)} values where the header names {width}"
+        for cell in cells:
+            try:
+                float(cell)
+            except ValueError:
+                return i + 2, f"{short_repr(cell)} is not a number"
+    return 1, "unreadable"
 
 
 NOTE_PT = 7.5  # phase notes' font size
@@ -85,7 +126,7 @@ def distance_figure(trace: Path, metrics: dict[str, Any]) -> Figure:
     quality = metrics.get("quality") or {}
     signal = quality.get("signal")
     fig, ax = plt.subplots(figsize=(10, FIG_H_IN), dpi=100)
-    if signal in header and data.size:
+    if signal in header and data.size and abs(float(quality["reference"])) < PLOTTABLE:
         t = data[:, 0]
         s = data[:, header.index(signal)]
         ref = float(quality["reference"])
@@ -100,7 +141,7 @@ def distance_figure(trace: Path, metrics: dict[str, Any]) -> Figure:
         )
         ax.axhline(ref, color="tab:green", lw=1.2, ls="--", label=f"reference {ref:g} m")
         ax.plot(t, s, color="tab:blue", lw=1.2, label=signal)
-        top = max(float(np.max(s)), ref + tol)
+        top = max(float(np.nanmax(s)) if np.isfinite(s).any() else 0.0, ref + tol)
         lines = _phase_notes(ax, metrics.get("phases", []))
         # the notes get a band of their own above the data: the curve never runs through them
         band = (len(lines) * NOTE_PT * 1.25 + 8) / AXES_HEIGHT_PT if lines else 0.05

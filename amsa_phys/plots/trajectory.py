@@ -19,7 +19,7 @@ def plot_trajectory(trace: Path, metrics: dict[str, Any], out: Path) -> Path:
     header, data = read_trace(trace)
     fig, ax = plt.subplots(figsize=(7, 6), dpi=100)
     drawn = False
-    for name in header:
+    for name in header if len(data) else []:  # a run that faulted at t = 0 logged no row
         if name.endswith(".posX") and name[:-4] + "posY" in header:
             comp = name[: -len(".posX")]
             x, y = data[:, header.index(name)], data[:, header.index(comp + ".posY")]

@@ -19,6 +19,8 @@ class Check:
     value: float | None
     passed: bool
     skipped: bool = False
+    #: why a trace check saw no sample, or how much of its window the run covered
+    note: str = ""
 
     @property
     def what(self) -> str:
@@ -32,16 +34,20 @@ class Check:
 
     @property
     def verdict(self) -> str:
-        """pass, FAIL or skipped."""
+        """pass, FAIL, skipped, or "no sample" (a trace window the run never logged)."""
+        if self.value is None and self.note.startswith("checked no sample"):
+            return "no sample" if self.skipped else "FAIL"
         return "skipped" if self.skipped else ("pass" if self.passed else "FAIL")
 
     def describe(self) -> str:
         """``max_distance (phase 1) = 24.3, below 26: pass``."""
+        if self.value is None and self.note:
+            return f"{self.what}: {self.note}: {self.verdict}"
         if self.skipped:
-            cut = "window" if self.expectation.trace is not None else "phase"
-            return f"{self.what}: skipped ({cut} not run, --duration cut it)"
+            return f"{self.what}: skipped (phase not run, --duration cut it)"
         value = "none" if self.value is None else f"{self.value:.4g}"
-        return f"{self.what} = {value}, {self.bound}: {self.verdict}"
+        note = f" ({self.note})" if self.note else ""
+        return f"{self.what} = {value}{note}, {self.bound}: {self.verdict}"
 
 
 def describe_what(e: Expectation) -> str:
@@ -72,11 +78,12 @@ def check_expectations(
     """
     checks = []
     columns: tuple[list[str], np.ndarray] | None = None
+    end = float(metrics.get("simulated", 0.0))
     for e in expect:
         if e.trace is not None:
             if columns is None:
                 columns = _read(trace)
-            checks.append(_trace_check(e, *columns))
+            checks.append(_trace_check(e, *columns, end))
             continue
         if e.phase is not None and e.phase >= len(metrics["phases"]):
             checks.append(Check(e, None, True, skipped=True))
@@ -100,7 +107,14 @@ def _read(trace: Path | None) -> tuple[list[str], np.ndarray]:
     return header, np.loadtxt(trace, delimiter=",", skiprows=1, ndmin=2)
 
 
-def _trace_check(e: Expectation, header: list[str], data: np.ndarray) -> Check:
+def _trace_check(e: Expectation, header: list[str], data: np.ndarray, end: float) -> Check:
+    """Judge every logged sample of the window; a window without one is said to be so.
+
+    A window that starts after the run's end (``end``: cut by ``--duration``, a fault or
+    Ctrl-C) checked no sample and is skipped, visibly; one inside the run that caught no
+    logged instant fails (its bound was never checked). A window running past the end
+    says up to when it was checked.
+    """
     t = data[:, 0]
     mask = np.ones_like(t, dtype=bool)
     if e.after is not None:
@@ -109,10 +123,13 @@ def _trace_check(e: Expectation, header: list[str], data: np.ndarray) -> Check:
         mask &= t <= e.before
     values = data[mask, header.index(e.trace)]
     if values.size == 0:
-        ran_until = float(t[-1]) if t.size else 0.0
-        # a window that starts after the run ended was cut off (--duration), like a phase
-        cut = e.after is not None and e.after > ran_until
-        return Check(e, None, cut, skipped=cut)
+        if e.after is not None and e.after > end:
+            note = f"checked no sample (the window starts after the run's end at t={end:g} s)"
+            return Check(e, None, True, skipped=True, note=note)
+        note = "checked no sample (no logged instant in the window: widen it or raise log_rate)"
+        return Check(e, None, False, note=note)
+    past_end = e.before is not None and e.before > end
+    note = f"checked up to the run's end at t={end:g} s" if past_end else ""
     worst: float | None = None
     ok = True
     if e.above is not None:
@@ -124,4 +141,4 @@ def _trace_check(e: Expectation, header: list[str], data: np.ndarray) -> Check:
         if worst is None or high >= e.below:
             worst = high
         ok = ok and high < e.below
-    return Check(e, worst, ok)
+    return Check(e, worst, ok, note=note)
