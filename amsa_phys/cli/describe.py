@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from ..errors import one_line
 from ..model.world import WorldSpec
 from ..runs.expect import describe_bound, describe_what
 from .loading import load_any
@@ -17,7 +18,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
 def describe_world(world: WorldSpec) -> list[str]:
     """Human-readable lines describing a world."""
     lines = [
-        f"world {world.name}: {len(world.leaves)} components, physics "
+        f"world {one_line(world.name)}: {len(world.leaves)} components, physics "
         f"{float(world.physics['rate']):g} Hz"
     ]
     for path in world.leaves:
@@ -44,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     kind, obj = load_any(args.file)
     if kind == "scenario":
         print(
-            f"scenario {obj.name}: {float(obj.duration):g} s, seed {obj.seed}, "
+            f"scenario {one_line(obj.name)}: {float(obj.duration):g} s, seed {obj.seed}, "
             f"trace at {float(obj.log_rate):g} Hz"
         )
         if obj.quality:

@@ -102,6 +102,21 @@ def _refuse_inputs(out: Path, inputs: Iterable[Path], flag: str) -> None:
             )
 
 
+def _without_dotdot(out: Path) -> Path:
+    """``out`` with its ``..`` resolved, so it is judged as the directory it really names.
+
+    ``new/..`` is the directory holding ``new``: checked as written, it does not exist (``new``
+    does not), and creating it would make ``new`` and then run into its parent -- the
+    current directory, full of the user's files. The last component itself is kept as
+    written (a symbolic link there must still be seen as one).
+    """
+    if ".." not in out.parts:
+        return out
+    if out.name == "..":
+        return Path(os.path.realpath(out))
+    return Path(os.path.realpath(out.parent)) / out.name
+
+
 def prepare_run_dir(
     out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "--out"
 ) -> Path:
@@ -112,6 +127,7 @@ def prepare_run_dir(
     followed into a removal.
     """
     inputs = list(inputs)
+    out = _without_dotdot(out)
     if out.is_symlink() and (force or out.exists()):
         raise ConfigError(
             "is a symbolic link; give the real directory (amsa-phys does not replace links)",
