@@ -18,7 +18,7 @@ import yaml
 from amsa_phys.cli.main import main
 from amsa_phys.model.scenario import load_scenario, written_values
 from amsa_phys.model.world import MAX_COMPONENTS
-from amsa_phys.model.yamlio import MAX_FILE_BYTES, parse_yaml
+from amsa_phys.model.yamlio import MAX_FILE_BYTES, MAX_NODES, parse_yaml
 from amsa_phys.runs.resolve import resolved_scenario
 
 ROOT = Path(__file__).resolve().parent.parent.parent
@@ -119,6 +119,17 @@ def test_binary_and_oversized_files_are_refused(
         fh.truncate(50 * 2**20)
     assert refused(capsys, ["validate", str(huge)]) == (
         f"{huge}: file too large (50.0 MiB or more; the limit is {MAX_FILE_BYTES // 2**20} MiB)"
+    )
+
+
+def test_a_file_of_too_many_values_is_refused_before_it_is_composed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # 1.2 MB of "1," is 600,000 values: counted from the parser's events, refused before
+    # PyYAML resolves each one (the file-level message has no line: nothing was built)
+    path = write(tmp_path / "many.yaml", "description: [" + "1," * 600_000 + "1]\n")
+    assert refused(capsys, ["validate", str(path)]) == (
+        f"{path}: document too large: over {MAX_NODES:,} values"
     )
 
 
