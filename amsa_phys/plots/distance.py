@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import functools
+import os
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -35,42 +37,65 @@ def read_trace(path: Path) -> tuple[list[str], np.ndarray]:
 
 @functools.lru_cache(maxsize=2)
 def _read_trace(path: str, mtime_ns: int, size: int) -> tuple[list[str], np.ndarray]:
+    with open(path, "rb") as fh:  # the checks read the first line and the last byte only
+        head = fh.readline()
+        fh.seek(-1 if size else 0, os.SEEK_END)
+        whole = fh.read(1) == b"\n"
     try:
-        with open(path, encoding="utf-8", newline="") as fh:
-            text = fh.read()
+        header = head.decode("utf-8").rstrip("\n").split(",")
     except UnicodeDecodeError as exc:
         raise ConfigError(f"not a trace: not UTF-8 text (byte {exc.start})", file=path) from None
-    lines = text.split("\n")
-    header = lines[0].split(",")
-    if header[0] != "t" or not text.endswith("\n"):
-        problem = "no header line starting with t" if header[0] != "t" else "cut short"
-        where = 1 if header[0] != "t" else len(lines)
-        raise ConfigError(f"not a whole trace: {problem}", file=path, line=where)
-    rows = lines[1:-1]
+    if header[0] != "t":
+        raise ConfigError("not a whole trace: no header line starting with t", file=path, line=1)
+    if not whole:  # a row cut short, as a killed writer would leave it
+        raise ConfigError("not a whole trace: cut short", file=path, line=_newlines(path) + 1)
     try:
-        data = np.loadtxt(rows, delimiter=",", ndmin=2) if rows else np.empty((0, len(header)))
-    except ValueError:
+        with warnings.catch_warnings():  # a header alone: no rows, not a warning
+            warnings.simplefilter("ignore")
+            data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, encoding="utf-8")
+    except (ValueError, UnicodeDecodeError):
         data = np.empty((0, 0))  # found below, with its line
+    if data.size == 0 and _newlines(path) == 1:  # the header alone: a run that faulted at 0
+        data = np.empty((0, len(header)))
     if data.shape[1:] != (len(header),):
-        line, problem = _bad_row(rows, len(header))
+        line, problem = _bad_row(path, len(header))
         raise ConfigError(f"not a whole trace: {problem}", file=path, line=line)
     data[~(np.abs(data) < PLOTTABLE)] = np.nan  # inf, nan and the unplottable
     data.flags.writeable = False  # shared between callers
     return header, data
 
 
-def _bad_row(rows: list[str], width: int) -> tuple[int, str]:
+def _newlines(path: str) -> int:
+    with open(path, "rb") as fh:
+        return sum(chunk.count(b"\n") for chunk in iter(lambda: fh.read(1 << 20), b""))
+
+
+def _bad_row(path: str, width: int) -> tuple[int, str]:
     """The first row (as a file line) that is not ``width`` numbers, and what is wrong."""
-    for i, row in enumerate(rows):
-        cells = row.split(",")
-        if len(cells) != width:
-            return i + 2, f"{len(cells)} values where the header names {width}"
-        for cell in cells:
+    with open(path, "rb") as fh:
+        fh.readline()
+        for line, raw in enumerate(fh, start=2):
             try:
-                float(cell)
-            except ValueError:
-                return i + 2, f"{short_repr(cell)} is not a number"
+                row = raw.decode("utf-8").rstrip("\n")
+            except UnicodeDecodeError:
+                return line, "not UTF-8 text"
+            problem = _row_problem(row, width)
+            if problem:
+                return line, problem
     return 1, "unreadable"
+
+
+def _row_problem(row: str, width: int) -> str:
+    """What is wrong with one row of a trace ("" if nothing)."""
+    cells = row.split(",")
+    if len(cells) != width:
+        return f"{len(cells)} values where the header names {width}"
+    for cell in cells:
+        try:
+            float(cell)
+        except ValueError:
+            return f"{short_repr(cell)} is not a number"
+    return ""
 
 
 NOTE_PT = 7.5  # phase notes' font size

@@ -63,7 +63,13 @@ RUN_CASES = {
     ),
     "trace-binary": (
         _replace("trace.csv", bytes(range(256)) * 8),
-        "trace.csv: not a trace: not UTF-8 text (byte 128)",
+        "trace.csv:1: not a whole trace: no header line starting with t",
+    ),
+    "trace-binary-rows": (
+        lambda d: (d / "trace.csv").write_bytes(
+            (d / "trace.csv").read_bytes().split(b"\n")[0] + b"\n" + bytes(range(128, 256)) + b"\n"
+        ),
+        "trace.csv:2: not a whole trace: not UTF-8 text",
     ),
     "trace-torn-row": (
         _edit("trace.csv", lambda t: t[:-7]),

@@ -67,6 +67,8 @@ def test_sys_exit_in_initialize_or_on_param_change_is_a_run_fault(
     assert one_error(capsys) == (
         "error: run fault at t=0.000 s in R (Rogue): initialize failed: SystemExit(0)\n"
     )
+    assert (tmp_path / "a" / "trace.csv").read_text() == "t,R.u\n"  # no instant ran
+    assert (tmp_path / "a" / "distance.png").stat().st_size > 0  # drawn all the same
     scen = rogue(tmp_path, "param_exit", "timeline:\n  - {at: 2, set: {R.k: 2}}\n")
     assert main(["run", str(scen), "--headless", "--out", str(tmp_path / "b"), "-q"]) == 3
     assert one_error(capsys) == (
