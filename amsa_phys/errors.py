@@ -45,7 +45,12 @@ class ConfigError(AmsaError):
 
 
 def one_line(text: str) -> str:
-    """Escape control characters (a key may hold a newline) so a message stays one line."""
+    """Escape control characters so a message stays one line and cannot drive the terminal.
+
+    A key may hold a newline, a scenario's ``name`` or a component's exception an ANSI
+    escape (``\\x1b[2J`` clears the screen): every message, table cell and name amsa-phys
+    prints goes through here, so what reaches the terminal is always printable text.
+    """
     if text.isprintable():
         return text
     return "".join(
@@ -65,7 +70,25 @@ class RunFault(AmsaError):
         super().__init__(str(self))
 
     def __str__(self) -> str:
-        return f"run fault at t={self.t:.3f} s in {self.component}: {self.cause}"
+        return one_line(f"run fault at t={self.t:.3f} s in {self.component}: {self.cause}")
+
+
+class OutputError(AmsaError):
+    """An output file could not be written (disk full, read-only file system, a directory
+    in the way): exit 3 like a run fault, with one line naming the file.
+
+    The file's final name never holds a partial file (``amsa_phys.atomic``).
+    """
+
+    exit_code = 3
+
+    def __init__(self, path: str | Path, reason: str) -> None:
+        self.path = str(path)
+        self.reason = reason
+        super().__init__(str(self))
+
+    def __str__(self) -> str:
+        return one_line(f"cannot write {self.path}: {self.reason}")
 
 
 class ExpectationFailed(AmsaError):

@@ -80,7 +80,9 @@ class Run:
         inputs = [p for p in input_files(self._loaded) if p.is_file()]  # a mapping has none
         prepare_run_dir(path, force, inputs=inputs)
         self._memory.save(path / "trace.csv")
-        write_run_files(path, self._ended, plot=plot)
+        unwritten = write_run_files(path, self._ended, plot=plot)
+        if unwritten:  # a full disk: every file that could be written was, say the first
+            raise unwritten[0]
         return path
 
     def __repr__(self) -> str:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from ..errors import ConfigError
+from ..errors import ConfigError, one_line
 from ..model.scenario import PHYSICS_PREFIX, Scenario, load_scenario
 from ..model.wording import plural
 from ..model.world import LeafSpec, WorldSpec
@@ -52,7 +52,7 @@ def describe_world(
     """
     start = start or {}
     lines = [
-        f"world {world.name}: {plural(len(world.leaves), 'component')}, physics "
+        f"world {one_line(world.name)}: {plural(len(world.leaves), 'component')}, physics "
         f"{float(world.physics['rate']):g} Hz"
     ]
     lines += _physics_lines(world, physics_from or {})
@@ -134,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
                 if key.startswith(PHYSICS_PREFIX):
                     physics_from[key.removeprefix(PHYSICS_PREFIX)] = "--set"
         print(
-            f"scenario {obj.name}: {float(obj.duration):g} s, seed {obj.seed}, "
+            f"scenario {one_line(obj.name)}: {float(obj.duration):g} s, seed {obj.seed}, "
             f"trace at {float(obj.log_rate):g} Hz"
         )
         if obj.quality:

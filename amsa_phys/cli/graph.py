@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..errors import ConfigError
+from ..errors import ConfigError, one_line
+from ..runs.rundir import check_output
 from .loading import load_any
 
 
@@ -25,12 +26,11 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.output)
     if out.suffix.lower() not in (".png", ".svg", ".dot"):
         raise ConfigError("expected a .png, .svg or .dot file name", key="--output", file=out)
+    check_output(out, "--output")
     kind, obj = load_any(args.file)
     world = obj.world if kind == "scenario" else obj
-    if not out.parent.is_dir():
-        raise ConfigError("directory does not exist", key="--output", file=out.parent)
     from ..plots.graph import draw  # matplotlib: imported by the commands that draw
 
     draw(world, out, collapse=not args.expand)
-    print(f"wrote {out}")
+    print(one_line(f"wrote {out}"))
     return 0

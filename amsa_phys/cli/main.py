@@ -8,6 +8,7 @@ Exit codes: 0 done, 1 an expectation failed, 2 bad input or usage, 3 a run fault
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import sysconfig
 import traceback
@@ -16,7 +17,7 @@ from pathlib import Path
 from typing import NoReturn
 
 from .. import __version__
-from ..errors import AmsaError
+from ..errors import AmsaError, one_line
 from . import describe, graph, plot, run, sweep, templates, validate
 from . import test as test_cmd
 
@@ -37,7 +38,7 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         """Print ``error: <prog>: <message>`` and exit 2."""
-        self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
+        self.exit(2, one_line(f"error: {self.prog}: {message} (see {self.prog} --help)") + "\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -65,12 +66,19 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: Exit code when the reader of our output went away (``amsa-phys templates | head -1``):
+#: 128 + SIGPIPE, what a program killed by the signal returns, as ``yes | head`` does.
+EXIT_BROKEN_PIPE = 141
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code (tests call this in-process)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.func(args))
+        code = int(args.func(args))
+        sys.stdout.flush()  # here, where a reader that went away is caught (not at exit)
+        return code
     except AmsaError as exc:
         if args.debug:
             cause = _root_cause(exc, hidden=True)
@@ -78,11 +86,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         cause = _root_cause(exc)  # raised *from* code: a component's exception, not a message
         user = cause is not None and _in_user_code(cause)
         hint = " (amsa-phys --debug shows its traceback)" if user and not args.debug else ""
-        print(f"error: {exc}{hint}", file=sys.stderr)
+        print(f"error: {one_line(str(exc))}{hint}", file=sys.stderr)
         return exc.exit_code
     except KeyboardInterrupt as exc:  # Interrupted says where; a bare one during loading
-        print(f"error: {exc}" if str(exc) else "interrupted", file=sys.stderr)
+        print(f"error: {one_line(str(exc))}" if str(exc) else "interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        _silence_stdout()
+        return EXIT_BROKEN_PIPE
 
 
 def _root_cause(exc: BaseException, hidden: bool = False) -> BaseException | None:
@@ -112,3 +123,14 @@ def _in_user_code(exc: BaseException) -> bool:
     return any(
         not frame.filename.startswith(ours) for frame in traceback.extract_tb(exc.__traceback__)
     )
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null: its reader is gone, and Python's final flush of what is
+    still buffered would print a second BrokenPipeError at exit."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):  # no real stdout (tests capture it)
+        pass

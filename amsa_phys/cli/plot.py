@@ -7,9 +7,10 @@ import json
 from pathlib import Path
 from typing import Any
 
-from ..errors import AmsaError, ConfigError
+from ..errors import AmsaError, ConfigError, one_line
 from ..model.scenario import load_scenario
 from ..runs.plotjob import draw_run_plots, plot_context
+from ..runs.rundir import check_output
 from ..runs.sweep import read_results, unknown_metric
 
 
@@ -48,16 +49,13 @@ def run(args: argparse.Namespace) -> int:
                 f"not a run directory: {name} is missing (nor a sweep's: no results.csv)",
                 file=rundir,
             )
-    try:
-        metrics = json.loads((rundir / "metrics.json").read_text())
-    except json.JSONDecodeError as exc:
-        raise ConfigError(
-            f"invalid JSON: {exc.msg}", file=rundir / "metrics.json", line=exc.lineno
-        ) from None
+    metrics = read_metrics(rundir / "metrics.json")
     out = Path(args.output) if args.output else rundir / "distance.png"
     traj = out.with_name(out.stem + "-trajectory.png") if args.output else rundir / "trajectory.png"
+    for target in (out, traj):
+        check_output(target, "--output")
     written = draw_run_plots(rundir / "trace.csv", metrics, out, traj, _world_of(rundir))
-    print("wrote " + " and ".join(str(p) for p in written))
+    print(one_line("wrote " + " and ".join(str(p) for p in written)))
     if out not in written:
         print(f"no {out.name}: the scenario has no quality: section (no signal to plot)")
     return 0
@@ -84,9 +82,10 @@ def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
         raise ConfigError(why, key="--metric")
     seeds = len({r["seed_index"] for r in rows})
     out = Path(args.output) if args.output else sweepdir / "summary.png"
-    title = f"{sweepdir.name}: {metric} ({seeds} seed{'s' if seeds != 1 else ''})"
+    check_output(out, "--output")
+    title = one_line(f"{sweepdir.name}: {metric} ({seeds} seed{'s' if seeds != 1 else ''})")
     plot_summary(rows, axes, metric, out, title)
-    print(f"wrote {out}")
+    print(one_line(f"wrote {out}"))
     failed = sum(1 for r in rows if r.get("error"))
     empty = sum(1 for r in rows if not r.get("error") and r.get(metric) is None)
     if failed or empty:
@@ -95,3 +94,46 @@ def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
             f" (null: e.g. never settled), {failed} failed"
         )
     return 0
+
+
+def read_metrics(path: Path) -> dict[str, Any]:
+    """A run's ``metrics.json``, checked for what the plots read (one line if it is not)."""
+    try:
+        metrics = json.loads(path.read_bytes())
+    except json.JSONDecodeError as exc:
+        raise ConfigError(f"invalid JSON: {exc.msg}", file=path, line=exc.lineno) from None
+    except UnicodeDecodeError:
+        raise ConfigError("invalid JSON: not UTF-8 text", file=path) from None
+    except OSError as exc:
+        raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
+    why = _metrics_problem(metrics)
+    if why is not None:
+        raise ConfigError(f"not a run's metrics: {why}", file=path)
+    return metrics
+
+
+def _metrics_problem(metrics: Any) -> str | None:
+    if not isinstance(metrics, dict):
+        return f"expected an object, got {type(metrics).__name__}"
+    phases = metrics.get("phases", [])
+    if not isinstance(phases, list):
+        return "phases is not a list"
+    for i, phase in enumerate(phases):
+        if not isinstance(phase, dict):
+            return f"phases[{i}] is not an object"
+        if not _is_number(phase.get("start")):
+            return f"phases[{i}].start is not a number"
+        if not isinstance(phase.get("set", {}), dict):
+            return f"phases[{i}].set is not an object"
+    quality = metrics.get("quality")
+    if quality is not None:
+        if not isinstance(quality, dict) or not isinstance(quality.get("signal"), str):
+            return "quality is not an object with a signal"
+        for key in ("reference", "tolerance"):
+            if not _is_number(quality.get(key)):
+                return f"quality.{key} is not a number"
+    return None
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)

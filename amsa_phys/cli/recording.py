@@ -108,6 +108,8 @@ def _target(name: str, formats: tuple[str, ...], flag: str, force: bool) -> Path
             file=path,
         )
     parent = path.parent if str(path.parent) else Path(".")
+    if path.is_dir():
+        raise ConfigError("is a directory; give a file name", key=flag, file=path)
     if not parent.is_dir():
         raise ConfigError("directory does not exist", key=flag, file=path)
     if not os.access(parent, os.W_OK):

@@ -5,6 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, TextIO
 
+from ..errors import one_line
+
 
 def _fmt(value: Any, digits: int = 2) -> str:
     if value is None:
@@ -42,7 +44,8 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
     line = "  ".join(c.ljust(w) for c, w in zip(cols, widths, strict=True))
     print(line.rstrip(), file=stream)
     for r in rows:
-        print("  ".join(v.ljust(w) for v, w in zip(r, widths, strict=True)).rstrip(), file=stream)
+        text = "  ".join(v.ljust(w) for v, w in zip(r, widths, strict=True)).rstrip()
+        print(one_line(text), file=stream)
     if metrics["overall"].get("partial"):
         print(
             f"(cut): the run stopped at t={metrics['simulated']:g} s, inside this block; "
@@ -56,15 +59,19 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
         print("no quality: section, so no metrics of control and no distance.png", file=stream)
     paused = metrics.get("paused_s")
     print(
-        f"simulated {metrics['simulated']:.1f} s in {metrics['wall_time_s']:.2f} s"
-        + (f", {paused:.2f} s of it paused" if paused else "")
-        + f" ({metrics['real_time_factor']}x real time); outputs in {out_dir}",
+        one_line(
+            f"simulated {metrics['simulated']:.1f} s in {metrics['wall_time_s']:.2f} s"
+            + (f", {paused:.2f} s of it paused" if paused else "")
+            + f" ({metrics['real_time_factor']}x real time); outputs in {out_dir}"
+        ),
         file=stream,
     )
     video = metrics.get("video")
     if video:
         w, h = video["size"]
         print(
-            f"video {video['path']}: {video['frames']} frames, {w}x{h} at {video['fps']} fps",
+            one_line(
+                f"video {video['path']}: {video['frames']} frames, {w}x{h} at {video['fps']} fps"
+            ),
             file=stream,
         )

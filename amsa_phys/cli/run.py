@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..engine import interrupt
-from ..errors import ConfigError
+from ..errors import ConfigError, one_line
 from ..model.scenario import load_scenario
 from ..runs.expect import check_expectations
 from ..runs.plotjob import PlotJob
@@ -89,5 +89,7 @@ def _run(
         print_summary(outcome.metrics, out, sys.stdout)
     checks = check_expectations(scenario.expect, outcome.metrics, out / "trace.csv")
     for check in checks:
-        print(f"expect {check.describe()}", file=sys.stdout if check.passed else sys.stderr)
+        print(
+            one_line(f"expect {check.describe()}"), file=sys.stdout if check.passed else sys.stderr
+        )
     return 0 if all(c.passed for c in checks) else 1

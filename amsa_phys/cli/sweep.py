@@ -12,9 +12,9 @@ from typing import Any
 
 from tqdm import tqdm
 
+from ..atomic import write_atomic
 from ..engine import interrupt
-from ..engine.recorder import write_atomic
-from ..errors import ConfigError, Interrupted
+from ..errors import ConfigError, Interrupted, one_line
 from ..model.scenario import load_scenario
 from ..model.wording import plural
 from ..model.yamlio import load_yaml
@@ -24,6 +24,7 @@ from ..runs.sweep import (
     Axis,
     SweepPlan,
     check_axes,
+    check_size,
     iter_dask,
     iter_local,
     parse_grid,
@@ -88,6 +89,10 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
     axes += cli_axes
     if not axes:
         raise ConfigError("nothing to sweep: give --grid/--range or a sweep: section", key="sweep")
+    seeds = args.seeds if args.seeds is not None else int(section.get("seeds", 1))
+    if seeds < 1:
+        raise ConfigError("must be at least 1", key="--seeds")
+    check_size(axes, seeds)  # before a single value is judged or a job built
     try:
         check_axes([a for a in axes if a.key != "context"], scenario)
     except ConfigError as exc:
@@ -104,9 +109,6 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
                 resolve_change(key, value, scenario.world)
             except ValueError as exc:
                 raise doc.error(("sweep", "contexts", name, key), str(exc)) from None
-    seeds = args.seeds if args.seeds is not None else int(section.get("seeds", 1))
-    if seeds < 1:
-        raise ConfigError("must be at least 1", key="--seeds")
     metric = args.metric or section.get("metric", "rms_error")
     end = args.duration if args.duration is not None else scenario.duration
     why = unknown_metric(metric, sum(1 for p in scenario.phases if p.at < end))
@@ -173,14 +175,17 @@ def run(args: argparse.Namespace) -> int:
         keys,
         plan.metric,
         out / "summary.png",
-        f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})",
+        one_line(f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})"),
     )
     failed = [r for r in rows if r["error"]]
     print(
-        f"{len(rows)} of {plural(len(jobs), 'run')} done ({len(failed)} failed); results in {out}"
+        one_line(
+            f"{len(rows)} of {plural(len(jobs), 'run')} done ({len(failed)} failed); "
+            f"results in {out}"
+        )
     )
     for r in failed[:5]:
-        print(f"run {r['run']}: {r['error']}", file=sys.stderr)
+        print(one_line(f"run {r['run']}: {r['error']}"), file=sys.stderr)
     if interrupted:
         raise Interrupted(f"sweep interrupted; {plural(len(rows), 'finished row')} kept in {out}")
     return 0

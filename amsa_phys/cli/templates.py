@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import argparse
 
-from ..model.template import BUILTINS, resolve_template
+from ..errors import ConfigError, one_line
+from ..model.suggest import did_you_mean
+from ..model.template import BUILTINS, TemplateNotFound, resolve_template
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -16,22 +18,35 @@ def run(args: argparse.Namespace) -> int:
     """Print each template."""
     names = [args.name] if args.name else list(BUILTINS)
     for name in names:
-        t = resolve_template(name)
-        print(f"{t.name()} ({t.kind.value}): {t.describe()}")
+        try:
+            t = resolve_template(name)
+        except TemplateNotFound as exc:
+            hint = did_you_mean(name, BUILTINS) if ":" not in name else ""
+            known = "" if hint else f"; built-in: {', '.join(BUILTINS)}"
+            raise ConfigError(f"{exc}{hint}{known}", key="templates") from None
+        print(one_line(f"{t.name()} ({t.kind.value}): {t.describe()}"))
         for port in t.inputs:
             print(
-                f"    in  {port.name}"
-                + (f" [{port.unit}]" if port.unit else "")
-                + (f"  {port.description}" if port.description else "")
+                one_line(
+                    f"    in  {port.name}"
+                    + (f" [{port.unit}]" if port.unit else "")
+                    + (f"  {port.description}" if port.description else "")
+                )
             )
         for port in t.outputs:
             print(
-                f"    out {port.name}"
-                + (f" [{port.unit}]" if port.unit else "")
-                + (f"  {port.description}" if port.description else "")
+                one_line(
+                    f"    out {port.name}"
+                    + (f" [{port.unit}]" if port.unit else "")
+                    + (f"  {port.description}" if port.description else "")
+                )
             )
         for p in t.params:
             unit = f" {p.unit}" if p.unit else ""
             rng = f" {p.range_text()}" if p.range_text() else ""
-            print(f"    param {p.name}: {p.type} = {p.default!r}{unit}{rng}  {p.description}")
+            print(
+                one_line(
+                    f"    param {p.name}: {p.type} = {p.default!r}{unit}{rng}  {p.description}"
+                )
+            )
     return 0

@@ -8,10 +8,11 @@ import sys
 from pathlib import Path
 
 from ..engine import interrupt
-from ..errors import ConfigError, Interrupted
+from ..errors import ConfigError, Interrupted, one_line
 from ..model.wording import plural
 from ..runs.junit import write_junit
 from ..runs.pool import WORKER_LOST, imap_resilient
+from ..runs.rundir import check_output
 from ..runs.suite import ScenarioResult, find_scenarios, run_dir_names, run_scenario_job
 from .options import add_jobs
 
@@ -46,6 +47,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("no scenario with an expect: section found", key=" ".join(args.paths))
     if args.jobs < 1:
         raise ConfigError("must be at least 1", key="--jobs")
+    if args.junit:  # before the suite runs, not after (its folder is made, as pytest does)
+        check_output(Path(args.junit), "--junit", make_parent=True)
     with interrupt.sigterm_as_ctrl_c():
         results = _run_all(files, min(args.jobs, len(files)), args.out)
     print_table(results)
@@ -112,10 +115,10 @@ def print_table(results: list[ScenarioResult]) -> None:
             rows.append((r.name, c.what, value, c.bound, c.verdict))
     widths = [max(len(row[i]) for row in rows) for i in range(5)]
     for row in rows:
-        print("  ".join(v.ljust(w) for v, w in zip(row, widths, strict=True)).rstrip())
+        print(one_line("  ".join(v.ljust(w) for v, w in zip(row, widths, strict=True)).rstrip()))
     for r in results:
         if r.error is not None:
-            print(f"error: {r.name}: {r.error}", file=sys.stderr)
+            print(one_line(f"error: {r.name}: {r.error}"), file=sys.stderr)
     n_checks = sum(len(r.checks) for r in results)
     n_fail = sum(1 for r in results for c in r.checks if not c.passed)
     n_err = sum(1 for r in results if r.error is not None)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..errors import AmsaError
+from ..errors import AmsaError, one_line
 from ..model.wording import plural
 from .loading import load_any
 
@@ -22,14 +22,16 @@ def run(args: argparse.Namespace) -> int:
         try:
             kind, obj = load_any(path)
         except AmsaError as exc:
-            print(f"error: {exc}", file=sys.stderr)
+            print(f"error: {one_line(str(exc))}", file=sys.stderr)
             bad += 1
             continue
         if kind == "scenario":
             print(
-                f"ok: {path} (scenario: {plural(len(obj.world.leaves), 'component')}, "
-                f"{plural(len(obj.phases), 'phase')}, {float(obj.duration):g} s)"
+                one_line(
+                    f"ok: {path} (scenario: {plural(len(obj.world.leaves), 'component')}, "
+                    f"{plural(len(obj.phases), 'phase')}, {float(obj.duration):g} s)"
+                )
             )
         else:
-            print(f"ok: {path} (world: {plural(len(obj.leaves), 'component')})")
+            print(one_line(f"ok: {path} (world: {plural(len(obj.leaves), 'component')})"))
     return 2 if bad else 0

@@ -11,8 +11,11 @@ from collections.abc import Iterable
 from fractions import Fraction
 from math import gcd, lcm
 
-#: Refuse schedules whose repeating pattern would be absurdly long (incommensurate rates).
-MAX_EVENTS_PER_CYCLE = 2_000_000
+from ..model.rates import MAX_EVENTS_PER_CYCLE
+
+#: Refuse schedules whose repeating pattern would be absurdly long (incommensurate rates);
+#: the loader checks the same limit first (``model/rates.py``).
+__all__ = ["MAX_EVENTS_PER_CYCLE", "TickGrid", "fraction_gcd", "hyperperiod", "to_fraction"]
 
 
 def to_fraction(value: float | int | str | Fraction) -> Fraction:

@@ -1,19 +1,23 @@
 """The trace: every Data buffer at the log rate, streamed to a temporary file and renamed.
 
 A run that is killed never leaves a half-written ``trace.csv``: rows go to
-``trace.csv.tmp`` and ``os.replace`` gives it its final name only when the run is finalised
-(normally, on a fault or on Ctrl-C). Floats are spelled as ``repr`` spells them (shortest exact
-round-trip), so the same run gives byte-identical files.
+``trace.csv.tmp`` (``amsa_phys.atomic``) and it gets its final name only when the run is
+finalised (normally, on a fault or on Ctrl-C). A write that fails (a full disk) raises
+:class:`~amsa_phys.errors.OutputError` from the run loop and removes the temporary file.
+Floats are spelled as ``repr`` spells them (shortest exact round-trip), so the same run gives
+byte-identical files.
 """
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import IO
 
 import orjson
+
+from ..atomic import AtomicFile, write_atomic
+
+__all__ = ["TraceWriter", "format_rows", "write_atomic"]
 
 #: Rows collected before they are formatted and written in one go.
 _CHUNK = 256
@@ -79,16 +83,21 @@ class TraceWriter:
 
     def __init__(self, path: Path, columns: Sequence[str]) -> None:
         self.path = Path(path)
-        self.tmp = self.path.with_name(self.path.name + ".tmp")
         self.columns = list(columns)
-        self._fh: IO[bytes] | None = open(self.tmp, "wb")  # noqa: SIM115
-        self._fh.write((",".join(["t", *self.columns]) + "\n").encode())
+        self._file = AtomicFile(self.path)
+        self.tmp = self._file.tmp
+        self._file.write((",".join(["t", *self.columns]) + "\n").encode())
         self.rows = 0
         self._rows: list[tuple[float, ...]] = []  # rows not yet written
+        self._closed = False
+
+    @property
+    def failed(self) -> bool:
+        """Whether a write failed (the temporary file is gone; there will be no trace)."""
+        return self._file.failed
 
     def write(self, t_s: float, values: Sequence[float]) -> None:
         """Append one row (``t`` in seconds, then one value per column)."""
-        assert self._fh is not None, "trace already closed"
         rows = self._rows
         rows.append((t_s, *values))
         self.rows += 1
@@ -97,29 +106,24 @@ class TraceWriter:
 
     def _flush_rows(self) -> None:
         """Format the collected rows and hand them to the file in one call."""
-        if self._rows and self._fh is not None:
-            self._fh.write(format_rows(self._rows))
+        if self._rows:
+            data = format_rows(self._rows)
             self._rows.clear()
+            self._file.write(data)
 
-    def close(self) -> Path:
-        """Flush, fsync and rename to the final name; safe to call twice."""
-        if self._fh is not None:
-            self._flush_rows()
-            self._fh.flush()
-            os.fsync(self._fh.fileno())
-            self._fh.close()
-            self._fh = None
-            os.replace(self.tmp, self.path)
-        return self.path
+    def close(self) -> Path | None:
+        """Flush, fsync and rename to the final name; safe to call twice.
 
+        None if a write failed (the trace is lost, never left truncated).
+        """
+        if not self._closed:
+            self._closed = True
+            if not self._file.failed:
+                self._flush_rows()
+                self._file.commit()
+        return None if self._file.failed else self.path
 
-def write_atomic(path: Path, data: str | bytes) -> None:
-    """Write a whole file under a temporary name, then rename it into place."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    mode = "wb" if isinstance(data, bytes) else "w"
-    with open(tmp, mode) as fh:
-        fh.write(data)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    def discard(self) -> None:
+        """Drop the trace (its temporary file) without giving it its final name."""
+        self._closed = True
+        self._file.discard()

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import RunFault
+from ..model.params import short_repr
 from ..model.scenario import Change, Phase, Scenario
 from ..model.template import Template
 from ..model.world import WorldSpec
@@ -129,6 +130,21 @@ def _runs(instants: list[_Instant]) -> list[Entry]:
     return out
 
 
+#: What a component's code may raise that is its fault, not the engine's: any exception,
+#: and ``sys.exit()`` (SystemExit), which would otherwise end the whole program with its
+#: code and no message. KeyboardInterrupt is the user's and stays one.
+COMPONENT_ERRORS = (Exception, SystemExit)
+
+
+def _is_mask(published: Any, n: int) -> bool:
+    """Whether ``published`` is a boolean array with one entry per copy."""
+    return (
+        isinstance(published, np.ndarray)
+        and published.dtype == np.bool_
+        and published.shape == (n,)
+    )
+
+
 class Simulation:
     """One run of a scenario (or of a bare world, for tests)."""
 
@@ -205,7 +221,9 @@ class Simulation:
         for path, comp in self.components.items():
             try:
                 comp.initialize(Context(self, path))
-            except Exception as exc:  # a component's own bug or bad configuration
+            except RunFault:
+                raise
+            except COMPONENT_ERRORS as exc:  # a component's own bug or bad configuration
                 raise RunFault(self._who(path), 0, f"initialize failed: {exc!r}") from exc
         self._compile()
 
@@ -433,7 +451,7 @@ class Simulation:
             out = task.comp.do_step(now, inp)
         except RunFault:
             raise
-        except Exception as exc:
+        except COMPONENT_ERRORS as exc:
             raise RunFault(self._who(task.path), now, f"do_step raised {exc!r}") from exc
         if not out:
             return
@@ -444,7 +462,7 @@ class Simulation:
                 if number - number != 0.0:  # inf or nan
                     raise ValueError
                 values[targets[key]] = number
-        except (KeyError, TypeError, ValueError):
+        except (KeyError, TypeError, ValueError, OverflowError, AttributeError):
             raise self._bad_output(task, out) from None
 
     def _step_group(self, group: batch.Group, now: Fraction) -> None:
@@ -458,34 +476,60 @@ class Simulation:
             )
         except RunFault:
             raise
-        except Exception as exc:
+        except COMPONENT_ERRORS as exc:
             who = self._who(group.paths[0])
-            raise RunFault(who, now, f"do_step raised {exc!r}") from exc
+            raise RunFault(who, now, f"step_many raised {exc!r}") from exc
+        except (TypeError, ValueError) as exc:  # not a pair (outputs, published)
+            who = self._who(group.paths[0])
+            raise RunFault(who, now, f"step_many must return (outputs, published): {exc}") from exc
         n = len(group.paths)
+        if not (isinstance(out, Mapping) and (published is None or _is_mask(published, n))):
+            who = self._who(group.paths[0])
+            raise RunFault(
+                who,
+                now,
+                f"step_many must return (outputs, published) with a mapping of outputs and "
+                f"None or a boolean mask of {n} rows, got ({short_repr(out)}, "
+                f"{short_repr(published)})",
+            )
         mask = None if published is None else published.tolist()
         for port, arr in out.items():
             bufs = group.outputs.get(port)
             if bufs is None:
                 who = self._who(group.paths[0])
-                raise RunFault(who, now, f"published unknown output {port!r}")
+                raise RunFault(who, now, f"published unknown output {short_repr(port)}")
             if not (type(arr) is np.ndarray and arr.shape == (n,) and arr.dtype == np.float64):
-                arr = np.broadcast_to(np.asarray(arr, dtype=np.float64), (n,))
+                try:
+                    arr = np.broadcast_to(np.asarray(arr, dtype=np.float64), (n,))
+                except (TypeError, ValueError, OverflowError):
+                    raise RunFault(
+                        self._who(group.paths[0]),
+                        now,
+                        f"output {port} of step_many has shape {np.shape(arr)}, expected "
+                        f"({n},): one number per copy",
+                    ) from None
             k = batch.first_bad(arr, published)
             if k is not None:
                 raise RunFault(self._who(group.paths[k]), now, f"output {port} is {arr[k]}")
             pairs = zip(bufs, arr.tolist(), strict=True)
             values.update(pairs if mask is None else compress(pairs, mask))
 
-    def _bad_output(self, task: _Task, out: Mapping[str, Any]) -> RunFault:
+    def _bad_output(self, task: _Task, out: Any) -> RunFault:
         """The fault for the first output ``_step`` refused (a slow path: faults are rare)."""
         who = self._who(task.path)
+        if not isinstance(out, Mapping):
+            return RunFault(
+                who, self.now, f"do_step must return a mapping of outputs, got {short_repr(out)}"
+            )
         for key, value in out.items():
             if key not in task.targets:
-                return RunFault(who, self.now, f"published unknown output {key!r}")
+                return RunFault(who, self.now, f"published unknown output {short_repr(key)}")
             try:
                 number = float(value)
+            except OverflowError:
+                return RunFault(who, self.now, f"output {key} is too large for a float")
             except (TypeError, ValueError):
-                return RunFault(who, self.now, f"output {key} is not a number: {value!r}")
+                return RunFault(who, self.now, f"output {key} is not a number: {short_repr(value)}")
             if not math.isfinite(number):
                 return RunFault(who, self.now, f"output {key} is {number}")
         return RunFault(who, self.now, f"published invalid outputs {dict(out)!r}")
@@ -527,9 +571,12 @@ class Simulation:
         self.change_log.append((self.now, change))
         try:
             comp.on_param_change(change.param, change.value)
-        except Exception as exc:
+        except RunFault:
+            raise
+        except COMPONENT_ERRORS as exc:
+            why = f"on_param_change raised {exc!r}" if isinstance(exc, SystemExit) else exc
             raise RunFault(
-                self._who(change.leaf), self.now, f"rejected {change.param}={change.value!r}: {exc}"
+                self._who(change.leaf), self.now, f"rejected {change.param}={change.value!r}: {why}"
             ) from None  # a rejection is a message, not a crash (--debug still finds it)
 
     def next_instant(self) -> Fraction:

@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import math
+import reprlib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -100,6 +101,10 @@ class Param:
         return tuple(points)
 
 
+#: Largest integer parameter: copies of a component keep their parameters in int64 arrays.
+MAX_INT = 2**63 - 1
+
+
 def _number(value: Any, integer: bool) -> Any:
     if isinstance(value, bool) or not isinstance(value, int | float):
         want = "an integer" if integer else "a number"
@@ -110,9 +115,20 @@ def _number(value: Any, integer: bool) -> Any:
         if isinstance(value, float):
             if not value.is_integer():
                 raise ValueError(f"expected an integer, got {value}")
-            return int(value)
+            value = int(value)
+        if abs(value) > MAX_INT:
+            raise ValueError(f"integer too large ({_digits(value)}; at most {MAX_INT})")
         return value
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:
+        raise ValueError(
+            f"number too large ({_digits(value)}; a number must fit a float, at most about 1.8e308)"
+        ) from None
+
+
+def _digits(value: int) -> str:
+    return f"{len(str(abs(value)))} digits"
 
 
 _YAML_TYPES = {
@@ -131,9 +147,18 @@ def yaml_type(value: Any) -> str:
     return _YAML_TYPES.get(type(value), type(value).__name__)
 
 
+_REPR = reprlib.Repr()
+_REPR.maxlevel = 3
+_REPR.maxstring = _REPR.maxother = _REPR.maxlong = 40
+
+
 def short_repr(value: Any) -> str:
-    """``repr`` cut to 40 characters, for one-line messages."""
-    text = repr(value)
+    """``repr`` cut to 40 characters, for one-line messages.
+
+    Bounded work whatever the value: a list shared a billion times over by YAML aliases
+    is not spelled out before it is cut.
+    """
+    text = _REPR.repr(value)
     return text if len(text) <= 40 else text[:37] + "..."
 
 

@@ -13,15 +13,16 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from ..errors import ConfigError
 from . import schema
+from .params import short_repr
+from .rates import MAX_RATE_HZ, MIN_RATE_HZ, cycle_problem
+from .schema import MAX_SEED
 from .suggest import did_you_mean
 from .template import Kind
 from .wording import plural
-from .world import WorldSpec, build_world, load_world
-from .yamlio import KeyPath, YamlDoc, load_yaml
+from .world import WorldSpec, build_world, load_world, resolved_values
+from .yamlio import MAX_NODES, KeyPath, YamlDoc, load_yaml, parse_value
 
 #: Metrics an ``expect`` entry may name (see engine/metrics.py), in the order of the columns
 #: of a sweep's ``results.csv``.
@@ -164,11 +165,26 @@ def configure_scenario(
     # with overrides, the rules are checked once they are in: a --set may repair the file
     scenario = build_scenario(doc, check_rules=not overrides)
     if seed is not None:
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED:
+            raise ConfigError(
+                f"must be an integer from 0 to {MAX_SEED} (2**63 - 1), like seed: in a "
+                f"scenario; got {short_repr(seed)}",
+                key="--seed",
+            )
         scenario.seed = seed
     if duration is not None:
         shorten(scenario, _positive_fraction(duration, "--duration"))
     if log_rate is not None:
         scenario.log_rate = _positive_fraction(log_rate, "--log-rate")
+        if not MIN_RATE_HZ <= scenario.log_rate <= MAX_RATE_HZ:
+            raise ConfigError(
+                f"{log_rate:g} Hz is outside the rates amsa-phys runs "
+                f"({MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} Hz)",
+                key="--log-rate",
+            )
+        why = _cycle_problem(scenario)
+        if why is not None:
+            raise ConfigError(why, key="--log-rate")
     in_file = len(scenario.phases[0].changes)
     for text in overrides or []:
         if text.strip().startswith(PHYSICS_PREFIX):
@@ -194,7 +210,7 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
         world_path = doc.path.parent / world_ref
         if world_path.is_dir():
             raise doc.error(("world",), f"{world_path} is a directory, expected a world file")
-        if not world_path.is_file():
+        if not world_path.exists():
             raise doc.error(
                 ("world",), f"world file not found: {world_path}" + _nearby_file(world_path)
             )
@@ -252,6 +268,12 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
                 )
             if "phase" in e:
                 raise doc.error((*kp, "phase"), "a trace check takes after/before, not phase")
+            if "after" in e and "before" in e and e["after"] > e["before"]:
+                raise doc.error(
+                    (*kp, "before"),
+                    f"before ({e['before']:g} s) is earlier than after ({e['after']:g} s): "
+                    "the window holds no instant",
+                )
             expect.append(
                 Expectation(
                     None,
@@ -296,6 +318,16 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
         expect=expect,
         data=data,
     )
+    why = _cycle_problem(scenario)
+    if why is not None:
+        raise doc.error(("log_rate",) if "log_rate" in data else ("world",), why)
+    size = written_values(world, data)
+    if size > MAX_NODES:
+        raise doc.error(
+            (),
+            f"too large: written out in full (every copy and parameter) the scenario holds "
+            f"{size:,} values, over the limit of {MAX_NODES:,}",
+        )
     if check_rules:
         check_phases(scenario, doc)
     return scenario
@@ -310,6 +342,34 @@ def _nearby_file(path: Path) -> str:
         return ""
     same_stem = [n for n in names if Path(n).stem == path.stem]
     return f" (did you mean {same_stem[0]}?)" if same_stem else did_you_mean(path.name, names)
+
+
+def _cycle_problem(scenario: Scenario) -> str | None:
+    """Why the world's rates with the trace's cannot be scheduled (``model/rates.py``)."""
+    world = scenario.world
+    rates = [leaf.freq for leaf in world.leaves.values()]
+    rates += [Fraction(str(world.physics["rate"])), _effective_log_rate(scenario.log_rate, world)]
+    return cycle_problem(rates)
+
+
+def written_values(world: WorldSpec, data: dict[str, Any]) -> int:
+    """At least as many values as the YAML loader builds from this scenario written out in
+    full (its resolved ``scenario.yaml``): kept under the loader's limit, so a run's
+    ``scenario.yaml`` always loads again."""
+    return resolved_values(world) + _own_values(data)
+
+
+def _own_values(data: dict[str, Any]) -> int:
+    """The values of a scenario document outside its world (as the YAML loader counts)."""
+
+    def count(value: Any) -> int:
+        if isinstance(value, dict):
+            return 1 + sum(count(v) for v in value.values())
+        if isinstance(value, list):
+            return 1 + sum(count(v) for v in value)
+        return 1
+
+    return 1 + sum(count(v) for k, v in data.items() if k != "world")
 
 
 def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = None) -> None:
@@ -389,10 +449,7 @@ def parse_override(text: str, world: WorldSpec) -> Change:
     key, sep, raw = text.partition("=")
     if not sep:
         raise ConfigError(f"expected Component.parameter=value, got {text!r}", key="--set")
-    try:
-        value = yaml.safe_load(raw) if raw.strip() else raw
-    except yaml.YAMLError:
-        value = raw
+    value = parse_value(raw, f"--set {key.strip()}")
     try:
         return resolve_change(key.strip(), value, world)
     except ValueError as exc:
@@ -428,10 +485,7 @@ def parse_physics_override(text: str) -> dict[str, Any]:
     key = key.strip()
     if not sep:
         raise ConfigError(f"expected physics.key=value, got {text!r}", key="--set")
-    try:
-        value = yaml.safe_load(raw) if raw.strip() else raw
-    except yaml.YAMLError:
-        value = raw
+    value = parse_value(raw, f"--set {key}")
     return physics_setting(key, value, option=f"--set {key}")
 
 

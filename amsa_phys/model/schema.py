@@ -9,17 +9,31 @@ parameter names, links) are judged afterwards by the world and scenario builders
 from __future__ import annotations
 
 import math
+import sys
 from typing import Any
 
 import jsonschema
 
 from .params import short_repr, yaml_type
+from .rates import MAX_RATE_HZ, MIN_PHYSICS_RATE_HZ, MIN_RATE_HZ
 from .suggest import did_you_mean
 from .yamlio import KeyPath, YamlDoc
 
 NAME = r"^[A-Za-z_][A-Za-z0-9_]*$"
+#: The largest seed: numpy's seed tree takes any non-negative integer, files stay int64.
+MAX_SEED = 2**63 - 1
 _num = {"type": "number"}
 _pos = {"type": "number", "exclusiveMinimum": 0}
+#: A component's rate and the trace's: what the engine can schedule in reasonable time
+#: (1e9 Hz would be 1e9 instants per simulated second; 1e-9 Hz a schedule that repeats
+#: every 30 years). ``model/rates.py`` checks that the rates together repeat soon enough.
+_rate = {"type": "number", "minimum": MIN_RATE_HZ, "maximum": MAX_RATE_HZ, "description": "rate"}
+_physics_rate = {
+    "type": "number",
+    "minimum": MIN_PHYSICS_RATE_HZ,
+    "maximum": MAX_RATE_HZ,
+    "description": "rate",
+}
 _nonneg = {"type": "number", "minimum": 0}
 _point = {"type": "array", "items": _num, "minItems": 2, "maxItems": 2}
 #: A time: seconds as a number, or an exact fraction "7/3" (an instant of a 3 Hz component,
@@ -74,7 +88,7 @@ PHYSICS = {
     "type": "object",
     "additionalProperties": False,
     "properties": {
-        "rate": _pos,
+        "rate": _physics_rate,
         "gravity": _pos,
         "ground": {
             "type": "object",
@@ -144,7 +158,7 @@ WORLD: dict[str, Any] = {
             "required": ["template"],
             "properties": {
                 "template": {"type": "string", "minLength": 1},
-                "freq": _pos,
+                "freq": _rate,
                 "params": {"type": "object"},
                 "inputs": {"type": "object", "additionalProperties": {"type": "string"}},
                 "description": {"type": "string"},
@@ -162,8 +176,8 @@ SCENARIO: dict[str, Any] = {
         "description": {"type": "string"},
         "world": {"type": ["string", "object"]},
         "duration": _time,
-        "seed": {"type": "integer", "minimum": 0, "maximum": 2**63 - 1},
-        "log_rate": _pos,
+        "seed": {"type": "integer", "minimum": 0, "maximum": MAX_SEED},
+        "log_rate": _rate,
         "quality": {
             "type": "object",
             "additionalProperties": False,
@@ -219,6 +233,8 @@ SCENARIO: dict[str, Any] = {
     },
 }
 
+_FLOAT_MAX = int(sys.float_info.max)
+
 _TYPE_WORDS = {
     "object": "a mapping",
     "array": "a list",
@@ -233,6 +249,9 @@ def validate(data: Any, schema: dict[str, Any], doc: YamlDoc, prefix: KeyPath = 
     """Raise the ConfigError of the first shape error (by line), or return."""
     bad = _first_nonfinite(data, prefix)
     if bad is not None:
+        value = doc_value(data, bad[len(prefix) :])
+        if isinstance(value, int):
+            raise doc.error(bad, f"number too large ({too_large(value)})")
         raise doc.error(bad, "expected a finite number, got NaN or infinity")
     validator = jsonschema.Draft202012Validator(schema)
     errors = list(validator.iter_errors(data))
@@ -273,7 +292,14 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
         want = err.validator_value
         wants = want if isinstance(want, list) else [want]
         words = " or ".join(_TYPE_WORDS.get(w, w) for w in wants)
+        if not path:  # the whole file: say what it is, never echo what it holds
+            return path, f"expected {words}, got {yaml_type(inst)}: not a world or scenario file"
         return path, f"expected {words}, got {yaml_type(inst)} {short_repr(inst)}"
+    if kind in ("minimum", "maximum") and err.schema.get("description") == "rate":
+        lo, hi = err.schema["minimum"], err.schema["maximum"]
+        if inst <= 0:
+            return path, f"must be > 0, got {inst}"
+        return path, f"{inst:g} Hz is outside the rates amsa-phys runs ({lo:g} to {hi:g} Hz)"
     if kind in ("exclusiveMinimum", "minimum", "maximum"):
         sign = {"exclusiveMinimum": ">", "minimum": ">=", "maximum": "<="}[kind]
         return path, f"must be {sign} {err.validator_value}, got {inst}"
@@ -281,6 +307,8 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
         allowed = err.validator_value if kind == "enum" else [err.validator_value]
         return path, f"expected one of {', '.join(map(str, allowed))}, got {short_repr(inst)}"
     if kind == "pattern":
+        if "propertyNames" in err.schema_path:  # a bad key: point at the key itself
+            path = (*path, inst)
         return path, (
             f"{inst!r} is not a valid name (letters, digits and _, not starting with a digit)"
         )
@@ -302,8 +330,23 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
     return path, err.message
 
 
+def too_large(value: int) -> str:
+    """Why an integer is refused as a number: ``401 digits; a number must fit a float``."""
+    return f"{len(str(abs(value)))} digits; a number must fit a float, at most about 1.8e308"
+
+
+def doc_value(data: Any, keypath: KeyPath) -> Any:
+    """The value at ``keypath`` in ``data``."""
+    for part in keypath:
+        data = data[part]
+    return data
+
+
 def _first_nonfinite(data: Any, path: KeyPath) -> KeyPath | None:
+    """The first NaN, infinity or integer too large for a float (401 digits) in ``data``."""
     if isinstance(data, float) and not math.isfinite(data):
+        return path
+    if isinstance(data, int) and not isinstance(data, bool) and abs(data) > _FLOAT_MAX:
         return path
     if isinstance(data, dict):
         for k, v in data.items():

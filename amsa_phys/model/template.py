@@ -9,10 +9,12 @@ when a world uses them, so this layer never imports the physics.
 from __future__ import annotations
 
 import importlib
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import Enum
 from fractions import Fraction
+from pathlib import Path
 from typing import Any, ClassVar, Protocol
 
 from .suggest import did_you_mean
@@ -155,6 +157,32 @@ class TemplateNotFound(LookupError):
     """A template reference that names nothing; the message says why."""
 
 
+#: An absolute dotted module path (``.foo`` or ``..`` would be a relative import).
+_MODULE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*")
+
+
+def _import(module_name: str) -> Any:
+    """Import a user module; whatever goes wrong in it becomes one line naming the module.
+
+    A user module may fail to import in any way -- missing, a syntax error, an exception
+    or even ``sys.exit()`` at import time: all are the world's problem, reported where the
+    world names the template (exit 2), never a traceback.
+    """
+    try:
+        return importlib.import_module(module_name)
+    except ModuleNotFoundError as exc:
+        raise TemplateNotFound(f"cannot import module {module_name!r}: {exc}") from None
+    except SyntaxError as exc:
+        where = f"{Path(exc.filename).name}:{exc.lineno}" if exc.filename else "its source"
+        raise TemplateNotFound(
+            f"cannot import module {module_name!r}: syntax error at {where}: {exc.msg}"
+        ) from None
+    except (Exception, SystemExit) as exc:
+        raise TemplateNotFound(
+            f"cannot import module {module_name!r}: importing it raised {exc!r}"
+        ) from None
+
+
 def resolve_template(ref: str) -> type[Template]:
     """Return the template class for a built-in name or an explicit ``module:Class``.
 
@@ -167,10 +195,12 @@ def resolve_template(ref: str) -> type[Template]:
             raise TemplateNotFound(f"unknown template {ref!r}")
         target = ref
     module_name, _, attr = target.partition(":")
-    try:
-        module = importlib.import_module(module_name)
-    except ImportError as exc:
-        raise TemplateNotFound(f"cannot import module {module_name!r}: {exc}") from None
+    if not _MODULE.fullmatch(module_name) or not attr.isidentifier():
+        raise TemplateNotFound(
+            f"{ref!r} is not a template name nor package.module:Class "
+            "(a dotted module path, then a class name)"
+        )
+    module = _import(module_name)
     cls = getattr(module, attr, None)
     if cls is None:
         found = [

@@ -16,12 +16,16 @@ from ..errors import ConfigError
 from . import schema
 from .dataflow import execution_order
 from .links import allowed_text, link_allowed
+from .rates import cycle_problem
 from .suggest import did_you_mean
 from .template import BUILTINS, Template, TemplateNotFound, resolve_template
 from .yamlio import KeyPath, YamlDoc, load_yaml
 
 #: The AMSA metamodel's default frequency (``TimeableObject.freq`` in amsaCore.ecore).
 DEFAULT_FREQ_HZ = 10
+#: Most Leaf components in a world, ``count:`` copies included (checked before any copy is
+#: built: 30 aliases of a ``count: 10000`` Composite would be 300,000 from a 1 KB file).
+MAX_COMPONENTS = 10_000
 
 PHYSICS_DEFAULTS: dict[str, Any] = {
     "rate": 100,
@@ -99,10 +103,14 @@ def load_world(path: str | Path) -> WorldSpec:
 
 def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
     """Check ``data`` (found at ``prefix`` in ``doc``) and build the WorldSpec."""
-    schema.validate(data, schema.WORLD, doc, prefix)
 
     def err(keypath: KeyPath, message: str) -> ConfigError:
         return doc.error((*prefix, *keypath), message)
+
+    if isinstance(data, dict) and isinstance(data.get("components"), dict):
+        _check_size(data["components"], err)  # before the (slow) shape check, too
+    schema.validate(data, schema.WORLD, doc, prefix)
+    _check_walls(data.get("physics", {}).get("walls"), err)
 
     leaves: dict[str, LeafSpec] = {}
     copy_schedule: list[str] = []  # the counted Composites' own schedules, per copy
@@ -178,6 +186,9 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
             raise err(("schedule", i), f"unknown component {item!r}" + did_you_mean(item, leaves))
     schedule += [x for x in copy_schedule if x not in schedule]
     physics = _merge(PHYSICS_DEFAULTS, data.get("physics", {}))
+    why = cycle_problem([*(leaf.freq for leaf in leaves.values()), Fraction(str(physics["rate"]))])
+    if why is not None:
+        raise err(("components",), why)
     order = execution_order(leaves, schedule, err)
     return WorldSpec(
         name=str(data.get("name", doc.path.stem)),
@@ -191,6 +202,69 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
         order=order,
         schedule=schedule,
     )
+
+
+def _check_size(comps: dict[str, Any], err: Any) -> None:
+    """Refuse a world of more than :data:`MAX_COMPONENTS` Leaves before building copies."""
+
+    def leaves(body: Any) -> int:  # any shape: the schema is checked after this
+        if not isinstance(body, dict) or not isinstance(body.get("components"), dict):
+            return 1
+        count = body.get("count", 1)
+        count = count if isinstance(count, int) and not isinstance(count, bool) else 1
+        inner = sum(leaves(child) for child in body["components"].values())
+        return inner * max(1, min(count, MAX_COMPONENTS + 1))
+
+    total = 0
+    for name, body in comps.items():
+        total += leaves(body)
+        if total > MAX_COMPONENTS:
+            raise err(
+                ("components", name),
+                f"the world has over {MAX_COMPONENTS:,} components (count: copies "
+                f"included), the limit",
+            )
+
+
+def _check_walls(walls: dict[str, Any] | None, err: Any) -> None:
+    """A walled arena must have an inside."""
+    if walls is None:
+        return
+    for lo, hi in (("xmin", "xmax"), ("ymin", "ymax")):
+        if not walls[lo] < walls[hi]:
+            raise err(
+                ("physics", "walls", hi),
+                f"{hi} ({walls[hi]:g}) must be greater than {lo} ({walls[lo]:g})",
+            )
+
+
+def resolved_values(world: WorldSpec) -> int:
+    """How many values the world has written out in full (every copy, every parameter).
+
+    An upper bound on what the YAML loader builds when it reads a resolved scenario's
+    world back: a scenario is refused if this and its own values pass the loader's limit,
+    so a run's ``scenario.yaml`` always loads again.
+    """
+    total = 16 + len(world.schedule) + sum(_values(ob) for ob in world.physics["obstacles"])
+    composites = [world.root]
+    while composites:
+        node = composites.pop()
+        for child in node.children:
+            if isinstance(child, CompositeSpec):
+                total += 2
+                composites.append(child)
+            else:
+                params = sum(_values(v) for v in child.params.values())
+                total += 6 + len(child.inputs) + params
+    return total
+
+
+def _values(value: Any) -> int:
+    if isinstance(value, list | tuple):
+        return 1 + sum(_values(v) for v in value)
+    if isinstance(value, dict):
+        return 1 + sum(_values(v) for v in value.values())
+    return 1
 
 
 @dataclass(frozen=True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import os
 import warnings
 from pathlib import Path
 from typing import Any
@@ -14,25 +15,87 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
+from ..errors import ConfigError
+from ..model.params import short_repr
 from .save import save_png
+
+#: Values beyond this are not drawn (NaN): matplotlib's limits overflow near the float limit.
+PLOTTABLE = 1e200
 
 
 def read_trace(path: Path) -> tuple[list[str], np.ndarray]:
     """The trace's column names and its values as a 2-D array (read once per file version:
-    a run draws several plots from the same trace)."""
+    a run draws several plots from the same trace).
+
+    A file that is not a whole trace -- binary junk, a row cut short (no end of line, as a
+    killed writer would leave), rows wider or narrower than the header -- is refused with
+    one line naming the file and line (ConfigError), never plotted as if it were one.
+    """
     st = Path(path).stat()
     return _read_trace(str(path), st.st_mtime_ns, st.st_size)
 
 
 @functools.lru_cache(maxsize=2)
 def _read_trace(path: str, mtime_ns: int, size: int) -> tuple[list[str], np.ndarray]:
-    with open(path, encoding="utf-8") as fh:
-        header = fh.readline().strip().split(",")
-    with warnings.catch_warnings():  # a run that faulted at t = 0 has a header only
-        warnings.simplefilter("ignore", UserWarning)
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    with open(path, "rb") as fh:  # the checks read the first line and the last byte only
+        head = fh.readline()
+        fh.seek(-1 if size else 0, os.SEEK_END)
+        whole = fh.read(1) == b"\n"
+    try:
+        header = head.decode("utf-8").rstrip("\n").split(",")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"not a trace: not UTF-8 text (byte {exc.start})", file=path) from None
+    if header[0] != "t":
+        raise ConfigError("not a whole trace: no header line starting with t", file=path, line=1)
+    if not whole:  # a row cut short, as a killed writer would leave it
+        raise ConfigError("not a whole trace: cut short", file=path, line=_newlines(path) + 1)
+    try:
+        with warnings.catch_warnings():  # a header alone: no rows, not a warning
+            warnings.simplefilter("ignore")
+            data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, encoding="utf-8")
+    except (ValueError, UnicodeDecodeError):
+        data = np.empty((0, 0))  # found below, with its line
+    if data.size == 0 and _newlines(path) == 1:  # the header alone: a run that faulted at 0
+        data = np.empty((0, len(header)))
+    if data.shape[1:] != (len(header),):
+        line, problem = _bad_row(path, len(header))
+        raise ConfigError(f"not a whole trace: {problem}", file=path, line=line)
+    data[~(np.abs(data) < PLOTTABLE)] = np.nan  # inf, nan and the unplottable
     data.flags.writeable = False  # shared between callers
     return header, data
+
+
+def _newlines(path: str) -> int:
+    with open(path, "rb") as fh:
+        return sum(chunk.count(b"\n") for chunk in iter(lambda: fh.read(1 << 20), b""))
+
+
+def _bad_row(path: str, width: int) -> tuple[int, str]:
+    """The first row (as a file line) that is not ``width`` numbers, and what is wrong."""
+    with open(path, "rb") as fh:
+        fh.readline()
+        for line, raw in enumerate(fh, start=2):
+            try:
+                row = raw.decode("utf-8").rstrip("\n")
+            except UnicodeDecodeError:
+                return line, "not UTF-8 text"
+            problem = _row_problem(row, width)
+            if problem:
+                return line, problem
+    return 1, "unreadable"
+
+
+def _row_problem(row: str, width: int) -> str:
+    """What is wrong with one row of a trace ("" if nothing)."""
+    cells = row.split(",")
+    if len(cells) != width:
+        return f"{len(cells)} values where the header names {width}"
+    for cell in cells:
+        try:
+            float(cell)
+        except ValueError:
+            return f"{short_repr(cell)} is not a number"
+    return ""
 
 
 NOTE_PT = 7.5  # phase notes' font size
@@ -128,7 +191,7 @@ def distance_figure(trace: Path, metrics: dict[str, Any]) -> Figure:
     quality = metrics.get("quality") or {}
     signal = quality.get("signal")
     fig, ax = plt.subplots(figsize=(10, FIG_H_IN), dpi=100)
-    if signal in header and data.size:
+    if signal in header and data.size and abs(float(quality["reference"])) < PLOTTABLE:
         t = data[:, 0]
         s = data[:, header.index(signal)]
         ref = float(quality["reference"])
@@ -144,7 +207,7 @@ def distance_figure(trace: Path, metrics: dict[str, Any]) -> Figure:
         ax.axhline(ref, color="tab:green", lw=1.2, ls="--", label=f"reference {ref:g} m")
         # near-black: blue and orange are the rovers' colours in every other picture
         ax.plot(t, s, color="0.15", lw=1.2, label=signal)
-        top = max(float(np.max(s)), ref + tol)
+        top = max(float(np.nanmax(s)) if np.isfinite(s).any() else 0.0, ref + tol)
         lines = _phase_notes(ax, metrics.get("phases", []))
         _inner_changes(ax, metrics.get("phases", []))
         _collisions(ax, metrics.get("events", []), t, s)

@@ -28,7 +28,7 @@ from matplotlib.patches import FancyArrowPatch, FancyBboxPatch
 from matplotlib.path import Path as MplPath
 from matplotlib.transforms import Bbox
 
-from ..engine.recorder import write_atomic
+from ..atomic import write_atomic
 from ..model.wording import plural
 from ..model.world import WorldSpec
 from .save import save_png

@@ -8,7 +8,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
-from ..engine.recorder import write_atomic
+from ..atomic import write_atomic
 
 
 def save_png(

@@ -66,8 +66,10 @@ def plot_summary(
         for key, by_x in groups.items():
             xs = sorted(by_x, key=lambda v: (str(type(v)), v))
             mean = [float(np.mean(by_x[x])) for x in xs]
-            lo = [m - min(by_x[x]) for m, x in zip(mean, xs, strict=True)]
-            hi = [max(by_x[x]) - m for m, x in zip(mean, xs, strict=True)]
+            # clamped: the mean of equal values can land 1 ulp outside [min, max], and
+            # matplotlib refuses a negative error bar (no summary.png at all)
+            lo = [max(0.0, m - min(by_x[x])) for m, x in zip(mean, xs, strict=True)]
+            hi = [max(0.0, max(by_x[x]) - m) for m, x in zip(mean, xs, strict=True)]
             label = ", ".join(f"{a}={v}" for a, v in zip(others, key, strict=True)) or metric
             positions = xs if _numeric(xs) else list(range(len(xs)))
             ax.errorbar(positions, mean, yerr=[lo, hi], marker="o", capsize=3, label=label)

@@ -19,7 +19,9 @@ class Check:
     value: float | None
     passed: bool
     skipped: bool = False
-    why: str = ""  # why it was skipped
+    why: str = ""  # why a metric check was skipped (a phase cut short or not reached)
+    #: why a trace check saw no sample, or how much of its window the run covered
+    note: str = ""
 
     @property
     def what(self) -> str:
@@ -33,15 +35,20 @@ class Check:
 
     @property
     def verdict(self) -> str:
-        """pass, FAIL or skipped."""
+        """pass, FAIL, skipped, or "no sample" (a trace window the run never logged)."""
+        if self.value is None and self.note.startswith("checked no sample"):
+            return "no sample" if self.skipped else "FAIL"
         return "skipped" if self.skipped else ("pass" if self.passed else "FAIL")
 
     def describe(self) -> str:
         """``max_distance (phase 1) = 24.3, below 26: pass``."""
+        if self.value is None and self.note:
+            return f"{self.what}: {self.note}: {self.verdict}"
         if self.skipped:
             return f"{self.what}: skipped ({self.why})"
         value = "none" if self.value is None else f"{self.value:.4g}"
-        return f"{self.what} = {value}, {self.bound}: {self.verdict}"
+        note = f" ({self.note})" if self.note else ""
+        return f"{self.what} = {value}{note}, {self.bound}: {self.verdict}"
 
 
 def describe_what(e: Expectation) -> str:
@@ -75,11 +82,12 @@ def check_expectations(
     """
     checks = []
     columns: tuple[list[str], np.ndarray] | None = None
+    end = float(metrics.get("simulated", 0.0))
     for e in expect:
         if e.trace is not None:
             if columns is None:
                 columns = _read(trace)
-            checks.append(_trace_check(e, *columns))
+            checks.append(_trace_check(e, *columns, end))
             continue
         why = skip_reason(e, metrics)
         if why is not None:
@@ -125,7 +133,14 @@ def _read(trace: Path | tuple[list[str], np.ndarray] | None) -> tuple[list[str],
     return header, np.loadtxt(trace, delimiter=",", skiprows=1, ndmin=2)
 
 
-def _trace_check(e: Expectation, header: list[str], data: np.ndarray) -> Check:
+def _trace_check(e: Expectation, header: list[str], data: np.ndarray, end: float) -> Check:
+    """Judge every logged sample of the window; a window without one is said to be so.
+
+    A window that starts after the run's end (``end``: cut by ``--duration``, a fault or
+    Ctrl-C) checked no sample and is skipped, visibly; one inside the run that caught no
+    logged instant fails (its bound was never checked). A window running past the end
+    says up to when it was checked.
+    """
     t = data[:, 0]
     mask = np.ones_like(t, dtype=bool)
     if e.after is not None:
@@ -134,11 +149,13 @@ def _trace_check(e: Expectation, header: list[str], data: np.ndarray) -> Check:
         mask &= t <= e.before
     values = data[mask, header.index(e.trace)]
     if values.size == 0:
-        ran_until = float(t[-1]) if t.size else 0.0
-        # a window that starts after the run ended was cut off (--duration), like a phase
-        cut = e.after is not None and e.after > ran_until
-        why = f"window not reached: the run ended at t={ran_until:g} s" if cut else ""
-        return Check(e, None, cut, skipped=cut, why=why)
+        if e.after is not None and e.after > end:
+            note = f"checked no sample (the window starts after the run's end at t={end:g} s)"
+            return Check(e, None, True, skipped=True, note=note)
+        note = "checked no sample (no logged instant in the window: widen it or raise log_rate)"
+        return Check(e, None, False, note=note)
+    past_end = e.before is not None and e.before > end
+    note = f"checked up to the run's end at t={end:g} s" if past_end else ""
     worst: float | None = None
     ok = True
     if e.above is not None:
@@ -150,4 +167,4 @@ def _trace_check(e: Expectation, header: list[str], data: np.ndarray) -> Check:
         if worst is None or high >= e.below:
             worst = high
         ok = ok and high < e.below
-    return Check(e, worst, ok)
+    return Check(e, worst, ok, note=note)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from ..engine.recorder import write_atomic
+from ..atomic import write_atomic
 from .suite import ScenarioResult
 
 

@@ -23,14 +23,19 @@ from __future__ import annotations
 
 import contextlib
 import multiprocessing
+import os
 import signal
 import sys
+import warnings
 from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from ..model.world import WorldSpec
+
+from ..errors import one_line
+from .pool import die_with_parent
 
 #: How long the parent waits for the child's plots before drawing them itself.
 TIMEOUT_S = 60.0
@@ -52,10 +57,15 @@ def draw_run_plots(
     from ..plots.distance import plot_distance
     from ..plots.trajectory import plot_trajectory
 
+    # titles show the scenario's name: printable, as on the terminal (an escape code would
+    # be a missing glyph and a warning on stderr)
+    metrics = {**metrics, "scenario": one_line(str(metrics.get("scenario", "")))}
     written = []
-    if metrics.get("quality"):
-        written.append(plot_distance(trace, metrics, distance))
-    written.append(plot_trajectory(trace, metrics, trajectory, world))
+    with warnings.catch_warnings():  # a picture's imperfections are not the run's messages
+        warnings.simplefilter("ignore")
+        if metrics.get("quality"):
+            written.append(plot_distance(trace, metrics, distance))
+        written.append(plot_trajectory(trace, metrics, trajectory, world))
     return written
 
 
@@ -70,8 +80,9 @@ def plot_context(world: WorldSpec) -> dict[str, Any]:
     return {"physics": world.physics, "gps_of": gps_of}
 
 
-def _child(jobs: Connection, parent_end: Connection) -> None:
+def _child(jobs: Connection, parent_end: Connection, parent_pid: int) -> None:
     """The child's life: import, wait for one job, draw it, report."""
+    die_with_parent(parent_pid)  # a SIGKILLed parent takes its plotter along at once
     parent_end.close()  # so that the parent's exit is an end of file here
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with contextlib.suppress(Exception):  # on failure the parent draws (and reports)
@@ -110,7 +121,9 @@ class PlotJob:
         try:
             ctx = multiprocessing.get_context("fork")
             parent_end, child_end = ctx.Pipe()
-            proc = ctx.Process(target=_child, args=(child_end, parent_end), daemon=True)
+            proc = ctx.Process(
+                target=_child, args=(child_end, parent_end, os.getpid()), daemon=True
+            )
             proc.start()
         except (OSError, ValueError):
             return job

@@ -102,6 +102,21 @@ def _refuse_inputs(out: Path, inputs: Iterable[Path], flag: str) -> None:
             )
 
 
+def _without_dotdot(out: Path) -> Path:
+    """``out`` with its ``..`` resolved, so it is judged as the directory it really names.
+
+    ``new/..`` is the directory holding ``new``: checked as written, it does not exist (``new``
+    does not), and creating it would make ``new`` and then run into its parent -- the
+    current directory, full of the user's files. The last component itself is kept as
+    written (a symbolic link there must still be seen as one).
+    """
+    if ".." not in out.parts:
+        return out
+    if out.name == "..":
+        return Path(os.path.realpath(out))
+    return Path(os.path.realpath(out.parent)) / out.name
+
+
 def prepare_run_dir(
     out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "--out"
 ) -> Path:
@@ -112,6 +127,7 @@ def prepare_run_dir(
     followed into a removal.
     """
     inputs = list(inputs)
+    out = _without_dotdot(out)
     if out.is_symlink() and (force or out.exists()):
         raise ConfigError(
             "is a symbolic link; give the real directory (amsa-phys does not replace links)",
@@ -145,3 +161,28 @@ def prepare_run_dir(
     if not os.access(out, os.W_OK):
         raise ConfigError("directory is not writable", key=flag, file=out)
     return out
+
+
+def check_output(path: Path, flag: str, make_parent: bool = False) -> Path:
+    """An output file's path, checked before any work (exit 2 naming ``flag``).
+
+    Refused: a directory (or a link to one) where the file should go, a directory that does
+    not exist (created with ``make_parent``), one that is not writable (a read-only file
+    system). A write that still fails later (a full disk) is an OutputError naming the file.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise ConfigError("is a directory; give a file name", key=flag, file=path)
+    parent = path.parent
+    if make_parent and not parent.exists():
+        try:
+            parent.mkdir(parents=True)
+        except OSError as exc:
+            raise ConfigError(
+                f"cannot create directory: {exc.strerror}", key=flag, file=parent
+            ) from None
+    if not parent.is_dir():
+        raise ConfigError("directory does not exist", key=flag, file=parent)
+    if not os.access(parent, os.W_OK):
+        raise ConfigError("directory is not writable", key=flag, file=parent)
+    return path

@@ -8,22 +8,25 @@ directory never holds a half-written file under its final name.
 from __future__ import annotations
 
 import json
+import math
 import sys
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
+import numpy as np
 import yaml
 from tqdm import tqdm
 
+from ..atomic import write_atomic
 from ..engine import interrupt
 from ..engine.metrics import block_metrics
-from ..engine.recorder import TraceWriter, write_atomic
+from ..engine.recorder import TraceWriter
 from ..engine.runner import RunResult, Simulation
-from ..errors import Interrupted, RunFault
+from ..errors import Interrupted, OutputError, RunFault, one_line
 from ..model.scenario import Change, Expectation, Scenario
 from ..view.drive import FrameSink, advance
 from ..view.encoder import EncoderError
@@ -66,7 +69,37 @@ def compute_metrics(
     window) are listed in that phase's ``changes``; they never start a phase of their own,
     so a session and its replay have the same phases. ``idle_s`` is wall-clock time the
     window spent paused (or finished, waiting to be closed): not part of the run's speed.
+    Always valid JSON: a metric that is not a finite number (a signal near the float limit
+    overflows ``rms_error``) is written as ``null`` and named in ``nonfinite``.
     """
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
+        metrics = _metrics(scenario, sim, result, wall_s, status, idle_s)
+    return _finite(metrics)
+
+
+def _finite(metrics: dict[str, Any]) -> dict[str, Any]:
+    """Replace non-finite metric values by None and list where they were."""
+    bad: list[str] = []
+    blocks = [("overall", metrics["overall"])]
+    blocks += [(f"phases[{i}]", p) for i, p in enumerate(metrics["phases"])]
+    for where, block in blocks:
+        for key, value in block.items():
+            if isinstance(value, float) and not math.isfinite(value):
+                block[key] = None
+                bad.append(f"{where}.{key}")
+    if bad:
+        metrics["nonfinite"] = bad
+    return metrics
+
+
+def _metrics(
+    scenario: Scenario,
+    sim: Simulation,
+    result: RunResult,
+    wall_s: float,
+    status: str,
+    idle_s: float,
+) -> dict[str, Any]:
     completed = status == "completed"
     end = float(scenario.duration) if completed else result.t_end
     bounds = [float(b) for b in scenario.planned_bounds or []] or [
@@ -224,19 +257,28 @@ def _run_scenario(
     ended = execute(
         scenario, trace, progress=progress, record=record, snapshot=snapshot, window=window
     )
-    write_run_files(out_dir, ended, plot=plot, plotter=plotter)
+    unwritten = ended.unwritten + write_run_files(out_dir, ended, plot=plot, plotter=plotter)
     error = ended.error
+    if error is None and unwritten:
+        error, unwritten = unwritten[0], unwritten[1:]
+    named = {error.path} if isinstance(error, OutputError) else set()
+    for exc in unwritten:  # besides the error raised below, each file once
+        if exc.path not in named:
+            named.add(exc.path)
+            print(one_line(f"amsa-phys: {exc}"), file=sys.stderr)
     t_end = ended.metrics["simulated"]
     if isinstance(error, KeyboardInterrupt):
         raise Interrupted(
-            f"interrupted at t={t_end:.2f} s; outputs so far are in {out_dir}"
+            one_line(f"interrupted at t={t_end:.2f} s; outputs so far are in {out_dir}")
         ) from None
     if error is not None:
         raise error
     if interrupt.requested():  # Ctrl-C after the last instant: the outputs are complete
         raise Interrupted(
-            f"interrupted after the run ended at t={t_end:.2f} s; "
-            f"its outputs are complete in {out_dir}"
+            one_line(
+                f"interrupted after the run ended at t={t_end:.2f} s; "
+                f"its outputs are complete in {out_dir}"
+            )
         )
     return RunOutcome(out_dir, ended.metrics, ended.simulation)
 
@@ -267,6 +309,8 @@ class Ended:
     resolved: dict[str, Any]
     error: BaseException | None
     note: str = ""  # a comment heading scenario.yaml (checks a cut run left out)
+    has_trace: bool = True  # False: the trace could not be written (no plots from it)
+    unwritten: list[OutputError] = field(default_factory=list)  # outputs that failed so far
 
 
 def execute(
@@ -309,7 +353,7 @@ def execute(
         else:
             sinks = [s for s in (recorder, still) if s is not None]
             _advance_with_progress(sim, scenario, progress, sinks)
-    except RunFault as exc:
+    except (RunFault, OutputError) as exc:  # OutputError: the trace's disk is full
         status, error = f"fault: {exc}", exc
     except EncoderError as exc:
         error = RunFault("recorder", sim.now, str(exc))
@@ -317,14 +361,28 @@ def execute(
     except KeyboardInterrupt as exc:
         status, error = "interrupted", exc
     wall = time.perf_counter() - t0
-    trace.close()
+    # Each output is written even if another could not be (a full disk): metrics.json
+    # above all. The first failure is raised once the run's own error, if any, is.
+    unwritten: list[OutputError] = []
+
+    def keep(write: Callable[..., Any], *args: Any) -> Any:
+        try:
+            return write(*args)
+        except OutputError as exc:
+            unwritten.append(exc)
+            return None
+
+    closed = keep(trace.close)  # a file trace: its path, or None if a write failed
+    has_trace = closed is not None or not isinstance(trace, TraceWriter)
     video = _finish_video(recorder, error)
     result = sim.result()
     metrics = compute_metrics(scenario, sim, result, wall, status, idle_s=idle)
     if video is not None:
         metrics["video"] = video
     if still is not None:
-        metrics["snapshot"] = {"path": str(still.close()), "t": float(still.at)}
+        picture = keep(still.close)
+        if picture is not None:
+            metrics["snapshot"] = {"path": str(picture), "t": float(still.at)}
     stopped_early = window and not sim.finished and error is None and sim.now > 0
     drop = [e for e in scenario.expect if skip_reason(e, metrics) is not None]
     resolved = resolved_scenario(
@@ -333,21 +391,40 @@ def execute(
         duration=sim.now if stopped_early else None,
         drop=drop,
     )
-    return Ended(scenario, sim, metrics, resolved, error, _cut_note(metrics, drop))
+    note = _cut_note(metrics, drop)
+    return Ended(scenario, sim, metrics, resolved, error, note, has_trace, unwritten)
 
 
 def write_run_files(
     out_dir: Path, ended: Ended, *, plot: bool = True, plotter: PlotJob | None = None
-) -> None:
+) -> list[OutputError]:
     """``metrics.json``, ``scenario.yaml`` and (with ``plot``) the two plots of a run whose
-    ``trace.csv`` is already in ``out_dir``; each file is written atomically."""
+    ``trace.csv`` is already in ``out_dir``; each file is written atomically.
+
+    Each file is written even if another could not be (a full disk): ``metrics.json`` first.
+    Returns the failures, for the caller to report once the run's own error is.
+    """
+    unwritten: list[OutputError] = []
+
+    def keep(write: Callable[..., Any], *args: Any) -> Any:
+        try:
+            return write(*args)
+        except OutputError as exc:
+            unwritten.append(exc)
+            return None
+
     metrics = ended.metrics
-    write_atomic(out_dir / "metrics.json", json.dumps(metrics, indent=2) + "\n")
+    keep(
+        write_atomic,
+        out_dir / "metrics.json",
+        json.dumps(metrics, indent=2, allow_nan=False) + "\n",
+    )
     text = ended.note + yaml.dump(ended.resolved, Dumper=_YAML_DUMPER, sort_keys=False)
-    write_atomic(out_dir / "scenario.yaml", text)
+    keep(write_atomic, out_dir / "scenario.yaml", text)
     plotter = plotter or PlotJob()
-    if plot:
-        plotter.draw(
+    if plot and ended.has_trace:
+        keep(
+            plotter.draw,
             out_dir / "trace.csv",
             metrics,
             out_dir / "distance.png",
@@ -355,6 +432,7 @@ def write_run_files(
             plot_context(ended.scenario.world),
         )
     plotter.close()
+    return unwritten
 
 
 def _cut_note(metrics: dict[str, Any], dropped: list[Expectation]) -> str:
@@ -389,7 +467,7 @@ def _finish_video(recorder: Recorder | None, error: BaseException | None) -> dic
         if error is None:
             raise RunFault("recorder", recorder.sim.now, str(exc)) from None
         if not (isinstance(error, RunFault) and error.component == "recorder"):
-            print(f"amsa-phys: {exc}", file=sys.stderr)  # besides the run's own error
+            print(one_line(f"amsa-phys: {exc}"), file=sys.stderr)  # besides the run's own
         return None
     return {
         "path": str(path),

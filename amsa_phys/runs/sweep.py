@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 import csv
 import functools
+import io
 import itertools
 import json
 import math
@@ -23,11 +24,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from ..engine import interrupt
 from ..engine.runner import Simulation
 from ..errors import AmsaError, ConfigError
+from ..model.params import short_repr
 from ..model.scenario import (
     METRICS,
     PHYSICS_PREFIX,
@@ -39,12 +40,16 @@ from ..model.scenario import (
     shorten,
     with_physics,
 )
+from ..model.yamlio import parse_value
 from .pool import WORKER_LOST, imap_resilient
 from .rundir import prepare_run_dir
 from .single import compute_metrics, run_scenario
 
 #: Metric columns written for the overall block and each phase.
 METRIC_KEYS = METRICS
+#: Most runs in one sweep (grid points × seeds): about 14 hours of 50 ms runs on 2 cores.
+#: A larger grid is refused before anything is allocated.
+MAX_RUNS = 1_000_000
 
 
 def metric_names(n_phases: int) -> list[str]:
@@ -68,22 +73,55 @@ def read_results(path: Path) -> tuple[list[dict[str, Any]], list[str]]:
     """``results.csv`` back as rows and the grid axes (the columns between run and seed_index).
 
     Axis values that read as numbers become floats (so a numeric axis plots as one), metrics
-    become floats or None (an empty cell: never settled, or the run failed).
+    become floats or None (an empty cell: never settled, or the run failed). A file that is
+    not a sweep's results (binary, a column missing, a row of the wrong width, text where a
+    metric belongs) is refused with one line naming the line.
     """
-    with open(path, newline="") as fh:
-        reader = csv.DictReader(fh)
-        fields = list(reader.fieldnames or [])
-        if fields[:1] != ["run"] or "seed_index" not in fields:
-            raise ConfigError("not a sweep's results.csv (no run/seed_index columns)", file=path)
-        axes = fields[1 : fields.index("seed_index")]
-        rows = []
-        for raw in reader:
-            row: dict[str, Any] = dict(raw)
-            for key in axes:
-                row[key] = _number_or_text(raw[key])
-            for key in fields[fields.index("error") + 1 :]:
-                row[key] = float(raw[key]) if raw[key] else None
-            rows.append(row)
+    try:
+        text = Path(path).read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(
+            f"not a results.csv: not UTF-8 text (byte {exc.start})", file=path
+        ) from None
+    except OSError as exc:
+        raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
+    try:
+        table = list(csv.reader(io.StringIO(text, newline="")))
+    except csv.Error as exc:
+        raise ConfigError(f"not a results.csv: {exc}", file=path) from None
+    fields = table[0] if table else []
+    needed = ("run", "seed_index", "seed", "error")
+    if fields[:1] != ["run"] or any(k not in fields for k in needed):
+        missing = [k for k in needed if k not in fields] or ["run (first)"]
+        raise ConfigError(
+            f"not a sweep's results.csv: no {', '.join(missing)} column", file=path, line=1
+        )
+    axes = fields[1 : fields.index("seed_index")]
+    metrics = fields[fields.index("error") + 1 :]
+    rows = []
+    for line, raw in enumerate(table[1:], start=2):
+        if not raw:
+            continue
+        if len(raw) != len(fields):
+            raise ConfigError(
+                f"not a sweep's results.csv: {len(raw)} cells where the header has {len(fields)}",
+                file=path,
+                line=line,
+            )
+        row: dict[str, Any] = dict(zip(fields, raw, strict=True))
+        for key in axes:
+            row[key] = _number_or_text(row[key])
+        for key in metrics:
+            try:
+                value = float(row[key]) if row[key] else None
+                row[key] = value if value is not None and math.isfinite(value) else None
+            except ValueError:
+                raise ConfigError(
+                    f"not a sweep's results.csv: {key} is {short_repr(row[key])}, not a number",
+                    file=path,
+                    line=line,
+                ) from None
+        rows.append(row)
     return rows, axes
 
 
@@ -131,6 +169,11 @@ class SweepPlan:
     inputs: tuple[Path, ...] = ()  # files the sweep reads: its --out must not hold them
     warnings: tuple[str, ...] = ()  # said once before the sweep starts
 
+    @property
+    def size(self) -> int:
+        """How many runs: grid points × seeds (computed without building them)."""
+        return math.prod(len(a.values) for a in self.axes) * self.seeds
+
     def jobs(self) -> list[Job]:
         """The Cartesian product of the axes, then seeds, in a fixed order."""
         ctx = tuple((name, tuple(sets.items())) for name, sets in self.contexts.items())
@@ -163,14 +206,14 @@ def derive_seed(base: int, index: int) -> int:
     return int(state[0])
 
 
-def parse_values(text: str) -> tuple[Any, ...]:
+def parse_values(text: str, what: str = "--grid") -> tuple[Any, ...]:
     """``0.05,0.1,true,circle`` -> values read as YAML scalars."""
     out = []
     for raw in text.split(","):
         raw = raw.strip()
         if not raw:
             raise ValueError("empty value")
-        out.append(yaml.safe_load(raw))
+        out.append(parse_value(raw, what))
     return tuple(out)
 
 
@@ -179,9 +222,11 @@ def parse_grid(text: str) -> Axis:
     key, sep, values = text.partition("=")
     if not sep or not key.strip():
         raise ConfigError(f"expected Comp.param=v1,v2,..., got {text!r}", key="--grid")
+    if values.count(",") >= MAX_RUNS:
+        raise ConfigError(f"more than {MAX_RUNS:,} values", key=f"--grid {key.strip()}")
     try:
-        return Axis(key.strip(), parse_values(values))
-    except (ValueError, yaml.YAMLError) as exc:
+        return Axis(key.strip(), parse_values(values, f"--grid {key.strip()}"))
+    except ValueError as exc:
         raise ConfigError(f"{exc} in {text!r}", key="--grid") from None
 
 
@@ -199,8 +244,22 @@ def parse_range(text: str) -> Axis:
         raise ConfigError(
             f"expected Comp.param=start:stop:n, got {text!r}", key="--range"
         ) from None
+    if n > MAX_RUNS:
+        raise ConfigError(f"{n:,} values: at most {MAX_RUNS:,}", key=f"--range {key.strip()}")
     values = np.linspace(start, stop, n) if n > 1 else np.array([start])
     return Axis(key.strip(), tuple(float(round(v, 12)) for v in values))
+
+
+def check_size(axes: list[Axis], seeds: int) -> None:
+    """Refuse a sweep of more than :data:`MAX_RUNS` runs before anything is allocated."""
+    runs = math.prod(len(a.values) for a in axes) * seeds
+    if runs > MAX_RUNS:
+        shape = " × ".join(str(len(a.values)) for a in axes)
+        raise ConfigError(
+            f"{shape} grid points × {seeds} seed{'s' if seeds != 1 else ''} = {runs:,} runs; "
+            f"a sweep has at most {MAX_RUNS:,}",
+            key="sweep",
+        )
 
 
 def check_axes(axes: list[Axis], scenario: Scenario) -> None:

@@ -31,6 +31,9 @@ import threading
 from pathlib import Path
 from typing import Any
 
+from ..atomic import open_exclusive, reason, temp_path
+from ..errors import OutputError
+
 FORMATS = (".mp4", ".gif")
 PIPE_BYTES = 1 << 20
 F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)
@@ -111,7 +114,11 @@ class VideoEncoder:
         #: the main thread, possibly between handing a frame over and counting it, so this is
         #: the count that matches the finished file
         self.written = 0
-        self.tmp = self.path.with_name(self.path.name + ".tmp")
+        self.tmp = temp_path(self.path)
+        try:  # created here, exclusively: ffmpeg then writes our file, not a planted link
+            os.close(open_exclusive(self.tmp))
+        except OSError as exc:
+            raise OutputError(self.path, reason(exc)) from None
         self._log = tempfile.TemporaryFile()  # noqa: SIM115 (lives as long as ffmpeg)
         self._proc = subprocess.Popen(
             ffmpeg_args(self.tmp, size, fps, pix_fmt, self.path.suffix),
@@ -190,8 +197,13 @@ class VideoEncoder:
             self._proc.stdin.close()  # type: ignore[union-attr]
         rc = self._proc.wait()
         if rc != 0 or self._error is not None:
+            self.tmp.unlink(missing_ok=True)  # unplayable; on a full disk, space for the rest
             raise EncoderError(self._failure())
-        os.replace(self.tmp, self.path)
+        try:
+            os.replace(self.tmp, self.path)
+        except OSError as exc:
+            self.tmp.unlink(missing_ok=True)
+            raise OutputError(self.path, reason(exc)) from None
         self._log.close()
         return self.path
 

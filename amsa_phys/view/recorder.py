@@ -8,12 +8,14 @@ slow one. A run of duration *D* gives ``ceil(D * fps / speedup)`` frames.
 
 from __future__ import annotations
 
+import io
 import math
 import sys
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 
+from ..atomic import write_atomic
 from ..engine.runner import Simulation
 from ..model.scenario import Quality
 from .camera import Camera
@@ -126,9 +128,9 @@ class Snapshot:
         surface = new_surface(size)
         Renderer(size).draw(surface, frame, camera)
         path = self.options.path
-        tmp = path.with_name(path.stem + ".tmp.png")
-        pygame.image.save(surface, str(tmp))
-        tmp.replace(path)
+        png = io.BytesIO()  # encoded in memory: a full disk cannot leave half a picture
+        pygame.image.save(surface, png, "png")
+        write_atomic(path, png.getvalue())
         self.written = path
         return path
 

@@ -4,6 +4,11 @@ Each generated case is written to a file and given to the CLI in-process. It mus
 accepted (then a 1 s run ends with exit 0, 1 or 3), or refused with exit 2 and exactly one
 line that names the file — never a traceback (any other exception fails the test) and never a
 hang (hypothesis's deadline). ``AMSA_FUZZ_EXAMPLES`` raises the number of cases (default 500).
+
+Besides wrong types, missing and unknown keys, NaN, duplicates, tags, truncation and junk,
+the generators make numbers too big for a float (401 digits), resource-amplifying structures
+(aliases of a ``count:`` Composite, nested aliases: "billion laughs") and files that are not
+regular files at all (devices, FIFOs, directories, links to them, sparse giants).
 """
 
 from __future__ import annotations
@@ -35,10 +40,16 @@ BASE = {
 }
 EXAMPLES = int(os.environ.get("AMSA_FUZZ_EXAMPLES", "500"))
 
+#: integers of 300..420 digits: most are too big for a float (about 1.8e308)
+huge_ints = st.builds(
+    lambda digits, sign: sign * int("7" * digits), st.integers(300, 420), st.sampled_from([1, -1])
+)
+
 weird = st.one_of(
     st.none(),
     st.booleans(),
     st.integers(min_value=-(10**20), max_value=10**20),
+    huge_ints,
     st.floats(allow_nan=True, allow_infinity=True),
     st.text(max_size=12),
     st.lists(st.integers(), max_size=3),
@@ -87,6 +98,20 @@ def mutated(draw: st.DrawFn) -> str:
             parent[draw(st.text(min_size=1, max_size=8))] = draw(weird)
         elif kind == "rename" and isinstance(parent, dict):
             parent[str(path[-1]) + draw(st.sampled_from(["x", "_", "s"]))] = parent.pop(path[-1])
+    amplify = draw(st.sampled_from(["none", "none", "none", "count", "laughs"]))
+    if amplify == "count" and isinstance(doc.get("world"), dict):
+        # one Composite written once, used many times: the dumper writes it as aliases
+        car = {"count": draw(st.sampled_from([2, 100, 10000])), "components": {}}
+        car["components"]["Power"] = {"template": "ConstantPower"}
+        components = doc["world"].setdefault("components", {})
+        if isinstance(components, dict):
+            for i in range(draw(st.integers(1, 40))):
+                components[f"Copy{i}_"] = car
+    elif amplify == "laughs":
+        nested: Any = ["lol"] * 9
+        for _ in range(draw(st.integers(2, 9))):
+            nested = [nested] * 9  # shared, so written as nested aliases
+        doc[draw(st.sampled_from(["description", "set", "sweep"]))] = nested
     text = yaml.safe_dump(doc, sort_keys=False, allow_unicode=True)
     textual = draw(
         st.sampled_from(
@@ -149,3 +174,50 @@ def test_mutated_scenarios_run_or_are_refused_in_one_line(text: str) -> None:
         event(f"run exit {code}")
         if code == 3:
             assert err.getvalue().startswith("error: run fault at t=")
+
+
+SPECIAL = ["fifo", "/dev/zero", "/dev/urandom", "directory", "link-to-zero", "sparse-giant"]
+
+
+@settings(max_examples=24, deadline=10_000, derandomize=True)
+@given(
+    st.sampled_from(SPECIAL),
+    st.sampled_from(["validate", "run", "world-of-a-scenario", "describe", "test"]),
+)
+def test_files_that_are_not_regular_files_are_refused_in_one_line(kind: str, command: str) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        target = Path(tmp) / "special.yaml"
+        if kind == "fifo":
+            os.mkfifo(target)  # nobody writes to it: reading it would never end
+        elif kind == "directory":
+            target.mkdir()
+        elif kind == "link-to-zero":
+            target.symlink_to("/dev/zero")
+        elif kind == "sparse-giant":
+            with target.open("wb") as fh:
+                fh.truncate(1 << 30)
+        else:
+            target = Path(kind)
+        named = target
+        if command == "world-of-a-scenario":
+            named = Path(tmp) / "s.yaml"
+            named.write_text(f"world: {target}\nduration: 1\n")
+            command = "validate"
+        argv = {
+            "validate": ["validate", str(named)],
+            "describe": ["describe", str(named)],
+            "test": ["test", str(named)],
+            "run": ["run", str(named), "--headless", "--out", str(Path(tmp) / "o")],
+        }[command]
+        err, out = io.StringIO(), io.StringIO()
+        with redirect_stderr(err), redirect_stdout(out):
+            code = main(argv)
+        # `test` reports a file it cannot load as an ERROR row (exit 1) and searches a
+        # directory (none found: exit 2); the other commands refuse the file itself
+        assert code in ((1, 2) if command == "test" else (2,)), (code, err.getvalue())
+        lines = err.getvalue().splitlines()
+        assert len(lines) == 1, err.getvalue()
+        assert lines[0].startswith("error: "), lines[0]
+        if command != "test":
+            assert any(w in lines[0] for w in ("regular file", "too large", "is a directory"))
+        assert not (Path(tmp) / "o").exists()

@@ -187,3 +187,24 @@ def test_safe_name_is_one_harmless_component() -> None:
     assert safe_name("scenario1") == "scenario1"
     assert len(safe_name("x" * 1000)) == 80
     assert unique_names(["a", "A", "a", "b"]) == ["a", "A-2", "a-3", "b"]
+
+
+@pytest.mark.parametrize("out", ["new/..", "new/../.", "a/b/../.."])
+def test_out_through_a_new_directory_and_back_is_judged_as_where_it_lands(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    out: str,
+) -> None:
+    # "new/.." is the current directory: it used to pass as "does not exist", was created
+    # (making new/) and the run wrote among the user's files
+    monkeypatch.chdir(tmp_path)
+    scen = _scenario(tmp_path / "s.yaml", "x")
+    (tmp_path / "mine.txt").write_text("keep")
+    before = _snapshot(tmp_path)
+    assert main(["run", str(scen), "--headless", "--out", out, "--force", "-q"]) == 2
+    assert capsys.readouterr().err == (
+        f"error: {tmp_path}: --out: is the current directory; choose a new directory for "
+        "the outputs\n"
+    )
+    assert _snapshot(tmp_path) == before
