@@ -18,6 +18,8 @@ from .suggest import did_you_mean
 from .yamlio import KeyPath, YamlDoc
 
 NAME = r"^[A-Za-z_][A-Za-z0-9_]*$"
+#: A Data name: a NAME, or ``Composite.NAME`` for a Data declared inside a Composite.
+DATA_NAME = r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$"
 _num = {"type": "number"}
 _pos = {"type": "number", "exclusiveMinimum": 0}
 _nonneg = {"type": "number", "minimum": 0}
@@ -103,6 +105,11 @@ WORLD: dict[str, Any] = {
         "physics": PHYSICS,
         "components": {"$ref": "#/$defs/components"},
         "schedule": {"type": "array", "items": {"type": "string"}, "uniqueItems": True},
+        "data": {
+            "type": "object",
+            "propertyNames": {"pattern": DATA_NAME},
+            "additionalProperties": {"type": "string"},
+        },
     },
     "$defs": {
         "components": {

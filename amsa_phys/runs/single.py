@@ -130,6 +130,7 @@ def run_scenario(
     snapshot: SnapshotOptions | None = None,
     window: bool | WindowDriver = False,
     plotter: PlotJob | None = None,
+    simulation: SimulationFactory | None = None,
 ) -> RunOutcome:
     """Run ``scenario`` and write its run directory (which must exist and be empty).
 
@@ -138,7 +139,8 @@ def run_scenario(
     interactive window (until the user closes it) instead of as fast as possible; a callable
     ``window`` replaces the window's own loop (tests drive it with scripted events and an
     exact clock). ``plotter`` draws the plots (a child started early, ``runs/plotjob.py``);
-    without one they are drawn in-process.
+    without one they are drawn in-process. ``simulation`` builds the Simulation from the
+    scenario and the trace callback (the ROS simulator node's, whose Leaves run as nodes).
 
     Ctrl-C (SIGINT, and SIGTERM from the CLI) during the run stops it between two instants
     (``engine/interrupt.py``): the outputs describe whole instants, then
@@ -154,7 +156,16 @@ def run_scenario(
             snapshot=snapshot,
             window=window,
             plotter=plotter,
+            simulation=simulation,
         )
+
+
+TraceFn = Callable[[float, list[float]], None]
+SimulationFactory = Callable[[Scenario, TraceFn], Simulation]
+
+
+def _default_simulation(scenario: Scenario, trace: TraceFn) -> Simulation:
+    return Simulation.from_scenario(scenario, trace=trace)
 
 
 def _run_scenario(
@@ -167,9 +178,10 @@ def _run_scenario(
     snapshot: SnapshotOptions | None,
     window: bool | WindowDriver,
     plotter: PlotJob | None,
+    simulation: SimulationFactory | None = None,
 ) -> RunOutcome:
     trace = TraceWriter(out_dir / "trace.csv", list(scenario.world.buffers))
-    sim = Simulation.from_scenario(scenario, trace=trace.write)
+    sim = (simulation or _default_simulation)(scenario, trace.write)
     status = "completed"
     error: BaseException | None = None
     recorder: Recorder | None = None

@@ -1,4 +1,5 @@
-"""Imports flow one way: model -> engine -> physics|sensors|control -> plots|view -> runs -> cli."""
+"""Imports flow one way: model -> engine -> physics|sensors|control|interop -> plots|view -> runs
+-> ros -> cli."""
 
 from __future__ import annotations
 
@@ -14,10 +15,12 @@ LAYER = {
     "physics": 2,
     "sensors": 2,
     "control": 2,
+    "interop": 2,
     "plots": 3,
     "view": 3,
     "runs": 4,
-    "cli": 5,
+    "ros": 5,
+    "cli": 6,
 }
 MODULES = sorted(p for p in PKG.rglob("*.py") if p.parent != PKG)
 
