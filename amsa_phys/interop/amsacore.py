@@ -245,8 +245,6 @@ class _Reader:
                     at, f"dangling reference {ref!r}: bad index {index_text!r}"
                 ) from None
             matches = [c for c in elem.children if c.local == feature]
-            if elem is self.root and feature == "rootComponent":
-                matches = [c for c in self.root.children if c.local == "rootComponent"]
             if index >= len(matches) or index < 0:
                 raise self.error(
                     at,

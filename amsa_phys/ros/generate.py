@@ -406,7 +406,8 @@ def _launch(graph: RosGraph, pkg: str, fname: str, mode: str, cpp: list[str], so
         '    <param name="duration" type="str" value="$(arg duration)"/>',
         '    <param name="plots" type="bool" value="$(arg plots)"/>',
         "  </node>",
-        f'  <node pkg="{pkg}" type="{names.SCENARIO}.py" name="{names.SCENARIO}" required="true"/>',
+        f'  <node pkg="{pkg}" type="{names.SCENARIO}.py" name="{names.SCENARIO}" required="true"'
+        ' output="screen"/>',
         "",
     ]
     for path in graph.remote:

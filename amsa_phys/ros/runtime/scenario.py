@@ -41,6 +41,6 @@ def main() -> None:
             rospy.set_param(names.param(change.leaf, change.param), rosio.ros_value(change.value))
         ack.publish(String(str(k)))
         text = ", ".join(f"{c.key}={c.value}" for c in phase.changes)
-        rospy.loginfo(f"phase {k} at t={float(phase.at):g} s: {text}")
+        print(f"{names.SCENARIO}: phase {k} at t={float(phase.at):g} s: {text}", flush=True)
     rospy.spin()
     del keep
