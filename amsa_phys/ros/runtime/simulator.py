@@ -29,6 +29,7 @@ from ...engine import batch, interrupt
 from ...engine.runner import Simulation
 from ...errors import AmsaError, ConfigError, Interrupted, RunFault
 from ...model.scenario import Change, Scenario
+from ...runs.expect import check_expectations
 from ...runs.rundir import default_run_dir, prepare_run_dir
 from ...runs.single import run_scenario
 from .. import names
@@ -369,6 +370,10 @@ def main() -> None:
                 simulation=lambda sc, trace: RosSimulation(sc, trace, link),
             )
         _summary(outcome.metrics, out_dir)
+        checks = check_expectations(scenario.expect, outcome.metrics, out_dir / "trace.csv")
+        for check in checks:
+            print(f"expect {check.describe()}", flush=True)
+        code = 0 if all(c.passed for c in checks) else 1
     except Interrupted as exc:
         print(f"error: {exc}", file=sys.stderr, flush=True)
         code = 130
