@@ -111,7 +111,9 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
     files: dict[str, str] = {}
     executable: set[str] = set()
 
-    def node(script: str, title: str, doc: str, module: str, args: str, extra: str = "") -> None:
+    extra = _extra_path(world)
+
+    def node(script: str, title: str, doc: str, module: str, args: str) -> None:
         rel = f"nodes/{script}.py"
         files[rel] = _fill(
             "node.py.in",
@@ -150,7 +152,6 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
             _leaf_doc(graph, path),
             "leaf",
             repr(path),
-            _extra_path(leaf),
         )
     for path in cpp:
         files[f"src/{names.script(path)}.cpp"] = _cpp_node(graph, path, pkg, source, bodies)
@@ -201,21 +202,27 @@ def _hz(freq: Fraction) -> str:
     return f"{float(freq):g}"
 
 
-def _extra_path(leaf: LeafSpec) -> str:
-    """A user template's module directory on ``sys.path`` (built-ins need nothing)."""
-    if leaf.template_ref in BUILTINS:
+def _extra_path(world: WorldSpec) -> str:
+    """The user templates' module directories on ``sys.path`` (built-ins need nothing).
+
+    Every node loads the whole scenario, so every node needs every template importable.
+    """
+    lines = []
+    for ref in sorted({leaf.template_ref for leaf in world.leaves.values()} - set(BUILTINS)):
+        module = ref.partition(":")[0]
+        spec = importlib.util.find_spec(module)
+        if spec is None or spec.origin is None:
+            continue
+        root = Path(spec.origin).resolve().parent
+        for _ in range(module.count(".") + (1 if spec.origin.endswith("__init__.py") else 0)):
+            root = root.parent
+        line = f"sys.path.insert(0, {str(root)!r})  # {ref}"
+        if line not in lines:
+            lines.append(line)
+    if not lines:
         return ""
-    module = leaf.template_ref.partition(":")[0]
-    spec = importlib.util.find_spec(module)
-    if spec is None or spec.origin is None:
-        return ""
-    root = Path(spec.origin).resolve().parent
-    for _ in range(module.count(".") + (1 if spec.origin.endswith("__init__.py") else 0)):
-        root = root.parent
-    return (
-        f"\n# the user template {leaf.template_ref} is imported from where it was at export\n"
-        f"sys.path.insert(0, {str(root)!r})\n"
-    )
+    head = "\n# user templates, imported from where they were found at export time\n"
+    return head + "\n".join(lines) + "\n"
 
 
 def _leaf_doc(graph: RosGraph, path: str) -> str:

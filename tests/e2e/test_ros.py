@@ -23,6 +23,7 @@ import sys
 import threading
 import time
 import uuid
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -91,8 +92,9 @@ class Launch:
             start_new_session=True,
         )
         self.lines: list[str] = []
-        self._watchdog = threading.Timer(LAUNCH_TIMEOUT, self.kill)
-        self._watchdog.start()
+        self.watchdog = threading.Timer(LAUNCH_TIMEOUT, self.kill)
+        self.watchdog.daemon = True
+        self.watchdog.start()
 
     def kill(self) -> None:
         """End the launch and anything it started (by process id)."""
@@ -114,13 +116,29 @@ class Launch:
         assert self.proc.stdout is not None
         self.lines += self.proc.stdout.readlines()
         self.proc.wait()
-        self._watchdog.cancel()
+        self.watchdog.cancel()
         left = _leftovers(self.token)
         if left:
             names = [Path(f"/proc/{p}/cmdline").read_bytes()[:80] for p in left]
             self.kill()
             pytest.fail(f"processes left running after roslaunch exited: {names}")
         return "".join(self.lines)
+
+
+@pytest.fixture
+def launcher() -> Iterator[Callable[..., Launch]]:
+    """Start launches; whatever a failing test leaves running is ended at teardown."""
+    started: list[Launch] = []
+
+    def start(ws: Path, launch: str, *args: str) -> Launch:
+        started.append(Launch(ws, launch, *args))
+        return started[-1]
+
+    yield start
+    for launch in started:
+        launch.watchdog.cancel()
+        launch.kill()
+        launch.proc.wait()
 
 
 @pytest.fixture(scope="module")
@@ -188,11 +206,13 @@ def _runs(values: list[float]) -> list[float]:
     return out
 
 
-def test_lockstep_reproduces_amsa_phys_run(workspace: Path, reference: Path) -> None:
+def test_lockstep_reproduces_amsa_phys_run(
+    workspace: Path, reference: Path, launcher: Callable[..., Launch]
+) -> None:
     out = workspace / "lockstep"
     bag = workspace / "lockstep.bag"
     t0 = time.perf_counter()
-    launch = Launch(workspace, "ros_short.launch", f"out:={out}", "plots:=false", f"bag:={bag}")
+    launch = launcher(workspace, "ros_short.launch", f"out:={out}", "plots:=false", f"bag:={bag}")
     text = launch.finish()
     print(f"lockstep launch to done: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
     assert "completed" in text, text[-3000:]
@@ -212,10 +232,12 @@ def test_lockstep_reproduces_amsa_phys_run(workspace: Path, reference: Path) -> 
         assert messages == trace, column
 
 
-def test_free_mode_metrics_within_bounds(workspace: Path, reference: Path) -> None:
+def test_free_mode_metrics_within_bounds(
+    workspace: Path, reference: Path, launcher: Callable[..., Launch]
+) -> None:
     out = workspace / "free"
     t0 = time.perf_counter()
-    launch = Launch(
+    launch = launcher(
         workspace, "ros_short.launch", f"out:={out}", "plots:=false", "mode:=free", "speed:=4"
     )
     text = launch.finish()
@@ -231,9 +253,13 @@ def test_free_mode_metrics_within_bounds(workspace: Path, reference: Path) -> No
     assert [p["set"] for p in free["phases"]] == [p["set"] for p in ref["phases"]]
 
 
-def test_ctrl_c_stops_every_node_and_keeps_the_outputs(workspace: Path, reference: Path) -> None:
+def test_ctrl_c_stops_every_node_and_keeps_the_outputs(
+    workspace: Path, reference: Path, launcher: Callable[..., Launch]
+) -> None:
     out = workspace / "interrupted"
-    launch = Launch(workspace, "ros_short.launch", f"out:={out}", "plots:=false", "duration:=3600")
+    launch = launcher(
+        workspace, "ros_short.launch", f"out:={out}", "plots:=false", "duration:=3600"
+    )
     # the scenario node says so when it applies the change at t = 10 s
     assert launch.read_until("phase 1 at t=10 s"), "".join(launch.lines)[-3000:]
     os.killpg(launch.proc.pid, signal.SIGINT)  # what a terminal's Ctrl-C sends

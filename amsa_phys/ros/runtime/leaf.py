@@ -212,6 +212,8 @@ def main(path: str) -> None:
     try:
         node = LeafNode(rospy, path)
         missing = node.gate.wait(node.cfg.timeout * 2)
+        if rospy.is_shutdown():
+            return  # roslaunch is stopping (another node failed, or Ctrl-C)
         if missing:
             rosio.fail(rospy, f"{path}: not connected after {node.cfg.timeout * 2:g} s: {missing}")
         keep = rosio.announce_ready(rospy, path)

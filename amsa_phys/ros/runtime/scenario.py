@@ -31,6 +31,8 @@ def main() -> None:
     gate = rosio.Gate(rospy)
     ack = gate.publisher(names.PHASE, String, 1, latch=True)
     missing = gate.wait(cfg.timeout * 2)
+    if rospy.is_shutdown():
+        return
     if missing:
         rosio.fail(rospy, f"{names.SCENARIO}: not connected: {missing}")
     keep: Any = rosio.announce_ready(rospy, names.SCENARIO)

@@ -404,6 +404,6 @@ def _summary(metrics: dict[str, Any], out_dir: Path) -> None:
     parts = [f"{k}={v:.3f}" for k, v in overall.items() if isinstance(v, float)]
     print(
         f"amsa_simulator: {metrics['status']}, simulated {metrics['simulated']:g} s in "
-        f"{metrics['wall_time_s']:g} s; {' '.join(parts)}; outputs in {out_dir}",
+        f"{metrics['wall_time_s']:g} s; {' '.join([*parts, f'outputs in {out_dir}'])}",
         flush=True,
     )
