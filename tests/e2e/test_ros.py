@@ -44,7 +44,7 @@ FREE_BOUNDS = {"max_distance": 1.0, "final_distance": 1.0, "mean_error": 0.5}
 
 
 def _ros_missing() -> str | None:
-    for tool in ("roslaunch", "catkin_make", "rosbag", "unshare", "ip"):
+    for tool in ("roslaunch", "catkin_make", "rosbag", "unshare", "nsenter", "ip"):
         if shutil.which(tool) is None:
             return f"{tool} is not installed (ROS 1 from Debian: see .ci/run)"
     if os.geteuid() != 0:
@@ -240,6 +240,18 @@ def test_free_mode_metrics_within_bounds(
     launch = launcher(
         workspace, "ros_short.launch", f"out:={out}", "plots:=false", "mode:=free", "speed:=4"
     )
+    assert launch.read_until("running ros_short"), "".join(launch.lines)[-3000:]
+    # live edits, as a user would make them (in the launch's network namespace): one the
+    # simulator takes (steering gain: no effect on a straight-driving leader), one a node
+    # refuses (out of the template's range)
+    for name, value in (("/Leader/steerGain", "30.0"), ("/MyFollowerController/Kv", "20")):
+        edit = subprocess.run(
+            ["nsenter", "-t", str(launch.proc.pid), "-n", "rosparam", "set", name, value],
+            capture_output=True,
+            text=True,
+            env={**os.environ, "ROS_MASTER_URI": "http://localhost:11311"},
+        )
+        assert edit.returncode == 0, edit.stderr
     text = launch.finish()
     print(f"free launch to done: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
     assert "completed" in text, text[-3000:]
@@ -249,8 +261,21 @@ def test_free_mode_metrics_within_bounds(
     for key, bound in FREE_BOUNDS.items():
         assert deviations[key] < bound, (key, free["overall"][key], ref["overall"][key])
     assert free["overall"]["collisions"] == 0
-    # every phase was entered at its instant: the scenario node's changes are in the trace
-    assert [p["set"] for p in free["phases"]] == [p["set"] for p in ref["phases"]]
+    live = [e["detail"] for e in json.loads((out / "metrics.json").read_text())["events"]]
+    assert live == ["Leader.steerGain=30.0"]
+    logs = "".join(p.read_text() for p in (workspace / "roshome" / "log").rglob("*.log"))
+    assert "/MyFollowerController/Kv: 20 is above the maximum 10" in logs
+    # the scenario node's change of the C++ node's motorCoef (100 -> 80 at t = 46/3 s) took
+    # effect: every delivered power is a commanded one times 1.0 before, times 0.8 after
+    rows = list(csv.reader((out / "trace.csv").open()))
+    col = {c: i for i, c in enumerate(rows[0])}
+    commanded = {float(r[col["MyFollowerController.LeftPower"]]) for r in rows[1:]}
+    for r in rows[1:]:
+        t, delivered = float(r[0]), float(r[col["MyNormalizePower.normalizedPowerL"]])
+        if t < 15.2 and delivered != 0.0:
+            assert any(min(100.0, max(-100.0, u)) * 1.0 == delivered for u in commanded), t
+        if t > 16.0:
+            assert any(min(100.0, max(-100.0, u)) * 0.8 == delivered for u in commanded), t
 
 
 def test_ctrl_c_stops_every_node_and_keeps_the_outputs(

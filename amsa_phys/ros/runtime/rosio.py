@@ -155,11 +155,24 @@ def ros_value(value: Any) -> Any:
     return value
 
 
+def fetch_param(rospy: Any, name: str) -> Any:
+    """A parameter's value asked of the master now (KeyError if unset).
+
+    Not ``rospy.get_param``: once a node has called ``get_param_cached`` for a key (free
+    mode, to see live edits), ``get_param`` answers from that cache, which the master updates
+    asynchronously — a timeline change read that way could be the old value.
+    """
+    code, _, value = rospy.get_master().target.getParam(rospy.get_name(), name)
+    if code != 1:
+        raise KeyError(name)
+    return value
+
+
 def read_param(rospy: Any, path: str, param: Param, cached: bool = False) -> Any:
     """A Leaf's parameter from the server, judged by the template (type and [min, max])."""
     name = names.param(path, param.name)
     try:
-        raw = rospy.get_param_cached(name) if cached else rospy.get_param(name)
+        raw = rospy.get_param_cached(name) if cached else fetch_param(rospy, name)
     except KeyError:
         raise ConfigError("is not on the parameter server", key=name) from None
     try:

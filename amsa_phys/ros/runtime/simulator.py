@@ -320,16 +320,61 @@ class RosSimulation(Simulation):
             for name, value in values.items():
                 setattr(comp.p, name, value)
             comp.do_step = link.publishing(path, comp.do_step)  # type: ignore[method-assign]
+        # the parameter cache's values for the Leaves stepped here, as last seen (free mode:
+        # a change of the cache is an edit; timeline changes are applied apart, at their instant)
+        self.seen = {
+            (path, name): rosio.ros_value(value)
+            for path in graph.local
+            for name, value in vars(self.components[path].p).items()
+        }
+        self.live: list[Change] = []  # live edits queued, not yet applied
         if not link.lockstep:
             rate = (
                 Fraction(str(scenario.world.physics["rate"])) if graph.local else scenario.log_rate
             )
             self.add_hook(rate, lambda: link.pace(self.now), "ros clock")
+            self.add_hook(scenario.log_rate, self._live_params, "ros parameters")
 
     def apply_change(self, change: Change) -> None:
         """A timeline change, with the value the scenario node put on the parameter server."""
+        for i, queued in enumerate(self.live):
+            if queued is change:  # a live edit (free mode), already judged
+                del self.live[i]
+                super().apply_change(change)
+                return
         value = self.link.phase_value(self.phase_index, self.now, change)
         super().apply_change(Change(change.leaf, change.param, value))
+
+    def _live_params(self) -> None:
+        """Free mode: a ``rosparam set`` of a Leaf stepped here lands at the next instant.
+
+        Judged like the window's live changes (type, range, rules between parameters;
+        parameters only ``initialize`` reads are refused); a refused value is one line in the
+        log and the old value stays. Applied changes are events, and in ``scenario.yaml``.
+        """
+        rospy = self.link.rospy
+        for (path, name), seen in self.seen.items():
+            try:
+                raw = rospy.get_param_cached(names.param(path, name))
+            except KeyError:
+                continue
+            if raw == seen:
+                continue
+            self.seen[(path, name)] = raw
+            leaf = self.link.graph.leaf(path)
+            try:
+                if name in leaf.template.fixed_once_running:
+                    raise ValueError("is read only when the run starts")
+                value = leaf.template.param(name).coerce(raw)
+                leaf.template.check_params({**vars(self.components[path].p), name: value})
+            except ValueError as exc:
+                rospy.logerr(f"{names.param(path, name)}: {exc}; keeping the old value")
+                continue
+            if value == getattr(self.components[path].p, name):
+                continue  # the scenario node's own change, applied at its instant already
+            change = Change(path, name, value)
+            self.live.append(change)
+            self.apply_live(change)
 
 
 def main() -> None:
