@@ -18,7 +18,7 @@ from typing import NoReturn
 
 from .. import __version__
 from ..errors import AmsaError, one_line
-from . import describe, graph, plot, run, sweep, templates, validate
+from . import describe, export, graph, imports, plot, run, sweep, templates, validate
 from . import test as test_cmd
 
 COMMANDS = {
@@ -30,6 +30,8 @@ COMMANDS = {
     "test": test_cmd,
     "sweep": sweep,
     "graph": graph,
+    "export": export,
+    "import": imports,
 }
 
 

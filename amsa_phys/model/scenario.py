@@ -190,7 +190,9 @@ def configure_scenario(
         if text.strip().startswith(PHYSICS_PREFIX):
             scenario.world = with_physics(scenario.world, parse_physics_override(text))
             continue
-        scenario.phases[0].changes.append(parse_override(text, scenario.world))
+        change = parse_override(text, scenario.world)
+        if change is not None:  # None: a frequency, set on the world's Leaf
+            scenario.phases[0].changes.append(change)
     if overrides:
         check_phases(scenario, doc, in_file)
     scenario.log_rate = _effective_log_rate(scenario.log_rate, scenario.world)
@@ -222,7 +224,8 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
     duration = Fraction(str(data["duration"]))
     if duration <= 0:
         raise doc.error(("duration",), f"must be > 0, got {data['duration']}")
-    phases = [Phase(Fraction(0), _changes(data.get("set", {}), ("set",), doc, world))]
+    initial = _changes(data.get("set", {}), ("set",), doc, world, frequencies=True)
+    phases = [Phase(Fraction(0), initial)]
     last = Fraction(0)
     for i, entry in enumerate(data.get("timeline", [])):
         at = Fraction(str(entry["at"]))
@@ -418,14 +421,51 @@ def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = 
                 raise error(entry, j, change, str(exc)) from None
 
 
-def _changes(sets: dict[str, Any], kp: KeyPath, doc: YamlDoc, world: WorldSpec) -> list[Change]:
+def _changes(
+    sets: dict[str, Any], kp: KeyPath, doc: YamlDoc, world: WorldSpec, frequencies: bool = False
+) -> list[Change]:
     out = []
     for key, value in sets.items():
         try:
+            if is_frequency(str(key), world):
+                if not frequencies:
+                    raise ValueError(
+                        "a Leaf's frequency holds for the whole run: set it in set:, "
+                        "not in the timeline"
+                    )
+                set_frequency(str(key), value, world)
+                continue
             out.append(resolve_change(str(key), value, world))
         except ValueError as exc:
             raise doc.error((*kp, key), str(exc)) from None
     return out
+
+
+def is_frequency(key: str, world: WorldSpec) -> bool:
+    """Whether ``key`` is ``Leaf.freq`` (and the Leaf's template has no parameter ``freq``)."""
+    leaf_path, _, name = key.rpartition(".")
+    leaf = world.leaves.get(leaf_path)
+    return (
+        name == "freq" and leaf is not None and "freq" not in {p.name for p in leaf.template.params}
+    )
+
+
+def set_frequency(key: str, value: Any, world: WorldSpec) -> None:
+    """Give a Leaf another frequency for the whole run (``set: {Leaf.freq: 4}``).
+
+    A value the world leaves to the scenario: an imported AMSA model whose Leaf has no
+    frequency runs at the metamodel's 10 Hz unless a scenario says otherwise. The world's
+    Leaf itself changes, so the resolved scenario writes the frequency into its world.
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float | str):
+        raise ValueError(f"expected a frequency in Hz, got {short_repr(value)}")
+    try:
+        freq = Fraction(str(value))
+    except (ValueError, ZeroDivisionError):
+        raise ValueError(f"expected a frequency in Hz, got {short_repr(value)}") from None
+    if freq <= 0 or freq > 1_000_000:
+        raise ValueError(f"a frequency must be in (0, 1e6] Hz, got {value}")
+    world.leaves[key.rpartition(".")[0]].freq = freq
 
 
 def resolve_change(key: str, value: Any, world: WorldSpec) -> Change:
@@ -444,13 +484,19 @@ def resolve_change(key: str, value: Any, world: WorldSpec) -> Change:
     return Change(leaf_path, param, leaf.template.param(param).coerce(value))
 
 
-def parse_override(text: str, world: WorldSpec) -> Change:
-    """``Comp.param=V`` from the command line (V read as a YAML scalar)."""
+def parse_override(text: str, world: WorldSpec) -> Change | None:
+    """``Comp.param=V`` from the command line (V read as a YAML scalar).
+
+    ``Leaf.freq=V`` sets the Leaf's frequency on ``world`` and returns None.
+    """
     key, sep, raw = text.partition("=")
     if not sep:
         raise ConfigError(f"expected Component.parameter=value, got {text!r}", key="--set")
     value = parse_value(raw, f"--set {key.strip()}")
     try:
+        if is_frequency(key.strip(), world):
+            set_frequency(key.strip(), value, world)
+            return None
         return resolve_change(key.strip(), value, world)
     except ValueError as exc:
         raise ConfigError(str(exc), key=f"--set {key.strip()}") from None

@@ -22,6 +22,8 @@ from .yamlio import KeyPath, YamlDoc
 NAME = r"^[A-Za-z_][A-Za-z0-9_]*$"
 #: The largest seed: numpy's seed tree takes any non-negative integer, files stay int64.
 MAX_SEED = 2**63 - 1
+#: A Data name: a NAME, or ``Composite.NAME`` for a Data declared inside a Composite.
+DATA_NAME = r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$"
 _num = {"type": "number"}
 _pos = {"type": "number", "exclusiveMinimum": 0}
 #: A component's rate and the trace's: what the engine can schedule in reasonable time
@@ -117,6 +119,11 @@ WORLD: dict[str, Any] = {
         "physics": PHYSICS,
         "components": {"$ref": "#/$defs/components"},
         "schedule": {"type": "array", "items": {"type": "string"}, "uniqueItems": True},
+        "data": {
+            "type": "object",
+            "propertyNames": {"pattern": DATA_NAME},
+            "additionalProperties": {"type": "string"},
+        },
     },
     "$defs": {
         "components": {

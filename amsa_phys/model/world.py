@@ -89,6 +89,8 @@ class WorldSpec:
     buffers: dict[str, BufferSpec]
     order: list[str]
     schedule: list[str]
+    #: Named Data (``data:``, the AMSA model's Data names): name -> buffer ``Component.output``
+    data_names: dict[str, str] = field(default_factory=dict)
 
     def error(self, keypath: KeyPath, message: str) -> ConfigError:
         """A ConfigError at ``keypath`` (relative to this world) in its source file."""
@@ -190,6 +192,11 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
     if why is not None:
         raise err(("components",), why)
     order = execution_order(leaves, schedule, err)
+    composites = {c.path for c in _composites(root)}
+    names = {
+        name: _data_buffer(name, ref, leaves, buffers, composites, err)
+        for name, ref in data.get("data", {}).items()
+    }
     return WorldSpec(
         name=str(data.get("name", doc.path.stem)),
         source=doc,
@@ -201,6 +208,7 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
         buffers=buffers,
         order=order,
         schedule=schedule,
+        data_names=names,
     )
 
 
@@ -265,6 +273,47 @@ def _values(value: Any) -> int:
     if isinstance(value, dict):
         return 1 + sum(_values(v) for v in value.values())
     return 1
+
+
+def _composites(node: CompositeSpec) -> list[CompositeSpec]:
+    out = [node]
+    for child in node.children:
+        if isinstance(child, CompositeSpec):
+            out += _composites(child)
+    return out
+
+
+def _data_buffer(
+    name: str,
+    ref: str,
+    leaves: dict[str, LeafSpec],
+    buffers: dict[str, BufferSpec],
+    composites: set[str],
+    err: Any,
+) -> str:
+    """The buffer a ``data:`` name stands for, looked up from the name's Composite outwards.
+
+    ``Team.posX: Leader.posX`` names a Data of Composite ``Team``, so ``Leader`` is found in
+    ``Team`` first, then at the root, as an input's producer would be.
+    """
+    scope = name.rpartition(".")[0]
+    if scope not in composites:
+        raise err(
+            ("data", name), f"{scope!r} is not a Composite (a Data is named NAME or Composite.NAME)"
+        )
+    comp, _, output = ref.rpartition(".")
+    producer = _resolve_scope(name, comp, leaves) if comp else None
+    if producer is None:
+        raise err(("data", name), f"unknown component {comp or ref!r}" + did_you_mean(comp, leaves))
+    buffer = f"{producer.path}.{output}"
+    if buffer not in buffers:
+        outs = [p.name for p in producer.template.outputs]
+        raise err(
+            ("data", name),
+            f"component {producer.path} ({producer.template.name()}) has no output "
+            f"{output!r}" + did_you_mean(output, outs),
+        )
+    return buffer
 
 
 @dataclass(frozen=True)

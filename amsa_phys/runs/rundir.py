@@ -117,6 +117,45 @@ def _without_dotdot(out: Path) -> Path:
     return Path(os.path.realpath(out.parent)) / out.name
 
 
+def check_output_dir(
+    out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "--out"
+) -> bool:
+    """The refusals of :func:`prepare_run_dir`, touching nothing.
+
+    Returns True if ``out`` exists and is not empty (and may be replaced: ``force`` was
+    given, amsa-phys made it and it holds none of ``inputs``).
+    """
+    inputs = list(inputs)
+    out = _without_dotdot(out)
+    if out.is_symlink() and (force or out.exists()):
+        raise ConfigError(
+            "is a symbolic link; give the real directory (amsa-phys does not replace links)",
+            key=flag,
+            file=out,
+        )
+    if not out.exists():
+        return False
+    if not out.is_dir():
+        raise ConfigError("exists and is not a directory", key=flag, file=out)
+    if not any(out.iterdir()):
+        return False
+    _refuse_inputs(out, inputs, flag)
+    if not force:
+        raise ConfigError(
+            "directory exists and is not empty (use --force to replace it)",
+            key=flag,
+            file=out,
+        )
+    if not is_ours(out):
+        raise ConfigError(
+            f"directory exists and was not made by amsa-phys (no {MARKER} in it); "
+            "--force replaces only run directories: choose a new one",
+            key=flag,
+            file=out,
+        )
+    return True
+
+
 def prepare_run_dir(
     out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "--out"
 ) -> Path:
@@ -128,31 +167,13 @@ def prepare_run_dir(
     """
     inputs = list(inputs)
     out = _without_dotdot(out)
-    if out.is_symlink() and (force or out.exists()):
-        raise ConfigError(
-            "is a symbolic link; give the real directory (amsa-phys does not replace links)",
-            key=flag,
-            file=out,
-        )
-    if out.exists():
-        if not out.is_dir():
-            raise ConfigError("exists and is not a directory", key=flag, file=out)
-        if any(out.iterdir()):
-            _refuse_inputs(out, inputs, flag)
-            if not force:
-                raise ConfigError(
-                    "directory exists and is not empty (use --force to replace it)",
-                    key=flag,
-                    file=out,
-                )
-            if not is_ours(out):
-                raise ConfigError(
-                    f"directory exists and was not made by amsa-phys (no {MARKER} in it); "
-                    "--force replaces only run directories: choose a new one",
-                    key=flag,
-                    file=out,
-                )
-            shutil.rmtree(out)
+    if check_output_dir(out, force, inputs, flag):
+        shutil.rmtree(out)
+    _make_marked(out, flag)
+    return out
+
+
+def _make_marked(out: Path, flag: str) -> None:
     try:
         out.mkdir(parents=True, exist_ok=True)
         (out / MARKER).write_text("amsa-phys output directory; --force may replace it\n")
@@ -160,7 +181,6 @@ def prepare_run_dir(
         raise ConfigError(f"cannot create directory: {exc.strerror}", key=flag, file=out) from None
     if not os.access(out, os.W_OK):
         raise ConfigError("directory is not writable", key=flag, file=out)
-    return out
 
 
 def check_output(path: Path, flag: str, make_parent: bool = False) -> Path:
@@ -186,3 +206,40 @@ def check_output(path: Path, flag: str, make_parent: bool = False) -> Path:
     if not os.access(parent, os.W_OK):
         raise ConfigError("directory is not writable", key=flag, file=parent)
     return path
+
+
+def staged_dir(out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "-o") -> Path:
+    """A new, marked, empty directory beside ``out`` to write a whole output tree into.
+
+    ``out`` is checked as :func:`prepare_run_dir` checks it (nothing is touched); the caller
+    fills the returned directory, then :func:`commit_staged` puts it in place in one rename,
+    so a failure half-way leaves ``out`` as it was (and :func:`discard_staged` cleans up).
+    """
+    out = _without_dotdot(out)
+    check_output_dir(out, force, inputs, flag)
+    staged = out.parent / f".{out.name}.amsa-tmp-{os.getpid()}"
+    if staged.exists() or staged.is_symlink():
+        discard_staged(staged)
+    _make_marked(staged, flag)
+    return staged
+
+
+def commit_staged(staged: Path, out: Path) -> None:
+    """Replace ``out`` (checked by :func:`staged_dir`: absent, empty or ours) by ``staged``."""
+    old = out.parent / f".{out.name}.amsa-old-{os.getpid()}"
+    moved = False
+    if out.exists():
+        os.replace(out, old)
+        moved = True
+    os.replace(staged, out)
+    if moved:
+        if is_ours(old):
+            shutil.rmtree(old)
+        else:
+            old.rmdir()  # an empty directory the user made
+
+
+def discard_staged(staged: Path) -> None:
+    """Remove a staged directory after a failure (only if it is ours)."""
+    if staged.is_dir() and not staged.is_symlink() and is_ours(staged):
+        shutil.rmtree(staged)

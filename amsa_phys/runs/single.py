@@ -215,6 +215,7 @@ def run_scenario(
     snapshot: SnapshotOptions | None = None,
     window: bool | WindowDriver = False,
     plotter: PlotJob | None = None,
+    simulation: SimulationFactory | None = None,
 ) -> RunOutcome:
     """Run ``scenario`` and write its run directory (which must exist and be empty).
 
@@ -223,7 +224,8 @@ def run_scenario(
     interactive window (until the user closes it) instead of as fast as possible; a callable
     ``window`` replaces the window's own loop (tests drive it with scripted events and an
     exact clock). ``plotter`` draws the plots (a child started early, ``runs/plotjob.py``);
-    without one they are drawn in-process.
+    without one they are drawn in-process. ``simulation`` builds the Simulation from the
+    scenario and the trace callback (the ROS simulator node's, whose Leaves run as nodes).
 
     Ctrl-C (SIGINT, and SIGTERM from the CLI) during the run stops it between two instants
     (``engine/interrupt.py``): the outputs describe whole instants, then
@@ -239,7 +241,16 @@ def run_scenario(
             snapshot=snapshot,
             window=window,
             plotter=plotter,
+            simulation=simulation,
         )
+
+
+TraceFn = Callable[[float, list[float]], None]
+SimulationFactory = Callable[[Scenario, TraceFn], Simulation]
+
+
+def _default_simulation(scenario: Scenario, trace: TraceFn) -> Simulation:
+    return Simulation.from_scenario(scenario, trace=trace)
 
 
 def _run_scenario(
@@ -252,10 +263,17 @@ def _run_scenario(
     snapshot: SnapshotOptions | None,
     window: bool | WindowDriver,
     plotter: PlotJob | None,
+    simulation: SimulationFactory | None = None,
 ) -> RunOutcome:
     trace = TraceWriter(out_dir / "trace.csv", list(scenario.world.buffers))
     ended = execute(
-        scenario, trace, progress=progress, record=record, snapshot=snapshot, window=window
+        scenario,
+        trace,
+        progress=progress,
+        record=record,
+        snapshot=snapshot,
+        window=window,
+        simulation=simulation,
     )
     unwritten = ended.unwritten + write_run_files(out_dir, ended, plot=plot, plotter=plotter)
     error = ended.error
@@ -321,14 +339,17 @@ def execute(
     record: RecordOptions | None = None,
     snapshot: SnapshotOptions | None = None,
     window: bool | WindowDriver = False,
+    simulation: SimulationFactory | None = None,
 ) -> Ended:
     """Run ``scenario``, streaming its trace to ``trace``; measure it, resolve it.
 
     A fault or an interrupt ends the run and is returned in :attr:`Ended.error` (the trace
     holds every instant up to it); only a failure to finish the video with no other error
     is raised here. Call inside :func:`interrupt.deferred` so Ctrl-C stops between instants.
+    ``simulation`` builds the Simulation (the ROS export's simulator node steps its Leaves
+    through their nodes); by default the engine's own.
     """
-    sim = Simulation.from_scenario(scenario, trace=trace.write)
+    sim = (simulation or _default_simulation)(scenario, trace.write)
     status = "completed"
     error: BaseException | None = None
     recorder: Recorder | None = None

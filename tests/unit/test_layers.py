@@ -1,5 +1,5 @@
-"""Imports flow one way: model -> engine -> physics|sensors|control -> plots|view -> runs ->
-cli|api -> gym."""
+"""Imports flow one way: model -> engine -> physics|sensors|control|interop -> plots|view -> runs
+-> ros -> cli|api -> gym."""
 
 from __future__ import annotations
 
@@ -15,12 +15,14 @@ LAYER = {
     "physics": 2,
     "sensors": 2,
     "control": 2,
+    "interop": 2,
     "plots": 3,
     "view": 3,
     "runs": 4,
-    "cli": 5,
-    "api": 5,
-    "gym": 6,
+    "ros": 5,
+    "cli": 6,
+    "api": 6,
+    "gym": 7,
 }
 MODULES = sorted(p for p in PKG.rglob("*.py") if p.parent != PKG)
 

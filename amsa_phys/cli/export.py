@@ -1,0 +1,139 @@
+"""Export a scenario as a ROS package, or a world as the original AMSA files."""
+
+from __future__ import annotations
+
+import argparse
+from fractions import Fraction
+from pathlib import Path
+
+from ..errors import ConfigError
+from ..interop.exporter import export_world
+from ..model.scenario import (
+    DEFAULT_LOG_RATE_HZ,
+    Phase,
+    Scenario,
+    load_scenario,
+    parse_override,
+)
+from ..model.template import Kind
+from ..model.world import load_world
+from ..model.yamlio import load_yaml
+from ..runs.rundir import commit_staged, discard_staged, staged_dir
+from ..runs.suite import input_files
+from .options import add_scenario_overrides
+
+#: Simulated seconds a package exported from a bare world runs for.
+WORLD_DURATION = 3600
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``amsa-phys export ros|amsa``."""
+    sub = p.add_subparsers(dest="target", required=True, metavar="TARGET")
+    ros = sub.add_parser(
+        "ros",
+        help="a catkin package: a node per Leaf, a topic per Data, a parameter per Parameter",
+        description="A ROS 1 catkin package named after the root component: a node per Leaf, "
+        "a std_msgs/Float64 topic per Data, a parameter per Parameter, a scenario node, a "
+        "simulator node publishing /clock, a launch file per scenario.",
+    )
+    ros.add_argument(
+        "files", nargs="+", metavar="SCENARIO|WORLD", help="scenarios of one world, or a world"
+    )
+    ros.add_argument("-o", "--out", required=True, metavar="DIR", help="the package directory")
+    ros.add_argument(
+        "--mode",
+        choices=("lockstep", "free"),
+        default="lockstep",
+        help="the launch files' default: lockstep reproduces amsa-phys run byte for byte; "
+        "free runs every node on its own timer (default lockstep)",
+    )
+    ros.add_argument("--force", action="store_true", help="replace a DIR amsa-phys made")
+    add_scenario_overrides(ros)
+    amsa = sub.add_parser(
+        "amsa",
+        help="the original AMSA files (.amsacore XMI, .amsatemplate)",
+        description="The original AMSA tool's files: NAME.amsacore (XMI) and "
+        "NAME.amsatemplate; amsa-phys import reads them back to the same world.",
+    )
+    amsa.add_argument("world", metavar="WORLD", help="a world (or a scenario: its world)")
+    amsa.add_argument("-o", "--out", required=True, metavar="DIR", help="where to write")
+    amsa.add_argument("--force", action="store_true", help="replace a DIR amsa-phys made")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Generate into a staged directory, then rename it into place."""
+    out = Path(args.out)
+    if args.target == "amsa":
+        return _amsa(args, out)
+    return _ros(args, out)
+
+
+def _load(path: str, args: argparse.Namespace) -> Scenario:
+    """A scenario file, or a bare world as a scenario with no timeline."""
+    doc = load_yaml(path)
+    if isinstance(doc.data, dict) and "world" in doc.data:
+        return load_scenario(
+            path,
+            overrides=args.overrides,
+            seed=args.seed,
+            duration=args.duration,
+            log_rate=args.log_rate,
+        )
+    world = load_world(path)
+    changes = [c for c in (parse_override(t, world) for t in args.overrides) if c is not None]
+    sensors = [leaf.freq for leaf in world.leaves.values() if leaf.kind is Kind.SENSOR]
+    rate = Fraction(str(args.log_rate)) if args.log_rate else Fraction(DEFAULT_LOG_RATE_HZ)
+    return Scenario(
+        path=Path(path),
+        name=world.name,
+        world=world,
+        duration=Fraction(str(args.duration or WORLD_DURATION)),
+        seed=args.seed or 0,
+        log_rate=max([rate, *sensors]),
+        quality=None,
+        phases=[Phase(Fraction(0), changes)],
+    )
+
+
+def _ros(args: argparse.Namespace, out: Path) -> int:
+    from ..ros.generate import generate
+
+    scenarios = [_load(f, args) for f in args.files]
+    inputs = [p for s in scenarios for p in input_files(s)]
+    staged = staged_dir(out, args.force, inputs)
+    try:
+        package = generate(scenarios, list(args.files), args.mode, staged)
+        commit_staged(staged, out)
+    except BaseException:
+        discard_staged(staged)
+        raise
+    nodes = len(package.nodes)
+    cpp = f"; C++ nodes: {', '.join(package.cpp)}" if package.cpp else ""
+    print(
+        f"wrote ROS package {package.name} in {out}: {nodes} nodes (physics in amsa_simulator: "
+        f"{', '.join(package.local) or 'none'}{cpp}); launch files: {', '.join(package.launch)}"
+    )
+    print(f"build it in a catkin workspace (WS/src/{package.name}): see {out / 'README.md'}")
+    return 0
+
+
+def _amsa(args: argparse.Namespace, out: Path) -> int:
+    doc = load_yaml(args.world)
+    if isinstance(doc.data, dict) and "world" in doc.data:
+        world = load_scenario(args.world).world
+    else:
+        world = load_world(args.world)
+    try:
+        exported = export_world(world)
+    except ValueError as exc:
+        raise ConfigError(str(exc), file=args.world) from None
+    staged = staged_dir(out, args.force, [Path(args.world)])
+    try:
+        (staged / exported.core_name).write_text(exported.core_text)
+        (staged / exported.template_name).write_text(exported.template_text)
+        commit_staged(staged, out)
+    except BaseException:
+        discard_staged(staged)
+        raise
+    print(f"wrote {out / exported.core_name} and {out / exported.template_name}")
+    return 0

@@ -1,0 +1,123 @@
+"""The ROS graph of a world: which Leaf runs where, and who listens to what.
+
+A Leaf whose ``initialize`` asks for a shared service of the run (``ctx.shared``: the pymunk
+world) or adds an engine hook cannot live alone in a process: it runs inside the simulator
+node, which owns the physics (the Leader and the Follower share one pymunk space). Every
+other Leaf is its own node. :func:`classify` finds out by initializing each Leaf with a
+context that refuses those two calls, so a new template that needs the physics (a lidar's
+ray casts) lands in the simulator without anyone listing it.
+
+The expected number of subscribers of every topic is computed here, by every node from the
+same inputs, for the start-up handshake: a publisher is ready when that many subscribers
+are connected, since ROS 1 drops what is published before a subscriber connects.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+from ..engine.rng import component_rng
+from ..errors import ConfigError
+from ..model.world import LeafSpec, WorldSpec
+from . import names
+
+
+class NeedsSimulator(Exception):
+    """A Leaf asked for the simulator's shared services while initializing."""
+
+
+class NodeContext:
+    """What a Leaf's ``initialize`` gets in its own node: its random stream, no shared world.
+
+    ``events`` collects what the Leaf records (sent to the simulator with its next answer).
+    """
+
+    def __init__(self, seed: int, path: str, world: WorldSpec) -> None:
+        self.path = path
+        self.rng = component_rng(seed, path)
+        self.world = world
+        self.events: list[tuple[str, str]] = []
+
+    def shared(self, name: str, factory: Any) -> Any:
+        """Shared services live in the simulator node."""
+        raise NeedsSimulator(name)
+
+    def add_hook(self, rate_hz: Any, fn: Any, name: str) -> None:
+        """Engine hooks live in the simulator node."""
+        raise NeedsSimulator(name)
+
+    def record_event(self, kind: str, detail: str) -> None:
+        """Kept until the next answer to the simulator, which records it at that instant."""
+        self.events.append((kind, detail))
+
+
+def classify(world: WorldSpec, seed: int = 0) -> list[str]:
+    """The Leaves that must run inside the simulator node, in world order."""
+    local = []
+    for path, leaf in world.leaves.items():
+        comp = leaf.template(path, dict(leaf.params))
+        try:
+            comp.initialize(NodeContext(seed, path, world))
+        except NeedsSimulator:
+            local.append(path)
+        except Exception as exc:  # a template's own failure, reported as for a run
+            raise ConfigError(
+                f"initialize failed: {exc!r}", key=f"component {path} ({leaf.template.name()})"
+            ) from None
+    return local
+
+
+@dataclass
+class RosGraph:
+    """The nodes and topics of one exported world."""
+
+    world: WorldSpec
+    local: frozenset[str]
+    bag: bool = False
+
+    @classmethod
+    def of(cls, world: WorldSpec, local: Iterable[str], bag: bool = False) -> RosGraph:
+        """The graph with ``local`` Leaves in the simulator (checked against the world)."""
+        local = frozenset(local)
+        unknown = sorted(local - set(world.leaves))
+        if unknown:
+            raise ConfigError(f"unknown Leaf {unknown[0]!r} in /amsa/local")
+        return cls(world, local, bag)
+
+    @property
+    def remote(self) -> list[str]:
+        """The Leaves that are nodes of their own, in world order."""
+        return [p for p in self.world.leaves if p not in self.local]
+
+    def leaf(self, path: str) -> LeafSpec:
+        """The Leaf at ``path``."""
+        return self.world.leaves[path]
+
+    def input_buffers(self, path: str) -> list[str]:
+        """The distinct buffers a remote Leaf subscribes to, in port order (its own excluded).
+
+        A Leaf reading its own output keeps its last value: no subscription.
+        """
+        out: list[str] = []
+        for buffer in self.leaf(path).inputs.values():
+            if buffer.rpartition(".")[0] != path and buffer not in out:
+                out.append(buffer)
+        return out
+
+    def outputs(self, path: str) -> list[str]:
+        """A Leaf's buffers, in its template's output order."""
+        return [f"{path}.{p.name}" for p in self.leaf(path).template.outputs]
+
+    def subscribers(self, buffer: str) -> int:
+        """How many subscribers the topic of ``buffer`` has once everything is connected."""
+        producer = buffer.rpartition(".")[0]
+        n = sum(1 for p in self.remote if p != producer and buffer in self.input_buffers(p))
+        if producer not in self.local:
+            n += 1  # the simulator: the trace, and the Leaves it steps
+        return n + (1 if self.bag else 0)
+
+    def data_topics(self) -> list[str]:
+        """Every Data topic, in trace-column order."""
+        return [names.topic(b) for b in self.world.buffers]

@@ -1,0 +1,84 @@
+"""ROS names for the model's things: a Leaf is a node, a Data a topic, a Parameter a parameter.
+
+A Leaf ``Team.Leader`` is the node ``/Team/Leader``; its output ``posX`` is the topic
+``/Team/Leader/posX`` (``std_msgs/Float64``) and its parameter ``x`` the parameter
+``/Team/Leader/x`` — the node's private names (``~posX``, ``~x``). The framework's own topics
+live under ``/amsa/``; the simulator and scenario nodes are ``/amsa_simulator`` and
+``/amsa_scenario``.
+"""
+
+from __future__ import annotations
+
+import re
+
+from ..errors import ConfigError
+from ..model.world import WorldSpec
+
+#: A ROS graph resource base name: a letter, then letters, digits and underscores.
+BASE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+SIMULATOR = "amsa_simulator"
+SCENARIO = "amsa_scenario"
+#: Names a top-level component may not take (the framework's nodes and namespaces).
+RESERVED = {"amsa", SIMULATOR, SCENARIO, "clock", "rosout", "rosout_agg", "amsa_bag"}
+
+CLOCK = "/clock"
+READY = "/amsa/ready"
+PHASE = "/amsa/phase"
+
+
+def ns(path: str) -> str:
+    """``Team.Leader`` -> ``/Team/Leader``."""
+    return "/" + path.replace(".", "/")
+
+
+def topic(buffer: str) -> str:
+    """The topic of a Data buffer ``Component.output``."""
+    return ns(buffer)
+
+
+def param(path: str, name: str) -> str:
+    """The ROS parameter of a Leaf's parameter."""
+    return f"{ns(path)}/{name}"
+
+
+def step_topic(path: str) -> str:
+    """Where the simulator tells a node to step (lockstep)."""
+    return "/amsa/step" + ns(path)
+
+
+def done_topic(path: str) -> str:
+    """Where a node says it has stepped (lockstep)."""
+    return "/amsa/done" + ns(path)
+
+
+def script(path: str) -> str:
+    """The file name (without extension) of a Leaf's node: ``Team__Leader``."""
+    return path.replace(".", "__")
+
+
+def check_world(world: WorldSpec) -> None:
+    """Every component, output and parameter name must be a valid ROS name (else one line)."""
+    for path, leaf in world.leaves.items():
+        parts = path.split(".")
+        for part in parts:
+            if not BASE.match(part):
+                raise ConfigError(
+                    f"{part!r} is not a valid ROS name (a letter, then letters, digits, _)",
+                    key=f"component {path}",
+                )
+        if parts[0] in RESERVED:
+            raise ConfigError(
+                f"{parts[0]!r} is a name the ROS package uses itself; rename the component",
+                key=f"component {path}",
+            )
+        for what, names in (
+            ("output", [p.name for p in leaf.template.outputs]),
+            ("parameter", [p.name for p in leaf.template.params]),
+        ):
+            for name in names:
+                if not BASE.match(name):
+                    raise ConfigError(
+                        f"{what} {name!r} of template {leaf.template.name()} is not a valid "
+                        "ROS name",
+                        key=f"component {path}",
+                    )

@@ -1,0 +1,1 @@
+"""What the generated nodes run (imports ``rospy``; see ``rosio.ros``)."""

@@ -1,0 +1,227 @@
+"""A Leaf as a ROS node: the project's own template class behind topics and parameters.
+
+Inputs are ``std_msgs/Float64`` topics ``/Producer/output``; outputs are published on
+``/Leaf/output``; parameters are read from ``/Leaf/param`` and judged by the template (type,
+[min, max], rules between parameters) whenever they change.
+
+**lockstep** (reproduces ``amsa-phys run``): the simulator sends ``step SEQ NUM DEN C1..Cn``
+on ``/amsa/step/Leaf`` — the instant as an exact fraction and, for each input topic, how many
+messages it has carried so far. The node steps once it has received exactly that many on
+each (messages on different topics travel on different connections, so a count, not arrival
+order, says an input is current), publishes its outputs, then answers ``done SEQ I..`` (the
+outputs it published) on ``/amsa/done/Leaf``. ``param SEQ NAME`` re-reads one parameter
+(a timeline change, at its exact instant). The steps are driven by whichever callback
+completes the condition last: no thread ever blocks waiting for another.
+
+**free** (as the paper's generated nodes ran): the node steps on its own timer at its own
+rate in simulated time (``/clock``), with whatever its inputs hold then, and picks up
+parameter changes (the scenario's, or a user's ``rosparam set``) at its next step.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from fractions import Fraction
+from typing import Any
+
+from ...errors import AmsaError, ConfigError
+from .. import names
+from ..graph import NodeContext
+from . import rosio
+from .config import load_config
+
+
+class LeafNode:
+    """One remote Leaf: its component, subscriptions, publishers and protocol state."""
+
+    def __init__(self, rospy: Any, path: str) -> None:
+        self.rospy = rospy
+        Float64, String, _ = rosio.msgs()
+        self.Float64, self.String = Float64, String
+        cfg = load_config(rospy)
+        self.cfg = cfg
+        graph = cfg.graph
+        self.path = path
+        self.leaf = leaf = graph.leaf(path)
+        world = cfg.scenario.world
+        self.params = rosio.read_params(rospy, leaf)
+        self.raw = dict(self.params)
+        self.comp = leaf.template(path, dict(self.params))
+        self.ctx = NodeContext(cfg.scenario.seed, path, world)
+        self.comp.initialize(self.ctx)
+        self.lock = threading.Lock()
+        self.ports = list(leaf.inputs.items())
+        self.buffers = graph.input_buffers(path)
+        self.outputs = graph.outputs(path)
+        self.count = {b: 0 for b in self.buffers}
+        self.value = {b: float(world.buffers[b].initial) for b in self.buffers}
+        self.own = {b: float(world.buffers[b].initial) for b in self.outputs}
+        self.pending: list[str] | None = None
+        self.subs = [
+            rospy.Subscriber(
+                names.topic(b), Float64, self._on_data, callback_args=b, tcp_nodelay=True
+            )
+            for b in self.buffers
+        ]
+        self.gate = rosio.Gate(rospy)
+        self.pubs = [
+            self.gate.publisher(names.topic(b), Float64, graph.subscribers(b)) for b in self.outputs
+        ]
+        if cfg.mode == "lockstep":
+            self.done = self.gate.publisher(names.done_topic(path), String, 1)
+            self.step_sub = rospy.Subscriber(
+                names.step_topic(path), String, self._on_step, tcp_nodelay=True
+            )
+        else:
+            for p in leaf.template.params:  # subscribe to updates from the start
+                rosio.read_param(rospy, path, p, cached=True)
+
+    # -- lockstep ---------------------------------------------------------------------------
+    def _on_data(self, msg: Any, buffer: str) -> None:
+        with self.lock:
+            self.count[buffer] += 1
+            self.value[buffer] = msg.data
+            if self.pending is not None:
+                self._try()
+
+    def _on_step(self, msg: Any) -> None:
+        with self.lock:
+            self.pending = msg.data.split()
+            self._try()
+
+    def _try(self) -> None:
+        """Run the pending request if its inputs are all in (the lock is held)."""
+        req = self.pending
+        assert req is not None
+        seq = req[1]
+        if req[0] == "param":
+            self.pending = None
+            self._reply(seq, self._reload(req[2]))
+            return
+        counts = [int(c) for c in req[4:]]
+        have = [self.count[b] for b in self.buffers]
+        if any(h < c for h, c in zip(have, counts, strict=True)):
+            return  # an input message is still on its way
+        self.pending = None
+        if have != counts:
+            self._reply(seq, ("fault", f"inputs out of step: received {have}, expected {counts}"))
+            return
+        self._reply(seq, self._step(Fraction(int(req[2]), int(req[3]))))
+
+    def _reply(self, seq: str, result: tuple[str, str]) -> None:
+        kind, text = result
+        lines = [f"{kind} {seq} {text}".rstrip()]
+        lines += [f"event {k}\t{d}" for k, d in self.ctx.events]
+        self.ctx.events.clear()
+        self.done.publish(self.String("\n".join(lines)))
+
+    # -- stepping (both modes) --------------------------------------------------------------
+    def _inputs(self) -> dict[str, float]:
+        return {port: (self.own[b] if b in self.own else self.value[b]) for port, b in self.ports}
+
+    def _step(self, t: Fraction) -> tuple[str, str]:
+        """``do_step`` at ``t``; publish the outputs; the answer for the simulator."""
+        try:
+            out = self.comp.do_step(t, self._inputs())
+        except Exception as exc:  # the engine reports it as "do_step raised ..."
+            return "error", repr(exc)
+        values: list[tuple[int, float]] = []
+        ports = [b.rpartition(".")[2] for b in self.outputs]
+        for key, value in (out or {}).items():
+            if key not in ports:
+                return "fault", f"published unknown output {key!r}"
+            try:
+                number = float(value)
+            except (TypeError, ValueError):
+                return "fault", f"output {key} is not a number: {value!r}"
+            values.append((ports.index(key), number))
+        for index, number in values:
+            self.pubs[index].publish(self.Float64(number))
+            self.own[self.outputs[index]] = number
+        return "done", " ".join(str(i) for i, _ in values)
+
+    def _reload(self, name: str, cached: bool = False) -> tuple[str, str]:
+        """Apply a parameter's value from the server (checked as a file value would be)."""
+        param = self.leaf.template.param(name)
+        try:
+            value = rosio.read_param(self.rospy, self.path, param, cached=cached)
+            self.leaf.template.check_params({**self.params, name: value})
+        except ConfigError as exc:
+            return "error", exc.message
+        except ValueError as exc:
+            return "error", str(exc)
+        self.params[name] = value
+        setattr(self.comp.p, name, value)
+        try:
+            self.comp.on_param_change(name, value)
+        except Exception as exc:
+            return "error", str(exc)
+        return "done", ""
+
+    # -- free -------------------------------------------------------------------------------
+    def run_free(self) -> None:
+        """Step at the Leaf's own rate in simulated time until shutdown."""
+        clock = rosio.ClockFollower(self.rospy)
+        period = 1 / self.leaf.freq
+        k = 0
+        missed = 0
+        while not self.rospy.is_shutdown():
+            t = k * period
+            if not clock.wait_until(rosio.to_ns(t)):
+                break
+            late = Fraction(clock.ns, 1_000_000_000) // period
+            if late > k:  # more than a period late: skip to the latest due instant
+                missed += int(late - k)
+                k = int(late)
+                t = k * period
+            self._refresh_params()
+            with self.lock:
+                kind, text = self._step(t)
+            if kind != "done":
+                self.rospy.logerr(f"{self.path} at t={float(t):g} s: {text}")
+            k += 1
+        if missed:
+            self.rospy.loginfo(f"{self.path}: {missed} steps skipped (the node ran late)")
+
+    def _refresh_params(self) -> None:
+        """Take parameter changes (scenario node, rosparam set) at this step; refuse bad ones."""
+        for p in self.leaf.template.params:
+            try:
+                raw = self.rospy.get_param_cached(names.param(self.path, p.name))
+            except KeyError:
+                continue
+            if raw == self.raw.get(p.name) or _same(raw, self.raw.get(p.name)):
+                continue
+            self.raw[p.name] = raw
+            kind, text = self._reload(p.name, cached=True)
+            if kind != "done":
+                self.rospy.logerr(
+                    f"{names.param(self.path, p.name)}: {text}; keeping {self.params[p.name]!r}"
+                )
+
+
+def _same(a: Any, b: Any) -> bool:
+    return isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b)
+
+
+def main(path: str) -> None:
+    """The node's entry point (the generated script calls it)."""
+    rospy = rosio.ros()
+    rospy.init_node(path.rpartition(".")[2])
+    try:
+        node = LeafNode(rospy, path)
+        missing = node.gate.wait(node.cfg.timeout * 2)
+        if rospy.is_shutdown():
+            return  # roslaunch is stopping (another node failed, or Ctrl-C)
+        if missing:
+            rosio.fail(rospy, f"{path}: not connected after {node.cfg.timeout * 2:g} s: {missing}")
+        keep = rosio.announce_ready(rospy, path)
+    except AmsaError as exc:
+        rosio.fail(rospy, f"{path}: {exc}")
+        return
+    if node.cfg.mode == "free":
+        node.run_free()
+    else:
+        rospy.spin()
+    del keep

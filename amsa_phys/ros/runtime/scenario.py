@@ -1,0 +1,48 @@
+"""The scenario node: the timeline applied to the parameter server, in simulated time.
+
+It follows ``/clock``; when simulated time reaches a phase's start it sets that phase's
+parameters (``/Leaf/param``, each value judged when the scenario was loaded) and announces
+the phase number on ``/amsa/phase``. The simulator waits for that announcement at the
+phase's instant before any component due then runs, so in lockstep the change lands exactly
+where ``amsa-phys run`` applies it; in free mode the nodes pick it up at their next step.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ...errors import AmsaError
+from .. import names
+from . import rosio
+from .config import load_config
+
+
+def main() -> None:
+    """The scenario node's entry point."""
+    rospy = rosio.ros()
+    rospy.init_node(names.SCENARIO)
+    _, String, _ = rosio.msgs()
+    try:
+        cfg = load_config(rospy)
+    except AmsaError as exc:
+        rosio.fail(rospy, f"{names.SCENARIO}: {exc}")
+        return
+    clock = rosio.ClockFollower(rospy)
+    gate = rosio.Gate(rospy)
+    ack = gate.publisher(names.PHASE, String, 1, latch=True)
+    missing = gate.wait(cfg.timeout * 2)
+    if rospy.is_shutdown():
+        return
+    if missing:
+        rosio.fail(rospy, f"{names.SCENARIO}: not connected: {missing}")
+    keep: Any = rosio.announce_ready(rospy, names.SCENARIO)
+    for k, phase in enumerate(cfg.scenario.phases[1:], start=1):
+        if not clock.wait_until(rosio.to_ns(phase.at)):
+            return
+        for change in phase.changes:
+            rospy.set_param(names.param(change.leaf, change.param), rosio.ros_value(change.value))
+        ack.publish(String(str(k)))
+        text = ", ".join(f"{c.key}={c.value}" for c in phase.changes)
+        print(f"{names.SCENARIO}: phase {k} at t={float(phase.at):g} s: {text}", flush=True)
+    rospy.spin()
+    del keep

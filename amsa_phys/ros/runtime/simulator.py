@@ -1,0 +1,454 @@
+"""The simulator node: the engine itself, with the Leaves that are nodes stepped over ROS.
+
+It runs ``runs.single.run_scenario`` — the very code behind ``amsa-phys run`` — on a
+:class:`RosSimulation`: the engine's own instant table decides who steps when and in what
+order (so latency models, a compiled physics step or new templates carry over untouched).
+The Leaves that need the shared pymunk world step in this process and publish their outputs
+on their topics; every other Leaf is a :class:`RemoteLeaf` whose ``do_step`` is a round trip
+to its node (lockstep) or nothing at all (free: the node runs on its own timer and this
+process only listens). Timeline changes are the scenario node's: at a phase's instant the
+simulator publishes ``/clock`` and waits until the scenario node has put the phase's values
+on the parameter server, then applies them from there. It publishes ``/clock`` (simulated
+time, latched), writes the run directory (trace.csv, metrics.json, scenario.yaml, plots)
+exactly as ``amsa-phys run`` does, and exits, which ends the launch.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import threading
+import time
+from collections.abc import Callable, Mapping
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+from ...engine import batch, interrupt
+from ...engine.runner import Simulation
+from ...errors import AmsaError, ConfigError, Interrupted, RunFault
+from ...model.scenario import Change, Scenario
+from ...runs.expect import check_expectations
+from ...runs.rundir import default_run_dir, prepare_run_dir
+from ...runs.single import run_scenario
+from .. import names
+from ..graph import RosGraph
+from . import rosio
+from .config import NodeConfig, load_config
+
+
+class RemoteError(Exception):
+    """An exception a node's ``do_step`` raised, shown as the node showed it (its repr)."""
+
+    def __init__(self, text: str) -> None:
+        super().__init__(text)
+        self.text = text
+
+    def __repr__(self) -> str:
+        return self.text
+
+
+class Link:
+    """The simulator's side of the graph: publishers, subscriptions, replies, the clock."""
+
+    def __init__(self, rospy: Any, cfg: NodeConfig) -> None:
+        self.rospy = rospy
+        self.cfg = cfg
+        self.graph: RosGraph = cfg.graph
+        self.lockstep = cfg.mode == "lockstep"
+        Float64, String, Clock = rosio.msgs()
+        self.Float64, self.String, self.Clock = Float64, String, Clock
+        self.cond = threading.Condition()
+        self.gate = rosio.Gate(rospy, self.cond)
+        world = self.graph.world
+        self.values: dict[str, float] | None = None  # the engine's, in free mode
+        self.sim: Simulation | None = None
+        self.published = dict.fromkeys(world.buffers, 0)
+        self.received: dict[str, list[Any]] = {}
+        self.replies: dict[str, list[str] | None] = {}
+        self.ready: set[str] = set()
+        self.phase_acked = 0
+        self.phase_asked = 0
+        self.seq = 0
+        self.last_clock = -1
+        self.wall0: float | None = None
+        self.speed = 1.0
+        self.clock_pub = rosio.make_publisher(rospy, names.CLOCK, Clock, latch=True)
+        self.data_pubs = {
+            b: self.gate.publisher(names.topic(b), Float64, self.graph.subscribers(b))
+            for p in self.graph.local
+            for b in self.graph.outputs(p)
+        }
+        self.step_pubs = {}
+        self.subs = []
+        for path in self.graph.remote:
+            for b in self.graph.outputs(path):
+                self.received[b] = [0, float(world.buffers[b].initial)]
+                self.subs.append(
+                    rospy.Subscriber(
+                        names.topic(b), Float64, self._on_data, callback_args=b, tcp_nodelay=True
+                    )
+                )
+            if self.lockstep:
+                self.replies[path] = None
+                self.step_pubs[path] = self.gate.publisher(names.step_topic(path), String, 1)
+                self.subs.append(
+                    rospy.Subscriber(
+                        names.done_topic(path),
+                        String,
+                        self._on_done,
+                        callback_args=path,
+                        tcp_nodelay=True,
+                    )
+                )
+        self.subs.append(rospy.Subscriber(names.PHASE, String, self._on_phase, tcp_nodelay=True))
+        self.subs.append(rospy.Subscriber(names.READY, String, self._on_ready, tcp_nodelay=True))
+        self.expected_ready = {*self.graph.remote, names.SCENARIO}
+
+    # -- callbacks (rospy's threads) ---------------------------------------------------------
+    def _on_data(self, msg: Any, buffer: str) -> None:
+        with self.cond:
+            r = self.received[buffer]
+            r[0] += 1
+            r[1] = msg.data
+            if self.values is not None:
+                self.values[buffer] = msg.data  # free mode: the latest value is the value
+            self.cond.notify_all()
+
+    def _on_done(self, msg: Any, path: str) -> None:
+        with self.cond:
+            self.replies[path] = msg.data.split("\n")
+            self.cond.notify_all()
+
+    def _on_phase(self, msg: Any) -> None:
+        with self.cond:
+            self.phase_acked = max(self.phase_acked, int(msg.data))
+            self.cond.notify_all()
+
+    def _on_ready(self, msg: Any) -> None:
+        with self.cond:
+            self.ready.add(msg.data)
+            self.cond.notify_all()
+
+    # -- start ------------------------------------------------------------------------------
+    def wait_ready(self, timeout: float) -> list[str]:
+        """Wait for every node's ready message and our own publishers' subscribers."""
+        missing = self.gate.wait(timeout, also=lambda: self.expected_ready <= self.ready)
+        nodes = sorted(self.expected_ready - self.ready)
+        return ([f"node /{n.replace('.', '/')}" for n in nodes] + missing) if missing else []
+
+    def attach(self, sim: Simulation) -> None:
+        """The simulation whose values free mode updates and whose events remote Leaves add."""
+        self.sim = sim
+        if not self.lockstep:
+            self.values = sim.values
+
+    # -- waiting ----------------------------------------------------------------------------
+    def _wait(self, ready: Callable[[], bool], who: str, t: Fraction, what: str) -> None:
+        """Wait (condition, woken by callbacks) until ``ready()``; Ctrl-C or a silent node end it.
+
+        A Ctrl-C (or roslaunch's SIGINT) raises at once: the nodes are stopping too, so this
+        instant cannot be finished; the outputs describe the instants before it.
+        """
+        deadline = time.monotonic() + self.cfg.timeout
+        with self.cond:
+            while not ready():
+                if interrupt.requested() or self.rospy.is_shutdown():
+                    raise KeyboardInterrupt
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    raise RunFault(
+                        who,
+                        t,
+                        f"no answer from ROS node {names.ns(who)} within "
+                        f"{self.cfg.timeout:g} s ({what}; see its log)",
+                    )
+                self.cond.wait(min(left, 0.2))
+
+    # -- lockstep requests -------------------------------------------------------------------
+    def _request(self, path: str, verb: str, args: str, t: Fraction, what: str) -> list[str]:
+        """Send ``VERB SEQ ARGS`` to a node, wait for its answer; ``[kind, seq, text]``."""
+        self.seq += 1
+        seq = str(self.seq)
+        with self.cond:
+            self.replies[path] = None
+        self.step_pubs[path].publish(self.String(f"{verb} {seq} {args}"))
+
+        def answered() -> bool:
+            reply = self.replies[path]
+            return reply is not None and reply[0].split(" ")[1] == seq
+
+        self._wait(answered, path, t, what)
+        reply = self.replies[path]
+        assert reply is not None
+        if self.sim is not None:
+            for line in reply[1:]:
+                kind, _, detail = line.removeprefix("event ").partition("\t")
+                self.sim.record_event(kind, detail)
+        return reply[0].split(" ", 2)
+
+    def step(self, path: str, t: Fraction) -> dict[str, float]:
+        """One step of a remote Leaf at ``t``: its outputs as its node published them."""
+        if not self.lockstep:
+            return {}
+        self.publish_clock(t)
+        counts = " ".join(str(self.published[b]) for b in self.graph.input_buffers(path))
+        head = self._request(path, "step", f"{t.numerator} {t.denominator} {counts}", t, "a step")
+        kind, text = head[0], head[2] if len(head) > 2 else ""
+        who = f"{path} ({self.graph.leaf(path).template.name()})"
+        if kind == "error":
+            raise RemoteError(text)
+        if kind == "fault":
+            raise RunFault(who, t, text)
+        outputs = self.graph.outputs(path)
+        got = [outputs[int(i)] for i in text.split()]
+        for b in got:
+            self.published[b] += 1
+        self._wait(
+            lambda: all(self.received[b][0] >= self.published[b] for b in got),
+            path,
+            t,
+            "its outputs",
+        )
+        return {b.rpartition(".")[2]: self.received[b][1] for b in got}
+
+    def reload(self, path: str, name: str, t: Fraction) -> None:
+        """A remote Leaf re-reads one parameter now (a timeline change at its instant)."""
+        if not self.lockstep:
+            return  # free: the node notices at its next step
+        head = self._request(path, "param", name, t, "a parameter change")
+        if head[0] != "done":
+            raise ValueError(head[2] if len(head) > 2 else "refused")
+
+    # -- local Leaves --------------------------------------------------------------------------
+    def publishing(self, path: str, do_step: Callable[..., Any]) -> Callable[..., Any]:
+        """``do_step`` of a Leaf stepped here, publishing its outputs on their topics."""
+        ports = [(b.rpartition(".")[2], b) for b in self.graph.outputs(path)]
+        pubs = self.data_pubs
+        Float64 = self.Float64
+        published = self.published
+
+        def step(t: Fraction, inp: Mapping[str, Any]) -> Any:
+            out = do_step(t, inp)
+            if out:
+                for port, b in ports:
+                    if port in out:
+                        try:
+                            number = float(out[port])
+                        except (TypeError, ValueError):
+                            continue  # the engine reports it
+                        pubs[b].publish(Float64(number))
+                        published[b] += 1
+            return out
+
+        return step
+
+    # -- time and the timeline ---------------------------------------------------------------
+    def publish_clock(self, t: Fraction) -> None:
+        """``/clock`` = ``t`` (latched), if it moved."""
+        ns = rosio.to_ns(t)
+        if ns != self.last_clock:
+            self.last_clock = ns
+            self.clock_pub.publish(self.Clock(self.rospy.Time(ns // 10**9, ns % 10**9)))
+
+    def pace(self, t: Fraction) -> None:
+        """Free mode: hold simulated time to ``speed`` x the wall clock, then publish it."""
+        now = time.perf_counter()
+        if self.wall0 is None:
+            self.wall0 = now - float(t) / self.speed
+        wait = self.wall0 + float(t) / self.speed - now
+        if wait > 0:
+            time.sleep(wait)  # real-time pacing is the point of free mode
+        if interrupt.requested() or self.rospy.is_shutdown():
+            raise KeyboardInterrupt
+        self.publish_clock(t)
+
+    def phase_value(self, phase: int, t: Fraction, change: Change) -> Any:
+        """The value the scenario node set for ``change`` when phase ``phase`` began at ``t``."""
+        if phase > self.phase_asked:
+            self.phase_asked = phase
+            self.publish_clock(t)
+        self._wait(lambda: self.phase_acked >= phase, names.SCENARIO, t, f"phase {phase}")
+        leaf = self.graph.leaf(change.leaf)
+        return rosio.read_param(self.rospy, change.leaf, leaf.template.param(change.param))
+
+
+class RemoteLeaf:
+    """In the engine, a Leaf that is a node: stepping it is asking its node to step."""
+
+    def __init__(self, path: str, p: Any, link: Link, sim: RosSimulation) -> None:
+        self.path = path
+        self.p = p
+        self.link = link
+        self.sim = sim
+
+    def initialize(self, ctx: Any) -> None:
+        """The node initialized itself."""
+
+    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+        """A round trip to the node (lockstep); nothing (free)."""
+        return self.link.step(self.path, t)
+
+    def on_param_change(self, name: str, value: Any) -> None:
+        """The node re-reads the parameter now."""
+        self.link.reload(self.path, name, self.sim.now)
+
+
+class RosSimulation(Simulation):
+    """The engine with remote Leaves, parameters from the server, ``/clock`` published."""
+
+    def __init__(self, scenario: Scenario, trace: Any, link: Link) -> None:
+        q = scenario.quality.signal if scenario.quality else None
+        super().__init__(
+            scenario.world,
+            seed=scenario.seed,
+            duration=scenario.duration,
+            phases=scenario.phases,
+            log_rate=scenario.log_rate,
+            quality_signal=q,
+            trace=trace,
+        )
+        self.link = link
+        link.attach(self)
+        graph = link.graph
+        for path in graph.remote:
+            self.components[path] = RemoteLeaf(path, self.components[path].p, link, self)  # type: ignore[assignment]
+        for path in sorted(graph.local):
+            comp = self.components[path]
+            values = rosio.read_params(link.rospy, graph.leaf(path))
+            for name, value in values.items():
+                setattr(comp.p, name, value)
+            comp.do_step = link.publishing(path, comp.do_step)  # type: ignore[method-assign]
+        # the parameter cache's values for the Leaves stepped here, as last seen (free mode:
+        # a change of the cache is an edit; timeline changes are applied apart, at their instant)
+        self.seen = {
+            (path, name): rosio.ros_value(value)
+            for path in graph.local
+            for name, value in vars(self.components[path].p).items()
+        }
+        self.live: list[Change] = []  # live edits queued, not yet applied
+        if not link.lockstep:
+            rate = (
+                Fraction(str(scenario.world.physics["rate"])) if graph.local else scenario.log_rate
+            )
+            self.add_hook(rate, lambda: link.pace(self.now), "ros clock")
+            self.add_hook(scenario.log_rate, self._live_params, "ros parameters")
+
+    def apply_change(self, change: Change) -> None:
+        """A timeline change, with the value the scenario node put on the parameter server."""
+        for i, queued in enumerate(self.live):
+            if queued is change:  # a live edit (free mode), already judged
+                del self.live[i]
+                super().apply_change(change)
+                return
+        value = self.link.phase_value(self.phase_index, self.now, change)
+        super().apply_change(Change(change.leaf, change.param, value))
+
+    def _live_params(self) -> None:
+        """Free mode: a ``rosparam set`` of a Leaf stepped here lands at the next instant.
+
+        Judged like the window's live changes (type, range, rules between parameters;
+        parameters only ``initialize`` reads are refused); a refused value is one line in the
+        log and the old value stays. Applied changes are events, and in ``scenario.yaml``.
+        """
+        rospy = self.link.rospy
+        for (path, name), seen in self.seen.items():
+            try:
+                raw = rospy.get_param_cached(names.param(path, name))
+            except KeyError:
+                continue
+            if raw == seen:
+                continue
+            self.seen[(path, name)] = raw
+            leaf = self.link.graph.leaf(path)
+            try:
+                if name in leaf.template.fixed_once_running:
+                    raise ValueError("is read only when the run starts")
+                value = leaf.template.param(name).coerce(raw)
+                leaf.template.check_params({**vars(self.components[path].p), name: value})
+            except ValueError as exc:
+                rospy.logerr(f"{names.param(path, name)}: {exc}; keeping the old value")
+                continue
+            if value == getattr(self.components[path].p, name):
+                continue  # the scenario node's own change, applied at its instant already
+            change = Change(path, name, value)
+            self.live.append(change)
+            self.apply_live(change)
+
+
+def main() -> None:
+    """The simulator node's entry point."""
+    rospy = rosio.ros()
+    rospy.init_node(names.SIMULATOR, disable_signals=True)  # Ctrl-C is the engine's
+    code = 0
+    try:
+        cfg = load_config(rospy)
+        scenario = cfg.scenario
+        duration = str(rospy.get_param("~duration", "") or "")
+        if duration:
+            _shorten(scenario, duration)
+        out = str(rospy.get_param("~out", "") or "")
+        root = Path(str(rospy.get_param("~runs", "") or os.environ.get("PWD", "."))) / "runs"
+        out_dir = Path(out) if out else default_run_dir(scenario.name, root)
+        prepare_run_dir(out_dir, bool(rospy.get_param("~force", False)), flag="out:=")
+        batch.ENABLED = False  # a Leaf stepped here publishes per call (no array groups)
+        link = Link(rospy, cfg)
+        link.speed = float(rospy.get_param("~speed", 1.0))
+        if not link.speed > 0 or math.isinf(link.speed):
+            raise AmsaError(f"speed:= must be a positive number, got {link.speed}")
+        ready_timeout = float(rospy.get_param("~ready_timeout", 120.0))
+        missing = link.wait_ready(ready_timeout)
+        if missing:
+            raise RunFault("ROS graph", 0, f"not connected after {ready_timeout:g} s: {missing}")
+        print(
+            f"amsa_simulator: {len(cfg.graph.remote)} nodes connected, running "
+            f"{scenario.name} ({cfg.mode})",
+            flush=True,
+        )
+        with interrupt.sigterm_as_ctrl_c():
+            outcome = run_scenario(
+                scenario,
+                out_dir,
+                plot=bool(rospy.get_param("~plots", True)),
+                progress=False,
+                simulation=lambda sc, trace: RosSimulation(sc, trace, link),
+            )
+        _summary(outcome.metrics, out_dir)
+        checks = check_expectations(scenario.expect, outcome.metrics, out_dir / "trace.csv")
+        for check in checks:
+            print(f"expect {check.describe()}", flush=True)
+        code = 0 if all(c.passed for c in checks) else 1
+    except Interrupted as exc:
+        print(f"error: {exc}", file=sys.stderr, flush=True)
+        code = 130
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr, flush=True)
+        code = 130
+    except AmsaError as exc:
+        print(f"error: {exc}", file=sys.stderr, flush=True)
+        code = exc.exit_code
+    rospy.signal_shutdown("the run is over")
+    sys.exit(code)
+
+
+def _shorten(scenario: Scenario, text: str) -> None:
+    """``duration:=S``: run for S simulated seconds (the timeline is cut there)."""
+    try:
+        duration = Fraction(text)
+    except (ValueError, ZeroDivisionError):
+        raise ConfigError(f"expected seconds, got {text!r}", key="duration:=") from None
+    if duration <= 0:
+        raise ConfigError(f"must be > 0, got {text}", key="duration:=")
+    scenario.duration = duration
+    scenario.phases = [p for p in scenario.phases if p.at < duration]
+
+
+def _summary(metrics: dict[str, Any], out_dir: Path) -> None:
+    overall = metrics["overall"]
+    parts = [f"{k}={v:.3f}" for k, v in overall.items() if isinstance(v, float)]
+    print(
+        f"amsa_simulator: {metrics['status']}, simulated {metrics['simulated']:g} s in "
+        f"{metrics['wall_time_s']:g} s; {' '.join([*parts, f'outputs in {out_dir}'])}",
+        flush=True,
+    )

@@ -1,0 +1,144 @@
+"""``amsa-phys export ros`` without ROS: what the package holds, and bad input.
+
+(Building and launching it is ``test_ros.py``, which needs ROS.)
+"""
+
+from __future__ import annotations
+
+import py_compile
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+import yaml
+
+from amsa_phys.cli.main import main
+from amsa_phys.model.scenario import load_scenario
+from amsa_phys.ros.graph import RosGraph, classify
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+SCENARIO = ROOT / "tests" / "fixtures" / "ros_short.yaml"
+REMOTE = [
+    "LeaderGPS",
+    "FollowerGPS",
+    "FollowerCompass",
+    "MyDistanceMonitor",
+    "MyFollowerController",
+    "MyNormalizePower",
+]
+
+
+def cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_package_has_a_node_per_leaf_a_topic_per_data_a_parameter_per_parameter(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pkg = tmp_path / "src" / "mdeChallenge"
+    code, out, err = cli(capsys, "export", "ros", str(SCENARIO), "-o", str(pkg), "--mode", "free")
+    assert code == 0, err
+    assert "physics in amsa_simulator: Leader, Follower" in out
+    manifest = ET.parse(pkg / "package.xml").getroot()
+    assert manifest.findtext("name") == "mdeChallenge"  # named after the root component
+    launch = ET.parse(pkg / "launch" / "ros_short.launch").getroot()
+    nodes = {n.get("name"): n for n in launch.iter("node")}
+    assert set(nodes) == {"amsa_simulator", "amsa_scenario", *REMOTE, "amsa_bag"}
+    assert all(n.get("required") == "true" for k, n in nodes.items() if k != "amsa_bag")
+    args = {a.get("name"): a.get("default") for a in launch.iter("arg")}
+    assert args["mode"] == "free"  # --mode sets the launch files' default
+    assert {"out", "bag", "speed", "duration", "cpp", "force", "plots"} <= set(args)
+    # the C++ route for the template with a C++ body, its Python twin otherwise
+    types = [n.get("type") for n in launch.iter("node") if n.get("name") == "MyNormalizePower"]
+    assert types == ["MyNormalizePower_cpp", "MyNormalizePower.py"]
+    assert "add_executable(MyNormalizePower_cpp" in (pkg / "CMakeLists.txt").read_text()
+    # one topic per Data: the bag records every trace column's topic
+    bag = next(n for n in launch.iter("node") if n.get("name") == "amsa_bag")
+    scenario = load_scenario(SCENARIO)
+    topics = ["/" + b.replace(".", "/") for b in scenario.world.buffers]
+    assert bag.get("args").split()[4:] == topics
+    # one parameter per Parameter, at t = 0 the world's values with the scenario's set:
+    params = yaml.safe_load((pkg / "config" / "ros_short_params.yaml").read_text())
+    for path, leaf in scenario.world.leaves.items():
+        assert set(params[path]) == {p.name for p in leaf.template.params}
+    assert params["MyFollowerController"]["Kv"] == 0.1
+    assert params["LeaderGPS"]["lostDataGPS"] == 10
+    assert params["Leader"]["x"] == 15.0
+    # the nodes are Python that compiles, and run the project's classes
+    for leaf in REMOTE:
+        script = pkg / "nodes" / f"{leaf}.py"
+        py_compile.compile(str(script), doraise=True)
+        assert script.stat().st_mode & 0o111
+        assert f"main({leaf!r})" in script.read_text()
+    assert "roslaunch mdeChallenge ros_short.launch" in (pkg / "README.md").read_text()
+    # the resolved scenario the nodes load replays the same run
+    config = load_scenario(pkg / "config" / "ros_short.yaml")
+    assert config.duration == scenario.duration
+    assert [p.at for p in config.phases] == [p.at for p in scenario.phases]
+
+
+def test_physical_leaves_are_found_by_what_they_ask_for() -> None:
+    world = load_scenario(SCENARIO).world
+    local = classify(world)
+    assert local == ["Leader", "Follower"]
+    graph = RosGraph.of(world, local, bag=True)
+    # the controller's left power: read by the actuator's node, the simulator and the bag
+    assert graph.subscribers("MyFollowerController.LeftPower") == 3
+    # the follower's pose: read by two sensor nodes and the bag (the simulator publishes it)
+    assert graph.subscribers("Follower.posX") == 3
+    assert graph.subscribers("Leader.speed") == 1  # the bag only
+
+
+def test_a_world_exports_with_a_launch_file_of_its_own(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pkg = tmp_path / "pkg"
+    code, _, err = cli(
+        capsys, "export", "ros", str(ROOT / "worlds" / "mde_challenge.yaml"), "-o", str(pkg)
+    )
+    assert code == 0, err
+    assert (pkg / "launch" / "mdeChallenge.launch").is_file()
+    config = yaml.safe_load((pkg / "config" / "mdeChallenge.yaml").read_text())
+    assert config["duration"] == 3600
+    assert "timeline" not in config
+
+
+def test_bad_output_directory_or_world_is_one_line_and_changes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("keep\n")
+    for extra in ([], ["--force"]):
+        code, _out, err = cli(capsys, "export", "ros", str(SCENARIO), "-o", str(mine), *extra)
+        assert code == 2
+        assert err.count("\n") == 1
+        assert "mine" in err
+        assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mine"]  # no staging left
+    # a package amsa-phys made is replaced with --force, not without
+    pkg = tmp_path / "pkg"
+    assert cli(capsys, "export", "ros", str(SCENARIO), "-o", str(pkg))[0] == 0
+    assert cli(capsys, "export", "ros", str(SCENARIO), "-o", str(pkg))[0] == 2
+    assert cli(capsys, "export", "ros", str(SCENARIO), "-o", str(pkg), "--force")[0] == 0
+    # a component name ROS cannot use
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(
+        "name: w\ncomponents:\n  _Pilot: {template: ConstantPower}\n"
+        "  Motors: {template: NormalizePower,\n"
+        "           inputs: {powerL: _Pilot.LeftPower, powerR: _Pilot.RightPower}}\n"
+    )
+    code, _, err = cli(capsys, "export", "ros", str(bad), "-o", str(tmp_path / "x"))
+    assert code == 2
+    assert "'_Pilot' is not a valid ROS name" in err
+    assert not (tmp_path / "x").exists()
+    # two scenarios of different worlds in one package
+    other = tmp_path / "other.yaml"
+    other.write_text(f"world: {ROOT / 'worlds' / 'platoon.yaml'}\nduration: 5\n")
+    code, _, err = cli(
+        capsys, "export", "ros", str(SCENARIO), str(other), "-o", str(tmp_path / "y")
+    )
+    assert code == 2
+    assert "runs another world" in err
