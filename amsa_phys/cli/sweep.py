@@ -22,6 +22,7 @@ from ..runs.sweep import (
     Axis,
     SweepPlan,
     check_axes,
+    deterministic_points,
     iter_dask,
     iter_local,
     parse_grid,
@@ -105,7 +106,7 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
         if args.metric is None:
             raise doc.error(("sweep", "metric"), why)
         raise ConfigError(why, key="--metric")
-    return SweepPlan(
+    plan = SweepPlan(
         Path(args.scenario).resolve(),
         axes,
         seeds,
@@ -114,6 +115,26 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
         metric,
         args.duration,
         inputs=tuple(input_files(scenario)),
+    )
+    if seeds > 1:
+        warn_same_seeds(plan, scenario)
+    return plan
+
+
+def warn_same_seeds(plan: SweepPlan, scenario: Any) -> None:
+    """One line on stderr if, at some grid points, nothing random runs: their seeds are copies."""
+    same = deterministic_points(plan, scenario)
+    if not same:
+        return
+    total = 1
+    for a in plan.axes:
+        total *= len(a.values)
+    example = ", ".join(f"{k}={v}" for k, v in same[0])
+    print(
+        f"warning: nothing random at {len(same)} of {total} grid points (e.g. {example}: no "
+        f"sensor noise or loss, no random leader), so their {plan.seeds} seeds give identical "
+        "runs",
+        file=sys.stderr,
     )
 
 
