@@ -1,4 +1,4 @@
-"""Trajectories: every true path (``X.posX``/``X.posY``) and every GPS track, to scale."""
+"""Trajectories: every true path (``X.posX``/``X.posY``), GPS track and odometry, to scale."""
 
 from __future__ import annotations
 
@@ -31,6 +31,11 @@ def plot_trajectory(trace: Path, metrics: dict[str, Any], out: Path) -> Path:
             comp = name[: -len(".gpsPosX")]
             x, y = data[:, header.index(name)], data[:, header.index(comp + ".gpsPosY")]
             ax.plot(x, y, ".", ms=3, alpha=0.35, label=f"{comp} (measured)", zorder=2)
+            drawn = True
+        elif name.endswith(".odomX") and name[:-5] + "odomY" in header:
+            comp = name[: -len(".odomX")]
+            x, y = data[:, header.index(name)], data[:, header.index(comp + ".odomY")]
+            ax.plot(x, y, "--", lw=1.2, label=f"{comp} (dead reckoning)", zorder=2)
             drawn = True
     if drawn:
         ax.set_aspect("equal", adjustable="datalim")

@@ -59,6 +59,18 @@ class GpsTrack:
     lost_total: int = 0
 
 
+@dataclass(frozen=True)
+class LidarScan:
+    """A lidar's last published scan: where it stood, each beam's direction and range."""
+
+    mount: str
+    x: float
+    y: float
+    angles: tuple[float, ...]  # absolute, world frame
+    ranges: tuple[float, ...]
+    range_max: float
+
+
 @dataclass
 class LiveMetrics:
     """Quality of control over the frames seen so far (the trace-based metrics come at the end)."""
@@ -91,6 +103,7 @@ class Frame:
     phase_count: int
     phase_text: str
     duration: float
+    scans: list[LidarScan] = field(default_factory=list)
 
 
 def static_obstacles(physics: dict[str, Any]) -> list[Obstacle]:
@@ -148,6 +161,7 @@ class Scene:
             if leaf.template.name() == "GPS":
                 source = leaf.inputs.get("posX", "")
                 self.gps.append(GpsTrack(path, source.rpartition(".")[0] or None))
+        self.lidars = [p for p, leaf in sim.world.leaves.items() if leaf.template.name() == "Lidar"]
         self.metrics = LiveMetrics()
         self._last_fix: dict[str, tuple[float, float]] = {}
 
@@ -226,4 +240,20 @@ class Scene:
             phase_count=len(sim.phases),
             phase_text=describe_phase(sim),
             duration=float(sim.duration),
+            scans=self.scans(),
         )
+
+    def scans(self) -> list[LidarScan]:
+        """Each lidar's last published scan (none before its first)."""
+        out = []
+        for path in self.lidars:
+            comp = self.sim.components.get(path)
+            scan = getattr(comp, "scan", None)
+            if comp is None or scan is None:
+                continue
+            x, y, heading, ranges = scan
+            angles = (heading + comp.angles()).tolist()
+            out.append(
+                LidarScan(comp.mount, x, y, tuple(angles), tuple(ranges.tolist()), comp.p.range_max)
+            )
+        return out
