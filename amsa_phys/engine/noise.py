@@ -191,6 +191,21 @@ def quantise_many(value: np.ndarray, precision: np.ndarray) -> np.ndarray:
     return np.where(precision > 0, np.floor(value / safe + 0.5) * safe, value)
 
 
+def check_burst(burst_loss_pct: float, length: float) -> None:
+    """Refuse a burst share no chain with this mean length reaches.
+
+    Entering a burst has probability ``pi / ((1 - pi) L)`` per sample, at most 1: a share
+    ``pi`` needs bursts of at least ``pi / (1 - pi)`` samples on average.
+    """
+    pi = burst_loss_pct / 100.0
+    need = pi / (1.0 - pi)
+    if need > length:
+        raise ValueError(
+            f"burstLoss {burst_loss_pct:g} % needs burstLength >= {need:.3g} samples "
+            f"(got {length:g}): a burst cannot start more often than every sample"
+        )
+
+
 def burst_chance(burst_loss_pct: float, length: float) -> tuple[float, float]:
     """``(enter, leave)``: per-sample probabilities of entering and leaving a bad state."""
     pi = burst_loss_pct / 100.0

@@ -46,6 +46,11 @@ class GPS(Template):
     param_aliases: ClassVar[Mapping[str, str]] = {"noise": "stddev", "bias": "mean"}
 
     @classmethod
+    def check_params(cls, values: Mapping[str, Any]) -> None:
+        """A burst share the chain can reach: entering a burst has a probability <= 1."""
+        nz.check_burst(values["burstLoss"], values["burstLength"])
+
+    @classmethod
     def is_random(cls, values: Mapping[str, Any]) -> bool:
         """Noise, a random bias or any loss makes the fixes depend on the seed."""
         return nz.is_noisy(values) or values["lostDataGPS"] > 0 or values["burstLoss"] > 0
@@ -56,6 +61,7 @@ class GPS(Template):
         The first two are the streams the GPS has always used, so a noise-and-loss-only GPS
         draws exactly what it did before the biases and bursts existed.
         """
+        self.check_params(self.p.as_dict())
         white, loss, bias, burst = ctx.rng.spawn(4)
         self.turn_on = nz.TurnOn(bias, 2)
         self.gm_start = bias.standard_normal(2).tolist()
@@ -72,7 +78,8 @@ class GPS(Template):
         self._derive()
 
     def on_param_change(self, name: str, value: Any) -> None:
-        """Recompute what depends on the parameters."""
+        """Recompute what depends on the parameters (changed from code: check them too)."""
+        self.check_params(self.p.as_dict())
         self._derive()
 
     def _derive(self) -> None:
