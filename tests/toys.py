@@ -186,3 +186,37 @@ class Die(Template):
         if self.p.gain == 2:
             os._exit(9)
         return {"u": self.p.gain}
+
+
+class Scanner(Template):
+    """An array output of ``n`` numbers: k, k+1, ... at step k; ``shape``/``bad`` misbehave."""
+
+    kind = Kind.SENSOR
+    outputs = (Port("vals", 0.0, "n numbers", "", array=True, size="n"),)
+    params = (
+        Param("n", "int", "how many", 3, 1, 100),
+        Param("shape", "int", "publish this many instead (0: n)", 0, 0, 100),
+        Param("bad", "bool", "publish a NaN", False),
+    )
+
+    def initialize(self, ctx: Any) -> None:
+        self.k = 0
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        self.k += 1
+        vals = np.arange(self.p.shape or self.p.n, dtype=float) + self.k
+        if self.p.bad:
+            vals[1] = np.nan
+        return {"vals": vals}
+
+
+class Summer(Template):
+    """Sums an array input (an observer)."""
+
+    kind = Kind.OBSERVER
+    inputs = (Port("vals", 0.0, "numbers", "", array=True),)
+    outputs = (Port("total"), Port("count"))
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        LOG.append((self.path, t, {"vals": list(inp["vals"])}))
+        return {"total": float(np.sum(inp["vals"])), "count": len(inp["vals"])}

@@ -74,8 +74,12 @@ def describe_world(
             text = f"      {p.name} = {value!r}{unit}" + (f"  {rng}" if rng else "")
             lines.append(f"{text}  ({source})")
         for port, buf in leaf.inputs.items():
-            lines.append(f"      <- {port}: {buf}")
-        outs = ", ".join(p.name for p in t.outputs)
+            size = f" ({len(world.arrays[buf])} values)" if buf in world.arrays else ""
+            lines.append(f"      <- {port}: {buf}{size}")
+        outs = ", ".join(
+            f"{p.name}[{len(world.arrays[f'{path}.{p.name}'])}]" if p.array else p.name
+            for p in t.outputs
+        )
         lines.append(f"      -> {outs}")
     lines.append("execution order at a shared instant: " + " -> ".join(world.order))
     if world.schedule:

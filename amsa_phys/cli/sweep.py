@@ -25,6 +25,7 @@ from ..runs.sweep import (
     SweepPlan,
     check_axes,
     check_size,
+    deterministic_points,
     iter_dask,
     iter_local,
     parse_grid,
@@ -118,7 +119,7 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
         raise ConfigError(why, key="--metric")
     swept = [a.key for a in axes if a.key != "context"]
     swept += [k for sets in contexts.values() for k in sets]
-    return SweepPlan(
+    plan = SweepPlan(
         Path(args.scenario).resolve(),
         axes,
         seeds,
@@ -128,6 +129,26 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
         args.duration,
         inputs=tuple(input_files(scenario)),
         warnings=tuple(timeline_overlaps(swept, scenario, Fraction(str(end)))),
+    )
+    if seeds > 1:
+        warn_same_seeds(plan, scenario)
+    return plan
+
+
+def warn_same_seeds(plan: SweepPlan, scenario: Any) -> None:
+    """One line on stderr if, at some grid points, nothing random runs: their seeds are copies."""
+    same = deterministic_points(plan, scenario)
+    if not same:
+        return
+    total = 1
+    for a in plan.axes:
+        total *= len(a.values)
+    example = ", ".join(f"{k}={v}" for k, v in same[0])
+    print(
+        f"warning: nothing random at {len(same)} of {total} grid points (e.g. {example}: no "
+        f"sensor noise or loss, no random leader), so their {plan.seeds} seeds give identical "
+        "runs",
+        file=sys.stderr,
     )
 
 

@@ -25,28 +25,26 @@ def run(args: argparse.Namespace) -> int:
             known = "" if hint else f"; built-in: {', '.join(BUILTINS)}"
             raise ConfigError(f"{exc}{hint}{known}", key="templates") from None
         print(one_line(f"{t.name()} ({t.kind.value}): {t.describe()}"))
-        for port in t.inputs:
-            print(
-                one_line(
-                    f"    in  {port.name}"
-                    + (f" [{port.unit}]" if port.unit else "")
-                    + (f"  {port.description}" if port.description else "")
+        for direction, ports in (("in ", t.inputs), ("out", t.outputs)):
+            for port in ports:
+                # an array port: out ranges[beams] (one Data per element), in ranges[]
+                shape = f"[{port.size}]" if port.array else ""
+                print(
+                    one_line(
+                        f"    {direction} {port.name}{shape}"
+                        + (f" [{port.unit}]" if port.unit else "")
+                        + (f"  {port.description}" if port.description else "")
+                    )
                 )
-            )
-        for port in t.outputs:
-            print(
-                one_line(
-                    f"    out {port.name}"
-                    + (f" [{port.unit}]" if port.unit else "")
-                    + (f"  {port.description}" if port.description else "")
-                )
-            )
         for p in t.params:
             unit = f" {p.unit}" if p.unit else ""
             rng = f" {p.range_text()}" if p.range_text() else ""
+            aliases = t.aliases_of(p.name)
+            also = f" (also {', '.join(aliases)})" if aliases else ""
             print(
                 one_line(
-                    f"    param {p.name}: {p.type} = {p.default!r}{unit}{rng}  {p.description}"
+                    f"    param {p.name}{also}: {p.type} = {p.default!r}{unit}{rng}  "
+                    f"{p.description}"
                 )
             )
     return 0

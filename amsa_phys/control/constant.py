@@ -14,6 +14,7 @@ class ConstantPower(Template):
     """Publishes fixed left/right powers (change them with the timeline)."""
 
     kind = Kind.CONTROLLER
+    uses_random = False
     outputs = (
         Port("LeftPower", 0.0, "left power", "%"),
         Port("RightPower", 0.0, "right power", "%"),

@@ -39,6 +39,7 @@ class FollowerController(Template):
     """Proportional follower law: Kv on the distance error, Kw on the bearing error."""
 
     kind = Kind.CONTROLLER
+    uses_random = False
     inputs = (
         Port("xLeader", 0.0, "leader x (GPS)", "m"),
         Port("yLeader", 0.0, "leader y (GPS)", "m"),

@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from ..model.params import Param
 from ..model.template import Kind, Port, Template
 
 
@@ -19,6 +20,7 @@ class DistanceMonitor(Template):
     """
 
     kind = Kind.SENSOR
+    uses_random = False
     inputs = (Port("xLeader"), Port("yLeader"), Port("xFollower"), Port("yFollower"))
     outputs = (Port("distanceFollowerToLeader", 0.0, "true distance", "m"),)
 
@@ -38,3 +40,22 @@ class DistanceMonitor(Template):
         dx = inp["xLeader"] - inp["xFollower"]
         dy = inp["yLeader"] - inp["yFollower"]
         return {"distanceFollowerToLeader": np.hypot(dx, dy)}, None
+
+
+class GoalMonitor(Template):
+    """Distance from a rover's true position to a goal point: the quality signal of a mission."""
+
+    kind = Kind.OBSERVER
+    inputs = (Port("posX", 0.0, "true x", "m"), Port("posY", 0.0, "true y", "m"))
+    outputs = (Port("distanceToGoal", 0.0, "true distance to the goal", "m"),)
+    params = (
+        Param("goalX", "float", "goal x", 0.0, -1e5, 1e5, "m"),
+        Param("goalY", "float", "goal y", 0.0, -1e5, 1e5, "m"),
+    )
+    uses_random = False
+
+    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+        """The paper's doStep: one distance."""
+        return {
+            "distanceToGoal": math.hypot(self.p.goalX - inp["posX"], self.p.goalY - inp["posY"])
+        }

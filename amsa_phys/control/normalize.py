@@ -20,6 +20,7 @@ class NormalizePower(Template):
     """
 
     kind = Kind.ACTUATOR
+    uses_random = False
     inputs = (
         Port("powerL", 0.0, "requested left power", "%"),
         Port("powerR", 0.0, "requested right power", "%"),

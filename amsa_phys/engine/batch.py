@@ -87,7 +87,7 @@ def group_key(task: Any, freq: Fraction) -> tuple[Any, ...] | None:
     """What members of one group share; None for a leaf that is no copy of anything."""
     parent, _, name = task.path.rpartition(".")
     m = _COPY.match(parent)
-    if m is None or not hasattr(type(task.comp), "step_many"):
+    if m is None or not hasattr(type(task.comp), "step_many") or type(task.comp).has_arrays():
         return None
     return (m.group(1), name, type(task.comp), freq, tuple(sorted(p for p, _ in task.inputs)))
 

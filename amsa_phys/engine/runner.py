@@ -85,6 +85,9 @@ class _Task:
     period: int
     inputs: list[tuple[str, str]]
     targets: dict[str, str]  # output port -> buffer name ("Component.port")
+    #: array ports (a lidar's ranges): port -> element buffer names, in order
+    arrays_in: dict[str, list[str]] = field(default_factory=dict)
+    arrays_out: dict[str, list[str]] = field(default_factory=dict)
 
 
 @dataclass
@@ -257,18 +260,24 @@ class Simulation:
         g = self.grid
         self._tick_num, self._tick_den = g.tick.numerator, g.tick.denominator
         self._tasks = []
+        arrays = self.world.arrays
         for path in self.world.order:
             leaf = leaves[path]
             comp = self.components[path]
-            self._tasks.append(
-                _Task(
-                    path,
-                    comp,
-                    g.ticks(1 / leaf.freq),
-                    list(leaf.inputs.items()),
-                    {p.name: f"{path}.{p.name}" for p in leaf.template.outputs},
-                )
+            task = _Task(
+                path,
+                comp,
+                g.ticks(1 / leaf.freq),
+                list(leaf.inputs.items()),
+                {p.name: f"{path}.{p.name}" for p in leaf.template.outputs},
             )
+            for port in leaf.template.inputs:
+                if port.array and port.name in leaf.inputs:
+                    task.arrays_in[port.name] = arrays[leaf.inputs[port.name]]
+            for port in leaf.template.outputs:
+                if port.array:
+                    task.arrays_out[port.name] = arrays[f"{path}.{port.name}"]
+            self._tasks.append(task)
         self._log_period = g.ticks(1 / self.log_rate)
         hook_periods = [g.ticks(1 / r) for r, _, _ in self._hooks]
         all_periods = [t.period for t in self._tasks] + [self._log_period] + hook_periods
@@ -298,7 +307,9 @@ class Simulation:
         self._groups_of: dict[str, list[batch.Group]] = {}
         for inst, seq in zip(instants, planned, strict=True):
             inst.tasks = [
-                (self._step_group, item) if isinstance(item, batch.Group) else (self._step, item)
+                (self._step_group, item)
+                if isinstance(item, batch.Group)
+                else (self._step_arrays if item.arrays_in or item.arrays_out else self._step, item)
                 for item in seq
             ]
             for item in seq:
@@ -464,6 +475,61 @@ class Simulation:
                 values[targets[key]] = number
         except (KeyError, TypeError, ValueError, OverflowError, AttributeError):
             raise self._bad_output(task, out) from None
+
+    def _step_arrays(self, task: _Task, now: Fraction) -> None:
+        """:meth:`_step` for a leaf with array ports (a lidar and its readers).
+
+        An array input arrives as a float numpy array of its elements; an array output must
+        be a sequence of exactly its length, every element finite, and is published whole
+        (or not at all, if the key is missing). Kept apart so the scalar path stays lean.
+        """
+        values = self.values
+        arrays_in = task.arrays_in
+        inp: dict[str, Any] = {}
+        for port, buf in task.inputs:
+            names = arrays_in.get(port)
+            inp[port] = values[buf] if names is None else np.array([values[n] for n in names])
+        try:
+            out = task.comp.do_step(now, inp)
+        except RunFault:
+            raise
+        except Exception as exc:
+            raise RunFault(self._who(task.path), now, f"do_step raised {exc!r}") from exc
+        if not out:
+            return
+        scalars = {k: v for k, v in out.items() if k not in task.arrays_out}
+        writes: list[tuple[str, float]] = []
+        for key, value in out.items():
+            names = task.arrays_out.get(key)
+            if names is None:
+                continue
+            try:
+                arr = np.asarray(value, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise RunFault(
+                    self._who(task.path), now, f"output {key} is not numbers: {value!r}"
+                ) from None
+            if arr.shape != (len(names),):
+                raise RunFault(
+                    self._who(task.path),
+                    now,
+                    f"output {key} has shape {arr.shape}, expected ({len(names)},)",
+                )
+            bad = np.flatnonzero(~np.isfinite(arr))
+            if bad.size:
+                k = int(bad[0])
+                raise RunFault(self._who(task.path), now, f"output {key}[{k}] is {arr[k]}")
+            writes.extend(zip(names, arr.tolist(), strict=True))
+        targets = task.targets
+        try:
+            for key, value in scalars.items():
+                number = float(value)
+                if number - number != 0.0:  # inf or nan
+                    raise ValueError
+                writes.append((targets[key], number))
+        except (KeyError, TypeError, ValueError):
+            raise self._bad_output(task, scalars) from None
+        values.update(writes)
 
     def _step_group(self, group: batch.Group, now: Fraction) -> None:
         """Run a group of like components in one call (``engine/batch.py``)."""

@@ -47,11 +47,18 @@ class Change:
     leaf: str
     param: str
     value: Any
+    #: the parameter's name as the user wrote it, if an alias (``noise`` for ``stddev``)
+    written: str = field(default="", compare=False)
 
     @property
     def key(self) -> str:
-        """``Leaf.param`` as written in files."""
+        """``Leaf.param`` with the parameter's declared name (as resolved files write it)."""
         return f"{self.leaf}.{self.param}"
+
+    @property
+    def written_key(self) -> str:
+        """``Leaf.param`` as the user wrote it (where an error about it points)."""
+        return f"{self.leaf}.{self.written or self.param}"
 
 
 @dataclass
@@ -390,11 +397,11 @@ def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = 
 
     def error(entry: int | None, index: int, change: Change, message: str) -> ConfigError:
         if doc is None:
-            return ConfigError(message, key=change.key)
+            return ConfigError(message, key=change.written_key)
         if entry is None and in_file is not None and index >= in_file:
-            return ConfigError(message, key=f"--set {change.key}")
+            return ConfigError(message, key=f"--set {change.written_key}")
         where = ("set",) if entry is None else ("timeline", entry, "set")
-        return doc.error((*where, change.key), message)
+        return doc.error((*where, change.written_key), message)
 
     steps: list[tuple[bool, int | None, list[Change]]] = []  # (at t = 0, entry, changes)
     for i, phase in enumerate(scenario.phases):
@@ -476,12 +483,20 @@ def resolve_change(key: str, value: Any, world: WorldSpec) -> Change:
     leaf = world.leaves.get(leaf_path)
     if leaf is None:
         raise ValueError(f"unknown component {leaf_path!r}" + did_you_mean(leaf_path, world.leaves))
-    names = [p.name for p in leaf.template.params]
-    if param not in names:
+    template = leaf.template
+    names = [p.name for p in template.params]
+    name = template.canonical(param)
+    if name not in names:
         raise ValueError(
-            f"unknown parameter of template {leaf.template.name()}" + did_you_mean(param, names)
+            f"unknown parameter of template {template.name()}"
+            + did_you_mean(param, [*names, *template.param_aliases])
         )
-    return Change(leaf_path, param, leaf.template.param(param).coerce(value))
+    if name in template.size_params():
+        raise ValueError(
+            f"{param} sets how many Data buffers the component has; set it in the world"
+        )
+    written = param if param != name else ""
+    return Change(leaf_path, name, template.param(name).coerce(value), written)
 
 
 def parse_override(text: str, world: WorldSpec) -> Change | None:

@@ -33,12 +33,24 @@ class Kind(str, Enum):
 
 @dataclass(frozen=True)
 class Port:
-    """An input or output of a template. ``initial`` is what an unwritten buffer holds."""
+    """An input or output of a template. ``initial`` is what an unwritten buffer holds.
+
+    An *array* port carries several numbers at once (a lidar's ranges). Data buffers hold one
+    number each, so an array output ``ranges`` of a leaf ``Lidar`` is the buffers
+    ``Lidar.ranges[0]`` .. ``Lidar.ranges[n-1]``, ``n`` being the value of the integer
+    parameter named by ``size`` (fixed by the world: it sizes the buffers). An array input
+    links to a whole array output (``ranges: Lidar.ranges``) and receives a numpy array of
+    its length; ``do_step`` returns an array output as a sequence of that length. The trace
+    thus has one column per element, and a scalar input or a quality signal may read one
+    element (``Lidar.ranges[3]``).
+    """
 
     name: str
     initial: float = 0.0
     description: str = ""
     unit: str = ""
+    array: bool = False
+    size: str = ""  # array outputs: the int parameter giving the length
 
 
 class ParamValues:
@@ -94,10 +106,24 @@ class Template:
     #: Parameters read only by ``initialize`` (a body's mass, an initial pose): changing them
     #: once the run has started is refused, so the window's parameter panel does not offer it.
     fixed_once_running: ClassVar[frozenset[str]] = frozenset()
+    #: Other names a parameter answers to (``{"noise": "stddev"}``): the paper's names kept
+    #: working beside the Gazebo/SDFormat ones. Files, ``--set`` and sweeps may use either;
+    #: resolved scenarios write the canonical name.
+    param_aliases: ClassVar[Mapping[str, str]] = {}
+    #: Whether a leaf of this template may draw random numbers that reach its outputs; a
+    #: template whose randomness depends on its values overrides :meth:`is_random`. The
+    #: default (True) is the safe answer for user templates: ``sweep`` warns that seeds
+    #: cannot differ only when every leaf says False.
+    uses_random: ClassVar[bool] = True
 
     def __init__(self, path: str, params: Mapping[str, Any]) -> None:
         self.path = path
-        self.p = ParamValues(params)
+        # direct construction (tests, scripts) may give a few values, by any alias: the rest
+        # are the declared defaults
+        aliases = self.param_aliases
+        values = {p.name: p.default for p in self.params}
+        values.update({aliases.get(k, k): v for k, v in params.items()})
+        self.p = ParamValues(values)
 
     @classmethod
     def name(cls) -> str:
@@ -112,11 +138,37 @@ class Template:
 
     @classmethod
     def param(cls, name: str) -> Any:
-        """The declared parameter called ``name`` (KeyError if none)."""
+        """The declared parameter called ``name`` or aliased by it (KeyError if none)."""
+        name = cls.param_aliases.get(name, name)
         for p in cls.params:
             if p.name == name:
                 return p
         raise KeyError(name)
+
+    @classmethod
+    def canonical(cls, name: str) -> str:
+        """The declared name of parameter ``name`` (``noise`` -> ``stddev``)."""
+        return cls.param_aliases.get(name, name)
+
+    @classmethod
+    def aliases_of(cls, name: str) -> list[str]:
+        """The other names of declared parameter ``name``."""
+        return [a for a, target in cls.param_aliases.items() if target == name]
+
+    @classmethod
+    def size_params(cls) -> frozenset[str]:
+        """Parameters that size array outputs: fixed by the world, like a body's mass."""
+        return frozenset(p.size for p in cls.outputs if p.array and p.size)
+
+    @classmethod
+    def has_arrays(cls) -> bool:
+        """Whether any port is an array (the engine steps such leaves on a general path)."""
+        return any(p.array for p in (*cls.inputs, *cls.outputs))
+
+    @classmethod
+    def is_random(cls, values: Mapping[str, Any]) -> bool:
+        """Whether a leaf with parameter ``values`` has random outputs (see ``uses_random``)."""
+        return cls.uses_random
 
     def initialize(self, ctx: InitContext) -> None:
         """The paper's ``initialize()``: called once, before the first step."""
@@ -146,6 +198,11 @@ BUILTINS: dict[str, str] = {
     "controlledRobot": "amsa_phys.physics.templates:ControlledRobot",
     "GPS": "amsa_phys.sensors.gps:GPS",
     "Compass": "amsa_phys.sensors.compass:Compass",
+    "IMU": "amsa_phys.sensors.imu:IMU",
+    "WheelOdometry": "amsa_phys.sensors.odometry:WheelOdometry",
+    "Lidar": "amsa_phys.physics.lidar:Lidar",
+    "GoalMonitor": "amsa_phys.control.monitor:GoalMonitor",
+    "ReactiveAvoider": "amsa_phys.control.avoider:ReactiveAvoider",
     "DistanceMonitor": "amsa_phys.control.monitor:DistanceMonitor",
     "NormalizePower": "amsa_phys.control.normalize:NormalizePower",
     "FollowerController": "amsa_phys.control.follower:FollowerController",

@@ -91,6 +91,8 @@ class WorldSpec:
     schedule: list[str]
     #: Named Data (``data:``, the AMSA model's Data names): name -> buffer ``Component.output``
     data_names: dict[str, str] = field(default_factory=dict)
+    #: array outputs: ``Lidar.ranges`` -> its element buffers ``Lidar.ranges[0]``, ...
+    arrays: dict[str, list[str]] = field(default_factory=dict)
 
     def error(self, keypath: KeyPath, message: str) -> ConfigError:
         """A ConfigError at ``keypath`` (relative to this world) in its source file."""
@@ -173,14 +175,20 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
     walk(data["components"], root, ("components",))
 
     buffers: dict[str, BufferSpec] = {}
+    arrays: dict[str, list[str]] = {}
     for leaf in leaves.values():
         for port in leaf.template.outputs:
             name = f"{leaf.path}.{port.name}"
-            buffers[name] = BufferSpec(name, leaf.path, port.name, port.initial)
+            if port.array:
+                arrays[name] = [f"{name}[{i}]" for i in range(array_size(leaf, port))]
+                for element in arrays[name]:
+                    buffers[element] = BufferSpec(element, leaf.path, port.name, port.initial)
+            else:
+                buffers[name] = BufferSpec(name, leaf.path, port.name, port.initial)
 
     for path, (inputs, kp) in raw_inputs.items():
         leaf = leaves[path]
-        _link_inputs(leaf, inputs, kp, leaves, err)
+        _link_inputs(leaf, inputs, kp, leaves, err, arrays)
 
     schedule = list(data.get("schedule", []))
     for i, item in enumerate(schedule):
@@ -209,6 +217,7 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
         order=order,
         schedule=schedule,
         data_names=names,
+        arrays=arrays,
     )
 
 
@@ -316,6 +325,11 @@ def _data_buffer(
     return buffer
 
 
+def array_size(leaf: LeafSpec, port: Any) -> int:
+    """The length of array output ``port`` of ``leaf`` (its size parameter's value)."""
+    return int(leaf.params[port.size]) if port.size else 1
+
+
 @dataclass(frozen=True)
 class Copy:
     """Copy ``i`` (from 1) of a Composite with ``count: N`` — the platoon's cars.
@@ -362,19 +376,27 @@ def _build_leaf(
     freq = Fraction(str(body.get("freq", DEFAULT_FREQ_HZ)))
     declared = {p.name: p for p in template.params}
     params = {name: p.default for name, p in declared.items()}
-    for name, value in body.get("params", {}).items():
+    given: dict[str, str] = {}
+    for written, value in body.get("params", {}).items():
+        name = template.canonical(written)
         if name not in declared:
             raise err(
-                (*kp, "params", name),
+                (*kp, "params", written),
                 f"unknown parameter of template {template.name()}"
-                + did_you_mean(str(name), declared),
+                + did_you_mean(str(written), [*declared, *template.param_aliases]),
             )
+        if name in given:
+            raise err(
+                (*kp, "params", written),
+                f"{written} and {given[name]} name the same parameter ({name})",
+            )
+        given[name] = written
         if copy is not None:
             value = copy.value(value)
         try:
             params[name] = declared[name].coerce(value)
         except ValueError as exc:
-            raise err((*kp, "params", name), str(exc)) from None
+            raise err((*kp, "params", written), str(exc)) from None
     try:
         template.check_params(params)
     except ValueError as exc:
@@ -391,7 +413,12 @@ def _build_leaf(
 
 
 def _link_inputs(
-    leaf: LeafSpec, inputs: dict[str, str], kp: KeyPath, leaves: dict[str, LeafSpec], err: Any
+    leaf: LeafSpec,
+    inputs: dict[str, str],
+    kp: KeyPath,
+    leaves: dict[str, LeafSpec],
+    err: Any,
+    arrays: dict[str, list[str]],
 ) -> None:
     ports = {p.name: p for p in leaf.template.inputs}
     for port_name, ref in inputs.items():
@@ -408,12 +435,27 @@ def _link_inputs(
         producer = _resolve_scope(leaf.path, comp, leaves)
         if producer is None:
             raise err(where, f"unknown component {comp!r}" + did_you_mean(comp, leaves))
-        outs = [p.name for p in producer.template.outputs]
-        if output not in outs:
+        outs = {p.name: p for p in producer.template.outputs}
+        base, bracket, _ = output.partition("[")
+        if base not in outs or (bracket and not outs[base].array):
             raise err(
                 where,
                 f"component {producer.path} ({producer.template.name()}) has no "
                 f"output {output!r}" + did_you_mean(output, outs),
+            )
+        source = f"{producer.path}.{output}"
+        if outs[base].array and bracket:  # one element of an array: a scalar
+            n = len(arrays[f"{producer.path}.{base}"])
+            if source not in arrays[f"{producer.path}.{base}"]:
+                raise err(where, f"{output!r} is not an element of {base} (0..{n - 1})")
+        is_array = outs[base].array and not bracket
+        if is_array != ports[port_name].array:
+            want = "an array" if ports[port_name].array else "one number"
+            got = f"the array {base}" if is_array else f"the number {output}"
+            raise err(
+                where,
+                f"input {port_name} of {leaf.template.name()} takes {want}, "
+                f"{producer.path}.{output} is {got}",
             )
         if not link_allowed(producer.kind, leaf.kind):
             raise err(
@@ -422,7 +464,7 @@ def _link_inputs(
                 f"({leaf.kind.value}) is not allowed: a {producer.kind.value} may feed "
                 f"only {allowed_text(producer.kind)}",
             )
-        leaf.inputs[port_name] = f"{producer.path}.{output}"
+        leaf.inputs[port_name] = source
     missing = [
         p for p in ports if p not in leaf.inputs and not getattr(ports[p], "optional", False)
     ]

@@ -49,7 +49,10 @@ def edges(world: WorldSpec) -> list[tuple[str, str, str]]:
     for path, leaf in world.leaves.items():
         for port, buffer in leaf.inputs.items():
             producer, _, output = buffer.rpartition(".")
-            out.append((producer, path, output if output == port else f"{output}→{port}"))
+            label = output if output == port else f"{output}→{port}"
+            if buffer in world.arrays:  # an array link: say how many Data it carries
+                label += f" [{len(world.arrays[buffer])}]"
+            out.append((producer, path, label))
     return out
 
 

@@ -1,4 +1,5 @@
-"""Trajectories: the arena, every true path and GPS track, and where collisions happened.
+"""Trajectories: the arena, every true path, GPS track and dead-reckoning (odometry) track,
+and where collisions happened.
 
 Colours match the window and the video (``amsa_phys/palette.py``: the leader orange, the
 follower blue). The static world — walls, obstacles — is drawn by one function,
@@ -139,6 +140,18 @@ def plot_trajectory(
             ax.plot([], [], "+", color=col, label=f"{comp} (measured)")
     if len(tracks) > 3:
         ax.plot([], [], "+", color="0.4", label="GPS fixes (the rover's colour)")
+    odometry = [c[: -len(".odomX")] for c in header if c.endswith(".odomX")]
+    for comp in [c for c in odometry if f"{c}.odomY" in header]:
+        xy = view(data[:, [header.index(f"{comp}.odomX"), header.index(f"{comp}.odomY")]])
+        ax.plot(
+            xy[:, 0],
+            xy[:, 1],
+            "--",
+            lw=1.2,
+            color="0.3",
+            zorder=2,
+            label=f"{comp} (dead reckoning)",
+        )
     hits = _collision_points(metrics, data, header, paths)
     if hits.size:
         p = view(hits)

@@ -198,6 +198,47 @@ class SweepPlan:
         return out
 
 
+#: ``is_random`` of templates whose module another branch owns (physics/templates.py): a
+#: free robot draws from the seed only in behaviour 4 (random), a controlled robot never.
+_ROBOT_RANDOMNESS: dict[str, Any] = {
+    "freeRobot": lambda values: values["behavior"] == 4,
+    "controlledRobot": lambda values: False,
+}
+
+
+def _leaf_is_random(template: Any, values: dict[str, Any]) -> bool:
+    rule = _ROBOT_RANDOMNESS.get(template.name())
+    return bool(rule(values) if rule is not None else template.is_random(values))
+
+
+def deterministic_points(plan: SweepPlan, scenario: Scenario) -> list[tuple[tuple[str, Any], ...]]:
+    """The grid points at which nothing random runs, so every seed gives the same run.
+
+    A leaf is random if its template says so for its values (``Template.is_random``: sensor
+    noise, losses, a random leader; user templates are assumed random) in any phase: the
+    world's values, the scenario's ``set`` and the point's, then each timeline entry.
+    """
+    world = scenario.world
+    out = []
+    for combo in itertools.product(*[a.values for a in plan.axes]):
+        point = tuple((a.key, v) for a, v in zip(plan.axes, combo, strict=True))
+        changes = list(scenario.phases[0].changes)
+        for key, value in point:
+            sets = plan.contexts[value].items() if key == "context" else [(key, value)]
+            changes += [resolve_change(k, v, world) for k, v in sets]
+        values = {path: dict(leaf.params) for path, leaf in world.leaves.items()}
+        random = False
+        for phase_changes in [changes, *(ph.changes for ph in scenario.phases[1:])]:
+            for c in phase_changes:
+                values[c.leaf][c.param] = c.value
+            if any(_leaf_is_random(world.leaves[path].template, v) for path, v in values.items()):
+                random = True
+                break
+        if not random:
+            out.append(point)
+    return out
+
+
 def derive_seed(base: int, index: int) -> int:
     """The seed of seed index ``index`` under scenario seed ``base``."""
     if index == 0:

@@ -1,44 +1,182 @@
-"""Compass: a noisy, biased heading sensor."""
+"""Compass: heading with a heading-dependent deviation, Gazebo noise and biases, losses."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
 from fractions import Fraction
-from typing import Any
+from typing import Any, ClassVar
 
+import numpy as np
+
+from ..engine import noise as nz
 from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
 
+_TWO_PI = 2 * math.pi
+
+
+def deviation(heading: Any, b: Any, c: Any, d: Any, e: Any) -> Any:
+    """The compass deviation δ(θ) = B sin θ + C cos θ + D sin 2θ + E cos 2θ (rad).
+
+    The navigator's classic deviation formula (its constant term A is the noise ``mean``):
+    B and C, one cycle per turn, come from hard iron — a magnetic field fixed to the vehicle
+    adds to the Earth's and pulls the needle towards one side of the hull; D and E, two
+    cycles per turn, from soft iron, which distorts the Earth's field with the heading.
+    Works on floats and numpy arrays alike.
+    """
+    if isinstance(heading, np.ndarray):
+        return (
+            b * np.sin(heading)
+            + c * np.cos(heading)
+            + d * np.sin(2 * heading)
+            + e * np.cos(2 * heading)
+        )
+    return (
+        b * math.sin(heading)
+        + c * math.cos(heading)
+        + d * math.sin(2 * heading)
+        + e * math.cos(2 * heading)
+    )
+
 
 class Compass(Template):
-    """Measured heading = true heading + bias + Gaussian noise, wrapped to [-pi, pi)."""
+    """Heading + deviation(heading) + Gazebo noise and biases, in [-pi, pi); may lose samples.
+
+    The measured heading is ``θ + δ(θ) + mean + turn-on bias + Gauss–Markov bias + white
+    noise`` (``sensors/noise.py``; δ: :func:`deviation`), wrapped to [-π, π), rounded to
+    ``precision``. A lost sample (``lostData`` %) publishes nothing. White noise comes from
+    the component's stream as before; biases and losses from two streams split off it.
+    """
 
     kind = Kind.SENSOR
     inputs = (Port("heading", 0.0, "true heading", "rad"),)
     outputs = (Port("compassHeading", 0.0, "measured heading in [-pi, pi)", "rad"),)
     params = (
-        Param("noise", "float", "standard deviation of the error", 0.0, 0.0, math.pi, "rad"),
-        Param("bias", "float", "constant offset", 0.0, -math.pi, math.pi, "rad"),
+        *nz.noise_params("", "rad", "heading", math.pi),
+        Param(
+            "deviationB",
+            "float",
+            "hard-iron deviation: coefficient of sin θ",
+            0.0,
+            -0.5,
+            0.5,
+            "rad",
+        ),
+        Param(
+            "deviationC",
+            "float",
+            "hard-iron deviation: coefficient of cos θ",
+            0.0,
+            -0.5,
+            0.5,
+            "rad",
+        ),
+        Param(
+            "deviationD",
+            "float",
+            "soft-iron deviation: coefficient of sin 2θ",
+            0.0,
+            -0.5,
+            0.5,
+            "rad",
+        ),
+        Param(
+            "deviationE",
+            "float",
+            "soft-iron deviation: coefficient of cos 2θ",
+            0.0,
+            -0.5,
+            0.5,
+            "rad",
+        ),
+        Param("lostData", "float", "share of samples lost", 0.0, 0.0, 100.0, "%"),
     )
+    #: the paper's names: ``noise`` (standard deviation) and ``bias`` (constant offset)
+    param_aliases: ClassVar[Mapping[str, str]] = {"noise": "stddev", "bias": "mean"}
+
+    @classmethod
+    def is_random(cls, values: Mapping[str, Any]) -> bool:
+        """Noise, a random bias or losses make the headings depend on the seed."""
+        return nz.is_noisy(values) or values["lostData"] > 0
 
     def initialize(self, ctx: Any) -> None:
-        """Take this component's own random stream (drawn in blocks)."""
+        """White noise from this component's stream; biases and losses from two split off it."""
+        bias, loss = ctx.rng.spawn(2)
+        self.turn_on = nz.TurnOn(bias, 1)
+        self.gm_start = float(bias.standard_normal())
         self.noise = Drawn(ctx.rng.standard_normal)
+        self.draw_bias = Drawn(bias.standard_normal)
+        self.draw_loss = Drawn(loss.random)
+        self.b = 0.0  # dynamic bias
+        self.t_prev: float | None = None
+        self.lost = 0
+        self._gm: tuple[tuple[float, float, float], tuple[float, float]] = ((-1, -1, -1), (1, 0))
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
-        """The paper's doStep: one heading sample."""
-        value = inp["heading"] + self.p.bias + self.p.noise * self.noise()
-        return {"compassHeading": (value + math.pi) % (2 * math.pi) - math.pi}
+        """The paper's doStep: one heading sample, or none if lost."""
+        w = self.noise()
+        g = self.draw_bias()
+        u = self.draw_loss()
+        p = self.p
+        now = float(t)
+        sigma = p.dynamic_bias_stddev
+        tau = p.dynamic_bias_correlation_time
+        if self.t_prev is None:
+            self.b = nz.stationary_std(sigma, tau) * self.gm_start
+        elif sigma > 0 or self.b != 0.0:
+            key = (sigma, tau, now - self.t_prev)
+            if key != self._gm[0]:
+                self._gm = (key, nz.gauss_markov(*key))
+            phi, q = self._gm[1]
+            self.b = phi * self.b + q * g
+        self.t_prev = now
+        if u * 100.0 < p.lostData:
+            self.lost += 1
+            return {}
+        h = inp["heading"]
+        value = h + p.mean + self.b + p.stddev * w
+        value += self.turn_on.value(0, p.bias_mean, p.bias_stddev)
+        if p.deviationB or p.deviationC or p.deviationD or p.deviationE:
+            value += deviation(h, p.deviationB, p.deviationC, p.deviationD, p.deviationE)
+        value = (value + math.pi) % _TWO_PI - math.pi
+        if p.precision > 0:
+            value = (nz.quantise(value, p.precision) + math.pi) % _TWO_PI - math.pi
+        return {"compassHeading": value}
 
     @classmethod
     def step_many(
         cls, comps: Sequence[Any], t: Fraction, inp: Mapping[str, Any], p: Any, state: Any
-    ) -> tuple[Mapping[str, Any], None]:
-        """``do_step`` for many copies at once, each from its own stream (``engine/batch.py``)."""
+    ) -> tuple[Mapping[str, Any], np.ndarray]:
+        """``do_step`` for many copies at once, each from its own streams (``engine/batch.py``)."""
         if "noise" not in state:
             state["noise"] = DrawnMany([c.noise for c in comps])
-        draws = state["noise"]()
-        value = inp["heading"] + p.bias + p.noise * draws
-        return {"compassHeading": (value + math.pi) % (2 * math.pi) - math.pi}, None
+            state["bias"] = DrawnMany([c.draw_bias for c in comps])
+            state["loss"] = DrawnMany([c.draw_loss for c in comps])
+            state["gm_start"] = np.array([c.gm_start for c in comps])
+            state["on_z"] = np.array([c.turn_on.z[0] for c in comps])
+            state["on_sign"] = np.array([c.turn_on.sign[0] for c in comps])
+            state["t_prev"] = None
+        w = state["noise"]()
+        g = state["bias"]()
+        u = state["loss"]()
+        now = float(t)
+        sigma, tau = p.dynamic_bias_stddev, p.dynamic_bias_correlation_time
+        if state["t_prev"] is None:
+            state["b"] = np.where(tau > 0, sigma * np.sqrt(tau / 2), 0.0) * state["gm_start"]
+        else:
+            phi, q = nz.gauss_markov_many(sigma, tau, now - state["t_prev"])
+            state["b"] = phi * state["b"] + q * g
+        state["t_prev"] = now
+        lost = u * 100.0 < p.lostData
+        for k in np.flatnonzero(lost).tolist():
+            comps[k].lost += 1
+        h = inp["heading"]
+        value = h + p.mean + state["b"] + p.stddev * w
+        value += state["on_sign"] * (p.bias_mean + p.bias_stddev * state["on_z"])
+        value += deviation(h, p.deviationB, p.deviationC, p.deviationD, p.deviationE)
+        value = (value + math.pi) % _TWO_PI - math.pi
+        q = nz.quantise_many(value, p.precision)
+        value = np.where(p.precision > 0, (q + math.pi) % _TWO_PI - math.pi, value)
+        return {"compassHeading": value}, ~lost

@@ -1,59 +1,145 @@
-"""GPS: a noisy, biased, lossy position sensor."""
+"""GPS: a position fix with per-axis noise and biases, latency, quantisation and losses."""
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Mapping, Sequence
 from fractions import Fraction
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
+from ..engine import noise as nz
 from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
 
+#: Slack when comparing float times (steps fall on a rational grid; floats of it round).
+_EPS = 1e-9
+
 
 class GPS(Template):
-    """Noisy, biased, lossy position fix; a lost sample publishes nothing.
+    """Position fix: Gazebo noise per axis, Gauss-Markov bias, latency, independent and burst loss.
 
-    Consumers then keep the stale fix, which is what the paper's degraded context (10 % of the
-    leader's fixes lost) relies on. The loss draw and the noise draws happen at every step,
-    lost or not, from two separate streams, so a sweep over ``lostDataGPS`` keeps the same
-    noise sequence.
+    Each axis gets ``mean`` + a turn-on bias + a Gauss–Markov dynamic bias + white noise
+    (``sensors/noise.py``), then is rounded to ``precision``. With ``latency`` L the fix
+    published at a step is the one *measured* at the newest earlier step at least L before:
+    the receiver measures at its own rate, so the lag is L rounded up to a whole number of
+    periods (L = 0.3 s at 4 Hz publishes the position of 0.5 s before); until such a fix
+    exists, nothing is published. A lost sample (``lostDataGPS`` %, independent, or a
+    Gilbert–Elliott burst: ``burstLoss`` %, mean ``burstLength`` samples) publishes nothing,
+    so consumers keep the stale fix — the paper's degraded context relies on it. Every step
+    draws from four separate streams (white noise, loss, bias, burst), lost or not, so a
+    sweep over any loss parameter keeps the same noise sequence.
     """
 
     kind = Kind.SENSOR
     inputs = (Port("posX", 0.0, "true x", "m"), Port("posY", 0.0, "true y", "m"))
     outputs = (Port("gpsPosX", 0.0, "measured x", "m"), Port("gpsPosY", 0.0, "measured y", "m"))
     params = (
-        Param(
-            "noise", "float", "standard deviation of the error on each axis", 0.0, 0.0, 100.0, "m"
-        ),
-        Param("bias", "float", "constant offset added to both axes", 0.0, -100.0, 100.0, "m"),
-        Param("lostDataGPS", "int", "share of samples lost", 0, 0, 100, "%"),
+        *nz.noise_params("", "m", "position on each axis", 100.0),
+        Param("latency", "float", "age of a fix when published", 0.0, 0.0, 10.0, "s"),
+        Param("lostDataGPS", "int", "share of samples lost independently", 0, 0, 100, "%"),
+        *nz.burst_params("samples"),
     )
+    #: the paper's names: ``noise`` (standard deviation) and ``bias`` (offset on both axes)
+    param_aliases: ClassVar[Mapping[str, str]] = {"noise": "stddev", "bias": "mean"}
+
+    @classmethod
+    def check_params(cls, values: Mapping[str, Any]) -> None:
+        """A burst share the chain can reach: entering a burst has a probability <= 1."""
+        nz.check_burst(values["burstLoss"], values["burstLength"])
+
+    @classmethod
+    def is_random(cls, values: Mapping[str, Any]) -> bool:
+        """Noise, a random bias or any loss makes the fixes depend on the seed."""
+        return nz.is_noisy(values) or values["lostDataGPS"] > 0 or values["burstLoss"] > 0
 
     def initialize(self, ctx: Any) -> None:
-        """Split this component's random stream: one for the noise, one for the losses."""
-        noise_rng, loss_rng = ctx.rng.spawn(2)
-        self.noise = Drawn(noise_rng.standard_normal)
-        self.draw_loss = Drawn(loss_rng.random)
+        """Split this component's stream: white noise, loss, bias and burst draws.
+
+        The first two are the streams the GPS has always used, so a noise-and-loss-only GPS
+        draws exactly what it did before the biases and bursts existed.
+        """
+        self.check_params(self.p.as_dict())
+        white, loss, bias, burst = ctx.rng.spawn(4)
+        self.turn_on = nz.TurnOn(bias, 2)
+        self.gm_start = bias.standard_normal(2).tolist()
+        self.noise = Drawn(white.standard_normal)
+        self.draw_loss = Drawn(loss.random)
+        self.draw_bias = Drawn(bias.standard_normal)
+        self.draw_burst = Drawn(burst.random)
         self.lost = 0  # samples lost so far: the renderer marks them
+        self.bx = self.by = 0.0  # dynamic biases
+        self.t_prev: float | None = None
+        self.bad = False  # Gilbert-Elliott state
+        self.history: deque[tuple[float, float, float]] = deque()
+        self._gm: tuple[tuple[float, float, float], tuple[float, float]] = ((-1, -1, -1), (1, 0))
+        self._derive()
+
+    def on_param_change(self, name: str, value: Any) -> None:
+        """Recompute what depends on the parameters (changed from code: check them too)."""
+        self.check_params(self.p.as_dict())
+        self._derive()
+
+    def _derive(self) -> None:
+        p = self.p
+        self.on_x = self.turn_on.value(0, p.bias_mean, p.bias_stddev)
+        self.on_y = self.turn_on.value(1, p.bias_mean, p.bias_stddev)
+        self.enter, self.leave = nz.burst_chance(p.burstLoss, p.burstLength)
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
-        """The paper's doStep: sample the position, or lose the sample."""
+        """The paper's doStep: measure the position, publish a (late) fix or lose it."""
         ex = self.noise()
         ey = self.noise()
-        lost = self.draw_loss() * 100.0 < self.p.lostDataGPS
+        gx = self.draw_bias()
+        gy = self.draw_bias()
+        u_loss = self.draw_loss()
+        u_burst = self.draw_burst()
+        p = self.p
+        now = float(t)
+        sigma = p.dynamic_bias_stddev
+        tau = p.dynamic_bias_correlation_time
+        first = self.t_prev is None
+        if first:
+            s0 = nz.stationary_std(sigma, tau)
+            self.bx, self.by = s0 * self.gm_start[0], s0 * self.gm_start[1]
+            # the burst chain starts from its stationary distribution
+            self.bad = u_burst * 100.0 < p.burstLoss
+        elif sigma > 0 or self.bx != 0.0 or self.by != 0.0:
+            key = (sigma, tau, now - self.t_prev)
+            if key != self._gm[0]:
+                self._gm = (key, nz.gauss_markov(*key))
+            phi, q = self._gm[1]
+            self.bx = phi * self.bx + q * gx
+            self.by = phi * self.by + q * gy
+        self.t_prev = now
+        x = inp["posX"] + p.mean + self.on_x + self.bx + p.stddev * ex
+        y = inp["posY"] + p.mean + self.on_y + self.by + p.stddev * ey
+        if p.precision > 0:
+            x = nz.quantise(x, p.precision)
+            y = nz.quantise(y, p.precision)
+        if not first:
+            self.bad = (u_burst >= self.leave) if self.bad else (u_burst < self.enter)
+        lost = self.bad or u_loss * 100.0 < p.lostDataGPS
+        if p.latency > 0 or self.history:
+            x, y, ready = self._delay(now, x, y, p.latency)
+            if not ready:
+                return {}
         if lost:
             self.lost += 1
             return {}
-        noise = self.p.noise
-        bias = self.p.bias
-        return {
-            "gpsPosX": inp["posX"] + bias + noise * ex,
-            "gpsPosY": inp["posY"] + bias + noise * ey,
-        }
+        return {"gpsPosX": x, "gpsPosY": y}
+
+    def _delay(self, now: float, x: float, y: float, latency: float) -> tuple[float, float, bool]:
+        """The newest fix measured at least ``latency`` ago (and whether there is one)."""
+        hist = self.history
+        hist.append((now, x, y))
+        due = now - latency + _EPS
+        while len(hist) > 1 and hist[1][0] <= due:
+            hist.popleft()
+        t0, x0, y0 = hist[0]
+        return x0, y0, t0 <= due
 
     @classmethod
     def step_many(
@@ -61,19 +147,82 @@ class GPS(Template):
     ) -> tuple[Mapping[str, Any], np.ndarray]:
         """``do_step`` for many copies at once (``engine/batch.py``).
 
-        Each copy draws from its own streams in the scalar order (x noise, y noise, loss);
-        the lost copies publish nothing (the mask returned).
+        Each copy draws from its own streams in the scalar order and follows the scalar
+        arithmetic (the same formulas on arrays); lost or not-yet-due copies publish
+        nothing (the mask returned).
         """
         if "noise" not in state:
             state["noise"] = DrawnMany([c.noise for c in comps])
             state["loss"] = DrawnMany([c.draw_loss for c in comps])
+            state["bias"] = DrawnMany([c.draw_bias for c in comps])
+            state["burst"] = DrawnMany([c.draw_burst for c in comps])
+            state["gm_start"] = np.array([c.gm_start for c in comps]).T
+            state["on_z"] = np.array([c.turn_on.z for c in comps]).T
+            state["on_sign"] = np.array([c.turn_on.sign for c in comps]).T
+            state["bad"] = np.zeros(len(comps), dtype=bool)
+            state["history"] = deque()
+            state["t_prev"] = None
         ex = state["noise"]()
         ey = state["noise"]()
-        lost = state["loss"]() * 100.0 < p.lostDataGPS
+        gx = state["bias"]()
+        gy = state["bias"]()
+        u_loss = state["loss"]()
+        u_burst = state["burst"]()
+        now = float(t)
+        sigma, tau = p.dynamic_bias_stddev, p.dynamic_bias_correlation_time
+        first = state["t_prev"] is None
+        if first:
+            s0 = np.where(tau > 0, sigma * np.sqrt(tau / 2), 0.0)
+            state["bx"], state["by"] = s0 * state["gm_start"][0], s0 * state["gm_start"][1]
+            state["bad"] = u_burst * 100.0 < p.burstLoss
+        else:
+            phi, q = nz.gauss_markov_many(sigma, tau, now - state["t_prev"])
+            state["bx"] = phi * state["bx"] + q * gx
+            state["by"] = phi * state["by"] + q * gy
+        state["t_prev"] = now
+        z, sign = state["on_z"], state["on_sign"]
+        on_x = sign[0] * (p.bias_mean + p.bias_stddev * z[0])
+        on_y = sign[1] * (p.bias_mean + p.bias_stddev * z[1])
+        x = inp["posX"] + p.mean + on_x + state["bx"] + p.stddev * ex
+        y = inp["posY"] + p.mean + on_y + state["by"] + p.stddev * ey
+        x = nz.quantise_many(x, p.precision)
+        y = nz.quantise_many(y, p.precision)
+        if not first:
+            pi = p.burstLoss / 100.0
+            leave = 1.0 / p.burstLength
+            enter = leave * pi / (1.0 - pi)
+            bad = state["bad"]
+            state["bad"] = np.where(bad, u_burst >= leave, u_burst < enter)
+        lost = state["bad"] | (u_loss * 100.0 < p.lostDataGPS)
+        published = ~lost
+        latency = p.latency
+        if latency.any() or state["history"]:
+            x, y, ready = _delay_many(state["history"], now, x, y, latency)
+            published &= ready
+            lost &= ready
         for k in np.flatnonzero(lost).tolist():
             comps[k].lost += 1
-        noise, bias = p.noise, p.bias
-        return {
-            "gpsPosX": inp["posX"] + bias + noise * ex,
-            "gpsPosY": inp["posY"] + bias + noise * ey,
-        }, ~lost
+        return {"gpsPosX": x, "gpsPosY": y}, published
+
+
+def _delay_many(
+    hist: deque[tuple[float, np.ndarray, np.ndarray]],
+    now: float,
+    x: np.ndarray,
+    y: np.ndarray,
+    latency: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each copy's newest fix measured at least its ``latency`` ago, and which copies have one."""
+    hist.append((now, x, y))
+    oldest_due = now - float(latency.max()) + _EPS
+    while len(hist) > 1 and hist[1][0] <= oldest_due:
+        hist.popleft()
+    times = np.array([h[0] for h in hist])
+    due = now - latency + _EPS
+    j = np.searchsorted(times, due, side="right") - 1
+    ready = j >= 0
+    j = np.maximum(j, 0)
+    xs = np.array([h[1] for h in hist])
+    ys = np.array([h[2] for h in hist])
+    cols = np.arange(len(x))
+    return xs[j, cols], ys[j, cols], ready

@@ -17,7 +17,7 @@ import numpy as np
 from ..palette import ALERT, rover_colour
 from .camera import Camera
 from .pg import font, pygame
-from .scene import Frame, RoverPose
+from .scene import Frame, LidarScan, RoverPose
 
 BACKGROUND = (246, 246, 241)
 GRID_MINOR = (228, 228, 221)
@@ -105,6 +105,8 @@ class Renderer:
                 px, py = camera.to_screen(x, y)
                 pygame.draw.line(surface, LOST, (px - 4, py - 4), (px + 4, py + 4), 2)
                 pygame.draw.line(surface, LOST, (px - 4, py + 4), (px + 4, py - 4), 2)
+        for scan in frame.scans:
+            self._scan(surface, camera, scan, colours.get(scan.mount, MUTED))
         self._distance_lines(surface, camera, frame)
         for r in frame.rovers:
             self._rover(surface, camera, r, colours[r.name])
@@ -150,6 +152,19 @@ class Renderer:
         else:
             width = max(2, round(2 * radius * camera.scale))
             pygame.draw.lines(surface, OBSTACLE, False, _screen(camera, points), width)
+
+    def _scan(
+        self, surface: pygame.Surface, camera: Camera, scan: LidarScan, colour: tuple[int, int, int]
+    ) -> None:
+        """Lidar beams: a faint ray to each echo and a dot where it hit; no echo, no ray."""
+        origin = camera.to_screen(scan.x, scan.y)
+        ray = _tint(colour, 0.6)
+        for a, r in zip(scan.angles, scan.ranges, strict=True):
+            if r >= scan.range_max:
+                continue
+            hit = camera.to_screen(scan.x + r * math.cos(a), scan.y + r * math.sin(a))
+            pygame.draw.line(surface, ray, origin, hit, 1)
+            pygame.draw.circle(surface, LOST, hit, 2)
 
     def _distance_lines(self, surface: pygame.Surface, camera: Camera, frame: Frame) -> None:
         q = frame.quality

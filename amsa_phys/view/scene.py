@@ -52,6 +52,18 @@ class GpsTrack:
     lost_total: int = 0
 
 
+@dataclass(frozen=True)
+class LidarScan:
+    """A lidar's last published scan: where it stood, each beam's direction and range."""
+
+    mount: str
+    x: float
+    y: float
+    angles: tuple[float, ...]  # absolute, world frame
+    ranges: tuple[float, ...]
+    range_max: float
+
+
 @dataclass
 class LiveMetrics:
     """Quality of control over the logged instants so far: ``metrics.json``'s samples."""
@@ -84,6 +96,7 @@ class Frame:
     phase_count: int
     phase_text: str
     duration: float
+    scans: list[LidarScan] = field(default_factory=list)
 
 
 def describe_phase(sim: Simulation) -> str:
@@ -123,6 +136,7 @@ class Scene:
             if leaf.template.name() == "GPS":
                 source = leaf.inputs.get("posX", "")
                 self.gps.append(GpsTrack(path, source.rpartition(".")[0] or None))
+        self.lidars = [p for p, leaf in sim.world.leaves.items() if leaf.template.name() == "Lidar"]
         self.metrics = LiveMetrics()
         self._last_fix: dict[str, tuple[float, float]] = {}
         # rovers in declaration order: the i-th has the i-th colour, as in the plots
@@ -216,4 +230,20 @@ class Scene:
             phase_count=len(sim.phases),
             phase_text=describe_phase(sim),
             duration=float(sim.duration),
+            scans=self.scans(),
         )
+
+    def scans(self) -> list[LidarScan]:
+        """Each lidar's last published scan (none before its first)."""
+        out = []
+        for path in self.lidars:
+            comp = self.sim.components.get(path)
+            scan = getattr(comp, "scan", None)
+            if comp is None or scan is None:
+                continue
+            x, y, heading, ranges = scan
+            angles = (heading + comp.angles()).tolist()
+            out.append(
+                LidarScan(comp.mount, x, y, tuple(angles), tuple(ranges.tolist()), comp.p.range_max)
+            )
+        return out

@@ -99,13 +99,25 @@ def test_imported_model_runs_like_the_projects_world(
         f"world: {ROOT / 'worlds' / 'mde_challenge.yaml'}\n{common}"
         "set: {Leader.behavior: 4, MyFollowerController.Kv: 0.35}\n"
     )
+    # the sensors' noise model is amsa-phys's own (the 2019 model's GPS has only lostDataGPS):
+    # the world ships realistic noise, which a scenario of the imported model supplies too
+    project, model = load_world(ROOT / "worlds" / "mde_challenge.yaml"), load_world(imported)
+    noise = {
+        f"{path}.{name}": value
+        for path in ("LeaderGPS", "FollowerGPS", "FollowerCompass")
+        for name, value in project.leaves[path].params.items()
+        if value != model.leaves[path].params.get(name) and name != "lostDataGPS"
+    }
+    assert "LeaderGPS.stddev" in noise
     theirs = tmp_path / "theirs.yaml"
     theirs.write_text(
         f"world: {imported}\n{common}"
         "set: {Leader.behavior: 4, MyFollowerController.Kv: 0.35,\n"
         # the values the original model leaves empty
         "      Leader.x: 15.0, MyFollowerController.Kw: 0.04, MyNormalizePower.motorCoef: 100,\n"
-        "      MyNormalizePower.freq: 4, MyDistanceMonitor.freq: 4, Leader.freq: 10}\n"
+        "      MyNormalizePower.freq: 4, MyDistanceMonitor.freq: 4, Leader.freq: 10,\n"
+        + "".join(f"      {k}: {v!r},\n" for k, v in noise.items())
+        + "}\n"
     )
     traces = []
     for name, scenario in (("a", ours), ("b", theirs)):

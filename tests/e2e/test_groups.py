@@ -30,9 +30,38 @@ def platoon(tmp_path: Path, **car_edits: Any) -> Path:
     data = yaml.safe_load((ROOT / "worlds" / "platoon.yaml").read_text())
     car = data["components"]["Car"]
     car["count"] = CARS
-    car["components"]["Gps"]["params"] = {"noise": 0.3, "lostDataGPS": 20}
-    car["components"]["AheadGps"]["params"] = {"noise": 0.3, "lostDataGPS": 10}
-    car["components"]["Compass"]["params"] = {"noise": 0.01}
+    # every GPS and compass feature on, in both the paper's names and Gazebo's
+    car["components"]["Gps"]["params"] = {
+        "noise": 0.3,
+        "lostDataGPS": 20,
+        "bias_mean": 0.2,
+        "bias_stddev": 0.1,
+        "dynamic_bias_stddev": 0.05,
+        "dynamic_bias_correlation_time": 20.0,
+        "precision": 0.01,
+        "latency": 0.3,
+        "burstLoss": 10.0,
+        "burstLength": 3.0,
+    }
+    car["components"]["AheadGps"]["params"] = {
+        "stddev": 0.3,
+        "bias": 0.1,
+        "lostDataGPS": 10,
+        "dynamic_bias_stddev": 0.02,  # correlation time 0: a random walk
+        "burstLoss": 5.0,
+        "latency": 0.5,
+    }
+    car["components"]["Compass"]["params"] = {
+        "noise": 0.01,
+        "deviationB": 0.02,
+        "deviationE": 0.01,
+        "bias_mean": 0.01,
+        "bias_stddev": 0.01,
+        "dynamic_bias_stddev": 0.002,
+        "dynamic_bias_correlation_time": 30.0,
+        "precision": 0.0017,
+        "lostData": 5.0,
+    }
     for leaf, edit in car_edits.items():
         car["components"][leaf].update(edit)
     (tmp_path / "w.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
@@ -41,7 +70,8 @@ def platoon(tmp_path: Path, **car_edits: Any) -> Path:
         "world: w.yaml\nduration: 40\nseed: 5\n"
         "timeline:\n"
         "  - {at: 10, set: {Car7.Pilot.Kv: 0.05, Car3.Drive.motorCoef: 70}}\n"
-        "  - {at: 20.25, set: {Car9.Gps.lostDataGPS: 90}}\n"
+        "  - {at: 20.25, set: {Car9.Gps.lostDataGPS: 90, Car4.Gps.latency: 1.0,\n"
+        "                      Car5.Compass.deviationB: 0.05, Car6.AheadGps.burstLength: 8}}\n"
     )
     return scen
 
