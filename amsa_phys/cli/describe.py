@@ -31,8 +31,8 @@ def describe_world(world: WorldSpec) -> list[str]:
             lines.append(f"      {p.name} = {value!r}{unit}" + (f"  {rng}" if rng else ""))
         for port, buf in leaf.inputs.items():
             lines.append(f"      <- {port}: {buf}")
-        outs = ", ".join(p.name for p in t.outputs)
-        lines.append(f"      -> {outs}")
+        if t.outputs:  # a terrain zone publishes nothing
+            lines.append("      -> " + ", ".join(p.name for p in t.outputs))
     lines.append("execution order at a shared instant: " + " -> ".join(world.order))
     if world.schedule:
         lines.append("explicit schedule: " + ", ".join(world.schedule))

@@ -127,6 +127,23 @@ class Terrain:
         return z.friction, z.rolling_resistance
 
 
+#: Zone colours (RGB): soft ground and slippery ground.
+MUD = (150, 110, 60)
+ICE = (120, 175, 225)
+
+
+def zone_colours(
+    friction: float, rolling_resistance: float, background: tuple[int, int, int]
+) -> tuple[tuple[int, int, int], tuple[int, int, int]]:
+    """Fill and edge colour of a zone, one definition for the window, video and plots: blue
+    if slippery (friction < 0.2), else brown, the fill (blended into ``background``) darker
+    the more the ground resists rolling (Crr 0 .. 0.3)."""
+    base = ICE if friction < 0.2 else MUD
+    strength = 0.25 if friction < 0.2 else 0.2 + 0.4 * min(1.0, rolling_resistance / 0.3)
+    fill = tuple(int(b + (c - b) * strength) for b, c in zip(background, base, strict=True))
+    return fill, base  # type: ignore[return-value]
+
+
 def polygon_area(points: Sequence[Sequence[float]]) -> float:
     """Signed area (shoelace): positive when counter-clockwise."""
     total = 0.0

@@ -12,12 +12,15 @@ import matplotlib.pyplot as plt
 
 from .distance import read_trace
 from .save import save_png
+from .zones import draw_zones, zones_of_run
 
 
 def plot_trajectory(trace: Path, metrics: dict[str, Any], out: Path) -> Path:
     """Draw the paths in ``trace`` into ``out`` (equal axes, start and end marked)."""
     header, data = read_trace(trace)
     fig, ax = plt.subplots(figsize=(7, 6), dpi=100)
+    zones = zones_of_run(trace.parent / "scenario.yaml")  # terrain, from the run's own file
+    draw_zones(ax, zones)
     drawn = False
     for name in header:
         if name.endswith(".posX") and name[:-4] + "posY" in header:

@@ -48,6 +48,16 @@ class Obstacle:
     radius: float = 0.0
 
 
+@dataclass(frozen=True)
+class ZoneView:
+    """A friction zone as drawn: its polygon (world metres) and current ground values."""
+
+    name: str
+    polygon: tuple[tuple[float, float], ...]
+    friction: float
+    rolling_resistance: float
+
+
 @dataclass
 class GpsTrack:
     """A GPS sensor's recent fixes and the true positions where fixes were lost."""
@@ -91,6 +101,8 @@ class Frame:
     phase_count: int
     phase_text: str
     duration: float
+    #: terrain zones, bottom first (their values now: a timeline change shows)
+    zones: list[ZoneView] = field(default_factory=list)
 
 
 def static_obstacles(physics: dict[str, Any]) -> list[Obstacle]:
@@ -153,6 +165,16 @@ class Scene:
 
     def _physics(self) -> Any:
         return self.sim.shared.get("physics")
+
+    def zones(self) -> list[ZoneView]:
+        """The world's friction zones with their current values (empty without physics)."""
+        physics = self._physics()
+        if physics is None:
+            return []
+        return [
+            ZoneView(z.name, z.polygon, z.friction, z.rolling_resistance)
+            for z in physics.terrain.zones
+        ]
 
     def rovers(self) -> list[RoverPose]:
         """Every rover's current pose (empty for a world without physics)."""
@@ -226,4 +248,5 @@ class Scene:
             phase_count=len(sim.phases),
             phase_text=describe_phase(sim),
             duration=float(sim.duration),
+            zones=self.zones(),
         )
