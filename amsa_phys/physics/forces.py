@@ -76,6 +76,8 @@ class Folded(NamedTuple):
     dt_m: float  # dt / m
     m_dt: float  # m / dt
     sphi: float  # turn-slip stiffness times speed per wheel: (3 pi/16) a^2 N / c_x
+    ky_dt_m: float  # ky dt / m
+    neg_m_dt: float  # -m / dt
 
 
 def fold(rover: DiffDriveRover, dt: float) -> Folded:
@@ -100,6 +102,8 @@ def fold(rover: DiffDriveRover, dt: float) -> Folded:
         dt_m=dt / rover.mass,
         m_dt=rover.mass / dt,
         sphi=TORSION * w.patch_radius_m**2 * kx,
+        ky_dt_m=w.load_n / w.slip_lat * dt / rover.mass,
+        neg_m_dt=-rover.mass / dt,
     )
 
 
@@ -229,16 +233,18 @@ class FewRovers:
             mw,
             bb,
             bbe,
-            _e,
+            e,
             e2,
             kx,
-            ky,
+            _ky,
             h,
             turn_k,
             dt_i,
             dt_m,
-            m_dt,
+            _m_dt,
             sphi,
+            ky_dt_m,
+            neg_m_dt,
             gnd,
             sc,
         ) in self._plan:
@@ -262,27 +268,51 @@ class FewRovers:
             kr = kx * ivr
             f0l = kp * r.drive_l
             f0r = kp * r.drive_r
-            al = (mw * ul + f0l - (rl if ul > 0.0 else -rl if ul < 0.0 else 0.0)) * bb
-            ar = (mw * ur + f0r - (rr if ur > 0.0 else -rr if ur < 0.0 else 0.0)) * bb
-            gl = 1.0 + kl * bbe
-            gr = 1.0 + kr * bbe
-            cl = kl * e2
-            cr = kr * e2
-            bl = kl * (al - vl)
-            br = kr * (ar - vr)
-            det = gl * gr - cl * cr
-            fxl = (bl * gr - cl * br) / det
-            fxr = (br * gl - cr * bl) / det
-            upl = al - bb * fxl
-            upr = ar - bb * fxr
-            fml = f0l - c * upl
-            fmr = f0r - c * upr
-            if not (
-                upl * ul > 0.0 and upr * ur > 0.0 and -fmax <= fml <= fmax and -fmax <= fmr <= fmax
-            ):
-                fxl, upl, fxr, upr = wheel_pair(
-                    (ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc
-                )
+            if ul == 0.0 and ur == 0.0:
+                # a parked rover (wheel.held): the tyres hold the body against still rims; the
+                # rims stay still if their resistance holds them against motor and tyre
+                gl = 1.0 + kl * e
+                gr = 1.0 + kr * e
+                cl = kl * e2
+                cr = kr * e2
+                bl = -kl * vl
+                br = -kr * vr
+                det = gl * gr - cl * cr
+                fxl = (bl * gr - cl * br) / det
+                fxr = (br * gl - cr * bl) / det
+                nl = (f0l if -fmax <= f0l <= fmax else (fmax if f0l > 0 else -fmax)) - fxl
+                nr = (f0r if -fmax <= f0r <= fmax else (fmax if f0r > 0 else -fmax)) - fxr
+                if -rl <= nl <= rl and -rr <= nr <= rr:
+                    upl = upr = 0.0
+                else:
+                    fxl, upl, fxr, upr = wheel_pair(
+                        (ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc
+                    )
+            else:
+                al = (mw * ul + f0l - (rl if ul > 0.0 else -rl if ul < 0.0 else 0.0)) * bb
+                ar = (mw * ur + f0r - (rr if ur > 0.0 else -rr if ur < 0.0 else 0.0)) * bb
+                gl = 1.0 + kl * bbe
+                gr = 1.0 + kr * bbe
+                cl = kl * e2
+                cr = kr * e2
+                bl = kl * (al - vl)
+                br = kr * (ar - vr)
+                det = gl * gr - cl * cr
+                fxl = (bl * gr - cl * br) / det
+                fxr = (br * gl - cr * bl) / det
+                upl = al - bb * fxl
+                upr = ar - bb * fxr
+                fml = f0l - c * upl
+                fmr = f0r - c * upr
+                if not (
+                    upl * ul > 0.0
+                    and upr * ur > 0.0
+                    and -fmax <= fml <= fmax
+                    and -fmax <= fmr <= fmax
+                ):
+                    fxl, upl, fxr, upr = wheel_pair(
+                        (ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc
+                    )
             # scrub: the patches' turn-slip moment, implicit in the yaw rate, capped
             isum = ivl + ivr
             torque = (fxr - fxl) * h
@@ -303,8 +333,8 @@ class FewRovers:
             fx = fxl + fxr
             a = fx * dt_m
             side = (vy + a * sm) * cos(end) - (vx + a * cm) * sin(end)
-            kd = ky * isum * dt_m
-            f_lat = -m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
+            kd = ky_dt_m * isum
+            f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
             fyl = f_lat * ivl / isum
             fyr = f_lat - fyl
             # friction ellipse per wheel; a saturated tyre's rim is re-solved with that force

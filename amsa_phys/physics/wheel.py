@@ -288,6 +288,27 @@ def joint(
     return fxl, al - bbl * fxl, fxr, ar - bbr * fxr
 
 
+def held(v: tuple[float, float], k: tuple[float, float], s: StepConstants) -> tuple[float, float]:
+    """The tyre forces against two rims held still: the joint backward Euler solve with the
+    rims fixed, ``F_i (1 + k_i E) + k_i E2 F_j = -k_i v_i`` (the body brought to rest)."""
+    (vl, vr), (kl, kr) = v, k
+    gl = 1.0 + kl * s.e
+    gr = 1.0 + kr * s.e
+    cl = kl * s.e2
+    cr = kr * s.e2
+    bl = -kl * vl
+    br = -kr * vr
+    det = gl * gr - cl * cr
+    return (bl * gr - cl * br) / det, (br * gl - cr * bl) / det
+
+
+def held_by(f0: float, fx: float, res: float, s: StepConstants) -> bool:
+    """Whether a rim at rest stays there: its motor at rest (current-limited) less the tyre
+    force is within its static resistance."""
+    f0_lim = f0 if -s.f_max <= f0 <= s.f_max else (s.f_max if f0 > 0 else -s.f_max)
+    return -res <= f0_lim - fx <= res
+
+
 def wheel_pair(
     u: tuple[float, float],
     v: tuple[float, float],
@@ -298,14 +319,20 @@ def wheel_pair(
 ) -> tuple[float, float, float, float]:
     """One step of both wheels, tyres gripping: ``(F_xL, u_L+, F_xR, u_R+)``.
 
-    While both rims turn on, :func:`joint` solves them together, a wheel whose motor the
-    solve finds beyond the current limit solved again as limited (at most twice: the usual
-    case — no limit — needs one solve; ``forces.py`` inlines it). A rim at rest or stopping
-    is a Coulomb stick-slip decision per wheel (:func:`rim_and_tyre`): the two wheels are then
-    coupled by three Jacobi passes (each wheel's hub moved by the other's last force), which
-    converge by a factor ``E2 / E`` <= 0.15 a pass and keep a rover at rest exactly at rest.
+    Both rims at rest stay at rest if each one's resistance can hold it against its motor and
+    the tyre force that keeps the rover still (:func:`held`; a parked rover costs one small
+    solve). While both rims turn on, :func:`joint` solves them together, a wheel whose motor
+    the solve finds beyond the current limit solved again as limited (at most twice: the
+    usual case — no limit — needs one solve; ``forces.py`` inlines it and the parked case).
+    Otherwise (a rim starting or stopping) each wheel is a Coulomb stick-slip decision
+    (:func:`rim_and_tyre`), the two coupled by three Jacobi passes (each wheel's hub moved by
+    the other's last force), which converge by a factor ``E2 / E`` <= 0.15 a pass.
     """
     ul, ur = u
+    if ul == 0.0 and ur == 0.0:  # both rims at rest: do they stay? (a parked rover)
+        fxl, fxr = held(v, k, s)
+        if held_by(f0[0], fxl, res[0], s) and held_by(f0[1], fxr, res[1], s):
+            return fxl, 0.0, fxr, 0.0
     fr = (
         res[0] if ul > 0.0 else -res[0] if ul < 0.0 else 0.0,
         res[1] if ur > 0.0 else -res[1] if ur < 0.0 else 0.0,
