@@ -18,16 +18,19 @@ from fractions import Fraction
 from pathlib import Path
 
 import pymunk
+import yaml
 
 from amsa_phys.engine.recorder import TraceWriter
 from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.physics.bodyio import BodyIO
-from amsa_phys.physics.forces import FewRovers, reference_forces
+from amsa_phys.physics.forces import FewRovers, ground_list, reference_forces
 from amsa_phys.physics.rover import DiffDriveRover
-from amsa_phys.physics.wheel import WheelModel
+from amsa_phys.physics.space import wheel_model
+from amsa_phys.physics.templates import rover_params
 
 ROOT = Path(__file__).resolve().parent.parent
+GROUND = (0.8, 0.02)  # the MDE world's (friction, rolling resistance)
 
 
 def engine_run(duration: float) -> float:
@@ -44,8 +47,9 @@ def engine_run(duration: float) -> float:
 def two_rovers() -> tuple[pymunk.Space, list[DiffDriveRover]]:
     """The two scenario1 rover bodies (default template parameters) driving in a space."""
     space = pymunk.Space()
-    load = 30.0 * 9.81 / 2
-    wheel = WheelModel(45.0, 5.5, 1.0, 0.8 * load, 0.02 * load)
+    world = yaml.safe_load((ROOT / "worlds" / "mde_challenge.yaml").read_text())
+    p = rover_params(**world["components"]["Follower"]["params"])
+    wheel = wheel_model(p, 9.81)
     rovers = [
         DiffDriveRover(
             space,
@@ -55,7 +59,6 @@ def two_rovers() -> tuple[pymunk.Space, list[DiffDriveRover]]:
             width_m=0.6,
             track_m=0.5,
             wheel=wheel,
-            lateral_limit_n=0.8 * 2 * load,
             x=x,
             y=0.0,
             heading=0.0,
@@ -75,7 +78,8 @@ def bare_loop(duration: float, rate: int = 100) -> float:
     """
     space, rovers = two_rovers()
     dt = 1.0 / rate
-    model = FewRovers(BodyIO(space, [r.body for r in rovers]), rovers, dt, (100.0, 1e4))
+    grounds = [ground_list(r, GROUND, GROUND) for r in rovers]
+    model = FewRovers(BodyIO(space, [r.body for r in rovers]), rovers, dt, (100.0, 1e4), grounds)
     io = model.io
     t0 = time.perf_counter()
     state = io.read()
@@ -138,9 +142,11 @@ def plain_loop(duration: float, rate: int = 100) -> float:
     space, rovers = two_rovers()
     dt = 1.0 / rate
     t0 = time.perf_counter()
+    rims = [(0.0, 0.0) for _ in rovers]
     for _ in range(int(duration * rate)):
-        for r in rovers:
-            fx, fy, torque = reference_forces(r, dt)
+        for k, r in enumerate(rovers):
+            fx, fy, torque, left, right = reference_forces(r, dt, rims[k], (GROUND, GROUND))
+            rims[k] = (left, right)
             r.body.force = (fx, fy)
             r.body.torque = torque
         space.step(dt)

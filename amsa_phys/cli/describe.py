@@ -76,11 +76,12 @@ def describe_world(
         for port, buf in leaf.inputs.items():
             size = f" ({len(world.arrays[buf])} values)" if buf in world.arrays else ""
             lines.append(f"      <- {port}: {buf}{size}")
-        outs = ", ".join(
-            f"{p.name}[{len(world.arrays[f'{path}.{p.name}'])}]" if p.array else p.name
-            for p in t.outputs
-        )
-        lines.append(f"      -> {outs}")
+        if t.outputs:  # a terrain zone publishes nothing
+            outs = ", ".join(
+                f"{p.name}[{len(world.arrays[f'{path}.{p.name}'])}]" if p.array else p.name
+                for p in t.outputs
+            )
+            lines.append(f"      -> {outs}")
     lines.append("execution order at a shared instant: " + " -> ".join(world.order))
     if world.schedule:
         lines.append("explicit schedule: " + ", ".join(world.schedule))

@@ -1,24 +1,35 @@
-"""Wheel and grip forces for a few rovers: plain floats, one batch read and write a step.
+"""Wheel, tyre and grip forces for a few rovers: plain floats, one batch read and write a step.
 
-The model per rover (``wheel.py`` states it per wheel, in closed form):
+The model per rover (``wheel.py`` states the wheel part and its closed forms):
 
-* each wheel's longitudinal force from its power and its ground speed
-  (``v_fwd -/+ w * track/2``): motor with back-EMF, capped by traction, minus rolling
-  resistance; their sum pushes along the heading, their difference turns the body;
-* lateral grip is a non-holonomic constraint: it must turn the velocity with the body
-  without doing work. pymunk integrates velocity first, then the angle with the new angular
-  velocity, so the heading at the end of the step is ``a + w' dt``. The grip impulse is
-  applied along the normal at the *mid-step* heading and sized so the end-of-step velocity
-  has no sideways component at the *end-of-step* heading: a pure rotation of the velocity
-  (speed kept exactly), capped by the tyres' grip (beyond it the rover skids). Cancelling
-  sideways velocity at the start-of-step heading instead bleeds speed in every turn, by an
-  amount that depends on the physics rate.
+* each wheel: motor and driver, spinning rim and tyre, solved together semi-implicitly
+  (:func:`wheel.rim_and_tyre`) from the wheel's rim speed and its hub's ground speed
+  ``v_fwd -/+ w * track/2``; the tyre forces' sum pushes along the heading, their difference
+  turns the body;
+* scrub: each tyre's contact patch resists the body's yaw with a turn-slip moment, linear in
+  ``w / max(|v|, v_min)`` (stiffness ``(3 pi/16) a^2 N / c_x`` per wheel) and saturating at
+  the patch's Coulomb torque ``(3 pi/16) a mu N``, integrated implicitly: when turning in place
+  the moment is the full patch torque; at speed it is small, so steering while driving is not
+  hampered;
+* lateral grip, a tyre with cornering compliance ``c_y`` on both wheels, integrated implicitly
+  (so at low speed it becomes the rigid non-holonomic constraint): it must turn the velocity
+  with the body without doing work. pymunk integrates velocity first, then the angle with the
+  new angular velocity, so the heading at the end of the step is ``a + w' dt``. The tyre
+  forces act along the *mid-step* heading and its normal (so the two stay orthogonal and the
+  friction ellipse bounds their sum), the grip sized from the sideways velocity at the
+  *end-of-step* heading (in the rigid limit: a pure rotation of the velocity, speed kept
+  exactly). Cancelling sideways velocity at the start-of-step heading instead bleeds speed in
+  every turn, by an amount that depends on the physics rate;
+* each wheel's longitudinal and lateral force are then projected onto its friction ellipse
+  (``|F| <= mu N``); a wheel whose tyre saturates has its rim re-solved with that force.
 
-Why inlined float arithmetic rather than calls into ``WheelModel``: at 100 Hz with two
-rovers every microsecond per step is 3 % of the run (issue 8), and a Python call costs about
-as much as the arithmetic it wraps. ``WheelModel.drive_force`` and ``wheel.lateral_force``
-stay the readable reference; the fidelity tests check this code against them, and
-``fleet.py`` (numpy, for many rovers) against this.
+Why inlined float arithmetic rather than calls into ``wheel.py``: at 100 Hz with two rovers
+every microsecond per step is 3 % of the run (issue 8), and a Python call costs about as much
+as the arithmetic it wraps. The usual path (tyres gripping, rims turning, no current limit)
+is inlined; the rare branches call ``wheel.py``'s functions. :func:`reference_forces` is the
+same model written plainly; the tests check this code against it, and ``fleet.py`` (numpy,
+for many rovers) against this. The arithmetic per rover is straight-line apart from those
+branches, so it can move to compiled code as it is.
 """
 
 from __future__ import annotations
@@ -31,50 +42,107 @@ import numpy as np
 
 from .bodyio import FORCE, STATE, BodyIO
 from .rover import DiffDriveRover
-from .wheel import lateral_force
+from .wheel import (
+    SLIP_SPEED_MIN,
+    TORSION,
+    friction_ellipse,
+    rim_alone,
+    slip_speed,
+    step_constants,
+    wheel_pair,
+)
+
+INV_SLIP_SPEED_MIN = 1.0 / SLIP_SPEED_MIN
+#: Grip below this (N) counts as this: a zero friction gives a zero force, not 1/0.
+GRIP_FLOOR_N = 1e-9
 
 
-class RoverConstants(NamedTuple):
-    """One rover's force-model constants, read once (and again after a parameter change)."""
+class Folded(NamedTuple):
+    """One rover's force-model constants, folded once (and again after a parameter change)."""
 
-    stall: float
-    free_speed: float
-    efficiency: float
-    traction: float
-    rolling: float
-    v_eps: float
+    kp: float  # motor force at rest per % of power (N/%)
+    c: float  # back-EMF: force lost per m/s of rim speed (N s/m)
+    f_max: float  # current limit at the ground (N)
+    mw: float  # rim mass / dt (kg/s)
+    big_b: float  # the rim's implicit compliance 1 / (mw + c)
+    big_be: float  # big_b + e
+    e: float  # contact-point velocity change per N over a step
+    e2: float  # the other wheel's contact point's
+    kx: float  # tyre longitudinal stiffness times speed: N / c_x (N)
+    ky: float  # lateral: N / c_y (N)
     half_track: float
-    mass: float
-    moment: float
-    lateral: float
+    turn_k: float  # dt^2 / I: heading change per N m
+    dt_i: float  # dt / I
+    dt_m: float  # dt / m
+    m_dt: float  # m / dt
+    sphi: float  # turn-slip stiffness times speed per wheel: (3 pi/16) a^2 N / c_x
+    ky_dt_m: float  # ky dt / m
+    neg_m_dt: float  # -m / dt
 
 
-def constants(rover: DiffDriveRover) -> RoverConstants:
-    """The constants the force model needs for ``rover``."""
+def fold(rover: DiffDriveRover, dt: float) -> Folded:
+    """The folded constants of ``rover`` for a step of ``dt``."""
     w = rover.wheel
-    return RoverConstants(
-        w.stall_force_n,
-        w.free_speed_mps,
-        w.efficiency,
-        w.traction_limit_n,
-        w.rolling_force_n,
-        w.v_eps_mps,
-        rover.half_track,
-        rover.mass,
-        rover.body.moment,
-        rover.lateral_limit,
+    s = step_constants(w, dt, rover.mass, rover.moment, rover.half_track)
+    kx = w.load_n / w.slip_long
+    return Folded(
+        kp=w.stall_force_n * w.efficiency * 0.01,
+        c=s.c,
+        f_max=s.f_max,
+        mw=s.mw,
+        big_b=s.big_b,
+        big_be=s.big_b + s.e,
+        e=s.e,
+        e2=s.e2,
+        kx=kx,
+        ky=w.load_n / w.slip_lat,
+        half_track=rover.half_track,
+        turn_k=dt * dt / rover.moment,
+        dt_i=dt / rover.moment,
+        dt_m=dt / rover.mass,
+        m_dt=rover.mass / dt,
+        sphi=TORSION * w.patch_radius_m**2 * kx,
+        ky_dt_m=w.load_n / w.slip_lat * dt / rover.mass,
+        neg_m_dt=-rover.mass / dt,
     )
+
+
+def ground_terms(rover: DiffDriveRover, mu: float, crr: float) -> tuple[float, float, float, float]:
+    """One wheel's ground-dependent terms: ``1/grip_x, 1/grip_y, resistance, scrub limit``."""
+    gx, gy = rover.wheel.grip(mu)
+    return (
+        1.0 / max(gx, GRIP_FLOOR_N),
+        1.0 / max(gy, GRIP_FLOOR_N),
+        rover.wheel.resistance(crr),
+        rover.wheel.scrub_limit(mu),
+    )
+
+
+def ground_list(
+    rover: DiffDriveRover, left: tuple[float, float], right: tuple[float, float]
+) -> list[float]:
+    """``[1/gx_L, 1/gy_L, R_L, 1/gx_R, 1/gy_R, R_R, scrub_L + scrub_R]`` for (mu, crr) pairs."""
+    il, jl, rl, tl = ground_terms(rover, *left)
+    ir, jr, rr, tr = ground_terms(rover, *right)
+    return [il, jl, rl, ir, jr, rr, tl + tr]
 
 
 class FewRovers:
     """The force model over plain floats for rovers at body ``rows`` of a batch state.
 
-    Constants are folded per rover once (``stall * efficiency``, ``dt / mass``, ...), so a
-    step is ~45 float operations and seven trig calls a rover.
+    Constants are folded per rover once; each step reads the rovers' state in one batch call,
+    computes forces (~90 float operations and seven trig calls a rover on the usual path),
+    writes them in one batch call and advances the rims (``rims``: left and right rim speed of
+    rover ``k`` at ``2k``, ``2k + 1``).
     """
 
     def __init__(
-        self, io: BodyIO, rovers: list[DiffDriveRover], dt: float, limits: tuple[float, float]
+        self,
+        io: BodyIO,
+        rovers: list[DiffDriveRover],
+        dt: float,
+        limits: tuple[float, float],
+        grounds: list[list[float]],
     ) -> None:
         self.io = io
         self.rovers = rovers
@@ -82,33 +150,29 @@ class FewRovers:
         self.dt = dt
         self.max_speed, self.extent = limits
         self._max2 = self.max_speed * self.max_speed * (1 - 1e-12)  # never above hypot's test
+        #: per rover, ground terms under each wheel (``ground_list``); terrain rewrites them
+        self.grounds = grounds
+        self.rims = [0.0] * (2 * len(rovers))
         self.refresh()
         self.state = io.read()
 
     def refresh(self) -> None:
         """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
-        dt = self.dt
         self._plan = []
-        for r, row in zip(self.rovers, self.rows, strict=True):
-            k = constants(r)
-            self._plan.append(
-                (
-                    r,
-                    row * STATE,
-                    row * FORCE,
-                    k.stall * k.efficiency * 0.01,  # force per % of power
-                    k.stall / k.free_speed,  # back-EMF: force lost per m/s
-                    k.traction,
-                    k.rolling,
-                    1.0 / k.v_eps,
-                    k.half_track,
-                    dt * dt / k.moment,  # heading change per N m of torque
-                    dt / k.mass,  # velocity change per N
-                    k.mass / dt,  # force that cancels 1 m/s in one step
-                    k.lateral,
-                )
-            )
+        for k, (r, row) in enumerate(zip(self.rovers, self.rows, strict=True)):
+            f = fold(r, self.dt)
+            s = step_constants(r.wheel, self.dt, r.mass, r.moment, r.half_track)
+            self._plan.append((r, row * STATE, row * FORCE, 2 * k, *f, self.grounds[k], s))
         self._offsets = [row * STATE for row in self.rows]
+
+    @property
+    def offsets(self) -> list[int]:
+        """Where each rover's six floats start in :attr:`state`."""
+        return self._offsets
+
+    def set_ground(self, k: int, terms: list[float]) -> None:
+        """Rover ``k``'s ground terms (``ground_list``) from the next step on."""
+        self.grounds[k][:] = terms
 
     def kinematics(self, k: int) -> list[float]:
         """Rover ``k``'s six state floats after the last step."""
@@ -119,6 +183,14 @@ class FewRovers:
         """(n, 6) state of the rovers at ``index`` after the last step."""
         rows = np.asarray(self.rows)[index]
         return np.array(self.state).reshape(-1, STATE)[rows]
+
+    def rim_speeds(self, k: int) -> tuple[float, float]:
+        """Rover ``k``'s left and right rim speeds (m/s) after the last step."""
+        return self.rims[2 * k], self.rims[2 * k + 1]
+
+    def rim_array(self, index: np.ndarray) -> np.ndarray:
+        """(n, 2) rim speeds of the rovers at ``index``."""
+        return np.array(self.rims).reshape(-1, 2)[index]
 
     def advance(self) -> tuple[int, str] | None:
         """One physics step: forces, pymunk's step, the new state; a safety violation or None."""
@@ -142,63 +214,147 @@ class FewRovers:
         return None
 
     def apply(self, state: Sequence[float]) -> None:
-        """Write each rover's ``fx, fy, torque`` for this step into the batch buffer."""
+        """Write each rover's ``fx, fy, torque`` for this step and advance the rims."""
         forces = self.io.forces
+        rims = self.rims
         dt = self.dt
+        vmin = SLIP_SPEED_MIN
+        ivmin = INV_SLIP_SPEED_MIN
         sin = math.sin
         cos = math.cos
-        for r, i, o, kp, kv, trac, roll, inv_veps, h, turn_k, dt_m, m_dt, lat in self._plan:
+        for (
+            r,
+            i,
+            o,
+            j,
+            kp,
+            c,
+            fmax,
+            mw,
+            bb,
+            bbe,
+            e,
+            e2,
+            kx,
+            _ky,
+            h,
+            turn_k,
+            dt_i,
+            dt_m,
+            _m_dt,
+            sphi,
+            ky_dt_m,
+            neg_m_dt,
+            gnd,
+            sc,
+        ) in self._plan:
             angle = state[i + 2]
             vx = state[i + 3]
             vy = state[i + 4]
             w = state[i + 5]
-            c = cos(angle)
-            s = sin(angle)
-            v_fwd = vx * c + vy * s
+            co = cos(angle)
+            si = sin(angle)
+            v_fwd = vx * co + vy * si
             wh = w * h
-            # left wheel: motor with back-EMF, capped by traction, minus rolling resistance
-            v = v_fwd - wh
-            motor = kp * r.power_l - kv * v
-            if motor > trac:
-                motor = trac
-            elif motor < -trac:
-                motor = -trac
-            ratio = v * inv_veps
-            if ratio > 1.0:
-                ratio = 1.0
-            elif ratio < -1.0:
-                ratio = -1.0
-            f_l = motor - roll * ratio
-            # right wheel
-            v = v_fwd + wh
-            motor = kp * r.power_r - kv * v
-            if motor > trac:
-                motor = trac
-            elif motor < -trac:
-                motor = -trac
-            ratio = v * inv_veps
-            if ratio > 1.0:
-                ratio = 1.0
-            elif ratio < -1.0:
-                ratio = -1.0
-            f_r = motor - roll * ratio
-            fx = f_l + f_r
-            torque = (f_r - f_l) * h
+            ixl, iyl, rl, ixr, iyr, rr, ts = gnd
+            # both rims and tyres, backward Euler (wheel.wheel_pair's usual branch)
+            ul = rims[j]
+            ur = rims[j + 1]
+            vl = v_fwd - wh
+            vr = v_fwd + wh
+            ivl = 1.0 / vl if vl > vmin else (-1.0 / vl if vl < -vmin else ivmin)
+            ivr = 1.0 / vr if vr > vmin else (-1.0 / vr if vr < -vmin else ivmin)
+            kl = kx * ivl
+            kr = kx * ivr
+            f0l = kp * r.drive_l
+            f0r = kp * r.drive_r
+            if ul == 0.0 and ur == 0.0:
+                # a parked rover (wheel.held): the tyres hold the body against still rims; the
+                # rims stay still if their resistance holds them against motor and tyre
+                gl = 1.0 + kl * e
+                gr = 1.0 + kr * e
+                cl = kl * e2
+                cr = kr * e2
+                bl = -kl * vl
+                br = -kr * vr
+                det = gl * gr - cl * cr
+                fxl = (bl * gr - cl * br) / det
+                fxr = (br * gl - cr * bl) / det
+                nl = (f0l if -fmax <= f0l <= fmax else (fmax if f0l > 0 else -fmax)) - fxl
+                nr = (f0r if -fmax <= f0r <= fmax else (fmax if f0r > 0 else -fmax)) - fxr
+                if -rl <= nl <= rl and -rr <= nr <= rr:
+                    upl = upr = 0.0
+                else:
+                    fxl, upl, fxr, upr = wheel_pair(
+                        (ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc
+                    )
+            else:
+                al = (mw * ul + f0l - (rl if ul > 0.0 else -rl if ul < 0.0 else 0.0)) * bb
+                ar = (mw * ur + f0r - (rr if ur > 0.0 else -rr if ur < 0.0 else 0.0)) * bb
+                gl = 1.0 + kl * bbe
+                gr = 1.0 + kr * bbe
+                cl = kl * e2
+                cr = kr * e2
+                bl = kl * (al - vl)
+                br = kr * (ar - vr)
+                det = gl * gr - cl * cr
+                fxl = (bl * gr - cl * br) / det
+                fxr = (br * gl - cr * bl) / det
+                upl = al - bb * fxl
+                upr = ar - bb * fxr
+                fml = f0l - c * upl
+                fmr = f0r - c * upr
+                if not (
+                    upl * ul > 0.0
+                    and upr * ur > 0.0
+                    and -fmax <= fml <= fmax
+                    and -fmax <= fmr <= fmax
+                ):
+                    fxl, upl, fxr, upr = wheel_pair(
+                        (ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc
+                    )
+            # scrub: the patches' turn-slip moment, implicit in the yaw rate, capped
+            isum = ivl + ivr
+            torque = (fxr - fxl) * h
+            kphi = sphi * isum
+            scrub = -kphi * (w + torque * dt_i) / (1.0 + kphi * dt_i)
+            if scrub > ts:
+                scrub = ts
+            elif scrub < -ts:
+                scrub = -ts
+            torque += scrub
             # predicted heading change over this step (semi-implicit Euler, as pymunk does)
             turn = w * dt + torque * turn_k
             end = angle + turn
             mid = angle + 0.5 * turn
+            cm = cos(mid)
+            sm = sin(mid)
             # velocity after the drive force alone, and its sideways part at the end heading
+            fx = fxl + fxr
             a = fx * dt_m
-            side = (vy + a * s) * cos(end) - (vx + a * c) * sin(end)
-            f_lat = -m_dt * side / cos(0.5 * turn)
-            if f_lat > lat:
-                f_lat = lat
-            elif f_lat < -lat:
-                f_lat = -lat
-            forces[o] = fx * c - f_lat * sin(mid)
-            forces[o + 1] = fx * s + f_lat * cos(mid)
+            side = (vy + a * sm) * cos(end) - (vx + a * cm) * sin(end)
+            kd = ky_dt_m * isum
+            f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
+            fyl = f_lat * ivl / isum
+            fyr = f_lat - fyl
+            # friction ellipse per wheel; a saturated tyre's rim is re-solved with that force
+            t1 = fxl * ixl
+            t2 = fyl * iyl
+            t3 = fxr * ixr
+            t4 = fyr * iyr
+            if t1 * t1 + t2 * t2 > 1.0 or t3 * t3 + t4 * t4 > 1.0:
+                fxl, fyl = friction_ellipse(fxl, fyl, ixl, iyl)
+                fxr, fyr = friction_ellipse(fxr, fyr, ixr, iyr)
+                upl = rim_alone(ul, f0l, rl, fxl, sc)
+                upr = rim_alone(ur, f0r, rr, fxr, sc)
+                fx = fxl + fxr
+                torque = (fxr - fxl) * h + scrub
+                f_lat = fyl + fyr
+            forces[o] = fx * cm - f_lat * sm
+            forces[o + 1] = fx * sm + f_lat * cm
             forces[o + 2] = torque
+            rims[j] = upl
+            rims[j + 1] = upr
 
     def first_violation(
         self, state: Sequence[float], max_speed: float, extent: float
@@ -214,29 +370,75 @@ class FewRovers:
         return None
 
 
-def reference_forces(rover: DiffDriveRover, dt: float) -> tuple[float, float, float]:
+def reference_forces(
+    rover: DiffDriveRover,
+    dt: float,
+    rims: tuple[float, float],
+    ground: tuple[tuple[float, float], tuple[float, float]],
+) -> tuple[float, float, float, float, float]:
     """The same model written plainly: pymunk properties, ``wheel.py``'s functions per wheel.
 
-    ``(fx, fy, torque)`` for ``rover`` this step. Slow (~5 µs a rover); it is what the fast
-    paths are tested against and the "plain loop" of the benchmarks.
+    ``rims`` are the left and right rim speeds now, ``ground`` the ``(mu, crr)`` under each
+    wheel. Returns ``(fx, fy, torque, u_left+, u_right+)``. Slow (~10 µs a rover); it is what
+    the fast paths are tested against and the "plain loop" of the benchmarks.
     """
     body = rover.body
+    wm = rover.wheel
+    s = step_constants(wm, dt, rover.mass, body.moment, rover.half_track)
     a = body.angle
-    c, s = math.cos(a), math.sin(a)
+    c, sn = math.cos(a), math.sin(a)
     vx, vy = body.velocity
     w = body.angular_velocity
-    v_fwd = vx * c + vy * s
-    f_l = rover.wheel.drive_force(rover.power_l, v_fwd - w * rover.half_track)
-    f_r = rover.wheel.drive_force(rover.power_r, v_fwd + w * rover.half_track)
-    fx = f_l + f_r
-    torque = (f_r - f_l) * rover.half_track
+    v_fwd = vx * c + vy * sn
+    kx = wm.load_n / wm.slip_long
+    vl, vr = v_fwd - w * rover.half_track, v_fwd + w * rover.half_track
+    sl, sr = slip_speed(vl), slip_speed(vr)
+    (mul, crl), (mur, crr) = ground
+    f0l, f0r = wm.drive_force(rover.power_l), wm.drive_force(rover.power_r)
+    rl, rr = wm.resistance(crl), wm.resistance(crr)
+    ul, ur = rims
+    fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kx / sl, kx / sr), s)
+    vl, vr = sl, sr
+    # scrub
+    torque = (fxr - fxl) * rover.half_track
+    kphi = TORSION * wm.patch_radius_m**2 * kx * (1 / vl + 1 / vr)
+    limit = wm.scrub_limit(mul) + wm.scrub_limit(mur)
+    scrub = -kphi * (w + torque * dt / body.moment) / (1 + kphi * dt / body.moment)
+    scrub = max(-limit, min(limit, scrub))
+    torque += scrub
+    # lateral grip at the end-of-step heading, applied along the mid-step normal
     turn = (w + torque / body.moment * dt) * dt
     end, mid = a + turn, a + 0.5 * turn
-    px = vx + fx * c / rover.mass * dt
-    py = vy + fx * s / rover.mass * dt
+    fx = fxl + fxr
+    px = vx + fx * math.cos(mid) / rover.mass * dt
+    py = vy + fx * math.sin(mid) / rover.mass * dt
     side = px * -math.sin(end) + py * math.cos(end)
-    f_lat = lateral_force(side / math.cos(0.5 * turn), rover.mass, dt, rover.lateral_limit)
-    return fx * c - f_lat * math.sin(mid), fx * s + f_lat * math.cos(mid), torque
+    ky = wm.load_n / wm.slip_lat * (1 / vl + 1 / vr)
+    kd = ky * dt / rover.mass
+    f_lat = -rover.mass / dt * side / math.cos(0.5 * turn) * kd / (1 + kd)
+    fyl = f_lat * (1 / vl) / (1 / vl + 1 / vr)
+    fyr = f_lat - fyl
+    # friction ellipses
+    gl, gr = wm.grip(mul), wm.grip(mur)
+    inv = [1 / max(g, GRIP_FLOOR_N) for g in (*gl, *gr)]
+    sat = (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1 or (fxr * inv[2]) ** 2 + (
+        fyr * inv[3]
+    ) ** 2 > 1
+    if sat:
+        fxl, fyl = friction_ellipse(fxl, fyl, inv[0], inv[1])
+        fxr, fyr = friction_ellipse(fxr, fyr, inv[2], inv[3])
+        upl = rim_alone(ul, f0l, rl, fxl, s)
+        upr = rim_alone(ur, f0r, rr, fxr, s)
+        fx = fxl + fxr
+        torque = (fxr - fxl) * rover.half_track + scrub
+        f_lat = fyl + fyr
+    return (
+        fx * math.cos(mid) - f_lat * math.sin(mid),
+        fx * math.sin(mid) + f_lat * math.cos(mid),
+        torque,
+        upl,
+        upr,
+    )
 
 
 def too_fast(speed: float, max_speed: float) -> str:

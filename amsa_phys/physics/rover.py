@@ -1,10 +1,14 @@
-"""A differential-drive rover: one pymunk rigid body driven by two wheel force points.
+"""A differential-drive rover: one pymunk rigid body driven by two wheels with spinning rims.
 
-The wheels sit on the axle through the centre of mass at ±track/2 (body-frame y). Each
-step ``forces.py`` (or ``fleet.py``, for many rovers) turns the body's velocity and the
-commanded powers into the body's total force and torque; pymunk integrates them and resolves
-collisions. Nothing teleports the body: sideways sliding is removed by a friction force, not
-by editing velocity.
+The wheels sit on the axle through the centre of mass at ±track/2 (body-frame y); a caster
+(not modelled: frictionless) carries the rest. Each step ``forces.py`` (or ``fleet.py``, for
+many rovers) turns the body's velocity, the rims' spin and the commanded powers into the
+body's total force and torque and the rims' new spin; pymunk integrates the body and resolves
+collisions. Nothing teleports the body: sideways sliding is removed by a tyre force, not by
+editing velocity.
+
+The collision shape is a box with rounded corners whose *outer* extent is length × width, so
+the rover drawn is the rover that touches.
 """
 
 from __future__ import annotations
@@ -16,6 +20,9 @@ from typing import Any
 import pymunk
 
 from .wheel import WheelModel
+
+#: Radius of the collision box's rounded corners (inside the rover's length × width).
+CORNER_RADIUS_M = 0.02
 
 
 class DiffDriveRover:
@@ -31,7 +38,6 @@ class DiffDriveRover:
         width_m: float,
         track_m: float,
         wheel: WheelModel,
-        lateral_limit_n: float,
         x: float,
         y: float,
         heading: float,
@@ -43,40 +49,59 @@ class DiffDriveRover:
         self.width = width_m
         self.half_track = track_m / 2
         self.wheel = wheel
-        self.lateral_limit = lateral_limit_n  # both wheels together
-        self.body = pymunk.Body(mass_kg, pymunk.moment_for_box(mass_kg, (length_m, width_m)))
+        self.moment = pymunk.moment_for_box(mass_kg, (length_m, width_m))
+        self.body = pymunk.Body(mass_kg, self.moment)
         self.body.position = (x, y)
         self.body.angle = heading
-        self.shape = pymunk.Poly.create_box(self.body, (length_m, width_m), radius=0.02)
+        rounding = min(CORNER_RADIUS_M, 0.25 * min(length_m, width_m))
+        self.shape = pymunk.Poly.create_box(
+            self.body, (length_m - 2 * rounding, width_m - 2 * rounding), radius=rounding
+        )
         self.shape.friction = 0.6
         self.shape.elasticity = 0.1
         self.shape.collision_type = collision_type
         space.add(self.body, self.shape)
+        #: commanded power (%), saturated at ±100 (what the renderer shows)
         self.power_l = 0.0
         self.power_r = 0.0
+        #: power the driver applies: 0 inside its deadband (what the force model reads)
+        self.drive_l = 0.0
+        self.drive_r = 0.0
         self._slot: tuple[Any, int] | None = None
         self._source: Callable[[], Sequence[float]] | None = None
+        self._rims: Callable[[], tuple[float, float]] | None = None
 
     def set_power(self, left_pct: float, right_pct: float) -> None:
-        """Command the wheels; the motor driver saturates at ±100 %."""
+        """Command the wheels; the motor driver saturates at ±100 % and has a deadband."""
         # chained comparisons, not min/max: this runs every control step of every rover
         self.power_l = left_pct if -100.0 <= left_pct <= 100.0 else _saturate(left_pct)
         self.power_r = right_pct if -100.0 <= right_pct <= 100.0 else _saturate(right_pct)
-        if self._slot is not None:
-            powers, i = self._slot
-            powers[0, i] = self.power_l
-            powers[1, i] = self.power_r
+        self.update_drive()
 
-    def attach_power_slot(self, powers: Any, index: int) -> None:
-        """Also write the commands into ``powers[:, index]`` (the batch path's arrays)."""
-        self._slot = (powers, index)
-        powers[0, index] = self.power_l
-        powers[1, index] = self.power_r
+    def update_drive(self) -> None:
+        """Apply the driver's deadband to the commands (again after the deadband changed)."""
+        band = self.wheel.deadband_pct
+        self.drive_l = self.power_l if not -band < self.power_l < band else 0.0
+        self.drive_r = self.power_r if not -band < self.power_r < band else 0.0
+        if self._slot is not None:
+            drives, i = self._slot
+            drives[0, i] = self.drive_l
+            drives[1, i] = self.drive_r
+
+    def attach_power_slot(self, drives: Any, index: int) -> None:
+        """Also write the applied powers into ``drives[:, index]`` (the batch path's arrays)."""
+        self._slot = (drives, index)
+        drives[0, index] = self.drive_l
+        drives[1, index] = self.drive_r
 
     # -- state, read by the templates ----------------------------------------------------
     def attach_state(self, source: Callable[[], Sequence[float]]) -> None:
         """Read :meth:`kinematics` from ``source`` (the world's last batch read) from now on."""
         self._source = source
+
+    def attach_rims(self, source: Callable[[], tuple[float, float]]) -> None:
+        """Read :meth:`wheel_speeds` from ``source`` (the force model's rim state) from now on."""
+        self._rims = source
 
     def kinematics(self) -> Sequence[float]:
         """``x, y, angle, vx, vy, w`` now (the same floats pymunk holds).
@@ -104,10 +129,12 @@ class DiffDriveRover:
         return vx * math.cos(a) + vy * math.sin(a)
 
     def wheel_speeds(self) -> tuple[float, float]:
-        """Ground speed of the left and right wheel contact points (m/s)."""
-        _, _, a, vx, vy, w = self.kinematics()
-        v = vx * math.cos(a) + vy * math.sin(a)
-        return v - w * self.half_track, v + w * self.half_track
+        """Left and right rim speeds ``omega * r`` (m/s): what a wheel encoder measures.
+
+        They differ from the ground speed of the hubs by the tyres' slip (a spinning wheel
+        reads fast, a locked one zero). Before the first physics step: 0.
+        """
+        return self._rims() if self._rims is not None else (0.0, 0.0)
 
 
 def _saturate(pct: float) -> float:

@@ -1,16 +1,26 @@
-"""The run's pymunk world: ground, walls, obstacles, rovers, collisions, the physics hook.
+"""The run's pymunk world: ground and terrain, walls, obstacles, rovers, collisions, the hook.
 
-One ``PhysicsWorld`` per run, created by the first robot template that asks for it
+One ``PhysicsWorld`` per run, created by the first robot or zone template that asks for it
 (``ctx.shared("physics", ...)``) and stepped by an engine hook at ``physics.rate`` Hz after
 the components due at the same instant. The Space is rebuilt for every run and uses one
 thread, so a run is deterministic. Top-down: no gravity in the plane; the ground acts only
-through the wheel model (normal load ``m g / 2`` per wheel).
+through the wheel model (normal load ``m g / 2`` per wheel), with the friction and rolling
+resistance of the terrain under each wheel (``terrain.py``).
+
+Contacts: pymunk lets shapes overlap by ``collision_slop`` before it pushes them apart (0.1 m
+by default: a rover resting 3 cm inside a wall); here the slop is :data:`CONTACT_SLOP_M` and
+the bias removes half of any deeper overlap every 1/60 s, so a rover pushing on a wall rests
+within a few millimetres of it. A *collision* is a contact episode between two objects (a
+rover and a rover, a wall, an obstacle): it starts when the first of their shape pairs
+touches and ends when all have been apart for :data:`EPISODE_GAP_S` (a corner touching two
+wall segments, or a bounce, is one collision).
 """
 
 from __future__ import annotations
 
 import functools
 import itertools
+import math
 from collections.abc import Sequence
 from fractions import Fraction
 from typing import Any
@@ -21,12 +31,19 @@ import pymunk
 from ..errors import RunFault
 from . import fleet
 from .bodyio import BodyIO
-from .forces import FewRovers
+from .forces import FewRovers, ground_list
 from .rover import DiffDriveRover
+from .terrain import Terrain
 from .wheel import WheelModel
 
 ROVER = 1
 OBSTACLE = 2
+#: Overlap pymunk tolerates before pushing shapes apart (m).
+CONTACT_SLOP_M = 0.002
+#: Share of an overlap (beyond the slop) left after 1/60 s: half is removed.
+CONTACT_BIAS = 0.5**60
+#: Two objects apart for less than this are still in the same collision episode (s).
+EPISODE_GAP_S = 0.5
 
 
 class PhysicsWorld:
@@ -38,20 +55,28 @@ class PhysicsWorld:
         self.rate = Fraction(str(settings["rate"]))
         self.dt = float(1 / self.rate)
         self.gravity = float(settings["gravity"])
-        self.ground_friction = float(settings["ground"]["friction"])
-        self.rolling_resistance = float(settings["ground"]["rolling_resistance"])
+        ground = settings["ground"]
+        self.terrain = Terrain(float(ground["friction"]), float(ground["rolling_resistance"]))
         self.max_speed = float(settings["max_speed"])
         self.extent = float(settings["extent"])
         self.space = pymunk.Space(threaded=False)
         self.space.gravity = (0.0, 0.0)
         self.space.iterations = 10
+        self.space.collision_slop = CONTACT_SLOP_M
+        self.space.collision_bias = CONTACT_BIAS
         self.rovers: list[DiffDriveRover] = []
         self._owner: dict[int, str] = {}
         self.collisions = 0
+        self._touching: dict[tuple[str, str], int] = {}
+        self._apart_since: dict[tuple[str, str], float] = {}
+        self._steps = 0
         self._model: FewRovers | fleet.Fleet | None = None
+        self._where: list[tuple[int, int, int] | None] = []
         self._add_obstacles(settings.get("obstacles") or [], settings.get("walls"))
-        self.space.on_collision(ROVER, ROVER, begin=self._on_collision)
-        self.space.on_collision(ROVER, OBSTACLE, begin=self._on_collision)
+        for kind in (ROVER, OBSTACLE):
+            self.space.on_collision(
+                ROVER, kind, begin=self._on_collision, separate=self._on_separate
+            )
         sim.add_hook(self.rate, self.step, "physics")
 
     def _add_obstacles(self, obstacles: list[dict[str, Any]], walls: dict[str, Any] | None) -> None:
@@ -93,7 +118,6 @@ class PhysicsWorld:
 
     def add_rover(self, name: str, p: Any) -> DiffDriveRover:
         """Add a rover whose template parameters are ``p`` (see templates.RoverParams)."""
-        wheel, lateral_limit = self._wheel_model(p)
         rover = DiffDriveRover(
             self.space,
             name,
@@ -101,8 +125,7 @@ class PhysicsWorld:
             length_m=p.length,
             width_m=p.width,
             track_m=p.track,
-            wheel=wheel,
-            lateral_limit_n=lateral_limit,
+            wheel=self._wheel_model(p),
             x=p.x,
             y=p.y,
             heading=p.heading,
@@ -113,27 +136,54 @@ class PhysicsWorld:
         self._model = None  # the batch layout changed
         return rover
 
-    def _wheel_model(self, p: Any) -> tuple[WheelModel, float]:
-        """A rover's wheel model and lateral grip limit from its template parameters.
-
-        Both scale with the normal load per wheel (``m g / 2``) and the ground's friction.
-        """
-        load = p.mass * self.gravity / 2
-        mu = self.ground_friction
-        wheel = WheelModel(
-            stall_force_n=p.stallForce,
-            free_speed_mps=p.freeSpeed,
-            efficiency=p.efficiency / 100.0,
-            traction_limit_n=mu * p.tractionCoef * load,
-            rolling_force_n=self.rolling_resistance * p.rollingCoef * load,
-        )
-        return wheel, mu * p.lateralCoef * 2 * load
+    def _wheel_model(self, p: Any) -> WheelModel:
+        return wheel_model(p, self.gravity)
 
     def update_wheel(self, rover: DiffDriveRover, p: Any) -> None:
         """Rebuild a rover's wheel model after a parameter change (motor wear, ...)."""
-        rover.wheel, rover.lateral_limit = self._wheel_model(p)
+        rover.wheel = self._wheel_model(p)
+        rover.update_drive()  # the deadband may have changed
         if self._model is not None:
             self._model.refresh()
+            self._where = [None] * len(self.rovers)  # grip and resistance changed too
+            self._update_grounds()
+
+    def _update_grounds(self) -> None:
+        """Recompute the ground terms of every wheel whose zone (or whose zone's values) changed.
+
+        The left wheel's contact point is at ``+track/2`` across the heading. Called every
+        step when the world has zones (a few µs a rover), never otherwise.
+        """
+        model = self._model
+        assert model is not None
+        terrain = self.terrain
+        n = len(self.rovers)
+        if isinstance(model, fleet.Fleet):
+            x, y, a = model.state[:, 0], model.state[:, 1], model.state[:, 2]
+            hx = -np.sin(a) * model.half_track
+            hy = np.cos(a) * model.half_track
+            where = terrain.locate_many(
+                np.concatenate([x + hx, x - hx]), np.concatenate([y + hy, y - hy])
+            )
+            left, right = where[:n].tolist(), where[n:].tolist()
+        else:
+            state = model.state
+            left, right = [], []
+            for k, rover in enumerate(self.rovers):
+                i = model.offsets[k]
+                x, y, a = state[i], state[i + 1], state[i + 2]
+                hx = -math.sin(a) * rover.half_track
+                hy = math.cos(a) * rover.half_track
+                left.append(terrain.locate(x + hx, y + hy))
+                right.append(terrain.locate(x - hx, y - hy))
+        version = terrain.version
+        for k, rover in enumerate(self.rovers):
+            key = (left[k], right[k], version)
+            if key != self._where[k]:
+                self._where[k] = key
+                model.set_ground(
+                    k, ground_list(rover, terrain.ground(left[k]), terrain.ground(right[k]))
+                )
 
     def step(self) -> None:
         """Advance the world by one physics step (the engine's hook).
@@ -142,7 +192,11 @@ class PhysicsWorld:
         state read after a step is the next step's input, since only the physics step moves
         bodies.
         """
-        bad = (self._model or self._start()).advance()
+        model = self._model or self._start()
+        if self.terrain.zones:
+            self._update_grounds()
+        bad = model.advance()
+        self._steps += 1
         if bad is not None:
             raise RunFault(self.rovers[bad[0]].name, self.sim.now + 1 / self.rate, bad[1])
 
@@ -150,13 +204,17 @@ class PhysicsWorld:
         """Choose the force model for this many rovers and read the initial state."""
         io = BodyIO(self.space, [r.body for r in self.rovers])
         limits = (self.max_speed, self.extent)
+        ground = self.terrain.ground(-1)
+        grounds = [ground_list(r, ground, ground) for r in self.rovers]
         if len(self.rovers) >= fleet.BATCH_MIN:
-            model: FewRovers | fleet.Fleet = fleet.Fleet(io, self.rovers, self.dt, limits)
+            model: FewRovers | fleet.Fleet = fleet.Fleet(io, self.rovers, self.dt, limits, grounds)
         else:
-            model = FewRovers(io, self.rovers, self.dt, limits)
+            model = FewRovers(io, self.rovers, self.dt, limits, grounds)
         self._model = model
+        self._where = [(-1, -1, -1)] * len(self.rovers)
         for k, rover in enumerate(self.rovers):
             rover.attach_state(functools.partial(self._kinematics, k))
+            rover.attach_rims(functools.partial(model.rim_speeds, k))
         return model
 
     def index_of(self, rovers: Sequence[DiffDriveRover]) -> np.ndarray:
@@ -180,27 +238,85 @@ class PhysicsWorld:
         """
         left = np.where(np.isnan(left), -100.0, np.clip(left, -100.0, 100.0))
         right = np.where(np.isnan(right), -100.0, np.clip(right, -100.0, 100.0))
+        drive_l, drive_r = [], []
         for rover, lp, rp in zip(rovers, left.tolist(), right.tolist(), strict=True):
+            band = rover.wheel.deadband_pct  # as rover.update_drive
             rover.power_l = lp
             rover.power_r = rp
+            rover.drive_l = dl = lp if not -band < lp < band else 0.0
+            rover.drive_r = dr = rp if not -band < rp < band else 0.0
+            drive_l.append(dl)
+            drive_r.append(dr)
         model = self._model
         if isinstance(model, fleet.Fleet):
-            model.powers[0, index] = left
-            model.powers[1, index] = right
+            model.drives[0, index] = drive_l
+            model.drives[1, index] = drive_r
 
     def kinematics_array(self, index: np.ndarray) -> np.ndarray:
         """(n, 6) ``x, y, angle, vx, vy, w`` of the rovers at ``index`` after the last step."""
         return (self._model or self._start()).kinematics_array(index)
 
+    def rim_array(self, index: np.ndarray) -> np.ndarray:
+        """(n, 2) left and right rim speeds of the rovers at ``index`` after the last step."""
+        return (self._model or self._start()).rim_array(index)
+
     def _kinematics(self, k: int) -> Sequence[float]:
         """Rover ``k``'s ``x, y, angle, vx, vy, w`` after the last step."""
         return (self._model or self._start()).kinematics(k)
 
-    def _on_collision(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
+    def _pair(self, arbiter: pymunk.Arbiter) -> tuple[str, str]:
         a, b = arbiter.shapes
         names = sorted((self._owner.get(id(a), "?"), self._owner.get(id(b), "?")))
+        return names[0], names[1]
+
+    def _on_collision(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
+        """A shape pair starts touching: a new collision unless its objects touch already
+        (another shape pair) or were apart for less than :data:`EPISODE_GAP_S`."""
+        pair = self._pair(arbiter)
+        count = self._touching.get(pair, 0)
+        self._touching[pair] = count + 1
+        if count:
+            return
+        apart = self._apart_since.get(pair)
+        if apart is not None and (self._steps - apart) * self.dt < EPISODE_GAP_S:
+            return
         self.collisions += 1
-        self.sim.record_event("collision", f"{names[0]}-{names[1]}")
+        self.sim.record_event("collision", f"{pair[0]}-{pair[1]}")
+
+    def _on_separate(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: Any) -> None:
+        """A shape pair stops touching; the episode may end when its objects' last does."""
+        pair = self._pair(arbiter)
+        count = self._touching.get(pair, 0) - 1
+        if count > 0:
+            self._touching[pair] = count
+        else:
+            self._touching.pop(pair, None)
+            self._apart_since[pair] = self._steps
+
+
+def wheel_model(p: Any, gravity: float) -> WheelModel:
+    """A rover's wheel model from its template parameters (``templates.ROVER_PARAMS``).
+
+    Torques become forces at the ground (divided by the wheel radius) and the wheel's
+    inertia a mass at the rim (``J / r^2``); the normal load is ``m g / 2`` per wheel.
+    """
+    r = p.wheelRadius
+    return WheelModel(
+        stall_force_n=p.stallForce,
+        free_speed_mps=p.freeSpeed,
+        efficiency=p.efficiency / 100.0,
+        max_force_n=p.maxWheelTorque / r,
+        deadband_pct=p.deadband,
+        joint_friction_n=p.jointFriction / r,
+        rim_mass_kg=p.wheelInertia / (r * r),
+        load_n=p.mass * gravity / 2,
+        slip_long=p.slipComplianceLongitudinal,
+        slip_lat=p.slipComplianceLateral,
+        traction_coef=p.tractionCoef,
+        lateral_coef=p.lateralCoef,
+        rolling_coef=p.rollingCoef,
+        patch_radius_m=p.patchRadius,
+    )
 
 
 def physics_of(ctx: Any) -> PhysicsWorld:

@@ -17,13 +17,18 @@ from typing import Any
 import numpy as np
 
 from ..model.params import Param
-from ..model.template import Kind, Port, Template
+from ..model.template import Kind, ParamValues, Port, Template
 from .rover import DiffDriveRover, wrap_angle
 from .space import physics_of
+from .wheel import scrub_moment
 
-#: Physical parameters shared by both robots. Defaults: a 30 kg outdoor rover, about 5.1 m/s
-#: top speed at 100 % on the default ground, motor time constant
-#: m * freeSpeed / (2 * stallForce) = 1.8 s.
+#: Physical parameters shared by both robots. The defaults describe a 30 kg two-wheel
+#: differential-drive base on casters, in the class of the AgileX Tracer or a MiR100-type
+#: indoor/outdoor carrier: 1.53 m/s top speed at 100 % on the default ground, 0.21 s motor
+#: time constant, launches at 2.2 m/s^2 (the driver's current limit, well under the tyres'
+#: grip on dry ground), starts moving from 4.1 % of power. Names follow Gazebo/SDFormat where
+#: one exists (wheel_radius, max_wheel_torque, joint friction, WheelSlip compliances,
+#: torsional patch_radius), in this project's camelCase.
 ROVER_PARAMS: tuple[Param, ...] = (
     Param("x", "float", "initial x position", 0.0, -1e5, 1e5, "m"),
     Param("y", "float", "initial y position", 0.0, -1e5, 1e5, "m"),
@@ -40,14 +45,31 @@ ROVER_PARAMS: tuple[Param, ...] = (
     Param("length", "float", "chassis length (along the heading)", 0.8, 0.05, 20.0, "m"),
     Param("width", "float", "chassis width", 0.6, 0.05, 20.0, "m"),
     Param("track", "float", "distance between the two driven wheels", 0.5, 0.02, 20.0, "m"),
+    Param("wheelRadius", "float", "driven wheel radius (Gazebo wheel_radius)", 0.1, 0.01, 5.0, "m"),
     Param(
-        "stallForce", "float", "motor force per wheel at 100 % and standstill", 45.0, 0.1, 1e5, "N"
+        "wheelInertia",
+        "float",
+        "one driven wheel's moment of inertia about its axle, motor rotor included "
+        "(reflected through the gearbox)",
+        0.01,
+        1e-5,
+        1000.0,
+        "kg m^2",
+    ),
+    Param(
+        "stallForce",
+        "float",
+        "motor force per wheel at the ground at 100 % and standstill, before the current limit",
+        120.0,
+        0.1,
+        1e5,
+        "N",
     ),
     Param(
         "freeSpeed",
         "float",
-        "wheel speed at which the motor force vanishes at 100 %",
-        5.5,
+        "rim speed at which the motor force vanishes at 100 % (no-load speed)",
+        1.6,
         0.01,
         100.0,
         "m/s",
@@ -60,6 +82,61 @@ ROVER_PARAMS: tuple[Param, ...] = (
         0.0,
         100.0,
         "%",
+    ),
+    Param(
+        "maxWheelTorque",
+        "float",
+        "driver current limit as wheel torque, driving and braking (Gazebo max_wheel_torque)",
+        4.0,
+        0.001,
+        1e5,
+        "N m",
+    ),
+    Param(
+        "deadband",
+        "float",
+        "driver deadband: commands of smaller magnitude apply no voltage",
+        2.0,
+        0.0,
+        50.0,
+        "%",
+    ),
+    Param(
+        "jointFriction",
+        "float",
+        "Coulomb friction of the wheel's axle and gearbox (SDFormat joint dynamics friction)",
+        0.2,
+        0.0,
+        1e4,
+        "N m",
+    ),
+    Param(
+        "slipComplianceLongitudinal",
+        "float",
+        "tyre slip ratio per unit of longitudinal force / normal load (Gazebo WheelSlip); "
+        "the force saturates at slip ratio friction x this",
+        0.1,
+        1e-4,
+        10.0,
+    ),
+    Param(
+        "slipComplianceLateral",
+        "float",
+        "tyre lateral slip (tan of the slip angle) per unit of lateral force / normal load "
+        "(Gazebo WheelSlip)",
+        0.1,
+        1e-4,
+        10.0,
+    ),
+    Param(
+        "patchRadius",
+        "float",
+        "tyre contact patch radius: sets the scrub torque resisting a turn in place "
+        "(SDFormat torsional patch_radius)",
+        0.03,
+        0.0,
+        1.0,
+        "m",
     ),
     Param(
         "tractionCoef",
@@ -80,17 +157,43 @@ ROVER_PARAMS: tuple[Param, ...] = (
     Param("rollingCoef", "float", "rolling resistance, times the ground's", 1.0, 0.0, 20.0),
 )
 
-#: Parameters that change the wheel model mid-run (motor wear, terrain).
+
+def rover_params(**overrides: Any) -> ParamValues:
+    """The rover parameters' defaults with ``overrides`` (for tests and benchmarks)."""
+    values = {q.name: q.default for q in ROVER_PARAMS}
+    unknown = set(overrides) - set(values)
+    if unknown:
+        raise KeyError(f"not rover parameters: {sorted(unknown)}")
+    return ParamValues(values | overrides)
+
+
+#: Parameters that change the wheel model mid-run (motor wear, tyres, driver settings).
 _WHEEL_PARAMS = {
     "stallForce",
     "freeSpeed",
     "efficiency",
+    "maxWheelTorque",
+    "deadband",
+    "jointFriction",
+    "slipComplianceLongitudinal",
+    "slipComplianceLateral",
+    "patchRadius",
     "tractionCoef",
     "lateralCoef",
     "rollingCoef",
 }
 #: Parameters fixed once the body exists.
-_BODY_PARAMS = {"x", "y", "heading", "mass", "length", "width", "track"}
+_BODY_PARAMS = {
+    "x",
+    "y",
+    "heading",
+    "mass",
+    "length",
+    "width",
+    "track",
+    "wheelRadius",
+    "wheelInertia",
+}
 
 _POSE_OUTPUTS = (
     Port("posX", 0.0, "true x position", "m"),
@@ -98,8 +201,18 @@ _POSE_OUTPUTS = (
     Port("heading", 0.0, "true heading in [-pi, pi)", "rad"),
     Port("speed", 0.0, "signed speed along the heading", "m/s"),
     Port("yawRate", 0.0, "angular velocity", "rad/s"),
-    Port("wheelSpeedL", 0.0, "left wheel ground speed (what an encoder measures)", "m/s"),
-    Port("wheelSpeedR", 0.0, "right wheel ground speed (what an encoder measures)", "m/s"),
+    Port(
+        "wheelSpeedL",
+        0.0,
+        "left wheel rim speed omega*r (what an encoder measures: includes tyre slip)",
+        "m/s",
+    ),
+    Port(
+        "wheelSpeedR",
+        0.0,
+        "right wheel rim speed omega*r (what an encoder measures: includes tyre slip)",
+        "m/s",
+    ),
 )
 
 
@@ -119,16 +232,15 @@ class _Robot(Template):
 
     def _pose(self) -> dict[str, float]:
         x, y, a, vx, vy, w = self.rover.kinematics()
-        v = vx * math.cos(a) + vy * math.sin(a)
-        h = self.rover.half_track
+        left, right = self.rover.wheel_speeds()
         return {
             "posX": x,
             "posY": y,
             "heading": wrap_angle(a),
-            "speed": v,
+            "speed": vx * math.cos(a) + vy * math.sin(a),
             "yawRate": w,
-            "wheelSpeedL": v - w * h,
-            "wheelSpeedR": v + w * h,
+            "wheelSpeedL": left,
+            "wheelSpeedR": right,
         }
 
 
@@ -162,21 +274,19 @@ class ControlledRobot(_Robot):
         physics = comps[0].physics
         if "index" not in state:
             state["index"] = physics.index_of([c.rover for c in comps])
-            state["half_track"] = np.array([c.rover.half_track for c in comps])
         if "rovers" not in state:
             state["rovers"] = [c.rover for c in comps]
         physics.set_powers(state["rovers"], state["index"], inp["powerL"], inp["powerR"])
         x, y, a, vx, vy, w = physics.kinematics_array(state["index"]).T
-        v = vx * np.cos(a) + vy * np.sin(a)
-        wh = w * state["half_track"]
+        left, right = physics.rim_array(state["index"]).T
         return {
             "posX": x,
             "posY": y,
             "heading": (a + math.pi) % (2 * math.pi) - math.pi,
-            "speed": v,
+            "speed": vx * np.cos(a) + vy * np.sin(a),
             "yawRate": w,
-            "wheelSpeedL": v - wh,
-            "wheelSpeedR": v + wh,
+            "wheelSpeedL": left,
+            "wheelSpeedR": right,
         }, None
 
 
@@ -273,10 +383,7 @@ class FreeRobot(_Robot):
         if b == 2:
             # wheel speeds v (1 -+ h / r) for the cruise speed v, each converted back to the
             # power that holds it (so rolling resistance does not shrink the circle)
-            wheel = self.rover.wheel
-            v = wheel.steady_speed(cruise)
-            k = self.rover.half_track / (p.circleRadius or 1e9)
-            return wheel.power_for_speed(v * (1 - k)), wheel.power_for_speed(v * (1 + k))
+            return self._circle(cruise, p.circleRadius or 1e9)
         if b == 1:
             return cruise, cruise
         if t >= self.next_change:
@@ -294,6 +401,19 @@ class FreeRobot(_Robot):
         if b == 5:
             return self._waypoints(cruise)
         return self._steer(cruise * self.speed_factor, self.target_heading)
+
+    def _circle(self, cruise: float, radius: float) -> tuple[float, float]:
+        """Wheel powers for a circle of ``radius`` at the cruise speed, from the rover's own
+        wheel model: hub speeds ``v (1 -+ h / r)``, each wheel also pushing against the
+        tyres' scrub moment (so neither rolling resistance nor scrub widens the circle)."""
+        wheel = self.rover.wheel
+        terrain = self.physics.terrain
+        crr, mu = terrain.rolling_resistance, terrain.friction
+        h = self.rover.half_track
+        v = wheel.steady_speed(cruise, crr)
+        v_l, v_r = v * (1 - h / radius), v * (1 + h / radius)
+        push = scrub_moment(v / radius, v_l, v_r, wheel, mu, mu) / (2 * h)
+        return wheel.power_for_speed(v_l, crr, push), wheel.power_for_speed(v_r, crr, -push)
 
     def _steer(self, power: float, heading: float) -> tuple[float, float]:
         """Hold ``heading``: forward power falls with cos(error), so a large error turns the

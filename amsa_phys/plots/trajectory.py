@@ -4,7 +4,8 @@ and where collisions happened.
 Colours match the window and the video (``amsa_phys/palette.py``: the leader orange, the
 follower blue). The static world — walls, obstacles — is drawn by one function,
 :func:`draw_static_world`, from the world's ``physics:`` settings, so another kind of
-static layer (terrain zones) is a few more lines there.
+static layer is a few more lines there. Terrain (friction zones) comes from the run's own
+``scenario.yaml`` (``plots/zones.py``) and goes through the same view.
 
 A long, nearly straight run (scenario 1: a 420 m straight line) drawn to scale is a
 hairline in a square of empty metres. When every true path stays within 5 % of its length
@@ -36,6 +37,7 @@ from ..model.geometry import static_obstacles
 from ..palette import ALERT, hex_colour, rover_colour, rover_names
 from .distance import read_trace
 from .save import save_png
+from .zones import draw_zones, zones_of_run
 
 #: a run is drawn in the lateral-offset view when its paths stay this close to one line
 STRAIGHT_RATIO = 0.05
@@ -122,6 +124,7 @@ def plot_trajectory(
     view = View() if arena else choose_view(list(paths.values()))
     fig, ax = plt.subplots(figsize=(10, 4.8) if view.lateral else (7, 6), dpi=100)
     draw_static_world(ax, physics, view)
+    draw_zones(ax, zones_of_run(trace.parent / "scenario.yaml"), view)  # terrain, from the run
     colour = {r: hex_colour(rover_colour(i)) for i, r in enumerate(rovers)}
     for r, xy in paths.items():  # leader under follower: where the paths coincide both show
         p = view(xy)

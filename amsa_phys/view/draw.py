@@ -1,9 +1,12 @@
 """Draws a :class:`~amsa_phys.view.scene.Frame` onto a pygame Surface.
 
 One renderer serves the window and the recorder, so what you debug is what you record. It
-draws in world order — grid, obstacles, trails, GPS fixes, the distance line, rovers — then
-the HUD in screen space. Rovers are drawn to scale (body, wheels at the track width, a nose
-for the heading) and never smaller than a few pixels, so they stay visible when zoomed out.
+draws in world order — grid, terrain zones, obstacles, trails, GPS fixes, the distance line,
+rovers — then the HUD in screen space. A zone is filled in a colour that says what it is
+(brown: soft ground, the darker the more it resists rolling; blue: slippery, friction below
+0.2) and labelled with its name, friction and rolling resistance as they are now. Rovers are
+drawn to scale (body, wheels at the track width, a nose for the heading) and never smaller
+than a few pixels, so they stay visible when zoomed out.
 """
 
 from __future__ import annotations
@@ -15,9 +18,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..palette import ALERT, rover_colour
+from ..physics.terrain import zone_colours
 from .camera import Camera
 from .pg import font, pygame
-from .scene import Frame, LidarScan, RoverPose
+from .scene import Frame, LidarScan, RoverPose, ZoneView
 
 BACKGROUND = (246, 246, 241)
 GRID_MINOR = (228, 228, 221)
@@ -85,6 +89,8 @@ class Renderer:
         """Draw ``frame`` as seen by ``camera``; ``status`` lines go top-right."""
         surface.fill(BACKGROUND)
         self._grid(surface, camera)
+        for zone in frame.zones:
+            self._zone(surface, camera, zone)
         for ob in frame.obstacles:
             self._obstacle(surface, camera, ob.kind, ob.points, ob.radius)
         colours = {r.name: rover_colour(i) for i, r in enumerate(frame.rovers)}
@@ -135,6 +141,20 @@ class Renderer:
         pygame.draw.line(surface, INK, (x + bar_px, y - 6), (x + bar_px, y + 2), 2)
         label = self.small.render(f"{bar_m:g} m", True, INK)
         surface.blit(label, (x + bar_px + 8, y - label.get_height() + 4))
+
+    def _zone(self, surface: pygame.Surface, camera: Camera, zone: ZoneView) -> None:
+        fill, edge = zone_colours(zone.friction, zone.rolling_resistance, BACKGROUND)
+        pts = _screen(camera, zone.polygon)
+        pygame.draw.polygon(surface, fill, pts)
+        pygame.draw.polygon(surface, edge, pts, 1)
+        name = zone.name.rpartition(".")[2]
+        text = f"{name}  μ {zone.friction:g}  Crr {zone.rolling_resistance:g}"
+        label = self.small.render(text, True, edge)
+        # inside the top edge, where it seldom covers a rover crossing the zone
+        left = min(p[0] for p in pts)
+        top = min(p[1] for p in pts)
+        width = max(p[0] for p in pts) - left
+        surface.blit(label, (left + max(4.0, (width - label.get_width()) / 2), top + 4))
 
     def _obstacle(
         self,

@@ -41,6 +41,16 @@ class RoverPose:
     speed: float
 
 
+@dataclass(frozen=True)
+class ZoneView:
+    """A friction zone as drawn: its polygon (world metres) and current ground values."""
+
+    name: str
+    polygon: tuple[tuple[float, float], ...]
+    friction: float
+    rolling_resistance: float
+
+
 @dataclass
 class GpsTrack:
     """A GPS sensor's recent fixes and the true positions where fixes were lost."""
@@ -97,6 +107,8 @@ class Frame:
     phase_text: str
     duration: float
     scans: list[LidarScan] = field(default_factory=list)
+    #: terrain zones, bottom first (their values now: a timeline change shows)
+    zones: list[ZoneView] = field(default_factory=list)
 
 
 def describe_phase(sim: Simulation) -> str:
@@ -145,6 +157,16 @@ class Scene:
 
     def _physics(self) -> Any:
         return self.sim.shared.get("physics")
+
+    def zones(self) -> list[ZoneView]:
+        """The world's friction zones with their current values (empty without physics)."""
+        physics = self._physics()
+        if physics is None:
+            return []
+        return [
+            ZoneView(z.name, z.polygon, z.friction, z.rolling_resistance)
+            for z in physics.terrain.zones
+        ]
 
     def rovers(self) -> list[RoverPose]:
         """Every rover's current pose (empty for a world without physics)."""
@@ -231,6 +253,7 @@ class Scene:
             phase_text=describe_phase(sim),
             duration=float(sim.duration),
             scans=self.scans(),
+            zones=self.zones(),
         )
 
     def scans(self) -> list[LidarScan]:

@@ -99,16 +99,19 @@ def test_imported_model_runs_like_the_projects_world(
         f"world: {ROOT / 'worlds' / 'mde_challenge.yaml'}\n{common}"
         "set: {Leader.behavior: 4, MyFollowerController.Kv: 0.35}\n"
     )
-    # the sensors' noise model is amsa-phys's own (the 2019 model's GPS has only lostDataGPS):
-    # the world ships realistic noise, which a scenario of the imported model supplies too
+    # the sensors' noise model and the wheels' motor model are amsa-phys's own (the 2019
+    # model's GPS has only lostDataGPS, its rovers no motor): the world ships realistic
+    # noise and the challenge's fast rover, which a scenario of the imported model supplies too
     project, model = load_world(ROOT / "worlds" / "mde_challenge.yaml"), load_world(imported)
     noise = {
         f"{path}.{name}": value
-        for path in ("LeaderGPS", "FollowerGPS", "FollowerCompass")
+        for path in ("LeaderGPS", "FollowerGPS", "FollowerCompass", "Leader", "Follower")
         for name, value in project.leaves[path].params.items()
-        if value != model.leaves[path].params.get(name) and name != "lostDataGPS"
+        if value != model.leaves[path].params.get(name)
+        and name not in ("lostDataGPS", "x", "behavior")
     }
     assert "LeaderGPS.stddev" in noise
+    assert "Follower.stallForce" in noise
     theirs = tmp_path / "theirs.yaml"
     theirs.write_text(
         f"world: {imported}\n{common}"

@@ -82,7 +82,7 @@ def final_poses(monkeypatch: pytest.MonkeyPatch, batch_min: int) -> list[tuple[f
     monkeypatch.setattr(fleet, "BATCH_MIN", batch_min)
     sim = Simulation.from_scenario(load_scenario(SCENARIO, duration=60))
     sim.run()
-    return [(*r.pose, r.forward_speed) for r in sim.shared["physics"].rovers]
+    return [(*r.pose, r.forward_speed, *r.wheel_speeds()) for r in sim.shared["physics"].rovers]
 
 
 def test_batch_physics_matches_the_per_rover_path(monkeypatch: pytest.MonkeyPatch) -> None:

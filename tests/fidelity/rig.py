@@ -24,8 +24,12 @@ def drive(
     physics: dict[str, Any] | None = None,
     timeline: list[dict[str, Any]] | None = None,
     rate_hz: int = 50,
+    extra: dict[str, Any] | None = None,
 ) -> tuple[dict[str, np.ndarray], Simulation]:
-    """Run the rig; return the trace as named columns (at ``rate_hz``) and the simulation."""
+    """Run the rig; return the trace as named columns (at ``rate_hz``) and the simulation.
+
+    ``extra`` adds components to the world (terrain zones).
+    """
     world = {
         "physics": {"rate": 100, **(physics or {})},
         "components": {
@@ -46,6 +50,7 @@ def drive(
                 "params": robot or {},
                 "inputs": {"powerL": "Norm.normalizedPowerL", "powerR": "Norm.normalizedPowerR"},
             },
+            **(extra or {}),
         },
     }
     scen: dict[str, Any] = {"world": world, "duration": duration, "log_rate": rate_hz}

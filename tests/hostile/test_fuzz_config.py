@@ -13,6 +13,7 @@ regular files at all (devices, FIFOs, directories, links to them, sparse giants)
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import io
 import os
@@ -89,7 +90,9 @@ def mutated(draw: st.DrawFn) -> str:
         if kind == "scale":
             # mostly-valid cases: a number moved within a few times its value, so runs happen
             if isinstance(value, int | float) and not isinstance(value, bool):
-                parent[path[-1]] = type(value)(value * draw(st.sampled_from([0, 0.5, 2, 3])))
+                factor = draw(st.sampled_from([0, 0.5, 2, 3]))
+                with contextlib.suppress(OverflowError):  # a huge int from a "replace": kept
+                    parent[path[-1]] = type(value)(value * factor)
         elif kind == "replace":
             parent[path[-1]] = draw(weird)
         elif kind == "delete":
@@ -137,7 +140,7 @@ def mutated(draw: st.DrawFn) -> str:
 
 @settings(
     max_examples=EXAMPLES,
-    deadline=10_000,
+    deadline=None,  # speed is the benchmarks' business; a loaded CI box must not fail this
     derandomize=True,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
 )
@@ -179,7 +182,7 @@ def test_mutated_scenarios_run_or_are_refused_in_one_line(text: str) -> None:
 SPECIAL = ["fifo", "/dev/zero", "/dev/urandom", "directory", "link-to-zero", "sparse-giant"]
 
 
-@settings(max_examples=24, deadline=10_000, derandomize=True)
+@settings(max_examples=24, deadline=None, derandomize=True)
 @given(
     st.sampled_from(SPECIAL),
     st.sampled_from(["validate", "run", "world-of-a-scenario", "describe", "test"]),

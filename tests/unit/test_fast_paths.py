@@ -13,6 +13,7 @@ import struct
 from fractions import Fraction
 from pathlib import Path
 
+import numpy as np
 import pymunk
 import pytest
 
@@ -22,16 +23,17 @@ from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import Change, load_scenario
 from amsa_phys.physics import bodyio
 from amsa_phys.physics.bodyio import BodyIO
-from amsa_phys.physics.forces import FewRovers, reference_forces
+from amsa_phys.physics.fleet import Fleet
+from amsa_phys.physics.forces import FewRovers, ground_list, reference_forces
 from amsa_phys.physics.rover import DiffDriveRover
-from amsa_phys.physics.wheel import WheelModel
+from amsa_phys.physics.space import wheel_model
+from amsa_phys.physics.templates import rover_params
 
 ROOT = Path(__file__).resolve().parents[2]
-WHEEL = WheelModel(45.0, 5.5, 0.9, 0.8 * 147.15, 0.02 * 147.15)
 DT = 0.01
 
 
-def make_rovers(n: int) -> tuple[pymunk.Space, list[DiffDriveRover]]:
+def make_rovers(n: int, **params: float) -> tuple[pymunk.Space, list[DiffDriveRover]]:
     space = pymunk.Space()
     box = pymunk.Body(body_type=pymunk.Body.STATIC)  # a static body first: rows must map
     space.add(box, pymunk.Poly.create_box(box, (1, 1)))
@@ -43,8 +45,7 @@ def make_rovers(n: int) -> tuple[pymunk.Space, list[DiffDriveRover]]:
             length_m=0.8,
             width_m=0.6,
             track_m=0.5,
-            wheel=WHEEL,
-            lateral_limit_n=0.8 * 2 * 147.15,
+            wheel=wheel_model(rover_params(efficiency=90.0, **params), 9.81),
             x=5.0 * i,
             y=1.0,
             heading=0.3 * i,
@@ -55,21 +56,65 @@ def make_rovers(n: int) -> tuple[pymunk.Space, list[DiffDriveRover]]:
     return space, rovers
 
 
-def test_inlined_forces_equal_the_reference_wheel_model() -> None:
-    space, rovers = make_rovers(3)
+#: (mu, crr) under each wheel: dry ground, mud, ice, one wheel on each
+GROUNDS = [((0.8, 0.02), (0.8, 0.02)), ((0.3, 0.15), (0.3, 0.15)), ((0.05, 0.02), (0.8, 0.02))]
+
+
+def every_regime(n: int) -> tuple[pymunk.Space, list[DiffDriveRover], list[tuple], list]:
+    """``n`` rovers in every regime of the wheel model, with their rim speeds and grounds.
+
+    Rims spinning forwards and backwards, faster and slower than the ground, exactly at rest
+    (stuck or breaking away), motors current-limited, regenerating, inside the deadband,
+    tyres gripping and saturated, on dry ground, mud and ice.
+    """
+    space, rovers = make_rovers(n)
     rng = random.Random(4)
-    for r in rovers:  # every regime: traction-limited, braking, skidding, at rest
-        r.body.velocity = (rng.uniform(-6, 6), rng.uniform(-6, 6))
-        r.body.angular_velocity = rng.uniform(-3, 3)
-    rovers[0].set_power(100, -100)
-    rovers[1].set_power(0, 0)
-    rovers[2].set_power(37.5, 12.0)
-    model = FewRovers(BodyIO(space, [r.body for r in rovers]), rovers, DT, (100.0, 1e4))
+    rims, grounds = [], []
+    for k, r in enumerate(rovers):
+        kind = k % 5
+        if kind == 0:  # at rest, small commands: stuck or just breaking away
+            r.set_power(rng.uniform(-8, 8), rng.uniform(-8, 8))
+            rims.append((0.0, 0.0))
+        else:
+            r.body.velocity = (rng.uniform(-3, 3), rng.uniform(-3, 3))
+            r.body.angular_velocity = rng.uniform(-3, 3)
+            r.set_power(rng.choice([100, -100, 0, 1.5, 37.5]), rng.uniform(-100, 100))
+            spin = rng.choice([0.0, 1.0, 1.3, -2.0])  # rims locked, rolling, spinning, reversed
+            rims.append((spin * rng.uniform(-3, 3), rng.uniform(-3, 3)))
+        grounds.append(GROUNDS[k % len(GROUNDS)])
+    return space, rovers, rims, grounds
+
+
+def test_inlined_forces_equal_the_reference_wheel_model() -> None:
+    space, rovers, rims, grounds = every_regime(20)
+    terms = [ground_list(r, *g) for r, g in zip(rovers, grounds, strict=True)]
+    model = FewRovers(BodyIO(space, [r.body for r in rovers]), rovers, DT, (100.0, 1e4), terms)
+    model.rims = [u for pair in rims for u in pair]
     model.apply(model.state)
     for k, r in enumerate(rovers):
         o = model.rows[k] * bodyio.FORCE
-        got = tuple(model.io.forces[o : o + 3])
-        assert got == pytest.approx(reference_forces(r, DT), rel=1e-12, abs=1e-12)
+        got = (*model.io.forces[o : o + 3], *model.rim_speeds(k))
+        expected = reference_forces(r, DT, rims[k], grounds[k])
+        assert got == pytest.approx(expected, rel=1e-11, abs=1e-11), f"rover {k}"
+
+
+def test_fleet_equals_the_float_path_in_every_regime() -> None:
+    """The numpy path (many rovers) and the float path agree on forces and rims, branch by
+    branch: the mix of regimes puts every rare branch in the same call."""
+    results = []
+    for cls in (FewRovers, Fleet):
+        space, rovers, rims, grounds = every_regime(60)
+        terms = [ground_list(r, *g) for r, g in zip(rovers, grounds, strict=True)]
+        model = cls(BodyIO(space, [r.body for r in rovers]), rovers, DT, (100.0, 1e4), terms)
+        if cls is Fleet:
+            model.rims = np.array(rims).T.copy()
+        else:
+            model.rims = [u for pair in rims for u in pair]
+        for _ in range(30):  # the regimes change as the steps go: rims stick, tyres grip
+            model.advance()
+        results.append([(*model.kinematics(k), *model.rim_speeds(k)) for k in range(len(rovers))])
+    for k, (a, b) in enumerate(zip(*results, strict=True)):
+        assert a == pytest.approx(b, rel=1e-9, abs=1e-9), f"rover {k}"
 
 
 @pytest.mark.parametrize("direct", [True, False], ids=["direct", "documented"])
