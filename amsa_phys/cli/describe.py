@@ -6,6 +6,7 @@ import argparse
 from typing import Any
 
 from ..errors import ConfigError, one_line
+from ..model import timing
 from ..model.scenario import PHYSICS_PREFIX, Scenario, load_scenario
 from ..model.wording import plural
 from ..model.world import LeafSpec, WorldSpec
@@ -43,12 +44,15 @@ def describe_world(
     world: WorldSpec,
     start: dict[str, dict[str, tuple[Any, Source]]] | None = None,
     physics_from: dict[str, Source] | None = None,
+    seed: int | None = None,
 ) -> list[str]:
     """Human-readable lines describing a world.
 
     Every parameter is shown with the value it starts with and where that comes from: the
     template's default, the world file, or (``start``, for a scenario) the scenario's
-    ``set:`` or a ``--set``, with the world's value it replaced.
+    ``set:`` or a ``--set``, with the world's value it replaced. A Leaf's loop timing
+    (latency, jitter, phase) follows its frequency; for a scenario (``seed`` given) a random
+    phase is shown as drawn.
     """
     start = start or {}
     lines = [
@@ -60,7 +64,11 @@ def describe_world(
         leaf = world.leaves[path]
         t = leaf.template
         written = raw_params(world, leaf)
-        lines.append(f"  {path}: {t.name()} ({t.kind.value}) at {float(leaf.freq):g} Hz")
+        timing = _timing_text(world, leaf, seed)
+        lines.append(
+            f"  {path}: {t.name()} ({t.kind.value}) at {float(leaf.freq):g} Hz"
+            + (f", {timing}" if timing else "")
+        )
         for p in t.params:
             world_value = leaf.params[p.name]
             source = "world" if p.name in written else "default"
@@ -83,9 +91,37 @@ def describe_world(
             )
             lines.append(f"      -> {outs}")
     lines.append("execution order at a shared instant: " + " -> ".join(world.order))
+    lines.append(_loop_timing_line(world))
     if world.schedule:
         lines.append("explicit schedule: " + ", ".join(world.schedule))
     return lines
+
+
+def _timing_text(world: WorldSpec, leaf: LeafSpec, seed: int | None) -> str:
+    """``latency 0.75 s, phase 0.137 s (random)``: what ``model/timing.py`` describes, with
+    a random phase drawn for this seed when there is one."""
+    text = timing.describe(leaf.timing, world.free_running)
+    random = leaf.timing.phase == timing.RANDOM or (
+        leaf.timing.phase is None and world.free_running
+    )
+    if random and seed is not None:
+        from ..engine.timing import leaf_phase  # numpy: only when there is one to draw
+
+        drawn = leaf_phase(leaf, world, seed)
+        text = text.replace("phase random", f"phase {float(drawn):g} s (random, seed {seed})")
+    return text
+
+
+def _loop_timing_line(world: WorldSpec) -> str:
+    """One line on how the world's Leaves are timed, so the default is visible too."""
+    delayed = [p for p, leaf in world.leaves.items() if leaf.timing.delayed]
+    free = "free-running: every Leaf without a phase ticks at a random one; " * world.free_running
+    if not delayed:
+        return f"loop timing: {free}outputs reach their readers in the instant they are published"
+    return (
+        f"loop timing: {free}outputs of {', '.join(delayed)} reach their readers after their "
+        "latency (and jitter); every other output in the instant it is published"
+    )
 
 
 def _physics_lines(world: WorldSpec, physics_from: dict[str, Source]) -> list[str]:
@@ -157,7 +193,7 @@ def run(args: argparse.Namespace) -> int:
             "values in force at t = 0, each with where it comes from: default (the "
             "template's), world, scenario set, --set"
         )
-        lines = describe_world(obj.world, scenario_start(obj, in_file), physics_from)
+        lines = describe_world(obj.world, scenario_start(obj, in_file), physics_from, seed=obj.seed)
     else:
         lines = describe_world(obj)
     print("\n".join(lines))

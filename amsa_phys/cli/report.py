@@ -16,9 +16,25 @@ def _fmt(value: Any, digits: int = 2) -> str:
     return str(value)
 
 
+def _dwell_text(q: dict[str, Any]) -> str:
+    dwell = q.get("dwell")
+    return "10 s (a tenth of a shorter block)" if dwell is None else f"{dwell:g} s"
+
+
 def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> None:
     """Per-phase metrics, the overall line, speed and where the files are."""
-    cols = ("phase", "start", "max", "min", "mean err", "rms err", "settle", "coll", "set")
+    cols = (
+        "phase",
+        "start",
+        "max",
+        "max after",
+        "min",
+        "mean err",
+        "rms err",
+        "settle",
+        "coll",
+        "set",
+    )
     rows = []
     blocks = [(str(i), p) for i, p in enumerate(metrics["phases"])]
     blocks.append(("all", {**metrics["overall"], "start": 0.0, "set": {}}))
@@ -32,6 +48,7 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
                 name + (" (cut)" if b.get("partial") else ""),
                 _fmt(b.get("start"), 1),
                 _fmt(b.get("max_distance")),
+                _fmt(b.get("max_after_approach")),
                 _fmt(b.get("min_distance")),
                 _fmt(b.get("mean_error")),
                 _fmt(b.get("rms_error")),
@@ -54,7 +71,12 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
         )
     q = metrics.get("quality")
     if q:
-        print(f"quality: {q['signal']} vs {q['reference']:g} m ± {q['tolerance']:g} m", file=stream)
+        print(
+            f"quality: {q['signal']} vs {q['reference']:g} m ± {q['tolerance']:g} m; "
+            "max after = max once first within tolerance (the paper's figure); settle needs "
+            f"{_dwell_text(q)} in the band",
+            file=stream,
+        )
     else:
         print("no quality: section, so no metrics of control and no distance.png", file=stream)
     paused = metrics.get("paused_s")

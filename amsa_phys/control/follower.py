@@ -74,7 +74,7 @@ class FollowerController(Template):
         ),
         Param("distanceRef", "float", "reference distance to the leader", 15.0, 0.0, 1000.0, "m"),
         Param(
-            "Kff", "float", "weight of the leader-speed feed-forward (0 disables it)", 1.0, 0.0, 2.0
+            "Kff", "float", "weight of the leader-speed feed-forward (0 disables it)", 0.0, 0.0, 2.0
         ),
         Param(
             "maxSpeed",

@@ -16,6 +16,10 @@ reads, the reader still runs before (or after) the writer as in the world's orde
 a group, members read before any member writes. Groups that would change a read are not
 formed (anywhere, so a leaf is either always or never stepped in its group).
 
+Copies with the same phase and latency group as usual (the group's outputs go through one
+delay line); copies with jitter step one by one, since each copy's messages arrive at
+instants of their own.
+
 Array arithmetic rounds like the scalar code except where numpy's transcendental functions
 or summation order differ in the last bit; a grouped run therefore matches the same world
 run leaf by leaf to ~1e-12, not bit for bit (the tests hold it to that).
@@ -79,6 +83,8 @@ class Group:
         ]
         self.outputs = {port: [t.targets[port] for t in tasks] for port in tasks[0].targets}
         self.params = ParamArrays(self.comps)
+        #: the members' common delay line (they share one latency and have no jitter)
+        self.delay = tasks[0].delay
         #: scratch space the template's ``step_many`` owns (arrays of per-member state)
         self.state: dict[str, Any] = {}
 
@@ -89,7 +95,12 @@ def group_key(task: Any, freq: Fraction) -> tuple[Any, ...] | None:
     m = _COPY.match(parent)
     if m is None or not hasattr(type(task.comp), "step_many") or type(task.comp).has_arrays():
         return None
-    return (m.group(1), name, type(task.comp), freq, tuple(sorted(p for p, _ in task.inputs)))
+    delay = task.delay
+    if delay is not None and delay.draw is not None:
+        return None  # jitter: each copy's messages arrive at their own instants
+    latency = None if delay is None else delay.fixed
+    inputs = tuple(sorted(p for p, _ in task.inputs))
+    return (m.group(1), name, type(task.comp), freq, task.phase, latency, inputs)
 
 
 def plan(

@@ -19,6 +19,19 @@ def component_rng(seed: int, path: str) -> np.random.Generator:
     return np.random.Generator(np.random.PCG64(ss))
 
 
+def named_rng(seed: int, path: str, name: str) -> np.random.Generator:
+    """A stream of ``path`` for one engine purpose (``"phase"``, ``"jitter"``), apart from
+    the component's own.
+
+    Keyed by the component's crc32 and the name's, with bit 32 set so it can never be a
+    child the component spawns from its own stream (``rng.spawn(n)`` keys 0 .. n-1 under
+    the same first key): adding timing to a world changes no component's random numbers.
+    """
+    key = (zlib.crc32(path.encode("utf-8")), (1 << 32) | zlib.crc32(name.encode("utf-8")))
+    ss = np.random.SeedSequence(entropy=seed, spawn_key=key)
+    return np.random.Generator(np.random.PCG64(ss))
+
+
 class Drawn:
     """Scalars from one random stream, drawn from numpy in blocks.
 

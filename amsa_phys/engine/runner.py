@@ -17,6 +17,7 @@ tight loop.
 
 from __future__ import annotations
 
+import heapq
 import math
 import operator
 from array import array
@@ -36,6 +37,7 @@ from ..model.world import WorldSpec
 from . import batch, interrupt
 from .clock import MAX_EVENTS_PER_CYCLE, TickGrid, hyperperiod
 from .rng import component_rng
+from .timing import DelayLine, run_phases
 
 Hook = Callable[[], None]
 
@@ -88,6 +90,12 @@ class _Task:
     #: array ports (a lidar's ranges): port -> element buffer names, in order
     arrays_in: dict[str, list[str]] = field(default_factory=dict)
     arrays_out: dict[str, list[str]] = field(default_factory=dict)
+    #: loop timing (``engine/timing.py``): the timer's phase in ticks, and the delay line of
+    #: a Leaf with latency or jitter (None: its outputs are visible at once)
+    phase: int = 0
+    delay: DelayLine | None = None
+    #: a delayed Leaf's own last outputs, which it reads back at once (as its node does)
+    own: dict[str, float] = field(default_factory=dict)
 
 
 @dataclass
@@ -191,6 +199,9 @@ class Simulation:
         self._pending_live: list[Change] = []
         self._initialized = False
         self._cursor = 0  # next tick to execute
+        #: publications of delayed Leaves in flight: (due tick, sequence, [(buffer, value)])
+        self._deliveries: list[tuple[int, int, list[tuple[str, float]]]] = []
+        self._sent = 0
         self._build()
 
     @classmethod
@@ -256,6 +267,9 @@ class Simulation:
         periods = [1 / leaves[p].freq for p in self.world.order]
         periods += [1 / r for r, _, _ in self._hooks] + [1 / self.log_rate]
         instants = [at for at, _, _ in self._change_points()] + [self.duration]
+        #: each Leaf's timer phase (0 unless the world gives or draws one): on the grid
+        self.timer_phases = run_phases(self.world, self.seed)
+        instants += [ph for ph in self.timer_phases.values() if ph]
         self.grid = TickGrid.for_run(periods, instants)
         g = self.grid
         self._tick_num, self._tick_den = g.tick.numerator, g.tick.denominator
@@ -277,6 +291,9 @@ class Simulation:
             for port in leaf.template.outputs:
                 if port.array:
                     task.arrays_out[port.name] = arrays[f"{path}.{port.name}"]
+            task.phase = g.ticks(self.timer_phases[path])
+            if leaf.timing.delayed:
+                task.delay = DelayLine(leaf, g.tick, self.seed)
             self._tasks.append(task)
         self._log_period = g.ticks(1 / self.log_rate)
         hook_periods = [g.ticks(1 / r) for r, _, _ in self._hooks]
@@ -293,7 +310,7 @@ class Simulation:
             )
         table: dict[int, _Instant] = {}
         for task in self._tasks:
-            for off in range(0, self._cycle, task.period):
+            for off in range(task.phase, self._cycle, task.period):
                 table.setdefault(off, _Instant(off)).tasks.append(task)
         for off in range(0, self._cycle, self._log_period):
             table.setdefault(off, _Instant(off)).log = True
@@ -309,7 +326,7 @@ class Simulation:
             inst.tasks = [
                 (self._step_group, item)
                 if isinstance(item, batch.Group)
-                else (self._step_arrays if item.arrays_in or item.arrays_out else self._step, item)
+                else (self._runner(item), item)
                 for item in seq
             ]
             for item in seq:
@@ -328,6 +345,12 @@ class Simulation:
         self._row: Callable[[dict[str, float]], Sequence[float]] = (
             operator.itemgetter(*cols) if len(cols) > 1 else lambda v: [v[c] for c in cols]
         )
+
+    def _runner(self, task: _Task) -> Callable[[_Task, Fraction], None]:
+        """How a task steps: the lean scalar path, array ports, or through its delay line."""
+        if task.arrays_in or task.arrays_out:
+            return self._step_arrays
+        return self._step if task.delay is None else self._step_delayed
 
     # -- running --------------------------------------------------------------------------
     def run(self) -> RunResult:
@@ -439,7 +462,14 @@ class Simulation:
         return points
 
     def _enter_phases(self, tick: int) -> None:
-        """Apply the timeline changes due at or before ``tick`` (new phases and in-phase)."""
+        """Apply what is due at or before ``tick``: deliveries of delayed outputs, then the
+        timeline changes (new phases and in-phase). ``_next_phase_tick`` is the next tick at
+        which either is due, so the hot loop makes one comparison for both."""
+        deliveries = self._deliveries
+        if deliveries and deliveries[0][0] <= tick:
+            values = self.values
+            while deliveries and deliveries[0][0] <= tick:
+                values.update(heapq.heappop(deliveries)[2])
         points = self._points
         while self._point_index < len(points) and points[self._point_index][0] <= tick:
             at, phase, changes = points[self._point_index]
@@ -453,6 +483,21 @@ class Simulation:
                 self._now_override = None
         i = self._point_index
         self._next_phase_tick = points[i][0] if i < len(points) else math.inf
+        if deliveries and deliveries[0][0] < self._next_phase_tick:
+            self._next_phase_tick = deliveries[0][0]
+
+    def _send(self, line: DelayLine, writes: list[tuple[str, float]]) -> None:
+        """Put a delayed Leaf's publication in flight: visible from ``line.due(now)``."""
+        due = line.due(self._tick)
+        self._sent += 1
+        heapq.heappush(self._deliveries, (due, self._sent, writes))
+        if due < self._next_phase_tick:
+            self._next_phase_tick = due
+
+    def in_flight(self, buffer: str) -> int:
+        """How many publications of ``buffer`` are sent but not yet visible (the ROS
+        simulator tells a node which message its reader sees by this)."""
+        return sum(1 for _, _, writes in self._deliveries for b, _ in writes if b == buffer)
 
     def _step(self, task: _Task, now: Fraction) -> None:
         """Run one component: read its inputs, call ``do_step``, publish its outputs."""
@@ -475,6 +520,34 @@ class Simulation:
                 values[targets[key]] = number
         except (KeyError, TypeError, ValueError, OverflowError, AttributeError):
             raise self._bad_output(task, out) from None
+
+    def _step_delayed(self, task: _Task, now: Fraction) -> None:
+        """:meth:`_step` for a Leaf with latency or jitter: its outputs go into its delay
+        line instead of the buffers (it reads its own outputs back at once)."""
+        values = self.values
+        own = task.own
+        inp = {port: own.get(buf, values[buf]) for port, buf in task.inputs}
+        try:
+            out = task.comp.do_step(now, inp)
+        except RunFault:
+            raise
+        except COMPONENT_ERRORS as exc:
+            raise RunFault(self._who(task.path), now, f"do_step raised {exc!r}") from exc
+        if not out:
+            return
+        targets = task.targets
+        writes: list[tuple[str, float]] = []
+        try:
+            for key, value in out.items():
+                number = float(value)
+                if number - number != 0.0:  # inf or nan
+                    raise ValueError
+                writes.append((targets[key], number))
+        except (KeyError, TypeError, ValueError, OverflowError, AttributeError):
+            raise self._bad_output(task, out) from None
+        own.update(writes)
+        assert task.delay is not None
+        self._send(task.delay, writes)
 
     def _step_arrays(self, task: _Task, now: Fraction) -> None:
         """:meth:`_step` for a leaf with array ports (a lidar and its readers).
@@ -529,7 +602,10 @@ class Simulation:
                 writes.append((targets[key], number))
         except (KeyError, TypeError, ValueError):
             raise self._bad_output(task, scalars) from None
-        values.update(writes)
+        if task.delay is not None:
+            self._send(task.delay, writes)
+        else:
+            values.update(writes)
 
     def _step_group(self, group: batch.Group, now: Fraction) -> None:
         """Run a group of like components in one call (``engine/batch.py``)."""
@@ -578,7 +654,10 @@ class Simulation:
             if k is not None:
                 raise RunFault(self._who(group.paths[k]), now, f"output {port} is {arr[k]}")
             pairs = zip(bufs, arr.tolist(), strict=True)
-            values.update(pairs if mask is None else compress(pairs, mask))
+            if group.delay is not None:  # the copies' common latency (no jitter: batch.py)
+                self._send(group.delay, list(pairs if mask is None else compress(pairs, mask)))
+            else:
+                values.update(pairs if mask is None else compress(pairs, mask))
 
     def _bad_output(self, task: _Task, out: Any) -> RunFault:
         """The fault for the first output ``_step`` refused (a slow path: faults are rare)."""

@@ -24,9 +24,11 @@ from ..model.world import DEFAULT_FREQ_HZ
 from .amsacore import CompositeNode, LeafNode, Model, read_model
 from .amsatemplate import COMPATIBLE, TemplateDecl, read_templates
 
-#: Automatic scheduling of a loop: against the control flow, so each component of the loop
-#: reads what its upstream published one period earlier, as separate ROS nodes do.
-AUTO_ORDER = (Kind.PROCESS, Kind.ACTUATOR, Kind.CONTROLLER, Kind.SENSOR, Kind.OBSERVER)
+#: Automatic scheduling of a loop: in dataflow order, cut where the actuator feeds the process
+#: (the process applies the power commanded a period earlier, then its sensors, observers,
+#: controllers and actuators run on its new state). The loop's further delay is each
+#: component's ``latency`` (``model/timing.py``), which an AMSA model has no place for.
+AUTO_ORDER = (Kind.PROCESS, Kind.SENSOR, Kind.OBSERVER, Kind.CONTROLLER, Kind.ACTUATOR)
 
 
 @dataclass
@@ -317,12 +319,14 @@ class _Importer:
         self.warn(
             self.model.root.elem.line,
             f"the model leaves the order to automatic scheduling but its {loop}: scheduled "
-            f"against the control flow ({words}), each component reading what its upstream "
-            f"published one period earlier as separate ROS nodes do: [{', '.join(order)}]",
+            f"in dataflow order ({words}), the process applying what was commanded a period "
+            f"earlier; any further delay is a component's latency, which the model has no "
+            f"place for (set it in a scenario's set:): [{', '.join(order)}]",
         )
         self.notes.setdefault("", []).append(
             "schedule: not in the model (automatic scheduling with a dataflow loop): "
-            "ordered process, actuator, controller, sensor, observer"
+            f"dataflow order, {words}; the model has no latency (set a component's "
+            "latency in a scenario's set:)"
         )
         return order
 

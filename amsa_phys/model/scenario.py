@@ -20,6 +20,7 @@ from .rates import MAX_RATE_HZ, MIN_RATE_HZ, cycle_problem
 from .schema import MAX_SEED
 from .suggest import did_you_mean
 from .template import Kind
+from .timing import TIMING_KEYS, check_phase, set_timing
 from .wording import plural
 from .world import WorldSpec, build_world, load_world, resolved_values
 from .yamlio import MAX_NODES, KeyPath, YamlDoc, load_yaml, parse_value
@@ -32,6 +33,7 @@ METRICS = (
     "mean_error",
     "rms_error",
     "settling_time",
+    "max_after_approach",
     "final_distance",
     "collisions",
 )
@@ -95,6 +97,9 @@ class Quality:
     signal: str
     reference: float
     tolerance: float
+    #: seconds the signal must stay in the band for ``settling_time`` (None: the default,
+    #: ``engine/metrics.default_dwell`` of each block)
+    dwell: float | None = None
 
 
 @dataclass
@@ -263,7 +268,10 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
                 f"unknown Data {q['signal']!r}" + did_you_mean(q["signal"], world.buffers),
             )
         quality = Quality(
-            q["signal"], float(q["reference"]), float(q.get("tolerance", DEFAULT_TOLERANCE))
+            q["signal"],
+            float(q["reference"]),
+            float(q.get("tolerance", DEFAULT_TOLERANCE)),
+            None if q.get("dwell") is None else float(q["dwell"]),
         )
     expect = []
     for i, e in enumerate(data.get("expect", [])):
@@ -436,8 +444,10 @@ def _changes(
         try:
             if is_frequency(str(key), world):
                 if not frequencies:
+                    name = str(key).rpartition(".")[2]
+                    what = "frequency" if name == "freq" else name
                     raise ValueError(
-                        "a Leaf's frequency holds for the whole run: set it in set:, "
+                        f"a Leaf's {what} holds for the whole run: set it in set:, "
                         "not in the timeline"
                     )
                 set_frequency(str(key), value, world)
@@ -448,22 +458,35 @@ def _changes(
     return out
 
 
+#: Leaf keys a scenario may set for the whole run (``set: {Leaf.freq: 4}``) besides
+#: parameters: the frequency and the loop timing (``model/timing.py``).
+WHOLE_RUN_KEYS = ("freq", *TIMING_KEYS)
+
+
 def is_frequency(key: str, world: WorldSpec) -> bool:
-    """Whether ``key`` is ``Leaf.freq`` (and the Leaf's template has no parameter ``freq``)."""
+    """Whether ``key`` is ``Leaf.freq`` or a timing key (``Leaf.latency``, ``.jitter``,
+    ``.phase``) and the Leaf's template has no parameter of that name."""
     leaf_path, _, name = key.rpartition(".")
     leaf = world.leaves.get(leaf_path)
     return (
-        name == "freq" and leaf is not None and "freq" not in {p.name for p in leaf.template.params}
+        name in WHOLE_RUN_KEYS
+        and leaf is not None
+        and name not in {p.name for p in leaf.template.params}
     )
 
 
 def set_frequency(key: str, value: Any, world: WorldSpec) -> None:
-    """Give a Leaf another frequency for the whole run (``set: {Leaf.freq: 4}``).
+    """Give a Leaf another frequency (``set: {Leaf.freq: 4}``) or timing for the whole run.
 
     A value the world leaves to the scenario: an imported AMSA model whose Leaf has no
     frequency runs at the metamodel's 10 Hz unless a scenario says otherwise. The world's
-    Leaf itself changes, so the resolved scenario writes the frequency into its world.
+    Leaf itself changes, so the resolved scenario writes the value into its world.
     """
+    leaf_path, _, name = key.rpartition(".")
+    leaf = world.leaves[leaf_path]
+    if name != "freq":
+        set_timing(leaf.timing, name, value, leaf.freq)
+        return
     if isinstance(value, bool) or not isinstance(value, int | float | str):
         raise ValueError(f"expected a frequency in Hz, got {short_repr(value)}")
     try:
@@ -472,7 +495,10 @@ def set_frequency(key: str, value: Any, world: WorldSpec) -> None:
         raise ValueError(f"expected a frequency in Hz, got {short_repr(value)}") from None
     if freq <= 0 or freq > 1_000_000:
         raise ValueError(f"a frequency must be in (0, 1e6] Hz, got {value}")
-    world.leaves[key.rpartition(".")[0]].freq = freq
+    why = check_phase(leaf.timing, freq)
+    if why is not None:
+        raise ValueError(why)
+    leaf.freq = freq
 
 
 def resolve_change(key: str, value: Any, world: WorldSpec) -> Change:

@@ -119,6 +119,14 @@ WORLD: dict[str, Any] = {
         "physics": PHYSICS,
         "components": {"$ref": "#/$defs/components"},
         "schedule": {"type": "array", "items": {"type": "string"}, "uniqueItems": True},
+        "timing": {
+            "type": "object",
+            "additionalProperties": False,
+            "properties": {
+                "free_running": {"type": "boolean"},
+                "resolution": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
+            },
+        },
         "data": {
             "type": "object",
             "propertyNames": {"pattern": DATA_NAME},
@@ -166,6 +174,10 @@ WORLD: dict[str, Any] = {
             "properties": {
                 "template": {"type": "string", "minLength": 1},
                 "freq": _rate,
+                # loop timing (model/timing.py judges the values and words the errors)
+                "latency": {"type": ["number", "string"]},
+                "jitter": {"type": ["number", "string"]},
+                "phase": {"type": ["number", "string"]},
                 "params": {"type": "object"},
                 "inputs": {"type": "object", "additionalProperties": {"type": "string"}},
                 "description": {"type": "string"},
@@ -189,7 +201,12 @@ SCENARIO: dict[str, Any] = {
             "type": "object",
             "additionalProperties": False,
             "required": ["signal", "reference"],
-            "properties": {"signal": {"type": "string"}, "reference": _num, "tolerance": _pos},
+            "properties": {
+                "signal": {"type": "string"},
+                "reference": _num,
+                "tolerance": _pos,
+                "dwell": _nonneg,
+            },
         },
         "physics": PHYSICS,  # merged over the world's (model/scenario.py: with_physics)
         "set": {"type": "object"},

@@ -19,6 +19,7 @@ from .links import allowed_text, link_allowed
 from .rates import cycle_problem
 from .suggest import did_you_mean
 from .template import BUILTINS, Template, TemplateNotFound, resolve_template
+from .timing import TIMING_KEYS, LeafTiming, set_timing
 from .yamlio import KeyPath, YamlDoc, load_yaml
 
 #: The AMSA metamodel's default frequency (``TimeableObject.freq`` in amsaCore.ecore).
@@ -50,6 +51,8 @@ class LeafSpec:
     #: input port -> buffer name (``Producer.path.output``)
     inputs: dict[str, str]
     keypath: KeyPath
+    #: transport latency, jitter and timer phase (``model/timing.py``)
+    timing: LeafTiming = field(default_factory=LeafTiming)
 
     @property
     def kind(self) -> Any:
@@ -93,6 +96,13 @@ class WorldSpec:
     data_names: dict[str, str] = field(default_factory=dict)
     #: array outputs: ``Lidar.ranges`` -> its element buffers ``Lidar.ranges[0]``, ...
     arrays: dict[str, list[str]] = field(default_factory=dict)
+    #: the world's ``timing:`` section (``free_running``, ``resolution``)
+    timing: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def free_running(self) -> bool:
+        """Whether Leaves without their own ``phase`` get a random one."""
+        return bool(self.timing.get("free_running", False))
 
     def error(self, keypath: KeyPath, message: str) -> ConfigError:
         """A ConfigError at ``keypath`` (relative to this world) in its source file."""
@@ -218,6 +228,7 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
         schedule=schedule,
         data_names=names,
         arrays=arrays,
+        timing=dict(data.get("timing", {})),
     )
 
 
@@ -401,6 +412,13 @@ def _build_leaf(
         template.check_params(params)
     except ValueError as exc:
         raise err((*kp, "params"), str(exc)) from None
+    timing = LeafTiming()
+    for key in TIMING_KEYS:
+        if key in body:
+            try:
+                set_timing(timing, key, body[key], freq)
+            except ValueError as exc:
+                raise err((*kp, key), str(exc)) from None
     return LeafSpec(
         path=path,
         template=template,
@@ -409,6 +427,7 @@ def _build_leaf(
         params=params,
         inputs={},
         keypath=kp,
+        timing=timing,
     )
 
 

@@ -29,6 +29,7 @@ from matplotlib.path import Path as MplPath
 from matplotlib.transforms import Bbox
 
 from ..atomic import write_atomic
+from ..model.timing import RANDOM, LeafTiming
 from ..model.wording import plural
 from ..model.world import WorldSpec
 from .save import save_png
@@ -44,7 +45,8 @@ KIND_COLOURS = {
 
 
 def edges(world: WorldSpec) -> list[tuple[str, str, str]]:
-    """(producer, consumer, label) for every link, label ``output -> port``."""
+    """(producer, consumer, label) for every link, label ``output -> port``; a link whose
+    producer has latency or jitter says how late its Data arrive (``+0.75 s``)."""
     out = []
     for path, leaf in world.leaves.items():
         for port, buffer in leaf.inputs.items():
@@ -52,8 +54,28 @@ def edges(world: WorldSpec) -> list[tuple[str, str, str]]:
             label = output if output == port else f"{output}→{port}"
             if buffer in world.arrays:  # an array link: say how many Data it carries
                 label += f" [{len(world.arrays[buffer])}]"
+            source = world.leaves.get(producer)
+            if source is not None and source.timing.delayed:
+                label += f" {delay_text(source.timing)}"
             out.append((producer, path, label))
     return out
+
+
+def delay_text(t: LeafTiming) -> str:
+    """``+0.75 s``, or ``+0.75..0.85 s`` with jitter: how late a Leaf's outputs arrive."""
+    lo = float(t.latency)
+    if not t.jitter:
+        return f"+{lo:g} s"
+    return f"+{lo:g}..{lo + float(t.jitter):g} s"
+
+
+def phase_text(world: WorldSpec, t: LeafTiming) -> str:
+    """`` · phase 0.1 s`` or `` · phase random`` for a Leaf whose timer is shifted."""
+    if t.phase == RANDOM or (t.phase is None and world.free_running):
+        return " · phase random"
+    if t.phase:
+        return f" · phase {float(t.phase):g} s"
+    return ""
 
 
 @dataclass(frozen=True)
@@ -65,12 +87,14 @@ class Node:
     kind: str
     freq: float
     count: int = 1
+    #: `` · phase 0.1 s`` when the Leaf's timer is shifted (``phase_text``)
+    phase: str = ""
 
     @property
     def subtitle(self) -> str:
-        """``controlledRobot · 4 Hz``, with ``· ×10`` for copies."""
+        """``controlledRobot · 4 Hz``, with ``· ×10`` for copies and the timer's phase."""
         copies = f" · ×{self.count}" if self.count > 1 else ""
-        return f"{self.template} · {self.freq:g} Hz{copies}"
+        return f"{self.template} · {self.freq:g} Hz{self.phase}{copies}"
 
 
 @dataclass
@@ -112,7 +136,13 @@ def structure(world: WorldSpec, collapse: bool = True) -> Structure:
             nodes[name] = replace(nodes[name], count=nodes[name].count + 1)
         else:
             kind = leaf.kind.value
-            nodes[name] = Node(name, leaf.template.name(), kind, float(leaf.freq))
+            nodes[name] = Node(
+                name,
+                leaf.template.name(),
+                kind,
+                float(leaf.freq),
+                phase=phase_text(world, leaf.timing),
+            )
     numbers: dict[str, set[int]] = {}
     for name, number in copy_of.values():
         numbers.setdefault(name, set()).add(number)

@@ -8,12 +8,26 @@ from fractions import Fraction
 from typing import Any
 
 from ..model.scenario import Change, Expectation, Scenario
+from ..model.timing import TIMING_KEYS, LeafTiming
 from ..model.world import LeafSpec
 
 
 def _number(x: Fraction | float) -> float | int:
     f = float(x)
     return int(f) if f.is_integer() else f
+
+
+def _write_timing(body: dict[str, Any], timing: LeafTiming) -> None:
+    """A Leaf's latency, jitter and phase as the run used them (a scenario's ``set:``
+    included); keys left at their defaults are left out."""
+    for key in TIMING_KEYS:
+        body.pop(key, None)
+    if timing.latency:
+        body["latency"] = _time(timing.latency)
+    if timing.jitter:
+        body["jitter"] = _time(timing.jitter)
+    if timing.phase is not None:
+        body["phase"] = timing.phase if isinstance(timing.phase, str) else _time(timing.phase)
 
 
 def _time(t: Fraction) -> float | int | str:
@@ -67,6 +81,7 @@ def resolved_scenario(
             leaf: LeafSpec = scenario.world.leaves[path]
             body["freq"] = _number(leaf.freq)
             body["params"] = {k: _plain(v) for k, v in leaf.params.items()}
+            _write_timing(body, leaf.timing)
 
     fill(world["components"], "")
     if scenario.world.schedule:
@@ -108,6 +123,8 @@ def resolved_scenario(
     if scenario.quality:
         q = scenario.quality
         out["quality"] = {"signal": q.signal, "reference": q.reference, "tolerance": q.tolerance}
+        if q.dwell is not None:
+            out["quality"]["dwell"] = q.dwell
     timeline = [at for at in sorted(entries) if at < end]
     if timeline:
         out["timeline"] = []

@@ -139,6 +139,7 @@ def _metrics(
                     q.tolerance,
                     collisions,
                     include_end=last,
+                    dwell=q.dwell,
                 )
             )
         else:
@@ -156,6 +157,7 @@ def _metrics(
             q.tolerance,
             collisions,
             include_end=True,
+            dwell=q.dwell,
         )
     else:
         overall = {"collisions": len(collisions)}
@@ -168,9 +170,7 @@ def _metrics(
         "duration": float(scenario.duration),
         "simulated": result.t_end,
         "status": status,
-        "quality": (
-            {"signal": q.signal, "reference": q.reference, "tolerance": q.tolerance} if q else None
-        ),
+        "quality": (_quality_json(q) if q else None),
         "overall": overall,
         "phases": phases,
         "events": [{"t": e.t, "kind": e.kind, "detail": e.detail} for e in result.events[:1000]],
@@ -178,6 +178,14 @@ def _metrics(
         **({"paused_s": round(idle_s, 3)} if idle_s > 0 else {}),
         "real_time_factor": round(result.t_end / busy, 1) if busy > 0 else None,
     }
+
+
+def _quality_json(q: Any) -> dict[str, Any]:
+    """The ``quality`` entry of ``metrics.json`` (``dwell`` only when the scenario sets it)."""
+    out = {"signal": q.signal, "reference": q.reference, "tolerance": q.tolerance}
+    if q.dwell is not None:
+        out["dwell"] = q.dwell
+    return out
 
 
 def _changes_within(

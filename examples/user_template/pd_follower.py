@@ -1,7 +1,7 @@
 """A user template: a PD follower controller, loaded by a world as ``pd_follower:PDFollower``.
 
 The paper's proportional law (``FollowerController``) oscillates in the nominal context at
-Kv = 0.35: a distance measured at 4 Hz reaches the wheels 0.75 s later. A derivative term on
+Kv = 0.35: a distance measured at 4 Hz reaches the wheels 1 s later. A derivative term on
 the distance error (the closing speed) damps that. Run it with::
 
     PYTHONPATH=examples/user_template amsa-phys run examples/user_template/scenario.yaml --headless

@@ -112,14 +112,23 @@ def test_imported_model_runs_like_the_projects_world(
     }
     assert "LeaderGPS.stddev" in noise
     assert "Follower.stallForce" in noise
+    # so is the loop timing: the 2019 model has no latency (its ROS nodes had one)
+    noise["MyFollowerController.latency"] = project.leaves["MyFollowerController"].timing.latency
+    assert noise["MyFollowerController.latency"] > 0
     theirs = tmp_path / "theirs.yaml"
+    # and the floor the paper-calibrated rovers drive on (the model has no physics)
+    ground = project.physics["ground"]
     theirs.write_text(
         f"world: {imported}\n{common}"
+        f"physics: {{ground: {{rolling_resistance: {ground['rolling_resistance']!r}}}}}\n"
         "set: {Leader.behavior: 4, MyFollowerController.Kv: 0.35,\n"
         # the values the original model leaves empty
         "      Leader.x: 15.0, MyFollowerController.Kw: 0.04, MyNormalizePower.motorCoef: 100,\n"
         "      MyNormalizePower.freq: 4, MyDistanceMonitor.freq: 4, Leader.freq: 10,\n"
-        + "".join(f"      {k}: {v!r},\n" for k, v in noise.items())
+        + "".join(
+            f"      {k}: {str(v) if k.endswith('latency') else repr(v)},\n"
+            for k, v in noise.items()
+        )
         + "}\n"
     )
     traces = []

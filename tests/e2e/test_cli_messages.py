@@ -45,7 +45,8 @@ def test_describe_shows_the_values_in_force_at_t0_and_their_source(
     assert "Kv = 0.35 1/m  [0, 10]  (scenario set; world 0.05)" in lines  # not the world's 0.05
     assert "Kw = 0.1 1/rad  [0, 10]  (--set; world 0.04)" in lines
     assert "distanceRef = 15.0 m  [0, 1000]  (world)" in lines
-    assert "Kff = 1.0  [0, 2]  (default)" in lines
+    assert "Kff = 0.0  [0, 2]  (default)" in lines  # the paper's law: no feed-forward
+    assert "MyFollowerController: FollowerController (controller) at 4 Hz, latency 0.75 s" in lines
     physics = next(line for line in lines if line.startswith("physics:"))
     assert "ground.friction 0.5 (--set)" in physics
     assert "gravity 9.81 (default)" in physics

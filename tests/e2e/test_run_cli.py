@@ -119,7 +119,7 @@ def test_existing_out_dir_is_not_overwritten_without_force(
 def test_summary_table_is_printed(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     main(["run", str(SCENARIO1), "--headless", "--out", str(tmp_path / "x"), "--duration", "10"])
     out = capsys.readouterr().out
-    assert out.splitlines()[0].split()[:4] == ["phase", "start", "max", "min"]
+    assert out.splitlines()[0].split()[:5] == ["phase", "start", "max", "max", "after"]
     assert "real time" in out
 
 
@@ -137,10 +137,14 @@ def test_validate_describe_templates(capsys: pytest.CaptureFixture[str]) -> None
     assert main(["validate", str(shipped), str(ROOT / "worlds" / "mde_challenge.yaml")]) == 0
     assert main(["describe", str(shipped)]) == 0
     text = capsys.readouterr().out
-    assert "MyFollowerController: FollowerController (controller) at 4 Hz" in text
+    assert "MyFollowerController: FollowerController (controller) at 4 Hz, latency 0.75 s" in text
     assert "Kv = 0.35 1/m  [0, 10]" in text or "Kv = 0.05 1/m  [0, 10]" in text
-    assert "execution order at a shared instant: Leader -> Follower -> MyNormalizePower" in text
-    assert "expect rms_error (phase 0) above 2\nexpect rms_error (phase 3) below 0.1\n" in text
+    assert (
+        "execution order at a shared instant: Leader -> Follower -> LeaderGPS -> FollowerGPS"
+        " -> FollowerCompass -> MyDistanceMonitor -> MyFollowerController -> MyNormalizePower"
+    ) in text
+    assert "loop timing: outputs of MyFollowerController reach their readers after" in text
+    assert "expect rms_error (phase 0) above 2\nexpect settling_time (phase 3) below 60\n" in text
     assert main(["templates"]) == 0
     text = capsys.readouterr().out
     for name in (

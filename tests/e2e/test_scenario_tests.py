@@ -19,7 +19,7 @@ FAILING = ROOT / "tests" / "fixtures" / "failing_expect.yaml"
 def test_shipped_scenarios_pass(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["test", str(ROOT / "scenarios"), "-j", "2"]) == 0
     out = capsys.readouterr().out
-    assert "4 scenarios, 9 checks: 9 passed, 0 failed" in out
+    assert "9 scenarios, 20 checks: 20 passed, 0 failed" in out
 
 
 def test_failing_scenario_gives_exit_1_a_table_and_junit(
@@ -76,7 +76,7 @@ def test_pytest_collects_scenarios_in_a_users_project(tmp_path: Path) -> None:
     )
     assert proc.returncode == 1, proc.stdout
     assert "1 failed, 1 passed" in proc.stdout
-    assert "max_distance = 20.15, below 16: FAIL" in proc.stdout
+    assert "max_distance = 27.4, below 16: FAIL" in proc.stdout
     assert "Traceback" not in proc.stdout
 
 

@@ -32,7 +32,10 @@ def circling_scenario(tmp_path: Path, duration: float = 20) -> Path:
         "quality: {signal: MyDistanceMonitor.distanceFollowerToLeader, reference: 15,"
         " tolerance: 1.5}\n"
         "set: {Leader.behavior: 2, Leader.circleRadius: 8, MyFollowerController.Kv: 0.1,"
-        " LeaderGPS.lostDataGPS: 30}\n"
+        " LeaderGPS.lostDataGPS: 30, Leader.cruisePower: 22, Leader.stallForce: 45,"
+        " Leader.maxWheelTorque: 4.5, Follower.stallForce: 45, Follower.maxWheelTorque: 4.5}\n"
+        # fast rovers on ordinary ground (the world's paper-calibrated ones are slow)
+        "physics: {ground: {rolling_resistance: 0.02}}\n"
     )
     return path
 

@@ -106,7 +106,7 @@ SWEEP_CASES = {
     ),
     "short-row": (
         _edit("results.csv", lambda t: t.rsplit(",", 1)[0] + "\n"),
-        "results.csv:3: not a sweep's results.csv: 18 cells where the header has 19",
+        "results.csv:3: not a sweep's results.csv: 20 cells where the header has 21",
     ),
     "text-cell": (
         _edit("results.csv", _text_cell),

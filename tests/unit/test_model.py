@@ -81,3 +81,32 @@ def test_metrics_by_hand() -> None:
     assert first["settling_time"] == 4.0
     never = block_metrics(t, np.full_like(t, 30.0), 0, 10, 15, 1.5, [], include_end=True)
     assert never["settling_time"] is None
+
+
+def test_settling_needs_a_dwell_in_the_band() -> None:
+    """Back in the band only for its last samples is not settled (issue 15: Kv = 0.35
+    "settled at 300 s" in a 300 s run, at None in a 290 s one)."""
+    t = np.arange(0.0, 300.05, 0.05)
+    s = np.where(t < 297, 20.0, 15.0)  # in the band for the last 3 s only
+    m = block_metrics(t, s, 0.0, 300.0, 15.0, 1.5, [], include_end=True)
+    assert m["settling_time"] is None  # default dwell: 10 s
+    s = np.where(t < 290, 20.0, 15.0)  # 10 s: settled
+    m = block_metrics(t, s, 0.0, 300.0, 15.0, 1.5, [], include_end=True)
+    assert m["settling_time"] == pytest.approx(290.0)
+    assert block_metrics(t, s, 0.0, 300.0, 15.0, 1.5, [], True, dwell=11.0)["settling_time"] is None
+    # a short block: a tenth of it (2 s of a 20 s block)
+    short = (t >= 100) & (t <= 120)
+    s = np.where(t < 117, 20.0, 15.0)
+    m = block_metrics(t[short], s[short], 100.0, 120.0, 15.0, 1.5, [], include_end=True)
+    assert m["settling_time"] == pytest.approx(17.0)
+
+
+def test_max_after_the_first_approach_is_the_papers_quality_figure() -> None:
+    t = np.arange(0.0, 60.0, 0.5)
+    # starts 40 m away, comes within tolerance at 20 s, then swings out to 24 m and back
+    s = np.interp(t, [0, 20, 30, 40, 60], [40.0, 15.0, 24.0, 15.0, 15.0])
+    m = block_metrics(t, s, 0.0, 60.0, 15.0, 1.5, [], include_end=True)
+    assert m["max_distance"] == 40.0
+    assert m["max_after_approach"] == 24.0
+    far = block_metrics(t, np.full_like(t, 30.0), 0.0, 60.0, 15.0, 1.5, [], include_end=True)
+    assert far["max_after_approach"] is None  # never approached

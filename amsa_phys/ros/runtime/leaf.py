@@ -6,16 +6,22 @@ Inputs are ``std_msgs/Float64`` topics ``/Producer/output``; outputs are publish
 
 **lockstep** (reproduces ``amsa-phys run``): the simulator sends ``step SEQ NUM DEN C1..Cn``
 on ``/amsa/step/Leaf`` — the instant as an exact fraction and, for each input topic, how many
-messages it has carried so far. The node steps once it has received exactly that many on
-each (messages on different topics travel on different connections, so a count, not arrival
-order, says an input is current), publishes its outputs, then answers ``done SEQ I..`` (the
-outputs it published) on ``/amsa/done/Leaf``. ``param SEQ NAME`` re-reads one parameter
-(a timeline change, at its exact instant). The steps are driven by whichever callback
-completes the condition last: no thread ever blocks waiting for another.
+of its messages the Leaf sees at that instant (all it has carried so far, less those a
+producer's ``latency`` still holds in flight in the engine). The node steps once it has
+received at least that many on each (messages on different topics travel on different
+connections, so a count, not arrival order, says an input is current) and reads message
+number C of each — the latest, unless a delayed producer has published later ones it must
+not see yet (it keeps those until they are due) —, publishes its outputs, then
+answers ``done SEQ I..`` (the outputs it published) on ``/amsa/done/Leaf``.
+``param SEQ NAME`` re-reads one parameter (a timeline change, at its exact instant). The
+steps are driven by whichever callback completes the condition last: no thread ever blocks
+waiting for another.
 
 **free** (as the paper's generated nodes ran): the node steps on its own timer at its own
-rate in simulated time (``/clock``), with whatever its inputs hold then, and picks up
-parameter changes (the scenario's, or a user's ``rosparam set``) at its next step.
+rate in simulated time (``/clock``), from its ``phase`` (drawn as the engine draws it for a
+random one), with whatever its inputs hold then, and picks up parameter changes (the
+scenario's, or a user's ``rosparam set``) at its next step. Latency and jitter are then the
+real network's and timers', not the world's.
 """
 
 from __future__ import annotations
@@ -25,6 +31,7 @@ import threading
 from fractions import Fraction
 from typing import Any
 
+from ...engine.timing import leaf_phase
 from ...errors import AmsaError, ConfigError
 from .. import names
 from ..graph import NodeContext
@@ -56,6 +63,12 @@ class LeafNode:
         self.outputs = graph.outputs(path)
         self.count = {b: 0 for b in self.buffers}
         self.value = {b: float(world.buffers[b].initial) for b in self.buffers}
+        #: messages of delayed producers by number (0: the initial value), kept until the
+        #: simulator says a later one is due; other producers' readers need only the latest
+        self.delayed = {
+            b for b in self.buffers if world.leaves[b.rpartition(".")[0]].timing.delayed
+        }
+        self.history: dict[str, dict[int, float]] = {b: {0: self.value[b]} for b in self.delayed}
         self.own = {b: float(world.buffers[b].initial) for b in self.outputs}
         self.pending: list[str] | None = None
         self.subs = [
@@ -82,6 +95,8 @@ class LeafNode:
         with self.lock:
             self.count[buffer] += 1
             self.value[buffer] = msg.data
+            if buffer in self.history:
+                self.history[buffer][self.count[buffer]] = msg.data
             if self.pending is not None:
                 self._try()
 
@@ -104,10 +119,21 @@ class LeafNode:
         if any(h < c for h, c in zip(have, counts, strict=True)):
             return  # an input message is still on its way
         self.pending = None
-        if have != counts:
+        ahead = [
+            h != c and b not in self.delayed
+            for b, h, c in zip(self.buffers, have, counts, strict=True)
+        ]
+        if any(ahead):
             self._reply(seq, ("fault", f"inputs out of step: received {have}, expected {counts}"))
             return
-        self._reply(seq, self._step(Fraction(int(req[2]), int(req[3]))))
+        seen = dict(self.value)
+        for b, c in zip(self.buffers, counts, strict=True):
+            if b in self.history:  # message number c is what the Leaf sees now
+                kept = self.history[b]
+                seen[b] = kept[c]
+                for old in [k for k in kept if k < c]:
+                    del kept[old]
+        self._reply(seq, self._step(Fraction(int(req[2]), int(req[3])), seen))
 
     def _reply(self, seq: str, result: tuple[str, str]) -> None:
         kind, text = result
@@ -117,13 +143,15 @@ class LeafNode:
         self.done.publish(self.String("\n".join(lines)))
 
     # -- stepping (both modes) --------------------------------------------------------------
-    def _inputs(self) -> dict[str, float]:
-        return {port: (self.own[b] if b in self.own else self.value[b]) for port, b in self.ports}
+    def _inputs(self, seen: dict[str, float] | None = None) -> dict[str, float]:
+        value = self.value if seen is None else seen
+        return {port: (self.own[b] if b in self.own else value[b]) for port, b in self.ports}
 
-    def _step(self, t: Fraction) -> tuple[str, str]:
-        """``do_step`` at ``t``; publish the outputs; the answer for the simulator."""
+    def _step(self, t: Fraction, seen: dict[str, float] | None = None) -> tuple[str, str]:
+        """``do_step`` at ``t`` on ``seen`` (default: the latest messages); publish the
+        outputs; the answer for the simulator."""
         try:
-            out = self.comp.do_step(t, self._inputs())
+            out = self.comp.do_step(t, self._inputs(seen))
         except Exception as exc:  # the engine reports it as "do_step raised ..."
             return "error", repr(exc)
         values: list[tuple[int, float]] = []
@@ -164,17 +192,19 @@ class LeafNode:
         """Step at the Leaf's own rate in simulated time until shutdown."""
         clock = rosio.ClockFollower(self.rospy)
         period = 1 / self.leaf.freq
+        world = self.cfg.scenario.world
+        phase = leaf_phase(self.leaf, world, self.cfg.scenario.seed)
         k = 0
         missed = 0
         while not self.rospy.is_shutdown():
-            t = k * period
+            t = phase + k * period
             if not clock.wait_until(rosio.to_ns(t)):
                 break
-            late = Fraction(clock.ns, 1_000_000_000) // period
+            late = (Fraction(clock.ns, 1_000_000_000) - phase) // period
             if late > k:  # more than a period late: skip to the latest due instant
                 missed += int(late - k)
                 k = int(late)
-                t = k * period
+                t = phase + k * period
             self._refresh_params()
             with self.lock:
                 kind, text = self._step(t)

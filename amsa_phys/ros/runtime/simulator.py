@@ -193,7 +193,12 @@ class Link:
         if not self.lockstep:
             return {}
         self.publish_clock(t)
-        counts = " ".join(str(self.published[b]) for b in self.graph.input_buffers(path))
+        sim = self.sim
+        # what the Leaf sees: every message so far, less a delayed producer's in flight
+        counts = " ".join(
+            str(self.published[b] - (sim.in_flight(b) if sim is not None else 0))
+            for b in self.graph.input_buffers(path)
+        )
         head = self._request(path, "step", f"{t.numerator} {t.denominator} {counts}", t, "a step")
         kind, text = head[0], head[2] if len(head) > 2 else ""
         who = f"{path} ({self.graph.leaf(path).template.name()})"
