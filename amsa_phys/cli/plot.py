@@ -17,7 +17,17 @@ from ..runs.sweep import read_results, unknown_metric
 def add_args(p: argparse.ArgumentParser) -> None:
     """Arguments of ``amsa-phys plot``."""
     p.add_argument(
-        "rundir", help="a run directory (`amsa-phys run`) or a sweep directory (`amsa-phys sweep`)"
+        "rundir",
+        nargs="*",
+        help="a run directory (`amsa-phys run`) or a sweep directory (`amsa-phys sweep`); "
+        "with --paper: the runs to draw, as run directories or scenario files (run in memory; "
+        "default scenarios/paper_fig5_kv*.yaml or scenarios/paper_fig6.yaml)",
+    )
+    p.add_argument(
+        "--paper",
+        choices=("fig5", "fig6"),
+        help="the paper's Fig. 5 or Fig. 6 redrawn from the runs, beside the paper's numbers "
+        "(-o default: paper_fig5.png / paper_fig6.png)",
     )
     p.add_argument(
         "-o",
@@ -34,7 +44,15 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Draw the plot."""
-    rundir = Path(args.rundir)
+    if args.paper:
+        if args.metric is not None:
+            raise ConfigError("only for a sweep directory (with results.csv)", key="--metric")
+        return _plot_paper(args)
+    if len(args.rundir) != 1:
+        raise ConfigError(
+            "expected one run or sweep directory (several only with --paper)", key="plot"
+        )
+    rundir = Path(args.rundir[0])
     if not rundir.is_dir():
         raise ConfigError(
             "no such directory" if not rundir.exists() else "not a directory", file=rundir
@@ -94,6 +112,87 @@ def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
             f" (null: e.g. never settled), {failed} failed"
         )
     return 0
+
+
+def _plot_paper(args: argparse.Namespace) -> int:
+    """``--paper fig5|fig6``: run (or read) the paper's scenarios and draw the figure."""
+    from ..plots import paper  # matplotlib: only once the runs are in
+
+    sources = [Path(s) for s in args.rundir] or _paper_scenarios(args.paper)
+    out = Path(args.output) if args.output else Path(f"paper_{args.paper}.png")
+    check_output(out, "--output")
+    runs = [_paper_run(src) for src in sources]
+    if args.paper == "fig5":
+        runs.sort(key=lambda r: -(r.kv if r.kv is not None else -1.0))
+        paper.fig5(runs, out)
+    else:
+        if len(runs) != 1:
+            raise ConfigError("Fig. 6 is one run (Kv 0.35, then 0.05)", key="--paper fig6")
+        paper.fig6(runs[0], out)
+    print(one_line(f"wrote {out} ({len(runs)} run{'s' if len(runs) != 1 else ''})"))
+    return 0
+
+
+def _paper_scenarios(figure: str) -> list[Path]:
+    """The shipped scenarios of a figure, found under ./scenarios."""
+    pattern = "paper_fig5_kv*.yaml" if figure == "fig5" else "paper_fig6.yaml"
+    found = sorted(Path("scenarios").glob(pattern))
+    if not found:
+        raise ConfigError(
+            f"no scenarios/{pattern} here: run it from the project's folder or name the "
+            "scenarios or run directories",
+            key=f"--paper {figure}",
+        )
+    return found
+
+
+def _paper_run(source: Path) -> Any:
+    """A :class:`~amsa_phys.plots.paper.PaperRun` from a run directory or a scenario file."""
+    from ..plots.distance import read_trace
+    from ..plots.paper import PaperRun
+
+    if source.is_dir():
+        for name in ("trace.csv", "metrics.json", "scenario.yaml"):
+            if not (source / name).is_file():
+                raise ConfigError(f"not a run directory: {name} is missing", file=source)
+        metrics = read_metrics(source / "metrics.json")
+        columns, data = read_trace(source / "trace.csv")
+        scenario = load_scenario(source / "scenario.yaml")
+    else:
+        from ..engine import interrupt
+        from ..engine.tracemem import TraceMemory
+        from ..runs.single import execute
+
+        scenario = load_scenario(source)
+        memory = TraceMemory(list(scenario.world.buffers))
+        with interrupt.deferred():
+            ended = execute(scenario, memory, progress=False)
+        if ended.error is not None:
+            raise ended.error
+        metrics = ended.metrics
+        columns, data = ["t", *memory.columns], memory.matrix()
+    q = metrics.get("quality")
+    if not q or q["signal"] not in columns:
+        raise ConfigError("the run has no quality signal to draw", file=source)
+    t, d = data[:, 0], data[:, columns.index(q["signal"])]
+    return PaperRun(_label(source, scenario), _kv(scenario), t, d, metrics)
+
+
+def _kv(scenario: Any) -> float | None:
+    """The controller's Kv at t = 0 (the world's, or the scenario's set:), if it has one."""
+    for path, leaf in scenario.world.leaves.items():
+        if "Kv" in leaf.params and leaf.kind.value == "controller":
+            value = leaf.params["Kv"]
+            for change in scenario.phases[0].changes:
+                if change.leaf == path and change.param == "Kv":
+                    value = change.value
+            return float(value)
+    return None
+
+
+def _label(source: Path, scenario: Any) -> str:
+    kv = _kv(scenario)
+    return one_line(f"{scenario.name}" + (f": Kv = {kv:g}" if kv is not None else ""))
 
 
 def read_metrics(path: Path) -> dict[str, Any]:

@@ -26,6 +26,7 @@ from xml.sax.saxutils import escape, quoteattr
 import yaml
 
 from .. import __version__
+from ..engine.timing import run_phases
 from ..errors import ConfigError
 from ..model.scenario import Scenario
 from ..model.template import BUILTINS
@@ -280,7 +281,8 @@ def _cpp_node(graph: RosGraph, path: str, pkg: str, source: str, bodies: dict[st
     buffers = graph.input_buffers(path)
     outputs = graph.outputs(path)
     topics = [
-        f"{{{_cpp_string(names.topic(b))}, {_cpp_double(world.buffers[b].initial)}}}"
+        f"{{{_cpp_string(names.topic(b))}, {_cpp_double(world.buffers[b].initial)}, "
+        f"{str(world.leaves[world.buffers[b].producer].timing.delayed).lower()}}}"
         for b in buffers
     ]
     inputs = []
@@ -344,6 +346,7 @@ def _params_yaml(scenario: Scenario) -> str:
     values = {path: dict(leaf.params) for path, leaf in scenario.world.leaves.items()}
     for change in scenario.phases[0].changes:
         values[change.leaf][change.param] = change.value
+    phases = run_phases(scenario.world, scenario.seed)
     tree: dict[str, Any] = {}
     for path, params in values.items():
         node = tree
@@ -351,6 +354,8 @@ def _params_yaml(scenario: Scenario) -> str:
             node = node.setdefault(part, {})
         for name, value in params.items():
             node[name] = _plain(value)
+        if phases[path]:  # the timer's phase, for a C++ node in free mode ("NUM/DEN" s)
+            node["amsa_phase"] = f"{phases[path].numerator}/{phases[path].denominator}"
     head = (
         f"# ROS parameters of {scenario.name} at t = 0 (the world's values and the scenario's\n"
         "# set:), loaded by the launch file; the scenario node changes them along the timeline.\n"

@@ -62,7 +62,10 @@ def test_package_has_a_node_per_leaf_a_topic_per_data_a_parameter_per_parameter(
     # one parameter per Parameter, at t = 0 the world's values with the scenario's set:
     params = yaml.safe_load((pkg / "config" / "ros_short_params.yaml").read_text())
     for path, leaf in scenario.world.leaves.items():
-        assert set(params[path]) == {p.name for p in leaf.template.params}
+        # and a shifted timer's phase, for a C++ node in free mode (Python nodes draw it)
+        timer = {"amsa_phase"} if path == "MyDistanceMonitor" else set()
+        assert set(params[path]) == {p.name for p in leaf.template.params} | timer
+    assert params["MyDistanceMonitor"]["amsa_phase"] == "1/8"
     assert params["MyFollowerController"]["Kv"] == 0.1
     assert params["LeaderGPS"]["lostDataGPS"] == 10
     assert params["Leader"]["x"] == 15.0

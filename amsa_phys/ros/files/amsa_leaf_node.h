@@ -5,9 +5,11 @@
 //  - inputs: std_msgs/Float64 topics /Producer/output; outputs: /Leaf/output;
 //  - parameters /Leaf/param, checked against the template's [min, max] whenever they change;
 //  - lockstep: "step SEQ NUM DEN C1..Cn" on /amsa/step/Leaf: step at t = NUM/DEN once each
-//    input topic has carried Ci messages, publish the outputs, answer "done SEQ I.." on
-//    /amsa/done/Leaf; "param SEQ NAME" re-reads one parameter;
-//  - free: step at the Leaf's own rate in simulated time (/clock) with the latest inputs;
+//    input topic has carried Ci messages, reading message number Ci of each (a delayed
+//    producer's later messages are kept until they are due), publish the outputs, answer
+//    "done SEQ I.." on /amsa/done/Leaf; "param SEQ NAME" re-reads one parameter;
+//  - free: step at the Leaf's own rate in simulated time (/clock), from its timer's phase
+//    (parameter /Leaf/amsa_phase, "NUM/DEN" seconds), with the latest inputs;
 //  - start-up: wait until every publisher has its subscribers, then say so on /amsa/ready.
 #pragma once
 
@@ -38,6 +40,7 @@ struct InputPort {
 struct Topic {
   std::string name;
   double initial;
+  bool delayed;  // its producer has latency or jitter: readers may be told an older message
 };
 
 struct OutputPort {
@@ -88,7 +91,11 @@ class LeafNode {
     if (!checkParams(&error)) return fail(error);
     count_.assign(topics_.size(), 0);
     latest_.clear();
-    for (const Topic& t : topics_) latest_.push_back(t.initial);
+    history_.assign(topics_.size(), std::map<std::int64_t, double>());
+    for (std::size_t i = 0; i < topics_.size(); ++i) {
+      latest_.push_back(topics_[i].initial);
+      if (topics_[i].delayed) history_[i][0] = topics_[i].initial;
+    }
     for (const OutputPort& o : outputs_) own_.push_back(o.initial);
 
     ros::AsyncSpinner spinner(2);
@@ -214,6 +221,7 @@ class LeafNode {
     std::lock_guard<std::mutex> lock(mutex_);
     count_[i] += 1;
     latest_[i] = value;
+    if (topics_[i].delayed) history_[i][count_[i]] = value;
     if (!pending_.empty()) tryPending();
     cond_.notify_all();
   }
@@ -250,18 +258,28 @@ class LeafNode {
       if (count_[i] < want[i]) return;  // an input message is still on its way
     pending_.clear();
     for (std::size_t i = 0; i < want.size() && i < count_.size(); ++i)
-      if (count_[i] != want[i]) { reply("fault " + seq + " inputs out of step"); return; }
-    const std::string result = step(static_cast<double>(num) / static_cast<double>(den));
+      if (count_[i] != want[i] && !topics_[i].delayed) {
+        reply("fault " + seq + " inputs out of step");
+        return;
+      }
+    std::vector<double> seen = latest_;
+    for (std::size_t i = 0; i < want.size() && i < count_.size(); ++i) {
+      if (!topics_[i].delayed) continue;
+      std::map<std::int64_t, double>& kept = history_[i];
+      seen[i] = kept.at(want[i]);  // message number want[i] is what the Leaf sees now
+      kept.erase(kept.begin(), kept.lower_bound(want[i]));
+    }
+    const std::string result = step(static_cast<double>(num) / static_cast<double>(den), seen);
     if (!result.empty() && result[0] == '!') reply("error " + seq + " " + result.substr(1));
     else reply("done " + seq + result);
   }
 
-  // doStep with the current inputs; publishes; " I J .." (the outputs published), or
-  // "!message" if doStep threw.
-  std::string step(double t) {
+  // doStep with the inputs ``seen`` (by topic); publishes; " I J .." (the outputs
+  // published), or "!message" if doStep threw.
+  std::string step(double t, const std::vector<double>& seen) {
     std::vector<double> in;
     for (const InputPort& ip : inputs_)
-      in.push_back(ip.topic >= 0 ? latest_[ip.topic] : own_[-(ip.topic + 1)]);
+      in.push_back(ip.topic >= 0 ? seen[ip.topic] : own_[-(ip.topic + 1)]);
     std::vector<double> out(outputs_.size(), 0.0);
     std::vector<bool> published(outputs_.size(), false);
     try {
@@ -288,14 +306,23 @@ class LeafNode {
   }
 
   void runFree() {
-    // step k at t = k / freq (simulated time); more than a period late: skip ahead
+    // step k at t = phase + k / freq (simulated time); more than a period late: skip ahead
+    std::int64_t phase_num = 0, phase_den = 1;
+    std::string phase;
+    if (ros::param::get(paramName("amsa_phase"), phase)) {
+      std::sscanf(phase.c_str(), "%lld/%lld", reinterpret_cast<long long*>(&phase_num),
+                  reinterpret_cast<long long*>(&phase_den));
+      if (phase_den <= 0) phase_den = 1;
+    }
+    const std::int64_t phase_ns = phase_num * 1000000000LL / phase_den;
     std::int64_t k = 0;
     while (ros::ok()) {
       ros::Time due;
-      due.fromNSec(static_cast<std::uint64_t>((k * freq_den_ * 1000000000LL) / freq_num_));
+      due.fromNSec(static_cast<std::uint64_t>(
+          phase_ns + (k * freq_den_ * 1000000000LL) / freq_num_));
       ros::Time::sleepUntil(due);
       if (!ros::ok()) break;
-      const std::int64_t now = static_cast<std::int64_t>(ros::Time::now().toNSec());
+      const std::int64_t now = static_cast<std::int64_t>(ros::Time::now().toNSec()) - phase_ns;
       const std::int64_t late = now * freq_num_ / (freq_den_ * 1000000000LL);
       if (late > k) k = late;
       for (const ParamSpec& spec : params_) {
@@ -310,7 +337,9 @@ class LeafNode {
       }
       {
         std::lock_guard<std::mutex> lock(mutex_);
-        std::string error = step(static_cast<double>(k * freq_den_) / static_cast<double>(freq_num_));
+        const double t = static_cast<double>(phase_num) / static_cast<double>(phase_den) +
+                         static_cast<double>(k * freq_den_) / static_cast<double>(freq_num_);
+        std::string error = step(t, latest_);
         if (!error.empty() && error[0] == '!') ROS_ERROR("%s", error.c_str() + 1);
       }
       k += 1;
@@ -330,6 +359,7 @@ class LeafNode {
   ros::Subscriber step_sub_;
   std::vector<std::int64_t> count_;
   std::vector<double> latest_, own_;
+  std::vector<std::map<std::int64_t, double>> history_;  // delayed topics' kept messages
   std::map<std::string, std::string> last_error_;
   std::string pending_;
   bool lockstep_ = true;
