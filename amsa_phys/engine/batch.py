@@ -167,8 +167,8 @@ def _breaks(
     for r in tasks:
         for _, buf in r.inputs:
             w = buf.rpartition(".")[0]
-            if w not in pos or w == r.path:
-                continue
+            if w not in pos or w == r.path or tasks[pos[w]].delay is not None:
+                continue  # a delayed writer's outputs are never read in the same instant
             before = pos[w] < pos[r.path]
             same = slot[w] == slot[r.path]
             if (not before) if same else ((slot[w] < slot[r.path]) == before):

@@ -198,3 +198,24 @@ def test_a_fault_in_a_group_names_the_copy_and_the_time(tmp_path: Path) -> None:
         assert exc.value.component.startswith("Box13.Div")
         assert exc.value.t == 1.5
         assert "output y is inf" in exc.value.cause
+
+
+def test_copies_with_latency_and_a_phase_still_group_copies_with_jitter_do_not(
+    tmp_path: Path,
+) -> None:
+    scen = platoon(
+        tmp_path,
+        Pilot={"latency": 0.5},  # every copy's commands 0.5 s late: one delay line
+        Gps={"phase": 0.1},  # every copy's GPS timer shifted alike
+        Drive={"jitter": 0.1},  # each copy's messages at their own instants
+    )
+    fast, a = run(scen, grouped=True)
+    slow, b = run(scen, grouped=False)
+    assert groups(fast) == {"Robot", "Pilot", "Gps", "AheadGps", "Compass", "Gap"}
+    assert lost(fast) == lost(slow)
+    assert np.abs(a - b).max() < 1e-9
+    # the latency is there: a Pilot's first command (at 0.25 s: at t = 0 its Gap, which runs
+    # after it, has measured nothing yet) reaches its buffer 0.5 s later
+    col = fast.columns.index("Car3.Pilot.LeftPower") + 1
+    first = a[np.flatnonzero(a[:, col] != 0.0)[0], 0]
+    assert first == 0.75
