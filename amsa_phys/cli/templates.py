@@ -47,4 +47,18 @@ def run(args: argparse.Namespace) -> int:
                     f"{p.description}"
                 )
             )
+    if not args.name:
+        for line in LEAF_KEYS:
+            print(line)
     return 0
+
+
+#: What every Leaf takes in a world besides its template's parameters (README, "World").
+LEAF_KEYS = (
+    "every Leaf (components.NAME in a world; also Leaf.KEY in a scenario's set: or --set):",
+    "    freq: Hz = 10  the rate of its doStep",
+    "    latency: s = 0  its outputs reach their readers this long after its step",
+    "    jitter: s = 0  each publication delayed by a further uniform draw in [0, jitter)",
+    "    phase: s or random = 0  its timer ticks at phase + k / freq (world timing: "
+    "{free_running: true} draws one for every Leaf without its own)",
+)

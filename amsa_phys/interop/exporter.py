@@ -18,6 +18,7 @@ from typing import Any
 from xml.sax.saxutils import quoteattr
 
 from ..model.template import BUILTINS, Template
+from ..model.timing import LeafTiming
 from ..model.world import CompositeSpec, LeafSpec, WorldSpec
 from .amsacore import AMSA_NS, EXTENDER, XMI_NS, XSI_NS
 from .amsatemplate import template_text
@@ -172,6 +173,12 @@ class _Writer:
             world["description"] = description
         if world["physics"].get("walls") is None:
             world["physics"] = {k: v for k, v in world["physics"].items() if k != "walls"}
+        if self.world.timing:
+            world["timing"] = self.world.timing
+        timing = {path: _timing(leaf.timing) for path, leaf in self.world.leaves.items()}
+        timing = {path: t for path, t in timing.items() if t}
+        if timing:  # the loop timing (model/timing.py): the metamodel has no place for it
+            world["leafTiming"] = timing
         out = [f'  <xmi:Extension extender="{EXTENDER}">']
         out.append(f"    <world json={quoteattr(json.dumps(world, sort_keys=True))}/>")
         for cls in templates:
@@ -187,6 +194,17 @@ class _Writer:
             out.append(f"    <unnamedData names={quoteattr(' '.join(self.unnamed))}/>")
         out.append("  </xmi:Extension>")
         return out
+
+
+def _timing(t: LeafTiming) -> dict[str, str]:
+    """A Leaf's latency, jitter and phase as exact texts (``"3/4"``, ``"random"``)."""
+    out = {}
+    for key in ("latency", "jitter", "phase"):
+        value = getattr(t, key)
+        if value is None or (key != "phase" and not value):
+            continue
+        out[key] = str(value)
+    return out
 
 
 def _composites(node: CompositeSpec) -> list[CompositeSpec]:

@@ -356,6 +356,8 @@ class _Importer:
             lines += ["  " + ln for ln in dumped.rstrip("\n").splitlines()]
         else:
             lines.append("# physics: not in the AMSA model; amsa-phys's defaults apply")
+        if "timing" in ext_world:
+            lines.append(f"timing: {_scalar(ext_world['timing'])}")
         unnamed = set(model.extension.get("unnamed", []))
         named = {n: b for n, (b, _) in model.data.items() if n not in unnamed}
         if named:
@@ -386,6 +388,9 @@ class _Importer:
             out.append(f"{pad}{name}:")
             out.append(f"{pad}  template: {_scalar(body['template'])}")
             out.append(_commented(f"{pad}  freq: {_scalar(body['freq'])}", notes.get("freq")))
+            timing = self.model.extension.get("world", {}).get("leafTiming", {})
+            for key, value in timing.get(child.path, {}).items():  # amsa-phys's own
+                out.append(f"{pad}  {key}: {_scalar(str(value))}")
             if "params" in body:
                 out.append(f"{pad}  params:")
                 for k, v in body["params"].items():

@@ -124,7 +124,7 @@ WORLD: dict[str, Any] = {
             "additionalProperties": False,
             "properties": {
                 "free_running": {"type": "boolean"},
-                "resolution": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
+                "resolution": {"type": "number", "minimum": 0.000001, "maximum": 1},
             },
         },
         "data": {

@@ -37,8 +37,18 @@ def cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
 
 def world_key(world: WorldSpec) -> tuple[object, ...]:
     """Everything that makes a world run as it does (not its comments or key order)."""
-    leaves = {p: (f.template_ref, f.freq, f.params, f.inputs) for p, f in world.leaves.items()}
-    return (world.name, leaves, world.order, world.schedule, world.physics, world.data_names)
+    leaves = {
+        p: (f.template_ref, f.freq, f.params, f.inputs, f.timing) for p, f in world.leaves.items()
+    }
+    return (
+        world.name,
+        leaves,
+        world.order,
+        world.schedule,
+        world.physics,
+        world.data_names,
+        world.timing,
+    )
 
 
 # -- the reference model ------------------------------------------------------------------
@@ -146,8 +156,9 @@ def test_imported_model_runs_like_the_projects_world(
 # -- export, round trip, metamodel -----------------------------------------------------------
 NESTED = """
 name: nested
-description: a Composite inside the root, with named Data
+description: a Composite inside the root, with named Data and loop timing
 physics: {rate: 50, obstacles: [{type: circle, x: 30, y: 5, radius: 1}]}
+timing: {free_running: true, resolution: 0.005}
 data: {leaderX: Leader.posX, Team.fix: Team.Gps.gpsPosX}
 components:
   Leader: {template: freeRobot, freq: 5, params: {behavior: 5, x: 10.0,
@@ -156,18 +167,18 @@ components:
     components:
       Rover: {template: controlledRobot, freq: 4,
               inputs: {powerL: Drive.normalizedPowerL, powerR: Drive.normalizedPowerR}}
-      Gps: {template: GPS, freq: 4, params: {noise: 0.25},
+      Gps: {template: GPS, freq: 4, params: {noise: 0.25}, jitter: 0.1, phase: random,
             inputs: {posX: Leader.posX, posY: Leader.posY}}
       MyGps: {template: GPS, freq: 4, inputs: {posX: Rover.posX, posY: Rover.posY}}
       Compass: {template: Compass, freq: 4, inputs: {heading: Rover.heading}}
       Dist: {template: DistanceMonitor, freq: 4,
              inputs: {xLeader: Leader.posX, yLeader: Leader.posY,
                       xFollower: Rover.posX, yFollower: Rover.posY}}
-      Pilot: {template: FollowerController, freq: 4, params: {Kv: 0.2},
+      Pilot: {template: FollowerController, freq: 4, params: {Kv: 0.2}, latency: "1/3",
               inputs: {xLeader: Gps.gpsPosX, yLeader: Gps.gpsPosY, xFollower: MyGps.gpsPosX,
                        yFollower: MyGps.gpsPosY, headingFollower: Compass.compassHeading,
                        distanceLeaderFollower: Dist.distanceFollowerToLeader}}
-      Drive: {template: NormalizePower, freq: 4, params: {motorCoef: 70},
+      Drive: {template: NormalizePower, freq: 4, params: {motorCoef: 70}, phase: 0,
               inputs: {powerL: Pilot.LeftPower, powerR: Pilot.RightPower}}
 schedule: [Team.Rover, Team.Drive, Team.Pilot, Team.MyGps, Team.Compass, Team.Dist]
 """

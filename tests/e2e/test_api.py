@@ -112,6 +112,7 @@ def test_a_mapping_runs_like_the_file_and_the_resolved_scenario_replays(tmp_path
         },
         "set": {
             "Leader.behavior": 4,
+            "Leader.cruisePower": 9.0,
             "LeaderGPS.lostDataGPS": np.int64(10),  # numpy numbers are accepted
             "MyNormalizePower.motorCoef": 60,
             "MyFollowerController.Kv": 0.35,

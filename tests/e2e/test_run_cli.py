@@ -147,6 +147,8 @@ def test_validate_describe_templates(capsys: pytest.CaptureFixture[str]) -> None
     assert "expect rms_error (phase 0) above 2\nexpect settling_time (phase 3) below 60\n" in text
     assert main(["templates"]) == 0
     text = capsys.readouterr().out
+    # the keys every Leaf takes besides its parameters, loop timing included
+    assert "    latency: s = 0  its outputs reach their readers this long after its step" in text
     for name in (
         "freeRobot (environment)",
         "controlledRobot (process)",

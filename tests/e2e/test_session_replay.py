@@ -186,7 +186,7 @@ def test_a_run_cut_by_duration_passes_and_its_scenario_replays(
     )
     printed = capsys.readouterr().out
     assert "expect rms_error (phase 0) = " in printed  # phase 0 (0-125 s) ran whole: judged
-    assert "expect rms_error (phase 3): skipped (phase 3 not reached" in printed
+    assert "expect settling_time (phase 3): skipped (phase 3 not reached" in printed
     assert "expect collisions: skipped (the run was cut short at t=130 s)" in printed
     metrics = json.loads((out / "metrics.json").read_text())
     assert "partial" not in metrics["phases"][0]
