@@ -152,7 +152,7 @@ class Renderer:
         label = self.small.render(text, True, edge)
         # inside the top edge, where it seldom covers a rover crossing the zone
         left = min(p[0] for p in pts)
-        top = min(p[1] for p in pts)
+        top = max(min(p[1] for p in pts), 0.0)  # a zone taller than the view: label at its top
         width = max(p[0] for p in pts) - left
         surface.blit(label, (left + max(4.0, (width - label.get_width()) / 2), top + 4))
 
@@ -187,6 +187,8 @@ class Renderer:
             pygame.draw.circle(surface, LOST, hit, 2)
 
     def _distance_lines(self, surface: pygame.Surface, camera: Camera, frame: Frame) -> None:
+        if not frame.pair_lines:
+            return
         q = frame.quality
         for a, b in itertools.pairwise(frame.rovers):
             d = math.hypot(a.x - b.x, a.y - b.y)
