@@ -38,17 +38,21 @@ MIN_ROVER_PX = 5.0
 
 
 def error_colour(error: float, tolerance: float) -> tuple[int, int, int]:
-    """Green within the tolerance band, amber at twice it, red from three times it."""
+    """Green within the tolerance band, amber up to twice it, then amber to red at three
+    times it. Green is never blended towards amber: halfway between them in RGB is an olive
+    that reads as "fine" on the HUD, so leaving the band switches colour at once."""
     r = abs(error) / tolerance if tolerance > 0 else (0.0 if error == 0 else math.inf)
     if r <= 1:
         return OK
+    if r <= 2:
+        return WARN
     if r >= 3:
         return BAD
-    a, b, k = (OK, WARN, r - 1) if r < 2 else (WARN, BAD, r - 2)
+    k = r - 2
     return (
-        int(a[0] + (b[0] - a[0]) * k),
-        int(a[1] + (b[1] - a[1]) * k),
-        int(a[2] + (b[2] - a[2]) * k),
+        int(WARN[0] + (BAD[0] - WARN[0]) * k),
+        int(WARN[1] + (BAD[1] - WARN[1]) * k),
+        int(WARN[2] + (BAD[2] - WARN[2]) * k),
     )
 
 

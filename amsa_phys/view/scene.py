@@ -114,9 +114,20 @@ class Frame:
 
 
 def describe_phase(sim: Simulation) -> str:
-    """``phase 2/4 from 125 s: Kv=0.15`` — what the HUD prints about the current phase."""
+    """``phase 2/4 from 125 s: Kv=0.15`` — what the HUD prints about the current phase.
+
+    A live change made in this phase (the window's panel) is in force now and the phase's
+    own value no longer is: it replaces that value in the line and says when it landed
+    (``Kv=0.35 live at 130.2 s``), so the HUD never shows a value the run is not using.
+    """
     phase = sim.phases[sim.phase_index]
-    sets = ", ".join(f"{c.param}={_short(c.value)}" for c in phase.changes)
+    live: dict[tuple[str, str], tuple[Any, Any]] = {}
+    for at, c in sim.live_changes:
+        if at >= phase.at:
+            live[(c.leaf, c.param)] = (at, c.value)
+    parts = [f"{c.param}={_short(c.value)}" for c in phase.changes if (c.leaf, c.param) not in live]
+    parts += [f"{p}={_short(v)} live at {float(at):.1f} s" for (_, p), (at, v) in live.items()]
+    sets = ", ".join(parts)
     label = f" {phase.label}" if phase.label else ""
     text = f"phase {sim.phase_index + 1}/{len(sim.phases)}{label} from {float(phase.at):g} s"
     return f"{text}: {sets}" if sets else text

@@ -148,6 +148,9 @@ class Window:
                 before = self.sim.now
                 advance(self.sim, min(tick, self._end), self.sinks)
                 self._owed -= float(self.sim.now - before)
+        if self._quit_asked and not self.sim.pending_live:  # the queued change has landed
+            self._quit_asked = False
+            self.notice = ""
         self.draw()
         return True
 
