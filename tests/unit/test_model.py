@@ -81,3 +81,13 @@ def test_metrics_by_hand() -> None:
     assert first["settling_time"] == 4.0
     never = block_metrics(t, np.full_like(t, 30.0), 0, 10, 15, 1.5, [], include_end=True)
     assert never["settling_time"] is None
+
+
+def test_did_you_mean_ignores_case_first() -> None:
+    """``posx`` is one letter from posX and from posY: the case-only difference wins."""
+    from amsa_phys.model.suggest import did_you_mean
+
+    assert did_you_mean("posx", ["posY", "posX"]) == " (did you mean posX?)"
+    assert did_you_mean("KV", ["Kw", "Kv"]) == " (did you mean Kv?)"
+    assert did_you_mean("seeed", ["set", "seed"]) == " (did you mean seed?)"
+    assert did_you_mean("zzz", ["seed"]) == ""
