@@ -63,8 +63,18 @@ class Run:
 
     @property
     def passed(self) -> bool:
-        """Whether every ``expect`` check passed (True for a scenario without any)."""
+        """Whether no ``expect`` check failed (True for a scenario without any).
+
+        As ``amsa-phys run`` exits 0 for a run cut short whose checks were skipped, a skipped
+        check does not fail: look at :attr:`skipped` to tell "all held" from "none judged".
+        """
         return all(c.passed for c in self.checks)
+
+    @property
+    def skipped(self) -> list[Check]:
+        """The checks not judged (a phase cut short or never reached; a trace window the
+        run never logged), each with ``why``."""
+        return [c for c in self.checks if c.skipped]
 
     def save(
         self, out: str | os.PathLike[str] | None = None, *, force: bool = False, plot: bool = True

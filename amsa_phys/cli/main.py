@@ -11,6 +11,7 @@ import argparse
 import os
 import sys
 import sysconfig
+import threading
 import traceback
 from collections.abc import Sequence
 from pathlib import Path
@@ -91,11 +92,28 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"error: {one_line(str(exc))}{hint}", file=sys.stderr)
         return exc.exit_code
     except KeyboardInterrupt as exc:  # Interrupted says where; a bare one during loading
+        if argv is None:  # the program itself (tests call main(argv) in their own process)
+            _deaf_to_more_signals()
         print(f"error: {one_line(str(exc))}" if str(exc) else "interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
         _silence_stdout()
         return EXIT_BROKEN_PIPE
+
+
+def _deaf_to_more_signals() -> None:
+    """Once the command has stopped for an interrupt, more Ctrl-C or SIGTERM are ignored.
+
+    A user pressing Ctrl-C again while the process exits (a pool shutting down, files
+    flushed, the interpreter tearing down: seconds on a loaded machine) would otherwise
+    kill it by the signal's default action: exit -2 instead of 130, after the message that
+    said what was kept.
+    """
+    import signal
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
 def _root_cause(exc: BaseException, hidden: bool = False) -> BaseException | None:

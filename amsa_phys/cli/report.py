@@ -83,7 +83,7 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
     print(
         one_line(
             f"simulated {metrics['simulated']:.1f} s in {metrics['wall_time_s']:.2f} s"
-            + (f", {paused:.2f} s of it paused" if paused else "")
+            + (f", {paused:.2f} s of it paused or ended with the window open" if paused else "")
             + f" ({metrics['real_time_factor']}x real time); outputs in {out_dir}"
         ),
         file=stream,

@@ -30,7 +30,11 @@ class ReactiveAvoider(Template):
     nearest edge is open, θ = α (turn towards it). Forward power is ``cruisePower ·
     cos θ``, scaled down as the free distance straight ahead falls from ``slowDistance`` to
     ``stopDistance`` (below it the rover turns in place) and near the goal; turning power
-    is ``Kw · θ``. Within ``goalRadius`` of the goal it stops. A reactive law with one
+    is ``Kw · θ``. A command whose stronger wheel is below ``minPower`` is scaled up until it
+    reaches it (deadband compensation, as real drivers do: on the wheel model a rover at rest
+    stays at rest below its breakaway power, so a slow creep past an obstacle's corner or
+    through mud would otherwise stall for good). Within ``goalRadius`` of the goal it stops.
+    A reactive law with one
     remembered angle and no map: a U-shaped trap can hold it (the obstacle course has
     none). ``angle_min``/``angle_max`` must be the lidar's: the beams' directions are
     computed from them and the number of ranges received.
@@ -109,6 +113,16 @@ class ReactiveAvoider(Template):
             "1",
         ),
         Param(
+            "minPower",
+            "float",
+            "deadband compensation: a moving command weaker than this is scaled up to it "
+            "(the motor's breakaway power; 0 = off)",
+            0.0,
+            0.0,
+            100.0,
+            "%",
+        ),
+        Param(
             "angle_min", "float", "the lidar's angle_min", -math.pi / 2, -math.pi, math.pi, "rad"
         ),
         Param("angle_max", "float", "the lidar's angle_max", math.pi / 2, -math.pi, math.pi, "rad"),
@@ -148,7 +162,11 @@ class ReactiveAvoider(Template):
         slow = min(1.0, max(0.0, room), max(0.3, dist / 3.0))
         forward = p.cruisePower * slow * max(0.0, math.cos(theta))
         turn = p.Kw * theta
-        return {"LeftPower": forward - turn, "RightPower": forward + turn}
+        left, right = forward - turn, forward + turn
+        strongest = max(abs(left), abs(right))
+        if 0.0 < strongest < p.minPower:  # below breakaway the rover would sit still
+            left, right = left * p.minPower / strongest, right * p.minPower / strongest
+        return {"LeftPower": left, "RightPower": right}
 
     def free_distance(self, angles: np.ndarray, ranges: np.ndarray) -> np.ndarray:
         """For each beam direction, how far its corridor runs before a return lies in it."""

@@ -229,7 +229,10 @@ def _import(module_name: str) -> Any:
     try:
         return importlib.import_module(module_name)
     except ModuleNotFoundError as exc:
-        raise TemplateNotFound(f"cannot import module {module_name!r}: {exc}") from None
+        hint = ""
+        if exc.name == module_name.split(".")[0]:  # the module itself, not one it imports
+            hint = " (user templates load from sys.path: put its folder on PYTHONPATH)"
+        raise TemplateNotFound(f"cannot import module {module_name!r}: {exc}{hint}") from None
     except SyntaxError as exc:
         where = f"{Path(exc.filename).name}:{exc.lineno}" if exc.filename else "its source"
         raise TemplateNotFound(

@@ -94,6 +94,13 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
             file=sources[0],
         )
     names.check_world(world)
+    for port, elements in world.arrays.items():  # one buffer per element, named port[i]
+        raise ConfigError(
+            f"{port} is an array port ({len(elements)} values): export ros publishes one "
+            "std_msgs/Float64 topic per Data and cannot carry arrays (a lidar's ranges); "
+            "export a world without array ports",
+            file=sources[0],
+        )
     for buffer in world.buffers.values():
         if not isinstance(buffer.initial, float | int) or isinstance(buffer.initial, bool):
             raise ConfigError(

@@ -140,13 +140,13 @@ def check_output_dir(
     if not any(out.iterdir()):
         return False
     _refuse_inputs(out, inputs, flag)
-    if not force:
+    if not force and is_ours(out):
         raise ConfigError(
             "directory exists and is not empty (use --force to replace it)",
             key=flag,
             file=out,
         )
-    if not is_ours(out):
+    if not is_ours(out):  # --force would not help: say so at once, not after a retry
         raise ConfigError(
             f"directory exists and was not made by amsa-phys (no {MARKER} in it); "
             "--force replaces only run directories: choose a new one",

@@ -38,17 +38,21 @@ MIN_ROVER_PX = 5.0
 
 
 def error_colour(error: float, tolerance: float) -> tuple[int, int, int]:
-    """Green within the tolerance band, amber at twice it, red from three times it."""
+    """Green within the tolerance band, amber up to twice it, then amber to red at three
+    times it. Green is never blended towards amber: halfway between them in RGB is an olive
+    that reads as "fine" on the HUD, so leaving the band switches colour at once."""
     r = abs(error) / tolerance if tolerance > 0 else (0.0 if error == 0 else math.inf)
     if r <= 1:
         return OK
+    if r <= 2:
+        return WARN
     if r >= 3:
         return BAD
-    a, b, k = (OK, WARN, r - 1) if r < 2 else (WARN, BAD, r - 2)
+    k = r - 2
     return (
-        int(a[0] + (b[0] - a[0]) * k),
-        int(a[1] + (b[1] - a[1]) * k),
-        int(a[2] + (b[2] - a[2]) * k),
+        int(WARN[0] + (BAD[0] - WARN[0]) * k),
+        int(WARN[1] + (BAD[1] - WARN[1]) * k),
+        int(WARN[2] + (BAD[2] - WARN[2]) * k),
     )
 
 
@@ -152,7 +156,7 @@ class Renderer:
         label = self.small.render(text, True, edge)
         # inside the top edge, where it seldom covers a rover crossing the zone
         left = min(p[0] for p in pts)
-        top = min(p[1] for p in pts)
+        top = max(min(p[1] for p in pts), 0.0)  # a zone taller than the view: label at its top
         width = max(p[0] for p in pts) - left
         surface.blit(label, (left + max(4.0, (width - label.get_width()) / 2), top + 4))
 
@@ -187,6 +191,8 @@ class Renderer:
             pygame.draw.circle(surface, LOST, hit, 2)
 
     def _distance_lines(self, surface: pygame.Surface, camera: Camera, frame: Frame) -> None:
+        if not frame.pair_lines:
+            return
         q = frame.quality
         for a, b in itertools.pairwise(frame.rovers):
             d = math.hypot(a.x - b.x, a.y - b.y)

@@ -109,12 +109,25 @@ class Frame:
     scans: list[LidarScan] = field(default_factory=list)
     #: terrain zones, bottom first (their values now: a timeline change shows)
     zones: list[ZoneView] = field(default_factory=list)
+    #: draw a "true distance" line between consecutive rovers (see Scene.pair_lines)
+    pair_lines: bool = True
 
 
 def describe_phase(sim: Simulation) -> str:
-    """``phase 2/4 from 125 s: Kv=0.15`` — what the HUD prints about the current phase."""
+    """``phase 2/4 from 125 s: Kv=0.15`` — what the HUD prints about the current phase.
+
+    A live change made in this phase (the window's panel) is in force now and the phase's
+    own value no longer is: it replaces that value in the line and says when it landed
+    (``Kv=0.35 live at 130.2 s``), so the HUD never shows a value the run is not using.
+    """
     phase = sim.phases[sim.phase_index]
-    sets = ", ".join(f"{c.param}={_short(c.value)}" for c in phase.changes)
+    live: dict[tuple[str, str], tuple[Any, Any]] = {}
+    for at, c in sim.live_changes:
+        if at >= phase.at:
+            live[(c.leaf, c.param)] = (at, c.value)
+    parts = [f"{c.param}={_short(c.value)}" for c in phase.changes if (c.leaf, c.param) not in live]
+    parts += [f"{p}={_short(v)} live at {float(at):.1f} s" for (_, p), (at, v) in live.items()]
+    sets = ", ".join(parts)
     label = f" {phase.label}" if phase.label else ""
     text = f"phase {sim.phase_index + 1}/{len(sim.phases)}{label} from {float(phase.at):g} s"
     return f"{text}: {sets}" if sets else text
@@ -153,7 +166,26 @@ class Scene:
         self._last_fix: dict[str, tuple[float, float]] = {}
         # rovers in declaration order: the i-th has the i-th colour, as in the plots
         self._rank = {name: i for i, name in enumerate(rover_names(list(sim.world.buffers)))}
+        self.pair_lines = self._between_rovers()
         sim.add_log_listener(self._sample)
+
+    def _between_rovers(self) -> bool:
+        """Whether the distance between rovers is what this run is about.
+
+        The line between consecutive rovers reads as "the distance the quality signal
+        measures" (leader and follower, a platoon's gaps). When the quality signal is
+        produced by a component that reads the position of fewer than two rovers (the
+        obstacle course's distance to a goal), a line to a parked rover would mislead:
+        no line. Without a quality signal the gaps are still drawn (a platoon's spacing).
+        """
+        if self.quality is None:
+            return True
+        producer = self.sim.world.leaves.get(self.quality.signal.rpartition(".")[0])
+        if producer is None:
+            return True
+        rovers = set(self._rank)
+        read = {src.rpartition(".")[0] for src in producer.inputs.values()}
+        return len(read & rovers) >= 2
 
     def _physics(self) -> Any:
         return self.sim.shared.get("physics")
@@ -254,6 +286,7 @@ class Scene:
             duration=float(sim.duration),
             scans=self.scans(),
             zones=self.zones(),
+            pair_lines=self.pair_lines,
         )
 
     def scans(self) -> list[LidarScan]:

@@ -75,6 +75,10 @@ def open_display() -> None:
         raise RuntimeError("no display to open a window on (no X11 or Wayland session)")
 
 
+#: the end of the warning shown when q would drop a queued live change (cleared once it lands)
+QUEUED_NOTICE = " is queued, not applied yet: q again quits without it"
+
+
 class Window:
     """One interactive session on one Simulation (already initialised)."""
 
@@ -148,6 +152,9 @@ class Window:
                 before = self.sim.now
                 advance(self.sim, min(tick, self._end), self.sinks)
                 self._owed -= float(self.sim.now - before)
+        if self.notice.endswith(QUEUED_NOTICE) and not self.sim.pending_live:
+            self._quit_asked = False  # the queued change has landed: the warning is stale
+            self.notice = ""
         self.draw()
         return True
 
@@ -252,7 +259,7 @@ class Window:
         pending = self.sim.pending_live
         if pending and not confirmed and not self.finished:
             changes = ", ".join(f"{c.key}={c.value}" for c in pending)
-            self.notice = f"{changes} is queued, not applied yet: q again quits without it"
+            self.notice = f"{changes}{QUEUED_NOTICE}"
             self._quit_asked = True
             return
         self.running = False

@@ -97,6 +97,8 @@ def test_run_holds_metrics_trace_events_and_resolved_scenario_in_memory(tmp_path
     assert run.checks[0].skipped
     assert run.checks[0].describe().startswith("rms_error (phase 0): skipped (phase 0 was cut")
     assert run.checks[1].skipped
+    assert run.passed  # nothing failed, as the CLI's exit 0 says ...
+    assert run.skipped == run.checks[:2]  # ... and nothing of the phases was judged
 
 
 def test_a_mapping_runs_like_the_file_and_the_resolved_scenario_replays(tmp_path: Path) -> None:
@@ -266,12 +268,16 @@ def test_save_follows_the_run_directory_rules(tmp_path: Path) -> None:
     (mine / "notes.txt").write_text("keep me")
     with pytest.raises(ap.ConfigError) as err:
         run.save(mine)
-    assert (
-        str(err.value)
-        == f"{mine}: --out: directory exists and is not empty (use --force to replace it)"
+    # a directory the user made: --force would not help, so the first message says so
+    assert str(err.value) == (
+        f"{mine}: --out: directory exists and was not made by amsa-phys (no .amsa-phys-run in "
+        "it); --force replaces only run directories: choose a new one"
     )
     with pytest.raises(ap.ConfigError, match="was not made by amsa-phys"):
         run.save(mine, force=True)
+    ours = run.save(tmp_path / "ours", plot=False)
+    with pytest.raises(ap.ConfigError, match=r"is not empty \(use --force to replace it\)"):
+        run.save(ours)
     assert (mine / "notes.txt").read_text() == "keep me"
     out = run.save(tmp_path / "r", plot=False)
     assert run.save(out, force=True, plot=False) == out  # our own directory may be replaced

@@ -145,3 +145,19 @@ def test_bad_output_directory_or_world_is_one_line_and_changes_nothing(
     )
     assert code == 2
     assert "runs another world" in err
+
+
+def test_a_world_with_an_array_port_is_refused_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The obstacle course's lidar publishes 31 ranges as one array port: a Float64 topic
+    per Data cannot carry it, and a topic named ``/Scanner/ranges[0]`` is not a legal ROS
+    name, so the export stops before writing anything."""
+    out = tmp_path / "oc"
+    course = ROOT / "scenarios" / "obstacle_course.yaml"
+    code, _, err = cli(capsys, "export", "ros", str(course), "-o", str(out))
+    assert code == 2
+    assert err.count("\n") == 1
+    assert "Scanner.ranges is an array port (31 values)" in err
+    assert not out.exists()
+    assert list(tmp_path.iterdir()) == []

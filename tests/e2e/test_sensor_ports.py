@@ -5,6 +5,7 @@ grouped sensors equal to one-by-one ones; the worked example's picture."""
 from __future__ import annotations
 
 import csv
+import statistics
 from pathlib import Path
 
 import pytest
@@ -143,6 +144,16 @@ def test_the_window_and_video_draw_the_lidar_scan() -> None:
     assert min(hits) > 5.0  # the first box is ~9 m ahead at the start
 
 
+def test_no_true_distance_line_to_a_parked_rover_when_the_run_is_about_a_goal() -> None:
+    """The course's quality is the distance to a goal (GoalMonitor reads one rover): a line
+    "true 10.1 m" from the rover to the parked one would read as that quality. The MDE world's
+    monitor reads both rovers: there the line is what the run is about."""
+    course = load_scenario(COURSE, duration=0.5)
+    assert not Scene(Simulation.from_scenario(course), course.quality).frame().pair_lines
+    mde = load_scenario(ROOT / "scenarios" / "scenario1.yaml", duration=0.5)
+    assert Scene(Simulation.from_scenario(mde), mde.quality).frame().pair_lines
+
+
 def test_paper_names_work_beside_gazebo_names(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -231,3 +242,30 @@ def test_no_warning_with_the_shipped_noisy_sensors(
         == 0
     )
     assert "warning" not in capsys.readouterr().err
+
+
+def test_the_obstacle_course_crosses_the_mud_slower_and_reaches_the_goal(
+    tmp_path: Path,
+) -> None:
+    """The worked example end to end: goal reached, nothing touched, and the mud strip it
+    cannot see (x 30-35 m, Crr 0.05 against the ground's 0.02) slows it to under half its
+    cruise speed on firm ground, a property of the terrain, not of the avoider: the same run
+    without the zone keeps its speed."""
+
+    def crossing(drop_mud: bool) -> tuple[float, float, int]:
+        out = tmp_path / ("dry" if drop_mud else "mud")
+        args = ["run", str(COURSE), "--headless", "-q", "--no-plot", "--out", str(out)]
+        if drop_mud:
+            args += ["--set", "Mud.rollingResistance=0.02", "--set", "Mud.friction=0.8"]
+        code = main(args)
+        with (out / "trace.csv").open() as f:
+            xv = [(float(r["Rover.posX"]), float(r["Rover.speed"])) for r in csv.DictReader(f)]
+        firm = statistics.median(v for x, v in xv if 24 < x < 29)
+        mud = statistics.median(v for x, v in xv if 31 < x < 34)
+        return firm, mud, code
+
+    firm, mud, code = crossing(drop_mud=False)
+    assert code == 0  # the scenario's own expectations: goal within 1 m, no collision
+    assert mud < 0.5 * firm
+    firm_dry, mud_dry, _ = crossing(drop_mud=True)
+    assert mud_dry > 0.8 * firm_dry  # mutation: ground values in the zone, no slowdown

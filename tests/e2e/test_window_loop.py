@@ -66,6 +66,7 @@ def test_esc_closes_the_panel_and_the_queued_change_survives() -> None:
     w.frame(0.1)
     assert sim.pending_live == []
     assert sim.live_changes[-1][1].value == 0.2
+    assert "queued" not in w.notice  # the warning went with the queue
     press(pygame.K_q)  # nothing queued any more: q quits at once
     assert not w.frame(0.0)
 

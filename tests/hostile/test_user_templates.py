@@ -171,7 +171,11 @@ def test_a_user_module_that_fails_to_import_is_a_load_error(
         ("Nope", "unknown template 'Nope'; built-in: freeRobot, controlledRobot, GPS"),
         ("gps", "unknown template 'gps' (did you mean GPS?)"),
         ("Follower", "unknown template 'Follower' (did you mean FollowerController?)"),
-        ("nosuch.mod:X", "cannot import module 'nosuch.mod': No module named 'nosuch'; built-in:"),
+        (
+            "nosuch.mod:X",
+            "cannot import module 'nosuch.mod': No module named 'nosuch' (user templates load "
+            "from sys.path: put its folder on PYTHONPATH); built-in:",
+        ),
         (":X", "':X' is not a template name nor package.module:Class"),
         (".foo:X", "'.foo:X' is not a template name nor package.module:Class"),
         ("..:X", "'..:X' is not a template name nor package.module:Class"),

@@ -110,3 +110,13 @@ def test_max_after_the_first_approach_is_the_papers_quality_figure() -> None:
     assert m["max_after_approach"] == 24.0
     far = block_metrics(t, np.full_like(t, 30.0), 0.0, 60.0, 15.0, 1.5, [], include_end=True)
     assert far["max_after_approach"] is None  # never approached
+
+
+def test_did_you_mean_ignores_case_first() -> None:
+    """``posx`` is one letter from posX and from posY: the case-only difference wins."""
+    from amsa_phys.model.suggest import did_you_mean
+
+    assert did_you_mean("posx", ["posY", "posX"]) == " (did you mean posX?)"
+    assert did_you_mean("KV", ["Kw", "Kv"]) == " (did you mean Kv?)"
+    assert did_you_mean("seeed", ["set", "seed"]) == " (did you mean seed?)"
+    assert did_you_mean("zzz", ["seed"]) == ""

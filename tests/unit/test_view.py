@@ -12,7 +12,7 @@ from amsa_phys.model.scenario import load_scenario
 from amsa_phys.view.camera import Camera
 from amsa_phys.view.draw import error_colour, nice_step
 from amsa_phys.view.panel import ParamPanel
-from amsa_phys.view.scene import Scene, static_obstacles
+from amsa_phys.view.scene import Scene, describe_phase, static_obstacles
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO = ROOT / "tests" / "fixtures" / "mde_short.yaml"
@@ -123,6 +123,10 @@ def test_live_change_lands_at_the_next_instant_after_the_timeline(sim: Simulatio
     assert sim.components["MyFollowerController"].p.Kv == 1.0
     assert sim.live_changes == [(at, change)]
     assert [e.kind for e in sim.events] == ["live change"]
+    # the HUD's phase line shows the value in force, not the phase's own
+    line = describe_phase(sim)
+    assert f"Kv=1 live at {float(at):.1f} s" in line
+    assert "Kv=0.35" not in line
 
 
 def test_scene_marks_lost_gps_fixes_at_the_true_position(tmp_path: Path) -> None:
@@ -166,3 +170,4 @@ def test_drawing_helpers() -> None:
     assert [nice_step(x) for x in (0.3, 1.0, 1.2, 3.0, 7.0)] == [0.5, 1.0, 2.0, 5.0, 10.0]
     assert error_colour(0.5, 1.0) == error_colour(-1.0, 1.0)  # inside the band: same green
     assert error_colour(5.0, 1.0) == (214, 39, 40)
+    assert error_colour(1.1, 1.0) == error_colour(2.0, 1.0) == (240, 170, 30)  # amber, not olive
