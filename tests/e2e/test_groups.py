@@ -115,7 +115,9 @@ def test_grouped_copies_run_like_the_leaf_by_leaf_run(tmp_path: Path) -> None:
     assert np.abs(a[:, col] - b[:, col]).max() < 1e-9
     # the changes reached the copies they name, and only those
     assert fast.components["Car7.Pilot"].p.Kv == 0.05
-    assert fast.components["Car8.Pilot"].p.Kv == 0.02
+    assert (
+        fast.components["Car8.Pilot"].p.Kv == 0.01
+    )  # the world's value: the change reached Car7 only
     last = {name: a[-1, fast.columns.index(name) + 1] for name in fast.columns}
     assert last["Car3.Drive.normalizedPowerL"] != pytest.approx(0.0)
 
