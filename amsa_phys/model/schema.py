@@ -311,6 +311,11 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
         return (*path, key), f"unknown key{hint}"
     if kind == "required":
         missing = err.message.split("'")[1] if "'" in err.message else err.message
+        if isinstance(inst, dict):  # ``durration:`` beside a missing ``duration``: say so there
+            known = set(err.schema.get("properties", {}))
+            for key in inst:
+                if str(key) not in known and did_you_mean(str(key), [missing]):
+                    return (*path, key), f"unknown key (did you mean {missing}?)"
         return path, f"missing required key '{missing}'"
     if kind == "type":
         want = err.validator_value
