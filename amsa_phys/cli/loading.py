@@ -8,7 +8,6 @@ from ..model.scenario import Scenario, build_scenario
 from ..model.world import WorldSpec, build_world
 from ..model.yamlio import load_yaml
 
-
 #: Keys only a scenario has: a file with one of them and no ``components:`` is a scenario
 #: whose ``world:`` is missing or misspelt (``wrld:``), not a world with odd keys.
 SCENARIO_ONLY = frozenset(
