@@ -10,7 +10,7 @@ its ``trace.csv`` is byte-identical.
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -21,7 +21,7 @@ from ..engine import interrupt
 from ..engine.runner import Event
 from ..engine.tracemem import TraceMemory
 from ..errors import Interrupted
-from ..model.scenario import Scenario
+from ..model.scenario import Scenario, traced_columns
 from ..runs.expect import Check, check_expectations
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import Ended, execute, write_run_files
@@ -113,6 +113,7 @@ def run(
     duration: float | Fraction | None = None,
     set: Mapping[str, Any] | None = None,  # the CLI's --set, by its name
     log_rate: float | None = None,
+    trace_columns: str | Sequence[str] | None = None,
     base_dir: str | os.PathLike[str] | None = None,
     progress: bool = False,
 ) -> Run:
@@ -127,9 +128,15 @@ def run(
     that instant as the exception's ``run`` attribute (inspect it, or ``save`` it).
     """
     scenario = load(
-        source, seed=seed, duration=duration, set=set, log_rate=log_rate, base_dir=base_dir
+        source,
+        seed=seed,
+        duration=duration,
+        set=set,
+        log_rate=log_rate,
+        trace_columns=trace_columns,
+        base_dir=base_dir,
     )
-    memory = TraceMemory(list(scenario.world.buffers))
+    memory = TraceMemory(traced_columns(scenario))
     with interrupt.deferred():
         ended = execute(scenario, memory, progress=progress)
         late_stop = interrupt.requested()  # Ctrl-C after the last instant

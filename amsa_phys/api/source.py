@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import operator
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -50,13 +50,15 @@ def load(
     duration: float | Fraction | None = None,
     set: Mapping[str, Any] | None = None,  # the CLI's --set, by its name
     log_rate: float | None = None,
+    trace_columns: str | Sequence[str] | None = None,
     base_dir: str | os.PathLike[str] | None = None,
 ) -> Scenario:
     """Load and check a scenario as ``amsa-phys run`` would, without running it.
 
     ``source`` is a scenario file or a mapping of the same shape; the keyword arguments are
-    the CLI's ``--seed``, ``--duration``, ``--set`` and ``--log-rate`` (errors name those
-    options, exactly as the CLI prints them). Raises :class:`~amsa_phys.errors.ConfigError`.
+    the CLI's ``--seed``, ``--duration``, ``--set``, ``--log-rate`` and ``--trace-columns``
+    (a comma-separated string or a list of patterns; errors name those options, exactly as
+    the CLI prints them). Raises :class:`~amsa_phys.errors.ConfigError`.
     """
     overrides = [override_text(key, value) for key, value in (set or {}).items()]
     seed = _seed(seed)
@@ -64,14 +66,14 @@ def load(
     rate = None if log_rate is None else _number(log_rate, "--log-rate")
     if isinstance(source, Mapping):
         doc = mapping_doc(source, base_dir)
-        return configure_scenario(doc, overrides, seed, dur, rate)
+        return configure_scenario(doc, overrides, seed, dur, rate, trace_columns)
     if isinstance(source, (str, os.PathLike)):
         if base_dir is not None:
             raise TypeError(
                 "base_dir= is for a scenario given as a mapping; "
                 "a file's relative paths resolve against the file"
             )
-        return load_scenario(source, overrides, seed, dur, rate)
+        return load_scenario(source, overrides, seed, dur, rate, trace_columns)
     raise TypeError(f"expected a scenario file path or a mapping, got {type(source).__name__}")
 
 

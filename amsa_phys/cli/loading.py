@@ -11,7 +11,18 @@ from ..model.yamlio import load_yaml
 #: Keys only a scenario has: a file with one of them and no ``components:`` is a scenario
 #: whose ``world:`` is missing or misspelt (``wrld:``), not a world with odd keys.
 SCENARIO_ONLY = frozenset(
-    {"world", "duration", "seed", "timeline", "quality", "expect", "set", "sweep", "log_rate"}
+    {
+        "world",
+        "duration",
+        "seed",
+        "timeline",
+        "quality",
+        "expect",
+        "set",
+        "sweep",
+        "log_rate",
+        "trace_columns",
+    }
 )
 
 

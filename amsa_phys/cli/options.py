@@ -31,6 +31,16 @@ def add_scenario_overrides(p: argparse.ArgumentParser) -> None:
     )
 
 
+def add_trace_columns(p: argparse.ArgumentParser) -> None:
+    """--trace-columns: which Data buffers trace.csv keeps."""
+    p.add_argument(
+        "--trace-columns",
+        metavar="GLOB,...",
+        help="trace only the Data buffers matching these patterns, e.g. 'Car*.Gap.*,Leader.*' "
+        "(the quality signal and expect: trace columns are always kept; default: all)",
+    )
+
+
 def add_output(p: argparse.ArgumentParser) -> None:
     """--out and --force."""
     p.add_argument(

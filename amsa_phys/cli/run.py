@@ -9,13 +9,14 @@ from typing import TYPE_CHECKING
 
 from ..engine import interrupt
 from ..errors import ConfigError, one_line
-from ..model.scenario import load_scenario
+from ..model.scenario import Scenario, load_scenario, traced_columns
+from ..model.tracecols import estimate_trace_bytes
 from ..runs.expect import check_expectations
 from ..runs.plotjob import PlotJob
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
 from ..runs.suite import input_files
-from .options import add_output, add_scenario_overrides
+from .options import add_output, add_scenario_overrides, add_trace_columns
 from .recording import add_recording, recording_options, snapshot_options
 from .report import print_summary
 
@@ -32,6 +33,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="no window: run as fast as possible (default: the interactive window)",
     )
     add_scenario_overrides(p)
+    add_trace_columns(p)
     add_output(p)
     add_recording(p)
     p.add_argument(
@@ -72,7 +74,9 @@ def _run(
         seed=args.seed,
         duration=args.duration,
         log_rate=args.log_rate,
+        trace_columns=args.trace_columns,
     )
+    warn_if_trace_is_large(scenario)
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
     prepare_run_dir(out, args.force, inputs=input_files(scenario))
     with interrupt.sigterm_as_ctrl_c():
@@ -93,3 +97,24 @@ def _run(
             one_line(f"expect {check.describe()}"), file=sys.stdout if check.passed else sys.stderr
         )
     return 0 if all(c.passed for c in checks) else 1
+
+
+#: Above this estimated size a run says how large its trace will be before it starts.
+LARGE_TRACE_BYTES = 1_000_000_000
+
+
+def warn_if_trace_is_large(scenario: Scenario) -> None:
+    """One line on stderr before a run whose trace will pass ~1 GB (a wide, long run), with
+    the two options that shrink it, so nobody finds a full disk an hour later."""
+    columns = traced_columns(scenario)
+    rate, duration = float(scenario.log_rate), float(scenario.duration)
+    size = estimate_trace_bytes(len(columns), rate, duration)
+    if size >= LARGE_TRACE_BYTES:
+        print(
+            one_line(
+                f"amsa-phys: note: trace.csv will be about {size / 1e9:.1f} GB "
+                f"({len(columns):,} columns at {rate:g} Hz for {duration:g} s); "
+                "--trace-columns or --log-rate make it smaller"
+            ),
+            file=sys.stderr,
+        )

@@ -31,7 +31,7 @@ import numpy as np
 
 from ..errors import RunFault
 from ..model.params import short_repr
-from ..model.scenario import Change, Phase, Scenario
+from ..model.scenario import Change, Phase, Scenario, traced_columns
 from ..model.template import Template
 from ..model.world import WorldSpec
 from . import batch, interrupt
@@ -169,6 +169,7 @@ class Simulation:
         log_rate: Fraction = Fraction(20),
         quality_signal: str | None = None,
         trace: Callable[[float, list[float]], None] | None = None,
+        columns: Sequence[str] | None = None,
     ) -> None:
         self.world = world
         self.seed = seed
@@ -180,7 +181,8 @@ class Simulation:
         self.values: dict[str, float] = {
             name: float(b.initial) for name, b in world.buffers.items()
         }
-        self.columns = list(world.buffers)
+        #: the buffers of a trace row, in order (all of them unless ``trace_columns:`` chose)
+        self.columns = list(world.buffers) if columns is None else list(columns)
         self._trace = trace
         self._quality = quality_signal
         # quality samples as packed doubles: a 1-hour run logs 72,000 of each, 1 MiB as
@@ -215,6 +217,7 @@ class Simulation:
             phases=scenario.phases,
             log_rate=scenario.log_rate,
             quality_signal=q,
+            columns=traced_columns(scenario),
             **kw,
         )
 

@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from . import schema
+from . import schema, tracecols
 from .params import short_repr
 from .rates import MAX_RATE_HZ, MIN_RATE_HZ, cycle_problem
 from .schema import MAX_SEED
@@ -138,6 +139,21 @@ class Scenario:
     #: duration. The phase the run stops in (and the run as a whole) is then cut short: its
     #: metrics are partial and its checks skipped, not judged as if it were complete.
     planned_bounds: list[Fraction] | None = None
+    #: ``trace_columns:`` glob patterns (None: trace every Data buffer); see
+    #: :func:`traced_columns` for what is kept
+    trace_columns: list[str] | None = None
+
+
+def traced_columns(scenario: Scenario) -> list[str]:
+    """The Data buffers the scenario's trace holds, in world order (``model/tracecols``).
+
+    The quality signal and every ``expect: {trace: ...}`` column are always kept: the run
+    reads them back.
+    """
+    required = [e.trace for e in scenario.expect if e.trace]
+    if scenario.quality:
+        required.append(scenario.quality.signal)
+    return tracecols.selected(scenario.trace_columns, list(scenario.world.buffers), required)
 
 
 def shorten(scenario: Scenario, duration: Fraction) -> None:
@@ -160,9 +176,10 @@ def load_scenario(
     seed: int | None = None,
     duration: float | None = None,
     log_rate: float | None = None,
+    trace_columns: str | Sequence[str] | None = None,
 ) -> Scenario:
     """Load a scenario; command-line overrides are judged like file values."""
-    return configure_scenario(load_yaml(path), overrides, seed, duration, log_rate)
+    return configure_scenario(load_yaml(path), overrides, seed, duration, log_rate, trace_columns)
 
 
 def configure_scenario(
@@ -171,6 +188,7 @@ def configure_scenario(
     seed: int | None = None,
     duration: float | None = None,
     log_rate: float | None = None,
+    trace_columns: str | Sequence[str] | None = None,
 ) -> Scenario:
     """:func:`load_scenario` of a document already parsed (a file, or a mapping given in
     Python: ``amsa_phys.run``), so both judge the options the same way."""
@@ -197,6 +215,23 @@ def configure_scenario(
         why = _cycle_problem(scenario)
         if why is not None:
             raise ConfigError(why, key="--log-rate")
+    if trace_columns is not None:
+        patterns = (
+            tracecols.parse_patterns(trace_columns)
+            if isinstance(trace_columns, str)
+            else [str(p) for p in trace_columns]
+        )
+        if not patterns:
+            raise ConfigError(
+                "needs at least one pattern, like 'Car*.Gap.*'", key="--trace-columns"
+            )
+        bad = tracecols.unmatched(patterns, list(scenario.world.buffers))
+        if bad:
+            raise ConfigError(
+                tracecols.no_match_message(bad[0], list(scenario.world.buffers)),
+                key="--trace-columns",
+            )
+        scenario.trace_columns = patterns
     in_file = len(scenario.phases[0].changes)
     for text in overrides or []:
         if text.strip().startswith(PHYSICS_PREFIX):
@@ -335,6 +370,7 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
         phases=phases,
         expect=expect,
         data=data,
+        trace_columns=_trace_patterns(doc, data, world),
     )
     why = _cycle_problem(scenario)
     if why is not None:
@@ -606,3 +642,16 @@ def _effective_log_rate(rate: Fraction, world: WorldSpec) -> Fraction:
     """The trace is never sampled slower than the fastest sensor (design.md)."""
     sensors = [leaf.freq for leaf in world.leaves.values() if leaf.kind is Kind.SENSOR]
     return max([rate, *sensors])
+
+
+def _trace_patterns(doc: YamlDoc, data: dict[str, Any], world: WorldSpec) -> list[str] | None:
+    """``trace_columns:``, each pattern checked to keep at least one buffer."""
+    if "trace_columns" not in data:
+        return None
+    patterns = [str(p) for p in data["trace_columns"]]
+    for i, pattern in enumerate(patterns):
+        if tracecols.unmatched([pattern], list(world.buffers)):
+            raise doc.error(
+                ("trace_columns", i), tracecols.no_match_message(pattern, list(world.buffers))
+            )
+    return patterns

@@ -197,6 +197,11 @@ SCENARIO: dict[str, Any] = {
         "duration": _time,
         "seed": {"type": "integer", "minimum": 0, "maximum": MAX_SEED},
         "log_rate": _rate,
+        "trace_columns": {
+            "type": "array",
+            "minItems": 1,
+            "items": {"type": "string", "minLength": 1},
+        },
         "quality": {
             "type": "object",
             "additionalProperties": False,

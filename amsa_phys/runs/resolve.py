@@ -120,6 +120,8 @@ def resolved_scenario(
         "log_rate": _number(scenario.log_rate),
         "set": initial,
     }
+    if scenario.trace_columns is not None:
+        out["trace_columns"] = list(scenario.trace_columns)
     if scenario.quality:
         q = scenario.quality
         out["quality"] = {"signal": q.signal, "reference": q.reference, "tolerance": q.tolerance}

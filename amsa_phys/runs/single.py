@@ -27,7 +27,7 @@ from ..engine.metrics import block_metrics
 from ..engine.recorder import TraceWriter
 from ..engine.runner import RunResult, Simulation
 from ..errors import Interrupted, OutputError, RunFault, one_line
-from ..model.scenario import Change, Expectation, Scenario
+from ..model.scenario import Change, Expectation, Scenario, traced_columns
 from ..view.drive import FrameSink, advance
 from ..view.encoder import EncoderError
 from .expect import describe_bound, describe_what, skip_reason
@@ -273,7 +273,7 @@ def _run_scenario(
     plotter: PlotJob | None,
     simulation: SimulationFactory | None = None,
 ) -> RunOutcome:
-    trace = TraceWriter(out_dir / "trace.csv", list(scenario.world.buffers))
+    trace = TraceWriter(out_dir / "trace.csv", traced_columns(scenario))
     ended = execute(
         scenario,
         trace,

@@ -28,7 +28,7 @@ from typing import Any
 from ...engine import batch, interrupt
 from ...engine.runner import Simulation
 from ...errors import AmsaError, ConfigError, Interrupted, RunFault
-from ...model.scenario import Change, Scenario
+from ...model.scenario import Change, Scenario, traced_columns
 from ...runs.expect import check_expectations
 from ...runs.rundir import default_run_dir, prepare_run_dir
 from ...runs.single import run_scenario
@@ -313,6 +313,7 @@ class RosSimulation(Simulation):
             log_rate=scenario.log_rate,
             quality_signal=q,
             trace=trace,
+            columns=traced_columns(scenario),
         )
         self.link = link
         link.attach(self)
