@@ -362,7 +362,15 @@ class FreeRobot(_Robot):
         *ROVER_PARAMS,
     )
 
+    @classmethod
+    def check_params(cls, values: Mapping[str, Any]) -> None:
+        """Refuse behaviour 5 without a waypoint: the leader would stand still all run,
+        which looks like a physics bug rather than the missing list it is."""
+        if values.get("behavior") == BEHAVIORS["waypoints"] and not values.get("waypoints"):
+            raise ValueError("behavior 5 (waypoints) needs at least one point in waypoints")
+
     def initialize(self, ctx: Any) -> None:
+        self.check_params(self.p.as_dict())
         super().initialize(ctx)
         self.rng = ctx.rng
         self.target_heading = self.p.heading
