@@ -182,7 +182,9 @@ def run(args: argparse.Namespace) -> int:
             q = obj.quality
             print(f"quality: {q.signal} vs {q.reference:g} ± {q.tolerance:g}")
         for i, phase in enumerate(obj.phases):
-            changes = ", ".join(f"{c.key}={c.value!r}" for c in phase.changes) or "-"
+            # a --set of a key the file's set: already gives replaces it: show the value in force
+            final = {c.key: c.value for c in phase.changes}
+            changes = ", ".join(f"{k}={v!r}" for k, v in final.items()) or "-"
             print(f"phase {i} at {float(phase.at):g} s: {changes}")
             for step in phase.within:
                 inner = ", ".join(f"{c.key}={c.value!r}" for c in step.changes)

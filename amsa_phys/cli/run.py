@@ -76,6 +76,12 @@ def _run(
         log_rate=args.log_rate,
         trace_columns=args.trace_columns,
     )
+    if snapshot is not None and snapshot.at is not None and snapshot.at > scenario.duration:
+        raise ConfigError(
+            f"{float(snapshot.at):g} s is after the run's end ({float(scenario.duration):g} s); "
+            "leave it out for a snapshot of the last instant",
+            key="--snapshot-at",
+        )
     warn_if_trace_is_large(scenario)
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
     prepare_run_dir(out, args.force, inputs=input_files(scenario))

@@ -159,3 +159,44 @@ def test_debug_shows_a_user_templates_traceback(
 def test_an_input_error_has_no_debug_hint(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["run", str(SCENARIO1), "--headless", "--set", "Leader.x=abc"]) == 2
     assert capsys.readouterr().err == "error: --set Leader.x: expected a number, got string 'abc'\n"
+
+
+def test_describe_lists_a_set_key_once_with_the_value_in_force(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    argv = ["describe", str(SCENARIO1)]
+    argv += ["--set", "MyFollowerController.Kv=0.2", "--set", "MyFollowerController.Kv=0.3"]
+    assert main(argv) == 0
+    phase0 = next(
+        line for line in capsys.readouterr().out.splitlines() if line.startswith("phase 0 ")
+    )
+    assert phase0.count("MyFollowerController.Kv=") == 1
+    assert "MyFollowerController.Kv=0.3" in phase0
+
+
+def test_a_snapshot_after_the_end_is_refused_before_anything_runs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = main(
+        [
+            "run",
+            str(ROOT / "tests" / "fixtures" / "mde_short.yaml"),
+            "--headless",
+            "--duration",
+            "10",
+            "--snapshot",
+            str(tmp_path / "s.png"),
+            "--snapshot-at",
+            "50",
+            "--out",
+            str(tmp_path / "o"),
+        ]
+    )
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err == (
+        "error: --snapshot-at: 50 s is after the run's end (10 s); "
+        "leave it out for a snapshot of the last instant\n"
+    )
+    assert not (tmp_path / "o").exists()
+    assert not (tmp_path / "s.png").exists()
