@@ -11,13 +11,14 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
 from amsa_phys.cli.main import main
 from amsa_phys.engine.runner import Simulation
 from amsa_phys.errors import ConfigError
-from amsa_phys.model.scenario import Scenario, load_scenario
+from amsa_phys.model.scenario import Expectation, Scenario, load_scenario
 from amsa_phys.runs.expect import check_expectations
 from amsa_phys.runs.single import run_scenario
 from amsa_phys.view.pg import pygame
@@ -197,3 +198,23 @@ def test_a_run_cut_by_duration_passes_and_its_scenario_replays(
     assert main(["run", str(out / "scenario.yaml"), "--headless", "-q", "--out", str(replay)]) == 0
     assert capsys.readouterr().out.count("expect rms_error (phase 0) = ") == 1
     assert (replay / "trace.csv").read_bytes() == (out / "trace.csv").read_bytes()
+
+
+def test_a_trace_window_the_cut_run_stopped_inside_is_judged_only_if_broken() -> None:
+    """A cut run's [90, end] window that held until the cut is skipped (the rest might not
+    have held), like a metric of a cut phase; a sample that broke the bound still fails."""
+    t = np.arange(0, 100.5, 0.5)
+    header, data = ["t", "Gap.d"], np.column_stack([t, np.full_like(t, 10.0)])
+    cut = {"simulated": 100.0, "overall": {"partial": True}, "phases": []}
+    whole = {"simulated": 100.0, "overall": {}, "phases": []}
+    holds = Expectation(None, None, 13.5, None, 1, trace="Gap.d", after=90.0)
+    inside = Expectation(None, None, 13.5, None, 2, trace="Gap.d", after=20.0, before=50.0)
+    [c] = check_expectations([holds], cut, (header, data))
+    assert (c.verdict, c.why) == (
+        "skipped",
+        "the run was cut short at t=100 s inside the window; held until then",
+    )
+    assert check_expectations([holds], whole, (header, data))[0].verdict == "pass"
+    assert check_expectations([inside], cut, (header, data))[0].verdict == "pass"  # whole window
+    data[-1, 1] = 14.0  # broke the bound before the cut: a real failure
+    assert check_expectations([holds], cut, (header, data))[0].verdict == "FAIL"
