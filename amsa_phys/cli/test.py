@@ -111,7 +111,7 @@ def print_table(results: list[ScenarioResult]) -> None:
             rows.append((r.name, "load and run", "-", "-", "ERROR"))
             continue
         for c in r.checks:
-            value = "-" if c.value is None else f"{c.value:.4g}"
+            value = "-" if c.value is None else c.measured
             rows.append((r.name, c.what, value, c.bound, c.verdict))
     widths = [max(len(row[i]) for row in rows) for i in range(5)]
     for row in rows:

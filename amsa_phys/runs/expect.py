@@ -22,6 +22,15 @@ class Check:
     why: str = ""  # why a metric check was skipped (a phase cut short or not reached)
     #: why a trace check saw no sample, or how much of its window the run covered
     note: str = ""
+    #: which statistic of a trace window ``value`` is: "max" (against ``below``) or "min"
+    stat: str = ""
+
+    @property
+    def measured(self) -> str:
+        """``0.6576``, or ``max 10.41`` for a trace window (its extreme sample)."""
+        if self.value is None:
+            return "none"
+        return f"{self.stat} {self.value:.4g}" if self.stat else f"{self.value:.4g}"
 
     @property
     def what(self) -> str:
@@ -46,9 +55,8 @@ class Check:
             return f"{self.what}: {self.note}: {self.verdict}"
         if self.skipped:
             return f"{self.what}: skipped ({self.why})"
-        value = "none" if self.value is None else f"{self.value:.4g}"
         note = f" ({self.note})" if self.note else ""
-        return f"{self.what} = {value}{note}, {self.bound}: {self.verdict}"
+        return f"{self.what} = {self.measured}{note}, {self.bound}: {self.verdict}"
 
 
 def describe_what(e: Expectation) -> str:
@@ -163,17 +171,18 @@ def _trace_check(
     past_end = e.before is None or e.before > end
     note = f"checked up to the run's end at t={end:g} s" if past_end and e.before else ""
     worst: float | None = None
+    stat = ""
     ok = True
     if e.above is not None:
         low = float(values.min())
-        worst = low
+        worst, stat = low, "min"
         ok = ok and low > e.above
     if e.below is not None:
         high = float(values.max())
         if worst is None or high >= e.below:
-            worst = high
+            worst, stat = high, "max"
         ok = ok and high < e.below
     if ok and cut and past_end:
         why = f"the run was cut short at t={end:g} s inside the window; held until then"
-        return Check(e, worst, True, skipped=True, why=why)
-    return Check(e, worst, ok, note=note)
+        return Check(e, worst, True, skipped=True, why=why, stat=stat)
+    return Check(e, worst, ok, note=note, stat=stat)
