@@ -29,7 +29,7 @@ import numpy as np
 import pymunk
 
 from ..errors import RunFault
-from . import fleet
+from . import compiled, fleet
 from .bodyio import BodyIO
 from .forces import FewRovers, ground_list
 from .rover import DiffDriveRover
@@ -206,10 +206,14 @@ class PhysicsWorld:
         limits = (self.max_speed, self.extent)
         ground = self.terrain.ground(-1)
         grounds = [ground_list(r, ground, ground) for r in self.rovers]
+        fast = compiled.usable(io)  # the C step when it was built (compiled.status says why)
+        model: FewRovers | fleet.Fleet
         if len(self.rovers) >= fleet.BATCH_MIN:
-            model: FewRovers | fleet.Fleet = fleet.Fleet(io, self.rovers, self.dt, limits, grounds)
+            cls = compiled.CompiledFleet if fast else fleet.Fleet
+            model = cls(io, self.rovers, self.dt, limits, grounds)
         else:
-            model = FewRovers(io, self.rovers, self.dt, limits, grounds)
+            few = compiled.CompiledFewRovers if fast else FewRovers
+            model = few(io, self.rovers, self.dt, limits, grounds)
         self._model = model
         self._where = [(-1, -1, -1)] * len(self.rovers)
         for k, rover in enumerate(self.rovers):
@@ -247,10 +251,10 @@ class PhysicsWorld:
             rover.drive_r = dr = rp if not -band < rp < band else 0.0
             drive_l.append(dl)
             drive_r.append(dr)
-        model = self._model
-        if isinstance(model, fleet.Fleet):
-            model.drives[0, index] = drive_l
-            model.drives[1, index] = drive_r
+        drives = getattr(self._model, "drives", None)  # the batch models' and the C step's
+        if drives is not None:
+            drives[0, index] = drive_l
+            drives[1, index] = drive_r
 
     def kinematics_array(self, index: np.ndarray) -> np.ndarray:
         """(n, 6) ``x, y, angle, vx, vy, w`` of the rovers at ``index`` after the last step."""

@@ -1,0 +1,250 @@
+"""The compiled physics step (``_step.c``), when it was built: the same step, ~2.5x cheaper.
+
+``FewRovers`` (forces.py) spends a headless run's step in Python: the wheel model, the body
+reads and writes and pymunk's step wrapper. ``CompiledFewRovers`` and ``CompiledFleet`` keep
+those classes' Python API (state, rims, kinematics, refresh, set_ground, ...) and hand each
+step to one C call that does all of it, calling Chipmunk through function pointers taken from
+pymunk's own cffi library (no second copy of Chipmunk, nothing to link).
+
+Same trace, bit for bit, as the pure few-rover path: the C code is ``FewRovers.apply``'s
+arithmetic in the same order (see ``_step.c``). ``CompiledFleet`` (many rovers) runs that same
+per-rover arithmetic too, not ``fleet.py``'s numpy one: its runs equal the pure few-rover
+path's, and differ from the pure numpy fleet by that path's rounding (the tests state the
+bound).
+
+The extension is optional (``setup.py``): :func:`status` says which path runs and why;
+``AMSA_PHYS_PURE=1`` forces the pure-Python path.
+"""
+
+from __future__ import annotations
+
+import array
+import os
+from typing import Any
+
+import numpy as np
+
+from .bodyio import STATE, BodyIO
+from .fleet import _GROUND_ROWS, Fleet
+from .forces import FewRovers, fold
+from .rover import DiffDriveRover
+from .wheel import step_constants
+
+try:
+    from . import _step
+except ImportError:  # not built (no compiler at install time): the pure path runs
+    _step = None  # type: ignore[assignment]
+
+#: Set to 1 (or anything but 0/empty) to run the pure-Python step even when the C one is built.
+PURE_ENV = "AMSA_PHYS_PURE"
+#: The order of a rover's constants in the C step's plan (``_step.c``'s ``P_*``).
+PLAN_FIELDS = (
+    "kp c f_max mw big_b big_be e e2 kx half_track turn_k dt_i dt_m sphi ky_dt_m neg_m_dt big_bc"
+).split()
+#: Chipmunk functions the C step calls, in the order ``Stepper`` takes them.
+_FUNCTIONS = (
+    "cpBodyGetPosition",
+    "cpBodyGetAngle",
+    "cpBodyGetVelocity",
+    "cpBodyGetAngularVelocity",
+    "cpBodySetForce",
+    "cpBodySetTorque",
+    "cpSpaceStep",
+)
+
+
+def forced_pure() -> bool:
+    """Whether ``AMSA_PHYS_PURE`` asks for the pure-Python step."""
+    return os.environ.get(PURE_ENV, "").strip() not in ("", "0")
+
+
+def status() -> tuple[bool, str]:
+    """(whether the compiled step runs, one phrase saying which path and why)."""
+    if _step is None:
+        return False, "pure Python (the compiled step was not built: no C compiler at install)"
+    if forced_pure():
+        return False, f"pure Python ({PURE_ENV} is set)"
+    if _functions() is None:
+        return False, "pure Python (this pymunk build hides Chipmunk's functions)"
+    return True, "compiled (C)"
+
+
+def active() -> bool:
+    """Whether new physics worlds take the compiled step."""
+    return status()[0]
+
+
+_cached: tuple[int, ...] | None | bool = False
+
+
+def _functions() -> tuple[int, ...] | None:
+    """Addresses of :data:`_FUNCTIONS` in pymunk's own Chipmunk, or None if not reachable."""
+    global _cached
+    if _cached is False:
+        try:
+            from pymunk._chipmunk import ffi, lib
+
+            _cached = tuple(
+                int(ffi.cast("uintptr_t", ffi.addressof(lib, name))) for name in _FUNCTIONS
+            )
+        except Exception:  # an older/newer pymunk layout: stay pure
+            _cached = None
+    return _cached  # type: ignore[return-value]
+
+
+def _address(handle: Any) -> int:
+    from pymunk._chipmunk import ffi
+
+    return int(ffi.cast("uintptr_t", handle))
+
+
+def plan_row(rover: DiffDriveRover, dt: float) -> list[float]:
+    """One rover's constants in :data:`PLAN_FIELDS` order (folded as FewRovers folds them)."""
+    f = fold(rover, dt)._asdict()
+    s = step_constants(rover.wheel, dt, rover.mass, rover.moment, rover.half_track)
+    f["big_bc"] = s.big_bc
+    return [f[name] for name in PLAN_FIELDS]
+
+
+def _locked_step(space: Any, step: Any) -> int:
+    """Run ``step`` (a C call that steps the space) locked as ``Space.step`` locks it."""
+    space._locked = True
+    try:
+        bad = step()
+    finally:
+        space._locked = False
+    # what pymunk would do after a step, refused if there is any (bodyio.BodyIO.step)
+    if space._add_later or space._remove_later or space._post_step_callbacks:
+        raise RuntimeError("a collision callback changed the space during a step")
+    if space._removed_shapes:
+        space._removed_shapes.clear()
+    return int(bad)
+
+
+def _step_with(io: BodyIO, stepper: Any, dt: float) -> int:
+    """One step through ``stepper``; pymunk's own ``Space.step`` when it has bodies to check."""
+    space = io.space
+    if space._bodies_to_check:  # new bodies (the first step): let pymunk validate them
+        stepper.apply()
+        space.step(dt)
+        return int(stepper.read_check())
+    return _locked_step(space, stepper.advance)
+
+
+def usable(io: BodyIO) -> bool:
+    """Whether the compiled step can drive ``io``'s space (the C step needs BodyIO's route)."""
+    return active() and io.direct
+
+
+class CompiledFewRovers(FewRovers):
+    """``FewRovers`` with the step in C: same API, same numbers."""
+
+    def __init__(
+        self,
+        io: BodyIO,
+        rovers: list[DiffDriveRover],
+        dt: float,
+        limits: tuple[float, float],
+        grounds: list[list[float]],
+    ) -> None:
+        self._stepper: Any = None
+        n = len(rovers)
+        self._plan_buf = array.array("d", bytes(8 * len(PLAN_FIELDS) * n))
+        self._ground = array.array("d", [t for terms in grounds for t in terms])
+        self.drives = np.zeros((2, n))
+        super().__init__(io, rovers, dt, limits, grounds)
+        self.rims = array.array("d", self.rims)  # type: ignore[assignment]
+        self.state = array.array("d", self.state)  # type: ignore[assignment]
+        for k, r in enumerate(rovers):
+            r.attach_power_slot(self.drives, k)
+        assert _step is not None
+        self._stepper = _step.Stepper(
+            _address(io.space._space),
+            _functions(),
+            array.array("Q", [_address(r.body._body) for r in rovers]),
+            array.array("q", self.offsets),
+            self._plan_buf,
+            self.drives,
+            self.rims,
+            (2, 1),
+            self._ground,
+            (7, tuple(range(7))),
+            self.state,
+            dt,
+            self._max2,
+            self.extent,
+        )
+
+    def refresh(self) -> None:
+        """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
+        super().refresh()
+        width = len(PLAN_FIELDS)
+        for k, r in enumerate(self.rovers):
+            self._plan_buf[k * width : (k + 1) * width] = array.array("d", plan_row(r, self.dt))
+
+    def set_ground(self, k: int, terms: list[float]) -> None:
+        """Rover ``k``'s ground terms (``ground_list``) from the next step on."""
+        super().set_ground(k, terms)
+        self._ground[7 * k : 7 * k + 7] = array.array("d", terms)
+
+    def kinematics(self, k: int) -> list[float]:
+        """Rover ``k``'s six state floats after the last step."""
+        return self._stepper.kinematics(k)  # type: ignore[no-any-return]
+
+    def rim_speeds(self, k: int) -> tuple[float, float]:
+        """Rover ``k``'s left and right rim speeds (m/s) after the last step."""
+        return self._stepper.rim_speeds(k)  # type: ignore[no-any-return]
+
+    def advance(self) -> tuple[int, str] | None:
+        """One physics step in C; a safety violation or None."""
+        bad = _step_with(self.io, self._stepper, self.dt)
+        if bad < 0:
+            return None
+        return self.first_violation(self.state, self.max_speed, self.extent)
+
+
+class CompiledFleet(Fleet):
+    """``Fleet`` (many rovers, numpy arrays) with the step in C, per rover as FewRovers."""
+
+    def __init__(
+        self,
+        io: BodyIO,
+        rovers: list[DiffDriveRover],
+        dt: float,
+        limits: tuple[float, float],
+        grounds: list[list[float]],
+    ) -> None:
+        self._stepper: Any = None
+        self._plan_buf = np.zeros((len(rovers), len(PLAN_FIELDS)))
+        super().__init__(io, rovers, dt, limits, grounds)
+        n = len(rovers)
+        self.state = np.ascontiguousarray(self.state)
+        self._stepper = _step.Stepper(  # type: ignore[union-attr]
+            _address(io.space._space),
+            _functions(),
+            array.array("Q", [_address(r.body._body) for r in rovers]),
+            array.array("q", range(0, STATE * n, STATE)),
+            self._plan_buf,
+            self.drives,
+            self.rims,
+            (1, n),
+            self.ground,
+            (1, tuple(row * n for row in _GROUND_ROWS)),
+            self.state,
+            dt,
+            self.max_speed * self.max_speed * (1 - 1e-12),
+            self.extent,
+        )
+
+    def refresh(self) -> None:
+        """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
+        super().refresh()
+        for k, r in enumerate(self.rovers):
+            self._plan_buf[k] = plan_row(r, self.dt)
+
+    def advance(self) -> tuple[int, str] | None:
+        """One physics step in C; a safety violation or None."""
+        bad = _step_with(self.io, self._stepper, self.dt)
+        if bad < 0:
+            return None
+        return self.first_violation(self.state, self.max_speed, self.extent)
