@@ -19,7 +19,6 @@ The extension is optional (``setup.py``): :func:`status` says which path runs an
 from __future__ import annotations
 
 import array
-import os
 from typing import Any
 
 import numpy as np
@@ -28,19 +27,30 @@ from .bodyio import STATE, BodyIO
 from .fleet import _GROUND_ROWS, Fleet
 from .forces import FewRovers, fold
 from .rover import DiffDriveRover
+from .step_path import describe, extension
 from .wheel import step_constants
 
-try:
-    from . import _step
-except ImportError:  # not built (no compiler at install time): the pure path runs
-    _step = None  # type: ignore[assignment]
-
-#: Set to 1 (or anything but 0/empty) to run the pure-Python step even when the C one is built.
-PURE_ENV = "AMSA_PHYS_PURE"
+_step = extension()
 #: The order of a rover's constants in the C step's plan (``_step.c``'s ``P_*``).
-PLAN_FIELDS = (
-    "kp c f_max mw big_b big_be e e2 kx half_track turn_k dt_i dt_m sphi ky_dt_m neg_m_dt big_bc"
-).split()
+PLAN_FIELDS = [
+    "kp",
+    "c",
+    "f_max",
+    "mw",
+    "big_b",
+    "big_be",
+    "e",
+    "e2",
+    "kx",
+    "half_track",
+    "turn_k",
+    "dt_i",
+    "dt_m",
+    "sphi",
+    "ky_dt_m",
+    "neg_m_dt",
+    "big_bc",
+]
 #: Chipmunk functions the C step calls, in the order ``Stepper`` takes them.
 _FUNCTIONS = (
     "cpBodyGetPosition",
@@ -53,20 +63,12 @@ _FUNCTIONS = (
 )
 
 
-def forced_pure() -> bool:
-    """Whether ``AMSA_PHYS_PURE`` asks for the pure-Python step."""
-    return os.environ.get(PURE_ENV, "").strip() not in ("", "0")
-
-
 def status() -> tuple[bool, str]:
     """(whether the compiled step runs, one phrase saying which path and why)."""
-    if _step is None:
-        return False, "pure Python (the compiled step was not built: no C compiler at install)"
-    if forced_pure():
-        return False, f"pure Python ({PURE_ENV} is set)"
-    if _functions() is None:
+    on, why = describe()
+    if on and _functions() is None:
         return False, "pure Python (this pymunk build hides Chipmunk's functions)"
-    return True, "compiled (C)"
+    return on, why
 
 
 def active() -> bool:
@@ -74,7 +76,7 @@ def active() -> bool:
     return status()[0]
 
 
-_cached: tuple[int, ...] | None | bool = False
+_cached: tuple[int, ...] | bool | None = False
 
 
 def _functions() -> tuple[int, ...] | None:
