@@ -82,7 +82,8 @@ class _Version(argparse.Action):
     def __call__(self, parser: argparse.ArgumentParser, *args: Any) -> NoReturn:
         from ..physics.step_path import describe as step_path
 
-        parser.exit(0, f"amsa-phys {__version__} (physics step: {step_path()[1]})\n")
+        print(f"amsa-phys {__version__} (physics step: {step_path()[1]})")  # stdout, as argparse
+        parser.exit(0)
 
 
 class _Parser(argparse.ArgumentParser):
