@@ -19,6 +19,7 @@ The extension is optional (``setup.py``): :func:`status` says which path runs an
 from __future__ import annotations
 
 import array
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -138,6 +139,19 @@ def usable(io: BodyIO) -> bool:
     return active() and io.direct
 
 
+def _fill(model: Any, name: str, values: Sequence[float]) -> None:
+    """Create ``model.<name>`` as a double array of ``values``, or copy them into it in place
+    (the C step holds it; its length never changes)."""
+    buf = model.__dict__.get(name)
+    if buf is None:
+        model.__dict__[name] = array.array("d", values)
+        return
+    new = array.array("d", values)
+    if len(new) != len(buf):
+        raise ValueError(f"{name[1:]}: {len(buf)} values expected, got {len(new)}")
+    buf[:] = new
+
+
 class CompiledFewRovers(FewRovers):
     """``FewRovers`` with the step in C: same API, same numbers."""
 
@@ -154,9 +168,7 @@ class CompiledFewRovers(FewRovers):
         self._plan_buf = array.array("d", bytes(8 * len(PLAN_FIELDS) * n))
         self._ground = array.array("d", [t for terms in grounds for t in terms])
         self.drives = np.zeros((2, n))
-        super().__init__(io, rovers, dt, limits, grounds)
-        self.rims = array.array("d", self.rims)  # type: ignore[assignment]
-        self.state = array.array("d", self.state)  # type: ignore[assignment]
+        super().__init__(io, rovers, dt, limits, grounds)  # sets rims and state (below)
         for k, r in enumerate(rovers):
             r.attach_power_slot(self.drives, k)
         assert _step is not None
@@ -176,6 +188,26 @@ class CompiledFewRovers(FewRovers):
             self._max2,
             self.extent,
         )
+
+    # rims and state are buffers the C step holds: assigning either copies into it (as the
+    # pure class's users assign lists), so the step never runs on a stale buffer
+    @property  # type: ignore[override]
+    def rims(self) -> array.array[float]:
+        """Left and right rim speed of rover ``k`` at ``2k``, ``2k + 1`` (m/s)."""
+        return self._rims
+
+    @rims.setter
+    def rims(self, values: Sequence[float]) -> None:
+        _fill(self, "_rims", values)
+
+    @property  # type: ignore[override]
+    def state(self) -> array.array[float]:
+        """Every body's ``x, y, angle, vx, vy, w`` after the last step (rovers' rows kept)."""
+        return self._state
+
+    @state.setter
+    def state(self, values: Sequence[float]) -> None:
+        _fill(self, "_state", values)
 
     def refresh(self) -> None:
         """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
@@ -233,9 +265,8 @@ class CompiledFleet(Fleet):
     ) -> None:
         self._stepper: Any = None
         self._plan_buf = np.zeros((len(rovers), len(PLAN_FIELDS)))
-        super().__init__(io, rovers, dt, limits, grounds)
+        super().__init__(io, rovers, dt, limits, grounds)  # sets rims and state (below)
         n = len(rovers)
-        self.state = np.ascontiguousarray(self.state)
         self._stepper = _step.Stepper(  # type: ignore[union-attr]
             _address(io.space._space),
             _functions(),
@@ -253,6 +284,25 @@ class CompiledFleet(Fleet):
             self.extent,
         )
 
+    # as CompiledFewRovers: assigning rims or state copies into the C step's arrays
+    @property  # type: ignore[override]
+    def rims(self) -> np.ndarray:
+        """(2, n) rim speeds, left row then right row (m/s)."""
+        return self._rims
+
+    @rims.setter
+    def rims(self, values: Any) -> None:
+        _fill_array(self, "_rims", values)
+
+    @property  # type: ignore[override]
+    def state(self) -> np.ndarray:
+        """(n, 6) ``x, y, angle, vx, vy, w`` of every rover after the last step."""
+        return self._state
+
+    @state.setter
+    def state(self, values: Any) -> None:
+        _fill_array(self, "_state", values)
+
     def refresh(self) -> None:
         """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
         super().refresh()
@@ -265,3 +315,12 @@ class CompiledFleet(Fleet):
         if bad < 0:
             return None
         return self.first_violation(self.state, self.max_speed, self.extent)
+
+
+def _fill_array(model: Any, name: str, values: Any) -> None:
+    """``_fill`` for numpy arrays: a C-contiguous float64 copy first, in place afterwards."""
+    buf = model.__dict__.get(name)
+    if buf is None:
+        model.__dict__[name] = np.array(values, dtype=np.float64, order="C")
+        return
+    buf[...] = values  # numpy refuses a shape that does not broadcast to it
