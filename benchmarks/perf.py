@@ -32,6 +32,7 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("MPLBACKEND", "Agg")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import bench_compiled
 import bench_record
 import bench_run
 import bench_sweep
@@ -227,6 +228,8 @@ TARGETS: dict[str, Callable[[int], None]] = {
     "recording": recording,
     "sweeps": sweeps,
     "memory": memory,
+    # issue 19: compiled step vs pure, process, --help, 1,000-rover platoon (bench_compiled.py)
+    "compiled": lambda reps: bench_compiled.run_all(reps, report),
 }
 
 

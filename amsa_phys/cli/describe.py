@@ -139,7 +139,9 @@ def _physics_lines(world: WorldSpec, physics_from: dict[str, Source]) -> list[st
             parts.append(f"{name} {_short(v)} ({source})")
     obstacles = len(world.physics.get("obstacles") or [])
     walls = "walls" if world.physics.get("walls") else "no walls"
-    return [f"  physics: {', '.join(parts)}; {obstacles} obstacles, {walls}"]
+    from ..physics.step_path import describe as step_path  # no numpy, no pymunk
+
+    return [f"  physics: {', '.join(parts)}; {obstacles} obstacles, {walls}; step {step_path()[1]}"]
 
 
 def _short(value: Any) -> str:

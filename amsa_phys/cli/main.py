@@ -8,6 +8,7 @@ Exit codes: 0 done, 1 an expectation failed, 2 bad input or usage, 3 a run fault
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 import sysconfig
@@ -15,25 +16,74 @@ import threading
 import traceback
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import Any, Literal, NoReturn
 
 from .. import __version__
 from ..errors import AmsaError, one_line
-from . import describe, export, graph, imports, plot, run, sweep, templates, validate
-from . import test as test_cmd
 
+#: command -> (its module in this package, its one-line help: the module docstring's first
+#: line, which a test keeps equal). Modules are imported only for the command that runs:
+#: ``amsa-phys --help`` must not pay for numpy, jsonschema, pymunk or matplotlib.
 COMMANDS = {
-    "run": run,
-    "validate": validate,
-    "describe": describe,
-    "templates": templates,
-    "plot": plot,
-    "test": test_cmd,
-    "sweep": sweep,
-    "graph": graph,
-    "export": export,
-    "import": imports,
+    "run": ("run", "Run one scenario and write its run directory."),
+    "validate": ("validate", "Check worlds and scenarios without running them."),
+    "describe": (
+        "describe",
+        "Components, kinds, parameters with ranges, links and execution order of a file.",
+    ),
+    "templates": (
+        "templates",
+        "List the template library: kind, ports and parameters of every built-in template.",
+    ),
+    "plot": (
+        "plot",
+        "Redraw a run's plots from its trace and metrics, or a sweep's summary from results.csv.",
+    ),
+    "test": ("test", "Run every scenario with expectations; print pass/fail against the bounds."),
+    "sweep": (
+        "sweep",
+        "Exhaustive exploration: a parameter grid × seeds in parallel, on this machine or Dask.",
+    ),
+    "graph": (
+        "graph",
+        "Draw the architecture of a world or scenario, components coloured by kind.",
+    ),
+    "export": (
+        "export",
+        "Export a scenario as a ROS package, or a world as the original AMSA files.",
+    ),
+    "import": (
+        "imports",
+        "Import an original AMSA model (.amsacore + .amsatemplate) as a world file.",
+    ),
 }
+
+
+def command_module(name: str) -> Any:
+    """The module implementing command ``name`` (imported now)."""
+    return importlib.import_module(f".{COMMANDS[name][0]}", __package__)
+
+
+def chosen_command(argv: Sequence[str]) -> str | None:
+    """The command ``argv`` names: its first word that is not an option (the top-level
+    options take no value), if it is a command."""
+    for word in argv:
+        if not word.startswith("-"):
+            return word if word in COMMANDS else None
+    return None
+
+
+class _Version(argparse.Action):
+    """``--version``: the version and which physics step runs (said once, here)."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, **kwargs: Any) -> None:
+        super().__init__(option_strings, dest, nargs=0, help="show the version and exit")
+
+    def __call__(self, parser: argparse.ArgumentParser, *args: Any) -> NoReturn:
+        from ..physics.step_path import describe as step_path
+
+        print(f"amsa-phys {__version__} (physics step: {step_path()[1]})")  # stdout, as argparse
+        parser.exit(0)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -44,13 +94,17 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, one_line(f"error: {self.prog}: {message} (see {self.prog} --help)") + "\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The full argument parser."""
+def build_parser(only: str | Literal[False] | None = False) -> argparse.ArgumentParser:
+    """The argument parser: every command's options, or (``only``) just that command's.
+
+    ``only=None``: no command's options (enough for ``--help`` and usage errors); other
+    commands are listed with their help either way.
+    """
     parser = _Parser(
         prog="amsa-phys",
         description="Physics-backed 2D rover testbed implementing the AMSA framework.",
     )
-    parser.add_argument("--version", action="version", version=f"amsa-phys {__version__}")
+    parser.add_argument("--version", action=_Version)
     debug_help = (
         "on an error caused by code (a user template's exception), print its traceback "
         "before the one-line message"
@@ -61,11 +115,12 @@ def build_parser() -> argparse.ArgumentParser:
     shared = argparse.ArgumentParser(add_help=False)
     shared.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=debug_help)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name, module in COMMANDS.items():
-        doc = (module.__doc__ or "").strip().splitlines()[0]
+    for name, (_, doc) in COMMANDS.items():
         p = sub.add_parser(name, help=doc, description=doc, parents=[shared])
-        module.add_args(p)
-        p.set_defaults(func=module.run)
+        if only is False or only == name:
+            module = command_module(name)
+            module.add_args(p)
+            p.set_defaults(func=module.run)
     return parser
 
 
@@ -76,7 +131,8 @@ EXIT_BROKEN_PIPE = 141
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code (tests call this in-process)."""
-    parser = build_parser()
+    words = sys.argv[1:] if argv is None else argv
+    parser = build_parser(only=chosen_command(words))
     args = parser.parse_args(argv)
     try:
         code = int(args.func(args))

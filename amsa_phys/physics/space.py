@@ -29,7 +29,7 @@ import numpy as np
 import pymunk
 
 from ..errors import RunFault
-from . import fleet
+from . import compiled, fleet
 from .bodyio import BodyIO
 from .forces import FewRovers, ground_list
 from .rover import DiffDriveRover
@@ -44,6 +44,10 @@ CONTACT_SLOP_M = 0.002
 CONTACT_BIAS = 0.5**60
 #: Two objects apart for less than this are still in the same collision episode (s).
 EPISODE_GAP_S = 0.5
+#: From this many rovers on, the collision index is a spatial hash, not the bounding-box tree.
+SPATIAL_HASH_MIN = 100
+#: Spatial hash cell size, in rover lengths (Chipmunk's advice: about the size of a shape).
+HASH_CELL_LENGTHS = 2.0
 
 
 class PhysicsWorld:
@@ -202,20 +206,38 @@ class PhysicsWorld:
 
     def _start(self) -> FewRovers | fleet.Fleet:
         """Choose the force model for this many rovers and read the initial state."""
+        self._choose_index()
         io = BodyIO(self.space, [r.body for r in self.rovers])
         limits = (self.max_speed, self.extent)
         ground = self.terrain.ground(-1)
         grounds = [ground_list(r, ground, ground) for r in self.rovers]
+        fast = compiled.usable(io)  # the C step when it was built (compiled.status says why)
+        model: FewRovers | fleet.Fleet
         if len(self.rovers) >= fleet.BATCH_MIN:
-            model: FewRovers | fleet.Fleet = fleet.Fleet(io, self.rovers, self.dt, limits, grounds)
+            cls = compiled.CompiledFleet if fast else fleet.Fleet
+            model = cls(io, self.rovers, self.dt, limits, grounds)
         else:
-            model = FewRovers(io, self.rovers, self.dt, limits, grounds)
+            few = compiled.CompiledFewRovers if fast else FewRovers
+            model = few(io, self.rovers, self.dt, limits, grounds)
         self._model = model
         self._where = [(-1, -1, -1)] * len(self.rovers)
         for k, rover in enumerate(self.rovers):
             rover.attach_state(functools.partial(self._kinematics, k))
             rover.attach_rims(functools.partial(model.rim_speeds, k))
         return model
+
+    def _choose_index(self) -> None:
+        """A spatial hash for wide worlds, Chipmunk's default bounding-box tree otherwise.
+
+        The tree's cost per step grows with its depth (at 1,000 rovers it was 45 % of the
+        loop); the hash's stays flat per shape, but it costs more than the tree for a few
+        shapes. Contacts are the same either way (the tests hold them to it): the index only
+        finds candidate pairs, the narrow phase decides.
+        """
+        n = len(self.rovers)
+        if n >= SPATIAL_HASH_MIN:
+            size = max(max(r.length, r.width) for r in self.rovers)
+            self.space.use_spatial_hash(HASH_CELL_LENGTHS * size, 10 * len(self.space.shapes))
 
     def index_of(self, rovers: Sequence[DiffDriveRover]) -> np.ndarray:
         """Positions of ``rovers`` in this world (for :meth:`kinematics_array`)."""
@@ -247,10 +269,10 @@ class PhysicsWorld:
             rover.drive_r = dr = rp if not -band < rp < band else 0.0
             drive_l.append(dl)
             drive_r.append(dr)
-        model = self._model
-        if isinstance(model, fleet.Fleet):
-            model.drives[0, index] = drive_l
-            model.drives[1, index] = drive_r
+        drives = getattr(self._model, "drives", None)  # the batch models' and the C step's
+        if drives is not None:
+            drives[0, index] = drive_l
+            drives[1, index] = drive_r
 
     def kinematics_array(self, index: np.ndarray) -> np.ndarray:
         """(n, 6) ``x, y, angle, vx, vy, w`` of the rovers at ``index`` after the last step."""

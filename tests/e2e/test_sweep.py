@@ -179,7 +179,7 @@ def test_ctrl_c_keeps_every_finished_row(tmp_path: Path, how: str) -> None:
             "--range",
             "MyFollowerController.Kv=0.01:0.4:400",
             "--duration",
-            "30",
+            "120",  # ~8 s of runs with the compiled step: still running when signalled at 4 s
             "-j",
             "2",
             "--out",

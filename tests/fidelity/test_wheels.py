@@ -96,6 +96,7 @@ def test_mutation_friction_circle_check_fails_with_separate_caps(
         return max(-1 / inv_x, min(1 / inv_x, fx)), max(-1 / inv_y, min(1 / inv_y, fy))
 
     monkeypatch.setattr(forces, "friction_ellipse", separate_caps)
+    monkeypatch.setenv("AMSA_PHYS_PURE", "1")  # the Python model (the C copy is held equal to it)
     tr, mu = skid(tmp_path)
     along, across = body_forces(tr, 30.0)
     assert np.hypot(along, across).max() > mu * 30.0 * G * 1.01

@@ -1,0 +1,630 @@
+/* The whole physics step of the rovers in C: wheel and tyre forces, grip, body I/O, the
+ * Chipmunk step and the safety check, for amsa_phys.physics.compiled.
+ *
+ * Why: in a headless run the Python force model, the body reads and writes and the step's
+ * Python layer were two thirds of the loop; this file does the same work in one call.
+ *
+ * Same numbers, bit for bit: every expression below is forces.py's (FewRovers.apply and the
+ * rare branches in wheel.py), written in the same order with C doubles. CPython's floats are
+ * C doubles and its math.sin/cos/sqrt are libm's, so with no reassociation and no FMA
+ * contraction (built with -ffp-contract=off, no -ffast-math) each result is the same double.
+ * Keep it that way: change forces.py and this file together (the tests compare the traces).
+ *
+ * No second copy of Chipmunk: the Chipmunk functions are called through pointers taken from
+ * pymunk's own cffi library (compiled.py passes them in), on pymunk's own bodies and space.
+ * This module links against nothing but libm.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <stdint.h>
+
+typedef struct {
+    double x, y;
+} cpVect;
+
+typedef cpVect (*get_vect_fn)(const void *);
+typedef double (*get_double_fn)(const void *);
+typedef void (*set_vect_fn)(void *, cpVect);
+typedef void (*set_double_fn)(void *, double);
+typedef void (*space_step_fn)(void *, double);
+
+/* Per-rover constants (compiled.py's PLAN_FIELDS, in this order). */
+enum {
+    P_KP, P_C, P_FMAX, P_MW, P_BB, P_BBE, P_E, P_E2, P_KX, P_H, P_TURN_K, P_DT_I, P_DT_M,
+    P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, PLAN_WIDTH
+};
+
+#define SLIP_SPEED_MIN 0.1
+#define N_BUFFERS 7
+
+typedef struct {
+    PyObject_HEAD
+    void *space;
+    get_vect_fn get_position;
+    get_double_fn get_angle;
+    get_vect_fn get_velocity;
+    get_double_fn get_angular_velocity;
+    set_vect_fn set_force;
+    set_double_fn set_torque;
+    space_step_fn space_step;
+    Py_ssize_t n;
+    /* buffers shared with Python (held until dealloc) */
+    Py_buffer views[N_BUFFERS];
+    int n_views;
+    void **bodies;        /* n cpBody pointers */
+    const int64_t *offsets; /* n: where rover k's six state floats start */
+    const double *plan;   /* n * PLAN_WIDTH */
+    const double *drives; /* (2, n): left row, right row */
+    double *rims;         /* rover k's left at k*rim_k, right at k*rim_k + rim_side */
+    const double *ground; /* term t of rover k at k*ground_k + ground_off[t] */
+    double *state;
+    Py_ssize_t rim_k, rim_side, ground_k;
+    Py_ssize_t ground_off[7];
+    double dt, max2, extent;
+} Stepper;
+
+/* ---- wheel.py's rare branches --------------------------------------------------------- */
+typedef struct {
+    double mw, c, f_max, big_b, big_bc, e, e2;
+} StepConstants;
+
+static void solve_one(double u, double v, double f0, double fr, double k, const StepConstants *s,
+                      double *fx_out, double *up_out)
+{ /* wheel._solve */
+    double a = (s->mw * u + f0 - fr) * s->big_b;
+    double fx = k * (a - v) / (1.0 + k * (s->big_b + s->e));
+    double up = a - s->big_b * fx;
+    double fm = f0 - s->c * up;
+    if (fm > s->f_max || fm < -s->f_max) {
+        double lim = fm > 0 ? s->f_max : -s->f_max;
+        a = u + (lim - fr) * s->big_bc;
+        fx = k * (a - v) / (1.0 + k * (s->big_bc + s->e));
+        up = a - s->big_bc * fx;
+    }
+    *fx_out = fx;
+    *up_out = up;
+}
+
+static double limited(double f0, const StepConstants *s)
+{
+    return (-s->f_max <= f0 && f0 <= s->f_max) ? f0 : (f0 > 0 ? s->f_max : -s->f_max);
+}
+
+static void rim_and_tyre(double u, double v, double f0, double res, double k,
+                         const StepConstants *s, double *fx_out, double *up_out)
+{ /* wheel.rim_and_tyre */
+    if (u != 0.0) {
+        double fx, up;
+        solve_one(u, v, f0, u > 0 ? res : -res, k, s, &fx, &up);
+        if (up * u > 0.0) {
+            *fx_out = fx;
+            *up_out = up;
+            return;
+        }
+    }
+    double fx = -k * v / (1.0 + k * s->e);
+    double f0_lim = limited(f0, s);
+    double need = f0_lim + s->mw * u - fx;
+    if (-res <= need && need <= res) {
+        *fx_out = fx;
+        *up_out = 0.0;
+        return;
+    }
+    solve_one(u, v, f0, need > 0 ? res : -res, k, s, fx_out, up_out);
+}
+
+static void joint(const double u[2], const double v[2], const double f0[2], const double fr[2],
+                  const double k[2], const int lim[2], const StepConstants *s, double out[4])
+{ /* wheel.joint */
+    double a[2], bw[2];
+    for (int i = 0; i < 2; i++) {
+        if (lim[i]) {
+            a[i] = u[i] + ((double)lim[i] * s->f_max - fr[i]) * s->big_bc;
+            bw[i] = s->big_bc;
+        } else {
+            a[i] = (s->mw * u[i] + f0[i] - fr[i]) * s->big_b;
+            bw[i] = s->big_b;
+        }
+    }
+    double gl = 1.0 + k[0] * (bw[0] + s->e);
+    double gr = 1.0 + k[1] * (bw[1] + s->e);
+    double cl = k[0] * s->e2;
+    double cr = k[1] * s->e2;
+    double bl = k[0] * (a[0] - v[0]);
+    double br = k[1] * (a[1] - v[1]);
+    double det = gl * gr - cl * cr;
+    double fxl = (bl * gr - cl * br) / det;
+    double fxr = (br * gl - cr * bl) / det;
+    out[0] = fxl;
+    out[1] = a[0] - bw[0] * fxl;
+    out[2] = fxr;
+    out[3] = a[1] - bw[1] * fxr;
+}
+
+static int held_by(double f0, double fx, double res, const StepConstants *s)
+{
+    double f0_lim = limited(f0, s);
+    double d = f0_lim - fx;
+    return -res <= d && d <= res;
+}
+
+static void wheel_pair(const double u[2], const double v[2], const double f0[2],
+                       const double res[2], const double k[2], const StepConstants *s,
+                       double out[4])
+{ /* wheel.wheel_pair: (F_xL, u_L+, F_xR, u_R+) */
+    double ul = u[0], ur = u[1];
+    if (ul == 0.0 && ur == 0.0) { /* wheel.held */
+        double gl = 1.0 + k[0] * s->e;
+        double gr = 1.0 + k[1] * s->e;
+        double cl = k[0] * s->e2;
+        double cr = k[1] * s->e2;
+        double bl = -k[0] * v[0];
+        double br = -k[1] * v[1];
+        double det = gl * gr - cl * cr;
+        double fxl = (bl * gr - cl * br) / det;
+        double fxr = (br * gl - cr * bl) / det;
+        if (held_by(f0[0], fxl, res[0], s) && held_by(f0[1], fxr, res[1], s)) {
+            out[0] = fxl;
+            out[1] = 0.0;
+            out[2] = fxr;
+            out[3] = 0.0;
+            return;
+        }
+    }
+    double fr[2] = {
+        ul > 0.0 ? res[0] : (ul < 0.0 ? -res[0] : 0.0),
+        ur > 0.0 ? res[1] : (ur < 0.0 ? -res[1] : 0.0),
+    };
+    int lim[2] = {0, 0};
+    double r[4];
+    for (int pass = 0; pass < 3; pass++) {
+        joint(u, v, f0, fr, k, lim, s, r);
+        int nw[2];
+        double fm[2] = {f0[0] - s->c * r[1], f0[1] - s->c * r[3]};
+        for (int i = 0; i < 2; i++)
+            nw[i] = lim[i] ? lim[i] : (fm[i] > s->f_max ? 1 : (fm[i] < -s->f_max ? -1 : 0));
+        if (nw[0] == lim[0] && nw[1] == lim[1])
+            break;
+        lim[0] = nw[0];
+        lim[1] = nw[1];
+    }
+    if (r[1] * ul > 0.0 && r[3] * ur > 0.0) {
+        out[0] = r[0];
+        out[1] = r[1];
+        out[2] = r[2];
+        out[3] = r[3];
+        return;
+    }
+    double fxl, upl, fxr, upr;
+    rim_and_tyre(ul, v[0], f0[0], res[0], k[0], s, &fxl, &upl);
+    rim_and_tyre(ur, v[1], f0[1], res[1], k[1], s, &fxr, &upr);
+    for (int pass = 0; pass < 2; pass++) {
+        double nfxl, nupl, nfxr, nupr;
+        rim_and_tyre(ul, v[0] + s->e2 * fxr, f0[0], res[0], k[0], s, &nfxl, &nupl);
+        rim_and_tyre(ur, v[1] + s->e2 * fxl, f0[1], res[1], k[1], s, &nfxr, &nupr);
+        fxl = nfxl;
+        upl = nupl;
+        fxr = nfxr;
+        upr = nupr;
+    }
+    out[0] = fxl;
+    out[1] = upl;
+    out[2] = fxr;
+    out[3] = upr;
+}
+
+static double rim_solve(double u, double f0, double fr, double fx, const StepConstants *s)
+{
+    double up = (s->mw * u + f0 - fr - fx) * s->big_b;
+    double fm = f0 - s->c * up;
+    if (fm > s->f_max || fm < -s->f_max)
+        up = u + ((fm > 0 ? s->f_max : -s->f_max) - fr - fx) * s->big_bc;
+    return up;
+}
+
+static double rim_alone(double u, double f0, double res, double fx, const StepConstants *s)
+{ /* wheel.rim_alone */
+    if (u != 0.0) {
+        double up = rim_solve(u, f0, u > 0 ? res : -res, fx, s);
+        if (up * u > 0.0)
+            return up;
+    }
+    double f0_lim = limited(f0, s);
+    double need = f0_lim + s->mw * u - fx;
+    if (-res <= need && need <= res)
+        return 0.0;
+    return rim_solve(u, f0, need > 0 ? res : -res, fx, s);
+}
+
+static void friction_ellipse(double *fx, double *fy, double inv_x, double inv_y)
+{ /* wheel.friction_ellipse (Python's x ** 2 is libm's pow(x, 2.0)) */
+    double q = pow(*fx * inv_x, 2.0) + pow(*fy * inv_y, 2.0);
+    if (q > 1.0) {
+        double scale = 1.0 / sqrt(q);
+        *fx = *fx * scale;
+        *fy = *fy * scale;
+    }
+}
+
+/* ---- forces.FewRovers.apply, one rover ------------------------------------------------ */
+static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
+{
+    const double *p = st->plan + k * PLAN_WIDTH;
+    const double *state = st->state + st->offsets[k];
+    const double *g = st->ground + k * st->ground_k;
+    double *rim_l = st->rims + k * st->rim_k;
+    double *rim_r = rim_l + st->rim_side;
+    const double dt = st->dt;
+    const double kp = p[P_KP], c = p[P_C], fmax = p[P_FMAX], mw = p[P_MW], bb = p[P_BB];
+    const double bbe = p[P_BBE], e = p[P_E], e2 = p[P_E2], kx = p[P_KX], h = p[P_H];
+    const double turn_k = p[P_TURN_K], dt_i = p[P_DT_I], dt_m = p[P_DT_M], sphi = p[P_SPHI];
+    const double ky_dt_m = p[P_KY_DT_M], neg_m_dt = p[P_NEG_M_DT];
+    const StepConstants sc = {mw, c, fmax, bb, p[P_BIG_BC], e, e2};
+    const double vmin = SLIP_SPEED_MIN, ivmin = 1.0 / SLIP_SPEED_MIN;
+    const Py_ssize_t *go = st->ground_off;
+    const double ixl = g[go[0]], iyl = g[go[1]], rl = g[go[2]];
+    const double ixr = g[go[3]], iyr = g[go[4]], rr = g[go[5]], ts = g[go[6]];
+
+    double angle = state[2], vx = state[3], vy = state[4], w = state[5];
+    double co = cos(angle);
+    double si = sin(angle);
+    double v_fwd = vx * co + vy * si;
+    double wh = w * h;
+    double ul = *rim_l, ur = *rim_r;
+    double vl = v_fwd - wh;
+    double vr = v_fwd + wh;
+    double ivl = vl > vmin ? 1.0 / vl : (vl < -vmin ? -1.0 / vl : ivmin);
+    double ivr = vr > vmin ? 1.0 / vr : (vr < -vmin ? -1.0 / vr : ivmin);
+    double kl = kx * ivl;
+    double kr = kx * ivr;
+    double f0l = kp * st->drives[k];
+    double f0r = kp * st->drives[st->n + k];
+    double fxl, fxr, upl, upr;
+    double pu[2] = {ul, ur}, pv[2] = {vl, vr}, pf0[2] = {f0l, f0r}, pres[2] = {rl, rr};
+    double pk[2] = {kl, kr}, pair[4];
+    if (ul == 0.0 && ur == 0.0) {
+        double gl = 1.0 + kl * e;
+        double gr = 1.0 + kr * e;
+        double cl = kl * e2;
+        double cr = kr * e2;
+        double bl = -kl * vl;
+        double br = -kr * vr;
+        double det = gl * gr - cl * cr;
+        fxl = (bl * gr - cl * br) / det;
+        fxr = (br * gl - cr * bl) / det;
+        double nl = ((-fmax <= f0l && f0l <= fmax) ? f0l : (f0l > 0 ? fmax : -fmax)) - fxl;
+        double nr = ((-fmax <= f0r && f0r <= fmax) ? f0r : (f0r > 0 ? fmax : -fmax)) - fxr;
+        if (-rl <= nl && nl <= rl && -rr <= nr && nr <= rr) {
+            upl = upr = 0.0;
+        } else {
+            wheel_pair(pu, pv, pf0, pres, pk, &sc, pair);
+            fxl = pair[0], upl = pair[1], fxr = pair[2], upr = pair[3];
+        }
+    } else {
+        double al = (mw * ul + f0l - (ul > 0.0 ? rl : (ul < 0.0 ? -rl : 0.0))) * bb;
+        double ar = (mw * ur + f0r - (ur > 0.0 ? rr : (ur < 0.0 ? -rr : 0.0))) * bb;
+        double gl = 1.0 + kl * bbe;
+        double gr = 1.0 + kr * bbe;
+        double cl = kl * e2;
+        double cr = kr * e2;
+        double bl = kl * (al - vl);
+        double br = kr * (ar - vr);
+        double det = gl * gr - cl * cr;
+        fxl = (bl * gr - cl * br) / det;
+        fxr = (br * gl - cr * bl) / det;
+        upl = al - bb * fxl;
+        upr = ar - bb * fxr;
+        double fml = f0l - c * upl;
+        double fmr = f0r - c * upr;
+        if (!(upl * ul > 0.0 && upr * ur > 0.0 && -fmax <= fml && fml <= fmax && -fmax <= fmr &&
+              fmr <= fmax)) {
+            wheel_pair(pu, pv, pf0, pres, pk, &sc, pair);
+            fxl = pair[0], upl = pair[1], fxr = pair[2], upr = pair[3];
+        }
+    }
+    /* scrub */
+    double isum = ivl + ivr;
+    double torque = (fxr - fxl) * h;
+    double kphi = sphi * isum;
+    double scrub = -kphi * (w + torque * dt_i) / (1.0 + kphi * dt_i);
+    if (scrub > ts)
+        scrub = ts;
+    else if (scrub < -ts)
+        scrub = -ts;
+    torque += scrub;
+    /* predicted heading change */
+    double turn = w * dt + torque * turn_k;
+    double end = angle + turn;
+    double mid = angle + 0.5 * turn;
+    double cm = cos(mid);
+    double sm = sin(mid);
+    double fx = fxl + fxr;
+    double a = fx * dt_m;
+    double side = (vy + a * sm) * cos(end) - (vx + a * cm) * sin(end);
+    double kd = ky_dt_m * isum;
+    double f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd);
+    double fyl = f_lat * ivl / isum;
+    double fyr = f_lat - fyl;
+    /* friction ellipse */
+    double t1 = fxl * ixl;
+    double t2 = fyl * iyl;
+    double t3 = fxr * ixr;
+    double t4 = fyr * iyr;
+    if (t1 * t1 + t2 * t2 > 1.0 || t3 * t3 + t4 * t4 > 1.0) {
+        friction_ellipse(&fxl, &fyl, ixl, iyl);
+        friction_ellipse(&fxr, &fyr, ixr, iyr);
+        upl = rim_alone(ul, f0l, rl, fxl, &sc);
+        upr = rim_alone(ur, f0r, rr, fxr, &sc);
+        fx = fxl + fxr;
+        torque = (fxr - fxl) * h + scrub;
+        f_lat = fyl + fyr;
+    }
+    out[0] = fx * cm - f_lat * sm;
+    out[1] = fx * sm + f_lat * cm;
+    out[2] = torque;
+    *rim_l = upl;
+    *rim_r = upr;
+}
+
+/* ---- the step's parts ------------------------------------------------------------------ */
+static void apply_all(Stepper *st)
+{
+    for (Py_ssize_t k = 0; k < st->n; k++) {
+        double f[3];
+        rover_forces(st, k, f);
+        cpVect force = {f[0], f[1]};
+        st->set_force(st->bodies[k], force);
+        st->set_torque(st->bodies[k], f[2]);
+    }
+}
+
+/* Read every rover's state; the first rover (by index) too fast or outside, or -1. */
+static Py_ssize_t read_check(Stepper *st)
+{
+    Py_ssize_t bad = -1;
+    const double max2 = st->max2, extent = st->extent;
+    for (Py_ssize_t k = 0; k < st->n; k++) {
+        void *b = st->bodies[k];
+        double *s = st->state + st->offsets[k];
+        cpVect p = st->get_position(b);
+        cpVect v = st->get_velocity(b);
+        s[0] = p.x;
+        s[1] = p.y;
+        s[2] = st->get_angle(b);
+        s[3] = v.x;
+        s[4] = v.y;
+        s[5] = st->get_angular_velocity(b);
+        if (bad < 0 && !(v.x * v.x + v.y * v.y <= max2 && -extent <= p.x && p.x <= extent &&
+                         -extent <= p.y && p.y <= extent))
+            bad = k;
+    }
+    return bad;
+}
+
+static PyObject *Stepper_advance(Stepper *st, PyObject *Py_UNUSED(ignored))
+{
+    apply_all(st);
+    st->space_step(st->space, st->dt);
+    if (PyErr_Occurred()) /* a collision callback raised (cffi reports, never sets) */
+        return NULL;
+    return PyLong_FromSsize_t(read_check(st));
+}
+
+static PyObject *Stepper_apply(Stepper *st, PyObject *Py_UNUSED(ignored))
+{
+    apply_all(st);
+    Py_RETURN_NONE;
+}
+
+static PyObject *Stepper_read_check(Stepper *st, PyObject *Py_UNUSED(ignored))
+{
+    return PyLong_FromSsize_t(read_check(st));
+}
+
+static PyObject *Stepper_kinematics(Stepper *st, PyObject *arg)
+{
+    Py_ssize_t k = PyLong_AsSsize_t(arg);
+    if (k == -1 && PyErr_Occurred())
+        return NULL;
+    if (k < 0 || k >= st->n) {
+        PyErr_SetString(PyExc_IndexError, "rover index out of range");
+        return NULL;
+    }
+    const double *s = st->state + st->offsets[k];
+    PyObject *out = PyList_New(6);
+    if (out == NULL)
+        return NULL;
+    for (int i = 0; i < 6; i++) {
+        PyObject *f = PyFloat_FromDouble(s[i]);
+        if (f == NULL) {
+            Py_DECREF(out);
+            return NULL;
+        }
+        PyList_SET_ITEM(out, i, f);
+    }
+    return out;
+}
+
+static PyObject *Stepper_rim_speeds(Stepper *st, PyObject *arg)
+{
+    Py_ssize_t k = PyLong_AsSsize_t(arg);
+    if (k == -1 && PyErr_Occurred())
+        return NULL;
+    if (k < 0 || k >= st->n) {
+        PyErr_SetString(PyExc_IndexError, "rover index out of range");
+        return NULL;
+    }
+    const double *r = st->rims + k * st->rim_k;
+    return Py_BuildValue("(dd)", r[0], r[st->rim_side]);
+}
+
+/* ---- construction ---------------------------------------------------------------------- */
+static void Stepper_dealloc(Stepper *st)
+{
+    for (int i = 0; i < st->n_views; i++)
+        PyBuffer_Release(&st->views[i]);
+    Py_TYPE(st)->tp_free((PyObject *)st);
+}
+
+/* Take a writable, C-contiguous buffer of at least ``need`` items of ``itemsize`` bytes. */
+static void *take(Stepper *st, PyObject *obj, Py_ssize_t itemsize, Py_ssize_t need,
+                  const char *what)
+{
+    Py_buffer *view = &st->views[st->n_views];
+    if (PyObject_GetBuffer(obj, view, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0)
+        return NULL;
+    st->n_views++;
+    if (view->itemsize != itemsize || view->len < need * itemsize) {
+        PyErr_Format(PyExc_ValueError, "%s: need %zd items of %zd bytes", what, need, itemsize);
+        return NULL;
+    }
+    return view->buf;
+}
+
+static int Stepper_init(Stepper *st, PyObject *args, PyObject *kwds)
+{
+    static char *kwlist[] = {"space",  "functions", "bodies",   "offsets", "plan",
+                             "drives", "rims",      "rim_strides", "ground", "ground_layout",
+                             "state",  "dt",        "max2",     "extent",  NULL};
+    unsigned long long space;
+    PyObject *fns, *bodies, *offsets, *plan, *drives, *rims, *ground, *state;
+    Py_ssize_t rim_k, rim_side, ground_k;
+    Py_ssize_t go[7];
+    double dt, max2, extent;
+    if (st->n_views) {
+        PyErr_SetString(PyExc_RuntimeError, "Stepper is initialised once");
+        return -1;
+    }
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "KO!OOOOO(nn)O(n(nnnnnnn))Oddd", kwlist, &space,
+                                     &PyTuple_Type, &fns, &bodies, &offsets, &plan, &drives,
+                                     &rims, &rim_k, &rim_side, &ground, &ground_k, &go[0],
+                                     &go[1], &go[2], &go[3], &go[4], &go[5], &go[6], &state, &dt,
+                                     &max2, &extent))
+        return -1;
+    if (PyTuple_GET_SIZE(fns) != 7) {
+        PyErr_SetString(PyExc_ValueError, "functions: seven addresses");
+        return -1;
+    }
+    void *fp[7];
+    for (int i = 0; i < 7; i++) {
+        fp[i] = PyLong_AsVoidPtr(PyTuple_GET_ITEM(fns, i));
+        if (fp[i] == NULL) {
+            if (!PyErr_Occurred())
+                PyErr_SetString(PyExc_ValueError, "functions: a null address");
+            return -1;
+        }
+    }
+    st->space = (void *)(uintptr_t)space;
+    st->get_position = (get_vect_fn)fp[0];
+    st->get_angle = (get_double_fn)fp[1];
+    st->get_velocity = (get_vect_fn)fp[2];
+    st->get_angular_velocity = (get_double_fn)fp[3];
+    st->set_force = (set_vect_fn)fp[4];
+    st->set_torque = (set_double_fn)fp[5];
+    st->space_step = (space_step_fn)fp[6];
+    Py_ssize_t nb;
+    {
+        Py_buffer *view = &st->views[st->n_views];
+        if (PyObject_GetBuffer(bodies, view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0)
+            return -1;
+        st->n_views++;
+        if (view->itemsize != (Py_ssize_t)sizeof(void *)) {
+            PyErr_SetString(PyExc_ValueError, "bodies: pointer-sized items");
+            return -1;
+        }
+        nb = view->len / view->itemsize;
+        st->bodies = (void **)view->buf;
+    }
+    st->n = nb;
+    if (!(st->offsets = take(st, offsets, 8, nb, "offsets")) ||
+        !(st->plan = take(st, plan, 8, nb * PLAN_WIDTH, "plan")) ||
+        !(st->drives = take(st, drives, 8, 2 * nb, "drives")) ||
+        !(st->rims = take(st, rims, 8, 2 * nb, "rims")))
+        return -1;
+    Py_ssize_t ground_need = 0, rim_need = 0;
+    for (int t = 0; t < 7; t++)
+        if (go[t] + 1 > ground_need)
+            ground_need = go[t] + 1;
+    if (nb) {
+        ground_need += (nb - 1) * ground_k;
+        rim_need = (nb - 1) * rim_k + rim_side + 1;
+    }
+    Py_buffer *rv = &st->views[st->n_views - 1];
+    if (rim_k < 0 || rim_side < 0 || rv->len < rim_need * 8) {
+        PyErr_SetString(PyExc_ValueError, "rims: strides out of range");
+        return -1;
+    }
+    if (!(st->ground = take(st, ground, 8, ground_need, "ground")))
+        return -1;
+    Py_ssize_t state_len;
+    if (!(st->state = take(st, state, 8, 0, "state")))
+        return -1;
+    state_len = st->views[st->n_views - 1].len / 8;
+    for (Py_ssize_t k = 0; k < nb; k++)
+        if (st->offsets[k] < 0 || st->offsets[k] + 6 > state_len) {
+            PyErr_SetString(PyExc_ValueError, "offsets: beyond the state");
+            return -1;
+        }
+    st->rim_k = rim_k;
+    st->rim_side = rim_side;
+    st->ground_k = ground_k;
+    for (int t = 0; t < 7; t++)
+        st->ground_off[t] = go[t];
+    st->dt = dt;
+    st->max2 = max2;
+    st->extent = extent;
+    return 0;
+}
+
+static PyMethodDef Stepper_methods[] = {
+    {"advance", (PyCFunction)Stepper_advance, METH_NOARGS,
+     "Forces, body writes, cpSpaceStep, body reads and the safety check: the first bad "
+     "rover's index, or -1. The caller locks the space as pymunk would."},
+    {"apply", (PyCFunction)Stepper_apply, METH_NOARGS,
+     "Forces and body writes only (the caller steps the space itself)."},
+    {"read_check", (PyCFunction)Stepper_read_check, METH_NOARGS,
+     "Body reads and the safety check only: the first bad rover's index, or -1."},
+    {"kinematics", (PyCFunction)Stepper_kinematics, METH_O,
+     "Rover k's x, y, angle, vx, vy, w as a new list."},
+    {"rim_speeds", (PyCFunction)Stepper_rim_speeds, METH_O,
+     "Rover k's left and right rim speeds."},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyTypeObject StepperType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "amsa_phys.physics._step.Stepper",
+    .tp_basicsize = sizeof(Stepper),
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "The rovers' physics step over buffers shared with compiled.py.",
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)Stepper_init,
+    .tp_dealloc = (destructor)Stepper_dealloc,
+    .tp_methods = Stepper_methods,
+};
+
+static struct PyModuleDef step_module = {
+    PyModuleDef_HEAD_INIT, "_step",
+    "The compiled physics step (see _step.c); imported by amsa_phys.physics.compiled.", -1,
+    NULL,
+};
+
+PyMODINIT_FUNC PyInit__step(void)
+{
+    if (PyType_Ready(&StepperType) < 0)
+        return NULL;
+    PyObject *m = PyModule_Create(&step_module);
+    if (m == NULL)
+        return NULL;
+    Py_INCREF(&StepperType);
+    if (PyModule_AddObject(m, "Stepper", (PyObject *)&StepperType) < 0) {
+        Py_DECREF(&StepperType);
+        Py_DECREF(m);
+        return NULL;
+    }
+    if (PyModule_AddIntConstant(m, "PLAN_WIDTH", PLAN_WIDTH) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
+}

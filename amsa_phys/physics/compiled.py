@@ -1,0 +1,326 @@
+"""The compiled physics step (``_step.c``), when it was built: the same step, ~2.5x cheaper.
+
+``FewRovers`` (forces.py) spends a headless run's step in Python: the wheel model, the body
+reads and writes and pymunk's step wrapper. ``CompiledFewRovers`` and ``CompiledFleet`` keep
+those classes' Python API (state, rims, kinematics, refresh, set_ground, ...) and hand each
+step to one C call that does all of it, calling Chipmunk through function pointers taken from
+pymunk's own cffi library (no second copy of Chipmunk, nothing to link).
+
+Same trace, bit for bit, as the pure few-rover path: the C code is ``FewRovers.apply``'s
+arithmetic in the same order (see ``_step.c``). ``CompiledFleet`` (many rovers) runs that same
+per-rover arithmetic too, not ``fleet.py``'s numpy one: its runs equal the pure few-rover
+path's, and differ from the pure numpy fleet by that path's rounding (the tests state the
+bound).
+
+The extension is optional (``setup.py``): :func:`status` says which path runs and why;
+``AMSA_PHYS_PURE=1`` forces the pure-Python path.
+"""
+
+from __future__ import annotations
+
+import array
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from .bodyio import STATE, BodyIO
+from .fleet import _GROUND_ROWS, Fleet
+from .forces import FewRovers, fold
+from .rover import DiffDriveRover
+from .step_path import describe, extension
+from .wheel import step_constants
+
+_step = extension()
+#: The order of a rover's constants in the C step's plan (``_step.c``'s ``P_*``).
+PLAN_FIELDS = [
+    "kp",
+    "c",
+    "f_max",
+    "mw",
+    "big_b",
+    "big_be",
+    "e",
+    "e2",
+    "kx",
+    "half_track",
+    "turn_k",
+    "dt_i",
+    "dt_m",
+    "sphi",
+    "ky_dt_m",
+    "neg_m_dt",
+    "big_bc",
+]
+#: Chipmunk functions the C step calls, in the order ``Stepper`` takes them.
+_FUNCTIONS = (
+    "cpBodyGetPosition",
+    "cpBodyGetAngle",
+    "cpBodyGetVelocity",
+    "cpBodyGetAngularVelocity",
+    "cpBodySetForce",
+    "cpBodySetTorque",
+    "cpSpaceStep",
+)
+
+
+def status() -> tuple[bool, str]:
+    """(whether the compiled step runs, one phrase saying which path and why)."""
+    on, why = describe()
+    if on and _functions() is None:
+        return False, "pure Python (this pymunk build hides Chipmunk's functions)"
+    return on, why
+
+
+def active() -> bool:
+    """Whether new physics worlds take the compiled step."""
+    return status()[0]
+
+
+_cached: tuple[int, ...] | bool | None = False
+
+
+def _functions() -> tuple[int, ...] | None:
+    """Addresses of :data:`_FUNCTIONS` in pymunk's own Chipmunk, or None if not reachable."""
+    global _cached
+    if _cached is False:
+        try:
+            from pymunk._chipmunk import ffi, lib
+
+            _cached = tuple(
+                int(ffi.cast("uintptr_t", ffi.addressof(lib, name))) for name in _FUNCTIONS
+            )
+        except Exception:  # an older/newer pymunk layout: stay pure
+            _cached = None
+    return _cached  # type: ignore[return-value]
+
+
+def _address(handle: Any) -> int:
+    from pymunk._chipmunk import ffi
+
+    return int(ffi.cast("uintptr_t", handle))
+
+
+def plan_row(rover: DiffDriveRover, dt: float) -> list[float]:
+    """One rover's constants in :data:`PLAN_FIELDS` order (folded as FewRovers folds them)."""
+    f = fold(rover, dt)._asdict()
+    s = step_constants(rover.wheel, dt, rover.mass, rover.moment, rover.half_track)
+    f["big_bc"] = s.big_bc
+    return [f[name] for name in PLAN_FIELDS]
+
+
+def _locked_step(space: Any, step: Any) -> int:
+    """Run ``step`` (a C call that steps the space) locked as ``Space.step`` locks it."""
+    space._locked = True
+    try:
+        bad = step()
+    finally:
+        space._locked = False
+    # what pymunk would do after a step, refused if there is any (bodyio.BodyIO.step)
+    if space._add_later or space._remove_later or space._post_step_callbacks:
+        raise RuntimeError("a collision callback changed the space during a step")
+    if space._removed_shapes:
+        space._removed_shapes.clear()
+    return int(bad)
+
+
+def _step_with(io: BodyIO, stepper: Any, dt: float) -> int:
+    """One step through ``stepper``; pymunk's own ``Space.step`` when it has bodies to check."""
+    space = io.space
+    if space._bodies_to_check:  # new bodies (the first step): let pymunk validate them
+        stepper.apply()
+        space.step(dt)
+        return int(stepper.read_check())
+    return _locked_step(space, stepper.advance)
+
+
+def usable(io: BodyIO) -> bool:
+    """Whether the compiled step can drive ``io``'s space (the C step needs BodyIO's route)."""
+    return active() and io.direct
+
+
+def _fill(model: Any, name: str, values: Sequence[float]) -> None:
+    """Create ``model.<name>`` as a double array of ``values``, or copy them into it in place
+    (the C step holds it; its length never changes)."""
+    buf = model.__dict__.get(name)
+    if buf is None:
+        model.__dict__[name] = array.array("d", values)
+        return
+    new = array.array("d", values)
+    if len(new) != len(buf):
+        raise ValueError(f"{name[1:]}: {len(buf)} values expected, got {len(new)}")
+    buf[:] = new
+
+
+class CompiledFewRovers(FewRovers):
+    """``FewRovers`` with the step in C: same API, same numbers."""
+
+    def __init__(
+        self,
+        io: BodyIO,
+        rovers: list[DiffDriveRover],
+        dt: float,
+        limits: tuple[float, float],
+        grounds: list[list[float]],
+    ) -> None:
+        self._stepper: Any = None
+        n = len(rovers)
+        self._plan_buf = array.array("d", bytes(8 * len(PLAN_FIELDS) * n))
+        self._ground = array.array("d", [t for terms in grounds for t in terms])
+        self.drives = np.zeros((2, n))
+        super().__init__(io, rovers, dt, limits, grounds)  # sets rims and state (below)
+        for k, r in enumerate(rovers):
+            r.attach_power_slot(self.drives, k)
+        assert _step is not None
+        self._stepper = _step.Stepper(
+            _address(io.space._space),
+            _functions(),
+            array.array("Q", [_address(r.body._body) for r in rovers]),
+            array.array("q", self.offsets),
+            self._plan_buf,
+            self.drives,
+            self.rims,
+            (2, 1),
+            self._ground,
+            (7, tuple(range(7))),
+            self.state,
+            dt,
+            self._max2,
+            self.extent,
+        )
+
+    # rims and state are buffers the C step holds: assigning either copies into it (as the
+    # pure class's users assign lists), so the step never runs on a stale buffer
+    @property  # type: ignore[override]
+    def rims(self) -> array.array[float]:
+        """Left and right rim speed of rover ``k`` at ``2k``, ``2k + 1`` (m/s)."""
+        return self._rims
+
+    @rims.setter
+    def rims(self, values: Sequence[float]) -> None:
+        _fill(self, "_rims", values)
+
+    @property  # type: ignore[override]
+    def state(self) -> array.array[float]:
+        """Every body's ``x, y, angle, vx, vy, w`` after the last step (rovers' rows kept)."""
+        return self._state
+
+    @state.setter
+    def state(self, values: Sequence[float]) -> None:
+        _fill(self, "_state", values)
+
+    def refresh(self) -> None:
+        """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
+        super().refresh()
+        width = len(PLAN_FIELDS)
+        for k, r in enumerate(self.rovers):
+            self._plan_buf[k * width : (k + 1) * width] = array.array("d", plan_row(r, self.dt))
+
+    def set_ground(self, k: int, terms: list[float]) -> None:
+        """Rover ``k``'s ground terms (``ground_list``) from the next step on."""
+        super().set_ground(k, terms)
+        self._ground[7 * k : 7 * k + 7] = array.array("d", terms)
+
+    def kinematics(self, k: int) -> list[float]:
+        """Rover ``k``'s six state floats after the last step."""
+        return self._stepper.kinematics(k)  # type: ignore[no-any-return]
+
+    def rim_speeds(self, k: int) -> tuple[float, float]:
+        """Rover ``k``'s left and right rim speeds (m/s) after the last step."""
+        return self._stepper.rim_speeds(k)  # type: ignore[no-any-return]
+
+    def advance(self) -> tuple[int, str] | None:
+        """One physics step in C; a safety violation or None.
+
+        ``_step_with`` inlined: at 100 Hz two Python calls a step are ~5 % of scenario1.
+        """
+        space = self.io.space
+        if space._bodies_to_check:
+            bad = _step_with(self.io, self._stepper, self.dt)
+        else:
+            space._locked = True
+            try:
+                bad = self._stepper.advance()
+            finally:
+                space._locked = False
+            if space._add_later or space._remove_later or space._post_step_callbacks:
+                raise RuntimeError("a collision callback changed the space during a step")
+            if space._removed_shapes:
+                space._removed_shapes.clear()
+        if bad < 0:
+            return None
+        return self.first_violation(self.state, self.max_speed, self.extent)
+
+
+class CompiledFleet(Fleet):
+    """``Fleet`` (many rovers, numpy arrays) with the step in C, per rover as FewRovers."""
+
+    def __init__(
+        self,
+        io: BodyIO,
+        rovers: list[DiffDriveRover],
+        dt: float,
+        limits: tuple[float, float],
+        grounds: list[list[float]],
+    ) -> None:
+        self._stepper: Any = None
+        self._plan_buf = np.zeros((len(rovers), len(PLAN_FIELDS)))
+        super().__init__(io, rovers, dt, limits, grounds)  # sets rims and state (below)
+        n = len(rovers)
+        self._stepper = _step.Stepper(  # type: ignore[union-attr]
+            _address(io.space._space),
+            _functions(),
+            array.array("Q", [_address(r.body._body) for r in rovers]),
+            array.array("q", range(0, STATE * n, STATE)),
+            self._plan_buf,
+            self.drives,
+            self.rims,
+            (1, n),
+            self.ground,
+            (1, tuple(row * n for row in _GROUND_ROWS)),
+            self.state,
+            dt,
+            self.max_speed * self.max_speed * (1 - 1e-12),
+            self.extent,
+        )
+
+    # as CompiledFewRovers: assigning rims or state copies into the C step's arrays
+    @property  # type: ignore[override]
+    def rims(self) -> np.ndarray:
+        """(2, n) rim speeds, left row then right row (m/s)."""
+        return self._rims
+
+    @rims.setter
+    def rims(self, values: Any) -> None:
+        _fill_array(self, "_rims", values)
+
+    @property  # type: ignore[override]
+    def state(self) -> np.ndarray:
+        """(n, 6) ``x, y, angle, vx, vy, w`` of every rover after the last step."""
+        return self._state
+
+    @state.setter
+    def state(self, values: Any) -> None:
+        _fill_array(self, "_state", values)
+
+    def refresh(self) -> None:
+        """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
+        super().refresh()
+        for k, r in enumerate(self.rovers):
+            self._plan_buf[k] = plan_row(r, self.dt)
+
+    def advance(self) -> tuple[int, str] | None:
+        """One physics step in C; a safety violation or None."""
+        bad = _step_with(self.io, self._stepper, self.dt)
+        if bad < 0:
+            return None
+        return self.first_violation(self.state, self.max_speed, self.extent)
+
+
+def _fill_array(model: Any, name: str, values: Any) -> None:
+    """``_fill`` for numpy arrays: a C-contiguous float64 copy first, in place afterwards."""
+    buf = model.__dict__.get(name)
+    if buf is None:
+        model.__dict__[name] = np.array(values, dtype=np.float64, order="C")
+        return
+    buf[...] = values  # numpy refuses a shape that does not broadcast to it

@@ -1,0 +1,22 @@
+"""The optional compiled physics step (``amsa_phys/physics/_step.c``); the rest is pyproject.toml.
+
+``optional=True``: where there is no C compiler (or no Python headers) the build of the
+extension fails quietly and the install goes on; ``amsa_phys.physics.compiled`` then finds no
+``_step`` module and the pure-Python step runs (``amsa-phys --version`` says which).
+``-ffp-contract=off`` and no ``-ffast-math``: the C step must round every operation as
+CPython does, or the traces would differ from the pure path's.
+"""
+
+from setuptools import Extension, setup
+
+setup(
+    ext_modules=[
+        Extension(
+            "amsa_phys.physics._step",
+            ["amsa_phys/physics/_step.c"],
+            extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"],
+            libraries=["m"],
+            optional=True,
+        )
+    ]
+)
