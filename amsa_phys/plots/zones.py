@@ -21,6 +21,7 @@ from matplotlib.patches import Polygon
 from ..physics.terrain import zone_colours
 
 TEMPLATE = "frictionZone"
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
 @dataclass(frozen=True)
@@ -37,7 +38,12 @@ class ZoneShape:
 def zones_of_run(scenario_yaml: Path) -> list[ZoneShape]:
     """The friction zones of a run directory's ``scenario.yaml`` (none if it has none)."""
     try:
-        data = yaml.safe_load(scenario_yaml.read_text())
+        text = scenario_yaml.read_text()
+        # a wide run's resolved scenario is ~700 kB of YAML (seconds to parse in Python):
+        # parsed only when it can hold a zone at all, and by libyaml when PyYAML has it
+        if TEMPLATE not in text:
+            return []
+        data = yaml.load(text, Loader=_LOADER)  # a safe loader (C or Python)
     except (OSError, yaml.YAMLError):
         return []
     if not isinstance(data, Mapping) or not isinstance(data.get("world"), Mapping):

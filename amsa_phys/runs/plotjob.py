@@ -70,14 +70,31 @@ def draw_run_plots(
 
 
 def plot_context(world: WorldSpec) -> dict[str, Any]:
-    """What the trajectory plot needs from the world: its static arena (``physics``) and
-    which rover each GPS measures (``gps_of``: GPS path -> rover path), plain data."""
+    """What the trajectory plot needs from the world: its static arena (``physics``),
+    which rover each GPS measures (``gps_of``: GPS path -> rover path) and the goals rovers
+    steer to (``goals``: x, y, radius), plain data."""
     gps_of = {}
+    goals: dict[tuple[float, float], dict[str, float]] = {}
     for path, leaf in world.leaves.items():
         source = leaf.inputs.get("posX", "")
         if leaf.template.name() == "GPS" and source.endswith(".posX"):
             gps_of[path] = source[: -len(".posX")]
-    return {"physics": world.physics, "gps_of": gps_of}
+        goal = _goal_of(leaf.params)
+        if goal is not None:  # a navigator and its monitor name the same goal: drawn once
+            key = (goal["x"], goal["y"])
+            goals[key] = {**goal, "radius": max(goal["radius"], goals.get(key, goal)["radius"])}
+    return {"physics": world.physics, "gps_of": gps_of, "goals": list(goals.values())}
+
+
+def _goal_of(params: dict[str, Any]) -> dict[str, float] | None:
+    """``{x, y, radius}`` of a Leaf steering to (or measuring the distance to) a goal: any
+    template with numeric ``goalX`` and ``goalY`` parameters (``goalRadius`` if it has one)."""
+    try:
+        x, y = float(params["goalX"]), float(params["goalY"])
+        radius = float(params.get("goalRadius", 0.0) or 0.0)
+    except (KeyError, TypeError, ValueError):
+        return None
+    return {"x": x, "y": y, "radius": radius}
 
 
 def _child(jobs: Connection, parent_end: Connection, parent_pid: int) -> None:
