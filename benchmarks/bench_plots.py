@@ -58,6 +58,17 @@ def measure(reps: int, cars: int = 199) -> dict[str, list[float]]:
     return walls
 
 
+def verdict(reps: int) -> tuple[str, bool]:
+    """perf.py's line: (what was measured, whether the 1.3x target is met)."""
+    walls = measure(reps)
+    ratio = statistics.median(walls["plots"]) / statistics.median(walls["no plots"])
+    spread = ", ".join(
+        f"{name} {statistics.median(xs):.2f} s (min {min(xs):.2f}, max {max(xs):.2f})"
+        for name, xs in walls.items()
+    )
+    return f"{ratio:.2f}; {spread}", ratio <= 1.3
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=3)

@@ -52,6 +52,7 @@ GROUP_ABOVE = 12
 #: in a grouped plot: points drawn per path, and GPS crosses drawn in all
 MAX_PATH_POINTS = 2000
 MAX_FIXES = 30_000
+MAX_GPS_TRACKS = 40
 #: past the palette's end the colours come again with these dashes
 LINE_STYLES = ("-", "--", "-.", ":")
 
@@ -117,16 +118,43 @@ def draw_static_world(ax: plt.Axes, physics: dict[str, Any] | None, view: View) 
     return drawn
 
 
+def plotted_columns(header: list[str]) -> frozenset[str]:
+    """The trace columns the trajectory plot reads: positions, odometry and the GPS fixes
+    it draws (a wide run's sample of its GPS: most of a 200-rover trace's columns are GPS
+    fixes, and parsing them was most of the plots' cost)."""
+    ends = (".posX", ".posY", ".odomX", ".odomY")
+    keep = {c for c in header if c.endswith(ends)}
+    for comp in shown_gps(header, len(rover_names(header)) > GROUP_ABOVE):
+        keep |= {f"{comp}.gpsPosX", f"{comp}.gpsPosY"}
+    return frozenset(keep)
+
+
+def shown_gps(header: list[str], grouped: bool) -> list[str]:
+    """The GPS components whose fixes are drawn: all, or in a wide run an evenly spaced
+    sample of at most :data:`MAX_GPS_TRACKS` (crosses along every path are a smear)."""
+    tracks = [c[: -len(".gpsPosX")] for c in header if c.endswith(".gpsPosX")]
+    tracks = [c for c in tracks if f"{c}.gpsPosY" in header]
+    if grouped and len(tracks) > MAX_GPS_TRACKS:
+        tracks = tracks[:: -(-len(tracks) // MAX_GPS_TRACKS)]
+    return tracks
+
+
 def plot_trajectory(
-    trace: Path, metrics: dict[str, Any], out: Path, world: dict[str, Any] | None = None
+    trace: Path,
+    metrics: dict[str, Any],
+    out: Path,
+    world: dict[str, Any] | None = None,
+    keep: frozenset[str] | None = None,
 ) -> Path:
     """Draw the paths in ``trace`` into ``out`` (start and end marked, collisions crossed).
 
     ``world`` (:func:`amsa_phys.runs.plotjob.plot_context`) brings the static world, which
-    rover each GPS measures and the goals; without it the paths are drawn alone.
+    rover each GPS measures, the goals and (if it has them) the terrain zones; without it
+    the paths are drawn alone, with the zones of the run's ``scenario.yaml``. ``keep``: the
+    columns to read (:func:`plotted_columns` and more; all if None).
     """
     world = world or {}
-    header, data = read_trace(trace)
+    header, data = read_trace(trace, keep)
     rovers = rover_names(header) if len(data) else []  # a run that faulted at t = 0 has none
     paths = {r: data[:, [header.index(f"{r}.posX"), header.index(f"{r}.posY")]] for r in rovers}
     physics = world.get("physics")
@@ -134,7 +162,8 @@ def plot_trajectory(
     view = View() if arena else choose_view(list(paths.values()))
     fig, ax = plt.subplots(figsize=(10, 4.8) if view.lateral else (7, 6), dpi=100)
     draw_static_world(ax, physics, view)
-    draw_zones(ax, zones_of_run(trace.parent / "scenario.yaml"), view)  # terrain, from the run
+    zones = world["zones"] if "zones" in world else zones_of_run(trace.parent / "scenario.yaml")
+    draw_zones(ax, zones, view)  # terrain, from the run (its timeline changes the labels)
     grouped = len(rovers) > GROUP_ABOVE
     style = role_styles(rovers) if grouped else rover_styles(rovers)
     if grouped:
@@ -291,10 +320,9 @@ def _draw_gps(
     gps_of: dict[str, str],
     grouped: bool,
 ) -> None:
-    """GPS fixes as crosses in the measured rover's colour; in a wide run one artist per
-    colour with at most :data:`MAX_FIXES` crosses in all."""
-    tracks = [c[: -len(".gpsPosX")] for c in header if c.endswith(".gpsPosX")]
-    tracks = [c for c in tracks if f"{c}.gpsPosY" in header]
+    """GPS fixes as crosses in the measured rover's colour; in a wide run a sample of the
+    GPS (:func:`shown_gps`), one artist per colour, at most :data:`MAX_FIXES` crosses."""
+    tracks = shown_gps(header, grouped)
     cols = {c: (header.index(f"{c}.gpsPosX"), header.index(f"{c}.gpsPosY")) for c in tracks}
 
     def colour(comp: str) -> str:
@@ -317,7 +345,9 @@ def _draw_gps(
             ax.plot(xy[:, 0], xy[:, 1], "+", ms=3, mew=0.6, alpha=0.45, color=col, zorder=2)
             if len(tracks) <= 3:
                 ax.plot([], [], "+", color=col, label=f"{comp} (measured)")
-    if len(tracks) > 3:
+    if grouped and tracks:
+        ax.plot([], [], "+", color="0.4", label="GPS fixes (a sample)")
+    elif len(tracks) > 3:
         ax.plot([], [], "+", color="0.4", label="GPS fixes (the rover's colour)")
 
 
