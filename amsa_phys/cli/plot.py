@@ -101,8 +101,9 @@ def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
     seeds = len({r["seed_index"] for r in rows})
     out = Path(args.output) if args.output else sweepdir / "summary.png"
     check_output(out, "--output")
-    title = one_line(f"{sweepdir.name}: {metric} ({seeds} seed{'s' if seeds != 1 else ''})")
-    plot_summary(rows, axes, metric, out, title)
+    name = _sweep_scenario(sweepdir)
+    title = one_line(f"{name}: {metric} ({seeds} seed{'s' if seeds != 1 else ''})")
+    plot_summary(rows, axes, metric, out, title, scenario=name)
     print(one_line(f"wrote {out}"))
     failed = sum(1 for r in rows if r.get("error"))
     empty = sum(1 for r in rows if not r.get("error") and r.get(metric) is None)
@@ -112,6 +113,24 @@ def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
             f" (null: e.g. never settled), {failed} failed"
         )
     return 0
+
+
+def _sweep_scenario(sweepdir: Path) -> str:
+    """The scenario a sweep ran, for the title: recorded in its ``summary.png``, else in a
+    kept run's metrics (``--keep-runs``), else (an older sweep) the folder's name."""
+    from ..plots.summary import scenario_of
+
+    name = scenario_of(sweepdir / "summary.png")
+    if name:
+        return name
+    for metrics in sorted((sweepdir / "runs").glob("*/metrics.json"))[:1]:
+        try:
+            found = json.loads(metrics.read_text()).get("scenario")
+        except (OSError, ValueError, AttributeError):
+            found = None
+        if isinstance(found, str) and found:
+            return found
+    return sweepdir.name
 
 
 def _plot_paper(args: argparse.Namespace) -> int:

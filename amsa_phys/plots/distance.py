@@ -172,13 +172,23 @@ def _phase_notes(ax: plt.Axes, phases: list[dict[str, Any]]) -> list[str]:
     return tallest
 
 
-def _inner_changes(ax: plt.Axes, phases: list[dict[str, Any]]) -> None:
+def _inner_changes(ax: plt.Axes, phases: list[dict[str, Any]]) -> list[float]:
     """Mark changes made inside a phase (live in the window, ``new_phase: false``): a dashed
-    line and what was set, upright along the bottom so it never meets the phase notes."""
+    line and what was set, upright along the bottom so it never meets the phase notes; one
+    legend entry for them all. Returns their times (the legend is kept off them)."""
+    times = []
     for phase in phases:
         for change in phase.get("changes", []):
             at = change["at"]
-            ax.axvline(at, color="tab:purple", lw=0.8, ls="--", alpha=0.8)
+            times.append(float(at))
+            ax.axvline(
+                at,
+                color="tab:purple",
+                lw=0.8,
+                ls="--",
+                alpha=0.8,
+                label="change inside a phase" if len(times) == 1 else None,
+            )
             what = ", ".join(f"{k.split('.')[-1]}={v}" for k, v in change["set"].items())
             label = change.get("label")
             ax.annotate(
@@ -192,7 +202,25 @@ def _inner_changes(ax: plt.Axes, phases: list[dict[str, Any]]) -> None:
                 va="bottom",
                 fontsize=NOTE_PT - 0.5,
                 color="tab:purple",
+                zorder=6,  # over the legend, should they ever meet
             )
+    return times
+
+
+#: where the legend may go, and the span of the time axis (fractions) it covers there
+LEGEND_PLACES = (("lower right", 0.6, 1.0), ("lower left", 0.0, 0.4), ("lower center", 0.3, 0.7))
+
+
+def _legend_place(ax: plt.Axes, times: list[float]) -> str:
+    """The first of :data:`LEGEND_PLACES` whose span holds no live-change label (those
+    stand upright along the bottom, just left of their line); "lower right" when every
+    span has one (the labels are drawn over the legend then)."""
+    lo, hi = ax.get_xlim()
+    at = [(t - lo) / (hi - lo) for t in times] if hi > lo else []
+    for place, start, end in LEGEND_PLACES:
+        if not any(start - 0.01 <= x <= end + 0.03 for x in at):
+            return place
+    return LEGEND_PLACES[0][0]
 
 
 def _collisions(ax: plt.Axes, events: list[dict[str, Any]], t: np.ndarray, s: np.ndarray) -> None:
@@ -229,6 +257,7 @@ def distance_figure(
     quality = metrics.get("quality") or {}
     signal = quality.get("signal")
     fig, ax = plt.subplots(figsize=(10, FIG_H_IN), dpi=100)
+    changes: list[float] = []
     if signal in header and data.size and abs(float(quality["reference"])) < PLOTTABLE:
         t = data[:, 0]
         s = data[:, header.index(signal)]
@@ -247,7 +276,7 @@ def distance_figure(
         ax.plot(t, s, color="0.15", lw=1.2, label=signal)
         top = max(float(np.nanmax(s)) if np.isfinite(s).any() else 0.0, ref + tol)
         lines = _phase_notes(ax, metrics.get("phases", []))
-        _inner_changes(ax, metrics.get("phases", []))
+        changes = _inner_changes(ax, metrics.get("phases", []))
         _collisions(ax, metrics.get("events", []), t, s)
         # the notes get a band of their own above the data: the curve never runs through them
         band = (len(lines) * NOTE_PT * 1.25 + 8) / AXES_HEIGHT_PT if lines else 0.05
@@ -259,6 +288,6 @@ def distance_figure(
     ax.set_title(f"{metrics.get('scenario', '')} (seed {metrics.get('seed', '')})")
     ax.grid(alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="lower right", fontsize=8)
+        ax.legend(loc=_legend_place(ax, changes), fontsize=8)
     fig.subplots_adjust(*MARGINS)
     return fig
