@@ -209,9 +209,35 @@ def _kv(scenario: Any) -> float | None:
     return None
 
 
+def _kv_changes(scenario: Any) -> list[tuple[float, float]]:
+    """(time, Kv) of every later change of the controller's Kv (phases and steps)."""
+    path = next(
+        (
+            p
+            for p, leaf in scenario.world.leaves.items()
+            if "Kv" in leaf.params and leaf.kind.value == "controller"
+        ),
+        None,
+    )
+    out = []
+    for phase in scenario.phases:
+        steps = [(phase.at, phase.changes)] if phase.entry is not None else []
+        steps += [(step.at, step.changes) for step in phase.within]
+        for at, changes in steps:
+            for change in changes:
+                if change.leaf == path and change.param == "Kv":
+                    out.append((float(at), float(change.value)))
+    return out
+
+
 def _label(source: Path, scenario: Any) -> str:
+    """The panel's title: the scenario and every Kv it shows (``Kv = 0.35, then 0.05 from
+    100 s``), not only the first."""
     kv = _kv(scenario)
-    return one_line(f"{scenario.name}" + (f": Kv = {kv:g}" if kv is not None else ""))
+    if kv is None:
+        return one_line(str(scenario.name))
+    later = "".join(f", then {value:g} from {at:g} s" for at, value in _kv_changes(scenario))
+    return one_line(f"{scenario.name}: Kv = {kv:g}{later}")
 
 
 def read_metrics(path: Path) -> dict[str, Any]:

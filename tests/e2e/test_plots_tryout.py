@@ -132,3 +132,18 @@ def test_a_live_change_label_is_not_under_the_legend_and_has_an_entry(
         assert not label.get_window_extent(renderer).overlaps(legend.get_window_extent(renderer))
     finally:
         plt.close(fig)
+
+
+@pytest.mark.parametrize(
+    ("scenario", "title"),
+    [
+        ("paper_fig6.yaml", "paper_fig6: Kv = 0.35, then 0.05 from 100 s"),
+        ("paper_fig5_kv01.yaml", "paper_fig5_kv01: Kv = 0.1"),
+    ],
+)
+def test_a_paper_panel_title_names_every_kv_it_shows(scenario: str, title: str) -> None:
+    from amsa_phys.cli.plot import _label
+    from amsa_phys.model.scenario import load_scenario
+
+    path = ROOT / "scenarios" / scenario
+    assert _label(path, load_scenario(path)) == title
