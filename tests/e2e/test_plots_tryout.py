@@ -147,3 +147,47 @@ def test_a_paper_panel_title_names_every_kv_it_shows(scenario: str, title: str) 
 
     path = ROOT / "scenarios" / scenario
     assert _label(path, load_scenario(path)) == title
+
+
+def test_a_rover_box_is_framed_in_its_trajectory_colour() -> None:
+    from matplotlib.colors import to_hex
+    from matplotlib.patches import FancyBboxPatch
+
+    from amsa_phys.model.world import load_world
+    from amsa_phys.plots.graph import LABEL_PT, diagram
+    from amsa_phys.plots.trajectory import rover_styles
+
+    fig, _, _ = diagram(load_world(ROOT / "worlds" / "mde_challenge.yaml"))
+    try:
+        ax = fig.axes[0]
+        names = [t.get_text() for t in ax.texts if t.get_fontweight() == "bold"]
+        boxes = [p for p in ax.patches if isinstance(p, FancyBboxPatch)]
+        edge = {n: to_hex(b.get_edgecolor()) for n, b in zip(names, boxes, strict=True)}
+        styles = rover_styles(["Leader", "Follower"])
+        assert edge["Follower"] == styles["Follower"].colour  # blue, as its path
+        assert edge["Leader"] == styles["Leader"].colour
+        assert edge["LeaderGPS"] == to_hex("0.2")  # not a rover
+        assert LABEL_PT >= 7
+    finally:
+        plt.close(fig)
+
+
+def test_the_expanded_platoon_is_laid_out_a_bounded_number_of_times(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Moving the columns apart stops once it stops helping (it took 33 s, four layouts)."""
+    from amsa_phys.model.world import load_world
+    from amsa_phys.plots import graph
+
+    calls = []
+    layout = graph._layout
+
+    def counted(*args: Any) -> Any:
+        calls.append(args[2])
+        return layout(*args)
+
+    monkeypatch.setattr(graph, "_layout", counted)
+    fig, boxes, _ = graph.diagram(load_world(ROOT / "worlds" / "platoon.yaml"), False)
+    plt.close(fig)
+    assert len(boxes) == 71
+    assert len(calls) <= 2
