@@ -241,6 +241,11 @@ CORNER = 0.3  # radius of a routed link's corners
 MARGINS = (0.01, 0.01, 0.99, 0.92)  # fixed: labels are placed against the final transform
 #: where along an arrow a label is tried (0 = source end, 1 = target end): middle first
 ALONG = tuple(sorted((k / 40 for k in range(4, 37)), key=lambda t: (abs(t - 0.5), t)))
+#: a diagram of more boxes is refused (PNG/SVG): its layout takes minutes and its picture
+#: outgrows what Agg renders (65536 px a side); DOT has no limit
+MAX_BOXES = 300
+#: from this many boxes on, ``amsa-phys graph`` says it is working before it starts
+SLOW_BOXES = 100
 #: how far the columns move apart, layout after layout, while labels find no free place
 WIDEN = (0.0, 1.5, 3.0, 4.5)
 #: a label on a component or on another label costs this many line crossings

@@ -191,3 +191,27 @@ def test_the_expanded_platoon_is_laid_out_a_bounded_number_of_times(
     plt.close(fig)
     assert len(boxes) == 71
     assert len(calls) <= 2
+
+
+def test_a_graph_too_big_to_draw_is_refused_at_once_and_a_big_one_says_it_is_working(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import yaml
+
+    world = yaml.safe_load((ROOT / "worlds" / "platoon.yaml").read_text())
+    for cars in (199, 15):
+        world["components"]["Car"]["count"] = cars
+        (tmp_path / f"p{cars}.yaml").write_text(yaml.safe_dump(world, sort_keys=False))
+    out = tmp_path / "g.png"
+    assert main(["graph", str(tmp_path / "p199.yaml"), "--expand", "-o", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        "error: --expand: 1394 components are too many to draw (at most 300): drop --expand "
+        "(copies drawn once), or write a .dot file for Graphviz\n"
+    )
+    assert not out.exists()
+    assert (
+        main(["graph", str(tmp_path / "p199.yaml"), "--expand", "-o", str(tmp_path / "g.dot")]) == 0
+    )
+    assert main(["graph", str(tmp_path / "p15.yaml"), "--expand", "-o", str(out)]) == 0
+    assert capsys.readouterr().err.startswith("laying out 106 components and ")
+    assert out.stat().st_size > 10_000
