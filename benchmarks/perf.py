@@ -13,7 +13,8 @@ compare. Targets (issue "Performance"):
   >= 50x real time with 200 rovers;
 * recording at 1280x720: >= 150 frames/s, within 1.3x of the encoder alone;
 * sweeps: speed-up from -j 1 to -j N >= 0.9 N;
-* memory: peak RSS of a 1-hour run and of a 1-hour recording within 1.5x of a 1-minute one.
+* memory: peak RSS of a 1-hour run and of a 1-hour recording within 1.5x of a 1-minute one;
+* plots never slow the run: a 200-rover, 30 s run with plots <= 1.3x the same run without.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import bench_compiled
+import bench_plots
 import bench_record
 import bench_run
 import bench_sweep
@@ -221,6 +223,11 @@ def memory(reps: int) -> None:
             )
 
 
+def plots(reps: int) -> None:
+    measured, ok = bench_plots.verdict(reps)  # 200 rovers, 30 s, whole processes
+    report("200-rover run, plots / --no-plot", measured, "<= 1.3", ok)
+
+
 TARGETS: dict[str, Callable[[int], None]] = {
     "headless": headless,
     "process": process,
@@ -228,6 +235,7 @@ TARGETS: dict[str, Callable[[int], None]] = {
     "recording": recording,
     "sweeps": sweeps,
     "memory": memory,
+    "plots": plots,
     # issue 19: compiled step vs pure, process, --help, 1,000-rover platoon (bench_compiled.py)
     "compiled": lambda reps: bench_compiled.run_all(reps, report),
 }

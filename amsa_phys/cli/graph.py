@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from ..errors import ConfigError, one_line
@@ -29,8 +30,24 @@ def run(args: argparse.Namespace) -> int:
     check_output(out, "--output")
     kind, obj = load_any(args.file)
     world = obj.world if kind == "scenario" else obj
-    from ..plots.graph import draw  # matplotlib: imported by the commands that draw
+    from ..plots.graph import MAX_BOXES, SLOW_BOXES, draw, structure  # matplotlib: here
 
+    if out.suffix.lower() != ".dot":
+        st = structure(world, collapse=not args.expand)
+        boxes, links = len(st.nodes), len({(a, b) for a, b, _ in st.links})
+        if boxes > MAX_BOXES:
+            hint = "drop --expand (copies drawn once), or " if args.expand else ""
+            raise ConfigError(
+                f"{boxes} components are too many to draw (at most {MAX_BOXES}): {hint}"
+                "write a .dot file for Graphviz",
+                key="--expand" if args.expand else "--output",
+            )
+        if boxes >= SLOW_BOXES:  # the label layout takes a while: say so before it starts
+            print(
+                one_line(f"laying out {boxes} components and {links} links (seconds per 100)..."),
+                file=sys.stderr,
+                flush=True,
+            )
     draw(world, out, collapse=not args.expand)
     print(one_line(f"wrote {out}"))
     return 0

@@ -101,8 +101,9 @@ def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
     seeds = len({r["seed_index"] for r in rows})
     out = Path(args.output) if args.output else sweepdir / "summary.png"
     check_output(out, "--output")
-    title = one_line(f"{sweepdir.name}: {metric} ({seeds} seed{'s' if seeds != 1 else ''})")
-    plot_summary(rows, axes, metric, out, title)
+    name = _sweep_scenario(sweepdir)
+    title = one_line(f"{name}: {metric} ({seeds} seed{'s' if seeds != 1 else ''})")
+    plot_summary(rows, axes, metric, out, title, scenario=name)
     print(one_line(f"wrote {out}"))
     failed = sum(1 for r in rows if r.get("error"))
     empty = sum(1 for r in rows if not r.get("error") and r.get(metric) is None)
@@ -112,6 +113,24 @@ def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
             f" (null: e.g. never settled), {failed} failed"
         )
     return 0
+
+
+def _sweep_scenario(sweepdir: Path) -> str:
+    """The scenario a sweep ran, for the title: recorded in its ``summary.png``, else in a
+    kept run's metrics (``--keep-runs``), else (an older sweep) the folder's name."""
+    from ..plots.summary import scenario_of
+
+    name = scenario_of(sweepdir / "summary.png")
+    if name:
+        return name
+    for metrics in sorted((sweepdir / "runs").glob("*/metrics.json"))[:1]:
+        try:
+            found = json.loads(metrics.read_text()).get("scenario")
+        except (OSError, ValueError, AttributeError):
+            found = None
+        if isinstance(found, str) and found:
+            return found
+    return sweepdir.name
 
 
 def _plot_paper(args: argparse.Namespace) -> int:
@@ -190,9 +209,35 @@ def _kv(scenario: Any) -> float | None:
     return None
 
 
+def _kv_changes(scenario: Any) -> list[tuple[float, float]]:
+    """(time, Kv) of every later change of the controller's Kv (phases and steps)."""
+    path = next(
+        (
+            p
+            for p, leaf in scenario.world.leaves.items()
+            if "Kv" in leaf.params and leaf.kind.value == "controller"
+        ),
+        None,
+    )
+    out = []
+    for phase in scenario.phases:
+        steps = [(phase.at, phase.changes)] if phase.entry is not None else []
+        steps += [(step.at, step.changes) for step in phase.within]
+        for at, changes in steps:
+            for change in changes:
+                if change.leaf == path and change.param == "Kv":
+                    out.append((float(at), float(change.value)))
+    return out
+
+
 def _label(source: Path, scenario: Any) -> str:
+    """The panel's title: the scenario and every Kv it shows (``Kv = 0.35, then 0.05 from
+    100 s``), not only the first."""
     kv = _kv(scenario)
-    return one_line(f"{scenario.name}" + (f": Kv = {kv:g}" if kv is not None else ""))
+    if kv is None:
+        return one_line(str(scenario.name))
+    later = "".join(f", then {value:g} from {at:g} s" for at, value in _kv_changes(scenario))
+    return one_line(f"{scenario.name}: Kv = {kv:g}{later}")
 
 
 def read_metrics(path: Path) -> dict[str, Any]:

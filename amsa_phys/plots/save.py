@@ -12,13 +12,17 @@ from ..atomic import write_atomic
 
 
 def save_png(
-    fig: Figure, out: Path, margins: tuple[float, float, float, float] | None = None
+    fig: Figure,
+    out: Path,
+    margins: tuple[float, float, float, float] | None = None,
+    metadata: dict[str, str] | None = None,
 ) -> Path:
     """Render ``fig`` to PNG, write it atomically to ``out`` and close the figure.
 
     ``margins`` (left, bottom, right, top, in figure fractions) places a single-axes figure
     directly; without it ``tight_layout`` measures every label first, which costs a full
     extra layout pass (~60 ms a figure, a tenth of a headless run's process time).
+    ``metadata``: PNG text chunks (``Title``...), read back by :func:`png_text`.
     """
     if margins is None:
         fig.tight_layout()
@@ -26,7 +30,18 @@ def save_png(
         left, bottom, right, top = margins
         fig.subplots_adjust(left=left, bottom=bottom, right=right, top=top)
     buf = io.BytesIO()
-    fig.savefig(buf, format="png")
+    fig.savefig(buf, format="png", metadata=metadata)
     plt.close(fig)
     write_atomic(out, buf.getvalue())
     return out
+
+
+def png_text(path: Path) -> dict[str, str]:
+    """The text chunks of a PNG (``{}`` if it is unreadable or has none)."""
+    from PIL import Image  # matplotlib's own dependency
+
+    try:
+        with Image.open(path) as im:
+            return {str(k): str(v) for k, v in getattr(im, "text", {}).items()}
+    except (OSError, ValueError, SyntaxError):
+        return {}

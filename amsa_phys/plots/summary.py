@@ -13,8 +13,16 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Rectangle
+from matplotlib.ticker import MaxNLocator
 
 from .save import save_png
+
+#: the PNG text chunk holding the sweep's scenario name
+SCENARIO_KEY = "amsa-phys scenario"
+#: metrics that count events: integer ticks
+COUNT_METRICS = frozenset({"collisions"})
+#: the best cell's frame, inside the cell by this much (cell widths)
+FRAME_INSET = 0.04
 
 
 def _numeric(values: list[Any]) -> bool:
@@ -22,9 +30,19 @@ def _numeric(values: list[Any]) -> bool:
 
 
 def plot_summary(
-    rows: list[dict[str, Any]], axes: list[str], metric: str, out: Path, title: str
+    rows: list[dict[str, Any]],
+    axes: list[str],
+    metric: str,
+    out: Path,
+    title: str,
+    scenario: str | None = None,
 ) -> Path:
-    """Draw ``metric`` of ``rows`` against the grid ``axes`` into ``out``."""
+    """Draw ``metric`` of ``rows`` against the grid ``axes`` into ``out``.
+
+    The PNG keeps ``title`` and ``scenario`` (the scenario's name, else the title up to its
+    ``": "``) as text chunks: ``amsa-phys plot SWEEPDIR`` titles a redraw with the scenario's
+    name from them (results.csv does not hold it, and the folder may be named anything).
+    """
     ok = [r for r in rows if r.get(metric) is not None and not r.get("error")]
     fig, ax = plt.subplots(figsize=(8, 5), dpi=100)
     numeric_axes = [a for a in axes if _numeric([r[a] for r in ok])]
@@ -42,11 +60,21 @@ def plot_summary(
             grid[ys.index(y), xs.index(x)] = float(np.mean(vals))
         cmap = plt.get_cmap("viridis").with_extremes(bad="0.88")
         im = ax.imshow(np.ma.masked_invalid(grid), origin="lower", aspect="auto", cmap=cmap)
-        _cell_values(ax, grid, im.norm)
+        _cell_values(ax, grid, im.norm, cmap)
         if np.isfinite(grid).any():
             j, i = np.unravel_index(int(np.nanargmin(grid)), grid.shape)
-            ax.add_patch(  # the best cell framed in gold (its value starred below)
-                Rectangle((i - 0.5, j - 0.5), 1, 1, fill=False, ec="gold", lw=3.5, zorder=3)
+            ax.add_patch(  # the best cell framed in gold (its value starred below), the
+                # frame inside the cell: on its border an edge cell's frame was cut in half
+                Rectangle(
+                    (i - 0.5 + FRAME_INSET, j - 0.5 + FRAME_INSET),
+                    1 - 2 * FRAME_INSET,
+                    1 - 2 * FRAME_INSET,
+                    fill=False,
+                    ec="gold",
+                    lw=3.5,
+                    zorder=3,
+                    clip_on=False,
+                )
             )
             ax.plot(i, j - 0.25, marker="*", ms=13, color="gold", mec="k", ls="none", zorder=4)
             ax.set_title(f"★ best: {axes[0]}={xs[i]:g}, {axes[1]}={ys[j]:g}", fontsize=9)
@@ -54,7 +82,9 @@ def plot_summary(
         ax.set_yticks(range(len(ys)), [f"{y:g}" for y in ys])
         ax.set_xlabel(axes[0])
         ax.set_ylabel(axes[1])
-        fig.colorbar(im, ax=ax, label=f"{metric} (seed mean; lowest ★)")
+        bar = fig.colorbar(im, ax=ax, label=f"{metric} (seed mean; lowest ★)")
+        if is_count(metric):
+            bar.ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     else:
         x_axis = numeric_axes[0] if numeric_axes else axes[0]
         others = [a for a in axes if a != x_axis]
@@ -88,6 +118,10 @@ def plot_summary(
             ax.set_xticks(range(len(labels)), [str(v) for v in labels])
         ax.set_xlabel(x_axis)
         ax.set_ylabel(metric + " (seed min–max as bars, ★ best)")
+        if is_count(metric):  # 0, 1, 2 collisions: no tick at 0.5 of one
+            low, high = ax.get_ylim()  # at least 0..1 shown: all-zero counts get 0 and 1
+            ax.set_ylim(min(low, -0.25), max(high, 1.25))
+            ax.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     dropped = len(rows) - len(ok)
@@ -96,14 +130,44 @@ def plot_summary(
     if ax.get_title():  # the heatmap's best cell
         title += "\n" + ax.get_title()
     ax.set_title(title, fontsize=10)
-    return save_png(fig, out)
+    name = scenario if scenario is not None else title.split("\n")[0].rpartition(": ")[0]
+    return save_png(fig, out, metadata={"Title": title, SCENARIO_KEY: name})
 
 
-def _cell_values(ax: plt.Axes, grid: np.ndarray, norm: Any) -> None:
-    """Each heatmap cell's value, in black on light cells and white on dark ones."""
+def scenario_of(summary_png: Path) -> str | None:
+    """The scenario's name a sweep's ``summary.png`` was drawn for (None if not known)."""
+    from .save import png_text
+
+    return png_text(summary_png).get(SCENARIO_KEY) or None
+
+
+def is_count(metric: str) -> bool:
+    """Whether a metric counts events (``collisions``, ``phase1.collisions``): its axis
+    gets integer ticks."""
+    return metric.rpartition(".")[2] in COUNT_METRICS
+
+
+def luminance(rgba: tuple[float, ...]) -> float:
+    """Relative luminance (WCAG, 0 black .. 1 white) of an sRGB colour."""
+
+    def linear(c: float) -> float:
+        return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+
+    r, g, b = (linear(float(c)) for c in rgba[:3])
+    return 0.2126 * r + 0.7152 * g + 0.0722 * b
+
+
+def text_colour_on(rgba: tuple[float, ...]) -> str:
+    """Black or white, whichever contrasts more with the background ``rgba`` (WCAG: black
+    above a luminance of 0.179): black on viridis' yellow and green, white on its blue."""
+    return "black" if luminance(rgba) > 0.179 else "white"
+
+
+def _cell_values(ax: plt.Axes, grid: np.ndarray, norm: Any, cmap: Any) -> None:
+    """Each heatmap cell's value, in black or white by its cell's luminance."""
     for (j, i), value in np.ndenumerate(grid):
         finite = bool(np.isfinite(value))
-        dark = finite and norm(value) < 0.5  # viridis is dark at its low end
+        colour = text_colour_on(cmap(norm(value))) if finite else "0.4"
         ax.text(
             i,
             j,
@@ -111,5 +175,5 @@ def _cell_values(ax: plt.Axes, grid: np.ndarray, norm: Any) -> None:
             ha="center",
             va="center",
             fontsize=8,
-            color="white" if dark else ("black" if finite else "0.4"),
+            color=colour,
         )

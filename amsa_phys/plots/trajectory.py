@@ -22,6 +22,7 @@ obstacles and collision marks in the same frame (they are rotated with the paths
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -31,10 +32,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.collections import LineCollection
 from matplotlib.patches import Polygon
 
 from ..model.geometry import static_obstacles
-from ..palette import ALERT, hex_colour, rover_colour, rover_names
+from ..palette import ALERT, ROVER_COLOURS, hex_colour, rover_colour, rover_names
 from .distance import read_trace
 from .save import save_png
 from .zones import draw_zones, zones_of_run
@@ -44,6 +46,15 @@ STRAIGHT_RATIO = 0.05
 STRAIGHT_MIN_LENGTH_M = 20.0
 MIN_OFFSET_HALF_RANGE_M = 2.0  # the offset axis shows at least +-2 m (a rover is 0.6 m wide)
 OBSTACLE_FILL = "#78746c"
+GOAL_COLOUR = "#ffd700"
+#: more rovers than this: one colour and one legend entry per role (``role_of``)
+GROUP_ABOVE = 12
+#: in a grouped plot: points drawn per path, and GPS crosses drawn in all
+MAX_PATH_POINTS = 2000
+MAX_FIXES = 30_000
+MAX_GPS_TRACKS = 40
+#: past the palette's end the colours come again with these dashes
+LINE_STYLES = ("-", "--", "-.", ":")
 
 
 @dataclass(frozen=True)
@@ -107,16 +118,43 @@ def draw_static_world(ax: plt.Axes, physics: dict[str, Any] | None, view: View) 
     return drawn
 
 
+def plotted_columns(header: list[str]) -> frozenset[str]:
+    """The trace columns the trajectory plot reads: positions, odometry and the GPS fixes
+    it draws (a wide run's sample of its GPS: most of a 200-rover trace's columns are GPS
+    fixes, and parsing them was most of the plots' cost)."""
+    ends = (".posX", ".posY", ".odomX", ".odomY")
+    keep = {c for c in header if c.endswith(ends)}
+    for comp in shown_gps(header, len(rover_names(header)) > GROUP_ABOVE):
+        keep |= {f"{comp}.gpsPosX", f"{comp}.gpsPosY"}
+    return frozenset(keep)
+
+
+def shown_gps(header: list[str], grouped: bool) -> list[str]:
+    """The GPS components whose fixes are drawn: all, or in a wide run an evenly spaced
+    sample of at most :data:`MAX_GPS_TRACKS` (crosses along every path are a smear)."""
+    tracks = [c[: -len(".gpsPosX")] for c in header if c.endswith(".gpsPosX")]
+    tracks = [c for c in tracks if f"{c}.gpsPosY" in header]
+    if grouped and len(tracks) > MAX_GPS_TRACKS:
+        tracks = tracks[:: -(-len(tracks) // MAX_GPS_TRACKS)]
+    return tracks
+
+
 def plot_trajectory(
-    trace: Path, metrics: dict[str, Any], out: Path, world: dict[str, Any] | None = None
+    trace: Path,
+    metrics: dict[str, Any],
+    out: Path,
+    world: dict[str, Any] | None = None,
+    keep: frozenset[str] | None = None,
 ) -> Path:
     """Draw the paths in ``trace`` into ``out`` (start and end marked, collisions crossed).
 
-    ``world`` (:func:`amsa_phys.runs.plotjob.plot_context`) brings the static world and
-    which rover each GPS measures; without it the paths are drawn alone.
+    ``world`` (:func:`amsa_phys.runs.plotjob.plot_context`) brings the static world, which
+    rover each GPS measures, the goals and (if it has them) the terrain zones; without it
+    the paths are drawn alone, with the zones of the run's ``scenario.yaml``. ``keep``: the
+    columns to read (:func:`plotted_columns` and more; all if None).
     """
     world = world or {}
-    header, data = read_trace(trace)
+    header, data = read_trace(trace, keep)
     rovers = rover_names(header) if len(data) else []  # a run that faulted at t = 0 has none
     paths = {r: data[:, [header.index(f"{r}.posX"), header.index(f"{r}.posY")]] for r in rovers}
     physics = world.get("physics")
@@ -124,37 +162,17 @@ def plot_trajectory(
     view = View() if arena else choose_view(list(paths.values()))
     fig, ax = plt.subplots(figsize=(10, 4.8) if view.lateral else (7, 6), dpi=100)
     draw_static_world(ax, physics, view)
-    draw_zones(ax, zones_of_run(trace.parent / "scenario.yaml"), view)  # terrain, from the run
-    colour = {r: hex_colour(rover_colour(i)) for i, r in enumerate(rovers)}
-    for r, xy in paths.items():  # leader under follower: where the paths coincide both show
-        p = view(xy)
-        width = 3.2 if r == rovers[0] and len(rovers) > 1 else 1.6
-        ax.plot(p[:, 0], p[:, 1], lw=width, color=colour[r], label=f"{r} (true)", zorder=3)
-        ax.plot(*p[0], "o", color=colour[r], ms=6, mec="k", mew=0.5, zorder=5)
-        ax.plot(*p[-1], "s", color=colour[r], ms=6, mec="k", mew=0.5, zorder=5)
-    gps_of = world.get("gps_of", {})
-    tracks = [c[: -len(".gpsPosX")] for c in header if c.endswith(".gpsPosX")]
-    tracks = [c for c in tracks if f"{c}.gpsPosY" in header]
-    for comp in tracks:
-        xy = view(data[:, [header.index(f"{comp}.gpsPosX"), header.index(f"{comp}.gpsPosY")]])
-        col = colour.get(gps_of.get(comp, ""), "0.5")
-        ax.plot(xy[:, 0], xy[:, 1], "+", ms=3, mew=0.6, alpha=0.45, color=col, zorder=2)
-        if len(tracks) <= 3:
-            ax.plot([], [], "+", color=col, label=f"{comp} (measured)")
-    if len(tracks) > 3:
-        ax.plot([], [], "+", color="0.4", label="GPS fixes (the rover's colour)")
-    odometry = [c[: -len(".odomX")] for c in header if c.endswith(".odomX")]
-    for comp in [c for c in odometry if f"{c}.odomY" in header]:
-        xy = view(data[:, [header.index(f"{comp}.odomX"), header.index(f"{comp}.odomY")]])
-        ax.plot(
-            xy[:, 0],
-            xy[:, 1],
-            "--",
-            lw=1.2,
-            color="0.3",
-            zorder=2,
-            label=f"{comp} (dead reckoning)",
-        )
+    zones = world["zones"] if "zones" in world else zones_of_run(trace.parent / "scenario.yaml")
+    draw_zones(ax, zones, view)  # terrain, from the run (its timeline changes the labels)
+    grouped = len(rovers) > GROUP_ABOVE
+    style = role_styles(rovers) if grouped else rover_styles(rovers)
+    if grouped:
+        _draw_roles(ax, paths, view, style)
+    else:
+        _draw_rovers(ax, paths, view, style)
+    _draw_gps(ax, header, data, view, style, world.get("gps_of", {}), grouped)
+    _draw_odometry(ax, header, data, view)
+    _draw_goals(ax, world.get("goals", []), view)
     hits = _collision_points(metrics, data, header, paths)
     if hits.size:
         p = view(hits)
@@ -172,7 +190,9 @@ def plot_trajectory(
         ax.set_ylabel("y (m)")
     entries = len(ax.get_legend_handles_labels()[0])
     right = 0.98
-    if entries > 6:  # a platoon: the legend beside the plot, not over its paths
+    # a platoon: the legend beside the plot, not over its paths (and "best" would test
+    # every one of a wide run's points against every place the legend could go)
+    if entries > 6 or grouped:
         ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
         right = 0.8
     elif entries:
@@ -180,6 +200,193 @@ def plot_trajectory(
     ax.grid(alpha=0.3)
     ax.set_title(title, fontsize=10)
     return save_png(fig, out, margins=(0.09, 0.1, right, 0.92))
+
+
+@dataclass(frozen=True)
+class Style:
+    """How one rover (or, in a wide run, one role) is drawn, and its legend name."""
+
+    colour: str
+    linestyle: str
+    name: str
+
+
+def role_of(rover: str) -> str:
+    """A rover's role: its path with the instance numbers of ``count:`` Composites starred
+    (``Car17.Robot`` -> ``Car*.Robot``); ``Leader`` stays ``Leader``."""
+    return re.sub(r"\d+(?=\.|$)", "*", rover)
+
+
+def _style(index: int, name: str) -> Style:
+    """The index-th colour of the window's palette; past its end the same colours again,
+    dashed, then dash-dotted, then dotted, so no two of 36 rovers (or roles) look alike."""
+    dash = LINE_STYLES[(index // len(ROVER_COLOURS)) % len(LINE_STYLES)]
+    return Style(hex_colour(rover_colour(index)), dash, name)
+
+
+def rover_styles(rovers: list[str]) -> dict[str, Style]:
+    """One style per rover, in declaration order (the window's colours)."""
+    return {r: _style(i, r) for i, r in enumerate(rovers)}
+
+
+def role_styles(rovers: list[str]) -> dict[str, Style]:
+    """Every rover styled by its role: one colour and one legend entry per role (a 200-car
+    platoon is a leader and a column of cars, not 200 colours nobody can tell apart)."""
+    roles: dict[str, list[str]] = {}
+    for r in rovers:
+        roles.setdefault(role_of(r), []).append(r)
+    out = {}
+    for k, (role, members) in enumerate(roles.items()):
+        name = role if len(members) == 1 else f"{role} ×{len(members)}"
+        for r in members:
+            out[r] = _style(k, name)
+    return out
+
+
+def _draw_rovers(
+    ax: plt.Axes, paths: dict[str, np.ndarray], view: View, style: dict[str, Style]
+) -> None:
+    """Each rover's path, start and end as lines of its own (a few rovers: every point)."""
+    first = next(iter(paths), None)
+    for r, xy in paths.items():  # leader under follower: where the paths coincide both show
+        p = view(xy)
+        st = style[r]
+        width = 3.2 if r == first and len(paths) > 1 else 1.6
+        ax.plot(
+            p[:, 0],
+            p[:, 1],
+            lw=width,
+            color=st.colour,
+            ls=st.linestyle,
+            label=f"{r} (true)",
+            zorder=3,
+        )
+        ax.plot(*p[0], "o", color=st.colour, ms=6, mec="k", mew=0.5, zorder=5)
+        ax.plot(*p[-1], "s", color=st.colour, ms=6, mec="k", mew=0.5, zorder=5)
+
+
+def _draw_roles(
+    ax: plt.Axes, paths: dict[str, np.ndarray], view: View, style: dict[str, Style]
+) -> None:
+    """A wide run: one LineCollection per role, its paths thinned to what a figure shows.
+
+    Drawing cost is bounded by :data:`MAX_PATH_POINTS` per path, whatever the run's length,
+    and the artists by the number of roles, whatever the number of rovers.
+    """
+    by_role: dict[Style, list[np.ndarray]] = {}
+    for r, xy in paths.items():
+        by_role.setdefault(style[r], []).append(view(_thin(xy, MAX_PATH_POINTS)))
+    for k, (st, lines) in enumerate(by_role.items()):
+        ax.add_collection(
+            LineCollection(
+                lines,
+                colors=st.colour,
+                linestyles=st.linestyle,
+                linewidths=2.4 if k == 0 and len(lines) == 1 else 1.0,
+                label=f"{st.name} (true)",
+                zorder=3,
+            )
+        )
+        for at, marker in ((0, "o"), (-1, "s")):
+            ends = np.array([p[at] for p in lines])
+            ax.plot(
+                ends[:, 0],
+                ends[:, 1],
+                marker,
+                ls="",
+                color=st.colour,
+                ms=4,
+                mec="k",
+                mew=0.4,
+                zorder=5,
+            )
+    ax.autoscale_view()
+
+
+def _thin(xy: np.ndarray, most: int) -> np.ndarray:
+    """At most about ``most`` evenly spaced rows of ``xy``, always with its last."""
+    if len(xy) <= most:
+        return xy
+    step = -(-len(xy) // most)
+    return np.concatenate([xy[::step], xy[-1:]])
+
+
+def _draw_gps(
+    ax: plt.Axes,
+    header: list[str],
+    data: np.ndarray,
+    view: View,
+    style: dict[str, Style],
+    gps_of: dict[str, str],
+    grouped: bool,
+) -> None:
+    """GPS fixes as crosses in the measured rover's colour; in a wide run a sample of the
+    GPS (:func:`shown_gps`), one artist per colour, at most :data:`MAX_FIXES` crosses."""
+    tracks = shown_gps(header, grouped)
+    cols = {c: (header.index(f"{c}.gpsPosX"), header.index(f"{c}.gpsPosY")) for c in tracks}
+
+    def colour(comp: str) -> str:
+        rover = gps_of.get(comp, "")
+        return style[rover].colour if rover in style else "0.5"
+
+    if grouped:
+        per_track = max(2, MAX_FIXES // max(1, len(tracks)))
+        by_colour: dict[str, list[np.ndarray]] = {}
+        for comp in tracks:
+            xy = _thin(data[:, list(cols[comp])], per_track)
+            by_colour.setdefault(colour(comp), []).append(view(xy))
+        for col, pts in by_colour.items():
+            xy = np.concatenate(pts)
+            ax.plot(xy[:, 0], xy[:, 1], "+", ls="", ms=3, mew=0.6, alpha=0.45, color=col, zorder=2)
+    else:
+        for comp in tracks:
+            xy = view(data[:, list(cols[comp])])
+            col = colour(comp)
+            ax.plot(xy[:, 0], xy[:, 1], "+", ms=3, mew=0.6, alpha=0.45, color=col, zorder=2)
+            if len(tracks) <= 3:
+                ax.plot([], [], "+", color=col, label=f"{comp} (measured)")
+    if grouped and tracks:
+        ax.plot([], [], "+", color="0.4", label="GPS fixes (a sample)")
+    elif len(tracks) > 3:
+        ax.plot([], [], "+", color="0.4", label="GPS fixes (the rover's colour)")
+
+
+def _draw_odometry(ax: plt.Axes, header: list[str], data: np.ndarray, view: View) -> None:
+    """Dead-reckoning tracks, dashed grey; more than three share one legend entry."""
+    odometry = [c[: -len(".odomX")] for c in header if c.endswith(".odomX")]
+    odometry = [c for c in odometry if f"{c}.odomY" in header]
+    for comp in odometry:
+        xy = data[:, [header.index(f"{comp}.odomX"), header.index(f"{comp}.odomY")]]
+        if len(odometry) > 3:
+            xy = _thin(xy, MAX_PATH_POINTS)
+        xy = view(xy)
+        label = f"{comp} (dead reckoning)" if len(odometry) <= 3 else None
+        ax.plot(xy[:, 0], xy[:, 1], "--", lw=1.2, color="0.3", zorder=2, label=label)
+    if len(odometry) > 3:
+        ax.plot([], [], "--", lw=1.2, color="0.3", label="dead reckoning")
+
+
+def _draw_goals(ax: plt.Axes, goals: list[dict[str, float]], view: View) -> None:
+    """Each goal a rover steers to (``plot_context``): a star, and its radius if it has one."""
+    for i, goal in enumerate(goals):
+        x, y = float(goal["x"]), float(goal["y"])
+        radius = float(goal.get("radius") or 0.0)
+        if radius > 0:
+            a = np.linspace(0, 2 * math.pi, 49)
+            ring = view(np.column_stack((x + radius * np.cos(a), y + radius * np.sin(a))))
+            ax.plot(ring[:, 0], ring[:, 1], color=GOAL_COLOUR, lw=1.0, zorder=4)
+        p = view(np.array([[x, y]]))[0]
+        ax.plot(
+            p[0],
+            p[1],
+            "*",
+            color=GOAL_COLOUR,
+            ms=14,
+            mec="k",
+            mew=0.7,
+            zorder=6,
+            label=f"goal ({x:g}, {y:g})" if i < 3 else None,
+        )
 
 
 def _lateral_axes(ax: plt.Axes, pts: np.ndarray) -> None:

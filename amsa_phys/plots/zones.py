@@ -11,16 +11,18 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import yaml
-from matplotlib.axes import Axes
-from matplotlib.patches import Polygon
 
 from ..physics.terrain import zone_colours
 
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
 TEMPLATE = "frictionZone"
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
 @dataclass(frozen=True)
@@ -37,9 +39,23 @@ class ZoneShape:
 def zones_of_run(scenario_yaml: Path) -> list[ZoneShape]:
     """The friction zones of a run directory's ``scenario.yaml`` (none if it has none)."""
     try:
-        data = yaml.safe_load(scenario_yaml.read_text())
+        text = scenario_yaml.read_text()
+        # a wide run's resolved scenario is ~700 kB of YAML (seconds to parse in Python):
+        # parsed only when it can hold a zone at all, and by libyaml when PyYAML has it
+        if TEMPLATE not in text:
+            return []
+        data = yaml.load(text, Loader=_LOADER)  # a safe loader (C or Python)
     except (OSError, yaml.YAMLError):
         return []
+    return zones_of_resolved(data)
+
+
+def zones_of_resolved(data: Any) -> list[ZoneShape]:
+    """The friction zones of a resolved scenario (the data ``scenario.yaml`` holds).
+
+    Matplotlib-free, so a run's process can hand the zones to its plotting child with the
+    job instead of the child reading ``scenario.yaml`` (which is then still being written).
+    """
     if not isinstance(data, Mapping) or not isinstance(data.get("world"), Mapping):
         return []
     leaves: dict[str, Mapping[str, Any]] = {}
@@ -93,6 +109,8 @@ def draw_zones(
     ``view`` maps world metres to plot coordinates (the trajectory plot's lateral-offset
     frame), so a zone stays under the paths that cross it in any view.
     """
+    from matplotlib.patches import Polygon  # here: zones_of_resolved runs without matplotlib
+
     for z in zones:
         pts = np.asarray(z.polygon, dtype=float)
         if view is not None:

@@ -17,6 +17,17 @@ Decisions:
 * Whatever goes wrong in the child — it died, hung for :data:`TIMEOUT_S`, or plotting raised —
   the parent draws the plots itself, so errors surface exactly as for an in-process draw.
 * Sweeps and ``amsa-phys test`` do not use it: their workers already keep every core busy.
+* The job is handed over (:meth:`PlotJob.begin`) before ``metrics.json`` and
+  ``scenario.yaml`` are written, with the terrain zones in it, so the child reads the trace
+  while the parent writes (a 200-rover run's ``scenario.yaml`` takes ~0.3 s, as long as
+  reading the plotted columns of its trace).
+* When the child starts was measured on 2 cores shared with another busy process
+  (``benchmarks/bench_plots.py``, 8 interleaved repetitions; process time with plots /
+  without): forked at start 1.27 (scenario 1) and 1.38 (200 rovers); the same child at
+  ``os.nice(10)`` 1.38 and 1.41; forked after the loop (import overlapping the file writing)
+  1.65 and 1.39. Niceness did not keep the import off the loop measurably and made the
+  drawing wait behind the other load; a late fork pays the import after the loop. So the
+  child is forked at start, at normal priority.
 """
 
 from __future__ import annotations
@@ -54,8 +65,8 @@ def draw_run_plots(
     (rather than left blank), and the caller says so. ``world`` is :func:`plot_context`.
     Returns the files written.
     """
-    from ..plots.distance import plot_distance
-    from ..plots.trajectory import plot_trajectory
+    from ..plots.distance import plot_distance, trace_header
+    from ..plots.trajectory import plot_trajectory, plotted_columns
 
     # titles show the scenario's name: printable, as on the terminal (an escape code would
     # be a missing glyph and a warning on stderr)
@@ -63,21 +74,47 @@ def draw_run_plots(
     written = []
     with warnings.catch_warnings():  # a picture's imperfections are not the run's messages
         warnings.simplefilter("ignore")
-        if metrics.get("quality"):
-            written.append(plot_distance(trace, metrics, distance))
-        written.append(plot_trajectory(trace, metrics, trajectory, world))
+        # both plots read one parse of only the columns they draw
+        quality = metrics.get("quality") or {}
+        keep = plotted_columns(trace_header(trace)) | {str(quality.get("signal"))}
+        if quality:
+            written.append(plot_distance(trace, metrics, distance, keep))
+        written.append(plot_trajectory(trace, metrics, trajectory, world, keep))
     return written
 
 
-def plot_context(world: WorldSpec) -> dict[str, Any]:
-    """What the trajectory plot needs from the world: its static arena (``physics``) and
-    which rover each GPS measures (``gps_of``: GPS path -> rover path), plain data."""
+def plot_context(world: WorldSpec, resolved: Any = None) -> dict[str, Any]:
+    """What the trajectory plot needs from the world: its static arena (``physics``),
+    which rover each GPS measures (``gps_of``: GPS path -> rover path) and the goals rovers
+    steer to (``goals``: x, y, radius), plain data. With the run's ``resolved`` scenario
+    also its terrain zones, so the plots need not wait for ``scenario.yaml``."""
     gps_of = {}
+    goals: dict[tuple[float, float], dict[str, float]] = {}
     for path, leaf in world.leaves.items():
         source = leaf.inputs.get("posX", "")
         if leaf.template.name() == "GPS" and source.endswith(".posX"):
             gps_of[path] = source[: -len(".posX")]
-    return {"physics": world.physics, "gps_of": gps_of}
+        goal = _goal_of(leaf.params)
+        if goal is not None:  # a navigator and its monitor name the same goal: drawn once
+            key = (goal["x"], goal["y"])
+            goals[key] = {**goal, "radius": max(goal["radius"], goals.get(key, goal)["radius"])}
+    context = {"physics": world.physics, "gps_of": gps_of, "goals": list(goals.values())}
+    if resolved is not None:  # the run's resolved scenario: its zones go with the job
+        from ..plots.zones import zones_of_resolved  # matplotlib-free
+
+        context["zones"] = zones_of_resolved(resolved)
+    return context
+
+
+def _goal_of(params: dict[str, Any]) -> dict[str, float] | None:
+    """``{x, y, radius}`` of a Leaf steering to (or measuring the distance to) a goal: any
+    template with numeric ``goalX`` and ``goalY`` parameters (``goalRadius`` if it has one)."""
+    try:
+        x, y = float(params["goalX"]), float(params["goalY"])
+        radius = float(params.get("goalRadius", 0.0) or 0.0)
+    except (KeyError, TypeError, ValueError):
+        return None
+    return {"x": x, "y": y, "radius": radius}
 
 
 def _child(jobs: Connection, parent_end: Connection, parent_pid: int) -> None:
@@ -108,6 +145,7 @@ class PlotJob:
     def __init__(self) -> None:
         self._conn: Connection | None = None
         self._proc: multiprocessing.process.BaseProcess | None = None
+        self._job: tuple[Any, ...] | None = None  # handed over by begin(), awaited by finish()
 
     @classmethod
     def start(cls) -> PlotJob:
@@ -145,17 +183,43 @@ class PlotJob:
         world: dict[str, Any] | None = None,
     ) -> None:
         """Draw the plots: by the child if it answers in time, else here."""
-        args = (Path(trace), metrics, Path(distance), Path(trajectory), world)
-        if self._handoff(args):
-            return
-        draw_run_plots(*args)
+        self.begin(trace, metrics, distance, trajectory, world)
+        self.finish()
 
-    def _handoff(self, args: tuple[Any, ...]) -> bool:
+    def begin(
+        self,
+        trace: Path,
+        metrics: dict[str, Any],
+        distance: Path,
+        trajectory: Path,
+        world: dict[str, Any] | None = None,
+    ) -> None:
+        """Hand the plots to the child, which draws them while the caller writes its other
+        files (a wide run's ``scenario.yaml`` takes as long as reading its trace);
+        :meth:`finish` waits for them."""
+        self._job = (Path(trace), metrics, Path(distance), Path(trajectory), world)
+        conn = self._conn
+        if conn is None:
+            return
+        try:
+            conn.send(self._job)
+        except (OSError, ValueError):
+            self.close()  # finish draws here
+
+    def finish(self) -> None:
+        """The plots :meth:`begin` handed over, done: by the child if it answers in time,
+        else drawn here (errors then surface as for an in-process draw)."""
+        job, self._job = self._job, None
+        if job is None:
+            return
+        if not self._wait():
+            draw_run_plots(*job)
+
+    def _wait(self) -> bool:
         conn = self._conn
         if conn is None:
             return False
         try:
-            conn.send(args)
             done = conn.poll(TIMEOUT_S) and conn.recv() == "ok"
         except (OSError, EOFError, ValueError):
             done = False

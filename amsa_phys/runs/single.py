@@ -443,6 +443,16 @@ def write_run_files(
             return None
 
     metrics = ended.metrics
+    plotter = plotter or PlotJob()
+    plotting = plot and ended.has_trace
+    if plotting:  # the plotting child draws while the files below are written
+        plotter.begin(
+            out_dir / "trace.csv",
+            metrics,
+            out_dir / "distance.png",
+            out_dir / "trajectory.png",
+            plot_context(ended.scenario.world, ended.resolved),
+        )
     keep(
         write_atomic,
         out_dir / "metrics.json",
@@ -450,16 +460,8 @@ def write_run_files(
     )
     text = ended.note + yaml.dump(ended.resolved, Dumper=_YAML_DUMPER, sort_keys=False)
     keep(write_atomic, out_dir / "scenario.yaml", text)
-    plotter = plotter or PlotJob()
-    if plot and ended.has_trace:
-        keep(
-            plotter.draw,
-            out_dir / "trace.csv",
-            metrics,
-            out_dir / "distance.png",
-            out_dir / "trajectory.png",
-            plot_context(ended.scenario.world),
-        )
+    if plotting:
+        keep(plotter.finish)
     plotter.close()
     return unwritten
 

@@ -65,7 +65,9 @@ def test_heatmap_writes_each_value_and_frames_the_best(
         cells = sorted(t.get_text() for t in ax.texts)
         assert cells == ["0.25", "0.3", "0.4", "2.9", "3", "none"]  # the failed run: none
         (frame,) = [p for p in ax.patches if isinstance(p, Rectangle)]
-        assert frame.get_xy() == (-0.5, 0.5)  # Kv = 0.1 (column 0), Kw = 0.04 (row 1)
+        x, y = frame.get_xy()  # framed inside the cell: its centre is the cell's
+        centre = (x + frame.get_width() / 2, y + frame.get_height() / 2)
+        assert centre == pytest.approx((0.0, 1.0))  # Kv = 0.1 (column 0), Kw = 0.04 (row 1)
         title = ax.get_title()
         assert "★ best: MyFollowerController.Kv=0.1, MyFollowerController.Kw=0.04" in title
         assert "1 of 6 runs have no rms_error and are left out" in title

@@ -57,7 +57,10 @@ def test_outside_the_main_thread_nothing_is_installed() -> None:
 class CtrlCWhilePlotting:
     """A plotter that receives Ctrl-C after the last instant, while drawing."""
 
-    def draw(self, *args: Any) -> None:
+    def begin(self, *args: Any) -> None:
+        pass  # handed over; the files are written while the plots are drawn
+
+    def finish(self) -> None:
         os.kill(os.getpid(), signal.SIGINT)
 
     def close(self) -> None:
