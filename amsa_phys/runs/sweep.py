@@ -382,22 +382,39 @@ def job_row(job: Job, error: str = "") -> dict[str, Any]:
     return row
 
 
+def prepare_job(job: Job) -> Scenario:
+    """The scenario of one job: the file's, cut to the sweep's duration, with the job's seed,
+    its context's and grid point's values (ValueError or AmsaError if they break a rule)."""
+    scenario = copy.deepcopy(_cached(job.scenario))
+    if job.duration is not None:
+        shorten(scenario, Fraction(str(job.duration)))
+    scenario.seed = job.seed
+    contexts = dict(job.contexts)
+    for key, value in job.point:
+        if key == "context":
+            for k, v in contexts[value]:
+                apply_setting(scenario, k, v)
+        else:
+            apply_setting(scenario, key, value)
+    check_phases(scenario, None)  # this point's combination may break a template's rule
+    return scenario
+
+
+def fill_metrics(row: dict[str, Any], metrics: dict[str, Any]) -> dict[str, Any]:
+    """Put a run's ``metrics.json`` document into its result row (overall, then phases)."""
+    for k in METRIC_KEYS:
+        row[k] = metrics["overall"].get(k)
+    for i, phase in enumerate(metrics["phases"]):
+        for k in METRIC_KEYS:
+            row[f"phase{i}.{k}"] = phase.get(k)
+    return row
+
+
 def run_job(job: Job) -> dict[str, Any]:
     """Run one job and return its result row (errors are reported in the row)."""
     row = job_row(job)
     try:
-        scenario = copy.deepcopy(_cached(job.scenario))
-        if job.duration is not None:
-            shorten(scenario, Fraction(str(job.duration)))
-        scenario.seed = job.seed
-        contexts = dict(job.contexts)
-        for key, value in job.point:
-            if key == "context":
-                for k, v in contexts[value]:
-                    apply_setting(scenario, k, v)
-            else:
-                apply_setting(scenario, key, value)
-        check_phases(scenario, None)  # this point's combination may break a template's rule
+        scenario = prepare_job(job)
         if job.keep_dir is not None:
             out = prepare_run_dir(Path(job.keep_dir) / f"run-{job.index:05d}", force=True)
             try:
@@ -417,12 +434,7 @@ def run_job(job: Job) -> dict[str, Any]:
     except (AmsaError, ValueError) as exc:
         row["error"] = str(exc)
         return row
-    for k in METRIC_KEYS:
-        row[k] = metrics["overall"].get(k)
-    for i, phase in enumerate(metrics["phases"]):
-        for k in METRIC_KEYS:
-            row[f"phase{i}.{k}"] = phase.get(k)
-    return row
+    return fill_metrics(row, metrics)
 
 
 def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
