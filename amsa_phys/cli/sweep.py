@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 import csv
 import io
+import itertools
 import sys
+from collections.abc import Iterator
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -18,15 +20,17 @@ from ..errors import ConfigError, Interrupted, one_line
 from ..model.scenario import load_scenario
 from ..model.wording import plural
 from ..model.yamlio import load_yaml
+from ..runs.batched import iter_batched, lost_rows, plan_units, run_unit
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.suite import input_files
 from ..runs.sweep import (
     Axis,
+    Job,
     SweepPlan,
     check_axes,
     check_size,
+    dask_map,
     deterministic_points,
-    iter_dask,
     iter_local,
     parse_grid,
     parse_range,
@@ -58,10 +62,17 @@ def add_args(p: argparse.ArgumentParser) -> None:
     add_jobs(p)
     p.add_argument(
         "--executor",
-        choices=("local", "dask"),
-        default="local",
-        help="where the runs go: local worker processes (default, -j of them) or an "
-        "existing Dask cluster (needs --scheduler and the cluster extra)",
+        choices=("batch", "local", "dask"),
+        default="batch",
+        help="where the runs go: batch (default): batches of runs as columns of one "
+        "simulation, on -j local worker processes; local: one run per process; dask: "
+        "batches on an existing Dask cluster (needs --scheduler and the cluster extra)",
+    )
+    p.add_argument(
+        "--batch-size",
+        type=int,
+        metavar="N",
+        help="runs per batch (default: two batches per worker, at most 250)",
     )
     p.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address (tcp://...)")
     p.add_argument("--metric", help="metric for summary.png (default rms_error)")
@@ -161,6 +172,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("the Dask executor needs --scheduler ADDR", key="--executor")
     if args.jobs < 1:
         raise ConfigError("must be at least 1", key="--jobs")
+    if args.batch_size is not None and args.batch_size < 1:
+        raise ConfigError("must be at least 1", key="--batch-size")
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-sweep")
     prepare_run_dir(out, args.force, inputs=plan.inputs)
@@ -168,11 +181,7 @@ def run(args: argparse.Namespace) -> int:
         plan.keep_dir = str((out / "runs").resolve())
     jobs = plan.jobs()
     rows: list[dict[str, Any]] = []
-    source = (
-        iter_dask(jobs, args.scheduler)
-        if args.executor == "dask"
-        else iter_local(jobs, min(args.jobs, len(jobs)))
-    )
+    source = rows_from(jobs, args)
     interrupted = False
     try:
         # Ctrl-C is raised between completions, never inside concurrent.futures or Dask
@@ -210,6 +219,18 @@ def run(args: argparse.Namespace) -> int:
     if interrupted:
         raise Interrupted(f"sweep interrupted; {plural(len(rows), 'finished row')} kept in {out}")
     return 0
+
+
+def rows_from(jobs: list[Job], args: argparse.Namespace) -> Iterator[dict[str, Any]]:
+    """Result rows as they come from the chosen executor (batched unless ``local``)."""
+    if args.executor == "local":
+        return iter_local(jobs, min(args.jobs, len(jobs)))
+    units, notes = plan_units(jobs, args.jobs, args.batch_size)
+    for note in notes:
+        print(one_line(f"note: {note}"), file=sys.stderr)
+    if args.executor == "dask":
+        return itertools.chain.from_iterable(dask_map(run_unit, units, args.scheduler, lost_rows))
+    return iter_batched(units, min(args.jobs, len(units)), iter_local)
 
 
 def write_results(rows: list[dict[str, Any]], axes: list[str], path: Path) -> None:

@@ -79,7 +79,7 @@ class Group:
         self.template = type(self.comps[0])
         first = dict(tasks[0].inputs)
         self.inputs: list[tuple[str, Callable[[dict[str, float]], tuple[float, ...]]]] = [
-            (port, operator.itemgetter(*[dict(t.inputs)[port] for t in tasks])) for port in first
+            (port, _gather([dict(t.inputs)[port] for t in tasks])) for port in first
         ]
         self.outputs = {port: [t.targets[port] for t in tasks] for port in tasks[0].targets}
         self.params = ParamArrays(self.comps)
@@ -87,6 +87,14 @@ class Group:
         self.delay = tasks[0].delay
         #: scratch space the template's ``step_many`` owns (arrays of per-member state)
         self.state: dict[str, Any] = {}
+
+
+def _gather(names: list[str]) -> Callable[[dict[str, float]], tuple[float, ...]]:
+    """The values of ``names`` as a tuple (``itemgetter`` of one name gives a bare value)."""
+    if len(names) == 1:
+        name = names[0]
+        return lambda values: (values[name],)
+    return operator.itemgetter(*names)
 
 
 def group_key(task: Any, freq: Fraction) -> tuple[Any, ...] | None:

@@ -236,7 +236,8 @@ class MultiRun(Simulation):
     def outcomes(self) -> list[RunOutcome]:
         """Each run's samples, events and changes so far."""
         t = np.array(self._q_t[: len(self._q_rows)], dtype=np.float64)
-        table = np.array(self._q_rows, dtype=np.float64).reshape(len(self._q_rows), -1)
+        shape = (len(self._q_rows), len(self._q_index))
+        table = np.array(self._q_rows, dtype=np.float64).reshape(shape)
         column = {k: j for j, k in enumerate(self._q_index)}
         t_end = float(self.now)
         out = []

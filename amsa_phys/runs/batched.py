@@ -35,6 +35,9 @@ from .sweep import Job, fill_metrics, job_row, prepare_job, run_job
 #: Most runs in one batch: a batch's memory is ~1 MB a run-minute of quality samples and
 #: world, and a batch is what a Ctrl-C or a dying worker costs.
 MAX_BATCH = 250
+#: Batches per worker when the size is automatic: enough that the pool balances and that a
+#: Ctrl-C keeps rows of the batches finished so far, few enough that each batch is wide.
+BATCHES_PER_WORKER = 8
 
 
 @dataclass(frozen=True)
@@ -69,8 +72,8 @@ def batch_key(scenario: Scenario) -> str:
 
 
 def auto_size(runs: int, workers: int) -> int:
-    """Runs per batch: two batches per worker (so the pool balances), at most MAX_BATCH."""
-    return max(1, min(MAX_BATCH, math.ceil(runs / (2 * max(1, workers)))))
+    """Runs per batch: :data:`BATCHES_PER_WORKER` batches per worker, at most MAX_BATCH."""
+    return max(1, min(MAX_BATCH, math.ceil(runs / (BATCHES_PER_WORKER * max(1, workers)))))
 
 
 def plan_units(

@@ -17,11 +17,11 @@ import itertools
 import json
 import math
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -44,6 +44,9 @@ from ..model.yamlio import parse_value
 from .pool import WORKER_LOST, imap_resilient
 from .rundir import prepare_run_dir
 from .single import compute_metrics, run_scenario
+
+T = TypeVar("T")
+R = TypeVar("R")
 
 #: Metric columns written for the overall block and each phase.
 METRIC_KEYS = METRICS
@@ -456,6 +459,19 @@ def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
 
 def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:
     """Rows as they complete, from an existing Dask distributed cluster."""
+    return dask_map(
+        run_job,
+        jobs,
+        scheduler,
+        functools.partial(job_row, error=f"{WORKER_LOST}, on every worker that ran it"),
+    )
+
+
+def dask_map(
+    fn: Callable[[T], R], items: Sequence[T], scheduler: str, lost: Callable[[T], R]
+) -> Iterator[R]:
+    """``fn(item)`` as they complete on an existing Dask cluster; ``lost(item)`` for an item
+    whose workers all died (a batched sweep's items are batches: ``runs/batched.py``)."""
     try:
         from distributed import Client, as_completed
     except ImportError:
@@ -470,8 +486,8 @@ def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:
     from distributed import KilledWorker
 
     try:
-        futures = client.map(run_job, jobs, pure=False)
-        job_of = dict(zip(futures, jobs, strict=True))
+        futures = client.map(fn, items, pure=False)
+        item_of = dict(zip(futures, items, strict=True))
         pending = as_completed(futures)
         while not pending.is_empty():
             batch = pending.next_batch(block=False)
@@ -482,6 +498,6 @@ def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:
                 try:
                     yield fut.result()
                 except KilledWorker:  # Dask retried it on other workers and they died too
-                    yield job_row(job_of[fut], f"{WORKER_LOST}, on every worker that ran it")
+                    yield lost(item_of[fut])
     finally:
         client.close()
