@@ -62,7 +62,15 @@ class RunView:
         return self._sim.now
 
     def add_hook(self, rate_hz: Fraction, fn: Callable[[], None], name: str) -> None:
-        """A subsystem step of this run (its physics), stepped by the batch."""
+        """A subsystem step of this run, stepped by the batch: its physics world's step is
+        taken over by the batch's column physics when there is one (one step for all)."""
+        columns = self._sim.column_physics
+        if name == "physics" and columns is not None:
+            if not columns.worlds:
+                columns.sim = self._sim
+                self._sim.add_hook(rate_hz, columns.step, name)
+            columns.adopt(fn.__self__)  # type: ignore[attr-defined]
+            return
         self._sim.add_hook(rate_hz, fn, name)
 
     def record_event(self, kind: str, detail: str) -> None:
@@ -166,14 +174,23 @@ class MultiRun(Simulation):
 
     ``scenarios`` must share duration, log rate and world structure (``runs/batched.py``
     checks that before it puts them in one batch). ``ungrouped`` names templates whose
-    ``step_many`` needs all members in one shared service (the robots' physics world):
-    they step one by one here.
+    ``step_many`` needs all members in one shared service (the robots' physics world, when
+    each run steps its own): they step one by one here. ``columns`` takes over the runs'
+    physics steps (``physics/columns.py``).
     """
 
     _min_group = 1
 
-    def __init__(self, scenarios: Sequence[Scenario], ungrouped: Collection[type] = ()) -> None:
+    def __init__(
+        self,
+        scenarios: Sequence[Scenario],
+        ungrouped: Collection[type] = (),
+        columns: Any = None,
+    ) -> None:
         self.scenarios = list(scenarios)
+        #: the batch's column physics (``physics/columns.py``), which takes over every
+        #: run's physics step; None: each run's world steps its own Space
+        self.column_physics = columns
         self._ungrouped = tuple(ungrouped)
         base = self.scenarios[0]
         self.runs: list[RunView] = []

@@ -376,6 +376,26 @@ class FreeRobot(_Robot):
         self.rover.set_power(left, right)
         return self._pose()
 
+    @classmethod
+    def step_many(
+        cls,
+        comps: Sequence[FreeRobot],
+        t: Fraction,
+        inp: Mapping[str, Any],
+        p: Any,
+        state: dict[str, Any],
+    ) -> tuple[Mapping[str, Any], None]:
+        """``do_step`` for many copies at once (a batched sweep's leaders): each copy's
+        behaviour as alone, the powers and poses as arrays (``ControlledRobot.step_many``)."""
+        powers = np.array([c._behaviour(t) for c in comps], dtype=np.float64)
+        return ControlledRobot.step_many(
+            comps,  # type: ignore[arg-type]
+            t,
+            {"powerL": powers[:, 0], "powerR": powers[:, 1]},
+            p,
+            state,
+        )
+
     def _behaviour(self, t: Fraction) -> tuple[float, float]:
         p = self.p
         cruise = p.cruisePower

@@ -59,7 +59,22 @@ def unbatchable(scenario: Scenario) -> str | None:
             return f"{path} is a user template ({template.name()}) without step_many"
         if leaf.timing.jitter or leaf.timing.phase == RANDOM:
             return f"{path} has random loop timing (jitter or a random phase)"
+        if template.has_arrays():
+            return f"{path} has array ports (a lidar casts rays in its run's space every scan)"
+        if template.name() == "frictionZone":
+            return f"{path} is a terrain zone (the batch's physics has one ground)"
+    robots = {p for p, leaf in world.leaves.items() if leaf.template.name() in _ROBOTS}
+    for i, phase in enumerate(scenario.phases):
+        steps = [phase.changes] if i > 0 else []
+        for changes in [*steps, *(step.changes for step in phase.within)]:
+            for c in changes:
+                if c.leaf in robots:
+                    return f"the timeline changes {c.key} during the run"
     return None
+
+
+#: Templates of rovers: a batch sets their parameters at t = 0 only.
+_ROBOTS = ("freeRobot", "controlledRobot")
 
 
 def batch_key(scenario: Scenario) -> str:
@@ -118,12 +133,11 @@ def plan_units(
     return units, notes
 
 
-def _robots() -> tuple[type, ...]:
-    """Templates whose ``step_many`` needs every member in one physics world: in a batch
-    each run has its own, so they step one by one."""
-    from ..physics.templates import ControlledRobot
+def _columns() -> Any:
+    """The batch's column physics: every run's rovers in one force pass and integration."""
+    from ..physics.columns import ColumnPhysics
 
-    return (ControlledRobot,)
+    return ColumnPhysics()
 
 
 def run_batch(jobs: Sequence[Job]) -> list[dict[str, Any]]:
@@ -137,7 +151,7 @@ def run_batch(jobs: Sequence[Job]) -> list[dict[str, Any]]:
             rows[job.index] = job_row(job, str(exc))
     while todo:
         t0 = time.perf_counter()
-        sim = MultiRun([sc for _, sc in todo], ungrouped=_robots())
+        sim = MultiRun([sc for _, sc in todo], columns=_columns())
         try:
             sim.run()
         except RunFault as exc:
