@@ -1,24 +1,28 @@
 """Every run's rovers of a batch as columns: one force pass and one integration a step.
 
 In a batched sweep (``engine/multirun.py``) each run keeps its own :class:`PhysicsWorld`
-with its own pymunk Space (its rovers, obstacles and walls, its collision handlers and
-counts), so runs can never touch: contacts are those of the run alone by construction, with
-no offsets (a far offset would change how positions round) and no collision filters (32
+with its own pymunk Space (its rovers, obstacles and walls), so runs can never touch: no
+offsets (a far offset would change how positions round) and no collision filters (32
 categories are too few for thousands of runs, and every run at the same place would make
 pymunk's broadphase quadratic). What is shared is the arithmetic:
 
 * the wheel, tyre and grip forces of all rovers of all runs are one ``fleet.Fleet`` pass
   (the numpy model the platoon uses, checked against the float path in the tests);
-* a rover whose run has no shape within reach is integrated here, in numpy, with
-  Chipmunk's own update for a body without contacts (``cpBodyUpdatePosition`` then
-  ``cpBodyUpdateVelocity``: ``p += v dt; a += w dt; v += (g + f / m) dt; w += t / I dt``,
-  the same operations in the same order, so the same floats);
-* a run with two shapes within reach of each other (:data:`REACH_M` plus what the rovers
-  can cover in two steps) is stepped by its own Space that step: its bodies get the state
-  and forces of the columns, pymunk steps, the columns get the bodies' state back. It stays
-  on its Space for :data:`HOLD_STEPS` steps after the last near step, longer than pymunk
-  keeps an arbiter of shapes that parted (``collision_persistence``, 3 steps), so a contact
-  starts, is solved and ends entirely inside pymunk, as alone.
+* every rover is integrated here, in numpy, with Chipmunk's own update for a body without
+  contacts (``cpBodyUpdatePosition`` then ``cpBodyUpdateVelocity``: ``p += v dt; a += w dt;
+  v += (g + f / m) dt; w += t / I dt``, the same operations in the same order, so the same
+  floats: a run's states equal those of its Space stepped alone, bit for bit).
+
+Contacts are where that stops: pymunk solves a contact with 10 sequential-impulse passes,
+which leave a residual that depends on the order of the contact points, and that order
+depends on the history of the Space's broadphase tree. Measured on the MDE world, a
+follower running into its leader: the same states and forces a step before, a Space
+stepped alone and one brought up to date at the contact differ by 3e-5 m/s after that one
+step; a difference of 1e-14 in the forces (numpy's arrangement of the force model against
+the float path's) grows to 1e-5 in the run's metrics. So a run whose shapes come within
+reach of each other (:data:`REACH_M` plus what they can cover in two steps) is marked
+(:attr:`ColumnPhysics.touched`) and its row comes from the run made alone: contacts are
+exactly those of a single run, because they are a single run's.
 
 Worlds with terrain zones, lidars (a ray cast needs the Space current every step) or
 changes to a rover during the run are not batched (``runs/batched.py`` says why).
@@ -40,17 +44,16 @@ from .forces import ground_list
 from .rover import DiffDriveRover
 from .space import PhysicsWorld
 
-#: Two shapes closer than this (plus two steps of their motion) put their run on its Space.
+#: Two shapes of a run closer than this (plus two steps of their motion): the run may be
+#: about to touch, and its row is made alone.
 REACH_M = 0.5
-#: Steps a run stays on its Space after its shapes were last within reach.
-HOLD_STEPS = 10
 
 
 class _ColumnIO:
     """What ``Fleet`` reads and writes through (``bodyio.BodyIO``'s interface), over columns.
 
-    ``step`` integrates every body as Chipmunk integrates one without contacts; the
-    :class:`ColumnPhysics` then re-steps the runs near a contact in their own Spaces.
+    ``step`` integrates every body as Chipmunk integrates one without contacts, then lets
+    :class:`ColumnPhysics` look for runs about to touch.
     """
 
     def __init__(self, state: np.ndarray, m_inv: np.ndarray, i_inv: np.ndarray) -> None:
@@ -91,7 +94,8 @@ class ColumnPhysics:
     """The batch's physics step: every run's :class:`PhysicsWorld`, stepped as columns.
 
     Each run's world registers its step hook here instead of with the engine
-    (:meth:`adopt`); the batch registers :meth:`step` once. The robots' grouped
+    (:meth:`adopt`); the batch registers :meth:`step` once. The runs' Spaces hold their
+    rovers where they started (they are never stepped). The robots' grouped
     ``step_many`` reaches the columns through each world's ``index_of``, ``set_powers``,
     ``kinematics_array`` and ``rim_array``, which :meth:`adopt` points here.
     """
@@ -102,6 +106,8 @@ class ColumnPhysics:
         self._model: Fleet | None = None
         self.steps = 0
         self.sim: Any = None
+        #: runs whose shapes came within reach of each other: their rows are made alone
+        self.touched: set[int] = set()
 
     def adopt(self, world: PhysicsWorld) -> None:
         """Take over ``world``'s step (its rovers and contacts stay its own)."""
@@ -171,8 +177,6 @@ class ColumnPhysics:
         ]
         self._pa = np.array([p[0] for p in pairs], dtype=np.intp)
         self._pb = np.array([p[1] for p in pairs], dtype=np.intp)
-        self._last_near = np.full(len(self.worlds), -(10**9), dtype=np.int64)
-        self._members = [np.flatnonzero(self._run == i) for i in range(len(self.worlds))]
         return model
 
     def step(self) -> None:
@@ -185,50 +189,24 @@ class ColumnPhysics:
             raise RunFault(rover.name, self.sim.now + 1 / self.worlds[0].rate, bad[1])
 
     def _contacts(self, dt: float) -> None:
-        """Runs with shapes within reach: this step again, in their own Spaces."""
+        """Mark the runs whose shapes are within reach of each other before this step."""
         before = self._io.before
         x, y = before[:, 0], before[:, 1]
         speed = np.hypot(before[:, 3], before[:, 4])
         reach = self._radius + REACH_M + 2.0 * dt * speed
-        near_runs = np.zeros(len(self.worlds), dtype=bool)
         if len(self._pa):
             pa, pb = self._pa, self._pb
             gap = np.hypot(x[pa] - x[pb], y[pa] - y[pb])
             near = gap < reach[pa] + reach[pb]
             if near.any():
-                near_runs[self._run[pa[near]]] = True
+                self.touched.update(self._run[pa[near]].tolist())
         if len(self._boxes):
             b = self._boxes
             dx = np.maximum(np.maximum(b[None, :, 0] - x[:, None], 0.0), x[:, None] - b[None, :, 2])
             dy = np.maximum(np.maximum(b[None, :, 1] - y[:, None], 0.0), y[:, None] - b[None, :, 3])
             near = (np.hypot(dx, dy) < reach[:, None]).any(axis=1)
             if near.any():
-                near_runs[self._run[near]] = True
-        self._last_near[near_runs] = self.steps
-        active = np.flatnonzero(self.steps - self._last_near <= HOLD_STEPS)
-        for i in active.tolist():
-            self._pymunk_step(i, dt)
-
-    def _pymunk_step(self, i: int, dt: float) -> None:
-        """Step run ``i``'s rovers in its own Space from the columns' state and forces."""
-        world = self.worlds[i]
-        io = self._io
-        rows = self._members[i].tolist()
-        forces = io._f
-        for k in rows:
-            body = self.rovers[k].body
-            x, y, a, vx, vy, w = io.before[k].tolist()
-            body.position = (x, y)
-            body.angle = a
-            body.velocity = (vx, vy)
-            body.angular_velocity = w
-            fx, fy, t = forces[k].tolist()
-            body.force = (fx, fy)
-            body.torque = t
-        world._steps = self.steps  # its collision episodes count its steps, as alone
-        world.space.step(dt)
-        for k in rows:
-            io.state[k] = _body_state(self.rovers[k].body)
+                self.touched.update(self._run[near].tolist())
 
 
 def _body_state(body: pymunk.Body) -> list[float]:
