@@ -140,8 +140,15 @@ def _columns() -> Any:
     return ColumnPhysics()
 
 
-def run_batch(jobs: Sequence[Job]) -> list[dict[str, Any]]:
-    """The result rows of ``jobs`` run as one batch (in job order)."""
+def run_batch(jobs: Sequence[Job], stats: dict[str, int] | None = None) -> list[dict[str, Any]]:
+    """The result rows of ``jobs`` run as one batch (in job order).
+
+    ``stats`` (if given) counts the runs made alone: ``faults`` (a run that faulted in the
+    batch) and ``contacts`` (shapes within reach).
+    """
+    counts = stats if stats is not None else {}
+    counts.setdefault("faults", 0)
+    counts.setdefault("contacts", 0)
     rows: dict[int, dict[str, Any]] = {}
     todo: list[tuple[Job, Scenario]] = []
     for job in jobs:
@@ -161,12 +168,14 @@ def run_batch(jobs: Sequence[Job]) -> list[dict[str, Any]]:
                 break
             job = todo.pop(k)[0]
             rows[job.index] = run_job(job)  # its error row and metrics, as alone
+            counts["faults"] += 1
             continue
         wall = (time.perf_counter() - t0) / len(todo)
         touched = sim.column_physics.touched
         for k, ((job, scenario), outcome) in enumerate(zip(todo, sim.outcomes(), strict=True)):
             if k in touched:  # shapes within reach: contacts are made by the run alone
                 rows[job.index] = run_job(job)
+                counts["contacts"] += 1
                 continue
             metrics = compute_metrics(scenario, outcome, outcome.result, wall, "completed")
             rows[job.index] = fill_metrics(job_row(job), metrics)
