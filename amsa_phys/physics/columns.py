@@ -127,8 +127,16 @@ class ColumnPhysics:
     def set_powers(
         self, rovers: Sequence[DiffDriveRover], index: np.ndarray, left: Any, right: Any
     ) -> None:
-        """:meth:`PhysicsWorld.set_powers` over the columns."""
-        PhysicsWorld.set_powers(self, rovers, index, left, right)  # type: ignore[arg-type]
+        """:meth:`PhysicsWorld.set_powers` over the columns, without its loop per rover:
+        saturation at ±100 % (NaN to -100), then each driver's deadband, written into the
+        force model's drives (the only reader in a batch: no window draws the rovers'
+        ``power_l``). A rover's wheel (and deadband) is fixed in a batch (``batched.py``)."""
+        model = self._model or self._start()
+        left = np.where(np.isnan(left), -100.0, np.clip(left, -100.0, 100.0))
+        right = np.where(np.isnan(right), -100.0, np.clip(right, -100.0, 100.0))
+        band = self._band[index]
+        model.drives[0, index] = np.where((-band < left) & (left < band), 0.0, left)
+        model.drives[1, index] = np.where((-band < right) & (right < band), 0.0, right)
 
     def kinematics_array(self, index: np.ndarray) -> np.ndarray:
         """(n, 6) state of the rovers at ``index`` after the last step."""
@@ -166,6 +174,7 @@ class ColumnPhysics:
         # reach: each rover's bounding radius; the static shapes' boxes (the same in every
         # run of a batch: one physics setting); rover pairs within each run
         self._radius = np.array([_radius(r.shape) for r in self.rovers])
+        self._band = np.array([r.wheel.deadband_pct for r in self.rovers])
         statics = [s for s in first.space.shapes if s.body.body_type == pymunk.Body.STATIC]
         self._boxes = np.array([[s.bb.left, s.bb.bottom, s.bb.right, s.bb.top] for s in statics])
         pairs = [

@@ -21,10 +21,25 @@ def _numeric(values: list[Any]) -> bool:
     return all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
 
 
+#: From this many seeds a grid point on, the line plot draws its seeds as a spread (every
+#: seed a dot, quartiles and min–max as bands) instead of min–max bars.
+BAND_SEEDS = 10
+
+
 def plot_summary(
-    rows: list[dict[str, Any]], axes: list[str], metric: str, out: Path, title: str
+    rows: list[dict[str, Any]],
+    axes: list[str],
+    metric: str,
+    out: Path,
+    title: str,
+    spread: str = "auto",
 ) -> Path:
-    """Draw ``metric`` of ``rows`` against the grid ``axes`` into ``out``."""
+    """Draw ``metric`` of ``rows`` against the grid ``axes`` into ``out``.
+
+    ``spread`` is how the line plot shows the seeds of a grid point: ``bars`` (min–max),
+    ``band`` (each seed a dot, quartile and min–max bands) or ``auto`` (bands from
+    :data:`BAND_SEEDS` seeds on, where bars would hide how the seeds spread).
+    """
     ok = [r for r in rows if r.get(metric) is not None and not r.get("error")]
     fig, ax = plt.subplots(figsize=(8, 5), dpi=100)
     numeric_axes = [a for a in axes if _numeric([r[a] for r in ok])]
@@ -63,6 +78,8 @@ def plot_summary(
         )
         for r in ok:
             groups[tuple(r[a] for a in others)][r[x_axis]].append(float(r[metric]))
+        most = max(len(v) for by_x in groups.values() for v in by_x.values())
+        band = spread == "band" or (spread == "auto" and most >= BAND_SEEDS)
         for key, by_x in groups.items():
             xs = sorted(by_x, key=lambda v: (str(type(v)), v))
             mean = [float(np.mean(by_x[x])) for x in xs]
@@ -72,7 +89,10 @@ def plot_summary(
             hi = [max(0.0, max(by_x[x]) - m) for m, x in zip(mean, xs, strict=True)]
             label = ", ".join(f"{a}={v}" for a, v in zip(others, key, strict=True)) or metric
             positions = xs if _numeric(xs) else list(range(len(xs)))
-            ax.errorbar(positions, mean, yerr=[lo, hi], marker="o", capsize=3, label=label)
+            if band:
+                _spread(ax, positions, [by_x[x] for x in xs], mean, label)
+            else:
+                ax.errorbar(positions, mean, yerr=[lo, hi], marker="o", capsize=3, label=label)
             best = int(np.argmin(mean))
             ax.plot(
                 [positions[best]],
@@ -87,7 +107,14 @@ def plot_summary(
             labels = sorted({r[x_axis] for r in ok}, key=str)
             ax.set_xticks(range(len(labels)), [str(v) for v in labels])
         ax.set_xlabel(x_axis)
-        ax.set_ylabel(metric + " (seed min–max as bars, ★ best)")
+        ax.set_ylabel(
+            metric
+            + (
+                f" ({most} seeds: dots, quartiles, min–max; ★ best mean)"
+                if band
+                else " (seed min–max as bars, ★ best)"
+            )
+        )
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
     dropped = len(rows) - len(ok)
@@ -97,6 +124,22 @@ def plot_summary(
         title += "\n" + ax.get_title()
     ax.set_title(title, fontsize=10)
     return save_png(fig, out)
+
+
+def _spread(
+    ax: plt.Axes, xs: list[Any], values: list[list[float]], mean: list[float], label: str
+) -> None:
+    """One line's seeds: the mean as a line, every seed a dot, the quartiles and the
+    min–max as bands in the line's colour."""
+    (line,) = ax.plot(xs, mean, marker="o", ms=3, label=label)
+    color = line.get_color()
+    lo, q1, q3, hi = (
+        [float(np.percentile(v, q)) for v in values] for q in (0.0, 25.0, 75.0, 100.0)
+    )
+    ax.fill_between(xs, lo, hi, color=color, alpha=0.1, lw=0)
+    ax.fill_between(xs, q1, q3, color=color, alpha=0.25, lw=0)
+    for x, v in zip(xs, values, strict=True):
+        ax.plot([x] * len(v), v, ls="none", marker=".", ms=2.5, color=color, alpha=0.45)
 
 
 def _cell_values(ax: plt.Axes, grid: np.ndarray, norm: Any) -> None:
