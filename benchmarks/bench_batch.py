@@ -100,10 +100,14 @@ def main() -> None:
         runs, workers, executor, limit = args.child
         child(int(runs), int(workers), executor, int(limit) or None)
         return
-    j = args.jobs
-    pool = measure(args.runs, j, "local", args.pool_runs)
+    targets(args.runs, args.pool_runs, args.big, args.jobs)
+
+
+def targets(runs: int = 1000, pool_runs: int = 200, big: int = 10000, j: int = 2) -> None:
+    """Measure the batched sweep against the pool and print the PASS/MISS lines."""
+    pool = measure(runs, j, "local", pool_runs)
     pool_rate = pool["runs"] / pool["wall"]
-    batch = measure(args.runs, j, "batch")
+    batch = measure(runs, j, "batch")
     rate = batch["runs"] / batch["wall"]
     pool_wall = batch["runs"] / pool_rate
     print(
@@ -121,16 +125,19 @@ def main() -> None:
     )
     ratio = pool_wall / batch["wall"]
     print(f"{verdict(ratio >= 10)} batched / process pool -j {j}: {ratio:.1f}x (target >= 10x)")
-    if args.big:
-        big = measure(args.big, j, "batch")
-        grow = big["rss_kib"] / batch["rss_kib"]
+    if big:
+        large = measure(big, j, "batch")
+        grow = large["rss_kib"] / batch["rss_kib"]
         print(
-            f"batched -j {j}: {big['runs']:,} runs in {big['wall']:.1f} s "
-            f"({big['runs'] / big['wall']:.0f} runs/s, RSS {big['rss_kib'] / 1024:.0f} MiB)"
+            f"batched -j {j}: {large['runs']:,} runs in {large['wall']:.1f} s "
+            f"({large['runs'] / large['wall']:.0f} runs/s, RSS {large['rss_kib'] / 1024:.0f} MiB)"
         )
-        print(f"{verdict(big['wall'] <= 60)} {big['runs']:,} runs in {big['wall']:.1f} s (<= 60 s)")
         print(
-            f"{verdict(grow <= 1.5)} RSS {big['runs']:,} / {batch['runs']:,} runs: "
+            f"{verdict(large['wall'] <= 60)} {large['runs']:,} runs in {large['wall']:.1f} s "
+            "(<= 60 s)"
+        )
+        print(
+            f"{verdict(grow <= 1.5)} RSS {large['runs']:,} / {batch['runs']:,} runs: "
             f"{grow:.2f}x (target <= 1.5x)"
         )
 

@@ -14,6 +14,8 @@ compare. Targets (issue "Performance"):
 * recording at 1280x720: >= 150 frames/s, within 1.3x of the encoder alone;
 * sweeps: speed-up from -j 1 to -j N >= 0.9 N;
 * memory: peak RSS of a 1-hour run and of a 1-hour recording within 1.5x of a 1-minute one.
+* batched sweeps (``bench_batch.py``): 1,000 runs of scenario1 <= 5 s on 2 cores and >= 10x
+  the process pool; 10,000 runs <= 60 s with RSS <= 1.5x that of 1,000.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("MPLBACKEND", "Agg")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import bench_batch
 import bench_record
 import bench_run
 import bench_sweep
@@ -220,6 +223,11 @@ def memory(reps: int) -> None:
             )
 
 
+def batched(reps: int) -> None:
+    """Batched sweeps (issue 18): 1,000 and 10,000 runs against the pool (bench_batch.py)."""
+    bench_batch.targets()
+
+
 TARGETS: dict[str, Callable[[int], None]] = {
     "headless": headless,
     "process": process,
@@ -227,6 +235,7 @@ TARGETS: dict[str, Callable[[int], None]] = {
     "recording": recording,
     "sweeps": sweeps,
     "memory": memory,
+    "batched": batched,
 }
 
 

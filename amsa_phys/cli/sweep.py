@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import csv
 import io
-import itertools
 import sys
 from collections.abc import Iterator
 from fractions import Fraction
@@ -20,7 +19,7 @@ from ..errors import ConfigError, Interrupted, one_line
 from ..model.scenario import load_scenario
 from ..model.wording import plural
 from ..model.yamlio import load_yaml
-from ..runs.batched import iter_batched, lost_rows, plan_units, run_unit
+from ..runs.batched import iter_batched, iter_dask_batched, plan_units
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.suite import input_files
 from ..runs.sweep import (
@@ -29,7 +28,6 @@ from ..runs.sweep import (
     SweepPlan,
     check_axes,
     check_size,
-    dask_map,
     deterministic_points,
     iter_local,
     parse_grid,
@@ -229,7 +227,7 @@ def rows_from(jobs: list[Job], args: argparse.Namespace) -> Iterator[dict[str, A
     for note in notes:
         print(one_line(f"note: {note}"), file=sys.stderr)
     if args.executor == "dask":
-        return itertools.chain.from_iterable(dask_map(run_unit, units, args.scheduler, lost_rows))
+        return iter_dask_batched(units, args.scheduler)
     return iter_batched(units, min(args.jobs, len(units)), iter_local)
 
 

@@ -226,3 +226,25 @@ def iter_batched(
 def lost_rows(unit: Unit) -> list[dict[str, Any]]:
     """The rows of a unit Dask could not run on any worker."""
     return [job_row(job, f"{WORKER_LOST}, on every worker that ran it") for job in unit.jobs]
+
+
+def iter_dask_batched(units: Sequence[Unit], scheduler: str) -> Iterator[dict[str, Any]]:
+    """Rows as units complete on a Dask cluster (a task is a batch). The runs of a batch
+    that killed every worker it met go again one per task, so the run that kills is found
+    and the others give their rows, as on local workers."""
+    from .sweep import dask_map
+
+    lost: list[Job] = []
+
+    def note_lost(unit: Unit) -> list[dict[str, Any]]:
+        if len(unit.jobs) == 1:
+            return lost_rows(unit)
+        lost.extend(unit.jobs)
+        return []
+
+    for rows in dask_map(run_unit, units, scheduler, note_lost):
+        yield from rows
+    if lost:
+        singles = [Unit((job,), batched=False) for job in lost]
+        for rows in dask_map(run_unit, singles, scheduler, lost_rows):
+            yield from rows

@@ -189,3 +189,34 @@ def test_a_batch_whose_worker_dies_costs_the_killing_run_only(
         "",
         "",
     ]
+
+
+def test_on_dask_a_batch_that_kills_its_workers_costs_the_killing_run_only(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    distributed = pytest.importorskip("distributed")
+    import dask
+
+    monkeypatch.setenv("PYTHONPATH", str(ROOT / "tests"))
+    monkeypatch.syspath_prepend(str(ROOT / "tests"))
+    path = tmp_path / "d.yaml"
+    path.write_text(
+        "world:\n  components:\n    D: {template: 'toys:DieMany', freq: 4}\nduration: 1\n"
+    )
+    argv = ["sweep", str(path), "--grid", "D.gain=1,2,3", "--executor", "dask"]
+    argv += ["--batch-size", "3"]
+    # one retry: a run queued on the worker the killing run takes down is run again
+    with (
+        dask.config.set({"distributed.scheduler.allowed-failures": 1}),
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+    ):
+        code = main([*argv, "--scheduler", cluster.scheduler_address, "--out", str(tmp_path / "o")])
+    assert code == 0
+    assert [r["error"] for r in rows(tmp_path / "o")] == [
+        "",
+        "a worker process died (killed, out of memory, or a crash in native code), "
+        "on every worker that ran it",
+        "",
+    ]
