@@ -387,11 +387,24 @@ class FreeRobot(_Robot):
     ) -> tuple[Mapping[str, Any], None]:
         """``do_step`` for many copies at once (a batched sweep's leaders): each copy's
         behaviour as alone, the powers and poses as arrays (``ControlledRobot.step_many``)."""
-        powers = np.array([c._behaviour(t) for c in comps], dtype=np.float64)
+        straight = p.behavior == 1  # behaviour 1 is the cruise power on both wheels
+        if straight.all():
+            left = right = p.cruisePower
+        else:
+            powers = np.array(
+                [
+                    (cp, cp) if s else c._behaviour(t)
+                    for c, s, cp in zip(
+                        comps, straight.tolist(), p.cruisePower.tolist(), strict=True
+                    )
+                ],
+                dtype=np.float64,
+            )
+            left, right = powers[:, 0], powers[:, 1]
         return ControlledRobot.step_many(
             comps,  # type: ignore[arg-type]
             t,
-            {"powerL": powers[:, 0], "powerR": powers[:, 1]},
+            {"powerL": left, "powerR": right},
             p,
             state,
         )
