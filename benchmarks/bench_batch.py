@@ -3,7 +3,7 @@
 Run: ``python benchmarks/bench_batch.py [--runs 1000] [--pool-runs 200] [--big 10000]``.
 Prints PASS/MISS lines for the targets of issue 18 and the ratio to today's process-pool
 sweep (``--executor local``) measured in the same run. The pool is timed on ``--pool-runs``
-of the same grid (its throughput is flat in the number of runs: one run per task) and
+spread over the same grid (its throughput is flat in the number of runs: one run per task) and
 scaled to the batch's run count; the memory of each sweep is the largest resident set of
 any of its processes, measured in a fresh interpreter per sweep.
 """
@@ -54,7 +54,9 @@ def sweep(runs: int, workers: int, executor: str, limit: int | None = None) -> d
     from amsa_phys.runs.batched import iter_batched, plan_units
     from amsa_phys.runs.sweep import iter_local
 
-    jobs = plan(runs).jobs()[:limit]
+    jobs = plan(runs).jobs()
+    if limit:  # spread over the grid: every context and Kv, as in the batched sweep
+        jobs = jobs[:: max(1, len(jobs) // limit)][:limit]
     t0 = time.perf_counter()
     if executor == "local":
         rows = list(iter_local(jobs, workers))
