@@ -129,7 +129,10 @@ def plan_units(
     notes = []
     kept = sum(1 for j in alone if j.keep_dir is not None)
     if kept:
-        notes.append(f"--keep-runs writes every run's directory: {kept} runs go one per process")
+        notes.append(
+            f"--keep-runs writes every run's directory (its plots cost ~20x the run): "
+            f"{kept} runs go one per process"
+        )
     for why in reasons:
         notes.append(f"runs that a batch cannot hold go one per process: {why}")
     return units, notes

@@ -164,7 +164,8 @@ def test_a_mixed_plan_batches_what_it_can(tmp_path: Path) -> None:
     units, notes = plan_units(plan.jobs(), workers=2)
     assert not any(u.batched for u in units)
     assert notes == [
-        f"--keep-runs writes every run's directory: {len(jobs)} runs go one per process"
+        "--keep-runs writes every run's directory (its plots cost ~20x the run): "
+        f"{len(jobs)} runs go one per process"
     ]
 
 
