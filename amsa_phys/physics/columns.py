@@ -11,7 +11,8 @@ pymunk's broadphase quadratic). What is shared is the arithmetic:
 * every rover is integrated here, in numpy, with Chipmunk's own update for a body without
   contacts (``cpBodyUpdatePosition`` then ``cpBodyUpdateVelocity``: ``p += v dt; a += w dt;
   v += (g + f / m) dt; w += t / I dt``, the same operations in the same order, so the same
-  floats: a run's states equal those of its Space stepped alone, bit for bit).
+  floats: given the same forces, a body ends each step where its Space would put it, bit
+  for bit; ``tests/fidelity/test_columns.py``).
 
 Contacts are where that stops: pymunk solves a contact with 10 sequential-impulse passes,
 which leave a residual that depends on the order of the contact points, and that order
