@@ -14,7 +14,9 @@ compare. Targets (issue "Performance"):
 * recording at 1280x720: >= 150 frames/s, within 1.3x of the encoder alone;
 * sweeps: speed-up from -j 1 to -j N >= 0.9 N;
 * memory: peak RSS of a 1-hour run and of a 1-hour recording within 1.5x of a 1-minute one;
-* plots never slow the run: a 200-rover, 30 s run with plots <= 1.3x the same run without.
+* plots never slow the run: a 200-rover, 30 s run with plots <= 1.3x the same run without;
+* batched sweeps (``bench_batch.py``): 1,000 runs of scenario1 <= 5 s on 2 cores and >= 10x
+  the process pool; 10,000 runs <= 60 s with RSS <= 1.5x that of 1,000.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("MPLBACKEND", "Agg")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import bench_batch
 import bench_compiled
 import bench_plots
 import bench_record
@@ -228,6 +231,11 @@ def plots(reps: int) -> None:
     report("200-rover run, plots / --no-plot", measured, "<= 1.3", ok)
 
 
+def batched(reps: int) -> None:
+    """Batched sweeps (issue 18): 1,000 and 10,000 runs against the pool (bench_batch.py)."""
+    bench_batch.targets()
+
+
 TARGETS: dict[str, Callable[[int], None]] = {
     "headless": headless,
     "process": process,
@@ -238,6 +246,7 @@ TARGETS: dict[str, Callable[[int], None]] = {
     "plots": plots,
     # issue 19: compiled step vs pure, process, --help, 1,000-rover platoon (bench_compiled.py)
     "compiled": lambda reps: bench_compiled.run_all(reps, report),
+    "batched": batched,
 }
 
 

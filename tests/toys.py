@@ -188,6 +188,16 @@ class Die(Template):
         return {"u": self.p.gain}
 
 
+class DieMany(Die):
+    """:class:`Die` with ``step_many``: a batch holding a copy with ``gain`` 2 dies whole."""
+
+    @classmethod
+    def step_many(cls, comps: Any, t: Fraction, inp: Any, p: Any, state: Any) -> Any:
+        if any(c.p.gain == 2 for c in comps):
+            os._exit(9)
+        return {"u": p.gain}, None
+
+
 class Scanner(Template):
     """An array output of ``n`` numbers: k, k+1, ... at step k; ``shape``/``bad`` misbehave."""
 

@@ -6,6 +6,7 @@ import argparse
 import csv
 import io
 import sys
+from collections.abc import Iterator
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -18,15 +19,16 @@ from ..errors import ConfigError, Interrupted, one_line
 from ..model.scenario import load_scenario
 from ..model.wording import plural
 from ..model.yamlio import load_yaml
+from ..runs.batched import iter_batched, iter_dask_batched, plan_units
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.suite import input_files
 from ..runs.sweep import (
     Axis,
+    Job,
     SweepPlan,
     check_axes,
     check_size,
     deterministic_points,
-    iter_dask,
     iter_local,
     parse_grid,
     parse_range,
@@ -58,10 +60,17 @@ def add_args(p: argparse.ArgumentParser) -> None:
     add_jobs(p)
     p.add_argument(
         "--executor",
-        choices=("local", "dask"),
-        default="local",
-        help="where the runs go: local worker processes (default, -j of them) or an "
-        "existing Dask cluster (needs --scheduler and the cluster extra)",
+        choices=("batch", "local", "dask"),
+        default="batch",
+        help="where the runs go: batch (default): batches of runs as columns of one "
+        "simulation, on -j local worker processes; local: one run per process; dask: "
+        "batches on an existing Dask cluster (needs --scheduler and the cluster extra)",
+    )
+    p.add_argument(
+        "--batch-size",
+        type=int,
+        metavar="N",
+        help="runs per batch (default: two batches per worker, at most 250)",
     )
     p.add_argument("--scheduler", metavar="ADDR", help="Dask scheduler address (tcp://...)")
     p.add_argument("--metric", help="metric for summary.png (default rms_error)")
@@ -161,6 +170,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("the Dask executor needs --scheduler ADDR", key="--executor")
     if args.jobs < 1:
         raise ConfigError("must be at least 1", key="--jobs")
+    if args.batch_size is not None and args.batch_size < 1:
+        raise ConfigError("must be at least 1", key="--batch-size")
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-sweep")
     prepare_run_dir(out, args.force, inputs=plan.inputs)
@@ -168,11 +179,7 @@ def run(args: argparse.Namespace) -> int:
         plan.keep_dir = str((out / "runs").resolve())
     jobs = plan.jobs()
     rows: list[dict[str, Any]] = []
-    source = (
-        iter_dask(jobs, args.scheduler)
-        if args.executor == "dask"
-        else iter_local(jobs, min(args.jobs, len(jobs)))
-    )
+    source = rows_from(jobs, args)
     interrupted = False
     try:
         # Ctrl-C is raised between completions, never inside concurrent.futures or Dask
@@ -188,16 +195,21 @@ def run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         interrupted = True
     keys = [a.key for a in plan.axes]
-    write_results(rows, keys, out / "results.csv")
-    from ..plots.summary import plot_summary  # matplotlib: only once the rows are in
+    # a signal while the files are written is noted, not raised inside matplotlib: the
+    # results and the picture are finished first (a SIGTERM in plot_summary killed the
+    # process with -15 and no summary.png)
+    with interrupt.sigterm_as_ctrl_c(), interrupt.deferred():
+        write_results(rows, keys, out / "results.csv")
+        from ..plots.summary import plot_summary  # matplotlib: only once the rows are in
 
-    plot_summary(
-        rows,
-        keys,
-        plan.metric,
-        out / "summary.png",
-        one_line(f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})"),
-    )
+        plot_summary(
+            rows,
+            keys,
+            plan.metric,
+            out / "summary.png",
+            one_line(f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})"),
+        )
+        late = interrupt.requested()
     failed = [r for r in rows if r["error"]]
     print(
         one_line(
@@ -209,7 +221,23 @@ def run(args: argparse.Namespace) -> int:
         print(one_line(f"run {r['run']}: {r['error']}"), file=sys.stderr)
     if interrupted:
         raise Interrupted(f"sweep interrupted; {plural(len(rows), 'finished row')} kept in {out}")
+    if late:
+        raise Interrupted(
+            f"interrupted after the sweep's last run; its outputs are complete in {out}"
+        )
     return 0
+
+
+def rows_from(jobs: list[Job], args: argparse.Namespace) -> Iterator[dict[str, Any]]:
+    """Result rows as they come from the chosen executor (batched unless ``local``)."""
+    if args.executor == "local":
+        return iter_local(jobs, min(args.jobs, len(jobs)))
+    units, notes = plan_units(jobs, args.jobs, args.batch_size)
+    for note in notes:
+        print(one_line(f"note: {note}"), file=sys.stderr)
+    if args.executor == "dask":
+        return iter_dask_batched(units, args.scheduler)
+    return iter_batched(units, min(args.jobs, len(units)), iter_local)
 
 
 def write_results(rows: list[dict[str, Any]], axes: list[str], path: Path) -> None:

@@ -79,7 +79,7 @@ class Group:
         self.template = type(self.comps[0])
         first = dict(tasks[0].inputs)
         self.inputs: list[tuple[str, Callable[[dict[str, float]], tuple[float, ...]]]] = [
-            (port, operator.itemgetter(*[dict(t.inputs)[port] for t in tasks])) for port in first
+            (port, _gather([dict(t.inputs)[port] for t in tasks])) for port in first
         ]
         self.outputs = {port: [t.targets[port] for t in tasks] for port in tasks[0].targets}
         self.params = ParamArrays(self.comps)
@@ -87,6 +87,14 @@ class Group:
         self.delay = tasks[0].delay
         #: scratch space the template's ``step_many`` owns (arrays of per-member state)
         self.state: dict[str, Any] = {}
+
+
+def _gather(names: list[str]) -> Callable[[dict[str, float]], tuple[float, ...]]:
+    """The values of ``names`` as a tuple (``itemgetter`` of one name gives a bare value)."""
+    if len(names) == 1:
+        name = names[0]
+        return lambda values: (values[name],)
+    return operator.itemgetter(*names)
 
 
 def group_key(task: Any, freq: Fraction) -> tuple[Any, ...] | None:
@@ -104,13 +112,17 @@ def group_key(task: Any, freq: Fraction) -> tuple[Any, ...] | None:
 
 
 def plan(
-    instants: Sequence[Sequence[Any]], keys: dict[str, tuple[Any, ...] | None]
+    instants: Sequence[Sequence[Any]],
+    keys: dict[str, tuple[Any, ...] | None],
+    min_group: int | None = None,
 ) -> list[list[Any]]:
     """Each instant's tasks with the allowed groups merged in (a :class:`Group` per group).
 
-    ``keys`` maps a task's path to its :func:`group_key`. Groups that would change what any
+    ``keys`` maps a task's path to its :func:`group_key`; groups smaller than ``min_group``
+    (default :data:`MIN_GROUP`) are not formed. Groups that would change what any
     component reads at any instant are dropped everywhere, then the rest re-checked.
     """
+    smallest = MIN_GROUP if min_group is None else min_group
     banned: set[tuple[Any, ...]] = set()
     cache: dict[tuple[str, ...], Group] = {}
     while True:
@@ -123,7 +135,7 @@ def plan(
                     key = keys.get(t.path)
                     if key is not None and key not in banned:
                         members.setdefault(key, []).append(t)
-            groups = {k: v for k, v in members.items() if len(v) >= MIN_GROUP}
+            groups = {k: v for k, v in members.items() if len(v) >= smallest}
             seq = _merged(tasks, groups, cache)
             bad |= _breaks(tasks, seq, keys, groups)
             out.append(seq)

@@ -237,12 +237,25 @@ class Simulation:
         self._initialized = True
         for path, comp in self.components.items():
             try:
-                comp.initialize(Context(self, path))
+                comp.initialize(self._context(path))
             except RunFault:
                 raise
             except COMPONENT_ERRORS as exc:  # a component's own bug or bad configuration
                 raise RunFault(self._who(path), 0, f"initialize failed: {exc!r}") from exc
         self._compile()
+
+    def _context(self, path: str) -> Context:
+        """What ``path``'s ``initialize`` receives (a batch of runs gives each its own)."""
+        return Context(self, path)
+
+    def _group_key(self, task: _Task, freq: Fraction) -> tuple[Any, ...] | None:
+        """Which group ``task`` steps in (``engine/batch.py``); a batch of runs keys by the
+        path within the run."""
+        return batch.group_key(task, freq)
+
+    #: Smallest group stepped as arrays (``batch.MIN_GROUP``; a batch of runs groups always,
+    #: so a run's arithmetic does not depend on how many runs share its batch).
+    _min_group: int | None = None
 
     def add_hook(self, rate_hz: Fraction, fn: Hook, name: str) -> None:
         """See :meth:`Context.add_hook`."""
@@ -322,8 +335,8 @@ class Simulation:
                 table.setdefault(off, _Instant(off)).hooks.append(fn)
         instants = [i for _, i in sorted(table.items())]
         # like components of repeated Composites step as arrays where that changes no read
-        keys = {t.path: batch.group_key(t, leaves[t.path].freq) for t in self._tasks}
-        planned = batch.plan([i.tasks for i in instants], keys)
+        keys = {t.path: self._group_key(t, leaves[t.path].freq) for t in self._tasks}
+        planned = batch.plan([i.tasks for i in instants], keys, self._min_group)
         self._groups_of: dict[str, list[batch.Group]] = {}
         for inst, seq in zip(instants, planned, strict=True):
             inst.tasks = [

@@ -384,6 +384,39 @@ class FreeRobot(_Robot):
         self.rover.set_power(left, right)
         return self._pose()
 
+    @classmethod
+    def step_many(
+        cls,
+        comps: Sequence[FreeRobot],
+        t: Fraction,
+        inp: Mapping[str, Any],
+        p: Any,
+        state: dict[str, Any],
+    ) -> tuple[Mapping[str, Any], None]:
+        """``do_step`` for many copies at once (a batched sweep's leaders): each copy's
+        behaviour as alone, the powers and poses as arrays (``ControlledRobot.step_many``)."""
+        straight = p.behavior == 1  # behaviour 1 is the cruise power on both wheels
+        if straight.all():
+            left = right = p.cruisePower
+        else:
+            powers = np.array(
+                [
+                    (cp, cp) if s else c._behaviour(t)
+                    for c, s, cp in zip(
+                        comps, straight.tolist(), p.cruisePower.tolist(), strict=True
+                    )
+                ],
+                dtype=np.float64,
+            )
+            left, right = powers[:, 0], powers[:, 1]
+        return ControlledRobot.step_many(
+            comps,  # type: ignore[arg-type]
+            t,
+            {"powerL": left, "powerR": right},
+            p,
+            state,
+        )
+
     def _behaviour(self, t: Fraction) -> tuple[float, float]:
         p = self.p
         cruise = p.cruisePower

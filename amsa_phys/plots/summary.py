@@ -29,6 +29,11 @@ def _numeric(values: list[Any]) -> bool:
     return all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
 
 
+#: From this many seeds a grid point on, the line plot draws its seeds as a spread (every
+#: seed a dot, quartiles and min–max as bands) instead of min–max bars.
+BAND_SEEDS = 10
+
+
 def plot_summary(
     rows: list[dict[str, Any]],
     axes: list[str],
@@ -36,12 +41,17 @@ def plot_summary(
     out: Path,
     title: str,
     scenario: str | None = None,
+    spread: str = "auto",
 ) -> Path:
     """Draw ``metric`` of ``rows`` against the grid ``axes`` into ``out``.
 
     The PNG keeps ``title`` and ``scenario`` (the scenario's name, else the title up to its
     ``": "``) as text chunks: ``amsa-phys plot SWEEPDIR`` titles a redraw with the scenario's
     name from them (results.csv does not hold it, and the folder may be named anything).
+
+    ``spread`` is how the line plot shows the seeds of a grid point: ``bars`` (min–max),
+    ``band`` (each seed a dot, quartile and min–max bands) or ``auto`` (bands from
+    :data:`BAND_SEEDS` seeds on, where bars would hide how the seeds spread).
     """
     ok = [r for r in rows if r.get(metric) is not None and not r.get("error")]
     fig, ax = plt.subplots(figsize=(8, 5), dpi=100)
@@ -93,6 +103,8 @@ def plot_summary(
         )
         for r in ok:
             groups[tuple(r[a] for a in others)][r[x_axis]].append(float(r[metric]))
+        most = max(len(v) for by_x in groups.values() for v in by_x.values())
+        band = spread == "band" or (spread == "auto" and most >= BAND_SEEDS)
         for key, by_x in groups.items():
             xs = sorted(by_x, key=lambda v: (str(type(v)), v))
             mean = [float(np.mean(by_x[x])) for x in xs]
@@ -102,7 +114,10 @@ def plot_summary(
             hi = [max(0.0, max(by_x[x]) - m) for m, x in zip(mean, xs, strict=True)]
             label = ", ".join(f"{a}={v}" for a, v in zip(others, key, strict=True)) or metric
             positions = xs if _numeric(xs) else list(range(len(xs)))
-            ax.errorbar(positions, mean, yerr=[lo, hi], marker="o", capsize=3, label=label)
+            if band:
+                _spread(ax, positions, [by_x[x] for x in xs], mean, label)
+            else:
+                ax.errorbar(positions, mean, yerr=[lo, hi], marker="o", capsize=3, label=label)
             best = int(np.argmin(mean))
             ax.plot(
                 [positions[best]],
@@ -117,7 +132,14 @@ def plot_summary(
             labels = sorted({r[x_axis] for r in ok}, key=str)
             ax.set_xticks(range(len(labels)), [str(v) for v in labels])
         ax.set_xlabel(x_axis)
-        ax.set_ylabel(metric + " (seed min–max as bars, ★ best)")
+        ax.set_ylabel(
+            metric
+            + (
+                f" ({most} seeds: dots, quartiles, min–max; ★ best mean)"
+                if band
+                else " (seed min–max as bars, ★ best)"
+            )
+        )
         if is_count(metric):  # 0, 1, 2 collisions: no tick at 0.5 of one
             low, high = ax.get_ylim()  # at least 0..1 shown: all-zero counts get 0 and 1
             ax.set_ylim(min(low, -0.25), max(high, 1.25))
@@ -161,6 +183,22 @@ def text_colour_on(rgba: tuple[float, ...]) -> str:
     """Black or white, whichever contrasts more with the background ``rgba`` (WCAG: black
     above a luminance of 0.179): black on viridis' yellow and green, white on its blue."""
     return "black" if luminance(rgba) > 0.179 else "white"
+
+
+def _spread(
+    ax: plt.Axes, xs: list[Any], values: list[list[float]], mean: list[float], label: str
+) -> None:
+    """One line's seeds: the mean as a line, every seed a dot, the quartiles and the
+    min–max as bands in the line's colour."""
+    (line,) = ax.plot(xs, mean, marker="o", ms=3, label=label)
+    color = line.get_color()
+    lo, q1, q3, hi = (
+        [float(np.percentile(v, q)) for v in values] for q in (0.0, 25.0, 75.0, 100.0)
+    )
+    ax.fill_between(xs, lo, hi, color=color, alpha=0.1, lw=0)
+    ax.fill_between(xs, q1, q3, color=color, alpha=0.25, lw=0)
+    for x, v in zip(xs, values, strict=True):
+        ax.plot([x] * len(v), v, ls="none", marker=".", ms=2.5, color=color, alpha=0.45)
 
 
 def _cell_values(ax: plt.Axes, grid: np.ndarray, norm: Any, cmap: Any) -> None:

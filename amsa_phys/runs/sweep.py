@@ -11,17 +11,18 @@ from __future__ import annotations
 
 import copy
 import csv
+import dataclasses
 import functools
 import io
 import itertools
 import json
 import math
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -44,6 +45,9 @@ from ..model.yamlio import parse_value
 from .pool import WORKER_LOST, imap_resilient
 from .rundir import prepare_run_dir
 from .single import compute_metrics, run_scenario
+
+T = TypeVar("T")
+R = TypeVar("R")
 
 #: Metric columns written for the overall block and each phase.
 METRIC_KEYS = METRICS
@@ -371,6 +375,15 @@ def _cached(path: str) -> Scenario:
     return load_scenario(path)
 
 
+@functools.lru_cache(maxsize=8)
+def _shortened(path: str, duration: float | None) -> Scenario:
+    """The scenario file's scenario cut to the sweep's ``--duration`` (once per process)."""
+    scenario = copy.deepcopy(_cached(path))
+    if duration is not None:
+        shorten(scenario, Fraction(str(duration)))
+    return scenario
+
+
 def job_row(job: Job, error: str = "") -> dict[str, Any]:
     """A result row's leading columns: run number, grid point, seed; no metrics yet."""
     row: dict[str, Any] = {"run": job.index}
@@ -382,22 +395,43 @@ def job_row(job: Job, error: str = "") -> dict[str, Any]:
     return row
 
 
+def prepare_job(job: Job) -> Scenario:
+    """The scenario of one job: the file's, cut to the sweep's duration, with the job's seed,
+    its context's and grid point's values (ValueError or AmsaError if they break a rule)."""
+    base = _shortened(job.scenario, job.duration)
+    # the world and later phases are shared (a run changes neither); the job's settings
+    # go into its own copy of phase 0 (a deep copy per run costs ~2 ms: a batch of 250
+    # runs would spend half a second on it)
+    scenario = copy.copy(base)
+    first = base.phases[0]
+    scenario.phases = [dataclasses.replace(first, changes=list(first.changes)), *base.phases[1:]]
+    scenario.seed = job.seed
+    contexts = dict(job.contexts)
+    for key, value in job.point:
+        if key == "context":
+            for k, v in contexts[value]:
+                apply_setting(scenario, k, v)
+        else:
+            apply_setting(scenario, key, value)
+    check_phases(scenario, None)  # this point's combination may break a template's rule
+    return scenario
+
+
+def fill_metrics(row: dict[str, Any], metrics: dict[str, Any]) -> dict[str, Any]:
+    """Put a run's ``metrics.json`` document into its result row (overall, then phases)."""
+    for k in METRIC_KEYS:
+        row[k] = metrics["overall"].get(k)
+    for i, phase in enumerate(metrics["phases"]):
+        for k in METRIC_KEYS:
+            row[f"phase{i}.{k}"] = phase.get(k)
+    return row
+
+
 def run_job(job: Job) -> dict[str, Any]:
     """Run one job and return its result row (errors are reported in the row)."""
     row = job_row(job)
     try:
-        scenario = copy.deepcopy(_cached(job.scenario))
-        if job.duration is not None:
-            shorten(scenario, Fraction(str(job.duration)))
-        scenario.seed = job.seed
-        contexts = dict(job.contexts)
-        for key, value in job.point:
-            if key == "context":
-                for k, v in contexts[value]:
-                    apply_setting(scenario, k, v)
-            else:
-                apply_setting(scenario, key, value)
-        check_phases(scenario, None)  # this point's combination may break a template's rule
+        scenario = prepare_job(job)
         if job.keep_dir is not None:
             out = prepare_run_dir(Path(job.keep_dir) / f"run-{job.index:05d}", force=True)
             try:
@@ -417,12 +451,7 @@ def run_job(job: Job) -> dict[str, Any]:
     except (AmsaError, ValueError) as exc:
         row["error"] = str(exc)
         return row
-    for k in METRIC_KEYS:
-        row[k] = metrics["overall"].get(k)
-    for i, phase in enumerate(metrics["phases"]):
-        for k in METRIC_KEYS:
-            row[f"phase{i}.{k}"] = phase.get(k)
-    return row
+    return fill_metrics(row, metrics)
 
 
 def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
@@ -444,6 +473,19 @@ def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
 
 def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:
     """Rows as they complete, from an existing Dask distributed cluster."""
+    return dask_map(
+        run_job,
+        jobs,
+        scheduler,
+        functools.partial(job_row, error=f"{WORKER_LOST}, on every worker that ran it"),
+    )
+
+
+def dask_map(
+    fn: Callable[[T], R], items: Sequence[T], scheduler: str, lost: Callable[[T], R]
+) -> Iterator[R]:
+    """``fn(item)`` as they complete on an existing Dask cluster; ``lost(item)`` for an item
+    whose workers all died (a batched sweep's items are batches: ``runs/batched.py``)."""
     try:
         from distributed import Client, as_completed
     except ImportError:
@@ -458,8 +500,8 @@ def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:
     from distributed import KilledWorker
 
     try:
-        futures = client.map(run_job, jobs, pure=False)
-        job_of = dict(zip(futures, jobs, strict=True))
+        futures = client.map(fn, items, pure=False)
+        item_of = dict(zip(futures, items, strict=True))
         pending = as_completed(futures)
         while not pending.is_empty():
             batch = pending.next_batch(block=False)
@@ -470,6 +512,6 @@ def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:
                 try:
                     yield fut.result()
                 except KilledWorker:  # Dask retried it on other workers and they died too
-                    yield job_row(job_of[fut], f"{WORKER_LOST}, on every worker that ran it")
+                    yield lost(item_of[fut])
     finally:
         client.close()

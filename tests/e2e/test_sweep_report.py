@@ -92,6 +92,8 @@ def test_sweep_executor_has_help(capsys: pytest.CaptureFixture[str]) -> None:
         main(["sweep", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert (
-        "--executor {local,dask} where the runs go: local worker processes (default, -j of "
-        "them) or an existing Dask cluster (needs --scheduler and the cluster extra)"
+        "--executor {batch,local,dask} where the runs go: batch (default): batches of runs as "
+        "columns of one simulation, on -j local worker processes; local: one run per "
+        "process; dask: batches on an existing Dask cluster (needs --scheduler and the "
+        "cluster extra)"
     ) in text

@@ -57,7 +57,10 @@ def start_stuck(tmp_path: Path, command: str, grace: float) -> tuple[subprocess.
         )
         files.append(str(path))
     if command == "sweep":
-        argv = ["sweep", files[0], "--grid", "R.k=1,2,3", "--out", str(tmp_path / "o")]
+        # one run per process: the pool's own stop (a batch steps Rogue's copies through
+        # its step_many, which never gets stuck)
+        argv = ["sweep", files[0], "--grid", "R.k=1,2,3", "--executor", "local"]
+        argv += ["--out", str(tmp_path / "o")]
     else:
         argv = ["test", *files]
     env = {

@@ -102,7 +102,9 @@ def test_sys_exit_in_a_sweep_is_a_row_error_not_a_lost_sweep(
 ) -> None:
     out = tmp_path / "sw"
     scen = rogue(tmp_path, "exit7")
-    assert main(["sweep", str(scen), "--grid", "R.k=1,2", "-j", "1", "--out", str(out)]) == 0
+    argv = ["sweep", str(scen), "--grid", "R.k=1,2", "-j", "1", "--out", str(out)]
+    # one run per process, do_step's SystemExit (a batch steps Rogue's copies by step_many)
+    assert main([*argv, "--executor", "local"]) == 0
     rows = list(csv.DictReader((out / "results.csv").open()))
     assert [r["error"] for r in rows] == [
         "run fault at t=1.000 s in R (Rogue): do_step raised SystemExit(7)"

@@ -1,0 +1,234 @@
+"""Every run's rovers of a batch as columns: one force pass and one integration a step.
+
+In a batched sweep (``engine/multirun.py``) each run keeps its own :class:`PhysicsWorld`
+with its own pymunk Space (its rovers, obstacles and walls), so runs can never touch: no
+offsets (a far offset would change how positions round) and no collision filters (32
+categories are too few for thousands of runs, and every run at the same place would make
+pymunk's broadphase quadratic). What is shared is the arithmetic:
+
+* the wheel, tyre and grip forces of all rovers of all runs are one ``fleet.Fleet`` pass
+  (the numpy model the platoon uses, checked against the float path in the tests);
+* every rover is integrated here, in numpy, with Chipmunk's own update for a body without
+  contacts (``cpBodyUpdatePosition`` then ``cpBodyUpdateVelocity``: ``p += v dt; a += w dt;
+  v += (g + f / m) dt; w += t / I dt``, the same operations in the same order, so the same
+  floats: given the same forces, a body ends each step where its Space would put it, bit
+  for bit; ``tests/fidelity/test_columns.py``).
+
+Contacts are where that stops: pymunk solves a contact with 10 sequential-impulse passes,
+which leave a residual that depends on the order of the contact points, and that order
+depends on the history of the Space's broadphase tree. Measured on the MDE world, a
+follower running into its leader: the same states and forces a step before, a Space
+stepped alone and one brought up to date at the contact differ by 3e-5 m/s after that one
+step; a difference of 1e-14 in the forces (numpy's arrangement of the force model against
+the float path's) grows to 1e-5 in the run's metrics. So a run whose shapes come within
+reach of each other (:data:`REACH_M` plus what they can cover in two steps) is marked
+(:attr:`ColumnPhysics.touched`) and its row comes from the run made alone: contacts are
+exactly those of a single run, because they are a single run's.
+
+Worlds with terrain zones, lidars (a ray cast needs the Space current every step) or
+changes to a rover during the run are not batched (``runs/batched.py`` says why).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pymunk
+
+from ..errors import RunFault
+from .fleet import Fleet
+from .forces import ground_list
+from .rover import DiffDriveRover
+from .space import PhysicsWorld
+
+#: Two shapes of a run closer than this (plus two steps of their motion): the run may be
+#: about to touch, and its row is made alone.
+REACH_M = 0.5
+
+
+class _ColumnIO:
+    """What ``Fleet`` reads and writes through (``bodyio.BodyIO``'s interface), over columns.
+
+    ``step`` integrates every body as Chipmunk integrates one without contacts, then lets
+    :class:`ColumnPhysics` look for runs about to touch.
+    """
+
+    def __init__(self, state: np.ndarray, m_inv: np.ndarray, i_inv: np.ndarray) -> None:
+        n = len(state)
+        self.rows = list(range(n))
+        self.state = state  # (n, 6): x, y, angle, vx, vy, w
+        self.forces = np.zeros(3 * n)
+        self._f = self.forces.reshape(n, 3)
+        self.m_inv = m_inv
+        self.i_inv = i_inv
+        self.before = state.copy()
+        self.on_step: Any = None
+
+    def read_array(self) -> np.ndarray:
+        return self.state
+
+    def write(self) -> None:
+        pass
+
+    def step(self, dt: float) -> None:
+        s = self.state
+        np.copyto(self.before, s)
+        # cpBodyUpdatePosition: p = p + (v + v_bias) * dt; a = a + (w + w_bias) * dt
+        s[:, 0] += (s[:, 3] + 0.0) * dt
+        s[:, 1] += (s[:, 4] + 0.0) * dt
+        s[:, 2] += (s[:, 5] + 0.0) * dt
+        # cpBodyUpdateVelocity (damping 1, gravity 0 in the plane):
+        # v = v * 1 + (g + f * m_inv) * dt; w = w * 1 + t * i_inv * dt
+        f = self._f
+        s[:, 3] += (0.0 + f[:, 0] * self.m_inv) * dt
+        s[:, 4] += (0.0 + f[:, 1] * self.m_inv) * dt
+        s[:, 5] += f[:, 2] * self.i_inv * dt
+        if self.on_step is not None:
+            self.on_step(dt)
+
+
+class ColumnPhysics:
+    """The batch's physics step: every run's :class:`PhysicsWorld`, stepped as columns.
+
+    Each run's world registers its step hook here instead of with the engine
+    (:meth:`adopt`); the batch registers :meth:`step` once. The runs' Spaces hold their
+    rovers where they started (they are never stepped). The robots' grouped
+    ``step_many`` reaches the columns through each world's ``index_of``, ``set_powers``,
+    ``kinematics_array`` and ``rim_array``, which :meth:`adopt` points here.
+    """
+
+    def __init__(self) -> None:
+        self.worlds: list[PhysicsWorld] = []
+        self.rovers: list[DiffDriveRover] = []
+        self._model: Fleet | None = None
+        self.steps = 0
+        self.sim: Any = None
+        #: runs whose shapes came within reach of each other: their rows are made alone
+        self.touched: set[int] = set()
+
+    def adopt(self, world: PhysicsWorld) -> None:
+        """Take over ``world``'s step (its rovers and contacts stay its own)."""
+        self.worlds.append(world)
+        world.index_of = self.index_of  # type: ignore[method-assign]
+        world.set_powers = self.set_powers  # type: ignore[method-assign]
+        world.kinematics_array = self.kinematics_array  # type: ignore[method-assign]
+        world.rim_array = self.rim_array  # type: ignore[method-assign]
+
+    # -- the robots' group interface (as PhysicsWorld's, over every run) -------------------
+    def index_of(self, rovers: Sequence[DiffDriveRover]) -> np.ndarray:
+        """Positions of ``rovers`` in the columns."""
+        self._model or self._start()
+        where = {id(r): k for k, r in enumerate(self.rovers)}
+        return np.array([where[id(r)] for r in rovers], dtype=np.intp)
+
+    def set_powers(
+        self, rovers: Sequence[DiffDriveRover], index: np.ndarray, left: Any, right: Any
+    ) -> None:
+        """:meth:`PhysicsWorld.set_powers` over the columns, without its loop per rover:
+        saturation at ±100 % (NaN to -100), then each driver's deadband, written into the
+        force model's drives (the only reader in a batch: no window draws the rovers'
+        ``power_l``). A rover's wheel (and deadband) is fixed in a batch (``batched.py``)."""
+        model = self._model or self._start()
+        left = np.where(np.isnan(left), -100.0, np.clip(left, -100.0, 100.0))
+        right = np.where(np.isnan(right), -100.0, np.clip(right, -100.0, 100.0))
+        band = self._band[index]
+        model.drives[0, index] = np.where((-band < left) & (left < band), 0.0, left)
+        model.drives[1, index] = np.where((-band < right) & (right < band), 0.0, right)
+
+    def kinematics_array(self, index: np.ndarray) -> np.ndarray:
+        """(n, 6) state of the rovers at ``index`` after the last step."""
+        return (self._model or self._start()).kinematics_array(index)
+
+    def rim_array(self, index: np.ndarray) -> np.ndarray:
+        """(n, 2) rim speeds of the rovers at ``index``."""
+        return (self._model or self._start()).rim_array(index)
+
+    # -- stepping ------------------------------------------------------------------------
+    def _start(self) -> Fleet:
+        """Gather every run's rovers (run by run) and their shapes' reach; start the model."""
+        self.rovers = [r for w in self.worlds for r in w.rovers]
+        run_of = [i for i, w in enumerate(self.worlds) for _ in w.rovers]
+        self._run = np.array(run_of, dtype=np.intp)
+        first = self.worlds[0]
+        self.dt = first.dt
+        state = np.array([_body_state(r.body) for r in self.rovers], dtype=np.float64)
+        state = state.reshape(len(self.rovers), 6)
+        m_inv = np.array([1.0 / r.body.mass for r in self.rovers])
+        i_inv = np.array([1.0 / r.body.moment for r in self.rovers])
+        io = _ColumnIO(state, m_inv, i_inv)
+        io.on_step = self._contacts
+        grounds = []
+        for w in self.worlds:
+            ground = w.terrain.ground(-1)
+            grounds += [ground_list(r, ground, ground) for r in w.rovers]
+        limits = (first.max_speed, first.extent)
+        model = Fleet(io, self.rovers, self.dt, limits, grounds)  # type: ignore[arg-type]
+        self._model = model
+        self._io = io
+        for k, rover in enumerate(self.rovers):
+            rover.attach_state(functools.partial(model.kinematics, k))
+            rover.attach_rims(functools.partial(model.rim_speeds, k))
+        # reach: each rover's bounding radius; the static shapes' boxes (the same in every
+        # run of a batch: one physics setting); rover pairs within each run
+        self._radius = np.array([_radius(r.shape) for r in self.rovers])
+        self._band = np.array([r.wheel.deadband_pct for r in self.rovers])
+        statics = [s for s in first.space.shapes if s.body.body_type == pymunk.Body.STATIC]
+        self._boxes = np.array([[s.bb.left, s.bb.bottom, s.bb.right, s.bb.top] for s in statics])
+        pairs = [
+            (a, b)
+            for i in range(len(self.worlds))
+            for a in np.flatnonzero(self._run == i)
+            for b in np.flatnonzero(self._run == i)
+            if a < b
+        ]
+        self._pa = np.array([p[0] for p in pairs], dtype=np.intp)
+        self._pb = np.array([p[1] for p in pairs], dtype=np.intp)
+        return model
+
+    def step(self) -> None:
+        """One physics step of every run (the batch's hook)."""
+        model = self._model or self._start()
+        bad = model.advance()
+        self.steps += 1
+        if bad is not None:
+            rover = self.rovers[bad[0]]
+            raise RunFault(rover.name, self.sim.now + 1 / self.worlds[0].rate, bad[1])
+
+    def _contacts(self, dt: float) -> None:
+        """Mark the runs whose shapes are within reach of each other before this step."""
+        before = self._io.before
+        x, y = before[:, 0], before[:, 1]
+        speed = np.hypot(before[:, 3], before[:, 4])
+        reach = self._radius + REACH_M + 2.0 * dt * speed
+        if len(self._pa):
+            pa, pb = self._pa, self._pb
+            gap = np.hypot(x[pa] - x[pb], y[pa] - y[pb])
+            near = gap < reach[pa] + reach[pb]
+            if near.any():
+                self.touched.update(self._run[pa[near]].tolist())
+        if len(self._boxes):
+            b = self._boxes
+            dx = np.maximum(np.maximum(b[None, :, 0] - x[:, None], 0.0), x[:, None] - b[None, :, 2])
+            dy = np.maximum(np.maximum(b[None, :, 1] - y[:, None], 0.0), y[:, None] - b[None, :, 3])
+            near = (np.hypot(dx, dy) < reach[:, None]).any(axis=1)
+            if near.any():
+                self.touched.update(self._run[near].tolist())
+
+
+def _body_state(body: pymunk.Body) -> list[float]:
+    x, y = body.position
+    vx, vy = body.velocity
+    return [x, y, body.angle, vx, vy, body.angular_velocity]
+
+
+def _radius(shape: pymunk.Shape) -> float:
+    """The largest distance of ``shape`` from its body's centre (a bounding circle)."""
+    if isinstance(shape, pymunk.Poly):
+        return max(math.hypot(v.x, v.y) for v in shape.get_vertices()) + shape.radius
+    if isinstance(shape, pymunk.Circle):
+        return math.hypot(*shape.offset) + shape.radius
+    return 1e9  # anything else: always within reach (stepped by its Space)

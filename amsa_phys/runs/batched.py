@@ -1,0 +1,254 @@
+"""Batched sweeps: a sweep's runs as columns of one simulation per batch (``--executor batch``).
+
+The sweep's jobs are split into *batches* of runs that one :class:`engine.multirun.MultiRun`
+can hold: same scenario, duration and physics settings (a ``physics.*`` axis splits them),
+built-in templates or user templates with ``step_many``, no random loop timing (jitter or
+free-running timers: each run's timer phases would put its instants elsewhere). A batch is
+the unit of work of the process pool and of Dask, so batches are split across cores and
+workers; the runs that no batch can hold go one per process as before, said once.
+
+A run that faults inside a batch (a component raising, a rover leaving the world) is run
+again alone, which gives its error row and its metrics up to the fault exactly as the
+process pool does; the batch then goes on without it (started again from t = 0). A batch
+whose worker dies twice has its runs run one per process, so the run that kills its process
+is found and reported as before, and the others give their rows.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from ..engine import interrupt
+from ..engine.multirun import MultiRun
+from ..errors import AmsaError, RunFault
+from ..model.scenario import Scenario
+from ..model.timing import RANDOM
+from .pool import WORKER_LOST, imap_resilient
+from .single import compute_metrics
+from .sweep import Job, fill_metrics, job_row, prepare_job, run_job
+
+#: Most runs in one batch: a batch's worker holds ~0.3 MB a run-minute (world, components,
+#: quality samples: peak RSS 125 MiB at 250 runs of 60 s, 204 MiB at 500), and a batch is
+#: what a Ctrl-C or a dying worker costs.
+MAX_BATCH = 250
+#: Batches per worker when the size is automatic: two, so the pool balances and a Ctrl-C
+#: keeps the rows of the batches finished so far, while each batch stays wide (numpy's
+#: fixed cost per call is shared by every run of a batch: 21 ms a run-minute at 63 runs
+#: a batch, 16 ms at 250, measured on scenario1).
+BATCHES_PER_WORKER = 2
+
+
+@dataclass(frozen=True)
+class Unit:
+    """What one pool task (or Dask task) runs: a batch, or runs one by one."""
+
+    jobs: tuple[Job, ...]
+    batched: bool = True
+
+
+def unbatchable(scenario: Scenario) -> str | None:
+    """Why a batch cannot hold runs of ``scenario`` (None if it can)."""
+    world = scenario.world
+    if world.free_running:
+        return "free-running timers (each run draws its own phases)"
+    for path, leaf in world.leaves.items():
+        template = leaf.template
+        if not template.__module__.startswith("amsa_phys.") and not hasattr(template, "step_many"):
+            return f"{path} is a user template ({template.name()}) without step_many"
+        if leaf.timing.jitter or leaf.timing.phase == RANDOM:
+            return f"{path} has random loop timing (jitter or a random phase)"
+        if template.has_arrays():
+            return f"{path} has array ports (a lidar casts rays in its run's space every scan)"
+        if template.name() == "frictionZone":
+            return f"{path} is a terrain zone (the batch's physics has one ground)"
+    robots = {p for p, leaf in world.leaves.items() if leaf.template.name() in _ROBOTS}
+    for i, phase in enumerate(scenario.phases):
+        steps = [phase.changes] if i > 0 else []
+        for changes in [*steps, *(step.changes for step in phase.within)]:
+            for c in changes:
+                if c.leaf in robots:
+                    return f"the timeline changes {c.key} during the run"
+    return None
+
+
+#: Templates of rovers: a batch sets their parameters at t = 0 only.
+_ROBOTS = ("freeRobot", "controlledRobot")
+
+
+def batch_key(scenario: Scenario) -> str:
+    """What runs of one batch share, as text: duration, log rate, physics settings."""
+    return json.dumps(
+        [str(scenario.duration), str(scenario.log_rate), scenario.world.physics],
+        sort_keys=True,
+        default=str,
+    )
+
+
+def auto_size(runs: int, workers: int) -> int:
+    """Runs per batch: :data:`BATCHES_PER_WORKER` batches per worker, at most MAX_BATCH."""
+    return max(1, min(MAX_BATCH, math.ceil(runs / (BATCHES_PER_WORKER * max(1, workers)))))
+
+
+def plan_units(
+    jobs: Sequence[Job], workers: int, size: int | None = None
+) -> tuple[list[Unit], list[str]]:
+    """Jobs as batches (in job order within each batch key), then the jobs no batch can hold;
+    and the notes to say once (why some runs go one per process)."""
+    keys: dict[tuple[tuple[str, Any], ...], str | None] = {}
+    reasons: dict[str, int] = {}
+    groups: dict[str, list[Job]] = {}
+    alone: list[Job] = []
+    for job in jobs:
+        if job.point not in keys:
+            try:
+                scenario = prepare_job(job)
+            except (AmsaError, ValueError):
+                keys[job.point] = None  # its row says why; run_job gives it
+            else:
+                why = unbatchable(scenario)
+                if why is not None:
+                    reasons[why] = 0
+                    keys[job.point] = None
+                else:
+                    keys[job.point] = batch_key(scenario)
+        key = keys[job.point]
+        if job.keep_dir is not None or key is None:
+            alone.append(job)
+        else:
+            groups.setdefault(key, []).append(job)
+    units = []
+    n = size or auto_size(sum(len(g) for g in groups.values()), workers)
+    for members in groups.values():
+        for start in range(0, len(members), n):
+            units.append(Unit(tuple(members[start : start + n])))
+    units += [Unit((job,), batched=False) for job in alone]
+    notes = []
+    kept = sum(1 for j in alone if j.keep_dir is not None)
+    if kept:
+        notes.append(
+            f"--keep-runs writes every run's directory (its plots cost ~20x the run): "
+            f"{kept} runs go one per process"
+        )
+    for why in reasons:
+        notes.append(f"runs that a batch cannot hold go one per process: {why}")
+    return units, notes
+
+
+def _columns() -> Any:
+    """The batch's column physics: every run's rovers in one force pass and integration."""
+    from ..physics.columns import ColumnPhysics
+
+    return ColumnPhysics()
+
+
+def run_batch(jobs: Sequence[Job], stats: dict[str, int] | None = None) -> list[dict[str, Any]]:
+    """The result rows of ``jobs`` run as one batch (in job order).
+
+    ``stats`` (if given) counts the runs made alone: ``faults`` (a run that faulted in the
+    batch) and ``contacts`` (shapes within reach).
+    """
+    counts = stats if stats is not None else {}
+    counts.setdefault("faults", 0)
+    counts.setdefault("contacts", 0)
+    rows: dict[int, dict[str, Any]] = {}
+    todo: list[tuple[Job, Scenario]] = []
+    for job in jobs:
+        try:
+            todo.append((job, prepare_job(job)))
+        except (AmsaError, ValueError) as exc:
+            rows[job.index] = job_row(job, str(exc))
+    while todo:
+        t0 = time.perf_counter()
+        sim = MultiRun([sc for _, sc in todo], columns=_columns())
+        try:
+            sim.run()
+        except RunFault as exc:
+            k = sim.run_of(exc.component)
+            if k is None:  # not any one run's: each alone says what it is
+                rows.update((job.index, run_job(job)) for job, _ in todo)
+                break
+            job = todo.pop(k)[0]
+            rows[job.index] = run_job(job)  # its error row and metrics, as alone
+            counts["faults"] += 1
+            continue
+        wall = (time.perf_counter() - t0) / len(todo)
+        touched = sim.column_physics.touched
+        for k, ((job, scenario), outcome) in enumerate(zip(todo, sim.outcomes(), strict=True)):
+            if k in touched:  # shapes within reach: contacts are made by the run alone
+                rows[job.index] = run_job(job)
+                counts["contacts"] += 1
+                continue
+            metrics = compute_metrics(scenario, outcome, outcome.result, wall, "completed")
+            rows[job.index] = fill_metrics(job_row(job), metrics)
+        break
+    return [rows[job.index] for job in jobs]
+
+
+def run_unit(unit: Unit) -> list[dict[str, Any]]:
+    """Run one unit: a batch, or its jobs one by one."""
+    if unit.batched and len(unit.jobs) > 0:
+        return run_batch(unit.jobs)
+    return [run_job(job) for job in unit.jobs]
+
+
+def iter_batched(
+    units: Sequence[Unit],
+    workers: int,
+    alone: Callable[[list[Job], int], Iterator[dict[str, Any]]],
+) -> Iterator[dict[str, Any]]:
+    """Rows as units complete, from local worker processes (in-process for 1 worker).
+
+    ``alone`` runs jobs one per process (``sweep.iter_local``): the runs of a batch whose
+    worker died twice go there, so the run that kills its process is found as before.
+    """
+    if workers <= 1:
+        for unit in units:
+            yield from run_unit(unit)
+            interrupt.check()
+        return
+    lost: list[Job] = []
+
+    def note_lost(unit: Unit) -> list[dict[str, Any]]:
+        if len(unit.jobs) == 1:
+            return [job_row(unit.jobs[0], f"{WORKER_LOST}, twice, running this job")]
+        lost.extend(unit.jobs)
+        return []
+
+    for _, rows in imap_resilient(
+        run_unit, units, min(workers, len(units)), note_lost, in_flight=2 * workers
+    ):
+        yield from rows
+    if lost:
+        yield from alone(lost, workers)
+
+
+def lost_rows(unit: Unit) -> list[dict[str, Any]]:
+    """The rows of a unit Dask could not run on any worker."""
+    return [job_row(job, f"{WORKER_LOST}, on every worker that ran it") for job in unit.jobs]
+
+
+def iter_dask_batched(units: Sequence[Unit], scheduler: str) -> Iterator[dict[str, Any]]:
+    """Rows as units complete on a Dask cluster (a task is a batch). The runs of a batch
+    that killed every worker it met go again one per task, so the run that kills is found
+    and the others give their rows, as on local workers."""
+    from .sweep import dask_map
+
+    lost: list[Job] = []
+
+    def note_lost(unit: Unit) -> list[dict[str, Any]]:
+        if len(unit.jobs) == 1:
+            return lost_rows(unit)
+        lost.extend(unit.jobs)
+        return []
+
+    for rows in dask_map(run_unit, units, scheduler, note_lost):
+        yield from rows
+    if lost:
+        singles = [Unit((job,), batched=False) for job in lost]
+        for rows in dask_map(run_unit, singles, scheduler, lost_rows):
+            yield from rows
