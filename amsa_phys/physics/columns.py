@@ -40,6 +40,7 @@ import numpy as np
 import pymunk
 
 from ..errors import RunFault
+from .compiled import ColumnForces, columns_compiled
 from .fleet import Fleet
 from .forces import ground_list
 from .rover import DiffDriveRover
@@ -166,7 +167,9 @@ class ColumnPhysics:
             ground = w.terrain.ground(-1)
             grounds += [ground_list(r, ground, ground) for r in w.rovers]
         limits = (first.max_speed, first.extent)
-        model = Fleet(io, self.rovers, self.dt, limits, grounds)  # type: ignore[arg-type]
+        # the C force model (a single run's own arithmetic) when built; numpy's otherwise
+        kind = ColumnForces if columns_compiled() else Fleet
+        model = kind(io, self.rovers, self.dt, limits, grounds)  # type: ignore[arg-type]
         self._model = model
         self._io = io
         for k, rover in enumerate(self.rovers):
