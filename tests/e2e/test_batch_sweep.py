@@ -26,7 +26,9 @@ WORLD = ROOT / "worlds" / "mde_challenge.yaml"
 #: The pure path's bound. Why not bitwise there: its batch computes the rovers' forces by the
 #: numpy model, which rounds unlike the scalar code in the last bits; over a run that stays
 #: ~1e-13 in every metric. With the compiled step a batch's forces are the single run's own C
-#: code and its integration is Chipmunk's (``physics/columns.py``): the rows are equal.
+#: code and its integration is Chipmunk's (``physics/columns.py``): the rows are equal (the
+#: components' array steps could still round apart where numpy's transcendental functions
+#: and libm's differ, ``engine/batch.py``; on these grids, here, they do not).
 TOL = 1e-9
 #: The force model a batch takes on each path (``compiled.columns_compiled``).
 MODEL = {"compiled": "ColumnForces", "pure": "Fleet"}
