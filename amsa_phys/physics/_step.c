@@ -238,9 +238,13 @@ static double rim_alone(double u, double f0, double res, double fx, const StepCo
     return rim_solve(u, f0, need > 0 ? res : -res, fx, s);
 }
 
+static double (*volatile libm_pow)(double, double) = pow;
+
 static void friction_ellipse(double *fx, double *fy, double inv_x, double inv_y)
-{ /* wheel.friction_ellipse (Python's x ** 2 is libm's pow(x, 2.0)) */
-    double q = pow(*fx * inv_x, 2.0) + pow(*fy * inv_y, 2.0);
+{ /* wheel.friction_ellipse. Python's x ** 2 is libm's pow(x, 2.0), which differs from x * x
+   * in the last bit for ~1 value in 1,000; GCC folds a direct pow(x, 2.0) into x * x, so
+   * libm's pow is called through a volatile pointer the compiler cannot see through. */
+    double q = libm_pow(*fx * inv_x, 2.0) + libm_pow(*fy * inv_y, 2.0);
     if (q > 1.0) {
         double scale = 1.0 / sqrt(q);
         *fx = *fx * scale;

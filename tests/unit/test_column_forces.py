@@ -4,8 +4,8 @@ A batched sweep computes its rovers' forces with the C force model of a run made
 the Fleet's arrays and without a Space. Held here: in every regime of the wheel model (rims
 stuck, breaking away, current-limited, reversed, tyres saturated on ice and mud), forces and
 rims equal those of the compiled single-run step (``_step.Stepper``) to the last bit, step
-after step as the regimes change, and the pure scalar model's within rounding; and wrong
-arrays are refused, not read out of bounds.
+after step as the regimes change, and the pure scalar model's; and wrong arrays are
+refused, not read out of bounds.
 """
 
 from __future__ import annotations
@@ -42,7 +42,10 @@ def single_run_forces(model: compiled.CompiledFewRovers) -> list[tuple[float, ..
 @built
 def test_column_forces_are_the_single_runs_compiled_forces_in_every_regime() -> None:
     """Bit for bit the compiled single run's forces and rims (the batched row equals the run
-    made alone), and within rounding of the pure scalar model (``FewRovers``)."""
+    made alone) and the pure scalar model's (``FewRovers``). The forces, not only the states
+    they lead to: a force a few ulps off can vanish in the integration (a direct
+    ``pow(x, 2.0)`` in ``_step.c``, folded by GCC into ``x * x``, did that at one rover and
+    step of these 40; the states stayed equal)."""
     space, rovers, rims, grounds = every_regime(60)
     terms = [ground_list(r, *g) for r, g in zip(rovers, grounds, strict=True)]
     io_alone = BodyIO(space, [r.body for r in rovers])
@@ -66,7 +69,7 @@ def test_column_forces_are_the_single_runs_compiled_forces_in_every_regime() -> 
             assert got == expected[k], f"rover {k}"
             assert columns.rim_speeds(k) == alone.rim_speeds(k), f"rover {k}"
             scalar = pure.io.forces[pure.rows[k] * bodyio.FORCE :][:3]
-            assert got == pytest.approx(tuple(scalar), rel=1e-12, abs=1e-12), f"rover {k}"
+            assert got == tuple(scalar), f"rover {k}"
             if 0.0 in columns.rim_speeds(k):
                 at_rest.add(k)
     assert len(at_rest) >= 5  # rims at rest were in the mix (the rare branches ran)
