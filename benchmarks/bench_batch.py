@@ -77,11 +77,15 @@ def child(runs: int, workers: int, executor: str, limit: int | None) -> None:
     print(json.dumps(out))
 
 
-def measure(runs: int, workers: int, executor: str, limit: int | None = None) -> dict:
-    """:func:`child` in a fresh interpreter (so RSS is this sweep's alone)."""
+def measure(
+    runs: int, workers: int, executor: str, limit: int | None = None, pure: bool = False
+) -> dict:
+    """:func:`child` in a fresh interpreter (so RSS is this sweep's alone); ``pure``: with
+    ``AMSA_PHYS_PURE=1`` (the numpy column forces, the pure step for runs made alone)."""
     argv = [sys.executable, __file__, "--child", str(runs), str(workers), executor]
     argv.append(str(limit) if limit else "0")
-    proc = subprocess.run(argv, capture_output=True, text=True, check=True)
+    env = {**os.environ, "AMSA_PHYS_PURE": "1"} if pure else None
+    proc = subprocess.run(argv, capture_output=True, text=True, check=True, env=env)
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
@@ -127,6 +131,15 @@ def targets(runs: int = 1000, pool_runs: int = 200, big: int = 10000, j: int = 2
     )
     ratio = pool_wall / batch["wall"]
     print(f"{verdict(ratio >= 10)} batched / process pool -j {j}: {ratio:.1f}x (target >= 10x)")
+    from amsa_phys.physics.compiled import columns_compiled
+
+    if columns_compiled():  # what the compiled column forces bring, measured alongside
+        pure = measure(runs, j, "batch", pure=True)
+        print(
+            f"batched -j {j}, pure path (AMSA_PHYS_PURE=1, numpy column forces): "
+            f"{pure['runs']} runs in {pure['wall']:.2f} s; compiled "
+            f"{pure['wall'] / batch['wall']:.1f}x faster"
+        )
     if big:
         large = measure(big, j, "batch")
         grow = large["rss_kib"] / batch["rss_kib"]

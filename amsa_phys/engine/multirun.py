@@ -18,9 +18,10 @@ makes each copy the run it would be alone:
 
 Groups are formed at any size (``_min_group = 1``), so a run's arithmetic is the same
 whatever batch it lands in: a batched sweep is byte-identical to itself across batch sizes
-and ``-j``. Against the run made alone it differs where array arithmetic rounds unlike the
-scalar code (numpy's transcendental functions, see ``engine/batch.py``): ~1e-12 in the
-rovers' distance over a run, held to 1e-9 by the tests.
+and ``-j``. Against the run made alone it can differ only where array arithmetic rounds
+unlike the scalar code (numpy's transcendental functions, see ``engine/batch.py``; on the
+pure path also the numpy force model): ~1e-13 in the rovers' distance over a run, held to
+1e-9 by the tests; with the compiled step the tests' rows are equal to the last bit.
 """
 
 from __future__ import annotations

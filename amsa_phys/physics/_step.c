@@ -18,6 +18,7 @@
 #include <Python.h>
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 typedef struct {
     double x, y;
@@ -237,9 +238,13 @@ static double rim_alone(double u, double f0, double res, double fx, const StepCo
     return rim_solve(u, f0, need > 0 ? res : -res, fx, s);
 }
 
+static double (*volatile libm_pow)(double, double) = pow;
+
 static void friction_ellipse(double *fx, double *fy, double inv_x, double inv_y)
-{ /* wheel.friction_ellipse (Python's x ** 2 is libm's pow(x, 2.0)) */
-    double q = pow(*fx * inv_x, 2.0) + pow(*fy * inv_y, 2.0);
+{ /* wheel.friction_ellipse. Python's x ** 2 is libm's pow(x, 2.0), which differs from x * x
+   * in the last bit for ~1 value in 1,000; GCC folds a direct pow(x, 2.0) into x * x, so
+   * libm's pow is called through a volatile pointer the compiler cannot see through. */
+    double q = libm_pow(*fx * inv_x, 2.0) + libm_pow(*fy * inv_y, 2.0);
     if (q > 1.0) {
         double scale = 1.0 / sqrt(q);
         *fx = *fx * scale;
@@ -251,7 +256,8 @@ static void friction_ellipse(double *fx, double *fy, double inv_x, double inv_y)
 static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
 {
     const double *p = st->plan + k * PLAN_WIDTH;
-    const double *state = st->state + st->offsets[k];
+    /* no offsets (column_forces): rover k's state is row k of an (n, 6) array */
+    const double *state = st->state + (st->offsets ? st->offsets[k] : 6 * k);
     const double *g = st->ground + k * st->ground_k;
     double *rim_l = st->rims + k * st->rim_k;
     double *rim_r = rim_l + st->rim_side;
@@ -603,10 +609,79 @@ static PyTypeObject StepperType = {
     .tp_methods = Stepper_methods,
 };
 
+/* ---- column_forces: the force model alone, over a batch's columns (physics/columns.py) ---
+ * Why: a batched sweep integrates its rovers itself (no Space to step), and the numpy fleet's
+ * masks for the rare branches cost half of a batch. This is rover_forces above (the same
+ * code, so the same floats as a run made alone with the compiled step) over arrays laid out
+ * as fleet.Fleet's: plan (n, PLAN_WIDTH), drives (2, n), rims (2, n, updated in place),
+ * ground (7, n) in fleet._GROUND_ROWS order, state (n, 6); forces (n, 3) are written. */
+static PyObject *column_forces(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    PyObject *objs[6];
+    double dt;
+    if (!PyArg_ParseTuple(args, "OOOOOOd", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4],
+                          &objs[5], &dt))
+        return NULL;
+    static const char *names[6] = {"plan", "drives", "rims", "ground", "state", "forces"};
+    static const int writable[6] = {0, 0, 1, 0, 0, 1};
+    Py_buffer views[6];
+    int held = 0;
+    PyObject *result = NULL;
+    for (; held < 6; held++) {
+        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable[held] ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[held], &views[held], flags) < 0)
+            goto done;
+        if (views[held].itemsize != 8 || strcmp(views[held].format, "d") != 0) {
+            PyErr_Format(PyExc_ValueError, "%s: float64 items expected", names[held]);
+            held++;
+            goto done;
+        }
+    }
+    Py_ssize_t n = views[4].len / (6 * 8);
+    const Py_ssize_t need[6] = {n * PLAN_WIDTH, 2 * n, 2 * n, 7 * n, 6 * n, 3 * n};
+    for (int i = 0; i < 6; i++)
+        if (views[i].len != need[i] * 8) {
+            PyErr_Format(PyExc_ValueError, "%s: %zd floats expected for %zd rovers, got %zd",
+                         names[i], need[i], n, views[i].len / 8);
+            goto done;
+        }
+    Stepper st;
+    memset(&st, 0, sizeof st);
+    st.n = n;
+    st.plan = views[0].buf;
+    st.drives = views[1].buf;
+    st.rims = views[2].buf;
+    st.rim_k = 1;
+    st.rim_side = n;
+    st.ground = views[3].buf;
+    st.ground_k = 1;
+    static const int rows[7] = {0, 2, 4, 1, 3, 5, 6}; /* fleet._GROUND_ROWS */
+    for (int t = 0; t < 7; t++)
+        st.ground_off[t] = rows[t] * n;
+    st.state = views[4].buf;
+    st.dt = dt;
+    double *forces = views[5].buf;
+    for (Py_ssize_t k = 0; k < n; k++)
+        rover_forces(&st, k, forces + 3 * k);
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    for (int i = 0; i < held; i++)
+        PyBuffer_Release(&views[i]);
+    return result;
+}
+
+static PyMethodDef module_methods[] = {
+    {"column_forces", column_forces, METH_VARARGS,
+     "column_forces(plan, drives, rims, ground, state, forces, dt): every rover's force and "
+     "torque into forces (n, 3), its rims advanced in place; no Space."},
+    {NULL, NULL, 0, NULL},
+};
+
 static struct PyModuleDef step_module = {
     PyModuleDef_HEAD_INIT, "_step",
     "The compiled physics step (see _step.c); imported by amsa_phys.physics.compiled.", -1,
-    NULL,
+    module_methods,
 };
 
 PyMODINIT_FUNC PyInit__step(void)

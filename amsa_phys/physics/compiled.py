@@ -324,3 +324,41 @@ def _fill_array(model: Any, name: str, values: Any) -> None:
         model.__dict__[name] = np.array(values, dtype=np.float64, order="C")
         return
     buf[...] = values  # numpy refuses a shape that does not broadcast to it
+
+
+def columns_compiled() -> bool:
+    """Whether a batch's column forces take the C force model (:class:`ColumnForces`).
+
+    Only ``_step.c``'s force code is needed (no Chipmunk functions: a batch integrates its
+    rovers itself), so only the extension and ``AMSA_PHYS_PURE`` decide.
+    """
+    return describe()[0] and hasattr(_step, "column_forces")
+
+
+class ColumnForces(Fleet):
+    """``Fleet`` whose force pass is ``_step.column_forces``: the C per-rover force model.
+
+    Why: in a batched sweep the numpy pass evaluated the masks of the wheel model's rare
+    branches over whole arrays at most steps (half of a batch's time); the C code takes
+    each rover's branch alone. And it is the code a run made alone takes (the compiled
+    step), so a batched row equals its single run's when the integration does
+    (``columns.py``). Everything else (drives, rims, ground, state, the safety check) is
+    the Fleet's, in the same arrays.
+    """
+
+    def refresh(self) -> None:
+        """Re-read every rover's constants into the C plan (folded as FewRovers folds them)."""
+        super().refresh()
+        self._plan = np.array(
+            [plan_row(r, self.dt) for r in self.rovers], dtype=np.float64
+        ).reshape(len(self.rovers), len(PLAN_FIELDS))
+
+    def apply(self, state: np.ndarray) -> None:
+        """Every rover's force and torque for this step (into the io's forces), rims advanced."""
+        out = self._out[self._span] if self._span is not None else self._gather
+        state = np.ascontiguousarray(state, dtype=np.float64)
+        _step.column_forces(  # type: ignore[union-attr]
+            self._plan, self.drives, self.rims, self.ground, state, out, self.dt
+        )
+        if self._span is None:
+            self._out[self.rows] = out

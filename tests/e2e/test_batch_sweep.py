@@ -1,7 +1,9 @@
-"""Batched sweeps (``--executor batch``): each row is the row of its run made alone (within
-1e-9), a batched sweep is byte-identical to itself across -j and batch sizes, the runs a
-batch cannot hold go one per process (said once), and faults, contacts and dying workers
-cost their own rows only."""
+"""Batched sweeps (``--executor batch``): each row is the row of its run made alone (equal
+with the compiled step, within 1e-9 on the pure path), a batched sweep is byte-identical to
+itself across -j and batch sizes, the runs a batch cannot hold go one per process (said
+once), and faults, contacts and dying workers cost their own rows only. The row, fault and
+byte-identity tests run on both physics paths: the compiled one (``_step.column_forces``)
+and the pure one (``AMSA_PHYS_PURE=1``)."""
 
 from __future__ import annotations
 
@@ -14,15 +16,46 @@ from typing import Any
 import pytest
 
 from amsa_phys.cli.main import main
+from amsa_phys.physics.columns import ColumnPhysics
+from amsa_phys.physics.step_path import PURE_ENV, extension
 from amsa_phys.runs.batched import plan_units, run_batch
 from amsa_phys.runs.sweep import Axis, SweepPlan, run_job
 
 ROOT = Path(__file__).resolve().parents[2]
 WORLD = ROOT / "worlds" / "mde_challenge.yaml"
-#: Why not bitwise: the batch steps like components as arrays and the rovers' forces by the
-#: numpy model, which round unlike the scalar code in the last bits (``engine/multirun.py``);
-#: over a run that stays ~1e-13 in every metric.
+#: The pure path's bound. Why not bitwise there: its batch computes the rovers' forces by the
+#: numpy model, which rounds unlike the scalar code in the last bits; over a run that stays
+#: ~1e-13 in every metric. With the compiled step a batch's forces are the single run's own C
+#: code and its integration is Chipmunk's (``physics/columns.py``): the rows are equal (the
+#: components' array steps could still round apart where numpy's transcendental functions
+#: and libm's differ, ``engine/batch.py``; on these grids, here, they do not).
 TOL = 1e-9
+#: The force model a batch takes on each path (``compiled.columns_compiled``).
+MODEL = {"compiled": "ColumnForces", "pure": "Fleet"}
+
+
+@pytest.fixture(params=["compiled", "pure"])
+def step_path(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> Any:
+    """Run the test on the compiled path and on the pure path (``AMSA_PHYS_PURE=1``, which a
+    sweep's worker processes inherit); yields the path and the force models the batches in
+    this process chose."""
+    if request.param == "compiled":
+        if extension() is None:
+            pytest.skip("the compiled step was not built (no C compiler at install)")
+        monkeypatch.delenv(PURE_ENV, raising=False)
+    else:
+        monkeypatch.setenv(PURE_ENV, "1")
+    chosen: list[str] = []
+    start = ColumnPhysics._start
+
+    def spy(self: ColumnPhysics) -> Any:
+        model = start(self)
+        chosen.append(type(model).__name__)
+        return model
+
+    monkeypatch.setattr(ColumnPhysics, "_start", spy)
+    return request.param, chosen
+
 
 CONTEXTS = {
     "nominal": {"Leader.behavior": 1},
@@ -61,24 +94,28 @@ def random_plan(path: Path, seed: int) -> SweepPlan:
     return SweepPlan(path, axes, seeds=2, base_seed=3, contexts=CONTEXTS)
 
 
-def assert_rows_close(alone: dict[str, Any], batched: dict[str, Any]) -> None:
+def assert_rows_close(alone: dict[str, Any], batched: dict[str, Any], path: str) -> None:
+    """Equal rows on the compiled path; within :data:`TOL` on the pure path."""
+    tol = 0.0 if path == "compiled" else TOL
     assert alone.keys() == batched.keys()
     for key, value in alone.items():
         other = batched[key]
         if isinstance(value, float) and isinstance(other, float):
-            assert math.isclose(value, other, rel_tol=0, abs_tol=TOL), (alone["run"], key)
+            assert math.isclose(value, other, rel_tol=0, abs_tol=tol), (alone["run"], key)
         else:
             assert value == other, (alone["run"], key)
 
 
 @pytest.mark.parametrize("seed", [1, 2])
-def test_batched_rows_equal_the_runs_made_alone(tmp_path: Path, seed: int) -> None:
+def test_batched_rows_equal_the_runs_made_alone(tmp_path: Path, seed: int, step_path: Any) -> None:
+    path, chosen = step_path
     jobs = random_plan(scenario(tmp_path), seed).jobs()
     stats: dict[str, int] = {}
     batched = run_batch(jobs, stats)
+    assert chosen == [MODEL[path]]
     alone = [run_job(job) for job in jobs]
     for a, b in zip(alone, batched, strict=True):
-        assert_rows_close(a, b)
+        assert_rows_close(a, b, path)
     # the grid holds what the batch must get right: collisions (runs made alone), runs
     # computed in the columns, GPS losses and a random leader (seed-tree streams), and a
     # timeline (phase metrics)
@@ -90,7 +127,10 @@ def test_batched_rows_equal_the_runs_made_alone(tmp_path: Path, seed: int) -> No
     assert by_seed[("random leader", 0)] != by_seed[("random leader", 1)]
 
 
-def test_a_run_that_faults_in_a_batch_has_its_own_row_and_the_rest_run(tmp_path: Path) -> None:
+def test_a_run_that_faults_in_a_batch_has_its_own_row_and_the_rest_run(
+    tmp_path: Path, step_path: Any
+) -> None:
+    path_kind, chosen = step_path
     # at full power the leader leaves a 25 m world within the 8 s; at 7 % it does not
     path = scenario(tmp_path, "")
     path.write_text(path.read_text().replace("physics:\n", "physics:\n  extent: 25\n"))
@@ -104,8 +144,9 @@ def test_a_run_that_faults_in_a_batch_has_its_own_row_and_the_rest_run(tmp_path:
     assert [bool(r["error"]) for r in batched] == [False, True, False]
     assert "outside" in batched[1]["error"] or "extent" in batched[1]["error"]
     assert stats["faults"] == 1
+    assert set(chosen) == {MODEL[path_kind]}
     for a, b in zip(alone, batched, strict=True):
-        assert_rows_close(a, b)
+        assert_rows_close(a, b, path_kind)
 
 
 def rows(out: Path) -> list[dict[str, str]]:
@@ -113,7 +154,9 @@ def rows(out: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(fh))
 
 
-def test_a_batched_sweep_is_byte_identical_across_j_and_batch_sizes(tmp_path: Path) -> None:
+def test_a_batched_sweep_is_byte_identical_across_j_and_batch_sizes(
+    tmp_path: Path, step_path: Any
+) -> None:
     path = scenario(tmp_path)
     section = (
         "sweep:\n  contexts:\n"
