@@ -20,6 +20,7 @@ state ``x, y, angle, vx, vy, w``; forces ``fx, fy, torque``.
 from __future__ import annotations
 
 import array
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -66,6 +67,26 @@ def _direct_available(space: pymunk.Space) -> bool:
         )
     except Exception:  # an ffi lib raises on unknown names in some builds
         return False
+
+
+def locked_step(space: pymunk.Space, step: Callable[[], Any]) -> Any:
+    """Run ``step`` (a C call that steps ``space``) locked as ``Space.step`` locks it.
+
+    Then what pymunk would do after a step: refused loudly if a collision callback queued
+    work (nothing in this project does; lost silently otherwise), removed shapes forgotten.
+    Shared by the plain C step (:meth:`BodyIO.step`) and the compiled step
+    (``physics/compiled.py``). Returns what ``step`` returned.
+    """
+    space._locked = True
+    try:
+        result = step()
+    finally:
+        space._locked = False
+    if space._add_later or space._remove_later or space._post_step_callbacks:
+        raise RuntimeError("a collision callback changed the space during a step")
+    if space._removed_shapes:
+        space._removed_shapes.clear()
+    return result
 
 
 class BodyIO:
@@ -158,16 +179,7 @@ class BodyIO:
         if not self.direct or space._bodies_to_check:  # new bodies: let pymunk validate them
             space.step(dt)
             return
-        space._locked = True
-        try:
-            self._space_step(self._handle, dt)
-        finally:
-            space._locked = False
-        # what pymunk would do after the step, refused if there is any (there never is)
-        if space._add_later or space._remove_later or space._post_step_callbacks:
-            raise RuntimeError("a collision callback changed the space during a step")
-        if space._removed_shapes:
-            space._removed_shapes.clear()
+        locked_step(space, lambda: self._space_step(self._handle, dt))
 
     def write(self) -> None:
         """Send :attr:`forces` to every body (forces of non-rover bodies stay zero)."""

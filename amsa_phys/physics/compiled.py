@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from .bodyio import STATE, BodyIO
+from .bodyio import STATE, BodyIO, locked_step
 from .fleet import _GROUND_ROWS, Fleet
 from .forces import FewRovers, fold
 from .rover import DiffDriveRover
@@ -110,18 +110,8 @@ def plan_row(rover: DiffDriveRover, dt: float) -> list[float]:
 
 
 def _locked_step(space: Any, step: Any) -> int:
-    """Run ``step`` (a C call that steps the space) locked as ``Space.step`` locks it."""
-    space._locked = True
-    try:
-        bad = step()
-    finally:
-        space._locked = False
-    # what pymunk would do after a step, refused if there is any (bodyio.BodyIO.step)
-    if space._add_later or space._remove_later or space._post_step_callbacks:
-        raise RuntimeError("a collision callback changed the space during a step")
-    if space._removed_shapes:
-        space._removed_shapes.clear()
-    return int(bad)
+    """Run the C step locked as ``Space.step`` locks it (``bodyio.locked_step``)."""
+    return int(locked_step(space, step))
 
 
 def _step_with(io: BodyIO, stepper: Any, dt: float) -> int:
