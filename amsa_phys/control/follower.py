@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from ..engine import libm
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
 
@@ -188,7 +189,7 @@ class FollowerController(Template):
         same = has & (X[:, -1] == xl) & (Y[:, -1] == yl)
         upd = active & ~same
         if upd.any():
-            jump = np.hypot(xl - X[:, -1], yl - Y[:, -1]) > 2 * p.maxSpeed * np.maximum(
+            jump = libm.hypot(xl - X[:, -1], yl - Y[:, -1]) > 2 * p.maxSpeed * np.maximum(
                 ts - T[:, -1], 0.25
             )
             used[upd & has & jump] = False
@@ -218,10 +219,10 @@ class FollowerController(Template):
             sty = (dt * (y_ - my[:, None])).sum(axis=1)
             ok = (k >= 2) & (stt > 0)
             safe = np.where(ok, stt, 1.0)
-            v_leader[rows[ok]] = np.hypot(stx / safe, sty / safe)[ok]
+            v_leader[rows[ok]] = libm.hypot(stx / safe, sty / safe)[ok]
         dx = xl - inp["xFollower"]
         dy = yl - inp["yFollower"]
-        alpha = np.arctan2(dy, dx) - inp["headingFollower"]
+        alpha = libm.atan2(dy, dx) - inp["headingFollower"]
         alpha = (alpha + math.pi) % (2 * math.pi) - math.pi
         e = d - p.distanceRef
         moving = v_leader > 0

@@ -7,8 +7,7 @@ from collections.abc import Mapping, Sequence
 from fractions import Fraction
 from typing import Any
 
-import numpy as np
-
+from ..engine import libm
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
 
@@ -39,7 +38,7 @@ class DistanceMonitor(Template):
         """``do_step`` for many copies at once (``engine/batch.py``)."""
         dx = inp["xLeader"] - inp["xFollower"]
         dy = inp["yLeader"] - inp["yFollower"]
-        return {"distanceFollowerToLeader": np.hypot(dx, dy)}, None
+        return {"distanceFollowerToLeader": libm.hypot(dx, dy)}, None  # math.hypot's bits
 
 
 class GoalMonitor(Template):

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from ..model.params import Param
+from . import libm
 from .rng import Drawn
 
 #: The SDFormat noise parameter names, in the order they are declared.
@@ -166,9 +167,10 @@ def gauss_markov_many(
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`gauss_markov` for arrays of parameters (one per copy)."""
     safe = np.where(tau > 0, tau, 1.0)
-    phi = np.where(tau > 0, np.exp(-dt / safe), 1.0)
+    # libm's exp/expm1, as gauss_markov's math calls: numpy's round otherwise (engine/libm.py)
+    phi = np.where(tau > 0, libm.exp(-dt / safe), 1.0)
     q = np.where(
-        tau > 0, sigma * np.sqrt(-0.5 * safe * np.expm1(-2 * dt / safe)), sigma * math.sqrt(dt)
+        tau > 0, sigma * np.sqrt(-0.5 * safe * libm.expm1(-2 * dt / safe)), sigma * math.sqrt(dt)
     )
     return phi, q
 
