@@ -129,7 +129,10 @@ def describe_phase(sim: Simulation) -> str:
     parts += [f"{p}={_short(v)} live at {float(at):.1f} s" for (_, p), (at, v) in live.items()]
     sets = ", ".join(parts)
     label = f" {phase.label}" if phase.label else ""
-    text = f"phase {sim.phase_index + 1}/{len(sim.phases)}{label} from {float(phase.at):g} s"
+    # numbered from 0 like the summary table, describe and expect: {phase: i}
+    last = len(sim.phases) - 1
+    of = f" (of 0–{last})" if last else ""
+    text = f"phase {sim.phase_index}{of}{label} from {float(phase.at):g} s"
     return f"{text}: {sets}" if sets else text
 
 

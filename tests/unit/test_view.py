@@ -127,6 +127,8 @@ def test_live_change_lands_at_the_next_instant_after_the_timeline(sim: Simulatio
     line = describe_phase(sim)
     assert f"Kv=1 live at {float(at):.1f} s" in line
     assert "Kv=0.35" not in line
+    # phases are numbered from 0, as in the summary table and expect: {phase: i}
+    assert line.startswith(f"phase {sim.phase_index} ")
 
 
 def test_scene_marks_lost_gps_fixes_at_the_true_position(tmp_path: Path) -> None:
