@@ -172,6 +172,10 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("must be at least 1", key="--jobs")
     if args.batch_size is not None and args.batch_size < 1:
         raise ConfigError("must be at least 1", key="--batch-size")
+    if args.batch_size is not None and args.executor == "local":
+        raise ConfigError(
+            "sets the runs of a batch; --executor local runs one per process", key="--batch-size"
+        )
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-sweep")
     prepare_run_dir(out, args.force, inputs=plan.inputs)
@@ -207,7 +211,10 @@ def run(args: argparse.Namespace) -> int:
             keys,
             plan.metric,
             out / "summary.png",
-            one_line(f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})"),
+            one_line(
+                f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})"
+                + (f"; interrupted: {len(rows)} of {len(jobs)} runs" if interrupted else "")
+            ),
         )
         late = interrupt.requested()
     failed = [r for r in rows if r["error"]]

@@ -216,11 +216,18 @@ def configure_scenario(
         if why is not None:
             raise ConfigError(why, key="--log-rate")
     if trace_columns is not None:
-        patterns = (
-            tracecols.parse_patterns(trace_columns)
-            if isinstance(trace_columns, str)
-            else [str(p) for p in trace_columns]
-        )
+        if isinstance(trace_columns, str):
+            patterns = tracecols.parse_patterns(trace_columns)
+        elif isinstance(trace_columns, (list, tuple)) and all(
+            isinstance(p, str) for p in trace_columns
+        ):
+            patterns = list(trace_columns)
+        else:
+            raise ConfigError(
+                "expected glob patterns: a comma-separated string or a list of strings, got "
+                + short_repr(trace_columns),
+                key="--trace-columns",
+            )
         if not patterns:
             raise ConfigError(
                 "needs at least one pattern, like 'Car*.Gap.*'", key="--trace-columns"
@@ -648,7 +655,18 @@ def _trace_patterns(doc: YamlDoc, data: dict[str, Any], world: WorldSpec) -> lis
     """``trace_columns:``, each pattern checked to keep at least one buffer."""
     if "trace_columns" not in data:
         return None
-    patterns = [str(p) for p in data["trace_columns"]]
+    raw = data["trace_columns"]
+    if isinstance(raw, str):  # "Car*.Gap.*, Leader.*", as --trace-columns takes it
+        patterns = tracecols.parse_patterns(raw)
+        if not patterns:
+            raise doc.error(("trace_columns",), "needs at least one pattern, like 'Car*.Gap.*'")
+        for pattern in patterns:
+            if tracecols.unmatched([pattern], list(world.buffers)):
+                raise doc.error(
+                    ("trace_columns",), tracecols.no_match_message(pattern, list(world.buffers))
+                )
+        return patterns
+    patterns = [str(p) for p in raw]
     for i, pattern in enumerate(patterns):
         if tracecols.unmatched([pattern], list(world.buffers)):
             raise doc.error(

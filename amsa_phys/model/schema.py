@@ -198,8 +198,9 @@ SCENARIO: dict[str, Any] = {
         "seed": {"type": "integer", "minimum": 0, "maximum": MAX_SEED},
         "log_rate": _rate,
         "trace_columns": {
-            "type": "array",
+            "type": ["array", "string"],
             "minItems": 1,
+            "minLength": 1,
             "items": {"type": "string", "minLength": 1},
         },
         "quality": {

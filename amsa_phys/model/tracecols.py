@@ -56,7 +56,15 @@ def selected(
 
 
 def no_match_message(pattern: str, columns: Sequence[str]) -> str:
-    """The one-line complaint for a pattern that keeps nothing."""
+    """The one-line complaint for a pattern that keeps nothing (with the buffer it would
+    keep if case did not matter: ``car*.gap.*`` is a likely slip for ``Car*.Gap.*``)."""
+    folded = pattern.lower()
+    near = next((c for c in columns if fnmatchcase(c.lower(), folded)), None)
+    if near is not None:
+        return (
+            f"{pattern!r} matches no Data buffer: patterns are case-sensitive "
+            f"(it would match {near} ignoring case)"
+        )
     return f"{pattern!r} matches no Data buffer" + did_you_mean(pattern, columns)
 
 

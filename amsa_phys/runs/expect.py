@@ -24,12 +24,17 @@ class Check:
     note: str = ""
     #: which statistic of a trace window ``value`` is: "max" (against ``below``) or "min"
     stat: str = ""
+    #: a two-sided trace window's other extreme (shown beside ``value``)
+    other: float | None = None
 
     @property
     def measured(self) -> str:
         """``0.6576``, or ``max 10.41`` for a trace window (its extreme sample)."""
         if self.value is None:
             return "none"
+        if self.stat and self.other is not None:  # both bounds: both extremes
+            low, high = sorted((self.value, self.other))
+            return f"min {low:.4g}, max {high:.4g}"
         return f"{self.stat} {self.value:.4g}" if self.stat else f"{self.value:.4g}"
 
     @property
@@ -173,16 +178,19 @@ def _trace_check(
     worst: float | None = None
     stat = ""
     ok = True
+    low = float(values.min())
+    high = float(values.max())
     if e.above is not None:
-        low = float(values.min())
         worst, stat = low, "min"
         ok = ok and low > e.above
     if e.below is not None:
-        high = float(values.max())
         if worst is None or high >= e.below:
             worst, stat = high, "max"
         ok = ok and high < e.below
+    other = None
+    if e.above is not None and e.below is not None:
+        other = high if worst == low and stat == "min" else low
     if ok and cut and past_end:
         why = f"the run was cut short at t={end:g} s inside the window; held until then"
-        return Check(e, worst, True, skipped=True, why=why, stat=stat)
-    return Check(e, worst, ok, note=note, stat=stat)
+        return Check(e, worst, True, skipped=True, why=why, stat=stat, other=other)
+    return Check(e, worst, ok, note=note, stat=stat, other=other)

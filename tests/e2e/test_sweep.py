@@ -212,6 +212,9 @@ def test_ctrl_c_keeps_every_finished_row(tmp_path: Path, how: str) -> None:
     assert 0 < len(table) < 2000
     assert len(table) % 25 == 0  # whole batches: a batch cut short gives no rows
     assert all(r["error"] == "" for r in table)
+    from amsa_phys.plots.save import png_text  # the picture says it is partial
+
+    assert f"interrupted: {len(table)} of 2000 runs" in png_text(out / "summary.png")["Title"]
 
 
 def test_phase_metrics_and_replotting_a_sweep(
@@ -353,3 +356,14 @@ def test_a_sigterm_while_the_summary_is_drawn_finishes_the_files_then_exits_130(
     assert "interrupted after the sweep's last run; its outputs are complete in" in err
     assert len((out / "results.csv").read_text().splitlines()) == 3
     assert (out / "summary.png").read_bytes().startswith(b"\x89PNG")
+
+
+def test_batch_size_with_the_one_run_per_process_executor_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["sweep", str(SCEN), *GRID, "--executor", "local", "--batch-size", "5"]
+    assert main([*argv, "--out", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err == (
+        "error: --batch-size: sets the runs of a batch; --executor local runs one per process\n"
+    )
+    assert not (tmp_path / "o").exists()

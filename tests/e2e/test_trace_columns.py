@@ -117,3 +117,38 @@ def test_a_wide_long_run_says_how_large_its_trace_will_be(
     short = load_scenario(SHORT, duration=300)
     warn_if_trace_is_large(short)
     assert capsys.readouterr().err == ""
+
+
+def test_the_file_takes_the_options_comma_string_too(tmp_path: Path) -> None:
+    scen = tmp_path / "s.yaml"
+    scen.write_text(
+        f"world: {ROOT / 'worlds' / 'mde_challenge.yaml'}\nduration: 1\n"
+        'trace_columns: "Leader.pos?, Follower.posX"\n'
+    )
+    assert load_scenario(scen).trace_columns == ["Leader.pos?", "Follower.posX"]
+
+
+def test_a_pattern_in_the_wrong_case_is_named_with_what_it_would_match(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    code = main(
+        [
+            "run",
+            str(SHORT),
+            "--headless",
+            "--out",
+            str(tmp_path / "o"),
+            "--trace-columns",
+            "leader.*",
+        ]
+    )
+    assert code == 2
+    assert capsys.readouterr().err == (
+        "error: --trace-columns: 'leader.*' matches no Data buffer: patterns are case-sensitive "
+        "(it would match Leader.posX ignoring case)\n"
+    )
+
+
+def test_the_api_refuses_patterns_that_are_not_strings() -> None:
+    with pytest.raises(amsa_phys.ConfigError, match="--trace-columns: expected glob patterns"):
+        amsa_phys.run(SHORT, duration=1, trace_columns=5)  # type: ignore[arg-type]
