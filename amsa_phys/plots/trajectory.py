@@ -180,7 +180,12 @@ def plot_trajectory(
         ax.plot([], [], "x", color=hex_colour(ALERT), mew=2, label=f"collision ({len(hits)})")
     title = f"{metrics.get('scenario', '')}: trajectories (o start, ■ end)"
     if not rovers:
-        ax.text(0.5, 0.5, "no positions in the trace", ha="center", transform=ax.transAxes)
+        why = (
+            "no positions in the trace"
+            if rover_names(header)  # a run that faulted at t = 0: no rows
+            else "no positions in the trace (no X.posX, X.posY columns: see trace_columns)"
+        )
+        ax.text(0.5, 0.5, why, ha="center", transform=ax.transAxes)
     elif view.lateral:
         _lateral_axes(ax, np.concatenate([view(xy) for xy in paths.values()]))
         title += " — a straight run: offset across it stretched"
