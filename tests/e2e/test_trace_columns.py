@@ -74,20 +74,15 @@ def test_the_resolved_scenario_replays_the_selection(tmp_path: Path) -> None:
     ).read_bytes()
 
 
+def run_with_columns(out: Path, patterns: str) -> int:
+    """``amsa-phys run`` of the short scenario with ``--trace-columns patterns``."""
+    return main(["run", str(SHORT), "--headless", "--out", str(out), "--trace-columns", patterns])
+
+
 def test_a_pattern_that_keeps_nothing_is_refused_in_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    code = main(
-        [
-            "run",
-            str(SHORT),
-            "--headless",
-            "--out",
-            str(tmp_path / "o"),
-            "--trace-columns",
-            "Leadr.*",
-        ]
-    )
+    code = run_with_columns(tmp_path / "o", "Leadr.*")
     err = capsys.readouterr().err
     assert code == 2
     assert (
@@ -131,17 +126,7 @@ def test_the_file_takes_the_options_comma_string_too(tmp_path: Path) -> None:
 def test_a_pattern_in_the_wrong_case_is_named_with_what_it_would_match(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
-    code = main(
-        [
-            "run",
-            str(SHORT),
-            "--headless",
-            "--out",
-            str(tmp_path / "o"),
-            "--trace-columns",
-            "leader.*",
-        ]
-    )
+    code = run_with_columns(tmp_path / "o", "leader.*")
     assert code == 2
     assert capsys.readouterr().err == (
         "error: --trace-columns: 'leader.*' matches no Data buffer: patterns are case-sensitive "
