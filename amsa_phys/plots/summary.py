@@ -1,5 +1,8 @@
 """A sweep's summary: a metric against one grid axis (lines, one per other value, with the
-seed spread as error bars) or against two numeric axes (heatmap of the seed mean)."""
+seed spread as error bars), against two numeric axes (heatmap of the seed mean), or, from
+three axes on, as small multiples (one panel per value of the other axes, see
+:mod:`.facets`): a legend entry per line stops being readable at a dozen lines, and a
+three-axis sweep of 13 values each had 169."""
 
 from __future__ import annotations
 
@@ -54,8 +57,12 @@ def plot_summary(
     :data:`BAND_SEEDS` seeds on, where bars would hide how the seeds spread).
     """
     ok = [r for r in rows if r.get(metric) is not None and not r.get("error")]
-    fig, ax = plt.subplots(figsize=(8, 5), dpi=100)
     numeric_axes = [a for a in axes if _numeric([r[a] for r in ok])]
+    if ok and len(axes) >= 3:
+        from .facets import plot_facets
+
+        return plot_facets(rows, ok, axes, numeric_axes, metric, out, title, scenario)
+    fig, ax = plt.subplots(figsize=(8, 5), dpi=100)
     if not ok or not axes:
         ax.text(0.5, 0.5, "no completed runs to plot", ha="center", transform=ax.transAxes)
     elif len(axes) == 2 and len(numeric_axes) == 2:
