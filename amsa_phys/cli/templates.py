@@ -1,30 +1,54 @@
 """List the template library: kind, ports and parameters of every built-in template."""
+# (the module docstring's first line is the command's help; plugins are listed too, with
+# where each template comes from)
 
 from __future__ import annotations
 
 import argparse
 
 from ..errors import ConfigError, one_line
+from ..model.plugins import installed
 from ..model.suggest import did_you_mean
-from ..model.template import BUILTINS, TemplateNotFound, resolve_template
+from ..model.template import BUILTINS, TemplateNotFound, known_names, resolve_template
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
     """Arguments of ``amsa-phys templates``."""
-    p.add_argument("name", nargs="?", help="show one template (built-in name or module:Class)")
+    p.add_argument(
+        "name",
+        nargs="?",
+        help="show one template (built-in name, installed plugin's name or module:Class)",
+    )
+
+
+def origin(name: str) -> str:
+    """Where template ``name`` comes from, as the listing shows it."""
+    if name in BUILTINS:
+        return "built-in"
+    if ":" in name:
+        return f"module {name.partition(':')[0]}"
+    found = installed().get(name, [])
+    return ", ".join(f"plugin {p.target} from {p.distribution}" for p in found) or "unknown"
 
 
 def run(args: argparse.Namespace) -> int:
-    """Print each template."""
-    names = [args.name] if args.name else list(BUILTINS)
+    """Print each template (built-ins, then installed plugins), saying where it comes from."""
+    plugins = installed()
+    names = [args.name] if args.name else [*BUILTINS, *(n for n in plugins if n not in BUILTINS)]
     for name in names:
         try:
             t = resolve_template(name)
         except TemplateNotFound as exc:
-            hint = did_you_mean(name, BUILTINS) if ":" not in name else ""
+            if not args.name:  # one broken plugin does not hide the rest of the library
+                print(one_line(f"{name} (not loadable: {exc}) [{origin(name)}]"))
+                continue
+            hint = did_you_mean(name, known_names()) if ":" not in name else ""
+            extra = [n for n in plugins if n not in BUILTINS]
             known = "" if hint else f"; built-in: {', '.join(BUILTINS)}"
+            if extra and not hint:
+                known += f"; plugins: {', '.join(extra)}"
             raise ConfigError(f"{exc}{hint}{known}", key="templates") from None
-        print(one_line(f"{t.name()} ({t.kind.value}): {t.describe()}"))
+        print(one_line(f"{t.name()} ({t.kind.value}): {t.describe()} [{origin(name)}]"))
         for direction, ports in (("in ", t.inputs), ("out", t.outputs)):
             for port in ports:
                 # an array port: out ranges[beams] (one Data per element), in ranges[]
@@ -48,6 +72,9 @@ def run(args: argparse.Namespace) -> int:
                 )
             )
     if not args.name:
+        for name in (n for n in plugins if n in BUILTINS):
+            who = ", ".join(p.distribution for p in plugins[name])
+            print(f"note: plugin name {name!r} from {who} is a built-in's: use module:Class")
         for line in LEAF_KEYS:
             print(line)
     return 0

@@ -231,7 +231,10 @@ def _import(module_name: str) -> Any:
     except ModuleNotFoundError as exc:
         hint = ""
         if exc.name == module_name.split(".")[0]:  # the module itself, not one it imports
-            hint = " (user templates load from sys.path: put its folder on PYTHONPATH)"
+            hint = (
+                " (user templates load from sys.path: install its package, or put its folder"
+                " on PYTHONPATH)"
+            )
         raise TemplateNotFound(f"cannot import module {module_name!r}: {exc}{hint}") from None
     except SyntaxError as exc:
         where = f"{Path(exc.filename).name}:{exc.lineno}" if exc.filename else "its source"
@@ -244,17 +247,37 @@ def _import(module_name: str) -> Any:
         ) from None
 
 
-def resolve_template(ref: str) -> type[Template]:
-    """Return the template class for a built-in name or an explicit ``module:Class``.
+def known_names() -> list[str]:
+    """Every short template name a world may use: built-ins, then installed plugins'
+    (what "did you mean" suggests from)."""
+    from .plugins import installed
 
-    A ``module:Class`` reference is the only way user code is loaded: the world file names
-    it explicitly, and the module is imported like any Python import.
+    return [*BUILTINS, *(n for n in installed() if n not in BUILTINS)]
+
+
+def _plugin_target(name: str) -> str:
+    """The ``module:Class`` an installed plugin registers under ``name``."""
+    from .plugins import target_of
+
+    try:
+        target = target_of(name)
+    except LookupError as exc:
+        raise TemplateNotFound(str(exc)) from None
+    if target is None:
+        raise TemplateNotFound(f"unknown template {name!r}")
+    return target
+
+
+def resolve_template(ref: str) -> type[Template]:
+    """Return the template class for a built-in name, an installed plugin's name (the
+    ``amsa_phys.templates`` entry points, :mod:`.plugins`) or an explicit ``module:Class``.
+
+    Code is loaded only where a world names it: a ``module:Class`` it writes, or a plugin
+    name whose package the user installed; the module is imported like any Python import.
     """
     target = BUILTINS.get(ref)
     if target is None:
-        if ":" not in ref:
-            raise TemplateNotFound(f"unknown template {ref!r}")
-        target = ref
+        target = _plugin_target(ref) if ":" not in ref else ref
     module_name, _, attr = target.partition(":")
     if not _MODULE.fullmatch(module_name) or not attr.isidentifier():
         raise TemplateNotFound(

@@ -18,7 +18,7 @@ from .dataflow import execution_order
 from .links import allowed_text, link_allowed
 from .rates import cycle_problem
 from .suggest import did_you_mean
-from .template import BUILTINS, Template, TemplateNotFound, resolve_template
+from .template import Template, TemplateNotFound, known_names, resolve_template
 from .timing import TIMING_KEYS, LeafTiming, set_timing
 from .yamlio import KeyPath, YamlDoc, load_yaml
 
@@ -382,7 +382,7 @@ def _build_leaf(
     try:
         template = resolve_template(ref)
     except TemplateNotFound as exc:
-        hint = did_you_mean(ref, BUILTINS) if ":" not in ref else ""
+        hint = did_you_mean(ref, known_names()) if ":" not in ref else ""
         raise err((*kp, "template"), f"{exc}{hint}") from None
     freq = Fraction(str(body.get("freq", DEFAULT_FREQ_HZ)))
     declared = {p.name: p for p in template.params}

@@ -176,7 +176,7 @@ def test_a_user_module_that_fails_to_import_is_a_load_error(
         (
             "nosuch.mod:X",
             "cannot import module 'nosuch.mod': No module named 'nosuch' (user templates load "
-            "from sys.path: put its folder on PYTHONPATH); built-in:",
+            "from sys.path: install its package, or put its folder on PYTHONPATH); built-in:",
         ),
         (":X", "':X' is not a template name nor package.module:Class"),
         (".foo:X", "'.foo:X' is not a template name nor package.module:Class"),
