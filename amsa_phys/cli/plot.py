@@ -90,7 +90,7 @@ def _world_of(rundir: Path) -> dict[str, Any] | None:
 
 def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
     """summary.png again, for any metric column: no need to rerun the sweep to see another."""
-    from ..plots.summary import plot_summary  # matplotlib: only once the rows are read
+    from ..plots.summary import nevers, plot_summary  # matplotlib: once the rows are read
 
     rows, axes = read_results(sweepdir / "results.csv")
     metric = args.metric or "rms_error"
@@ -107,10 +107,14 @@ def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
     print(one_line(f"wrote {out}"))
     failed = sum(1 for r in rows if r.get("error"))
     empty = sum(1 for r in rows if not r.get("error") and r.get(metric) is None)
+    never = len(nevers(rows, metric))
+    if never:
+        print(f"{never} of {len(rows)} runs never reached a {metric}: drawn as 'never'")
+        empty -= never
     if failed or empty:
         print(
-            f"left out {failed + empty} of {len(rows)} runs: {empty} with no {metric} value"
-            f" (null: e.g. never settled), {failed} failed"
+            f"left out {failed + empty} of {len(rows)} runs: {empty} with no {metric} value,"
+            f" {failed} failed"
         )
     return 0
 

@@ -61,7 +61,7 @@ def plot_facets(
     ``rows`` are every run (grid points without a value are drawn grey), ``ok`` the runs
     with a value of ``metric``; ``numeric_axes`` the axes whose values are all numbers.
     """
-    from .summary import SCENARIO_KEY, text_colour_on
+    from .summary import NEVER_COLOUR, SCENARIO_KEY, left_out_text, nevers, text_colour_on
 
     def count(axis: str) -> int:
         return len({r[axis] for r in rows})
@@ -99,6 +99,11 @@ def plot_facets(
             cells[(panel, r[x_axis], r[y_axis] if y_axis else None)].append(float(r[metric]))
     grids = np.full((len(keys), len(ys), len(xs)), np.nan)
     spread = np.full((len(keys), 2, len(xs)), np.nan)  # seed min, max (line panels)
+    never = np.zeros(grids.shape, dtype=int)
+    for r in nevers(rows, metric):
+        panel = panel_of.get(tuple(r[a] for a in facet_axes))
+        if panel is not None:
+            never[panel, ys.index(r[y_axis] if y_axis else None), xs.index(r[x_axis])] += 1
     for (panel, x, y), vals in cells.items():
         grids[panel, ys.index(y), xs.index(x)] = float(np.mean(vals))
         spread[panel, :, xs.index(x)] = (min(vals), max(vals))
@@ -140,6 +145,9 @@ def plot_facets(
                     ok_value = bool(np.isfinite(value))
                     colour = text_colour_on(cmap(image.norm(value))) if ok_value else "0.4"
                     text = f"{value:.3g}" if ok_value else "none"
+                    if never[i, j, k]:
+                        text = f"{text}\n+{never[i, j, k]} never" if ok_value else "never"
+                        colour = colour if ok_value else NEVER_COLOUR
                     ax.text(k, j, text, ha="center", va="center", fontsize=6.5, color=colour)
         if best is not None:
             p, j, k = (int(v) for v in best)
@@ -185,10 +193,7 @@ def plot_facets(
         p = int(best[0])
         where = ", ".join(f"{a}={_label(v)}" for a, v in zip(facet_axes, keys[p], strict=True))
         best_text = f"★ best: {best_text}, {where}"
-    dropped = len(rows) - len(ok)
-    lines = [title]
-    if dropped:
-        lines.append(f"{dropped} of {len(rows)} runs have no {metric} and are left out")
+    lines = [title, *left_out_text(rows, ok, metric).splitlines()[1:]]
     if notes:
         lines.append("; ".join(notes))
     if best_text:

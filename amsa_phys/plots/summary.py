@@ -24,6 +24,9 @@ from .save import save_png
 SCENARIO_KEY = "amsa-phys scenario"
 #: metrics that count events: integer ticks
 COUNT_METRICS = frozenset({"collisions"})
+#: metrics whose empty value means "it never happened" (the distance never settled), not a
+#: failed run: such runs are drawn as "never", not left out
+NEVER_METRICS = frozenset({"settling_time"})
 #: the best cell's frame, inside the cell by this much (cell widths)
 FRAME_INSET = 0.04
 
@@ -75,9 +78,13 @@ def plot_summary(
             cells[(r[axes[0]], r[axes[1]])].append(float(r[metric]))
         for (x, y), vals in cells.items():
             grid[ys.index(y), xs.index(x)] = float(np.mean(vals))
+        never = np.zeros(grid.shape, dtype=int)
+        for r in nevers(rows, metric):
+            if _numeric([r[axes[0]], r[axes[1]]]):
+                never[ys.index(r[axes[1]]), xs.index(r[axes[0]])] += 1
         cmap = plt.get_cmap("viridis").with_extremes(bad="0.88")
         im = ax.imshow(np.ma.masked_invalid(grid), origin="lower", aspect="auto", cmap=cmap)
-        _cell_values(ax, grid, im.norm, cmap)
+        _cell_values(ax, grid, im.norm, cmap, never)
         if np.isfinite(grid).any():
             j, i = np.unravel_index(int(np.nanargmin(grid)), grid.shape)
             ax.add_patch(  # the best cell framed in gold (its value starred below), the
@@ -135,8 +142,25 @@ def plot_summary(
                 markeredgecolor="k",
                 zorder=5,
             )
+        never_at: dict[Any, int] = defaultdict(int)
+        for r in nevers(rows, metric):
+            never_at[r[x_axis]] += 1
+        labels = sorted({r[x_axis] for r in ok}, key=str)
+        for x, count in sorted(never_at.items(), key=lambda kv: str(kv[0])):
+            at = x if _numeric([x]) else (labels.index(x) if x in labels else None)
+            if at is not None:  # at the top edge of the plot, above its x
+                ax.annotate(
+                    f"{count} never",
+                    (at, 1.0),
+                    xycoords=("data", "axes fraction"),
+                    xytext=(0, -3),
+                    textcoords="offset points",
+                    ha="center",
+                    va="top",
+                    fontsize=7,
+                    color=NEVER_COLOUR,
+                )
         if not _numeric([r[x_axis] for r in ok]):
-            labels = sorted({r[x_axis] for r in ok}, key=str)
             ax.set_xticks(range(len(labels)), [str(v) for v in labels])
         ax.set_xlabel(x_axis)
         ax.set_ylabel(
@@ -153,14 +177,37 @@ def plot_summary(
             ax.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    dropped = len(rows) - len(ok)
-    if dropped:  # runs with no value (failed, or e.g. never settled) are not in the picture
-        title += f"\n{dropped} of {len(rows)} runs have no {metric} and are left out"
+    title += left_out_text(rows, ok, metric)
     if ax.get_title():  # the heatmap's best cell
         title += "\n" + ax.get_title()
     ax.set_title(title, fontsize=10)
     name = scenario if scenario is not None else title.split("\n")[0].rpartition(": ")[0]
     return save_png(fig, out, metadata={"Title": title, SCENARIO_KEY: name})
+
+
+#: the colour "never" is written in (a dark red: the run did not reach the metric)
+NEVER_COLOUR = "#a01010"
+
+
+def nevers(rows: list[dict[str, Any]], metric: str) -> list[dict[str, Any]]:
+    """The runs that completed without ever reaching ``metric`` (``settling_time`` empty:
+    the distance never settled); empty for metrics where no value means a failed run."""
+    if metric.rpartition(".")[2] not in NEVER_METRICS:
+        return []
+    return [r for r in rows if r.get(metric) is None and not r.get("error")]
+
+
+def left_out_text(rows: list[dict[str, Any]], ok: list[dict[str, Any]], metric: str) -> str:
+    """The title's line on runs without a value: never reached (drawn as "never") apart
+    from failed or empty runs (left out)."""
+    never = len(nevers(rows, metric))
+    dropped = len(rows) - len(ok) - never
+    text = ""
+    if never:
+        text += f"\n{never} of {len(rows)} runs never reached a {metric} (drawn as 'never')"
+    if dropped:
+        text += f"\n{dropped} of {len(rows)} runs have no {metric} and are left out"
+    return text
 
 
 def scenario_of(summary_png: Path) -> str | None:
@@ -208,15 +255,23 @@ def _spread(
         ax.plot([x] * len(v), v, ls="none", marker=".", ms=2.5, color=color, alpha=0.45)
 
 
-def _cell_values(ax: plt.Axes, grid: np.ndarray, norm: Any, cmap: Any) -> None:
-    """Each heatmap cell's value, in black or white by its cell's luminance."""
+def _cell_values(
+    ax: plt.Axes, grid: np.ndarray, norm: Any, cmap: Any, never: np.ndarray | None = None
+) -> None:
+    """Each heatmap cell's value, in black or white by its cell's luminance; a cell whose
+    runs never reached the metric (never settled) says so, with how many."""
     for (j, i), value in np.ndenumerate(grid):
         finite = bool(np.isfinite(value))
+        count = int(never[j, i]) if never is not None else 0
         colour = text_colour_on(cmap(norm(value))) if finite else "0.4"
+        text = f"{value:.3g}" if finite else "none"
+        if count:
+            text = f"{text}\n+{count} never" if finite else "never"
+            colour = colour if finite else NEVER_COLOUR
         ax.text(
             i,
             j,
-            f"{value:.3g}" if finite else "none",
+            text,
             ha="center",
             va="center",
             fontsize=8,

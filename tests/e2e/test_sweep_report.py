@@ -82,9 +82,29 @@ def test_plot_metric_says_how_many_runs_it_left_out(
     assert main(["plot", str(tmp_path), "--metric", "settling_time"]) == 0
     assert capsys.readouterr().out == (
         f"wrote {tmp_path / 'summary.png'}\n"
-        "left out 3 of 6 runs: 2 with no settling_time value (null: e.g. never settled), "
-        "1 failed\n"
+        "2 of 6 runs never reached a settling_time: drawn as 'never'\n"
+        "left out 1 of 6 runs: 0 with no settling_time value, 1 failed\n"
     )
+
+
+def test_never_settled_runs_are_drawn_as_never_not_hidden(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    (tmp_path / "results.csv").write_text(RESULTS)
+    rows, axes = read_results(tmp_path / "results.csv")
+    caught: list[plt.Figure] = []
+    monkeypatch.setattr(summary, "save_png", lambda fig, out, **kw: caught.append(fig) or out)
+    summary.plot_summary(rows, axes, "settling_time", tmp_path / "s.png", "sweep")
+    fig = caught[0]
+    try:
+        ax = fig.axes[0]
+        texts = [t.get_text() for t in ax.texts]
+        assert texts.count("never") + sum("never" in t and t != "never" for t in texts) == 2
+        title = ax.get_title()
+        assert "2 of 6 runs never reached a settling_time (drawn as 'never')" in title
+        assert "1 of 6 runs have no settling_time and are left out" in title
+    finally:
+        plt.close(fig)
 
 
 def test_sweep_executor_has_help(capsys: pytest.CaptureFixture[str]) -> None:
