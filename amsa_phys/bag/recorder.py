@@ -22,7 +22,6 @@ byte-identical from run to run.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from fractions import Fraction
 from pathlib import Path
@@ -57,21 +56,20 @@ def ns_of(t: Fraction) -> int:
 
 
 class _Stream:
-    """One source's bookkeeping: its Leaf's timer, the samples seen, the lost count."""
+    """One source's bookkeeping: its Leaf's timer in ticks, the steps seen, the lost count."""
 
     def __init__(self, src: Source, channel: int, freq: Fraction) -> None:
         self.src = src
         self.channel = channel
         self.freq = freq
-        self.phase = Fraction(0)
+        self.period = 1  # ticks between the Leaf's steps (set once the grid exists)
+        self.phase = 0  # tick of its first step
         self.count = -1  # index of the Leaf's last step already seen
         self.lost = 0
 
-    def steps(self, now: Fraction) -> int:
-        """Index of the Leaf's last step at or before ``now`` (-1: none yet)."""
-        if now < self.phase:
-            return -1
-        return math.floor((now - self.phase) * self.freq)
+    def steps(self, tick: int) -> int:
+        """Index of the Leaf's last step at or before ``tick`` (-1: none yet)."""
+        return (tick - self.phase) // self.period if tick >= self.phase else -1
 
 
 class BagRecorder:
@@ -143,11 +141,14 @@ class BagRecorder:
         w = self.writer
         assert sim is not None
         assert w is not None
-        if not self._ready:  # the timer phases exist once the run is initialised
+        grid = sim.grid
+        if not self._ready:  # the grid and timer phases exist once the run is initialised
             self._ready = True
             for st in self._streams:
-                st.phase = Fraction(sim.timer_phases.get(st.src.leaf, 0))
+                st.period = grid.ticks(1 / st.freq)
+                st.phase = grid.ticks(Fraction(sim.timer_phases.get(st.src.leaf, 0)))
         now = sim.now
+        tick = grid.ticks(now)
         ns = ns_of(now)
         self._flush_events(now)
         prefix = scalar_prefix(ns)
@@ -156,7 +157,7 @@ class BagRecorder:
         for cid, col in self._scalars:
             write_raw(cid, prefix + pack(values[col]), ns)
         for st in self._streams:
-            k = st.steps(now)
+            k = st.steps(tick)
             if k <= st.count:
                 continue
             due, st.count = k - st.count, k
@@ -166,8 +167,8 @@ class BagRecorder:
                 dropped, st.lost = lost - st.lost, lost
                 if dropped >= due:  # every step since the last message lost its sample
                     continue
-            step_at = st.phase + Fraction(k) / st.freq
-            ctx = Context(split_ns(ns_of(step_at)), float(step_at), float(1 / st.freq), self.origin)
+            step_at = grid.time(st.phase + k * st.period)
+            ctx = Context(split_ns(ns_of(step_at)), float(step_at), 1 / float(st.freq), self.origin)
             src = st.src
             msg = build(src, values, comp.p.as_dict(), ctx)
             w.write(src.topic, src.role.msg, msg, ns)

@@ -6,10 +6,11 @@ The file is written under ``NAME.tmp`` (``amsa_phys.atomic``) and renamed by
 :meth:`BagWriter.close` once MCAP's summary and footer are written: a bag under its final
 name is always complete and indexed, whatever ended the run.
 
-Messages are encoded by ``mcap-ros2-support``'s encoder built from each type's definition
-text (:mod:`amsa_phys.stdmsgs.defs`), except the stamped scalars, one per traced Data buffer
-per trace row (the bulk of a bag): their CDR is packed directly (:func:`scalar_cdr`, 1 µs
-instead of ~14 µs a message), and a test checks it against the library's encoder.
+Messages are CDR-encoded by :mod:`.cdr` from each type's definition text
+(:mod:`amsa_phys.stdmsgs.defs`), which the file also carries as its schema; the stamped
+scalars, one per traced Data buffer per trace row (the bulk of a bag), are packed directly
+(:func:`scalar_cdr`, ~1 µs a message). Tests check both against ``mcap-ros2-support``'s
+encoder byte for byte.
 """
 
 from __future__ import annotations
@@ -21,13 +22,11 @@ from typing import Any
 
 from mcap.writer import CompressionType
 from mcap.writer import Writer as McapWriter
-from mcap_ros2._dynamic import serialize_dynamic
 
 from ..atomic import AtomicFile
 from ..stdmsgs.defs import msgdef, schema_name
+from .cdr import CDR_LE, encoder
 
-#: CDR little-endian encapsulation header (``\0\1``), no options.
-_CDR_LE = b"\x00\x01\x00\x00"
 _STAMP = struct.Struct("<iII")
 _DOUBLE = struct.Struct("<d")
 _NS = 1_000_000_000
@@ -62,7 +61,7 @@ def scalar_prefix(ns: int) -> bytes:
     """The CDR of an ``amsa_msgs/msg/Scalar`` up to its ``data``: header stamped ``ns``, an
     empty ``frame_id`` (length 1: its NUL), padding to the double's 8-byte alignment."""
     sec, nsec = split_ns(ns)
-    return _CDR_LE + _STAMP.pack(sec, nsec, 1) + b"\x00\x00\x00\x00"
+    return CDR_LE + _STAMP.pack(sec, nsec, 1) + b"\x00\x00\x00\x00"
 
 
 def scalar_cdr(ns: int, value: float) -> bytes:
@@ -98,9 +97,7 @@ class BagWriter:
             text = msgdef(msg_type)
             sid = self._mcap.register_schema(schema_name(msg_type), "ros2msg", text.encode())
             self._schemas[msg_type] = sid
-            self._encoders[msg_type] = serialize_dynamic(schema_name(msg_type), text)[
-                schema_name(msg_type)
-            ]
+            self._encoders[msg_type] = encoder(msg_type)
         cid = self._mcap.register_channel(topic=topic, message_encoding="cdr", schema_id=sid)
         self._channels[topic] = (cid, msg_type)
         return cid
