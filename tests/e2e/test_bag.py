@@ -318,3 +318,37 @@ def test_follower_track_from_the_bag(mde: dict[str, Any], tmp_path: Path) -> Non
     assert err.max() < 0.2  # an RTK-class receiver: centimetres, a wandering bias
     assert (tmp_path / "bag_plot.png").read_bytes()[:4] == b"\x89PNG"
     assert math.isfinite(err.mean())
+
+
+def test_ros1_bag_by_conversion(mde: dict[str, Any], tmp_path: Path) -> None:
+    """``rosbags-convert`` turns the bag into a ROS 1 ``.bag`` with the same messages; where
+    ROS 1 is installed its own ``rosbag info`` reads it, standard types with their md5sums."""
+    convert = Path(sys.executable).with_name("rosbags-convert")
+    if not convert.exists():
+        pytest.skip("rosbags-convert is not installed (pip install -e '.[dev]')")
+    ros1 = tmp_path / "run.bag"
+    subprocess.run(
+        [str(convert), "--src", str(mde["bag"]), "--dst", str(ros1)],
+        check=True,
+        capture_output=True,
+    )
+    by_mcap: Counter[str] = Counter(topic for topic, _, _ in mde["msgs"])
+    with AnyReader([ros1]) as reader:
+        assert reader.is2 is False
+        counts = Counter(c.topic for c, _, _ in reader.messages())
+    assert counts == by_mcap
+    rosbag = Path("/usr/bin/rosbag")
+    if not rosbag.exists():
+        pytest.skip("ROS 1 is not installed: rosbag info not tried")
+    env = {"PATH": "/usr/bin:/bin", "HOME": str(tmp_path), "LANG": "C.UTF-8"}
+    info = subprocess.run(
+        [str(rosbag), "info", "--yaml", str(ros1)],
+        env=env,
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    assert "type: sensor_msgs/NavSatFix" in info
+    assert "md5: 2d3a8cd499b9b4a0249fb98fd05cfa48" in info  # ROS 1's NavSatFix
+    assert "topic: /Leader/LeaderGPS/fix" in info
+    assert f"messages: {sum(by_mcap.values())}" in info
