@@ -352,3 +352,53 @@ def test_ros1_bag_by_conversion(mde: dict[str, Any], tmp_path: Path) -> None:
     assert "md5: 2d3a8cd499b9b4a0249fb98fd05cfa48" in info  # ROS 1's NavSatFix
     assert "topic: /Leader/LeaderGPS/fix" in info
     assert f"messages: {sum(by_mcap.values())}" in info
+
+
+def test_live_changes_and_a_fault_reach_the_events(tmp_path: Path) -> None:
+    """A change made in a (scripted) window session lands on /amsa/events at its instant; a
+    run that faults still leaves a finalised bag of what ran."""
+    from fractions import Fraction
+
+    from amsa_phys.bag import BagRecorder
+    from amsa_phys.model.scenario import Change, load_scenario
+    from amsa_phys.runs.single import run_scenario
+
+    def session(sim: Any, scenario: Any, recorder: Any) -> float:
+        sim.advance(sim.grid.ticks(Fraction(2)))
+        landed["at"] = sim.apply_live(Change("MyFollowerController", "Kv", 0.2))
+        sim.advance(sim.grid.ticks(Fraction(4)))
+        return 0.0
+
+    landed: dict[str, Fraction] = {}
+    scenario = load_scenario(FIXTURE, duration=10)
+    bag = BagRecorder(tmp_path / "live.mcap", scenario)
+    out = tmp_path / "live"
+    out.mkdir()
+    try:
+        run_scenario(scenario, out, window=session, plot=False, simulation=bag.simulation)
+    finally:
+        bag.close()
+    _, msgs = read_mcap(tmp_path / "live.mcap")
+    events = [(t, m.kind, m.detail) for topic, t, m in msgs if topic == "/amsa/events"]
+    at = landed["at"]
+    assert events[1:] == [
+        (at.numerator * NS // at.denominator, "live change", "MyFollowerController.Kv=0.2")
+    ]
+    assert max(t for _, t, _ in msgs) == 4 * NS  # the session closed at t = 4 s
+
+    rogue = {
+        "world": {
+            "name": "r",
+            "components": {
+                "Bot": {"template": "freeRobot", "freq": 10},
+                "R": {"template": "rogue:Rogue", "freq": 10, "params": {"mode": "list"}},
+            },
+        },
+        "duration": 5,
+        "set": {"R.at": 2.5},
+    }
+    with pytest.raises(ap.RunFault, match="do_step must return a mapping"):
+        ap.run(rogue, bag=tmp_path / "fault.mcap")
+    types, msgs = read_mcap(tmp_path / "fault.mcap")
+    assert types["/Bot/ground_truth/odom"] == "nav_msgs/msg/Odometry"
+    assert max(t for _, t, _ in msgs) == 2_450_000_000  # the last whole trace instant
