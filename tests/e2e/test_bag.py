@@ -402,3 +402,16 @@ def test_live_changes_and_a_fault_reach_the_events(tmp_path: Path) -> None:
     types, msgs = read_mcap(tmp_path / "fault.mcap")
     assert types["/Bot/ground_truth/odom"] == "nav_msgs/msg/Odometry"
     assert max(t for _, t, _ in msgs) == 2_450_000_000  # the last whole trace instant
+
+
+def test_a_collision_is_an_event(tmp_path: Path) -> None:
+    """The leader turned round towards a follower without power: their collision is on
+    /amsa/events at the instant the run recorded it."""
+    bag = tmp_path / "hit.mcap"
+    push = {"Leader.heading": 3.14159, "Leader.x": 3.0, "MyNormalizePower.motorCoef": 0}
+    run = ap.run(FIXTURE, duration=30, set=push, bag=bag)
+    hits = [e for e in run.events if e.kind == "collision"]
+    assert len(hits) == 1
+    _, msgs = read_mcap(bag)
+    events = [(t, m.kind, m.detail) for topic, t, m in msgs if topic == "/amsa/events"]
+    assert events[1:] == [(round(hits[0].t * NS), "collision", hits[0].detail)]
