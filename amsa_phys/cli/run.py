@@ -103,10 +103,10 @@ def _run(
             )
     finally:
         written = bag.close() if bag is not None else None  # whatever ended the run
-    if written is not None and not args.quiet:
-        print(f"bag: {written}")
     if not args.quiet:
         print_summary(outcome.metrics, out, sys.stdout)
+        if written is not None:
+            print(f"bag: {written}")
     checks = check_expectations(scenario.expect, outcome.metrics, out / "trace.csv")
     for check in checks:
         print(
