@@ -7,10 +7,10 @@ live parameters) and the events so far. From that it writes:
 * every traced Data buffer as an ``amsa_msgs/msg/Scalar`` on ``/amsa/data/<path>/<port>``,
   one per trace row, the very values of ``trace.csv``;
 * the standard messages of :mod:`amsa_phys.stdmsgs` on their topics, each at the trace
-  instants at which its Leaf stepped since the previous one (so at the sensor's own rate when
-  its instants fall on the trace's, as with the default rates), stamped with the Leaf's step
-  instant; a sample the Leaf reports lost (its ``lost`` counter, kept by GPS, Compass and
-  Lidar) writes no message, as the sensor publishes none;
+  instants at which a new step of its Leaf became visible (so at the sensor's own rate when
+  its instants fall on the trace's, as with the default rates; a Leaf's transport latency
+  later), stamped with that step's instant; a sample the Leaf reports lost (its ``lost``
+  counter, kept by GPS, Compass and Lidar) writes no message, as the sensor publishes none;
 * ``/tf`` (``tf2_msgs/msg/TFMessage``): each robot's pose in ``map`` at its own instants;
 * ``/amsa/events`` (``amsa_msgs/msg/Event``): phase starts with their ``set``, changes inside
   a phase, and the run's events (collisions, live changes...), at their own instants.
@@ -22,6 +22,8 @@ byte-identical from run to run.
 
 from __future__ import annotations
 
+import math
+from collections import deque
 from collections.abc import Mapping
 from fractions import Fraction
 from pathlib import Path
@@ -66,10 +68,23 @@ class _Stream:
         self.phase = 0  # tick of its first step
         self.count = -1  # index of the Leaf's last step already seen
         self.lost = 0
+        #: ticks from a step to its outputs' visibility (a Leaf's transport latency; with
+        #: jitter its least); 0: visible at once
+        self.delay = 0
+        #: a delayed Leaf's (last step run, lost count then), noted at each trace instant:
+        #: its losses are counted when they happen, its outputs seen ``delay`` later
+        self.history: deque[tuple[int, int]] = deque()
 
     def steps(self, tick: int) -> int:
         """Index of the Leaf's last step at or before ``tick`` (-1: none yet)."""
         return (tick - self.phase) // self.period if tick >= self.phase else -1
+
+    def lost_by(self, k: int) -> int:
+        """A delayed Leaf's lost count once step ``k`` had run (the last one noted by then)."""
+        hist = self.history
+        while len(hist) > 1 and hist[1][0] <= k:
+            hist.popleft()
+        return hist[0][1] if hist and hist[0][0] <= k else self.lost
 
 
 class BagRecorder:
@@ -147,6 +162,9 @@ class BagRecorder:
             for st in self._streams:
                 st.period = grid.ticks(1 / st.freq)
                 st.phase = grid.ticks(Fraction(sim.timer_phases.get(st.src.leaf, 0)))
+                timing = self.scenario.world.leaves[st.src.leaf].timing
+                if timing.delayed:  # as the engine's DelayLine: whole ticks, at least one
+                    st.delay = max(1, math.ceil(timing.latency / grid.tick))
         now = sim.now
         tick = grid.ticks(now)
         ns = ns_of(now)
@@ -157,14 +175,17 @@ class BagRecorder:
         for cid, col in self._scalars:
             write_raw(cid, prefix + pack(values[col]), ns)
         for st in self._streams:
-            k = st.steps(tick)
+            comp = sim.components[st.src.leaf]
+            lost = getattr(comp, "lost", None)
+            if st.delay and isinstance(lost, int):
+                st.history.append((st.steps(tick), lost))
+            k = st.steps(tick - st.delay)  # the last step whose outputs are visible now
             if k <= st.count:
                 continue
             due, st.count = k - st.count, k
-            comp = sim.components[st.src.leaf]
-            lost = getattr(comp, "lost", None)
             if isinstance(lost, int):
-                dropped, st.lost = lost - st.lost, lost
+                total = st.lost_by(k) if st.delay else lost
+                dropped, st.lost = total - st.lost, total
                 if dropped >= due:  # every step since the last message lost its sample
                     continue
             step_at = grid.time(st.phase + k * st.period)

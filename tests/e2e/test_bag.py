@@ -415,3 +415,32 @@ def test_a_collision_is_an_event(tmp_path: Path) -> None:
     _, msgs = read_mcap(bag)
     events = [(t, m.kind, m.detail) for topic, t, m in msgs if topic == "/amsa/events"]
     assert events[1:] == [(round(hits[0].t * NS), "collision", hits[0].detail)]
+
+
+def test_a_delayed_sensor_is_stamped_when_it_measured(tmp_path: Path) -> None:
+    """A compass Leaf with a 0.5 s transport latency: each heading appears in the bag when
+    the trace sees it, stamped 0.5 s earlier (its step, the measurement's instant); its lost
+    samples are still absent, each absence a stale heading in the trace."""
+    out, bag = run_with_bag(
+        tmp_path,
+        "late",
+        "--set",
+        "FollowerCompass.latency=0.5",
+        "--set",
+        "FollowerCompass.lostData=40",
+    )
+    header, trace = read_trace(out)
+    row = {round(t * NS): i for i, t in enumerate(trace[:, 0])}
+    ih = header.index("FollowerCompass.compassHeading")
+    _, msgs = read_mcap(bag)
+    heads = {t: m for topic, t, m in msgs if topic == "/Follower/FollowerCompass/heading"}
+    for log_time, m in heads.items():
+        assert m.header.stamp.sec * NS + m.header.stamp.nanosec == log_time - NS // 2
+        yaw = quaternion_yaw(m.orientation)
+        assert yaw == pytest.approx(trace[row[log_time], ih], abs=1e-12)
+    visible = [k * NS // 4 + NS // 2 for k in range(4 * 40 - 1)]  # steps 0 .. 39.5 s, +0.5 s
+    assert set(heads) <= set(visible)
+    missing = [t for t in visible if t not in heads]
+    assert 0.25 < len(missing) / len(visible) < 0.55
+    for t in missing:
+        assert trace[row[t], ih] == trace[row[t] - 5, ih]
