@@ -17,10 +17,11 @@ from typing import Any
 
 import numpy as np
 
+from ..bag import BagRecorder
 from ..engine import interrupt
 from ..engine.runner import Event
 from ..engine.tracemem import TraceMemory
-from ..errors import Interrupted
+from ..errors import ConfigError, Interrupted
 from ..model.scenario import Scenario, traced_columns
 from ..runs.expect import Check, check_expectations
 from ..runs.rundir import default_run_dir, prepare_run_dir
@@ -116,6 +117,7 @@ def run(
     trace_columns: str | Sequence[str] | None = None,
     base_dir: str | os.PathLike[str] | None = None,
     progress: bool = False,
+    bag: str | os.PathLike[str] | None = None,
 ) -> Run:
     """Run a scenario (a file path or a mapping) as ``amsa-phys run --headless`` does.
 
@@ -126,6 +128,8 @@ def run(
     message; Ctrl-C stops the run between two instants and raises
     :class:`~amsa_phys.errors.Interrupted`. A fault or an interrupt carries the run up to
     that instant as the exception's ``run`` attribute (inspect it, or ``save`` it).
+    ``bag`` also writes the run as a ROS 2 MCAP bag there (``--bag``; an existing file is
+    refused), finalised whatever ended the run.
     """
     scenario = load(
         source,
@@ -137,9 +141,19 @@ def run(
         base_dir=base_dir,
     )
     memory = TraceMemory(traced_columns(scenario))
-    with interrupt.deferred():
-        ended = execute(scenario, memory, progress=progress)
-        late_stop = interrupt.requested()  # Ctrl-C after the last instant
+    recorder = bag_recorder(bag, scenario) if bag is not None else None
+    try:
+        with interrupt.deferred():
+            ended = execute(
+                scenario,
+                memory,
+                progress=progress,
+                simulation=recorder.simulation if recorder is not None else None,
+            )
+            late_stop = interrupt.requested()  # Ctrl-C after the last instant
+    finally:
+        if recorder is not None:
+            recorder.close()
     result = Run(ended, memory)
     error = ended.error
     t_end = result.metrics["simulated"]
@@ -155,3 +169,15 @@ def run(
     if isinstance(error, Interrupted):
         raise error from None
     raise error  # a RunFault keeps its cause: a user template's own traceback
+
+
+def bag_recorder(path: str | os.PathLike[str], scenario: Scenario) -> BagRecorder:
+    """The recorder of ``run(bag=path)``: a new ``.mcap`` file in an existing directory."""
+    target = Path(path)
+    if target.suffix.lower() != ".mcap":
+        raise ConfigError("a bag is an .mcap file", key="bag", file=target)
+    if target.exists():
+        raise ConfigError("file exists (remove it or choose another name)", key="bag", file=target)
+    if not (target.parent if str(target.parent) else Path(".")).is_dir():
+        raise ConfigError("directory does not exist", key="bag", file=target)
+    return BagRecorder(target, scenario)

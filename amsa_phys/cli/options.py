@@ -62,3 +62,13 @@ def add_jobs(p: argparse.ArgumentParser) -> None:
         default=os.cpu_count() or 1,
         help="parallel worker processes (default: all cores)",
     )
+
+
+def add_bag(p: argparse.ArgumentParser) -> None:
+    """--bag: the run also as a ROS 2 MCAP bag."""
+    p.add_argument(
+        "--bag",
+        metavar="FILE.mcap",
+        help="also write the run as an MCAP bag with ROS 2 encodings: standard messages "
+        "(NavSatFix, Imu, Odometry, LaserScan, tf), every traced buffer, the events",
+    )

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..bag import BagRecorder
 from ..engine import interrupt
 from ..errors import ConfigError, one_line
 from ..model.scenario import Scenario, load_scenario, traced_columns
@@ -16,8 +17,8 @@ from ..runs.plotjob import PlotJob
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
 from ..runs.suite import input_files
-from .options import add_output, add_scenario_overrides, add_trace_columns
-from .recording import add_recording, recording_options, snapshot_options
+from .options import add_bag, add_output, add_scenario_overrides, add_trace_columns
+from .recording import _target, add_recording, recording_options, snapshot_options
 from .report import print_summary
 
 if TYPE_CHECKING:  # pygame is imported only by runs that draw
@@ -36,6 +37,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
     add_trace_columns(p)
     add_output(p)
     add_recording(p)
+    add_bag(p)
     p.add_argument(
         "--no-plot", action="store_true", help="skip the plots (distance.png, trajectory.png)"
     )
@@ -83,20 +85,28 @@ def _run(
             key="--snapshot-at",
         )
     warn_if_trace_is_large(scenario)
+    bag_path = _target(args.bag, (".mcap",), "--bag", args.force) if args.bag else None
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
     prepare_run_dir(out, args.force, inputs=input_files(scenario))
-    with interrupt.sigterm_as_ctrl_c():
-        outcome = run_scenario(
-            scenario,
-            out,
-            plot=not args.no_plot,
-            record=record,
-            snapshot=snapshot,
-            window=not args.headless,
-            plotter=plotter,
-        )
+    bag = BagRecorder(bag_path, scenario) if bag_path is not None else None
+    try:
+        with interrupt.sigterm_as_ctrl_c():
+            outcome = run_scenario(
+                scenario,
+                out,
+                plot=not args.no_plot,
+                record=record,
+                snapshot=snapshot,
+                window=not args.headless,
+                plotter=plotter,
+                simulation=bag.simulation if bag is not None else None,
+            )
+    finally:
+        written = bag.close() if bag is not None else None  # whatever ended the run
     if not args.quiet:
         print_summary(outcome.metrics, out, sys.stdout)
+        if written is not None:
+            print(f"bag: {written}")
     checks = check_expectations(scenario.expect, outcome.metrics, out / "trace.csv")
     for check in checks:
         print(
