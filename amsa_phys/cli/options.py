@@ -62,3 +62,12 @@ def add_jobs(p: argparse.ArgumentParser) -> None:
         default=os.cpu_count() or 1,
         help="parallel worker processes (default: all cores)",
     )
+
+
+def add_no_adapt(p: argparse.ArgumentParser) -> None:
+    """--no-adapt: the scenario with its ``adapt:`` rules off."""
+    p.add_argument(
+        "--no-adapt",
+        action="store_true",
+        help="turn the scenario's adapt: rules off (compare with fixed parameters)",
+    )
