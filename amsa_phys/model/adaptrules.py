@@ -50,7 +50,7 @@ class Rule:
         return f"rule {self.number}" + (f" ({self.label})" if self.label else "")
 
 
-SCHEMA: dict[str, Any] = {
+RULES: dict[str, Any] = {
     "type": "array",
     "items": {
         "type": "object",
@@ -73,6 +73,33 @@ SCHEMA: dict[str, Any] = {
         },
     },
 }
+
+#: ``adapt:`` in a scenario: the rules, or the name of a rules file (``amsa-phys adapt -o``)
+SCHEMA: dict[str, Any] = {**RULES, "type": ["array", "string"], "minLength": 1}
+
+#: A rules file: ``adapt:`` and nothing else (its comments say where the rules came from).
+FILE: dict[str, Any] = {
+    "type": "object",
+    "additionalProperties": False,
+    "required": ["adapt"],
+    "properties": {"adapt": RULES},
+}
+
+
+def load_rules(doc: YamlDoc, entries: list[dict[str, Any]] | str, world: Any) -> list[Rule]:
+    """A scenario's ``adapt:`` as rules: written inline, or in the file it names (resolved
+    against the scenario's folder; errors then point into that file)."""
+    if not isinstance(entries, str):
+        return parse_rules(doc, entries, world)
+    from . import schema  # schema imports this module's shapes
+    from .yamlio import load_yaml
+
+    path = doc.path.parent / entries
+    if not path.is_file():
+        raise doc.error(("adapt",), f"rules file not found: {path}")
+    rules_doc = load_yaml(path)
+    schema.validate(rules_doc.data, FILE, rules_doc)
+    return parse_rules(rules_doc, rules_doc.data["adapt"], world)
 
 
 def parse_rules(doc: YamlDoc, entries: list[dict[str, Any]], world: Any) -> list[Rule]:

@@ -16,7 +16,7 @@ from typing import Any
 
 from ..errors import ConfigError
 from . import schema, tracecols
-from .adaptrules import RULE_COLUMN, Rule, parse_rules
+from .adaptrules import RULE_COLUMN, Rule, load_rules
 from .params import short_repr
 from .rates import MAX_RATE_HZ, MIN_RATE_HZ, cycle_problem
 from .schema import MAX_SEED
@@ -383,7 +383,7 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
         data=data,
         trace_columns=_trace_patterns(doc, data, world),
     )
-    scenario.adapt = parse_rules(doc, data.get("adapt", []), world)
+    scenario.adapt = load_rules(doc, data.get("adapt", []), world)
     why = _cycle_problem(scenario)
     if why is not None:
         raise doc.error(("log_rate",) if "log_rate" in data else ("world",), why)

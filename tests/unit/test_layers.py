@@ -19,6 +19,7 @@ LAYER = {
     "plots": 3,
     "view": 3,
     "runs": 4,
+    "adapt": 5,
     "ros": 5,
     "cli": 6,
     "api": 6,

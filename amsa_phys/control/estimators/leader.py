@@ -46,7 +46,7 @@ class LeaderMonitor(Template):
         Param("minTravel", "float", "shortest segment with a course", 0.2, 0.0, 100.0, "m"),
     )
     estimates = (
-        Estimates("turning", "behavior", ("freeRobot",), levels=((1.0, 0.0), (4.0, 1.0))),
+        Estimates("turning", "behavior", ("freeRobot",), levels=((1.0, 0.0), (2.0, 1.0), (3.0, 0.0), (4.0, 0.5))),
     )
 
     def initialize(self, ctx: Any) -> None:
