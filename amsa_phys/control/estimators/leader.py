@@ -16,13 +16,15 @@ from .window import Window
 class LeaderMonitor(Template):
     """How much of the time the leader turns: its course rate from GPS fixes.
 
-    Every ``spacing`` seconds the course of the last ``spacing`` seconds of track (the
-    bearing from the fix then to the fix now) is compared with the previous one: the
-    difference over ``spacing`` is a course rate. ``turnRate`` is the mean absolute rate
+    Every second the course of the last ``spacing`` seconds of track (the bearing from the
+    fix then to the fix now) is compared with the course of the ``spacing`` seconds before:
+    the difference over ``spacing`` is a course rate (overlapping segments: ~30 rates in a
+    30 s window, so the share moves in steps of ~0.03, not 0.14). ``turnRate`` is the mean absolute rate
     over ``window`` seconds; ``turning`` the share of those rates above ``threshold``
     (0 for a straight leader, near 1 for one that keeps turning). A segment shorter than
-    ``minTravel`` (a stopped leader, or only held fixes) gives no course, and the
-    comparison restarts after it. Noise: the MDE GPS's 1.5 cm per fix over a 0.9 m segment
+    ``minTravel`` (a stopped leader, or only held fixes) gives no course. Fixes are taken
+    at the first step at least a second after the previous one: run it at a rate whose
+    period divides 1 s (the MDE world's 4 Hz). Noise: the MDE GPS's 1.5 cm per fix over a 0.9 m segment
     (4 s at 0.22 m/s) is 0.024 rad of course, so a straight leader's rates scatter by about
     0.008 rad/s; the default threshold (0.02 rad/s) sits at 2.5 of those, and a leader on
     the random behaviour (a new heading within ±1.2 rad every 10 s) turns at ~0.06 rad/s.
@@ -52,30 +54,22 @@ class LeaderMonitor(Template):
     def initialize(self, ctx: Any) -> None:
         """No track yet."""
         self.rates: Window[float] = Window(self.p.window)
-        self.fix: tuple[float, float, float] | None = None
-        self.course: float | None = None
-        self.started = 0.0
+        #: fixes kept once a second (the last 2 x ``spacing`` s of them)
+        self.track: Window[tuple[float, float]] = Window(2 * self.p.spacing)
+        self.started: float | None = None
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
-        """The paper's doStep: a new course every ``spacing`` s, then the window's shares."""
+        """The paper's doStep: a new course rate every second, then the window's shares."""
         now = float(t)
         p = self.p
-        x, y = inp["gpsPosX"], inp["gpsPosY"]
-        if self.fix is None:
-            self.fix = (now, x, y)
+        if self.started is None:
             self.started = now
-            return {}
-        t0, x0, y0 = self.fix
-        if now - t0 >= p.spacing - 1e-9:
-            self.fix = (now, x, y)
-            if math.hypot(x - x0, y - y0) < p.minTravel:
-                self.course = None
-            else:
-                course = math.atan2(y - y0, x - x0)
-                if self.course is not None:
-                    turn = (course - self.course + math.pi) % (2 * math.pi) - math.pi
-                    self.rates.add(now, abs(turn) / (now - t0))
-                self.course = course
+        track = self.track
+        if not track.items or now - track.items[-1][0] >= 1.0 - 1e-9:
+            track.add(now, (inp["gpsPosX"], inp["gpsPosY"]))
+            rate = self._rate(now)
+            if rate is not None:
+                self.rates.add(now, rate)
         rates = self.rates.items
         if not rates or now - self.started < p.window - 1e-9:
             return {"turning": 0.0, "turnRate": 0.0}
@@ -84,3 +78,20 @@ class LeaderMonitor(Template):
             "turning": sum(1 for _, r in rates if r > p.threshold) / n,
             "turnRate": sum(r for _, r in rates) / n,
         }
+
+    def _rate(self, now: float) -> float | None:
+        """|course change| / ``spacing`` between the last two ``spacing``-s segments (None:
+        the track is too short, or a segment under ``minTravel``)."""
+        p = self.p
+        points = {round(t - now, 6): xy for t, xy in self.track.items}
+        a, b, c = points.get(round(-2 * p.spacing, 6)), points.get(round(-p.spacing, 6)), points.get(0.0)
+        if a is None or b is None or c is None:
+            return None
+        if math.hypot(b[0] - a[0], b[1] - a[1]) < p.minTravel:
+            return None
+        if math.hypot(c[0] - b[0], c[1] - b[1]) < p.minTravel:
+            return None
+        first = math.atan2(b[1] - a[1], b[0] - a[0])
+        second = math.atan2(c[1] - b[1], c[0] - b[0])
+        turn = (second - first + math.pi) % (2 * math.pi) - math.pi
+        return abs(turn) / p.spacing
