@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ..model.adaptrules import describe_rules
+
 import argparse
 from typing import Any
 
@@ -193,6 +195,8 @@ def run(args: argparse.Namespace) -> int:
                 print(f"  change at {float(step.at):g} s (same phase): {inner}")
         for e in obj.expect:
             print(f"expect {describe_what(e)} {describe_bound(e)}")
+        for line in describe_rules(obj.adapt):
+            print(f"adapt {line}")
         print(
             "values in force at t = 0, each with where it comes from: default (the "
             "template's), world, scenario set, --set"

@@ -60,8 +60,8 @@ class AdaptRules:
             else:
                 self._since[i] = None
                 continue
-            since = self._since[i] or now
-            if firing is not None or now - since < rule.hold:
+            since = self._since[i]
+            if firing is not None or since is None or now - since < rule.hold:
                 continue
             if self._last_switch is not None and now - self._last_switch < rule.hold:
                 continue
