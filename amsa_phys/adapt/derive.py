@@ -83,7 +83,9 @@ def derive(
             for a, v in zip(context_axes, key, strict=True):
                 if a == "context":
                     if v not in contexts:
-                        raise ConfigError(f"context {v!r} is not in the scenario's sweep.contexts", file=results)
+                        raise ConfigError(
+                            f"context {v!r} is not in the scenario's sweep.contexts", file=results
+                        )
                     ctx.update(contexts[v])
                 else:
                     ctx[a] = v
@@ -102,7 +104,11 @@ def derive(
         cell.score = statistics.fmean(by_point[best])
         cell.runs = sum(len(v) for v in by_point.values())
     unplaced = _place(list(cells.values()), found, watched)
-    placed = [c for c in cells.values() if c.best and c.levels is not None and c.name not in _names(unplaced)]
+    placed = [
+        c
+        for c in cells.values()
+        if c.best and c.levels is not None and c.name not in _names(unplaced)
+    ]
     rules = _rules(placed, hold)
     return Derivation(metric, tuned, list(cells.values()), rules, unplaced, found)
 
@@ -114,7 +120,9 @@ def _names(unplaced: Sequence[str]) -> set[str]:
 def _base_values(scenario: Scenario) -> dict[str, Any]:
     """Every Leaf parameter at t = 0 (world values, then the scenario's ``set``)."""
     out = {
-        f"{path}.{k}": v for path, leaf in scenario.world.leaves.items() for k, v in leaf.params.items()
+        f"{path}.{k}": v
+        for path, leaf in scenario.world.leaves.items()
+        for k, v in leaf.params.items()
     }
     out.update({c.key: c.value for c in scenario.phases[0].changes})
     return out
@@ -123,7 +131,14 @@ def _base_values(scenario: Scenario) -> dict[str, Any]:
 def _place(cells: list[Cell], found: list[Watch], watched: set[str]) -> list[str]:
     """Give each cell its estimator levels; return why some cells cannot be told apart."""
     problems: list[str] = []
-    varying = sorted({k for c in cells for k, v in c.context.items() if any(d.context.get(k) != v for d in cells)})
+    varying = sorted(
+        {
+            k
+            for c in cells
+            for k, v in c.context.items()
+            if any(d.context.get(k) != v for d in cells)
+        }
+    )
     blind = [k for k in varying if k not in watched]
     for cell in cells:
         if not cell.best:
@@ -147,7 +162,11 @@ def _place(cells: list[Cell], found: list[Watch], watched: set[str]) -> list[str
     for group in groups.values():
         if len(group) > 1 and len({tuple(sorted(c.best.items())) for c in group}) > 1:
             differ = [k for k in blind if len({c.context.get(k) for c in group}) > 1]
-            why = f" (they differ in {', '.join(differ)}, which no estimator watches)" if differ else ""
+            why = (
+                f" (they differ in {', '.join(differ)}, which no estimator watches)"
+                if differ
+                else ""
+            )
             names = ", ".join(c.name for c in group)
             for c in group:
                 problems.append(
@@ -178,11 +197,15 @@ def _rules(cells: list[Cell], hold: float) -> list[dict[str, Any]]:
             when[s] = bound
         if not when:
             continue
-        key = (tuple(sorted((k, tuple(sorted(v.items()))) for k, v in when.items())), tuple(sorted(cell.best.items())))
+        key = (
+            tuple(sorted((k, tuple(sorted(v.items()))) for k, v in when.items())),
+            tuple(sorted(cell.best.items())),
+        )
         if key in seen:
             seen[key]["label"] += f", {cell.name}"
             continue
-        rule = {"when": when, "set": dict(cell.best), "hold": hold, "label": cell.name}
+        whole = int(hold) if float(hold).is_integer() else hold
+        rule = {"when": when, "set": dict(cell.best), "hold": whole, "label": cell.name}
         seen[key] = rule
         rules.append(rule)
     return rules

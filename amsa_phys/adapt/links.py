@@ -57,7 +57,9 @@ def watches(world: WorldSpec) -> list[Watch]:
     return out
 
 
-def _nearest(start: str, near: dict[str, set[str]], world: WorldSpec, names: tuple[str, ...]) -> str | None:
+def _nearest(
+    start: str, near: dict[str, set[str]], world: WorldSpec, names: tuple[str, ...]
+) -> str | None:
     """The closest Leaf of one of the templates ``names`` (ties: world order)."""
     order = {p: i for i, p in enumerate(world.leaves)}
     seen = {start}

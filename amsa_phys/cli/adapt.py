@@ -24,9 +24,14 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="the scenario the sweep ran (its sweep.contexts and the world's estimators)",
     )
     p.add_argument("-o", "--output", required=True, metavar="RULES.yaml", help="rules file")
-    p.add_argument("--metric", default="rms_error", help="the metric to minimise (default rms_error)")
     p.add_argument(
-        "--hold", type=float, default=10.0, metavar="S",
+        "--metric", default="rms_error", help="the metric to minimise (default rms_error)"
+    )
+    p.add_argument(
+        "--hold",
+        type=float,
+        default=10.0,
+        metavar="S",
         help="each rule's hold time in seconds (default 10)",
     )
     p.add_argument("--force", action="store_true", help="replace an existing rules file")
@@ -36,7 +41,9 @@ def run(args: argparse.Namespace) -> int:
     """Read the sweep, derive, write the rules file, print the table."""
     results = Path(args.sweepdir) / "results.csv"
     if not results.is_file():
-        raise ConfigError(f"no results.csv in {args.sweepdir} (is it a sweep's --out?)", key="adapt")
+        raise ConfigError(
+            f"no results.csv in {args.sweepdir} (is it a sweep's --out?)", key="adapt"
+        )
     if not (args.hold >= 0 and math.isfinite(args.hold)):
         raise ConfigError(f"must be a number of seconds >= 0, got {args.hold}", key="--hold")
     out = Path(args.output)
@@ -70,5 +77,7 @@ def rules_text(found: Derivation, sweepdir: str) -> str:
     head += [f"#   {w.signal} ~ {w.key}" for w in found.watches]
     head += [f"# {line}" for line in table(found)]
     head += [f"# not placed: {p}" for p in found.unplaced]
-    body = yaml.safe_dump({"adapt": found.rules}, sort_keys=False, default_flow_style=None, width=100)
+    body = yaml.safe_dump(
+        {"adapt": found.rules}, sort_keys=False, default_flow_style=None, width=100
+    )
     return "\n".join(head) + "\n" + body

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-from ..model.adaptrules import describe_rules
-
 import argparse
 from typing import Any
 
 from ..errors import ConfigError, one_line
 from ..model import timing
+from ..model.adaptrules import describe_rules
 from ..model.scenario import PHYSICS_PREFIX, Scenario, load_scenario
 from ..model.wording import plural
 from ..model.world import LeafSpec, WorldSpec

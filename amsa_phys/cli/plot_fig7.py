@@ -34,7 +34,9 @@ def plot_fig7(args: argparse.Namespace) -> int:
     key = scenario.adapt[0].changes[0].key  # the parameter the rules tune
 
     def one(value: float | None) -> Fig7Run:
-        s: Scenario = scenario if value is None else load_scenario(source, overrides=[f"{key}={value}"])
+        s: Scenario = (
+            scenario if value is None else load_scenario(source, overrides=[f"{key}={value}"])
+        )
         if value is not None:
             s.adapt = []
         memory = TraceMemory(traced_columns(s))

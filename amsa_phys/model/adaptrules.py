@@ -115,7 +115,8 @@ def parse_rules(doc: YamlDoc, entries: list[dict[str, Any]], world: Any) -> list
             if signal not in world.buffers:
                 raise doc.error(
                     (*kp, "when", signal),
-                    f"unknown Data {signal!r}" + did_you_mean(signal, world.buffers)
+                    f"unknown Data {signal!r}"
+                    + did_you_mean(signal, world.buffers)
                     + " (a condition reads an estimator's output, Component.output)",
                 )
             below, above = bound.get("below"), bound.get("above")
@@ -141,7 +142,8 @@ def parse_rules(doc: YamlDoc, entries: list[dict[str, Any]], world: Any) -> list
             if changes[-1].param in template.fixed_once_running:
                 raise doc.error(
                     (*kp, "set", key),
-                    f"{changes[-1].param} is read only when the run starts; a rule cannot change it",
+                    f"{changes[-1].param} is read only when the run starts; "
+                    "a rule cannot change it",
                 )
         hold = Fraction(str(entry.get("hold", 0)))
         rules.append(
@@ -182,14 +184,13 @@ def describe_rules(rules: list[Rule]) -> list[str]:
     """One line per rule, for ``describe`` and ``validate``."""
     lines = []
     for rule in rules:
-        conds = " and ".join(
-            " ".join(
-                [c.signal]
-                + ([f"> {c.above:g}"] if c.above is not None else [])
-                + ([f"< {c.below:g}"] if c.below is not None else [])
-            )
-            for c in rule.when
-        )
+        conds = " and ".join(_condition_text(c) for c in rule.when)
         sets = ", ".join(f"{c.key}={c.value}" for c in rule.changes)
         lines.append(f"{rule.name()}: when {conds} for {float(rule.hold):g} s: set {sets}")
     return lines
+
+
+def _condition_text(c: Condition) -> str:
+    """``0.375 < MotorMonitor.delivered < 0.75``."""
+    text = c.signal if c.above is None else f"{c.above:g} < {c.signal}"
+    return text if c.below is None else f"{text} < {c.below:g}"

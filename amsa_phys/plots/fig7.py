@@ -53,17 +53,32 @@ def fig7(adaptive: Fig7Run, fixed: list[Fig7Run], out: Path, param: str = "Kv") 
     ax.axhline(ref, color="tab:green", lw=1, ls="--")
     best = sorted(fixed, key=lambda r: r.rms)[:2]
     for run, colour in zip(best, FIXED_COLOURS, strict=False):
-        ax.plot(run.t, run.d, color=colour, lw=0.9, alpha=0.75,
-                label=f"fixed {param} = {run.value:g} (rms {run.rms:.2f} m)")
-    ax.plot(adaptive.t, adaptive.d, color=ADAPTIVE, lw=1.5,
-            label=f"adaptive (rms {adaptive.rms:.2f} m)")
+        ax.plot(
+            run.t,
+            run.d,
+            color=colour,
+            lw=0.9,
+            alpha=0.75,
+            label=f"fixed {param} = {run.value:g} (rms {run.rms:.2f} m)",
+        )
+    ax.plot(
+        adaptive.t, adaptive.d, color=ADAPTIVE, lw=1.5, label=f"adaptive (rms {adaptive.rms:.2f} m)"
+    )
     adapt_switches(ax, adaptive.metrics.get("events", []), adaptive.t, adaptive.d)
     for phase in adaptive.metrics["phases"]:
         if phase["start"] > 0:
             ax.axvline(phase["start"], color="0.4", lw=0.8, ls=":")
         name = phase.get("label") or ("nominal" if phase["start"] == 0 else "")
-        ax.annotate(name, (phase["start"], 1.0), xycoords=("data", "axes fraction"),
-                    xytext=(3, -3), textcoords="offset points", va="top", fontsize=8, color="0.25")
+        ax.annotate(
+            name,
+            (phase["start"], 1.0),
+            xycoords=("data", "axes fraction"),
+            xytext=(3, -3),
+            textcoords="offset points",
+            va="top",
+            fontsize=8,
+            color="0.25",
+        )
     lo = min(float(np.nanmin(r.d)) for r in [adaptive, *best])
     hi = max(float(np.nanmax(r.d)) for r in [adaptive, *best])
     ax.set_ylim(min(lo, ref - tol) - 0.5, max(hi, ref + tol) + 1.5)
@@ -73,7 +88,9 @@ def fig7(adaptive: Fig7Run, fixed: list[Fig7Run], out: Path, param: str = "Kv") 
     ax.legend(loc="lower right", fontsize=8, ncol=2)
     ax.set_title(
         f"{adaptive.label}: the best {param} depends on the context; rules derived from a "
-        "context sweep switch it at run time", fontsize=10, loc="left",
+        "context sweep switch it at run time",
+        fontsize=10,
+        loc="left",
     )
     names = [f"{r.value:g}" for r in fixed] + ["adaptive"]
     values = [r.rms for r in fixed] + [adaptive.rms]
@@ -87,7 +104,9 @@ def fig7(adaptive: Fig7Run, fixed: list[Fig7Run], out: Path, param: str = "Kv") 
     bars.set_xlabel(f"fixed {param} (--no-adapt), and the adaptive run")
     bars.set_ylim(0, max(values) * 1.2)
     bars.grid(alpha=0.3, axis="y")
-    fig.suptitle("Fig. 7: adaptive reconfiguration against every fixed gain (seed "
-                 f"{adaptive.metrics.get('seed')})")
+    fig.suptitle(
+        "Fig. 7: adaptive reconfiguration against every fixed gain (seed "
+        f"{adaptive.metrics.get('seed')})"
+    )
     fig.tight_layout()
     return save_png(fig, out)

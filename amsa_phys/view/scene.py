@@ -144,8 +144,10 @@ def adapt_text(sim: Simulation) -> str:
         if event.kind == "adapt":
             rule, _, rest = event.detail.partition(": ")
             sets = rest.rsplit(" (", 1)[0]
-            short = ", ".join(part.split("=", 1)[0].rsplit(".", 1)[-1] + "=" + part.split("=", 1)[-1]
-                              for part in sets.split(", "))
+            short = ", ".join(
+                part.split("=", 1)[0].rsplit(".", 1)[-1] + "=" + part.split("=", 1)[-1]
+                for part in sets.split(", ")
+            )
             return f" | adapt at {event.t:.1f} s: {rule}: {short}"
     return ""
 

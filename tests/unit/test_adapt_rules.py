@@ -107,7 +107,8 @@ def test_the_engine_applies_a_rule_at_the_exact_instant_and_records_it() -> None
     assert events[0].detail.startswith("rule 1 (always): MyFollowerController.Kv=0.3 (")
     assert run.metrics["events"][0]["kind"] == "adapt"
     t, rule = run.trace["t"], run.trace["adapt.rule"]
-    assert rule[t < 2].max() == 0.0 and rule[t >= 2].min() == 1.0
+    assert rule[t < 2].max() == 0.0
+    assert rule[t >= 2].min() == 1.0
     # the controller's command from t = 2 s uses Kv 0.3: the run differs from --no-adapt after
     fixed = ap.run(_scenario(ALWAYS), adapt=False)
     left = "MyFollowerController.LeftPower"
@@ -142,16 +143,31 @@ def test_no_adapt_equals_the_scenario_without_rules_byte_for_byte(tmp_path: Path
     ("adapt", "message"),
     [
         (
-            [{"when": {"MotorMonitor.delivred": {"below": 1}}, "set": {"MyFollowerController.Kv": 1}}],
+            [
+                {
+                    "when": {"MotorMonitor.delivred": {"below": 1}},
+                    "set": {"MyFollowerController.Kv": 1},
+                }
+            ],
             "adapt[0].when.MotorMonitor.delivred: unknown Data 'MotorMonitor.delivred' "
             "(did you mean MotorMonitor.delivered?)",
         ),
         (
-            [{"when": {"MotorMonitor.delivered": {"below": 1}}, "set": {"MyFollowerController.Kv": 99}}],
+            [
+                {
+                    "when": {"MotorMonitor.delivered": {"below": 1}},
+                    "set": {"MyFollowerController.Kv": 99},
+                }
+            ],
             "adapt[0].set.MyFollowerController.Kv: 99 is above the maximum 10",
         ),
         (
-            [{"when": {"MotorMonitor.delivered": {"below": 0.2, "above": 0.5}}, "set": {"MyFollowerController.Kv": 1}}],
+            [
+                {
+                    "when": {"MotorMonitor.delivered": {"below": 0.2, "above": 0.5}},
+                    "set": {"MyFollowerController.Kv": 1},
+                }
+            ],
             "below 0.2 is not above above 0.5: the condition never holds",
         ),
         (
@@ -185,7 +201,10 @@ def test_describe_shows_the_rules(tmp_path: Path, capsys) -> None:
 
 def test_derive_from_a_fixture_sweep_gives_the_expected_table() -> None:
     found = derive(FIXTURE / "results.csv", load_scenario(FIXTURE / "sweep.yaml"), "rms_error", 5)
-    table = {c.name: (c.best["MyFollowerController.Kv"], round(c.score, 6), c.levels) for c in found.cells}
+    table = {
+        c.name: (c.best["MyFollowerController.Kv"], round(c.score, 6), c.levels)
+        for c in found.cells
+    }
     turning, delivered = "LeaderMonitor.turning", "MotorMonitor.delivered"
     assert table == {
         "nominal": (0.2, 0.55, {delivered: 1.0, turning: 0.0}),

@@ -74,9 +74,7 @@ def test_motor_monitor_holds_its_estimate_when_nothing_is_commanded() -> None:
 
 
 def test_leader_monitor_straight_track_is_not_turning() -> None:
-    out = _feed(
-        LeaderMonitor("M", {}), 200, lambda t, k: {"gpsPosX": 0.22 * t, "gpsPosY": 0.1 * t}
-    )
+    out = _feed(LeaderMonitor("M", {}), 200, lambda t, k: {"gpsPosX": 0.22 * t, "gpsPosY": 0.1 * t})
     assert out["turning"] == 0.0
     assert out["turnRate"] == pytest.approx(0.0, abs=1e-9)
 

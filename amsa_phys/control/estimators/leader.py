@@ -19,16 +19,20 @@ class LeaderMonitor(Template):
     Every second the course of the last ``spacing`` seconds of track (the bearing from the
     fix then to the fix now) is compared with the course of the ``spacing`` seconds before:
     the difference over ``spacing`` is a course rate (overlapping segments: ~30 rates in a
-    30 s window, so the share moves in steps of ~0.03, not 0.14). ``turnRate`` is the mean absolute rate
-    over ``window`` seconds; ``turning`` the share of those rates above ``threshold``
-    (0 for a straight leader, near 1 for one that keeps turning). A segment shorter than
-    ``minTravel`` (a stopped leader, or only held fixes) gives no course. Fixes are taken
-    at the first step at least a second after the previous one: run it at a rate whose
-    period divides 1 s (the MDE world's 4 Hz). Noise: the MDE GPS's 1.5 cm per fix over a 0.9 m segment
-    (4 s at 0.22 m/s) is 0.024 rad of course, so a straight leader's rates scatter by about
-    0.008 rad/s; the default threshold (0.02 rad/s) sits at 2.5 of those, and a leader on
-    the random behaviour (a new heading within ±1.2 rad every 10 s) turns at ~0.06 rad/s.
-    Until ``window`` seconds of rates are in, both outputs are 0.
+    30 s window, so the share moves in steps of ~0.03). ``turnRate`` is the mean absolute
+    rate over ``window`` seconds; ``turning`` the share of those rates above ``threshold``
+    (0 for a straight leader, 1 for one that keeps turning, about 0.5 for the random
+    behaviour, which turns to a new heading every ``changePeriod`` s and then drives
+    straight). A segment shorter than ``minTravel`` (a stopped leader, or only held fixes)
+    gives no course. Fixes are taken at the first step at least a second after the previous
+    one: run it at a rate whose period divides 1 s (the MDE world's 4 Hz).
+
+    Noise: the MDE GPS's 1.5 cm per fix over a 0.9 m segment (4 s at 0.22 m/s) is 0.024 rad
+    of course, so a straight leader's rates scatter by ~0.008 rad/s and the default
+    threshold (0.02 rad/s) sits at 2.5 of those. Measured on the MDE world (seeds 1-3, from
+    t = 40 s): a straight leader's share stays at or below 0.36 (0 once its start is out of
+    the window), the random leader's spans 0 to 1 (a run of small heading changes looks
+    straight for a while). Until ``window`` seconds have passed, both outputs are 0.
     """
 
     kind = Kind.OBSERVER
@@ -43,12 +47,27 @@ class LeaderMonitor(Template):
     )
     params = (
         Param("window", "float", "length of the estimate's window", 30.0, 1.0, 3600.0, "s"),
-        Param("spacing", "float", "time between the fixes a course is taken on", 4.0, 0.01, 60.0, "s"),
-        Param("threshold", "float", "course rate above which the leader turns", 0.02, 0.0, 10.0, "rad/s"),
+        Param(
+            "spacing", "float", "time between the fixes a course is taken on", 4.0, 0.01, 60.0, "s"
+        ),
+        Param(
+            "threshold",
+            "float",
+            "course rate above which the leader turns",
+            0.02,
+            0.0,
+            10.0,
+            "rad/s",
+        ),
         Param("minTravel", "float", "shortest segment with a course", 0.2, 0.0, 100.0, "m"),
     )
     estimates = (
-        Estimates("turning", "behavior", ("freeRobot",), levels=((1.0, 0.0), (2.0, 1.0), (3.0, 0.0), (4.0, 0.5))),
+        Estimates(
+            "turning",
+            "behavior",
+            ("freeRobot",),
+            levels=((1.0, 0.0), (2.0, 1.0), (3.0, 0.0), (4.0, 0.5)),
+        ),
     )
 
     def initialize(self, ctx: Any) -> None:
@@ -84,7 +103,11 @@ class LeaderMonitor(Template):
         the track is too short, or a segment under ``minTravel``)."""
         p = self.p
         points = {round(t - now, 6): xy for t, xy in self.track.items}
-        a, b, c = points.get(round(-2 * p.spacing, 6)), points.get(round(-p.spacing, 6)), points.get(0.0)
+        a, b, c = (
+            points.get(round(-2 * p.spacing, 6)),
+            points.get(round(-p.spacing, 6)),
+            points.get(0.0),
+        )
         if a is None or b is None or c is None:
             return None
         if math.hypot(b[0] - a[0], b[1] - a[1]) < p.minTravel:

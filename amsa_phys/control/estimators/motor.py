@@ -44,12 +44,52 @@ class MotorMonitor(Template):
     outputs = (Port("delivered", 1.0, "share of commanded power delivered (0..)", ""),)
     params = (
         Param("window", "float", "length of the estimate's window", 30.0, 1.0, 3600.0, "s"),
-        Param("spacing", "float", "time between the fixes the path is measured on", 1.0, 0.01, 60.0, "s"),
-        Param("maxSpeed", "float", "speed gained per 100 % of power (rover model)", 5.5, 0.01, 100.0, "m/s"),
-        Param("frictionPower", "float", "power that overcomes rolling resistance (rover model)", 2.9, 0.0, 100.0, "%"),
+        Param(
+            "spacing",
+            "float",
+            "time between the fixes the path is measured on",
+            1.0,
+            0.01,
+            60.0,
+            "s",
+        ),
+        Param(
+            "maxSpeed",
+            "float",
+            "speed gained per 100 % of power (rover model)",
+            5.5,
+            0.01,
+            100.0,
+            "m/s",
+        ),
+        Param(
+            "frictionPower",
+            "float",
+            "power that overcomes rolling resistance (rover model)",
+            2.9,
+            0.0,
+            100.0,
+            "%",
+        ),
         Param("minPower", "float", "least mean command for an estimate", 3.0, 0.01, 100.0, "%"),
-        Param("timeConstant", "float", "the rover's speed time constant (rover model)", 10.0, 0.0, 600.0, "s"),
-        Param("edge", "float", "time over which the window's first and last speeds are taken", 4.0, 0.01, 60.0, "s"),
+        Param(
+            "timeConstant",
+            "float",
+            "the rover's speed time constant (rover model)",
+            10.0,
+            0.0,
+            600.0,
+            "s",
+        ),
+        Param(
+            "edge",
+            "float",
+            "time over which the window's first and last speeds are taken",
+            4.0,
+            0.01,
+            60.0,
+            "s",
+        ),
     )
     estimates = (Estimates("delivered", "motorCoef", ("NormalizePower",), scale=0.01),)
 
