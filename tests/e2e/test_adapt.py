@@ -10,6 +10,7 @@ the scenario's header and run this test again.
 
 from __future__ import annotations
 
+import json
 import statistics
 from pathlib import Path
 
@@ -55,8 +56,6 @@ def test_the_adaptive_run_switches_and_marks_it(tmp_path: Path) -> None:
     """The run's switches are events in metrics.json, and the distance plot is drawn."""
     out = tmp_path / "run"
     assert main(["run", str(SCENARIO), "--headless", "-q", "--out", str(out)]) == 0
-    import json
-
     metrics = json.loads((out / "metrics.json").read_text())
     switches = [e for e in metrics["events"] if e["kind"] == "adapt"]
     # at least one switch into each of the contexts after the first

@@ -28,6 +28,8 @@ class GPSLossMonitor(Template):
 
     kind = Kind.OBSERVER
     uses_random = False
+    #: the windows are sized once, at initialize
+    fixed_once_running = frozenset({"window"})
     inputs = (
         Port("gpsPosX", 0.0, "the GPS fix, x", "m"),
         Port("gpsPosY", 0.0, "the GPS fix, y", "m"),

@@ -37,6 +37,8 @@ class LeaderMonitor(Template):
 
     kind = Kind.OBSERVER
     uses_random = False
+    #: the windows are sized once, at initialize
+    fixed_once_running = frozenset({"window", "spacing"})
     inputs = (
         Port("gpsPosX", 0.0, "the leader's GPS fix, x", "m"),
         Port("gpsPosY", 0.0, "the leader's GPS fix, y", "m"),

@@ -35,6 +35,8 @@ class MotorMonitor(Template):
 
     kind = Kind.OBSERVER
     uses_random = False
+    #: the windows are sized once, at initialize
+    fixed_once_running = frozenset({"window"})
     inputs = (
         Port("powerL", 0.0, "commanded left power", "%"),
         Port("powerR", 0.0, "commanded right power", "%"),
