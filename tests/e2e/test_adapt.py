@@ -2,7 +2,7 @@
 every fixed gain on the whole run.
 
 ``scenarios/adaptive.yaml`` changes the context during the run (nominal, a random leader,
-worn motors, very worn motors); its rules (``scenarios/adaptive_rules.yaml``) come from
+worn motors, very worn motors); its rules (``scenarios/rules/adaptive_rules.yaml``) come from
 ``amsa-phys sweep scenarios/adaptive_sweep.yaml`` then ``amsa-phys adapt``. The test asserts
 the claim, not numbers: when the dynamics change, regenerate the rules with the commands in
 the scenario's header and run this test again.
