@@ -118,11 +118,13 @@ def run(
     base_dir: str | os.PathLike[str] | None = None,
     progress: bool = False,
     bag: str | os.PathLike[str] | None = None,
+    adapt: bool = True,
 ) -> Run:
     """Run a scenario (a file path or a mapping) as ``amsa-phys run --headless`` does.
 
     Nothing is written (call :meth:`Run.save` for the run directory). Options are the CLI's
-    (see :func:`~amsa_phys.api.source.load`); ``progress=True`` shows the progress bar.
+    (see :func:`~amsa_phys.api.source.load`; ``adapt=False`` is ``--no-adapt``);
+    ``progress=True`` shows the progress bar.
     Errors are the CLI's, raised: :class:`~amsa_phys.errors.ConfigError` for bad input and
     :class:`~amsa_phys.errors.RunFault` for a fault during the run, with the CLI's one-line
     message; Ctrl-C stops the run between two instants and raises
@@ -139,6 +141,7 @@ def run(
         log_rate=log_rate,
         trace_columns=trace_columns,
         base_dir=base_dir,
+        adapt=adapt,
     )
     memory = TraceMemory(traced_columns(scenario))
     recorder = bag_recorder(bag, scenario) if bag is not None else None

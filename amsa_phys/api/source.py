@@ -52,14 +52,32 @@ def load(
     log_rate: float | None = None,
     trace_columns: str | Sequence[str] | None = None,
     base_dir: str | os.PathLike[str] | None = None,
+    adapt: bool = True,
 ) -> Scenario:
     """Load and check a scenario as ``amsa-phys run`` would, without running it.
 
     ``source`` is a scenario file or a mapping of the same shape; the keyword arguments are
     the CLI's ``--seed``, ``--duration``, ``--set``, ``--log-rate`` and ``--trace-columns``
     (a comma-separated string or a list of patterns; errors name those options, exactly as
-    the CLI prints them). Raises :class:`~amsa_phys.errors.ConfigError`.
+    the CLI prints them); ``adapt=False`` is ``--no-adapt``. Raises
+    :class:`~amsa_phys.errors.ConfigError`.
     """
+    scenario = _load(source, seed, duration, set, log_rate, trace_columns, base_dir)
+    if not adapt:
+        scenario.adapt = []  # as if the scenario had no adapt: section
+    return scenario
+
+
+def _load(
+    source: Source,
+    seed: int | None,
+    duration: float | Fraction | None,
+    set: Mapping[str, Any] | None,
+    log_rate: float | None,
+    trace_columns: str | Sequence[str] | None,
+    base_dir: str | os.PathLike[str] | None,
+) -> Scenario:
+    """:func:`load` before ``adapt``."""
     overrides = [override_text(key, value) for key, value in (set or {}).items()]
     seed = _seed(seed)
     dur = None if duration is None else _number(duration, "--duration")

@@ -7,6 +7,7 @@ from typing import Any
 
 from ..errors import ConfigError, one_line
 from ..model import timing
+from ..model.adaptrules import describe_rules
 from ..model.scenario import PHYSICS_PREFIX, Scenario, load_scenario
 from ..model.wording import plural
 from ..model.world import LeafSpec, WorldSpec
@@ -193,6 +194,8 @@ def run(args: argparse.Namespace) -> int:
                 print(f"  change at {float(step.at):g} s (same phase): {inner}")
         for e in obj.expect:
             print(f"expect {describe_what(e)} {describe_bound(e)}")
+        for line in describe_rules(obj.adapt):
+            print(f"adapt {line}")
         print(
             "values in force at t = 0, each with where it comes from: default (the "
             "template's), world, scenario set, --set"

@@ -56,6 +56,10 @@ COMMANDS = {
         "imports",
         "Import an original AMSA model (.amsacore + .amsatemplate) as a world file.",
     ),
+    "adapt": (
+        "adapt",
+        "Derive adapt: rules from a context sweep: best parameters per context, on estimators.",
+    ),
 }
 
 

@@ -72,3 +72,12 @@ def add_bag(p: argparse.ArgumentParser) -> None:
         help="also write the run as an MCAP bag with ROS 2 encodings: standard messages "
         "(NavSatFix, Imu, Odometry, LaserScan, tf), every traced buffer, the events",
     )
+
+
+def add_no_adapt(p: argparse.ArgumentParser) -> None:
+    """--no-adapt: the scenario with its ``adapt:`` rules off."""
+    p.add_argument(
+        "--no-adapt",
+        action="store_true",
+        help="turn the scenario's adapt: rules off (compare with fixed parameters)",
+    )

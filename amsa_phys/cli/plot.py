@@ -25,9 +25,10 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--paper",
-        choices=("fig5", "fig6"),
+        choices=("fig5", "fig6", "fig7"),
         help="the paper's Fig. 5 or Fig. 6 redrawn from the runs, beside the paper's numbers "
-        "(-o default: paper_fig5.png / paper_fig6.png)",
+        "(-o default: paper_fig5.png / paper_fig6.png); fig7: the adaptive run of "
+        "scenarios/adaptive.yaml against every fixed Kv",
     )
     p.add_argument(
         "-o",
@@ -139,6 +140,10 @@ def _sweep_scenario(sweepdir: Path) -> str:
 
 def _plot_paper(args: argparse.Namespace) -> int:
     """``--paper fig5|fig6``: run (or read) the paper's scenarios and draw the figure."""
+    if args.paper == "fig7":
+        from .plot_fig7 import plot_fig7
+
+        return plot_fig7(args)
     from ..plots import paper  # matplotlib: only once the runs are in
 
     sources = [Path(s) for s in args.rundir] or _paper_scenarios(args.paper)

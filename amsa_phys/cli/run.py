@@ -17,7 +17,7 @@ from ..runs.plotjob import PlotJob
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
 from ..runs.suite import input_files
-from .options import add_bag, add_output, add_scenario_overrides, add_trace_columns
+from .options import add_bag, add_no_adapt, add_output, add_scenario_overrides, add_trace_columns
 from .recording import _target, add_recording, recording_options, snapshot_options
 from .report import print_summary
 
@@ -34,6 +34,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="no window: run as fast as possible (default: the interactive window)",
     )
     add_scenario_overrides(p)
+    add_no_adapt(p)
     add_trace_columns(p)
     add_output(p)
     add_recording(p)
@@ -78,6 +79,8 @@ def _run(
         log_rate=args.log_rate,
         trace_columns=args.trace_columns,
     )
+    if args.no_adapt:
+        scenario.adapt = []  # as if the file had no adapt: section
     if snapshot is not None and snapshot.at is not None and snapshot.at > scenario.duration:
         raise ConfigError(
             f"{float(snapshot.at):g} s is after the run's end ({float(scenario.duration):g} s); "

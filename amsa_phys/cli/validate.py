@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from ..errors import AmsaError, one_line
+from ..model.adaptrules import describe_rules
 from ..model.wording import plural
 from .loading import load_any
 
@@ -32,6 +33,8 @@ def run(args: argparse.Namespace) -> int:
                     f"{plural(len(obj.phases), 'phase')}, {float(obj.duration):g} s)"
                 )
             )
+            for line in describe_rules(obj.adapt):  # what each rule reads and sets, checked
+                print(one_line(f"  adapt {line}"))
         else:
             print(one_line(f"ok: {path} (world: {plural(len(obj.leaves), 'component')})"))
     return 2 if bad else 0

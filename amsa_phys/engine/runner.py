@@ -30,11 +30,13 @@ from typing import Any
 import numpy as np
 
 from ..errors import RunFault
+from ..model.adaptrules import RULE_COLUMN, Rule
 from ..model.params import short_repr
 from ..model.scenario import Change, Phase, Scenario, traced_columns
 from ..model.template import Template
 from ..model.world import WorldSpec
 from . import batch, interrupt
+from .adapt import AdaptRules
 from .clock import MAX_EVENTS_PER_CYCLE, TickGrid, hyperperiod
 from .rng import component_rng
 from .timing import DelayLine, run_phases
@@ -170,6 +172,7 @@ class Simulation:
         quality_signal: str | None = None,
         trace: Callable[[float, list[float]], None] | None = None,
         columns: Sequence[str] | None = None,
+        adapt: Sequence[Rule] = (),
     ) -> None:
         self.world = world
         self.seed = seed
@@ -204,6 +207,10 @@ class Simulation:
         #: publications of delayed Leaves in flight: (due tick, sequence, [(buffer, value)])
         self._deliveries: list[tuple[int, int, list[tuple[str, float]]]] = []
         self._sent = 0
+        #: ``adapt:`` rules (``engine/adapt.py``), asked at every instant with components
+        self._adapt = AdaptRules(adapt, self._param_value) if adapt else None
+        if adapt:
+            self.values[RULE_COLUMN] = 0.0
         self._build()
 
     @classmethod
@@ -218,6 +225,7 @@ class Simulation:
             log_rate=scenario.log_rate,
             quality_signal=q,
             columns=traced_columns(scenario),
+            adapt=scenario.adapt,
             **kw,
         )
 
@@ -447,6 +455,8 @@ class Simulation:
                         self._tick = tick
                         if self._pending_live:
                             self._apply_live()
+                        if tasks and self._adapt is not None:
+                            self._apply_adapt()
                         if tasks:
                             now = self.now
                             for run, task in tasks:
@@ -767,6 +777,21 @@ class Simulation:
             self.apply_change(change)
             self.live_changes.append((self.now, change))
             self.record_event("live change", f"{change.key}={change.value}")
+
+    def _apply_adapt(self) -> None:
+        """Apply the ``adapt:`` rule due now, like a timeline change at this instant."""
+        assert self._adapt is not None
+        firing = self._adapt.due(self.now, self.values)
+        if firing is None:
+            return
+        for change in firing.rule.changes:
+            self.apply_change(change)
+        self.values[RULE_COLUMN] = float(firing.rule.number)
+        self.record_event("adapt", firing.detail())
+
+    def _param_value(self, leaf: str, param: str) -> Any:
+        """The value of ``leaf.param`` in force now."""
+        return getattr(self.components[leaf].p, param)
 
     def record_event(self, kind: str, detail: str) -> None:
         """See :meth:`Context.record_event`."""

@@ -16,6 +16,7 @@ from typing import Any
 
 from ..errors import ConfigError
 from . import schema, tracecols
+from .adaptrules import RULE_COLUMN, Rule, load_rules
 from .params import short_repr
 from .rates import MAX_RATE_HZ, MIN_RATE_HZ, cycle_problem
 from .schema import MAX_SEED
@@ -142,6 +143,8 @@ class Scenario:
     #: ``trace_columns:`` glob patterns (None: trace every Data buffer); see
     #: :func:`traced_columns` for what is kept
     trace_columns: list[str] | None = None
+    #: ``adapt:`` reconfiguration rules (``model/adaptrules.py``); empty with ``--no-adapt``
+    adapt: list[Rule] = field(default_factory=list)
 
 
 def traced_columns(scenario: Scenario) -> list[str]:
@@ -153,7 +156,8 @@ def traced_columns(scenario: Scenario) -> list[str]:
     required = [e.trace for e in scenario.expect if e.trace]
     if scenario.quality:
         required.append(scenario.quality.signal)
-    return tracecols.selected(scenario.trace_columns, list(scenario.world.buffers), required)
+    columns = tracecols.selected(scenario.trace_columns, list(scenario.world.buffers), required)
+    return [*columns, RULE_COLUMN] if scenario.adapt else columns
 
 
 def shorten(scenario: Scenario, duration: Fraction) -> None:
@@ -379,6 +383,7 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
         data=data,
         trace_columns=_trace_patterns(doc, data, world),
     )
+    scenario.adapt = load_rules(doc, data.get("adapt", []), world)
     why = _cycle_problem(scenario)
     if why is not None:
         raise doc.error(("log_rate",) if "log_rate" in data else ("world",), why)

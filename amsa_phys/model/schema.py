@@ -14,6 +14,7 @@ from typing import Any
 
 import jsonschema
 
+from .adaptrules import SCHEMA as ADAPT
 from .params import short_repr, yaml_type
 from .rates import MAX_RATE_HZ, MIN_PHYSICS_RATE_HZ, MIN_RATE_HZ
 from .suggest import did_you_mean
@@ -230,6 +231,7 @@ SCENARIO: dict[str, Any] = {
                 },
             },
         },
+        "adapt": ADAPT,  # reconfiguration rules (model/adaptrules.py)
         "sweep": {
             "type": "object",
             "additionalProperties": False,

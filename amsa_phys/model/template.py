@@ -208,6 +208,9 @@ BUILTINS: dict[str, str] = {
     "FollowerController": "amsa_phys.control.follower:FollowerController",
     "ConstantPower": "amsa_phys.control.constant:ConstantPower",
     "frictionZone": "amsa_phys.physics.terrain:FrictionZone",
+    "GPSLossMonitor": "amsa_phys.control.estimators.gpsloss:GPSLossMonitor",
+    "MotorMonitor": "amsa_phys.control.estimators.motor:MotorMonitor",
+    "LeaderMonitor": "amsa_phys.control.estimators.leader:LeaderMonitor",
 }
 
 

@@ -17,6 +17,7 @@ from matplotlib.figure import Figure
 
 from ..errors import ConfigError
 from ..model.params import short_repr
+from .adaptmarks import adapt_switches
 from .save import save_png
 
 #: Values beyond this are not drawn (NaN): matplotlib's limits overflow near the float limit.
@@ -278,6 +279,7 @@ def distance_figure(
         lines = _phase_notes(ax, metrics.get("phases", []))
         changes = _inner_changes(ax, metrics.get("phases", []))
         _collisions(ax, metrics.get("events", []), t, s)
+        adapt_switches(ax, metrics.get("events", []), t, s)
         # the notes get a band of their own above the data: the curve never runs through them
         band = (len(lines) * NOTE_PT * 1.25 + 8) / AXES_HEIGHT_PT if lines else 0.05
         ax.set_ylim(bottom=0, top=top * 1.05 / max(0.4, 1 - band))

@@ -54,6 +54,8 @@ class Unit:
 def unbatchable(scenario: Scenario) -> str | None:
     """Why a batch cannot hold runs of ``scenario`` (None if it can)."""
     world = scenario.world
+    if scenario.adapt:
+        return "adapt: rules (each run switches its parameters at its own instants)"
     if world.free_running:
         return "free-running timers (each run draws its own phases)"
     for path, leaf in world.leaves.items():

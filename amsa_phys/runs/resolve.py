@@ -7,6 +7,7 @@ from collections.abc import Sequence
 from fractions import Fraction
 from typing import Any
 
+from ..model.adaptrules import written_rules
 from ..model.scenario import Change, Expectation, Scenario
 from ..model.timing import TIMING_KEYS, LeafTiming
 from ..model.world import LeafSpec
@@ -138,6 +139,8 @@ def resolved_scenario(
             if not e["new_phase"]:
                 item["new_phase"] = False
             out["timeline"].append(item)
+    if scenario.adapt:
+        out["adapt"] = written_rules(scenario.adapt)
     kept = [e for e in scenario.expect if not any(e is d for d in drop)]
     if kept:
         out["expect"] = []

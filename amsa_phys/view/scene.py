@@ -133,7 +133,23 @@ def describe_phase(sim: Simulation) -> str:
     last = len(sim.phases) - 1
     of = f" (of 0–{last})" if last else ""
     text = f"phase {sim.phase_index}{of}{label} from {float(phase.at):g} s"
-    return f"{text}: {sets}" if sets else text
+    text = f"{text}: {sets}" if sets else text
+    return text + adapt_text(sim)
+
+
+def adapt_text(sim: Simulation) -> str:
+    """`` | adapt at 327.3 s: rule 3 (worn motors): Kv=0.35``: the last ``adapt:`` switch
+    (events are few: the scan from the end stops at the first one found)."""
+    for event in reversed(sim.events):
+        if event.kind == "adapt":
+            rule, _, rest = event.detail.partition(": ")
+            sets = rest.rsplit(" (", 1)[0]
+            short = ", ".join(
+                part.split("=", 1)[0].rsplit(".", 1)[-1] + "=" + part.split("=", 1)[-1]
+                for part in sets.split(", ")
+            )
+            return f" | adapt at {event.t:.1f} s: {rule}: {short}"
+    return ""
 
 
 def _short(value: Any) -> str:

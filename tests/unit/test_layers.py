@@ -20,6 +20,7 @@ LAYER = {
     "view": 3,
     "runs": 4,
     "stdmsgs": 4.5,  # the standard ROS messages of a world: model only, for ros/ and bag/
+    "adapt": 5,
     "ros": 5,
     "bag": 5.5,  # a run as an MCAP bag: engine, stdmsgs; used by cli/ and api/
     "cli": 6,

@@ -1,0 +1,78 @@
+"""Which context parameter each estimator of a world watches (its ``estimates``).
+
+An estimator template declares what it estimates (``control/estimators``: "``delivered`` is
+about 0.01 x ``motorCoef`` of a NormalizePower"). In a world, the Leaf it watches is the
+nearest Leaf of that template on the estimator's dataflow: a producer of its inputs, their
+producers, or another reader of the same Data (the actuator fed the same commands), at
+most ``MAX_HOPS`` links away. This keeps the mapping out of the user's hands and wrong
+wiring visible: an estimator that watches nothing is reported.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+from ..control.estimators import Estimates
+from ..model.world import WorldSpec
+
+MAX_HOPS = 3
+
+
+@dataclass(frozen=True)
+class Watch:
+    """Estimator output ``signal`` (``Leaf.output``) estimates context parameter ``key``."""
+
+    signal: str
+    key: str
+    estimates: Estimates
+
+
+def _neighbours(world: WorldSpec) -> dict[str, set[str]]:
+    """Leaves linked by a Data (producer to reader, and readers of the same Data)."""
+    near: dict[str, set[str]] = {p: set() for p in world.leaves}
+    readers: dict[str, set[str]] = {}
+    for path, leaf in world.leaves.items():
+        for buffer in leaf.inputs.values():
+            producer = buffer.rpartition(".")[0]
+            if producer in near:
+                near[path].add(producer)
+                near[producer].add(path)
+            readers.setdefault(buffer, set()).add(path)
+    for group in readers.values():
+        for a in group:
+            near[a] |= group - {a}
+    return near
+
+
+def watches(world: WorldSpec) -> list[Watch]:
+    """Every (estimator output, context parameter) pair of ``world``, in world order."""
+    near = _neighbours(world)
+    out = []
+    for path, leaf in world.leaves.items():
+        for est in getattr(leaf.template, "estimates", ()):
+            target = _nearest(path, near, world, est.templates)
+            if target is not None:
+                out.append(Watch(f"{path}.{est.output}", f"{target}.{est.param}", est))
+    return out
+
+
+def _nearest(
+    start: str, near: dict[str, set[str]], world: WorldSpec, names: tuple[str, ...]
+) -> str | None:
+    """The closest Leaf of one of the templates ``names`` (ties: world order)."""
+    order = {p: i for i, p in enumerate(world.leaves)}
+    seen = {start}
+    frontier = deque([(start, 0)])
+    found: list[tuple[int, int, str]] = []
+    while frontier:
+        path, hops = frontier.popleft()
+        if hops and world.leaves[path].template.name() in names:
+            found.append((hops, order[path], path))
+        if hops == MAX_HOPS:
+            continue
+        for other in sorted(near[path], key=order.__getitem__):
+            if other not in seen:
+                seen.add(other)
+                frontier.append((other, hops + 1))
+    return min(found)[2] if found else None
