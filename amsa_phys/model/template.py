@@ -207,7 +207,7 @@ BUILTINS: dict[str, str] = {
     "NormalizePower": "amsa_phys.control.normalize:NormalizePower",
     "FollowerController": "amsa_phys.control.follower:FollowerController",
     "ConstantPower": "amsa_phys.control.constant:ConstantPower",
-    "frictionZone": "amsa_phys.physics.terrain:FrictionZone",
+    "frictionZone": "amsa_phys.physics.zones:FrictionZone",
 }
 
 

@@ -30,14 +30,25 @@ typedef void (*set_vect_fn)(void *, cpVect);
 typedef void (*set_double_fn)(void *, double);
 typedef void (*space_step_fn)(void *, double);
 
-/* Per-rover constants (compiled.py's PLAN_FIELDS, in this order). */
+/* Per-rover constants, in this order: the layout is exported as PLAN_FIELDS (below), and
+ * compiled.py fills each rover's row by these names from forces.fold, checking at import that
+ * it knows every one. Add a constant here and in plan_fields together. */
 enum {
     P_KP, P_C, P_FMAX, P_MW, P_BB, P_BBE, P_E, P_E2, P_KX, P_H, P_TURN_K, P_DT_I, P_DT_M,
     P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, PLAN_WIDTH
 };
 
+static const char *const plan_fields[PLAN_WIDTH] = {
+    "kp", "c", "f_max", "mw", "big_b", "big_be", "e", "e2", "kx", "half_track", "turn_k",
+    "dt_i", "dt_m", "sphi", "ky_dt_m", "neg_m_dt", "big_bc",
+};
+
 #define SLIP_SPEED_MIN 0.1
 #define N_BUFFERS 7
+/* The seven ground terms of a rover (forces.ground_list's order) and where a batch's (7, n)
+ * ground array keeps each (fleet._GROUND_ROWS); both exported and checked at import. */
+#define GROUND_TERMS 7
+static const int ground_rows[GROUND_TERMS] = {0, 2, 4, 1, 3, 5, 6};
 
 typedef struct {
     PyObject_HEAD
@@ -61,7 +72,7 @@ typedef struct {
     const double *ground; /* term t of rover k at k*ground_k + ground_off[t] */
     double *state;
     Py_ssize_t rim_k, rim_side, ground_k;
-    Py_ssize_t ground_off[7];
+    Py_ssize_t ground_off[GROUND_TERMS];
     double dt, max2, extent;
 } Stepper;
 
@@ -655,9 +666,8 @@ static PyObject *column_forces(PyObject *Py_UNUSED(module), PyObject *args)
     st.rim_side = n;
     st.ground = views[3].buf;
     st.ground_k = 1;
-    static const int rows[7] = {0, 2, 4, 1, 3, 5, 6}; /* fleet._GROUND_ROWS */
-    for (int t = 0; t < 7; t++)
-        st.ground_off[t] = rows[t] * n;
+    for (int t = 0; t < GROUND_TERMS; t++)
+        st.ground_off[t] = ground_rows[t] * n;
     st.state = views[4].buf;
     st.dt = dt;
     double *forces = views[5].buf;
@@ -697,9 +707,38 @@ PyMODINIT_FUNC PyInit__step(void)
         Py_DECREF(m);
         return NULL;
     }
-    if (PyModule_AddIntConstant(m, "PLAN_WIDTH", PLAN_WIDTH) < 0) {
-        Py_DECREF(m);
-        return NULL;
+    PyObject *fields = PyTuple_New(PLAN_WIDTH);
+    PyObject *rows = PyTuple_New(GROUND_TERMS);
+    PyObject *slip = PyFloat_FromDouble(SLIP_SPEED_MIN);
+    if (fields == NULL || rows == NULL || slip == NULL)
+        goto fail;
+    for (int i = 0; i < PLAN_WIDTH; i++) {
+        PyObject *name = PyUnicode_FromString(plan_fields[i]);
+        if (name == NULL)
+            goto fail;
+        PyTuple_SET_ITEM(fields, i, name);
     }
+    for (int i = 0; i < GROUND_TERMS; i++) {
+        PyObject *row = PyLong_FromLong(ground_rows[i]);
+        if (row == NULL)
+            goto fail;
+        PyTuple_SET_ITEM(rows, i, row);
+    }
+    /* PyModule_AddObjectRef does not steal: the tuples are released below either way */
+    if (PyModule_AddIntConstant(m, "PLAN_WIDTH", PLAN_WIDTH) < 0 ||
+        PyModule_AddIntConstant(m, "GROUND_TERMS", GROUND_TERMS) < 0 ||
+        PyModule_AddObjectRef(m, "PLAN_FIELDS", fields) < 0 ||
+        PyModule_AddObjectRef(m, "GROUND_ROWS", rows) < 0 ||
+        PyModule_AddObjectRef(m, "SLIP_SPEED_MIN", slip) < 0)
+        goto fail;
+    Py_DECREF(fields);
+    Py_DECREF(rows);
+    Py_DECREF(slip);
     return m;
+fail:
+    Py_XDECREF(fields);
+    Py_XDECREF(rows);
+    Py_XDECREF(slip);
+    Py_DECREF(m);
+    return NULL;
 }

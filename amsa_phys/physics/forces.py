@@ -27,16 +27,16 @@ Why inlined float arithmetic rather than calls into ``wheel.py``: at 100 Hz with
 every microsecond per step is 3 % of the run (issue 8), and a Python call costs about as much
 as the arithmetic it wraps. The usual path (tyres gripping, rims turning, no current limit)
 is inlined; the rare branches call ``wheel.py``'s functions. :func:`reference_forces` is the
-same model written plainly; the tests check this code against it, and ``fleet.py`` (numpy,
-for many rovers) against this. The arithmetic per rover is straight-line apart from those
-branches, so it can move to compiled code as it is.
+same model written plainly; the tests check this code against it. :func:`rover_step` is the
+pure path's one copy of the per-rover arithmetic (``FewRovers`` and ``fleet.Fleet`` call
+it; ``_step.c`` mirrors it in C, bit for bit).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -136,6 +136,9 @@ class FewRovers:
     rover ``k`` at ``2k``, ``2k + 1``).
     """
 
+    #: the rovers' drives are read from the rovers themselves (``force_model.ForceModel``)
+    drives: np.ndarray | None = None
+
     def __init__(
         self,
         io: BodyIO,
@@ -162,7 +165,7 @@ class FewRovers:
         for k, (r, row) in enumerate(zip(self.rovers, self.rows, strict=True)):
             f = fold(r, self.dt)
             s = step_constants(r.wheel, self.dt, r.mass, r.moment, r.half_track)
-            self._plan.append((r, row * STATE, row * FORCE, 2 * k, *f, self.grounds[k], s))
+            self._plan.append((r, row * STATE, row * FORCE, 2 * k, (*f, s), self.grounds[k]))
         self._offsets = [row * STATE for row in self.rows]
 
     @property
@@ -218,143 +221,23 @@ class FewRovers:
         forces = self.io.forces
         rims = self.rims
         dt = self.dt
-        vmin = SLIP_SPEED_MIN
-        ivmin = INV_SLIP_SPEED_MIN
-        sin = math.sin
-        cos = math.cos
-        for (
-            r,
-            i,
-            o,
-            j,
-            kp,
-            c,
-            fmax,
-            mw,
-            bb,
-            bbe,
-            e,
-            e2,
-            kx,
-            _ky,
-            h,
-            turn_k,
-            dt_i,
-            dt_m,
-            _m_dt,
-            sphi,
-            ky_dt_m,
-            neg_m_dt,
-            gnd,
-            sc,
-        ) in self._plan:
-            angle = state[i + 2]
-            vx = state[i + 3]
-            vy = state[i + 4]
-            w = state[i + 5]
-            co = cos(angle)
-            si = sin(angle)
-            v_fwd = vx * co + vy * si
-            wh = w * h
-            ixl, iyl, rl, ixr, iyr, rr, ts = gnd
-            # both rims and tyres, backward Euler (wheel.wheel_pair's usual branch)
-            ul = rims[j]
-            ur = rims[j + 1]
-            vl = v_fwd - wh
-            vr = v_fwd + wh
-            ivl = 1.0 / vl if vl > vmin else (-1.0 / vl if vl < -vmin else ivmin)
-            ivr = 1.0 / vr if vr > vmin else (-1.0 / vr if vr < -vmin else ivmin)
-            kl = kx * ivl
-            kr = kx * ivr
-            f0l = kp * r.drive_l
-            f0r = kp * r.drive_r
-            if ul == 0.0 and ur == 0.0:
-                # a parked rover (wheel.held): the tyres hold the body against still rims; the
-                # rims stay still if their resistance holds them against motor and tyre
-                gl = 1.0 + kl * e
-                gr = 1.0 + kr * e
-                cl = kl * e2
-                cr = kr * e2
-                bl = -kl * vl
-                br = -kr * vr
-                det = gl * gr - cl * cr
-                fxl = (bl * gr - cl * br) / det
-                fxr = (br * gl - cr * bl) / det
-                nl = (f0l if -fmax <= f0l <= fmax else (fmax if f0l > 0 else -fmax)) - fxl
-                nr = (f0r if -fmax <= f0r <= fmax else (fmax if f0r > 0 else -fmax)) - fxr
-                if -rl <= nl <= rl and -rr <= nr <= rr:
-                    upl = upr = 0.0
-                else:
-                    fxl, upl, fxr, upr = wheel_pair(
-                        (ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc
-                    )
-            else:
-                al = (mw * ul + f0l - (rl if ul > 0.0 else -rl if ul < 0.0 else 0.0)) * bb
-                ar = (mw * ur + f0r - (rr if ur > 0.0 else -rr if ur < 0.0 else 0.0)) * bb
-                gl = 1.0 + kl * bbe
-                gr = 1.0 + kr * bbe
-                cl = kl * e2
-                cr = kr * e2
-                bl = kl * (al - vl)
-                br = kr * (ar - vr)
-                det = gl * gr - cl * cr
-                fxl = (bl * gr - cl * br) / det
-                fxr = (br * gl - cr * bl) / det
-                upl = al - bb * fxl
-                upr = ar - bb * fxr
-                fml = f0l - c * upl
-                fmr = f0r - c * upr
-                if not (
-                    upl * ul > 0.0
-                    and upr * ur > 0.0
-                    and -fmax <= fml <= fmax
-                    and -fmax <= fmr <= fmax
-                ):
-                    fxl, upl, fxr, upr = wheel_pair(
-                        (ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc
-                    )
-            # scrub: the patches' turn-slip moment, implicit in the yaw rate, capped
-            isum = ivl + ivr
-            torque = (fxr - fxl) * h
-            kphi = sphi * isum
-            scrub = -kphi * (w + torque * dt_i) / (1.0 + kphi * dt_i)
-            if scrub > ts:
-                scrub = ts
-            elif scrub < -ts:
-                scrub = -ts
-            torque += scrub
-            # predicted heading change over this step (semi-implicit Euler, as pymunk does)
-            turn = w * dt + torque * turn_k
-            end = angle + turn
-            mid = angle + 0.5 * turn
-            cm = cos(mid)
-            sm = sin(mid)
-            # velocity after the drive force alone, and its sideways part at the end heading
-            fx = fxl + fxr
-            a = fx * dt_m
-            side = (vy + a * sm) * cos(end) - (vx + a * cm) * sin(end)
-            kd = ky_dt_m * isum
-            f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
-            fyl = f_lat * ivl / isum
-            fyr = f_lat - fyl
-            # friction ellipse per wheel; a saturated tyre's rim is re-solved with that force
-            t1 = fxl * ixl
-            t2 = fyl * iyl
-            t3 = fxr * ixr
-            t4 = fyr * iyr
-            if t1 * t1 + t2 * t2 > 1.0 or t3 * t3 + t4 * t4 > 1.0:
-                fxl, fyl = friction_ellipse(fxl, fyl, ixl, iyl)
-                fxr, fyr = friction_ellipse(fxr, fyr, ixr, iyr)
-                upl = rim_alone(ul, f0l, rl, fxl, sc)
-                upr = rim_alone(ur, f0r, rr, fxr, sc)
-                fx = fxl + fxr
-                torque = (fxr - fxl) * h + scrub
-                f_lat = fyl + fyr
-            forces[o] = fx * cm - f_lat * sm
-            forces[o + 1] = fx * sm + f_lat * cm
+        for r, i, o, j, plan, gnd in self._plan:
+            fx, fy, torque, rims[j], rims[j + 1] = rover_step(
+                plan,
+                gnd,
+                dt,
+                state[i + 2],
+                state[i + 3],
+                state[i + 4],
+                state[i + 5],
+                rims[j],
+                rims[j + 1],
+                r.drive_l,
+                r.drive_r,
+            )
+            forces[o] = fx
+            forces[o + 1] = fy
             forces[o + 2] = torque
-            rims[j] = upl
-            rims[j + 1] = upr
 
     def first_violation(
         self, state: Sequence[float], max_speed: float, extent: float
@@ -368,6 +251,146 @@ class FewRovers:
             if not (abs(x) <= extent and abs(y) <= extent):
                 return k, outside(x, y, extent)
         return None
+
+
+def rover_step(
+    plan: tuple[Any, ...],
+    gnd: Sequence[float],
+    dt: float,
+    angle: float,
+    vx: float,
+    vy: float,
+    w: float,
+    ul: float,
+    ur: float,
+    drive_l: float,
+    drive_r: float,
+) -> tuple[float, float, float, float, float]:
+    """One rover's force for one step: ``(fx, fy, torque, u_left+, u_right+)``.
+
+    The pure path's only copy of the per-rover arithmetic (``_step.c``'s ``rover_forces`` is
+    its C twin, bit for bit): ``FewRovers`` and ``Fleet`` both call it. ``plan`` is
+    :func:`fold`'s constants followed by the wheel's :class:`wheel.StepConstants`, ``gnd``
+    :func:`ground_list`'s terms, ``drive_*`` the drivers' outputs (%, deadband applied).
+    The usual path (tyres gripping, rims turning, no current limit) is inlined: at 100 Hz
+    with two rovers every microsecond per step is 3 % of the run, and a Python call costs
+    about as much as the arithmetic it wraps; the rare branches call ``wheel.py``.
+    """
+    (
+        kp,
+        c,
+        fmax,
+        mw,
+        bb,
+        bbe,
+        e,
+        e2,
+        kx,
+        _ky,
+        h,
+        turn_k,
+        dt_i,
+        dt_m,
+        _m_dt,
+        sphi,
+        ky_dt_m,
+        neg_m_dt,
+        sc,
+    ) = plan
+    vmin = SLIP_SPEED_MIN
+    ivmin = INV_SLIP_SPEED_MIN
+    sin = math.sin
+    cos = math.cos
+    co = cos(angle)
+    si = sin(angle)
+    v_fwd = vx * co + vy * si
+    wh = w * h
+    ixl, iyl, rl, ixr, iyr, rr, ts = gnd
+    # both rims and tyres, backward Euler (wheel.wheel_pair's usual branch)
+    vl = v_fwd - wh
+    vr = v_fwd + wh
+    ivl = 1.0 / vl if vl > vmin else (-1.0 / vl if vl < -vmin else ivmin)
+    ivr = 1.0 / vr if vr > vmin else (-1.0 / vr if vr < -vmin else ivmin)
+    kl = kx * ivl
+    kr = kx * ivr
+    f0l = kp * drive_l
+    f0r = kp * drive_r
+    if ul == 0.0 and ur == 0.0:
+        # a parked rover (wheel.held): the tyres hold the body against still rims; the
+        # rims stay still if their resistance holds them against motor and tyre
+        gl = 1.0 + kl * e
+        gr = 1.0 + kr * e
+        cl = kl * e2
+        cr = kr * e2
+        bl = -kl * vl
+        br = -kr * vr
+        det = gl * gr - cl * cr
+        fxl = (bl * gr - cl * br) / det
+        fxr = (br * gl - cr * bl) / det
+        nl = (f0l if -fmax <= f0l <= fmax else (fmax if f0l > 0 else -fmax)) - fxl
+        nr = (f0r if -fmax <= f0r <= fmax else (fmax if f0r > 0 else -fmax)) - fxr
+        if -rl <= nl <= rl and -rr <= nr <= rr:
+            upl = upr = 0.0
+        else:
+            fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc)
+    else:
+        al = (mw * ul + f0l - (rl if ul > 0.0 else -rl if ul < 0.0 else 0.0)) * bb
+        ar = (mw * ur + f0r - (rr if ur > 0.0 else -rr if ur < 0.0 else 0.0)) * bb
+        gl = 1.0 + kl * bbe
+        gr = 1.0 + kr * bbe
+        cl = kl * e2
+        cr = kr * e2
+        bl = kl * (al - vl)
+        br = kr * (ar - vr)
+        det = gl * gr - cl * cr
+        fxl = (bl * gr - cl * br) / det
+        fxr = (br * gl - cr * bl) / det
+        upl = al - bb * fxl
+        upr = ar - bb * fxr
+        fml = f0l - c * upl
+        fmr = f0r - c * upr
+        if not (
+            upl * ul > 0.0 and upr * ur > 0.0 and -fmax <= fml <= fmax and -fmax <= fmr <= fmax
+        ):
+            fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc)
+    # scrub: the patches' turn-slip moment, implicit in the yaw rate, capped
+    isum = ivl + ivr
+    torque = (fxr - fxl) * h
+    kphi = sphi * isum
+    scrub = -kphi * (w + torque * dt_i) / (1.0 + kphi * dt_i)
+    if scrub > ts:
+        scrub = ts
+    elif scrub < -ts:
+        scrub = -ts
+    torque += scrub
+    # predicted heading change over this step (semi-implicit Euler, as pymunk does)
+    turn = w * dt + torque * turn_k
+    end = angle + turn
+    mid = angle + 0.5 * turn
+    cm = cos(mid)
+    sm = sin(mid)
+    # velocity after the drive force alone, and its sideways part at the end heading
+    fx = fxl + fxr
+    a = fx * dt_m
+    side = (vy + a * sm) * cos(end) - (vx + a * cm) * sin(end)
+    kd = ky_dt_m * isum
+    f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
+    fyl = f_lat * ivl / isum
+    fyr = f_lat - fyl
+    # friction ellipse per wheel; a saturated tyre's rim is re-solved with that force
+    t1 = fxl * ixl
+    t2 = fyl * iyl
+    t3 = fxr * ixr
+    t4 = fyr * iyr
+    if t1 * t1 + t2 * t2 > 1.0 or t3 * t3 + t4 * t4 > 1.0:
+        fxl, fyl = friction_ellipse(fxl, fyl, ixl, iyl)
+        fxr, fyr = friction_ellipse(fxr, fyr, ixr, iyr)
+        upl = rim_alone(ul, f0l, rl, fxl, sc)
+        upr = rim_alone(ur, f0r, rr, fxr, sc)
+        fx = fxl + fxr
+        torque = (fxr - fxl) * h + scrub
+        f_lat = fyl + fyr
+    return fx * cm - f_lat * sm, fx * sm + f_lat * cm, torque, upl, upr
 
 
 def reference_forces(

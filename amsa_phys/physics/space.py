@@ -29,9 +29,10 @@ import numpy as np
 import pymunk
 
 from ..errors import RunFault
-from . import compiled, fleet
+from . import fleet
 from .bodyio import BodyIO
-from .forces import FewRovers, ground_list
+from .force_model import ForceModel, make_force_model
+from .forces import ground_list
 from .rover import DiffDriveRover
 from .terrain import Terrain
 from .wheel import WheelModel
@@ -74,14 +75,20 @@ class PhysicsWorld:
         self._touching: dict[tuple[str, str], int] = {}
         self._apart_since: dict[tuple[str, str], float] = {}
         self._steps = 0
-        self._model: FewRovers | fleet.Fleet | None = None
+        self._model: ForceModel | None = None
+        #: the batch's column physics stepping this world (``columns.py``), or None
+        self.group: Any = None
         self._where: list[tuple[int, int, int] | None] = []
         self._add_obstacles(settings.get("obstacles") or [], settings.get("walls"))
         for kind in (ROVER, OBSTACLE):
             self.space.on_collision(
                 ROVER, kind, begin=self._on_collision, separate=self._on_separate
             )
-        sim.add_hook(self.rate, self.step, "physics")
+        columns = getattr(sim, "column_physics", None)  # a batch's run declares its columns
+        if columns is not None:
+            columns.adopt(self, sim)
+        else:
+            sim.add_hook(self.rate, self.step, "physics")
 
     def _add_obstacles(self, obstacles: list[dict[str, Any]], walls: dict[str, Any] | None) -> None:
         static = self.space.static_body
@@ -204,21 +211,14 @@ class PhysicsWorld:
         if bad is not None:
             raise RunFault(self.rovers[bad[0]].name, self.sim.now + 1 / self.rate, bad[1])
 
-    def _start(self) -> FewRovers | fleet.Fleet:
+    def _start(self) -> ForceModel:
         """Choose the force model for this many rovers and read the initial state."""
         self._choose_index()
         io = BodyIO(self.space, [r.body for r in self.rovers])
         limits = (self.max_speed, self.extent)
         ground = self.terrain.ground(-1)
         grounds = [ground_list(r, ground, ground) for r in self.rovers]
-        fast = compiled.usable(io)  # the C step when it was built (compiled.status says why)
-        model: FewRovers | fleet.Fleet
-        if len(self.rovers) >= fleet.BATCH_MIN:
-            cls = compiled.CompiledFleet if fast else fleet.Fleet
-            model = cls(io, self.rovers, self.dt, limits, grounds)
-        else:
-            few = compiled.CompiledFewRovers if fast else FewRovers
-            model = few(io, self.rovers, self.dt, limits, grounds)
+        model = make_force_model(io, self.rovers, self.dt, limits, grounds)
         self._model = model
         self._where = [(-1, -1, -1)] * len(self.rovers)
         for k, rover in enumerate(self.rovers):
@@ -241,6 +241,8 @@ class PhysicsWorld:
 
     def index_of(self, rovers: Sequence[DiffDriveRover]) -> np.ndarray:
         """Positions of ``rovers`` in this world (for :meth:`kinematics_array`)."""
+        if self.group is not None:
+            return self.group.index_of(rovers)  # type: ignore[no-any-return]
         where = {id(r): k for k, r in enumerate(self.rovers)}
         return np.array([where[id(r)] for r in rovers], dtype=np.intp)
 
@@ -258,6 +260,9 @@ class PhysicsWorld:
         NaN to -100 as :func:`rover._saturate`); the rovers' ``power_l``/``power_r`` (which the
         per-rover force model and the renderer read) and the batch model's arrays both follow.
         """
+        if self.group is not None:  # a batch's columns: no window reads power_l there
+            self.group.set_powers(rovers, index, left, right)
+            return
         left = np.where(np.isnan(left), -100.0, np.clip(left, -100.0, 100.0))
         right = np.where(np.isnan(right), -100.0, np.clip(right, -100.0, 100.0))
         drive_l, drive_r = [], []
@@ -269,17 +274,21 @@ class PhysicsWorld:
             rover.drive_r = dr = rp if not -band < rp < band else 0.0
             drive_l.append(dl)
             drive_r.append(dr)
-        drives = getattr(self._model, "drives", None)  # the batch models' and the C step's
+        drives = self._model.drives if self._model is not None else None
         if drives is not None:
             drives[0, index] = drive_l
             drives[1, index] = drive_r
 
     def kinematics_array(self, index: np.ndarray) -> np.ndarray:
         """(n, 6) ``x, y, angle, vx, vy, w`` of the rovers at ``index`` after the last step."""
+        if self.group is not None:
+            return self.group.kinematics_array(index)  # type: ignore[no-any-return]
         return (self._model or self._start()).kinematics_array(index)
 
     def rim_array(self, index: np.ndarray) -> np.ndarray:
         """(n, 2) left and right rim speeds of the rovers at ``index`` after the last step."""
+        if self.group is not None:
+            return self.group.rim_array(index)  # type: ignore[no-any-return]
         return (self._model or self._start()).rim_array(index)
 
     def _kinematics(self, k: int) -> Sequence[float]:

@@ -1,6 +1,6 @@
 """Terrain: friction zones (polygons with their own friction and rolling resistance).
 
-A zone is an *environment* component (template ``frictionZone``), so everything the
+A zone is an *environment* component (template ``frictionZone``, in ``zones.py``), so everything the
 framework does with parameters works on terrain too: ``describe`` lists a zone's friction
 with its range, ``templates`` documents it, a sweep varies it, the window's panel edits it,
 and "mud from t = 60" is an ordinary timeline change ``Mud.friction: 0.3``. The zone
@@ -15,15 +15,11 @@ with one wheel in mud pulls towards it.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
-from fractions import Fraction
 from typing import Any
 
 import numpy as np
-
-from ..model.params import Param
-from ..model.template import Kind, Template
 
 
 @dataclass
@@ -150,74 +146,3 @@ def polygon_area(points: Sequence[Sequence[float]]) -> float:
     for (x0, y0), (x1, y1) in zip(points, [*points[1:], points[0]], strict=True):
         total += x0 * y1 - x1 * y0
     return total / 2
-
-
-class FrictionZone(Template):
-    """A patch of ground with its own friction and rolling resistance (mud, ice, sand, grass).
-
-    The wheels of any rover over ``polygon`` use this friction (tyre grip, scrub) and
-    rolling resistance instead of the world's ``physics.ground``. Change ``friction`` in a
-    scenario's timeline to make the ground change mid-run ("mud from t = 60":
-    ``{at: 60, set: {Mud.friction: 0.3}}``). Overlapping zones: the last declared wins.
-    """
-
-    template_name = "frictionZone"
-    kind = Kind.ENVIRONMENT
-    params = (
-        Param(
-            "friction",
-            "float",
-            "tyre-ground friction coefficient mu in the zone (dry asphalt 0.8, wet grass "
-            "0.35, mud 0.3, snow 0.2, ice 0.05)",
-            0.3,
-            0.0,
-            5.0,
-        ),
-        Param(
-            "rollingResistance",
-            "float",
-            "rolling-resistance coefficient Crr in the zone (concrete 0.015, grass 0.05, "
-            "sand 0.15, mud 0.1-0.3)",
-            0.1,
-            0.0,
-            1.0,
-        ),
-        Param(
-            "polygon",
-            "points",
-            "the zone's corners [[x, y], ...] in order (at least 3, not crossing)",
-            (),
-            unit="m",
-        ),
-    )
-
-    @classmethod
-    def check_params(cls, values: Mapping[str, Any]) -> None:
-        """A zone needs a polygon with an area."""
-        pts = values.get("polygon", ())
-        if len(pts) < 3:
-            raise ValueError(f"polygon needs at least 3 corners, got {len(pts)}")
-        if abs(polygon_area(pts)) < 1e-9:
-            raise ValueError("polygon has no area (its corners are on one line)")
-
-    def initialize(self, ctx: Any) -> None:
-        """Register the zone with the run's physics world."""
-        from .space import physics_of  # the world module imports this one
-
-        self.check_params(self.p.as_dict())
-        self.terrain = physics_of(ctx).terrain
-        self.terrain.add(
-            Zone(self.path, tuple(self.p.polygon), self.p.friction, self.p.rollingResistance)
-        )
-
-    def on_param_change(self, name: str, value: Any) -> None:
-        """Tell the physics: the next step's wheels see the new ground."""
-        self.check_params(self.p.as_dict())
-        key = {"friction": "friction", "rollingResistance": "rolling_resistance"}.get(
-            name, "polygon"
-        )
-        self.terrain.update(self.path, **{key: tuple(value) if key == "polygon" else value})
-
-    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
-        """The paper's doStep: nothing to publish (the ground acts through the physics)."""
-        return {}

@@ -1,8 +1,9 @@
 """One driven wheel: motor and driver, spinning rim, tyre. Pure math, no pymunk.
 
-This module is the readable statement of the wheel model and its closed forms; ``forces.py``
-(a few rovers, plain floats) and ``fleet.py`` (many rovers, numpy) inline the same arithmetic
-and are tested against :func:`rim_and_tyre`, :func:`rim_alone` and :func:`friction_ellipse`.
+This module is the readable statement of the wheel model and its closed forms;
+``forces.rover_step`` (the pure path's one copy, which ``_step.c`` mirrors) inlines the same
+arithmetic and is tested against :func:`rim_and_tyre`, :func:`rim_alone` and
+:func:`friction_ellipse`.
 
 Forces are expressed at the ground (N), speeds at the rim (m/s): the wheel's spin state is its
 rim speed ``u = omega * r`` (what an encoder measures), and its inertia acts as a mass

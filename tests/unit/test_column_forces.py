@@ -92,7 +92,7 @@ def test_column_forces_refuse_arrays_of_the_wrong_size() -> None:
         )
 
 
-def test_the_pure_switch_keeps_batches_on_the_numpy_fleet(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_pure_switch_keeps_batches_on_the_pure_fleet(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv(PURE_ENV, "1")
     assert not compiled.columns_compiled()
     monkeypatch.delenv(PURE_ENV)
