@@ -35,12 +35,12 @@ typedef void (*space_step_fn)(void *, double);
  * it knows every one. Add a constant here and in plan_fields together. */
 enum {
     P_KP, P_C, P_FMAX, P_MW, P_BB, P_BBE, P_E, P_E2, P_KX, P_H, P_TURN_K, P_DT_I, P_DT_M,
-    P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, PLAN_WIDTH
+    P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, P_KY, PLAN_WIDTH
 };
 
 static const char *const plan_fields[PLAN_WIDTH] = {
     "kp", "c", "f_max", "mw", "big_b", "big_be", "e", "e2", "kx", "half_track", "turn_k",
-    "dt_i", "dt_m", "sphi", "ky_dt_m", "neg_m_dt", "big_bc",
+    "dt_i", "dt_m", "sphi", "ky_dt_m", "neg_m_dt", "big_bc", "ky",
 };
 
 #define SLIP_SPEED_MIN 0.1
@@ -226,44 +226,75 @@ static void wheel_pair(const double u[2], const double v[2], const double f0[2],
     out[3] = upr;
 }
 
-static double rim_solve(double u, double f0, double fr, double fx, const StepConstants *s)
+/* ---- wheel.slide: a sliding tyre solved with its rim ----------------------------------- */
+#define SLIDE_ITERATIONS 100
+
+typedef struct {
+    double u, v, f0, ivs, kx, ix, qy;
+    const StepConstants *s;
+} Slide;
+
+static double slide_tyre_x(const Slide *w, double up, double *scale)
 {
-    double up = (s->mw * u + f0 - fr - fx) * s->big_b;
-    double fm = f0 - s->c * up;
-    if (fm > s->f_max || fm < -s->f_max)
-        up = u + ((fm > 0 ? s->f_max : -s->f_max) - fr - fx) * s->big_bc;
-    return up;
+    double fx = w->kx * (up - w->v) * w->ivs;
+    double qx = fx * w->ix;
+    double qq = qx * qx + w->qy * w->qy;
+    *scale = qq > 1.0 ? 1.0 / sqrt(qq) : 1.0;
+    return fx * *scale;
 }
 
-static double rim_alone(double u, double f0, double res, double fx, const StepConstants *s)
-{ /* wheel.rim_alone */
-    if (u != 0.0) {
-        double up = rim_solve(u, f0, u > 0 ? res : -res, fx, s);
-        if (up * u > 0.0)
-            return up;
+static double slide_excess(const Slide *w, double up, double fr)
+{
+    const StepConstants *s = w->s;
+    double fm = w->f0 - s->c * up;
+    if (fm > s->f_max)
+        fm = s->f_max;
+    else if (fm < -s->f_max)
+        fm = -s->f_max;
+    double scale;
+    double fx = slide_tyre_x(w, up, &scale);
+    return s->mw * (up - w->u) - fm + fr + fx;
+}
+
+static void slide(double u, double v, double f0, double res, double ivs, double kx, double ky,
+                  double ix, double iy, double side, double fy_cap, const StepConstants *s,
+                  double *fx_out, double *fy_out, double *up_out)
+{
+    Slide w = {u, v, f0, ivs, kx, ix, -ky * side * ivs * iy, s};
+    double scale;
+    double up;
+    double need = s->mw * u + limited(f0, s) - slide_tyre_x(&w, 0.0, &scale);
+    if (-res <= need && need <= res) {
+        up = 0.0;
+    } else {
+        double reach = (s->f_max + 1.0 / ix) / s->mw;
+        double lo, hi, fr;
+        if (need > 0) {
+            lo = 0.0, hi = u + reach, fr = res;
+        } else {
+            lo = u - reach, hi = 0.0, fr = -res;
+        }
+        for (int i = 0; i < SLIDE_ITERATIONS; i++) {
+            double mid = 0.5 * (lo + hi);
+            if (mid <= lo || mid >= hi)
+                break;
+            if (slide_excess(&w, mid, fr) > 0.0)
+                hi = mid;
+            else
+                lo = mid;
+        }
+        up = 0.5 * (lo + hi);
     }
-    double f0_lim = limited(f0, s);
-    double need = f0_lim + s->mw * u - fx;
-    if (-res <= need && need <= res)
-        return 0.0;
-    return rim_solve(u, f0, need > 0 ? res : -res, fx, s);
+    double fx = slide_tyre_x(&w, up, &scale);
+    double fy = -ky * side * ivs * scale;
+    if (fabs(fy_cap) < fabs(fy))
+        fy = fy_cap;
+    *fx_out = fx;
+    *fy_out = fy;
+    *up_out = up;
 }
 
-static double (*volatile libm_pow)(double, double) = pow;
-
-static void friction_ellipse(double *fx, double *fy, double inv_x, double inv_y)
-{ /* wheel.friction_ellipse. Python's x ** 2 is libm's pow(x, 2.0), which differs from x * x
-   * in the last bit for ~1 value in 1,000; GCC folds a direct pow(x, 2.0) into x * x, so
-   * libm's pow is called through a volatile pointer the compiler cannot see through. */
-    double q = libm_pow(*fx * inv_x, 2.0) + libm_pow(*fy * inv_y, 2.0);
-    if (q > 1.0) {
-        double scale = 1.0 / sqrt(q);
-        *fx = *fx * scale;
-        *fy = *fy * scale;
-    }
-}
-
-/* ---- forces.FewRovers.apply, one rover ------------------------------------------------ */
+/* ---- forces.rover_step, one rover ------------------------------------------------------ */
 static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
 {
     const double *p = st->plan + k * PLAN_WIDTH;
@@ -368,11 +399,14 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double t2 = fyl * iyl;
     double t3 = fxr * ixr;
     double t4 = fyr * iyr;
-    if (t1 * t1 + t2 * t2 > 1.0 || t3 * t3 + t4 * t4 > 1.0) {
-        friction_ellipse(&fxl, &fyl, ixl, iyl);
-        friction_ellipse(&fxr, &fyr, ixr, iyr);
-        upl = rim_alone(ul, f0l, rl, fxl, &sc);
-        upr = rim_alone(ur, f0r, rr, fxr, &sc);
+    int sat_l = t1 * t1 + t2 * t2 > 1.0;
+    int sat_r = t3 * t3 + t4 * t4 > 1.0;
+    if (sat_l || sat_r) {
+        double side0 = vy * co - vx * si;
+        if (sat_l)
+            slide(ul, vl, f0l, rl, ivl, kx, p[P_KY], ixl, iyl, side0, fyl, &sc, &fxl, &fyl, &upl);
+        if (sat_r)
+            slide(ur, vr, f0r, rr, ivr, kx, p[P_KY], ixr, iyr, side0, fyr, &sc, &fxr, &fyr, &upr);
         fx = fxl + fxr;
         torque = (fxr - fxl) * h + scrub;
         f_lat = fyl + fyr;

@@ -45,8 +45,7 @@ from .rover import DiffDriveRover
 from .wheel import (
     SLIP_SPEED_MIN,
     TORSION,
-    friction_ellipse,
-    rim_alone,
+    slide,
     slip_speed,
     step_constants,
     wheel_pair,
@@ -286,7 +285,7 @@ def rover_step(
         e,
         e2,
         kx,
-        _ky,
+        ky,
         h,
         turn_k,
         dt_i,
@@ -377,16 +376,20 @@ def rover_step(
     f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
     fyl = f_lat * ivl / isum
     fyr = f_lat - fyl
-    # friction ellipse per wheel; a saturated tyre's rim is re-solved with that force
+    # friction ellipse per wheel: a tyre the gripping solve puts beyond it slides, and the
+    # tyre law is solved with its rim instead (wheel.slide)
     t1 = fxl * ixl
     t2 = fyl * iyl
     t3 = fxr * ixr
     t4 = fyr * iyr
-    if t1 * t1 + t2 * t2 > 1.0 or t3 * t3 + t4 * t4 > 1.0:
-        fxl, fyl = friction_ellipse(fxl, fyl, ixl, iyl)
-        fxr, fyr = friction_ellipse(fxr, fyr, ixr, iyr)
-        upl = rim_alone(ul, f0l, rl, fxl, sc)
-        upr = rim_alone(ur, f0r, rr, fxr, sc)
+    sat_l = t1 * t1 + t2 * t2 > 1.0
+    sat_r = t3 * t3 + t4 * t4 > 1.0
+    if sat_l or sat_r:
+        side0 = vy * co - vx * si
+        if sat_l:
+            fxl, fyl, upl = slide(ul, vl, f0l, rl, ivl, (kx, ky, ixl, iyl), side0, fyl, sc)
+        if sat_r:
+            fxr, fyr, upr = slide(ur, vr, f0r, rr, ivr, (kx, ky, ixr, iyr), side0, fyr, sc)
         fx = fxl + fxr
         torque = (fxr - fxl) * h + scrub
         f_lat = fyl + fyr
@@ -447,11 +450,18 @@ def reference_forces(
     sat = (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1 or (fxr * inv[2]) ** 2 + (
         fyr * inv[3]
     ) ** 2 > 1
-    if sat:
-        fxl, fyl = friction_ellipse(fxl, fyl, inv[0], inv[1])
-        fxr, fyr = friction_ellipse(fxr, fyr, inv[2], inv[3])
-        upl = rim_alone(ul, f0l, rl, fxl, s)
-        upr = rim_alone(ur, f0r, rr, fxr, s)
+    if sat:  # a sliding tyre: the tyre law solved with its rim (wheel.slide)
+        side0 = vy * math.cos(a) - vx * math.sin(a)
+        ky1 = wm.load_n / wm.slip_lat
+        hub = (v_fwd - w * rover.half_track, v_fwd + w * rover.half_track)
+        if (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1:
+            fxl, fyl, upl = slide(
+                ul, hub[0], f0l, rl, 1 / sl, (kx, ky1, inv[0], inv[1]), side0, fyl, s
+            )
+        if (fxr * inv[2]) ** 2 + (fyr * inv[3]) ** 2 > 1:
+            fxr, fyr, upr = slide(
+                ur, hub[1], f0r, rr, 1 / sr, (kx, ky1, inv[2], inv[3]), side0, fyr, s
+            )
         fx = fxl + fxr
         torque = (fxr - fxl) * rover.half_track + scrub
         f_lat = fyl + fyr
