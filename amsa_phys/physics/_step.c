@@ -74,6 +74,8 @@ typedef struct {
     Py_ssize_t rim_k, rim_side, ground_k;
     Py_ssize_t ground_off[GROUND_TERMS];
     double dt, max2, extent;
+    double sub_speed; /* faster than this a step is cut into sub-steps (bodyio.substeps) */
+    double top2;      /* the fastest rover's squared speed after the last step */
 } Stepper;
 
 /* ---- wheel.py's rare branches --------------------------------------------------------- */
@@ -419,6 +421,15 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
 }
 
 /* ---- the step's parts ------------------------------------------------------------------ */
+/* bodyio.substeps: Chipmunk steps in this physics step, so that no rover tunnels */
+static int substeps(double top2, double sub_speed)
+{
+    double sub2 = sub_speed * sub_speed;
+    if (!(top2 > sub2))
+        return 1;
+    return (int)ceil(sqrt(top2) / sub_speed);
+}
+
 static void apply_all(Stepper *st)
 {
     for (Py_ssize_t k = 0; k < st->n; k++) {
@@ -435,6 +446,7 @@ static Py_ssize_t read_check(Stepper *st)
 {
     Py_ssize_t bad = -1;
     const double max2 = st->max2, extent = st->extent;
+    double top2 = 0.0;
     for (Py_ssize_t k = 0; k < st->n; k++) {
         void *b = st->bodies[k];
         double *s = st->state + st->offsets[k];
@@ -446,17 +458,25 @@ static Py_ssize_t read_check(Stepper *st)
         s[3] = v.x;
         s[4] = v.y;
         s[5] = st->get_angular_velocity(b);
-        if (bad < 0 && !(v.x * v.x + v.y * v.y <= max2 && -extent <= p.x && p.x <= extent &&
+        double v2 = v.x * v.x + v.y * v.y;
+        if (v2 > top2)
+            top2 = v2;
+        if (bad < 0 && !(v2 <= max2 && -extent <= p.x && p.x <= extent &&
                          -extent <= p.y && p.y <= extent))
             bad = k;
     }
+    if (bad < 0)
+        st->top2 = top2;
     return bad;
 }
 
 static PyObject *Stepper_advance(Stepper *st, PyObject *Py_UNUSED(ignored))
 {
     apply_all(st);
-    st->space_step(st->space, st->dt);
+    int n = substeps(st->top2, st->sub_speed);
+    double h = st->dt / (double)n;
+    for (int i = 0; i < n && !PyErr_Occurred(); i++)
+        st->space_step(st->space, h);
     if (PyErr_Occurred()) /* a collision callback raised (cffi reports, never sets) */
         return NULL;
     return PyLong_FromSsize_t(read_check(st));
@@ -537,21 +557,21 @@ static int Stepper_init(Stepper *st, PyObject *args, PyObject *kwds)
 {
     static char *kwlist[] = {"space",  "functions", "bodies",   "offsets", "plan",
                              "drives", "rims",      "rim_strides", "ground", "ground_layout",
-                             "state",  "dt",        "max2",     "extent",  NULL};
+                             "state",  "dt",        "max2",     "extent",  "sub_speed", NULL};
     unsigned long long space;
     PyObject *fns, *bodies, *offsets, *plan, *drives, *rims, *ground, *state;
     Py_ssize_t rim_k, rim_side, ground_k;
     Py_ssize_t go[7];
-    double dt, max2, extent;
+    double dt, max2, extent, sub_speed = INFINITY;
     if (st->n_views) {
         PyErr_SetString(PyExc_RuntimeError, "Stepper is initialised once");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "KO!OOOOO(nn)O(n(nnnnnnn))Oddd", kwlist, &space,
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "KO!OOOOO(nn)O(n(nnnnnnn))Oddd|d", kwlist, &space,
                                      &PyTuple_Type, &fns, &bodies, &offsets, &plan, &drives,
                                      &rims, &rim_k, &rim_side, &ground, &ground_k, &go[0],
                                      &go[1], &go[2], &go[3], &go[4], &go[5], &go[6], &state, &dt,
-                                     &max2, &extent))
+                                     &max2, &extent, &sub_speed))
         return -1;
     if (PyTuple_GET_SIZE(fns) != 7) {
         PyErr_SetString(PyExc_ValueError, "functions: seven addresses");
@@ -625,6 +645,14 @@ static int Stepper_init(Stepper *st, PyObject *args, PyObject *kwds)
     st->dt = dt;
     st->max2 = max2;
     st->extent = extent;
+    st->sub_speed = sub_speed;
+    st->top2 = 0.0;
+    for (Py_ssize_t k = 0; k < st->n; k++) { /* as FewRovers.__init__ */
+        const double *s = st->state + st->offsets[k];
+        double v2 = s[3] * s[3] + s[4] * s[4];
+        if (v2 > st->top2)
+            st->top2 = v2;
+    }
     return 0;
 }
 

@@ -49,7 +49,7 @@ from .fleet import Fleet
 from .force_model import make_force_model
 from .forces import ground_list
 from .rover import DiffDriveRover
-from .space import PhysicsWorld
+from .space import PhysicsWorld, resolvable_speed
 
 #: Two shapes of a run closer than this (plus two steps of their motion): the run may be
 #: about to touch, and its row is made alone.
@@ -80,7 +80,9 @@ class _ColumnIO:
     def write(self) -> None:
         pass
 
-    def step(self, dt: float) -> None:
+    def step(self, dt: float, substeps: int = 1) -> None:
+        """One step of every body (``substeps`` is the Space's business: a run fast enough to
+        need them is made alone, :meth:`ColumnPhysics._contacts`)."""
         s = self.state
         np.copyto(self.before, s)
         # cpBodyUpdatePosition: p = p + (v + v_bias) * dt; a = a + (w + w_bias) * dt
@@ -173,6 +175,12 @@ class ColumnPhysics:
         for w in self.worlds:
             ground = w.terrain.ground(-1)
             grounds += [ground_list(r, ground, ground) for r in w.rovers]
+        # faster than its world's resolvable speed a run's Space would take sub-steps
+        # (``bodyio.substeps``), which these columns do not: such a run is made alone (with a
+        # margin, so that rounding at the threshold cannot decide it)
+        self._sub = np.array(
+            [resolvable_speed(w.rovers, w.space, self.dt) for w in self.worlds for _ in w.rovers]
+        )
         limits = (first.max_speed, first.extent)
         # the C force model (a single run's own arithmetic) when built; the pure one otherwise
         model = make_force_model(io, self.rovers, self.dt, limits, grounds, columns=True)
@@ -214,6 +222,9 @@ class ColumnPhysics:
         x, y = before[:, 0], before[:, 1]
         speed = np.hypot(before[:, 3], before[:, 4])
         reach = self._radius + REACH_M + 2.0 * dt * speed
+        fast = speed > 0.99 * self._sub
+        if fast.any():
+            self.touched.update(self._run[fast].tolist())
         if len(self._pa):
             pa, pb = self._pa, self._pb
             gap = np.hypot(x[pa] - x[pb], y[pa] - y[pb])

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from .bodyio import STATE, BodyIO, locked_step
+from .bodyio import STATE, BodyIO, locked_step, substeps
 from .fleet import _GROUND_ROWS, Fleet
 from .forces import FewRovers, Folded, fold
 from .rover import DiffDriveRover
@@ -124,12 +124,15 @@ def _locked_step(space: Any, step: Any) -> int:
     return int(locked_step(space, step))
 
 
-def _step_with(io: BodyIO, stepper: Any, dt: float) -> int:
-    """One step through ``stepper``; pymunk's own ``Space.step`` when it has bodies to check."""
+def _step_with(io: BodyIO, stepper: Any, dt: float, top2: float, sub_speed: float) -> int:
+    """One step through ``stepper``; pymunk's own ``Space.step`` when it has bodies to check
+    (in as many sub-steps as the C step would take: ``bodyio.substeps``)."""
     space = io.space
     if space._bodies_to_check:  # new bodies (the first step): let pymunk validate them
         stepper.apply()
-        space.step(dt)
+        n = substeps(top2, sub_speed)
+        for _ in range(n):
+            space.step(dt / n)
         return int(stepper.read_check())
     return _locked_step(space, stepper.advance)
 
@@ -187,6 +190,7 @@ class CompiledFewRovers(FewRovers):
             dt,
             self._max2,
             self.extent,
+            self.sub_speed,
         )
 
     # rims and state are buffers the C step holds: assigning either copies into it (as the
@@ -236,7 +240,7 @@ class CompiledFewRovers(FewRovers):
         """
         space = self.io.space
         if space._bodies_to_check:
-            bad = _step_with(self.io, self._stepper, self.dt)
+            bad = _step_with(self.io, self._stepper, self.dt, self._top2, self.sub_speed)
         else:
             space._locked = True
             try:
@@ -282,6 +286,7 @@ class CompiledFleet(Fleet):
             dt,
             self.max_speed * self.max_speed * (1 - 1e-12),
             self.extent,
+            self.sub_speed,
         )
 
     # as CompiledFewRovers: assigning rims or state copies into the C step's arrays
@@ -311,7 +316,7 @@ class CompiledFleet(Fleet):
 
     def advance(self) -> tuple[int, str] | None:
         """One physics step in C; a safety violation or None."""
-        bad = _step_with(self.io, self._stepper, self.dt)
+        bad = _step_with(self.io, self._stepper, self.dt, self._top2, self.sub_speed)
         if bad < 0:
             return None
         return self.first_violation(self.state, self.max_speed, self.extent)

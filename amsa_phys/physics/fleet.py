@@ -17,9 +17,11 @@ run large fleets or batched sweeps should have a compiler, which ``pip install``
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from .bodyio import BodyIO
+from .bodyio import BodyIO, substeps
 from .forces import fold, outside, rover_step, too_fast
 from .rover import DiffDriveRover
 from .wheel import step_constants
@@ -46,7 +48,9 @@ class Fleet:
         self.io = io
         self.rovers = rovers
         self.dt = dt
-        self.max_speed, self.extent = limits
+        self.max_speed, self.extent, *sub = limits
+        #: faster than this a step is cut into Chipmunk sub-steps (``bodyio.substeps``)
+        self.sub_speed = sub[0] if sub else math.inf
         self.rows = np.array(io.rows, dtype=np.intp)
         n = len(rovers)
         self.drives = np.zeros((2, n))
@@ -63,6 +67,7 @@ class Fleet:
         self._gather = np.zeros((n, 3))  # forces when the rovers are not consecutive bodies
         self.refresh()
         self.state = self.read()
+        self._top2 = _top_speed2(self.state)
 
     def refresh(self) -> None:
         """Re-read every rover's constants (after a parameter change: motor wear, ...).
@@ -99,13 +104,11 @@ class Fleet:
         """One physics step: forces, pymunk's step, the new state; a safety violation or None."""
         self.apply(self.state)
         self.io.write()
-        self.io.step(self.dt)
+        self.io.step(self.dt, substeps(self._top2, self.sub_speed))
         state = self.state = self.read()
         # the usual case in five array operations; NaN makes max() NaN, which fails
-        vx, vy = state[:, 3], state[:, 4]
-        speed2 = vx * vx
-        speed2 += vy * vy
-        if speed2.max() <= self.max_speed**2 and np.abs(state[:, :2]).max() <= self.extent:
+        self._top2 = top2 = _top_speed2(state)
+        if top2 <= self.max_speed**2 and np.abs(state[:, :2]).max() <= self.extent:
             return None
         return self.first_violation(state, self.max_speed, self.extent)
 
@@ -152,3 +155,13 @@ class Fleet:
         if bad_speed[i]:
             return i, too_fast(float(speed[i]), max_speed)
         return i, outside(float(state[i, 0]), float(state[i, 1]), extent)
+
+
+def _top_speed2(state: np.ndarray) -> float:
+    """The largest ``vx * vx + vy * vy`` of the rovers (NaN if any is NaN), 0 for none."""
+    if not len(state):
+        return 0.0
+    vx, vy = state[:, 3], state[:, 4]
+    speed2 = vx * vx
+    speed2 += vy * vy
+    return float(speed2.max())

@@ -40,7 +40,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .bodyio import FORCE, STATE, BodyIO
+from .bodyio import FORCE, STATE, BodyIO, substeps
 from .rover import DiffDriveRover
 from .wheel import (
     SLIP_SPEED_MIN,
@@ -150,13 +150,19 @@ class FewRovers:
         self.rovers = rovers
         self.rows = io.rows
         self.dt = dt
-        self.max_speed, self.extent = limits
+        self.max_speed, self.extent, *sub = limits
+        #: faster than this a step is cut into Chipmunk sub-steps (``bodyio.substeps``)
+        self.sub_speed = sub[0] if sub else math.inf
         self._max2 = self.max_speed * self.max_speed * (1 - 1e-12)  # never above hypot's test
+        self._top2 = 0.0  # the fastest rover's squared speed after the last step
         #: per rover, ground terms under each wheel (``ground_list``); terrain rewrites them
         self.grounds = grounds
         self.rims = [0.0] * (2 * len(rovers))
         self.refresh()
         self.state = io.read()
+        state = self.state
+        for i in self._offsets:
+            self._top2 = max(self._top2, state[i + 3] * state[i + 3] + state[i + 4] * state[i + 4])
 
     def refresh(self) -> None:
         """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
@@ -199,20 +205,23 @@ class FewRovers:
         io = self.io
         self.apply(self.state)
         io.write()
-        io.step(self.dt)
+        io.step(self.dt, substeps(self._top2, self.sub_speed))
         state = self.state = io.read()
         # the safety check, inline: written so that NaN fails every comparison
         max2 = self._max2
         extent = self.extent
+        top2 = 0.0
         for i in self._offsets:
             vx = state[i + 3]
             vy = state[i + 4]
+            v2 = vx * vx + vy * vy
+            if v2 > top2:
+                top2 = v2
             if not (
-                vx * vx + vy * vy <= max2
-                and -extent <= state[i] <= extent
-                and -extent <= state[i + 1] <= extent
+                v2 <= max2 and -extent <= state[i] <= extent and -extent <= state[i + 1] <= extent
             ):
                 return self.first_violation(state, self.max_speed, extent)
+        self._top2 = top2
         return None
 
     def apply(self, state: Sequence[float]) -> None:

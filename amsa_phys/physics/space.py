@@ -215,7 +215,7 @@ class PhysicsWorld:
         """Choose the force model for this many rovers and read the initial state."""
         self._choose_index()
         io = BodyIO(self.space, [r.body for r in self.rovers])
-        limits = (self.max_speed, self.extent)
+        limits = (self.max_speed, self.extent, resolvable_speed(self.rovers, self.space, self.dt))
         ground = self.terrain.ground(-1)
         grounds = [ground_list(r, ground, ground) for r in self.rovers]
         model = make_force_model(io, self.rovers, self.dt, limits, grounds)
@@ -323,6 +323,40 @@ class PhysicsWorld:
         else:
             self._touching.pop(pair, None)
             self._apart_since[pair] = self._steps
+
+
+def resolvable_speed(rovers: Sequence[DiffDriveRover], space: pymunk.Space, dt: float) -> float:
+    """The speed (m/s) up to which one Chipmunk step of ``dt`` cannot let a rover tunnel.
+
+    Chipmunk tests overlaps at the step's end positions: a rover that moves further in one
+    step than half the thinnest pair of shapes it can meet (itself and a wall, or two rovers
+    closing at twice the speed) may stop past the middle and be pushed out the far side.
+    So a step resolves a speed ``v`` when ``v dt`` is at most half of ``t_r + t_s`` (the
+    thinnest rover and the thinnest static shape) and a quarter of ``2 t_r`` (two rovers
+    head-on); faster, the step is cut into sub-steps (``bodyio.substeps``).
+    """
+    if not rovers:
+        return math.inf
+    rover = min(min(r.length, r.width) for r in rovers)
+    statics = [s for s in space.shapes if s.body.body_type == pymunk.Body.STATIC]
+    thin = min((_thickness(s) for s in statics), default=math.inf)
+    return min(0.5 * rover, 0.5 * (rover + thin)) / dt
+
+
+def _thickness(shape: pymunk.Shape) -> float:
+    """The thinnest width of a static shape (m): a segment's or circle's diameter, a
+    polygon's narrowest projection on its edges' normals (plus its rounding)."""
+    if isinstance(shape, pymunk.Segment | pymunk.Circle):
+        return 2.0 * shape.radius
+    if isinstance(shape, pymunk.Poly):
+        pts = shape.get_vertices()
+        widths = []
+        for a, b in zip(pts, [*pts[1:], pts[0]], strict=True):
+            n = (b - a).perpendicular_normal()
+            proj = [p.dot(n) for p in pts]
+            widths.append(max(proj) - min(proj))
+        return min(widths) + 2.0 * shape.radius
+    return math.inf
 
 
 def wheel_model(p: Any, gravity: float) -> WheelModel:
