@@ -208,6 +208,7 @@ BUILTINS: dict[str, str] = {
     "FollowerController": "amsa_phys.control.follower:FollowerController",
     "ConstantPower": "amsa_phys.control.constant:ConstantPower",
     "frictionZone": "amsa_phys.physics.zones:FrictionZone",
+    "gradeZone": "amsa_phys.physics.zones:GradeZone",
 }
 
 

@@ -35,20 +35,20 @@ typedef void (*space_step_fn)(void *, double);
  * it knows every one. Add a constant here and in plan_fields together. */
 enum {
     P_KP, P_C, P_FMAX, P_MW, P_BB, P_BBE, P_E, P_E2, P_KX, P_H, P_TURN_K, P_DT_I, P_DT_M,
-    P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, P_KY, PLAN_WIDTH
+    P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, P_KY, P_MASS, PLAN_WIDTH
 };
 
 static const char *const plan_fields[PLAN_WIDTH] = {
     "kp", "c", "f_max", "mw", "big_b", "big_be", "e", "e2", "kx", "half_track", "turn_k",
-    "dt_i", "dt_m", "sphi", "ky_dt_m", "neg_m_dt", "big_bc", "ky",
+    "dt_i", "dt_m", "sphi", "ky_dt_m", "neg_m_dt", "big_bc", "ky", "mass",
 };
 
 #define SLIP_SPEED_MIN 0.1
 #define N_BUFFERS 7
-/* The seven ground terms of a rover (forces.ground_list's order) and where a batch's (7, n)
+/* The nine ground terms of a rover (forces.ground_list's order) and where a batch's (9, n)
  * ground array keeps each (fleet._GROUND_ROWS); both exported and checked at import. */
-#define GROUND_TERMS 7
-static const int ground_rows[GROUND_TERMS] = {0, 2, 4, 1, 3, 5, 6};
+#define GROUND_TERMS 9
+static const int ground_rows[GROUND_TERMS] = {0, 2, 4, 1, 3, 5, 6, 7, 8};
 
 typedef struct {
     PyObject_HEAD
@@ -317,6 +317,12 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     const double ixr = g[go[3]], iyr = g[go[4]], rr = g[go[5]], ts = g[go[6]];
 
     double angle = state[2], vx = state[3], vy = state[4], w = state[5];
+    const double gax = g[go[7]], gay = g[go[8]];
+    const int sloped = gax != 0.0 || gay != 0.0;
+    if (sloped) { /* the solves see the velocity gravity gives the body within the step */
+        vx = vx + gax * dt;
+        vy = vy + gay * dt;
+    }
     double co = cos(angle);
     double si = sin(angle);
     double v_fwd = vx * co + vy * si;
@@ -333,20 +339,28 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double fxl, fxr, upl, upr;
     double pu[2] = {ul, ur}, pv[2] = {vl, vr}, pf0[2] = {f0l, f0r}, pres[2] = {rl, rr};
     double pk[2] = {kl, kr}, pair[4];
+    int rigid = 0;
     if (ul == 0.0 && ur == 0.0) {
-        double gl = 1.0 + kl * e;
-        double gr = 1.0 + kr * e;
-        double cl = kl * e2;
-        double cr = kr * e2;
-        double bl = -kl * vl;
-        double br = -kr * vr;
-        double det = gl * gr - cl * cr;
-        fxl = (bl * gr - cl * br) / det;
-        fxr = (br * gl - cr * bl) / det;
+        if (sloped) { /* held rigidly on a slope (forces.rover_step says why) */
+            double det = e * e - e2 * e2;
+            fxl = (e2 * vr - e * vl) / det;
+            fxr = (e2 * vl - e * vr) / det;
+        } else {
+            double gl = 1.0 + kl * e;
+            double gr = 1.0 + kr * e;
+            double cl = kl * e2;
+            double cr = kr * e2;
+            double bl = -kl * vl;
+            double br = -kr * vr;
+            double det = gl * gr - cl * cr;
+            fxl = (bl * gr - cl * br) / det;
+            fxr = (br * gl - cr * bl) / det;
+        }
         double nl = ((-fmax <= f0l && f0l <= fmax) ? f0l : (f0l > 0 ? fmax : -fmax)) - fxl;
         double nr = ((-fmax <= f0r && f0r <= fmax) ? f0r : (f0r > 0 ? fmax : -fmax)) - fxr;
         if (-rl <= nl && nl <= rl && -rr <= nr && nr <= rr) {
             upl = upr = 0.0;
+            rigid = sloped;
         } else {
             wheel_pair(pu, pv, pf0, pres, pk, &sc, pair);
             fxl = pair[0], upl = pair[1], fxr = pair[2], upr = pair[3];
@@ -393,7 +407,8 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double a = fx * dt_m;
     double side = (vy + a * sm) * cos(end) - (vx + a * cm) * sin(end);
     double kd = ky_dt_m * isum;
-    double f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd);
+    double f_lat = rigid ? neg_m_dt * side / cos(0.5 * turn)
+                         : neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd);
     double fyl = f_lat * ivl / isum;
     double fyr = f_lat - fyl;
     /* friction ellipse */
@@ -413,8 +428,14 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
         torque = (fxr - fxl) * h + scrub;
         f_lat = fyl + fyr;
     }
-    out[0] = fx * cm - f_lat * sm;
-    out[1] = fx * sm + f_lat * cm;
+    double fwx = fx * cm - f_lat * sm;
+    double fwy = fx * sm + f_lat * cm;
+    if (sloped) {
+        fwx = fwx + p[P_MASS] * gax;
+        fwy = fwy + p[P_MASS] * gay;
+    }
+    out[0] = fwx;
+    out[1] = fwy;
     out[2] = torque;
     *rim_l = upl;
     *rim_r = upr;
@@ -561,16 +582,16 @@ static int Stepper_init(Stepper *st, PyObject *args, PyObject *kwds)
     unsigned long long space;
     PyObject *fns, *bodies, *offsets, *plan, *drives, *rims, *ground, *state;
     Py_ssize_t rim_k, rim_side, ground_k;
-    Py_ssize_t go[7];
+    Py_ssize_t go[GROUND_TERMS];
     double dt, max2, extent, sub_speed = INFINITY;
     if (st->n_views) {
         PyErr_SetString(PyExc_RuntimeError, "Stepper is initialised once");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "KO!OOOOO(nn)O(n(nnnnnnn))Oddd|d", kwlist, &space,
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "KO!OOOOO(nn)O(n(nnnnnnnnn))Oddd|d", kwlist, &space,
                                      &PyTuple_Type, &fns, &bodies, &offsets, &plan, &drives,
                                      &rims, &rim_k, &rim_side, &ground, &ground_k, &go[0],
-                                     &go[1], &go[2], &go[3], &go[4], &go[5], &go[6], &state, &dt,
+                                     &go[1], &go[2], &go[3], &go[4], &go[5], &go[6], &go[7], &go[8], &state, &dt,
                                      &max2, &extent, &sub_speed))
         return -1;
     if (PyTuple_GET_SIZE(fns) != 7) {
@@ -614,7 +635,7 @@ static int Stepper_init(Stepper *st, PyObject *args, PyObject *kwds)
         !(st->rims = take(st, rims, 8, 2 * nb, "rims")))
         return -1;
     Py_ssize_t ground_need = 0, rim_need = 0;
-    for (int t = 0; t < 7; t++)
+    for (int t = 0; t < GROUND_TERMS; t++)
         if (go[t] + 1 > ground_need)
             ground_need = go[t] + 1;
     if (nb) {
@@ -640,7 +661,7 @@ static int Stepper_init(Stepper *st, PyObject *args, PyObject *kwds)
     st->rim_k = rim_k;
     st->rim_side = rim_side;
     st->ground_k = ground_k;
-    for (int t = 0; t < 7; t++)
+    for (int t = 0; t < GROUND_TERMS; t++)
         st->ground_off[t] = go[t];
     st->dt = dt;
     st->max2 = max2;
@@ -687,7 +708,7 @@ static PyTypeObject StepperType = {
  * masks for the rare branches cost half of a batch. This is rover_forces above (the same
  * code, so the same floats as a run made alone with the compiled step) over arrays laid out
  * as fleet.Fleet's: plan (n, PLAN_WIDTH), drives (2, n), rims (2, n, updated in place),
- * ground (7, n) in fleet._GROUND_ROWS order, state (n, 6); forces (n, 3) are written. */
+ * ground (9, n) in fleet._GROUND_ROWS order, state (n, 6); forces (n, 3) are written. */
 static PyObject *column_forces(PyObject *Py_UNUSED(module), PyObject *args)
 {
     PyObject *objs[6];
@@ -711,7 +732,7 @@ static PyObject *column_forces(PyObject *Py_UNUSED(module), PyObject *args)
         }
     }
     Py_ssize_t n = views[4].len / (6 * 8);
-    const Py_ssize_t need[6] = {n * PLAN_WIDTH, 2 * n, 2 * n, 7 * n, 6 * n, 3 * n};
+    const Py_ssize_t need[6] = {n * PLAN_WIDTH, 2 * n, 2 * n, GROUND_TERMS * n, 6 * n, 3 * n};
     for (int i = 0; i < 6; i++)
         if (views[i].len != need[i] * 8) {
             PyErr_Format(PyExc_ValueError, "%s: %zd floats expected for %zd rovers, got %zd",

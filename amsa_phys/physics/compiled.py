@@ -185,7 +185,7 @@ class CompiledFewRovers(FewRovers):
             self.rims,
             (2, 1),
             self._ground,
-            (7, tuple(range(7))),
+            (len(_GROUND_ROWS), tuple(range(len(_GROUND_ROWS)))),
             self.state,
             dt,
             self._max2,
@@ -223,7 +223,8 @@ class CompiledFewRovers(FewRovers):
     def set_ground(self, k: int, terms: list[float]) -> None:
         """Rover ``k``'s ground terms (``ground_list``) from the next step on."""
         super().set_ground(k, terms)
-        self._ground[7 * k : 7 * k + 7] = array.array("d", terms)
+        width = len(_GROUND_ROWS)
+        self._ground[width * k : width * (k + 1)] = array.array("d", terms)
 
     def kinematics(self, k: int) -> list[float]:
         """Rover ``k``'s six state floats after the last step."""

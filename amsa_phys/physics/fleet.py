@@ -2,7 +2,7 @@
 
 The force arithmetic is the pure path's one copy, ``forces.rover_step``, called per rover over
 the arrays' rows; what this class owns is the array bookkeeping the many-rover callers need:
-drives, rims and ground terms as (2, n) and (7, n) arrays (the robots' grouped steps and a
+drives, rims and ground terms as (2, n) and (9, n) arrays (the robots' grouped steps and a
 batch's columns read and write them whole), the state as one array, one vectorised safety
 check. ``compiled.CompiledFleet`` and ``compiled.ColumnForces`` keep these arrays and hand the
 arithmetic to C.
@@ -31,7 +31,7 @@ from .wheel import step_constants
 BATCH_MIN = 40
 #: Where ``forces.ground_list``'s seven terms go in :attr:`Fleet.ground`'s rows: the left and
 #: right wheel of each term next to each other, so each term is one (2, n) view.
-_GROUND_ROWS = [0, 2, 4, 1, 3, 5, 6]
+_GROUND_ROWS = [0, 2, 4, 1, 3, 5, 6, 7, 8]
 
 
 class Fleet:
@@ -57,7 +57,7 @@ class Fleet:
         for i, r in enumerate(rovers):
             r.attach_power_slot(self.drives, i)
         self.rims = np.zeros((2, n))
-        self.ground = np.zeros((7, n))
+        self.ground = np.zeros((len(_GROUND_ROWS), n))
         for k, terms in enumerate(grounds):
             self.set_ground(k, terms)
         self._out = np.frombuffer(io.forces, dtype=np.float64).reshape(-1, 3)

@@ -77,6 +77,7 @@ class Folded(NamedTuple):
     sphi: float  # turn-slip stiffness times speed per wheel: (3 pi/16) a^2 N / c_x
     ky_dt_m: float  # ky dt / m
     neg_m_dt: float  # -m / dt
+    mass: float  # m: a slope's pull is m g
 
 
 def fold(rover: DiffDriveRover, dt: float) -> Folded:
@@ -103,6 +104,7 @@ def fold(rover: DiffDriveRover, dt: float) -> Folded:
         sphi=TORSION * w.patch_radius_m**2 * kx,
         ky_dt_m=w.load_n / w.slip_lat * dt / rover.mass,
         neg_m_dt=-rover.mass / dt,
+        mass=rover.mass,
     )
 
 
@@ -118,12 +120,20 @@ def ground_terms(rover: DiffDriveRover, mu: float, crr: float) -> tuple[float, f
 
 
 def ground_list(
-    rover: DiffDriveRover, left: tuple[float, float], right: tuple[float, float]
+    rover: DiffDriveRover,
+    left: tuple[float, float],
+    right: tuple[float, float],
+    slope: tuple[float, float, float] = (1.0, 0.0, 0.0),
 ) -> list[float]:
-    """``[1/gx_L, 1/gy_L, R_L, 1/gx_R, 1/gy_R, R_R, scrub_L + scrub_R]`` for (mu, crr) pairs."""
-    il, jl, rl, tl = ground_terms(rover, *left)
-    ir, jr, rr, tr = ground_terms(rover, *right)
-    return [il, jl, rl, ir, jr, rr, tl + tr]
+    """``[1/gx_L, 1/gy_L, R_L, 1/gx_R, 1/gy_R, R_R, scrub_L + scrub_R, g_x, g_y]`` for
+    (mu, crr) pairs under the wheels and the slope ``(cos(angle), g_x, g_y)`` under the rover
+    (``terrain.Terrain.slope``): the ground carries ``cos(angle)`` of the weight, so grip,
+    scrub and rolling resistance scale with it (``mu cos``, ``crr cos``: the same floats on
+    the flat), and gravity pulls along the slope with ``(g_x, g_y)`` (m/s²)."""
+    cos, gx, gy = slope
+    il, jl, rl, tl = ground_terms(rover, left[0] * cos, left[1] * cos)
+    ir, jr, rr, tr = ground_terms(rover, right[0] * cos, right[1] * cos)
+    return [il, jl, rl, ir, jr, rr, tl + tr, gx, gy]
 
 
 class FewRovers:
@@ -303,17 +313,24 @@ def rover_step(
         sphi,
         ky_dt_m,
         neg_m_dt,
+        mass,
         sc,
     ) = plan
     vmin = SLIP_SPEED_MIN
     ivmin = INV_SLIP_SPEED_MIN
     sin = math.sin
     cos = math.cos
+    gax = gnd[7]
+    gay = gnd[8]
+    sloped = gax != 0.0 or gay != 0.0
+    if sloped:  # the solves see the velocity gravity gives the body within the step
+        vx = vx + gax * dt
+        vy = vy + gay * dt
     co = cos(angle)
     si = sin(angle)
     v_fwd = vx * co + vy * si
     wh = w * h
-    ixl, iyl, rl, ixr, iyr, rr, ts = gnd
+    ixl, iyl, rl, ixr, iyr, rr, ts, _, _ = gnd
     # both rims and tyres, backward Euler (wheel.wheel_pair's usual branch)
     vl = v_fwd - wh
     vr = v_fwd + wh
@@ -323,22 +340,32 @@ def rover_step(
     kr = kx * ivr
     f0l = kp * drive_l
     f0r = kp * drive_r
+    rigid = False
     if ul == 0.0 and ur == 0.0:
         # a parked rover (wheel.held): the tyres hold the body against still rims; the
         # rims stay still if their resistance holds them against motor and tyre
-        gl = 1.0 + kl * e
-        gr = 1.0 + kr * e
-        cl = kl * e2
-        cr = kr * e2
-        bl = -kl * vl
-        br = -kr * vr
-        det = gl * gr - cl * cr
-        fxl = (bl * gr - cl * br) / det
-        fxr = (br * gl - cr * bl) / det
+        if sloped:
+            # on a slope the tyres carry a steady load at rest, which a slip-rate tyre could
+            # only carry by creeping at its slip floor (~0.3 mm/s at 2°): the tyre's static
+            # deflection (not a state here) holds it, so the held body is held rigidly
+            det = e * e - e2 * e2
+            fxl = (e2 * vr - e * vl) / det
+            fxr = (e2 * vl - e * vr) / det
+        else:
+            gl = 1.0 + kl * e
+            gr = 1.0 + kr * e
+            cl = kl * e2
+            cr = kr * e2
+            bl = -kl * vl
+            br = -kr * vr
+            det = gl * gr - cl * cr
+            fxl = (bl * gr - cl * br) / det
+            fxr = (br * gl - cr * bl) / det
         nl = (f0l if -fmax <= f0l <= fmax else (fmax if f0l > 0 else -fmax)) - fxl
         nr = (f0r if -fmax <= f0r <= fmax else (fmax if f0r > 0 else -fmax)) - fxr
         if -rl <= nl <= rl and -rr <= nr <= rr:
             upl = upr = 0.0
+            rigid = sloped
         else:
             fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc)
     else:
@@ -382,7 +409,10 @@ def rover_step(
     a = fx * dt_m
     side = (vy + a * sm) * cos(end) - (vx + a * cm) * sin(end)
     kd = ky_dt_m * isum
-    f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
+    if rigid:  # held on a slope: sideways too
+        f_lat = neg_m_dt * side / cos(0.5 * turn)
+    else:
+        f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
     fyl = f_lat * ivl / isum
     fyr = f_lat - fyl
     # friction ellipse per wheel: a tyre the gripping solve puts beyond it slides, and the
@@ -402,7 +432,12 @@ def rover_step(
         fx = fxl + fxr
         torque = (fxr - fxl) * h + scrub
         f_lat = fyl + fyr
-    return fx * cm - f_lat * sm, fx * sm + f_lat * cm, torque, upl, upr
+    fwx = fx * cm - f_lat * sm
+    fwy = fx * sm + f_lat * cm
+    if sloped:
+        fwx = fwx + mass * gax
+        fwy = fwy + mass * gay
+    return fwx, fwy, torque, upl, upr
 
 
 def reference_forces(

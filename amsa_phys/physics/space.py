@@ -61,7 +61,9 @@ class PhysicsWorld:
         self.dt = float(1 / self.rate)
         self.gravity = float(settings["gravity"])
         ground = settings["ground"]
-        self.terrain = Terrain(float(ground["friction"]), float(ground["rolling_resistance"]))
+        self.terrain = Terrain(
+            float(ground["friction"]), float(ground["rolling_resistance"]), self.gravity
+        )
         self.max_speed = float(settings["max_speed"])
         self.extent = float(settings["extent"])
         self.space = pymunk.Space(threaded=False)
@@ -78,7 +80,7 @@ class PhysicsWorld:
         self._model: ForceModel | None = None
         #: the batch's column physics stepping this world (``columns.py``), or None
         self.group: Any = None
-        self._where: list[tuple[int, int, int] | None] = []
+        self._where: list[tuple[int, int, int, int] | None] = []
         self._add_obstacles(settings.get("obstacles") or [], settings.get("walls"))
         for kind in (ROVER, OBSTACLE):
             self.space.on_collision(
@@ -177,9 +179,10 @@ class PhysicsWorld:
                 np.concatenate([x + hx, x - hx]), np.concatenate([y + hy, y - hy])
             )
             left, right = where[:n].tolist(), where[n:].tolist()
+            under = terrain.locate_grades(x, y).tolist() if terrain.grades else [-1] * n
         else:
             state = model.state
-            left, right = [], []
+            left, right, under = [], [], []
             for k, rover in enumerate(self.rovers):
                 i = model.offsets[k]
                 x, y, a = state[i], state[i + 1], state[i + 2]
@@ -187,13 +190,20 @@ class PhysicsWorld:
                 hy = math.cos(a) * rover.half_track
                 left.append(terrain.locate(x + hx, y + hy))
                 right.append(terrain.locate(x - hx, y - hy))
+                under.append(terrain.locate_grade(x, y))
         version = terrain.version
         for k, rover in enumerate(self.rovers):
-            key = (left[k], right[k], version)
+            key = (left[k], right[k], under[k], version)
             if key != self._where[k]:
                 self._where[k] = key
                 model.set_ground(
-                    k, ground_list(rover, terrain.ground(left[k]), terrain.ground(right[k]))
+                    k,
+                    ground_list(
+                        rover,
+                        terrain.ground(left[k]),
+                        terrain.ground(right[k]),
+                        terrain.slope(under[k]),
+                    ),
                 )
 
     def step(self) -> None:
@@ -204,7 +214,7 @@ class PhysicsWorld:
         bodies.
         """
         model = self._model or self._start()
-        if self.terrain.zones:
+        if self.terrain.zones or self.terrain.grades:
             self._update_grounds()
         bad = model.advance()
         self._steps += 1
@@ -220,7 +230,7 @@ class PhysicsWorld:
         grounds = [ground_list(r, ground, ground) for r in self.rovers]
         model = make_force_model(io, self.rovers, self.dt, limits, grounds)
         self._model = model
-        self._where = [(-1, -1, -1)] * len(self.rovers)
+        self._where = [(-1, -1, -1, -1)] * len(self.rovers)
         for k, rover in enumerate(self.rovers):
             rover.attach_state(functools.partial(self._kinematics, k))
             rover.attach_rims(functools.partial(model.rim_speeds, k))

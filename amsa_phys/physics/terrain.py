@@ -15,6 +15,7 @@ with one wheel in mud pulls towards it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -71,14 +72,70 @@ class Zone:
         return inside
 
 
-class Terrain:
-    """The world's ground and its zones; ``version`` changes whenever any value does."""
+@dataclass
+class Grade:
+    """One grade zone (a slope): a polygon, its angle (rad) and its uphill direction (rad)."""
 
-    def __init__(self, friction: float, rolling_resistance: float) -> None:
+    name: str
+    polygon: tuple[tuple[float, float], ...]
+    angle: float
+    direction: float
+
+    def __post_init__(self) -> None:
+        self.area = Zone(self.name, self.polygon, 0.0, 0.0)  # the geometry and its tests
+
+
+class Terrain:
+    """The world's ground, its friction zones and its grade zones; ``version`` changes
+    whenever any value does."""
+
+    def __init__(self, friction: float, rolling_resistance: float, gravity: float = 0.0) -> None:
         self.friction = friction
         self.rolling_resistance = rolling_resistance
+        self.gravity = gravity
         self.zones: list[Zone] = []
+        self.grades: list[Grade] = []
         self.version = 0
+
+    def add_grade(self, grade: Grade) -> None:
+        """Add a grade zone on top of the others."""
+        self.grades.append(grade)
+        self.version += 1
+
+    def update_grade(self, name: str, **values: Any) -> None:
+        """Change a grade zone's angle, direction or polygon (a timeline change)."""
+        for i, g in enumerate(self.grades):
+            if g.name == name:
+                fields = {"polygon": g.polygon, "angle": g.angle, "direction": g.direction}
+                fields.update(values)
+                self.grades[i] = Grade(name, **fields)
+                self.version += 1
+                return
+        raise KeyError(name)
+
+    def locate_grade(self, x: float, y: float) -> int:
+        """Index of the grade zone at ``(x, y)`` (the last declared containing it), or -1."""
+        for k in range(len(self.grades) - 1, -1, -1):
+            if self.grades[k].area.contains(x, y):
+                return k
+        return -1
+
+    def locate_grades(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """:meth:`locate_grade` for arrays of points."""
+        out = np.full(x.shape, -1, dtype=np.intp)
+        for k, grade in enumerate(self.grades):
+            out[grade.area.contains_many(x, y)] = k
+        return out
+
+    def slope(self, index: int) -> tuple[float, float, float]:
+        """``(cos(angle), g_x, g_y)`` of grade zone ``index`` (-1: flat): the share of the
+        weight the ground carries and gravity's pull along the slope (m/s², world frame,
+        downhill)."""
+        if index < 0:
+            return 1.0, 0.0, 0.0
+        g = self.grades[index]
+        pull = -self.gravity * math.sin(g.angle)
+        return math.cos(g.angle), pull * math.cos(g.direction), pull * math.sin(g.direction)
 
     def add(self, zone: Zone) -> None:
         """Add a zone on top of the others."""
