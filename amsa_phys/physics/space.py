@@ -3,9 +3,11 @@
 One ``PhysicsWorld`` per run, created by the first robot or zone template that asks for it
 (``ctx.shared("physics", ...)``) and stepped by an engine hook at ``physics.rate`` Hz after
 the components due at the same instant. The Space is rebuilt for every run and uses one
-thread, so a run is deterministic. Top-down: no gravity in the plane; the ground acts only
-through the wheel model (normal load ``m g / 2`` per wheel), with the friction and rolling
-resistance of the terrain under each wheel (``terrain.py``).
+thread, so a run is deterministic. Top-down: no gravity in the plane but a grade zone's pull
+along its slope; the ground acts only through the wheel model (normal load ``m g / 2`` per
+wheel, times ``cos(angle)`` on a slope), with the friction and rolling resistance of the
+terrain under each wheel (``terrain.py``). A step faster than :func:`resolvable_speed` is cut
+into Chipmunk sub-steps (no tunnelling).
 
 Contacts: pymunk lets shapes overlap by ``collision_slop`` before it pushes them apart (0.1 m
 by default: a rover resting 3 cm inside a wall); here the slop is :data:`CONTACT_SLOP_M` and
