@@ -18,7 +18,7 @@ the others. :func:`make_force_model` is the only code that chooses among them, s
 "C when built, array fleets from :data:`fleet.BATCH_MIN` rovers" is written once. Every
 model computes a rover's forces with the same arithmetic: ``_step.c``'s ``rover_forces`` or
 its pure twin ``forces.rover_step``, bit for bit; ``wheel.py`` and
-``forces.reference_forces`` state the model readably and are the tests' specification.
+``reference.reference_forces`` state the model readably and are the tests' specification.
 """
 
 from __future__ import annotations
