@@ -25,7 +25,8 @@ from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.physics import compiled
 from amsa_phys.physics.bodyio import BodyIO
-from amsa_phys.physics.forces import FewRovers, ground_list, reference_forces
+from amsa_phys.physics.forces import FewRovers, ground_list
+from amsa_phys.physics.reference import reference_forces
 from amsa_phys.physics.rover import DiffDriveRover
 from amsa_phys.physics.space import wheel_model
 from amsa_phys.physics.templates import rover_params
@@ -143,7 +144,7 @@ def fused_loop(duration: float, trace: bool = True) -> float:
 def plain_loop(duration: float, rate: int = 100) -> float:
     """Wall seconds for the straightforward loop the issue describes (context, not a target).
 
-    Same bodies and wheel model, written the obvious way (``forces.reference_forces``: pymunk
+    Same bodies and wheel model, written the obvious way (``reference.reference_forces``: pymunk
     properties read and set per body, the wheel functions called per wheel), ``space.step``.
     """
     space, rovers = two_rovers()

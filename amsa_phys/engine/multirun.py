@@ -62,16 +62,14 @@ class RunView:
         """The batch's (every run's) simulated time."""
         return self._sim.now
 
+    @property
+    def column_physics(self) -> Any:
+        """The batch's column physics (``physics/columns.py``), which steps every run's
+        physics world in one pass, or None: a run's physics world asks for it by this name."""
+        return self._sim.column_physics
+
     def add_hook(self, rate_hz: Fraction, fn: Callable[[], None], name: str) -> None:
-        """A subsystem step of this run, stepped by the batch: its physics world's step is
-        taken over by the batch's column physics when there is one (one step for all)."""
-        columns = self._sim.column_physics
-        if name == "physics" and columns is not None:
-            if not columns.worlds:
-                columns.sim = self._sim
-                self._sim.add_hook(rate_hz, columns.step, name)
-            columns.adopt(fn.__self__)  # type: ignore[attr-defined]
-            return
+        """A subsystem step of this run, stepped by the batch."""
         self._sim.add_hook(rate_hz, fn, name)
 
     def record_event(self, kind: str, detail: str) -> None:

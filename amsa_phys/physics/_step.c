@@ -30,14 +30,25 @@ typedef void (*set_vect_fn)(void *, cpVect);
 typedef void (*set_double_fn)(void *, double);
 typedef void (*space_step_fn)(void *, double);
 
-/* Per-rover constants (compiled.py's PLAN_FIELDS, in this order). */
+/* Per-rover constants, in this order: the layout is exported as PLAN_FIELDS (below), and
+ * compiled.py fills each rover's row by these names from forces.fold, checking at import that
+ * it knows every one. Add a constant here and in plan_fields together. */
 enum {
     P_KP, P_C, P_FMAX, P_MW, P_BB, P_BBE, P_E, P_E2, P_KX, P_H, P_TURN_K, P_DT_I, P_DT_M,
-    P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, PLAN_WIDTH
+    P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, P_KY, P_MASS, PLAN_WIDTH
+};
+
+static const char *const plan_fields[PLAN_WIDTH] = {
+    "kp", "c", "f_max", "mw", "big_b", "big_be", "e", "e2", "kx", "half_track", "turn_k",
+    "dt_i", "dt_m", "sphi", "ky_dt_m", "neg_m_dt", "big_bc", "ky", "mass",
 };
 
 #define SLIP_SPEED_MIN 0.1
 #define N_BUFFERS 7
+/* The nine ground terms of a rover (forces.ground_list's order) and where a batch's (9, n)
+ * ground array keeps each (fleet._GROUND_ROWS); both exported and checked at import. */
+#define GROUND_TERMS 9
+static const int ground_rows[GROUND_TERMS] = {0, 2, 4, 1, 3, 5, 6, 7, 8};
 
 typedef struct {
     PyObject_HEAD
@@ -61,8 +72,10 @@ typedef struct {
     const double *ground; /* term t of rover k at k*ground_k + ground_off[t] */
     double *state;
     Py_ssize_t rim_k, rim_side, ground_k;
-    Py_ssize_t ground_off[7];
+    Py_ssize_t ground_off[GROUND_TERMS];
     double dt, max2, extent;
+    double sub_speed; /* faster than this a step is cut into sub-steps (bodyio.substeps) */
+    double top2;      /* the fastest rover's squared speed after the last step */
 } Stepper;
 
 /* ---- wheel.py's rare branches --------------------------------------------------------- */
@@ -215,44 +228,75 @@ static void wheel_pair(const double u[2], const double v[2], const double f0[2],
     out[3] = upr;
 }
 
-static double rim_solve(double u, double f0, double fr, double fx, const StepConstants *s)
+/* ---- wheel.slide: a sliding tyre solved with its rim ----------------------------------- */
+#define SLIDE_ITERATIONS 100
+
+typedef struct {
+    double u, v, f0, ivs, kx, ix, qy;
+    const StepConstants *s;
+} Slide;
+
+static double slide_tyre_x(const Slide *w, double up, double *scale)
 {
-    double up = (s->mw * u + f0 - fr - fx) * s->big_b;
-    double fm = f0 - s->c * up;
-    if (fm > s->f_max || fm < -s->f_max)
-        up = u + ((fm > 0 ? s->f_max : -s->f_max) - fr - fx) * s->big_bc;
-    return up;
+    double fx = w->kx * (up - w->v) * w->ivs;
+    double qx = fx * w->ix;
+    double qq = qx * qx + w->qy * w->qy;
+    *scale = qq > 1.0 ? 1.0 / sqrt(qq) : 1.0;
+    return fx * *scale;
 }
 
-static double rim_alone(double u, double f0, double res, double fx, const StepConstants *s)
-{ /* wheel.rim_alone */
-    if (u != 0.0) {
-        double up = rim_solve(u, f0, u > 0 ? res : -res, fx, s);
-        if (up * u > 0.0)
-            return up;
+static double slide_excess(const Slide *w, double up, double fr)
+{
+    const StepConstants *s = w->s;
+    double fm = w->f0 - s->c * up;
+    if (fm > s->f_max)
+        fm = s->f_max;
+    else if (fm < -s->f_max)
+        fm = -s->f_max;
+    double scale;
+    double fx = slide_tyre_x(w, up, &scale);
+    return s->mw * (up - w->u) - fm + fr + fx;
+}
+
+static void slide(double u, double v, double f0, double res, double ivs, double kx, double ky,
+                  double ix, double iy, double side, double fy_cap, const StepConstants *s,
+                  double *fx_out, double *fy_out, double *up_out)
+{
+    Slide w = {u, v, f0, ivs, kx, ix, -ky * side * ivs * iy, s};
+    double scale;
+    double up;
+    double need = s->mw * u + limited(f0, s) - slide_tyre_x(&w, 0.0, &scale);
+    if (-res <= need && need <= res) {
+        up = 0.0;
+    } else {
+        double reach = (s->f_max + 1.0 / ix) / s->mw;
+        double lo, hi, fr;
+        if (need > 0) {
+            lo = 0.0, hi = u + reach, fr = res;
+        } else {
+            lo = u - reach, hi = 0.0, fr = -res;
+        }
+        for (int i = 0; i < SLIDE_ITERATIONS; i++) {
+            double mid = 0.5 * (lo + hi);
+            if (mid <= lo || mid >= hi)
+                break;
+            if (slide_excess(&w, mid, fr) > 0.0)
+                hi = mid;
+            else
+                lo = mid;
+        }
+        up = 0.5 * (lo + hi);
     }
-    double f0_lim = limited(f0, s);
-    double need = f0_lim + s->mw * u - fx;
-    if (-res <= need && need <= res)
-        return 0.0;
-    return rim_solve(u, f0, need > 0 ? res : -res, fx, s);
+    double fx = slide_tyre_x(&w, up, &scale);
+    double fy = -ky * side * ivs * scale;
+    if (fabs(fy_cap) < fabs(fy))
+        fy = fy_cap;
+    *fx_out = fx;
+    *fy_out = fy;
+    *up_out = up;
 }
 
-static double (*volatile libm_pow)(double, double) = pow;
-
-static void friction_ellipse(double *fx, double *fy, double inv_x, double inv_y)
-{ /* wheel.friction_ellipse. Python's x ** 2 is libm's pow(x, 2.0), which differs from x * x
-   * in the last bit for ~1 value in 1,000; GCC folds a direct pow(x, 2.0) into x * x, so
-   * libm's pow is called through a volatile pointer the compiler cannot see through. */
-    double q = libm_pow(*fx * inv_x, 2.0) + libm_pow(*fy * inv_y, 2.0);
-    if (q > 1.0) {
-        double scale = 1.0 / sqrt(q);
-        *fx = *fx * scale;
-        *fy = *fy * scale;
-    }
-}
-
-/* ---- forces.FewRovers.apply, one rover ------------------------------------------------ */
+/* ---- forces.rover_step, one rover ------------------------------------------------------ */
 static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
 {
     const double *p = st->plan + k * PLAN_WIDTH;
@@ -273,6 +317,12 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     const double ixr = g[go[3]], iyr = g[go[4]], rr = g[go[5]], ts = g[go[6]];
 
     double angle = state[2], vx = state[3], vy = state[4], w = state[5];
+    const double gax = g[go[7]], gay = g[go[8]];
+    const int sloped = gax != 0.0 || gay != 0.0;
+    if (sloped) { /* the solves see the velocity gravity gives the body within the step */
+        vx = vx + gax * dt;
+        vy = vy + gay * dt;
+    }
     double co = cos(angle);
     double si = sin(angle);
     double v_fwd = vx * co + vy * si;
@@ -289,20 +339,28 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double fxl, fxr, upl, upr;
     double pu[2] = {ul, ur}, pv[2] = {vl, vr}, pf0[2] = {f0l, f0r}, pres[2] = {rl, rr};
     double pk[2] = {kl, kr}, pair[4];
+    int rigid = 0;
     if (ul == 0.0 && ur == 0.0) {
-        double gl = 1.0 + kl * e;
-        double gr = 1.0 + kr * e;
-        double cl = kl * e2;
-        double cr = kr * e2;
-        double bl = -kl * vl;
-        double br = -kr * vr;
-        double det = gl * gr - cl * cr;
-        fxl = (bl * gr - cl * br) / det;
-        fxr = (br * gl - cr * bl) / det;
+        if (sloped) { /* held rigidly on a slope (forces.rover_step says why) */
+            double det = e * e - e2 * e2;
+            fxl = (e2 * vr - e * vl) / det;
+            fxr = (e2 * vl - e * vr) / det;
+        } else {
+            double gl = 1.0 + kl * e;
+            double gr = 1.0 + kr * e;
+            double cl = kl * e2;
+            double cr = kr * e2;
+            double bl = -kl * vl;
+            double br = -kr * vr;
+            double det = gl * gr - cl * cr;
+            fxl = (bl * gr - cl * br) / det;
+            fxr = (br * gl - cr * bl) / det;
+        }
         double nl = ((-fmax <= f0l && f0l <= fmax) ? f0l : (f0l > 0 ? fmax : -fmax)) - fxl;
         double nr = ((-fmax <= f0r && f0r <= fmax) ? f0r : (f0r > 0 ? fmax : -fmax)) - fxr;
         if (-rl <= nl && nl <= rl && -rr <= nr && nr <= rr) {
             upl = upr = 0.0;
+            rigid = sloped;
         } else {
             wheel_pair(pu, pv, pf0, pres, pk, &sc, pair);
             fxl = pair[0], upl = pair[1], fxr = pair[2], upr = pair[3];
@@ -349,7 +407,8 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double a = fx * dt_m;
     double side = (vy + a * sm) * cos(end) - (vx + a * cm) * sin(end);
     double kd = ky_dt_m * isum;
-    double f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd);
+    double f_lat = rigid ? neg_m_dt * side / cos(0.5 * turn)
+                         : neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd);
     double fyl = f_lat * ivl / isum;
     double fyr = f_lat - fyl;
     /* friction ellipse */
@@ -357,23 +416,41 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double t2 = fyl * iyl;
     double t3 = fxr * ixr;
     double t4 = fyr * iyr;
-    if (t1 * t1 + t2 * t2 > 1.0 || t3 * t3 + t4 * t4 > 1.0) {
-        friction_ellipse(&fxl, &fyl, ixl, iyl);
-        friction_ellipse(&fxr, &fyr, ixr, iyr);
-        upl = rim_alone(ul, f0l, rl, fxl, &sc);
-        upr = rim_alone(ur, f0r, rr, fxr, &sc);
+    int sat_l = t1 * t1 + t2 * t2 > 1.0;
+    int sat_r = t3 * t3 + t4 * t4 > 1.0;
+    if (sat_l || sat_r) {
+        double side0 = vy * co - vx * si;
+        if (sat_l)
+            slide(ul, vl, f0l, rl, ivl, kx, p[P_KY], ixl, iyl, side0, fyl, &sc, &fxl, &fyl, &upl);
+        if (sat_r)
+            slide(ur, vr, f0r, rr, ivr, kx, p[P_KY], ixr, iyr, side0, fyr, &sc, &fxr, &fyr, &upr);
         fx = fxl + fxr;
         torque = (fxr - fxl) * h + scrub;
         f_lat = fyl + fyr;
     }
-    out[0] = fx * cm - f_lat * sm;
-    out[1] = fx * sm + f_lat * cm;
+    double fwx = fx * cm - f_lat * sm;
+    double fwy = fx * sm + f_lat * cm;
+    if (sloped) {
+        fwx = fwx + p[P_MASS] * gax;
+        fwy = fwy + p[P_MASS] * gay;
+    }
+    out[0] = fwx;
+    out[1] = fwy;
     out[2] = torque;
     *rim_l = upl;
     *rim_r = upr;
 }
 
 /* ---- the step's parts ------------------------------------------------------------------ */
+/* bodyio.substeps: Chipmunk steps in this physics step, so that no rover tunnels */
+static int substeps(double top2, double sub_speed)
+{
+    double sub2 = sub_speed * sub_speed;
+    if (!(top2 > sub2))
+        return 1;
+    return (int)ceil(sqrt(top2) / sub_speed);
+}
+
 static void apply_all(Stepper *st)
 {
     for (Py_ssize_t k = 0; k < st->n; k++) {
@@ -390,6 +467,7 @@ static Py_ssize_t read_check(Stepper *st)
 {
     Py_ssize_t bad = -1;
     const double max2 = st->max2, extent = st->extent;
+    double top2 = 0.0;
     for (Py_ssize_t k = 0; k < st->n; k++) {
         void *b = st->bodies[k];
         double *s = st->state + st->offsets[k];
@@ -401,17 +479,25 @@ static Py_ssize_t read_check(Stepper *st)
         s[3] = v.x;
         s[4] = v.y;
         s[5] = st->get_angular_velocity(b);
-        if (bad < 0 && !(v.x * v.x + v.y * v.y <= max2 && -extent <= p.x && p.x <= extent &&
+        double v2 = v.x * v.x + v.y * v.y;
+        if (v2 > top2)
+            top2 = v2;
+        if (bad < 0 && !(v2 <= max2 && -extent <= p.x && p.x <= extent &&
                          -extent <= p.y && p.y <= extent))
             bad = k;
     }
+    if (bad < 0)
+        st->top2 = top2;
     return bad;
 }
 
 static PyObject *Stepper_advance(Stepper *st, PyObject *Py_UNUSED(ignored))
 {
     apply_all(st);
-    st->space_step(st->space, st->dt);
+    int n = substeps(st->top2, st->sub_speed);
+    double h = st->dt / (double)n;
+    for (int i = 0; i < n && !PyErr_Occurred(); i++)
+        st->space_step(st->space, h);
     if (PyErr_Occurred()) /* a collision callback raised (cffi reports, never sets) */
         return NULL;
     return PyLong_FromSsize_t(read_check(st));
@@ -492,21 +578,21 @@ static int Stepper_init(Stepper *st, PyObject *args, PyObject *kwds)
 {
     static char *kwlist[] = {"space",  "functions", "bodies",   "offsets", "plan",
                              "drives", "rims",      "rim_strides", "ground", "ground_layout",
-                             "state",  "dt",        "max2",     "extent",  NULL};
+                             "state",  "dt",        "max2",     "extent",  "sub_speed", NULL};
     unsigned long long space;
     PyObject *fns, *bodies, *offsets, *plan, *drives, *rims, *ground, *state;
     Py_ssize_t rim_k, rim_side, ground_k;
-    Py_ssize_t go[7];
-    double dt, max2, extent;
+    Py_ssize_t go[GROUND_TERMS];
+    double dt, max2, extent, sub_speed = INFINITY;
     if (st->n_views) {
         PyErr_SetString(PyExc_RuntimeError, "Stepper is initialised once");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "KO!OOOOO(nn)O(n(nnnnnnn))Oddd", kwlist, &space,
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "KO!OOOOO(nn)O(n(nnnnnnnnn))Oddd|d", kwlist, &space,
                                      &PyTuple_Type, &fns, &bodies, &offsets, &plan, &drives,
                                      &rims, &rim_k, &rim_side, &ground, &ground_k, &go[0],
-                                     &go[1], &go[2], &go[3], &go[4], &go[5], &go[6], &state, &dt,
-                                     &max2, &extent))
+                                     &go[1], &go[2], &go[3], &go[4], &go[5], &go[6], &go[7], &go[8], &state, &dt,
+                                     &max2, &extent, &sub_speed))
         return -1;
     if (PyTuple_GET_SIZE(fns) != 7) {
         PyErr_SetString(PyExc_ValueError, "functions: seven addresses");
@@ -549,7 +635,7 @@ static int Stepper_init(Stepper *st, PyObject *args, PyObject *kwds)
         !(st->rims = take(st, rims, 8, 2 * nb, "rims")))
         return -1;
     Py_ssize_t ground_need = 0, rim_need = 0;
-    for (int t = 0; t < 7; t++)
+    for (int t = 0; t < GROUND_TERMS; t++)
         if (go[t] + 1 > ground_need)
             ground_need = go[t] + 1;
     if (nb) {
@@ -575,11 +661,19 @@ static int Stepper_init(Stepper *st, PyObject *args, PyObject *kwds)
     st->rim_k = rim_k;
     st->rim_side = rim_side;
     st->ground_k = ground_k;
-    for (int t = 0; t < 7; t++)
+    for (int t = 0; t < GROUND_TERMS; t++)
         st->ground_off[t] = go[t];
     st->dt = dt;
     st->max2 = max2;
     st->extent = extent;
+    st->sub_speed = sub_speed;
+    st->top2 = 0.0;
+    for (Py_ssize_t k = 0; k < st->n; k++) { /* as FewRovers.__init__ */
+        const double *s = st->state + st->offsets[k];
+        double v2 = s[3] * s[3] + s[4] * s[4];
+        if (v2 > st->top2)
+            st->top2 = v2;
+    }
     return 0;
 }
 
@@ -614,7 +708,7 @@ static PyTypeObject StepperType = {
  * masks for the rare branches cost half of a batch. This is rover_forces above (the same
  * code, so the same floats as a run made alone with the compiled step) over arrays laid out
  * as fleet.Fleet's: plan (n, PLAN_WIDTH), drives (2, n), rims (2, n, updated in place),
- * ground (7, n) in fleet._GROUND_ROWS order, state (n, 6); forces (n, 3) are written. */
+ * ground (9, n) in fleet._GROUND_ROWS order, state (n, 6); forces (n, 3) are written. */
 static PyObject *column_forces(PyObject *Py_UNUSED(module), PyObject *args)
 {
     PyObject *objs[6];
@@ -638,7 +732,7 @@ static PyObject *column_forces(PyObject *Py_UNUSED(module), PyObject *args)
         }
     }
     Py_ssize_t n = views[4].len / (6 * 8);
-    const Py_ssize_t need[6] = {n * PLAN_WIDTH, 2 * n, 2 * n, 7 * n, 6 * n, 3 * n};
+    const Py_ssize_t need[6] = {n * PLAN_WIDTH, 2 * n, 2 * n, GROUND_TERMS * n, 6 * n, 3 * n};
     for (int i = 0; i < 6; i++)
         if (views[i].len != need[i] * 8) {
             PyErr_Format(PyExc_ValueError, "%s: %zd floats expected for %zd rovers, got %zd",
@@ -655,9 +749,8 @@ static PyObject *column_forces(PyObject *Py_UNUSED(module), PyObject *args)
     st.rim_side = n;
     st.ground = views[3].buf;
     st.ground_k = 1;
-    static const int rows[7] = {0, 2, 4, 1, 3, 5, 6}; /* fleet._GROUND_ROWS */
-    for (int t = 0; t < 7; t++)
-        st.ground_off[t] = rows[t] * n;
+    for (int t = 0; t < GROUND_TERMS; t++)
+        st.ground_off[t] = ground_rows[t] * n;
     st.state = views[4].buf;
     st.dt = dt;
     double *forces = views[5].buf;
@@ -697,9 +790,38 @@ PyMODINIT_FUNC PyInit__step(void)
         Py_DECREF(m);
         return NULL;
     }
-    if (PyModule_AddIntConstant(m, "PLAN_WIDTH", PLAN_WIDTH) < 0) {
-        Py_DECREF(m);
-        return NULL;
+    PyObject *fields = PyTuple_New(PLAN_WIDTH);
+    PyObject *rows = PyTuple_New(GROUND_TERMS);
+    PyObject *slip = PyFloat_FromDouble(SLIP_SPEED_MIN);
+    if (fields == NULL || rows == NULL || slip == NULL)
+        goto fail;
+    for (int i = 0; i < PLAN_WIDTH; i++) {
+        PyObject *name = PyUnicode_FromString(plan_fields[i]);
+        if (name == NULL)
+            goto fail;
+        PyTuple_SET_ITEM(fields, i, name);
     }
+    for (int i = 0; i < GROUND_TERMS; i++) {
+        PyObject *row = PyLong_FromLong(ground_rows[i]);
+        if (row == NULL)
+            goto fail;
+        PyTuple_SET_ITEM(rows, i, row);
+    }
+    /* PyModule_AddObjectRef does not steal: the tuples are released below either way */
+    if (PyModule_AddIntConstant(m, "PLAN_WIDTH", PLAN_WIDTH) < 0 ||
+        PyModule_AddIntConstant(m, "GROUND_TERMS", GROUND_TERMS) < 0 ||
+        PyModule_AddObjectRef(m, "PLAN_FIELDS", fields) < 0 ||
+        PyModule_AddObjectRef(m, "GROUND_ROWS", rows) < 0 ||
+        PyModule_AddObjectRef(m, "SLIP_SPEED_MIN", slip) < 0)
+        goto fail;
+    Py_DECREF(fields);
+    Py_DECREF(rows);
+    Py_DECREF(slip);
     return m;
+fail:
+    Py_XDECREF(fields);
+    Py_XDECREF(rows);
+    Py_XDECREF(slip);
+    Py_DECREF(m);
+    return NULL;
 }

@@ -9,7 +9,7 @@ pymunk's broadphase quadratic). What is shared is the arithmetic:
 * the wheel, tyre and grip forces of all rovers of all runs are one pass: the compiled
   step's own per-rover C code (``compiled.ColumnForces``, ``_step.column_forces``) where
   the extension is built, so each rover gets the very floats its run made alone gets; the
-  numpy ``fleet.Fleet`` (the platoon's model, within rounding of the float path) under
+  pure ``fleet.Fleet`` (the same per-rover arithmetic in Python, ``forces.rover_step``) under
   ``AMSA_PHYS_PURE=1`` or without the extension. Profiled on a 250-run scenario1 batch, the
   numpy pass was half of the batch's time, most of it in the rare branches' masks (some
   rover takes one at two steps in three); the C pass takes each rover's branch alone;
@@ -45,11 +45,11 @@ import numpy as np
 import pymunk
 
 from ..errors import RunFault
-from .compiled import ColumnForces, columns_compiled
 from .fleet import Fleet
+from .force_model import make_force_model
 from .forces import ground_list
 from .rover import DiffDriveRover
-from .space import PhysicsWorld
+from .space import PhysicsWorld, resolvable_speed
 
 #: Two shapes of a run closer than this (plus two steps of their motion): the run may be
 #: about to touch, and its row is made alone.
@@ -80,7 +80,9 @@ class _ColumnIO:
     def write(self) -> None:
         pass
 
-    def step(self, dt: float) -> None:
+    def step(self, dt: float, substeps: int = 1) -> None:
+        """One step of every body (``substeps`` is the Space's business: a run fast enough to
+        need them is made alone, :meth:`ColumnPhysics._contacts`)."""
         s = self.state
         np.copyto(self.before, s)
         # cpBodyUpdatePosition: p = p + (v + v_bias) * dt; a = a + (w + w_bias) * dt
@@ -116,13 +118,15 @@ class ColumnPhysics:
         #: runs whose shapes came within reach of each other: their rows are made alone
         self.touched: set[int] = set()
 
-    def adopt(self, world: PhysicsWorld) -> None:
-        """Take over ``world``'s step (its rovers and contacts stay its own)."""
+    def adopt(self, world: PhysicsWorld, run: Any) -> None:
+        """Take over ``world``'s step (its rovers and contacts stay its own); ``run`` is its
+        run's view of the batch, through which the first world registers the one step of
+        all. The world sends its robots' group calls here (``PhysicsWorld.group``)."""
+        if not self.worlds:
+            self.sim = run
+            run.add_hook(world.rate, self.step, "physics")
         self.worlds.append(world)
-        world.index_of = self.index_of  # type: ignore[method-assign]
-        world.set_powers = self.set_powers  # type: ignore[method-assign]
-        world.kinematics_array = self.kinematics_array  # type: ignore[method-assign]
-        world.rim_array = self.rim_array  # type: ignore[method-assign]
+        world.group = self
 
     # -- the robots' group interface (as PhysicsWorld's, over every run) -------------------
     def index_of(self, rovers: Sequence[DiffDriveRover]) -> np.ndarray:
@@ -171,10 +175,16 @@ class ColumnPhysics:
         for w in self.worlds:
             ground = w.terrain.ground(-1)
             grounds += [ground_list(r, ground, ground) for r in w.rovers]
+        # faster than its world's resolvable speed a run's Space would take sub-steps
+        # (``bodyio.substeps``), which these columns do not: such a run is made alone (with a
+        # margin, so that rounding at the threshold cannot decide it)
+        self._sub = np.array(
+            [resolvable_speed(w.rovers, w.space, self.dt) for w in self.worlds for _ in w.rovers]
+        )
         limits = (first.max_speed, first.extent)
-        # the C force model (a single run's own arithmetic) when built; numpy's otherwise
-        kind = ColumnForces if columns_compiled() else Fleet
-        model = kind(io, self.rovers, self.dt, limits, grounds)  # type: ignore[arg-type]
+        # the C force model (a single run's own arithmetic) when built; the pure one otherwise
+        model = make_force_model(io, self.rovers, self.dt, limits, grounds, columns=True)
+        assert isinstance(model, Fleet)
         self._model = model
         self._io = io
         for k, rover in enumerate(self.rovers):
@@ -212,6 +222,9 @@ class ColumnPhysics:
         x, y = before[:, 0], before[:, 1]
         speed = np.hypot(before[:, 3], before[:, 4])
         reach = self._radius + REACH_M + 2.0 * dt * speed
+        fast = speed > 0.99 * self._sub
+        if fast.any():
+            self.touched.update(self._run[fast].tolist())
         if len(self._pa):
             pa, pb = self._pa, self._pb
             gap = np.hypot(x[pa] - x[pb], y[pa] - y[pb])

@@ -8,9 +8,8 @@ pymunk's own cffi library (no second copy of Chipmunk, nothing to link).
 
 Same trace, bit for bit, as the pure few-rover path: the C code is ``FewRovers.apply``'s
 arithmetic in the same order (see ``_step.c``). ``CompiledFleet`` (many rovers) runs that same
-per-rover arithmetic too, not ``fleet.py``'s numpy one: its runs equal the pure few-rover
-path's, and differ from the pure numpy fleet by that path's rounding (the tests state the
-bound).
+per-rover arithmetic too: its runs equal the pure few-rover path's and the pure fleet's
+(``forces.rover_step`` is the pure path's one copy).
 
 The extension is optional (``setup.py``): :func:`status` says which path runs and why;
 ``AMSA_PHYS_PURE=1`` forces the pure-Python path.
@@ -24,34 +23,45 @@ from typing import Any
 
 import numpy as np
 
-from .bodyio import STATE, BodyIO, locked_step
+from .bodyio import STATE, BodyIO, locked_step, substeps
 from .fleet import _GROUND_ROWS, Fleet
-from .forces import FewRovers, fold
+from .forces import FewRovers, Folded, fold
 from .rover import DiffDriveRover
 from .step_path import describe, extension
-from .wheel import step_constants
+from .wheel import SLIP_SPEED_MIN, step_constants
 
 _step = extension()
-#: The order of a rover's constants in the C step's plan (``_step.c``'s ``P_*``).
-PLAN_FIELDS = [
-    "kp",
-    "c",
-    "f_max",
-    "mw",
-    "big_b",
-    "big_be",
-    "e",
-    "e2",
-    "kx",
-    "half_track",
-    "turn_k",
-    "dt_i",
-    "dt_m",
-    "sphi",
-    "ky_dt_m",
-    "neg_m_dt",
-    "big_bc",
-]
+#: Constants ``plan_row`` can give a rover's plan: ``forces.fold``'s and the rim's compliance
+#: without back-EMF (the current limit's branch).
+KNOWN_FIELDS = (*Folded._fields, "big_bc")
+
+
+def check_layout(ext: Any) -> tuple[str, ...]:
+    """The C step's plan layout (its ``PLAN_FIELDS``), after checking that it matches this
+    source: every constant it wants is one :func:`plan_row` can fill, its slip floor and
+    ground layout are the Python model's. A build from another version of ``_step.c`` (an
+    in-place build not redone after a change) would otherwise run on shifted constants;
+    raises ImportError naming the difference instead."""
+    fields = tuple(ext.PLAN_FIELDS)
+    unknown = [f for f in fields if f not in KNOWN_FIELDS]
+    problems = []
+    if unknown or len(fields) != ext.PLAN_WIDTH:
+        problems.append(f"plan constants {unknown or fields} unknown to forces.fold")
+    if ext.SLIP_SPEED_MIN != SLIP_SPEED_MIN:
+        problems.append(f"SLIP_SPEED_MIN {ext.SLIP_SPEED_MIN} != wheel.py's {SLIP_SPEED_MIN}")
+    if list(ext.GROUND_ROWS) != _GROUND_ROWS or len(_GROUND_ROWS) != ext.GROUND_TERMS:
+        problems.append(f"ground rows {ext.GROUND_ROWS} != fleet._GROUND_ROWS {_GROUND_ROWS}")
+    if problems:
+        raise ImportError(
+            "amsa_phys.physics._step was built from another version of _step.c ("
+            + "; ".join(problems)
+            + "): rebuild it (pip install -e .)"
+        )
+    return fields
+
+
+#: The order of a rover's constants in the C step's plan, as ``_step.c`` declares it.
+PLAN_FIELDS: tuple[str, ...] = check_layout(_step) if _step is not None else ()
 #: Chipmunk functions the C step calls, in the order ``Stepper`` takes them.
 _FUNCTIONS = (
     "cpBodyGetPosition",
@@ -114,12 +124,15 @@ def _locked_step(space: Any, step: Any) -> int:
     return int(locked_step(space, step))
 
 
-def _step_with(io: BodyIO, stepper: Any, dt: float) -> int:
-    """One step through ``stepper``; pymunk's own ``Space.step`` when it has bodies to check."""
+def _step_with(io: BodyIO, stepper: Any, dt: float, top2: float, sub_speed: float) -> int:
+    """One step through ``stepper``; pymunk's own ``Space.step`` when it has bodies to check
+    (in as many sub-steps as the C step would take: ``bodyio.substeps``)."""
     space = io.space
     if space._bodies_to_check:  # new bodies (the first step): let pymunk validate them
         stepper.apply()
-        space.step(dt)
+        n = substeps(top2, sub_speed)
+        for _ in range(n):
+            space.step(dt / n)
         return int(stepper.read_check())
     return _locked_step(space, stepper.advance)
 
@@ -172,11 +185,12 @@ class CompiledFewRovers(FewRovers):
             self.rims,
             (2, 1),
             self._ground,
-            (7, tuple(range(7))),
+            (len(_GROUND_ROWS), tuple(range(len(_GROUND_ROWS)))),
             self.state,
             dt,
             self._max2,
             self.extent,
+            self.sub_speed,
         )
 
     # rims and state are buffers the C step holds: assigning either copies into it (as the
@@ -209,7 +223,8 @@ class CompiledFewRovers(FewRovers):
     def set_ground(self, k: int, terms: list[float]) -> None:
         """Rover ``k``'s ground terms (``ground_list``) from the next step on."""
         super().set_ground(k, terms)
-        self._ground[7 * k : 7 * k + 7] = array.array("d", terms)
+        width = len(_GROUND_ROWS)
+        self._ground[width * k : width * (k + 1)] = array.array("d", terms)
 
     def kinematics(self, k: int) -> list[float]:
         """Rover ``k``'s six state floats after the last step."""
@@ -226,7 +241,7 @@ class CompiledFewRovers(FewRovers):
         """
         space = self.io.space
         if space._bodies_to_check:
-            bad = _step_with(self.io, self._stepper, self.dt)
+            bad = _step_with(self.io, self._stepper, self.dt, self._top2, self.sub_speed)
         else:
             space._locked = True
             try:
@@ -243,7 +258,7 @@ class CompiledFewRovers(FewRovers):
 
 
 class CompiledFleet(Fleet):
-    """``Fleet`` (many rovers, numpy arrays) with the step in C, per rover as FewRovers."""
+    """``Fleet`` (many rovers, arrays) with the step in C, per rover as FewRovers."""
 
     def __init__(
         self,
@@ -272,6 +287,7 @@ class CompiledFleet(Fleet):
             dt,
             self.max_speed * self.max_speed * (1 - 1e-12),
             self.extent,
+            self.sub_speed,
         )
 
     # as CompiledFewRovers: assigning rims or state copies into the C step's arrays
@@ -301,7 +317,7 @@ class CompiledFleet(Fleet):
 
     def advance(self) -> tuple[int, str] | None:
         """One physics step in C; a safety violation or None."""
-        bad = _step_with(self.io, self._stepper, self.dt)
+        bad = _step_with(self.io, self._stepper, self.dt, self._top2, self.sub_speed)
         if bad < 0:
             return None
         return self.first_violation(self.state, self.max_speed, self.extent)

@@ -26,28 +26,26 @@ The model per rover (``wheel.py`` states the wheel part and its closed forms):
 Why inlined float arithmetic rather than calls into ``wheel.py``: at 100 Hz with two rovers
 every microsecond per step is 3 % of the run (issue 8), and a Python call costs about as much
 as the arithmetic it wraps. The usual path (tyres gripping, rims turning, no current limit)
-is inlined; the rare branches call ``wheel.py``'s functions. :func:`reference_forces` is the
-same model written plainly; the tests check this code against it, and ``fleet.py`` (numpy,
-for many rovers) against this. The arithmetic per rover is straight-line apart from those
-branches, so it can move to compiled code as it is.
+is inlined; the rare branches call ``wheel.py``'s functions. ``reference.reference_forces`` is the
+same model written plainly; the tests check this code against it. :func:`rover_step` is the
+pure path's one copy of the per-rover arithmetic (``FewRovers`` and ``fleet.Fleet`` call
+it; ``_step.c`` mirrors it in C, bit for bit).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
-from .bodyio import FORCE, STATE, BodyIO
+from .bodyio import FORCE, STATE, BodyIO, substeps
 from .rover import DiffDriveRover
 from .wheel import (
     SLIP_SPEED_MIN,
     TORSION,
-    friction_ellipse,
-    rim_alone,
-    slip_speed,
+    slide,
     step_constants,
     wheel_pair,
 )
@@ -78,6 +76,7 @@ class Folded(NamedTuple):
     sphi: float  # turn-slip stiffness times speed per wheel: (3 pi/16) a^2 N / c_x
     ky_dt_m: float  # ky dt / m
     neg_m_dt: float  # -m / dt
+    mass: float  # m: a slope's pull is m g
 
 
 def fold(rover: DiffDriveRover, dt: float) -> Folded:
@@ -104,6 +103,7 @@ def fold(rover: DiffDriveRover, dt: float) -> Folded:
         sphi=TORSION * w.patch_radius_m**2 * kx,
         ky_dt_m=w.load_n / w.slip_lat * dt / rover.mass,
         neg_m_dt=-rover.mass / dt,
+        mass=rover.mass,
     )
 
 
@@ -119,12 +119,20 @@ def ground_terms(rover: DiffDriveRover, mu: float, crr: float) -> tuple[float, f
 
 
 def ground_list(
-    rover: DiffDriveRover, left: tuple[float, float], right: tuple[float, float]
+    rover: DiffDriveRover,
+    left: tuple[float, float],
+    right: tuple[float, float],
+    slope: tuple[float, float, float] = (1.0, 0.0, 0.0),
 ) -> list[float]:
-    """``[1/gx_L, 1/gy_L, R_L, 1/gx_R, 1/gy_R, R_R, scrub_L + scrub_R]`` for (mu, crr) pairs."""
-    il, jl, rl, tl = ground_terms(rover, *left)
-    ir, jr, rr, tr = ground_terms(rover, *right)
-    return [il, jl, rl, ir, jr, rr, tl + tr]
+    """``[1/gx_L, 1/gy_L, R_L, 1/gx_R, 1/gy_R, R_R, scrub_L + scrub_R, g_x, g_y]`` for
+    (mu, crr) pairs under the wheels and the slope ``(cos(angle), g_x, g_y)`` under the rover
+    (``terrain.Terrain.slope``): the ground carries ``cos(angle)`` of the weight, so grip,
+    scrub and rolling resistance scale with it (``mu cos``, ``crr cos``: the same floats on
+    the flat), and gravity pulls along the slope with ``(g_x, g_y)`` (m/s²)."""
+    cos, gx, gy = slope
+    il, jl, rl, tl = ground_terms(rover, left[0] * cos, left[1] * cos)
+    ir, jr, rr, tr = ground_terms(rover, right[0] * cos, right[1] * cos)
+    return [il, jl, rl, ir, jr, rr, tl + tr, gx, gy]
 
 
 class FewRovers:
@@ -135,6 +143,9 @@ class FewRovers:
     writes them in one batch call and advances the rims (``rims``: left and right rim speed of
     rover ``k`` at ``2k``, ``2k + 1``).
     """
+
+    #: the rovers' drives are read from the rovers themselves (``force_model.ForceModel``)
+    drives: np.ndarray | None = None
 
     def __init__(
         self,
@@ -148,13 +159,19 @@ class FewRovers:
         self.rovers = rovers
         self.rows = io.rows
         self.dt = dt
-        self.max_speed, self.extent = limits
+        self.max_speed, self.extent, *sub = limits
+        #: faster than this a step is cut into Chipmunk sub-steps (``bodyio.substeps``)
+        self.sub_speed = sub[0] if sub else math.inf
         self._max2 = self.max_speed * self.max_speed * (1 - 1e-12)  # never above hypot's test
+        self._top2 = 0.0  # the fastest rover's squared speed after the last step
         #: per rover, ground terms under each wheel (``ground_list``); terrain rewrites them
         self.grounds = grounds
         self.rims = [0.0] * (2 * len(rovers))
         self.refresh()
         self.state = io.read()
+        state = self.state
+        for i in self._offsets:
+            self._top2 = max(self._top2, state[i + 3] * state[i + 3] + state[i + 4] * state[i + 4])
 
     def refresh(self) -> None:
         """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
@@ -162,7 +179,7 @@ class FewRovers:
         for k, (r, row) in enumerate(zip(self.rovers, self.rows, strict=True)):
             f = fold(r, self.dt)
             s = step_constants(r.wheel, self.dt, r.mass, r.moment, r.half_track)
-            self._plan.append((r, row * STATE, row * FORCE, 2 * k, *f, self.grounds[k], s))
+            self._plan.append((r, row * STATE, row * FORCE, 2 * k, (*f, s), self.grounds[k]))
         self._offsets = [row * STATE for row in self.rows]
 
     @property
@@ -197,20 +214,23 @@ class FewRovers:
         io = self.io
         self.apply(self.state)
         io.write()
-        io.step(self.dt)
+        io.step(self.dt, substeps(self._top2, self.sub_speed))
         state = self.state = io.read()
         # the safety check, inline: written so that NaN fails every comparison
         max2 = self._max2
         extent = self.extent
+        top2 = 0.0
         for i in self._offsets:
             vx = state[i + 3]
             vy = state[i + 4]
+            v2 = vx * vx + vy * vy
+            if v2 > top2:
+                top2 = v2
             if not (
-                vx * vx + vy * vy <= max2
-                and -extent <= state[i] <= extent
-                and -extent <= state[i + 1] <= extent
+                v2 <= max2 and -extent <= state[i] <= extent and -extent <= state[i + 1] <= extent
             ):
                 return self.first_violation(state, self.max_speed, extent)
+        self._top2 = top2
         return None
 
     def apply(self, state: Sequence[float]) -> None:
@@ -218,143 +238,23 @@ class FewRovers:
         forces = self.io.forces
         rims = self.rims
         dt = self.dt
-        vmin = SLIP_SPEED_MIN
-        ivmin = INV_SLIP_SPEED_MIN
-        sin = math.sin
-        cos = math.cos
-        for (
-            r,
-            i,
-            o,
-            j,
-            kp,
-            c,
-            fmax,
-            mw,
-            bb,
-            bbe,
-            e,
-            e2,
-            kx,
-            _ky,
-            h,
-            turn_k,
-            dt_i,
-            dt_m,
-            _m_dt,
-            sphi,
-            ky_dt_m,
-            neg_m_dt,
-            gnd,
-            sc,
-        ) in self._plan:
-            angle = state[i + 2]
-            vx = state[i + 3]
-            vy = state[i + 4]
-            w = state[i + 5]
-            co = cos(angle)
-            si = sin(angle)
-            v_fwd = vx * co + vy * si
-            wh = w * h
-            ixl, iyl, rl, ixr, iyr, rr, ts = gnd
-            # both rims and tyres, backward Euler (wheel.wheel_pair's usual branch)
-            ul = rims[j]
-            ur = rims[j + 1]
-            vl = v_fwd - wh
-            vr = v_fwd + wh
-            ivl = 1.0 / vl if vl > vmin else (-1.0 / vl if vl < -vmin else ivmin)
-            ivr = 1.0 / vr if vr > vmin else (-1.0 / vr if vr < -vmin else ivmin)
-            kl = kx * ivl
-            kr = kx * ivr
-            f0l = kp * r.drive_l
-            f0r = kp * r.drive_r
-            if ul == 0.0 and ur == 0.0:
-                # a parked rover (wheel.held): the tyres hold the body against still rims; the
-                # rims stay still if their resistance holds them against motor and tyre
-                gl = 1.0 + kl * e
-                gr = 1.0 + kr * e
-                cl = kl * e2
-                cr = kr * e2
-                bl = -kl * vl
-                br = -kr * vr
-                det = gl * gr - cl * cr
-                fxl = (bl * gr - cl * br) / det
-                fxr = (br * gl - cr * bl) / det
-                nl = (f0l if -fmax <= f0l <= fmax else (fmax if f0l > 0 else -fmax)) - fxl
-                nr = (f0r if -fmax <= f0r <= fmax else (fmax if f0r > 0 else -fmax)) - fxr
-                if -rl <= nl <= rl and -rr <= nr <= rr:
-                    upl = upr = 0.0
-                else:
-                    fxl, upl, fxr, upr = wheel_pair(
-                        (ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc
-                    )
-            else:
-                al = (mw * ul + f0l - (rl if ul > 0.0 else -rl if ul < 0.0 else 0.0)) * bb
-                ar = (mw * ur + f0r - (rr if ur > 0.0 else -rr if ur < 0.0 else 0.0)) * bb
-                gl = 1.0 + kl * bbe
-                gr = 1.0 + kr * bbe
-                cl = kl * e2
-                cr = kr * e2
-                bl = kl * (al - vl)
-                br = kr * (ar - vr)
-                det = gl * gr - cl * cr
-                fxl = (bl * gr - cl * br) / det
-                fxr = (br * gl - cr * bl) / det
-                upl = al - bb * fxl
-                upr = ar - bb * fxr
-                fml = f0l - c * upl
-                fmr = f0r - c * upr
-                if not (
-                    upl * ul > 0.0
-                    and upr * ur > 0.0
-                    and -fmax <= fml <= fmax
-                    and -fmax <= fmr <= fmax
-                ):
-                    fxl, upl, fxr, upr = wheel_pair(
-                        (ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc
-                    )
-            # scrub: the patches' turn-slip moment, implicit in the yaw rate, capped
-            isum = ivl + ivr
-            torque = (fxr - fxl) * h
-            kphi = sphi * isum
-            scrub = -kphi * (w + torque * dt_i) / (1.0 + kphi * dt_i)
-            if scrub > ts:
-                scrub = ts
-            elif scrub < -ts:
-                scrub = -ts
-            torque += scrub
-            # predicted heading change over this step (semi-implicit Euler, as pymunk does)
-            turn = w * dt + torque * turn_k
-            end = angle + turn
-            mid = angle + 0.5 * turn
-            cm = cos(mid)
-            sm = sin(mid)
-            # velocity after the drive force alone, and its sideways part at the end heading
-            fx = fxl + fxr
-            a = fx * dt_m
-            side = (vy + a * sm) * cos(end) - (vx + a * cm) * sin(end)
-            kd = ky_dt_m * isum
-            f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
-            fyl = f_lat * ivl / isum
-            fyr = f_lat - fyl
-            # friction ellipse per wheel; a saturated tyre's rim is re-solved with that force
-            t1 = fxl * ixl
-            t2 = fyl * iyl
-            t3 = fxr * ixr
-            t4 = fyr * iyr
-            if t1 * t1 + t2 * t2 > 1.0 or t3 * t3 + t4 * t4 > 1.0:
-                fxl, fyl = friction_ellipse(fxl, fyl, ixl, iyl)
-                fxr, fyr = friction_ellipse(fxr, fyr, ixr, iyr)
-                upl = rim_alone(ul, f0l, rl, fxl, sc)
-                upr = rim_alone(ur, f0r, rr, fxr, sc)
-                fx = fxl + fxr
-                torque = (fxr - fxl) * h + scrub
-                f_lat = fyl + fyr
-            forces[o] = fx * cm - f_lat * sm
-            forces[o + 1] = fx * sm + f_lat * cm
+        for r, i, o, j, plan, gnd in self._plan:
+            fx, fy, torque, rims[j], rims[j + 1] = rover_step(
+                plan,
+                gnd,
+                dt,
+                state[i + 2],
+                state[i + 3],
+                state[i + 4],
+                state[i + 5],
+                rims[j],
+                rims[j + 1],
+                r.drive_l,
+                r.drive_r,
+            )
+            forces[o] = fx
+            forces[o + 1] = fy
             forces[o + 2] = torque
-            rims[j] = upl
-            rims[j + 1] = upr
 
     def first_violation(
         self, state: Sequence[float], max_speed: float, extent: float
@@ -370,75 +270,173 @@ class FewRovers:
         return None
 
 
-def reference_forces(
-    rover: DiffDriveRover,
+def rover_step(
+    plan: tuple[Any, ...],
+    gnd: Sequence[float],
     dt: float,
-    rims: tuple[float, float],
-    ground: tuple[tuple[float, float], tuple[float, float]],
+    angle: float,
+    vx: float,
+    vy: float,
+    w: float,
+    ul: float,
+    ur: float,
+    drive_l: float,
+    drive_r: float,
 ) -> tuple[float, float, float, float, float]:
-    """The same model written plainly: pymunk properties, ``wheel.py``'s functions per wheel.
+    """One rover's force for one step: ``(fx, fy, torque, u_left+, u_right+)``.
 
-    ``rims`` are the left and right rim speeds now, ``ground`` the ``(mu, crr)`` under each
-    wheel. Returns ``(fx, fy, torque, u_left+, u_right+)``. Slow (~10 µs a rover); it is what
-    the fast paths are tested against and the "plain loop" of the benchmarks.
+    The pure path's only copy of the per-rover arithmetic (``_step.c``'s ``rover_forces`` is
+    its C twin, bit for bit): ``FewRovers`` and ``Fleet`` both call it. ``plan`` is
+    :func:`fold`'s constants followed by the wheel's :class:`wheel.StepConstants`, ``gnd``
+    :func:`ground_list`'s terms, ``drive_*`` the drivers' outputs (%, deadband applied).
+    The usual path (tyres gripping, rims turning, no current limit) is inlined: at 100 Hz
+    with two rovers every microsecond per step is 3 % of the run, and a Python call costs
+    about as much as the arithmetic it wraps; the rare branches call ``wheel.py``.
     """
-    body = rover.body
-    wm = rover.wheel
-    s = step_constants(wm, dt, rover.mass, body.moment, rover.half_track)
-    a = body.angle
-    c, sn = math.cos(a), math.sin(a)
-    vx, vy = body.velocity
-    w = body.angular_velocity
-    v_fwd = vx * c + vy * sn
-    kx = wm.load_n / wm.slip_long
-    vl, vr = v_fwd - w * rover.half_track, v_fwd + w * rover.half_track
-    sl, sr = slip_speed(vl), slip_speed(vr)
-    (mul, crl), (mur, crr) = ground
-    f0l, f0r = wm.drive_force(rover.power_l), wm.drive_force(rover.power_r)
-    rl, rr = wm.resistance(crl), wm.resistance(crr)
-    ul, ur = rims
-    fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kx / sl, kx / sr), s)
-    vl, vr = sl, sr
-    # scrub
-    torque = (fxr - fxl) * rover.half_track
-    kphi = TORSION * wm.patch_radius_m**2 * kx * (1 / vl + 1 / vr)
-    limit = wm.scrub_limit(mul) + wm.scrub_limit(mur)
-    scrub = -kphi * (w + torque * dt / body.moment) / (1 + kphi * dt / body.moment)
-    scrub = max(-limit, min(limit, scrub))
+    (
+        kp,
+        c,
+        fmax,
+        mw,
+        bb,
+        bbe,
+        e,
+        e2,
+        kx,
+        ky,
+        h,
+        turn_k,
+        dt_i,
+        dt_m,
+        _m_dt,
+        sphi,
+        ky_dt_m,
+        neg_m_dt,
+        mass,
+        sc,
+    ) = plan
+    vmin = SLIP_SPEED_MIN
+    ivmin = INV_SLIP_SPEED_MIN
+    sin = math.sin
+    cos = math.cos
+    gax = gnd[7]
+    gay = gnd[8]
+    sloped = gax != 0.0 or gay != 0.0
+    if sloped:  # the solves see the velocity gravity gives the body within the step
+        vx = vx + gax * dt
+        vy = vy + gay * dt
+    co = cos(angle)
+    si = sin(angle)
+    v_fwd = vx * co + vy * si
+    wh = w * h
+    ixl, iyl, rl, ixr, iyr, rr, ts, _, _ = gnd
+    # both rims and tyres, backward Euler (wheel.wheel_pair's usual branch)
+    vl = v_fwd - wh
+    vr = v_fwd + wh
+    ivl = 1.0 / vl if vl > vmin else (-1.0 / vl if vl < -vmin else ivmin)
+    ivr = 1.0 / vr if vr > vmin else (-1.0 / vr if vr < -vmin else ivmin)
+    kl = kx * ivl
+    kr = kx * ivr
+    f0l = kp * drive_l
+    f0r = kp * drive_r
+    rigid = False
+    if ul == 0.0 and ur == 0.0:
+        # a parked rover (wheel.held): the tyres hold the body against still rims; the
+        # rims stay still if their resistance holds them against motor and tyre
+        if sloped:
+            # on a slope the tyres carry a steady load at rest, which a slip-rate tyre could
+            # only carry by creeping at its slip floor (~0.3 mm/s at 2°): the tyre's static
+            # deflection (not a state here) holds it, so the held body is held rigidly
+            det = e * e - e2 * e2
+            fxl = (e2 * vr - e * vl) / det
+            fxr = (e2 * vl - e * vr) / det
+        else:
+            gl = 1.0 + kl * e
+            gr = 1.0 + kr * e
+            cl = kl * e2
+            cr = kr * e2
+            bl = -kl * vl
+            br = -kr * vr
+            det = gl * gr - cl * cr
+            fxl = (bl * gr - cl * br) / det
+            fxr = (br * gl - cr * bl) / det
+        nl = (f0l if -fmax <= f0l <= fmax else (fmax if f0l > 0 else -fmax)) - fxl
+        nr = (f0r if -fmax <= f0r <= fmax else (fmax if f0r > 0 else -fmax)) - fxr
+        if -rl <= nl <= rl and -rr <= nr <= rr:
+            upl = upr = 0.0
+            rigid = sloped
+        else:
+            fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc)
+    else:
+        al = (mw * ul + f0l - (rl if ul > 0.0 else -rl if ul < 0.0 else 0.0)) * bb
+        ar = (mw * ur + f0r - (rr if ur > 0.0 else -rr if ur < 0.0 else 0.0)) * bb
+        gl = 1.0 + kl * bbe
+        gr = 1.0 + kr * bbe
+        cl = kl * e2
+        cr = kr * e2
+        bl = kl * (al - vl)
+        br = kr * (ar - vr)
+        det = gl * gr - cl * cr
+        fxl = (bl * gr - cl * br) / det
+        fxr = (br * gl - cr * bl) / det
+        upl = al - bb * fxl
+        upr = ar - bb * fxr
+        fml = f0l - c * upl
+        fmr = f0r - c * upr
+        if not (
+            upl * ul > 0.0 and upr * ur > 0.0 and -fmax <= fml <= fmax and -fmax <= fmr <= fmax
+        ):
+            fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc)
+    # scrub: the patches' turn-slip moment, implicit in the yaw rate, capped
+    isum = ivl + ivr
+    torque = (fxr - fxl) * h
+    kphi = sphi * isum
+    scrub = -kphi * (w + torque * dt_i) / (1.0 + kphi * dt_i)
+    if scrub > ts:
+        scrub = ts
+    elif scrub < -ts:
+        scrub = -ts
     torque += scrub
-    # lateral grip at the end-of-step heading, applied along the mid-step normal
-    turn = (w + torque / body.moment * dt) * dt
-    end, mid = a + turn, a + 0.5 * turn
+    # predicted heading change over this step (semi-implicit Euler, as pymunk does)
+    turn = w * dt + torque * turn_k
+    end = angle + turn
+    mid = angle + 0.5 * turn
+    cm = cos(mid)
+    sm = sin(mid)
+    # velocity after the drive force alone, and its sideways part at the end heading
     fx = fxl + fxr
-    px = vx + fx * math.cos(mid) / rover.mass * dt
-    py = vy + fx * math.sin(mid) / rover.mass * dt
-    side = px * -math.sin(end) + py * math.cos(end)
-    ky = wm.load_n / wm.slip_lat * (1 / vl + 1 / vr)
-    kd = ky * dt / rover.mass
-    f_lat = -rover.mass / dt * side / math.cos(0.5 * turn) * kd / (1 + kd)
-    fyl = f_lat * (1 / vl) / (1 / vl + 1 / vr)
+    a = fx * dt_m
+    side = (vy + a * sm) * cos(end) - (vx + a * cm) * sin(end)
+    kd = ky_dt_m * isum
+    if rigid:  # held on a slope: sideways too
+        f_lat = neg_m_dt * side / cos(0.5 * turn)
+    else:
+        f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
+    fyl = f_lat * ivl / isum
     fyr = f_lat - fyl
-    # friction ellipses
-    gl, gr = wm.grip(mul), wm.grip(mur)
-    inv = [1 / max(g, GRIP_FLOOR_N) for g in (*gl, *gr)]
-    sat = (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1 or (fxr * inv[2]) ** 2 + (
-        fyr * inv[3]
-    ) ** 2 > 1
-    if sat:
-        fxl, fyl = friction_ellipse(fxl, fyl, inv[0], inv[1])
-        fxr, fyr = friction_ellipse(fxr, fyr, inv[2], inv[3])
-        upl = rim_alone(ul, f0l, rl, fxl, s)
-        upr = rim_alone(ur, f0r, rr, fxr, s)
+    # friction ellipse per wheel: a tyre the gripping solve puts beyond it slides, and the
+    # tyre law is solved with its rim instead (wheel.slide)
+    t1 = fxl * ixl
+    t2 = fyl * iyl
+    t3 = fxr * ixr
+    t4 = fyr * iyr
+    sat_l = t1 * t1 + t2 * t2 > 1.0
+    sat_r = t3 * t3 + t4 * t4 > 1.0
+    if sat_l or sat_r:
+        side0 = vy * co - vx * si
+        if sat_l:
+            fxl, fyl, upl = slide(ul, vl, f0l, rl, ivl, (kx, ky, ixl, iyl), side0, fyl, sc)
+        if sat_r:
+            fxr, fyr, upr = slide(ur, vr, f0r, rr, ivr, (kx, ky, ixr, iyr), side0, fyr, sc)
         fx = fxl + fxr
-        torque = (fxr - fxl) * rover.half_track + scrub
+        torque = (fxr - fxl) * h + scrub
         f_lat = fyl + fyr
-    return (
-        fx * math.cos(mid) - f_lat * math.sin(mid),
-        fx * math.sin(mid) + f_lat * math.cos(mid),
-        torque,
-        upl,
-        upr,
-    )
+    fwx = fx * cm - f_lat * sm
+    fwy = fx * sm + f_lat * cm
+    if sloped:
+        fwx = fwx + mass * gax
+        fwy = fwy + mass * gay
+    return fwx, fwy, torque, upl, upr
 
 
 def too_fast(speed: float, max_speed: float) -> str:

@@ -3,9 +3,11 @@
 One ``PhysicsWorld`` per run, created by the first robot or zone template that asks for it
 (``ctx.shared("physics", ...)``) and stepped by an engine hook at ``physics.rate`` Hz after
 the components due at the same instant. The Space is rebuilt for every run and uses one
-thread, so a run is deterministic. Top-down: no gravity in the plane; the ground acts only
-through the wheel model (normal load ``m g / 2`` per wheel), with the friction and rolling
-resistance of the terrain under each wheel (``terrain.py``).
+thread, so a run is deterministic. Top-down: no gravity in the plane but a grade zone's pull
+along its slope; the ground acts only through the wheel model (normal load ``m g / 2`` per
+wheel, times ``cos(angle)`` on a slope), with the friction and rolling resistance of the
+terrain under each wheel (``terrain.py``). A step faster than :func:`resolvable_speed` is cut
+into Chipmunk sub-steps (no tunnelling).
 
 Contacts: pymunk lets shapes overlap by ``collision_slop`` before it pushes them apart (0.1 m
 by default: a rover resting 3 cm inside a wall); here the slop is :data:`CONTACT_SLOP_M` and
@@ -29,9 +31,10 @@ import numpy as np
 import pymunk
 
 from ..errors import RunFault
-from . import compiled, fleet
+from . import fleet
 from .bodyio import BodyIO
-from .forces import FewRovers, ground_list
+from .force_model import ForceModel, make_force_model
+from .forces import ground_list
 from .rover import DiffDriveRover
 from .terrain import Terrain
 from .wheel import WheelModel
@@ -60,7 +63,9 @@ class PhysicsWorld:
         self.dt = float(1 / self.rate)
         self.gravity = float(settings["gravity"])
         ground = settings["ground"]
-        self.terrain = Terrain(float(ground["friction"]), float(ground["rolling_resistance"]))
+        self.terrain = Terrain(
+            float(ground["friction"]), float(ground["rolling_resistance"]), self.gravity
+        )
         self.max_speed = float(settings["max_speed"])
         self.extent = float(settings["extent"])
         self.space = pymunk.Space(threaded=False)
@@ -74,14 +79,20 @@ class PhysicsWorld:
         self._touching: dict[tuple[str, str], int] = {}
         self._apart_since: dict[tuple[str, str], float] = {}
         self._steps = 0
-        self._model: FewRovers | fleet.Fleet | None = None
-        self._where: list[tuple[int, int, int] | None] = []
+        self._model: ForceModel | None = None
+        #: the batch's column physics stepping this world (``columns.py``), or None
+        self.group: Any = None
+        self._where: list[tuple[int, int, int, int] | None] = []
         self._add_obstacles(settings.get("obstacles") or [], settings.get("walls"))
         for kind in (ROVER, OBSTACLE):
             self.space.on_collision(
                 ROVER, kind, begin=self._on_collision, separate=self._on_separate
             )
-        sim.add_hook(self.rate, self.step, "physics")
+        columns = getattr(sim, "column_physics", None)  # a batch's run declares its columns
+        if columns is not None:
+            columns.adopt(self, sim)
+        else:
+            sim.add_hook(self.rate, self.step, "physics")
 
     def _add_obstacles(self, obstacles: list[dict[str, Any]], walls: dict[str, Any] | None) -> None:
         static = self.space.static_body
@@ -170,9 +181,10 @@ class PhysicsWorld:
                 np.concatenate([x + hx, x - hx]), np.concatenate([y + hy, y - hy])
             )
             left, right = where[:n].tolist(), where[n:].tolist()
+            under = terrain.locate_grades(x, y).tolist() if terrain.grades else [-1] * n
         else:
             state = model.state
-            left, right = [], []
+            left, right, under = [], [], []
             for k, rover in enumerate(self.rovers):
                 i = model.offsets[k]
                 x, y, a = state[i], state[i + 1], state[i + 2]
@@ -180,13 +192,20 @@ class PhysicsWorld:
                 hy = math.cos(a) * rover.half_track
                 left.append(terrain.locate(x + hx, y + hy))
                 right.append(terrain.locate(x - hx, y - hy))
+                under.append(terrain.locate_grade(x, y))
         version = terrain.version
         for k, rover in enumerate(self.rovers):
-            key = (left[k], right[k], version)
+            key = (left[k], right[k], under[k], version)
             if key != self._where[k]:
                 self._where[k] = key
                 model.set_ground(
-                    k, ground_list(rover, terrain.ground(left[k]), terrain.ground(right[k]))
+                    k,
+                    ground_list(
+                        rover,
+                        terrain.ground(left[k]),
+                        terrain.ground(right[k]),
+                        terrain.slope(under[k]),
+                    ),
                 )
 
     def step(self) -> None:
@@ -197,30 +216,23 @@ class PhysicsWorld:
         bodies.
         """
         model = self._model or self._start()
-        if self.terrain.zones:
+        if self.terrain.zones or self.terrain.grades:
             self._update_grounds()
         bad = model.advance()
         self._steps += 1
         if bad is not None:
             raise RunFault(self.rovers[bad[0]].name, self.sim.now + 1 / self.rate, bad[1])
 
-    def _start(self) -> FewRovers | fleet.Fleet:
+    def _start(self) -> ForceModel:
         """Choose the force model for this many rovers and read the initial state."""
         self._choose_index()
         io = BodyIO(self.space, [r.body for r in self.rovers])
-        limits = (self.max_speed, self.extent)
+        limits = (self.max_speed, self.extent, resolvable_speed(self.rovers, self.space, self.dt))
         ground = self.terrain.ground(-1)
         grounds = [ground_list(r, ground, ground) for r in self.rovers]
-        fast = compiled.usable(io)  # the C step when it was built (compiled.status says why)
-        model: FewRovers | fleet.Fleet
-        if len(self.rovers) >= fleet.BATCH_MIN:
-            cls = compiled.CompiledFleet if fast else fleet.Fleet
-            model = cls(io, self.rovers, self.dt, limits, grounds)
-        else:
-            few = compiled.CompiledFewRovers if fast else FewRovers
-            model = few(io, self.rovers, self.dt, limits, grounds)
+        model = make_force_model(io, self.rovers, self.dt, limits, grounds)
         self._model = model
-        self._where = [(-1, -1, -1)] * len(self.rovers)
+        self._where = [(-1, -1, -1, -1)] * len(self.rovers)
         for k, rover in enumerate(self.rovers):
             rover.attach_state(functools.partial(self._kinematics, k))
             rover.attach_rims(functools.partial(model.rim_speeds, k))
@@ -241,6 +253,8 @@ class PhysicsWorld:
 
     def index_of(self, rovers: Sequence[DiffDriveRover]) -> np.ndarray:
         """Positions of ``rovers`` in this world (for :meth:`kinematics_array`)."""
+        if self.group is not None:
+            return self.group.index_of(rovers)  # type: ignore[no-any-return]
         where = {id(r): k for k, r in enumerate(self.rovers)}
         return np.array([where[id(r)] for r in rovers], dtype=np.intp)
 
@@ -258,6 +272,9 @@ class PhysicsWorld:
         NaN to -100 as :func:`rover._saturate`); the rovers' ``power_l``/``power_r`` (which the
         per-rover force model and the renderer read) and the batch model's arrays both follow.
         """
+        if self.group is not None:  # a batch's columns: no window reads power_l there
+            self.group.set_powers(rovers, index, left, right)
+            return
         left = np.where(np.isnan(left), -100.0, np.clip(left, -100.0, 100.0))
         right = np.where(np.isnan(right), -100.0, np.clip(right, -100.0, 100.0))
         drive_l, drive_r = [], []
@@ -269,17 +286,21 @@ class PhysicsWorld:
             rover.drive_r = dr = rp if not -band < rp < band else 0.0
             drive_l.append(dl)
             drive_r.append(dr)
-        drives = getattr(self._model, "drives", None)  # the batch models' and the C step's
+        drives = self._model.drives if self._model is not None else None
         if drives is not None:
             drives[0, index] = drive_l
             drives[1, index] = drive_r
 
     def kinematics_array(self, index: np.ndarray) -> np.ndarray:
         """(n, 6) ``x, y, angle, vx, vy, w`` of the rovers at ``index`` after the last step."""
+        if self.group is not None:
+            return self.group.kinematics_array(index)  # type: ignore[no-any-return]
         return (self._model or self._start()).kinematics_array(index)
 
     def rim_array(self, index: np.ndarray) -> np.ndarray:
         """(n, 2) left and right rim speeds of the rovers at ``index`` after the last step."""
+        if self.group is not None:
+            return self.group.rim_array(index)  # type: ignore[no-any-return]
         return (self._model or self._start()).rim_array(index)
 
     def _kinematics(self, k: int) -> Sequence[float]:
@@ -314,6 +335,40 @@ class PhysicsWorld:
         else:
             self._touching.pop(pair, None)
             self._apart_since[pair] = self._steps
+
+
+def resolvable_speed(rovers: Sequence[DiffDriveRover], space: pymunk.Space, dt: float) -> float:
+    """The speed (m/s) up to which one Chipmunk step of ``dt`` cannot let a rover tunnel.
+
+    Chipmunk tests overlaps at the step's end positions: a rover that moves further in one
+    step than half the thinnest pair of shapes it can meet (itself and a wall, or two rovers
+    closing at twice the speed) may stop past the middle and be pushed out the far side.
+    So a step resolves a speed ``v`` when ``v dt`` is at most half of ``t_r + t_s`` (the
+    thinnest rover and the thinnest static shape) and a quarter of ``2 t_r`` (two rovers
+    head-on); faster, the step is cut into sub-steps (``bodyio.substeps``).
+    """
+    if not rovers:
+        return math.inf
+    rover = min(min(r.length, r.width) for r in rovers)
+    statics = [s for s in space.shapes if s.body.body_type == pymunk.Body.STATIC]
+    thin = min((_thickness(s) for s in statics), default=math.inf)
+    return min(0.5 * rover, 0.5 * (rover + thin)) / dt
+
+
+def _thickness(shape: pymunk.Shape) -> float:
+    """The thinnest width of a static shape (m): a segment's or circle's diameter, a
+    polygon's narrowest projection on its edges' normals (plus its rounding)."""
+    if isinstance(shape, pymunk.Segment | pymunk.Circle):
+        return 2.0 * shape.radius
+    if isinstance(shape, pymunk.Poly):
+        pts = shape.get_vertices()
+        widths = []
+        for a, b in zip(pts, [*pts[1:], pts[0]], strict=True):
+            n = (b - a).perpendicular_normal()
+            proj = [p.dot(n) for p in pts]
+            widths.append(max(proj) - min(proj))
+        return min(widths) + 2.0 * shape.radius
+    return math.inf
 
 
 def wheel_model(p: Any, gravity: float) -> WheelModel:

@@ -1,6 +1,6 @@
 """Terrain: friction zones (polygons with their own friction and rolling resistance).
 
-A zone is an *environment* component (template ``frictionZone``), so everything the
+A zone is an *environment* component (template ``frictionZone``, in ``zones.py``), so everything the
 framework does with parameters works on terrain too: ``describe`` lists a zone's friction
 with its range, ``templates`` documents it, a sweep varies it, the window's panel edits it,
 and "mud from t = 60" is an ordinary timeline change ``Mud.friction: 0.3``. The zone
@@ -15,15 +15,12 @@ with one wheel in mud pulls towards it.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from fractions import Fraction
 from typing import Any
 
 import numpy as np
-
-from ..model.params import Param
-from ..model.template import Kind, Template
 
 
 @dataclass
@@ -75,14 +72,70 @@ class Zone:
         return inside
 
 
-class Terrain:
-    """The world's ground and its zones; ``version`` changes whenever any value does."""
+@dataclass
+class Grade:
+    """One grade zone (a slope): a polygon, its angle (rad) and its uphill direction (rad)."""
 
-    def __init__(self, friction: float, rolling_resistance: float) -> None:
+    name: str
+    polygon: tuple[tuple[float, float], ...]
+    angle: float
+    direction: float
+
+    def __post_init__(self) -> None:
+        self.area = Zone(self.name, self.polygon, 0.0, 0.0)  # the geometry and its tests
+
+
+class Terrain:
+    """The world's ground, its friction zones and its grade zones; ``version`` changes
+    whenever any value does."""
+
+    def __init__(self, friction: float, rolling_resistance: float, gravity: float = 0.0) -> None:
         self.friction = friction
         self.rolling_resistance = rolling_resistance
+        self.gravity = gravity
         self.zones: list[Zone] = []
+        self.grades: list[Grade] = []
         self.version = 0
+
+    def add_grade(self, grade: Grade) -> None:
+        """Add a grade zone on top of the others."""
+        self.grades.append(grade)
+        self.version += 1
+
+    def update_grade(self, name: str, **values: Any) -> None:
+        """Change a grade zone's angle, direction or polygon (a timeline change)."""
+        for i, g in enumerate(self.grades):
+            if g.name == name:
+                fields = {"polygon": g.polygon, "angle": g.angle, "direction": g.direction}
+                fields.update(values)
+                self.grades[i] = Grade(name, **fields)
+                self.version += 1
+                return
+        raise KeyError(name)
+
+    def locate_grade(self, x: float, y: float) -> int:
+        """Index of the grade zone at ``(x, y)`` (the last declared containing it), or -1."""
+        for k in range(len(self.grades) - 1, -1, -1):
+            if self.grades[k].area.contains(x, y):
+                return k
+        return -1
+
+    def locate_grades(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """:meth:`locate_grade` for arrays of points."""
+        out = np.full(x.shape, -1, dtype=np.intp)
+        for k, grade in enumerate(self.grades):
+            out[grade.area.contains_many(x, y)] = k
+        return out
+
+    def slope(self, index: int) -> tuple[float, float, float]:
+        """``(cos(angle), g_x, g_y)`` of grade zone ``index`` (-1: flat): the share of the
+        weight the ground carries and gravity's pull along the slope (m/s², world frame,
+        downhill)."""
+        if index < 0:
+            return 1.0, 0.0, 0.0
+        g = self.grades[index]
+        pull = -self.gravity * math.sin(g.angle)
+        return math.cos(g.angle), pull * math.cos(g.direction), pull * math.sin(g.direction)
 
     def add(self, zone: Zone) -> None:
         """Add a zone on top of the others."""
@@ -150,74 +203,3 @@ def polygon_area(points: Sequence[Sequence[float]]) -> float:
     for (x0, y0), (x1, y1) in zip(points, [*points[1:], points[0]], strict=True):
         total += x0 * y1 - x1 * y0
     return total / 2
-
-
-class FrictionZone(Template):
-    """A patch of ground with its own friction and rolling resistance (mud, ice, sand, grass).
-
-    The wheels of any rover over ``polygon`` use this friction (tyre grip, scrub) and
-    rolling resistance instead of the world's ``physics.ground``. Change ``friction`` in a
-    scenario's timeline to make the ground change mid-run ("mud from t = 60":
-    ``{at: 60, set: {Mud.friction: 0.3}}``). Overlapping zones: the last declared wins.
-    """
-
-    template_name = "frictionZone"
-    kind = Kind.ENVIRONMENT
-    params = (
-        Param(
-            "friction",
-            "float",
-            "tyre-ground friction coefficient mu in the zone (dry asphalt 0.8, wet grass "
-            "0.35, mud 0.3, snow 0.2, ice 0.05)",
-            0.3,
-            0.0,
-            5.0,
-        ),
-        Param(
-            "rollingResistance",
-            "float",
-            "rolling-resistance coefficient Crr in the zone (concrete 0.015, grass 0.05, "
-            "sand 0.15, mud 0.1-0.3)",
-            0.1,
-            0.0,
-            1.0,
-        ),
-        Param(
-            "polygon",
-            "points",
-            "the zone's corners [[x, y], ...] in order (at least 3, not crossing)",
-            (),
-            unit="m",
-        ),
-    )
-
-    @classmethod
-    def check_params(cls, values: Mapping[str, Any]) -> None:
-        """A zone needs a polygon with an area."""
-        pts = values.get("polygon", ())
-        if len(pts) < 3:
-            raise ValueError(f"polygon needs at least 3 corners, got {len(pts)}")
-        if abs(polygon_area(pts)) < 1e-9:
-            raise ValueError("polygon has no area (its corners are on one line)")
-
-    def initialize(self, ctx: Any) -> None:
-        """Register the zone with the run's physics world."""
-        from .space import physics_of  # the world module imports this one
-
-        self.check_params(self.p.as_dict())
-        self.terrain = physics_of(ctx).terrain
-        self.terrain.add(
-            Zone(self.path, tuple(self.p.polygon), self.p.friction, self.p.rollingResistance)
-        )
-
-    def on_param_change(self, name: str, value: Any) -> None:
-        """Tell the physics: the next step's wheels see the new ground."""
-        self.check_params(self.p.as_dict())
-        key = {"friction": "friction", "rollingResistance": "rolling_resistance"}.get(
-            name, "polygon"
-        )
-        self.terrain.update(self.path, **{key: tuple(value) if key == "polygon" else value})
-
-    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
-        """The paper's doStep: nothing to publish (the ground acts through the physics)."""
-        return {}

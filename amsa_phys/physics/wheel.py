@@ -1,8 +1,8 @@
 """One driven wheel: motor and driver, spinning rim, tyre. Pure math, no pymunk.
 
-This module is the readable statement of the wheel model and its closed forms; ``forces.py``
-(a few rovers, plain floats) and ``fleet.py`` (many rovers, numpy) inline the same arithmetic
-and are tested against :func:`rim_and_tyre`, :func:`rim_alone` and :func:`friction_ellipse`.
+This module is the readable statement of the wheel model and its closed forms;
+``forces.rover_step`` (the pure path's one copy, which ``_step.c`` mirrors) inlines the same
+arithmetic and is tested against :func:`rim_and_tyre`, :func:`wheel_pair` and :func:`slide`.
 
 Forces are expressed at the ground (N), speeds at the rim (m/s): the wheel's spin state is its
 rim speed ``u = omega * r`` (what an encoder measures), and its inertia acts as a mass
@@ -37,7 +37,8 @@ magic formula's falling branch (``mu_peak > mu_slide``) would need an iterative 
 wheel per step. What a linear-saturating tyre leaves out: the peak-then-drop of grip with slip
 (here grip holds at ``mu N`` however hard the wheel spins) and relaxation length.
 
-Integration, per physics step ``dt`` (semi-implicit, one pass, no iteration): the rim's speed
+Integration, per physics step ``dt`` (semi-implicit, one pass; only a sliding tyre's rim is
+found by bisection, :func:`slide`): the rim's speed
 and the tyre force are solved together by backward Euler on the linear part —
 
     rim:   M_w (u+ - u) / dt = F0 - c u+ - R_dir - F_x        (M_w = J / r^2, c = F_stall / v_free)
@@ -52,8 +53,10 @@ nonlinear pieces are then applied as projections: the rim may not reverse throug
 against its resistance (it sticks instead, if the resistance can hold it), the motor force is
 clamped by the current limit (the rim is then re-solved without back-EMF) — in these rare
 branches each wheel is solved alone (:func:`rim_and_tyre`), the other's force from the joint
-pass taken as known — and the tyre force is projected onto the friction ellipse (the rim is
-then re-solved alone with that force, :func:`rim_alone`).
+pass taken as known. A tyre that this gripping solve puts beyond its friction ellipse
+*slides*: its force is then the tyre law itself, solved together with its rim by
+:func:`slide` (scaling the gripping solve's forces onto the ellipse instead made a drift
+depend on the physics step, issue 31).
 """
 
 from __future__ import annotations
@@ -360,34 +363,86 @@ def wheel_pair(
     return fxl, upl, fxr, upr
 
 
-def rim_alone(u: float, f0: float, res: float, fx: float, s: StepConstants) -> float:
-    """The rim's next speed when the tyre force is fixed at ``fx`` (a saturated tyre)."""
+#: Bisection steps of :func:`slide`'s rim solve at most (a double's bracket is exhausted
+#: sooner unless the root is within ~1e-30 of zero; the loop also stops there).
+SLIDE_ITERATIONS = 100
 
-    def solve(fr: float) -> float:
-        up = (s.mw * u + f0 - fr - fx) * s.big_b
+
+def slide(
+    u: float,
+    v: float,
+    f0: float,
+    res: float,
+    ivs: float,
+    tyre: tuple[float, float, float, float],
+    side: float,
+    fy_cap: float,
+    s: StepConstants,
+) -> tuple[float, float, float]:
+    """One step of a wheel whose tyre slides: ``(F_x, F_y, u+)``.
+
+    Why not the gripping solve scaled back onto the ellipse: the gripping solve's forces are
+    the ones that would cancel each slip *within the step* (the longitudinal one through the
+    1 kg rim, the lateral one through the whole body), so their ratio, and with it the
+    direction of the scaled force, was set by the masses and the step instead of by the
+    slip: a steady drift's yaw rate moved by 12 % between 100 and 1,600 Hz (issue 31).
+    Here the tyre law itself, ``F = (N kappa / c_x, -N tan(alpha) / c_y) / max(1, |q|)``
+    with ``q`` the two forces over their grips (the friction ellipse), is solved with the
+    rim's next speed: ``M_w (u+ - u) / dt = F_m(u+) - R sign(u+) - F_x(u+)`` (backward Euler;
+    the motor on its curve or at its current limit, the rim stuck at zero if its resistance
+    holds it). The left side rises with ``u+`` and the right side falls, so the root is
+    unique; bisection finds it, the same operations in C and Python. The lateral slip
+    ``side * ivs`` (sideways velocity over the slip speed) is the step's start value: the
+    body is ~30 times the rim's mass, so its lateral slip moves slowly; the lateral force is
+    capped by ``fy_cap``, the gripping solve's (which cancels the sideways velocity within
+    the step), so that a slide ending within the step does not overshoot into the other
+    side. ``tyre`` is ``(N / c_x, N / c_y, 1 / grip_x, 1 / grip_y)``; ``ivs`` is ``1 /
+    max(|v|, v_min)``.
+    """
+    kx, ky, ix, iy = tyre
+    qy = -ky * side * ivs * iy
+
+    def tyre_x(up: float) -> tuple[float, float]:
+        """The tyre's longitudinal force and the ellipse's scale at rim speed ``up``."""
+        fx = kx * (up - v) * ivs
+        qx = fx * ix
+        qq = qx * qx + qy * qy
+        scale = 1.0 / math.sqrt(qq) if qq > 1.0 else 1.0
+        return fx * scale, scale
+
+    def excess(up: float, fr: float) -> float:
+        """``M_w (u+ - u)/dt - F_m(u+) + R_dir + F_x(u+)``: zero at the step's rim speed."""
         fm = f0 - s.c * up
-        if fm > s.f_max or fm < -s.f_max:
-            up = u + ((s.f_max if fm > 0 else -s.f_max) - fr - fx) * s.big_bc
-        return up
+        if fm > s.f_max:
+            fm = s.f_max
+        elif fm < -s.f_max:
+            fm = -s.f_max
+        return s.mw * (up - u) - fm + fr + tyre_x(up)[0]
 
-    if u != 0.0:
-        up = solve(res if u > 0 else -res)
-        if up * u > 0.0:
-            return up
     f0_lim = f0 if -s.f_max <= f0 <= s.f_max else (s.f_max if f0 > 0 else -s.f_max)
-    need = f0_lim + s.mw * u - fx
+    need = s.mw * u + f0_lim - tyre_x(0.0)[0]
     if -res <= need <= res:
-        return 0.0
-    return solve(res if need > 0 else -res)
-
-
-def friction_ellipse(fx: float, fy: float, inv_x: float, inv_y: float) -> tuple[float, float]:
-    """``(fx, fy)`` scaled back onto the ellipse of half-axes ``1/inv_x``, ``1/inv_y``."""
-    q = (fx * inv_x) ** 2 + (fy * inv_y) ** 2
-    if q > 1.0:
-        scale = 1.0 / math.sqrt(q)
-        return fx * scale, fy * scale
-    return fx, fy
+        up = 0.0
+    else:
+        reach = (s.f_max + 1.0 / ix) / s.mw  # |F_m| <= f_max and |F_x| <= grip
+        if need > 0:
+            lo, hi, fr = 0.0, u + reach, res
+        else:
+            lo, hi, fr = u - reach, 0.0, -res
+        for _ in range(SLIDE_ITERATIONS):
+            mid = 0.5 * (lo + hi)
+            if mid <= lo or mid >= hi:
+                break
+            if excess(mid, fr) > 0.0:
+                hi = mid
+            else:
+                lo = mid
+        up = 0.5 * (lo + hi)
+    fx, scale = tyre_x(up)
+    fy = -ky * side * ivs * scale
+    if abs(fy_cap) < abs(fy):
+        fy = fy_cap
+    return fx, fy, up
 
 
 def slip_speed(v: float) -> float:

@@ -1,6 +1,6 @@
 """Terrain zones on the trajectory plot, read from a run's resolved ``scenario.yaml``.
 
-A zone is a ``frictionZone`` component of the world (``physics/terrain.py``); the resolved
+A zone is a ``frictionZone`` component of the world (``physics/zones.py``); the resolved
 scenario holds its polygon and values at t = 0, and the timeline its changes, so the plot can
 say "Mud: μ 0.8, from 60 s μ 0.3" without the run's objects. Drawn under the paths, in the
 colours the window uses.

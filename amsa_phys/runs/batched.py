@@ -66,7 +66,7 @@ def unbatchable(scenario: Scenario) -> str | None:
             return f"{path} has random loop timing (jitter or a random phase)"
         if template.has_arrays():
             return f"{path} has array ports (a lidar casts rays in its run's space every scan)"
-        if template.name() == "frictionZone":
+        if template.name() in ("frictionZone", "gradeZone"):
             return f"{path} is a terrain zone (the batch's physics has one ground)"
     robots = {p for p, leaf in world.leaves.items() if leaf.template.name() in _ROBOTS}
     for i, phase in enumerate(scenario.phases):

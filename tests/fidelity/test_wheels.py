@@ -83,7 +83,10 @@ def test_friction_circle_bounds_the_ground_force_in_a_braking_skid(tmp_path: Pat
     # and the bound is reached, in a combined slip (braking and sliding sideways at once)
     full = braking & (total > 0.999 * limit)
     assert full.sum() > 20
-    assert np.abs(across[full]).max() > 0.3 * limit
+    # (a sliding tyre's force points along its combined slip, issue 31: with the rims spun
+    # backwards at full reverse the longitudinal slip dominates, so the sideways share of the
+    # full force is smaller than the old mass-weighted direction gave: 0.27 against 0.3+)
+    assert np.abs(across[full]).max() > 0.2 * limit
     assert np.abs(along[full]).max() > 0.9 * limit
 
 
@@ -92,10 +95,17 @@ def test_mutation_friction_circle_check_fails_with_separate_caps(
 ) -> None:
     """The old model capped the two directions separately: up to sqrt(2) mu N a wheel."""
 
-    def separate_caps(fx: float, fy: float, inv_x: float, inv_y: float) -> tuple[float, float]:
-        return max(-1 / inv_x, min(1 / inv_x, fx)), max(-1 / inv_y, min(1 / inv_y, fy))
+    real = forces.slide
 
-    monkeypatch.setattr(forces, "friction_ellipse", separate_caps)
+    def separate_caps(
+        u: float, v: float, f0: float, res: float, ivs: float, tyre: Any, side: float, *rest: Any
+    ) -> tuple[float, float, float]:
+        kx, ky, ix, iy = tyre
+        _, _, up = real(u, v, f0, res, ivs, tyre, side, *rest)
+        fx, fy = kx * (up - v) * ivs, -ky * side * ivs
+        return max(-1 / ix, min(1 / ix, fx)), max(-1 / iy, min(1 / iy, fy)), up
+
+    monkeypatch.setattr(forces, "slide", separate_caps)
     monkeypatch.setenv("AMSA_PHYS_PURE", "1")  # the Python model (the C copy is held equal to it)
     tr, mu = skid(tmp_path)
     along, across = body_forces(tr, 30.0)

@@ -1,6 +1,7 @@
 """Regenerate the golden traces after an intended change, printing what moved.
 
-Usage: ``python tests/golden/regenerate.py`` (from the repository root). For each golden
+Usage: ``python tests/golden/regenerate.py`` (from the repository root); with ``--engine``
+it stores the shipped scenarios' traces for the installed pymunk instead. For each golden
 scenario it runs the simulation, compares with the stored trace column by column, prints the
 largest change of every column that moved, then overwrites the stored trace.
 """
@@ -47,7 +48,15 @@ def differences(old: Path, new: Path) -> list[str]:
 
 
 def main() -> int:
-    """Regenerate every golden trace."""
+    """Regenerate every golden trace (``--engine``: the shipped scenarios' traces for the
+    installed pymunk, ``engine_golden.py``)."""
+    if "--engine" in sys.argv[1:]:
+        from engine_golden import pymunk_version, write
+
+        version = pymunk_version()
+        print(f"engine traces for pymunk {version}:")
+        print("\n".join(write(version)))
+        return 0
     for scenario in sorted(HERE.glob("golden_*.yaml")):
         stored = scenario.with_suffix(".csv")
         fresh = simulate(scenario)

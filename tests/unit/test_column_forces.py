@@ -81,10 +81,10 @@ def test_column_forces_refuse_arrays_of_the_wrong_size() -> None:
 
     n = 4
     plan = np.zeros((n, len(compiled.PLAN_FIELDS)))
-    good = [plan, np.zeros((2, n)), np.zeros((2, n)), np.zeros((7, n)), np.zeros((n, 6))]
+    good = [plan, np.zeros((2, n)), np.zeros((2, n)), np.zeros((9, n)), np.zeros((n, 6))]
     with pytest.raises(ValueError, match="forces: 12 floats expected for 4 rovers, got 9"):
         _step.column_forces(*good, np.zeros((3, 3)), DT)
-    with pytest.raises(ValueError, match="ground: 28 floats expected"):
+    with pytest.raises(ValueError, match="ground: 36 floats expected"):
         _step.column_forces(*good[:3], np.zeros((6, n)), good[4], np.zeros((n, 3)), DT)
     with pytest.raises(ValueError, match="rims: float64"):
         _step.column_forces(
@@ -92,7 +92,7 @@ def test_column_forces_refuse_arrays_of_the_wrong_size() -> None:
         )
 
 
-def test_the_pure_switch_keeps_batches_on_the_numpy_fleet(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_pure_switch_keeps_batches_on_the_pure_fleet(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv(PURE_ENV, "1")
     assert not compiled.columns_compiled()
     monkeypatch.delenv(PURE_ENV)

@@ -1,0 +1,96 @@
+"""The wheel, tyre and grip model of one rover written plainly: the tests' specification.
+
+``forces.rover_step`` (and ``_step.c``, its C twin) compute the same forces with the usual
+path inlined and constants folded for speed; this function reads pymunk's properties and
+calls ``wheel.py``'s functions per wheel, so a reader can check the model line by line
+against ``wheel.py``'s equations, and ``tests/unit/test_fast_paths.py`` holds the fast paths
+to it in every regime. Slow (~10 µs a rover): it is also the "plain loop" of the benchmarks.
+Flat ground only (a slope's terms are the fast paths' alone; ``tests/fidelity/test_slopes.py``
+holds them to closed forms).
+"""
+
+from __future__ import annotations
+
+import math
+
+from .forces import GRIP_FLOOR_N
+from .rover import DiffDriveRover
+from .wheel import TORSION, slide, slip_speed, step_constants, wheel_pair
+
+
+def reference_forces(
+    rover: DiffDriveRover,
+    dt: float,
+    rims: tuple[float, float],
+    ground: tuple[tuple[float, float], tuple[float, float]],
+) -> tuple[float, float, float, float, float]:
+    """The same model written plainly: pymunk properties, ``wheel.py``'s functions per wheel.
+
+    ``rims`` are the left and right rim speeds now, ``ground`` the ``(mu, crr)`` under each
+    wheel. Returns ``(fx, fy, torque, u_left+, u_right+)``. Slow (~10 µs a rover); it is what
+    the fast paths are tested against and the "plain loop" of the benchmarks.
+    """
+    body = rover.body
+    wm = rover.wheel
+    s = step_constants(wm, dt, rover.mass, body.moment, rover.half_track)
+    a = body.angle
+    c, sn = math.cos(a), math.sin(a)
+    vx, vy = body.velocity
+    w = body.angular_velocity
+    v_fwd = vx * c + vy * sn
+    kx = wm.load_n / wm.slip_long
+    vl, vr = v_fwd - w * rover.half_track, v_fwd + w * rover.half_track
+    sl, sr = slip_speed(vl), slip_speed(vr)
+    (mul, crl), (mur, crr) = ground
+    f0l, f0r = wm.drive_force(rover.power_l), wm.drive_force(rover.power_r)
+    rl, rr = wm.resistance(crl), wm.resistance(crr)
+    ul, ur = rims
+    fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kx / sl, kx / sr), s)
+    vl, vr = sl, sr
+    # scrub
+    torque = (fxr - fxl) * rover.half_track
+    kphi = TORSION * wm.patch_radius_m**2 * kx * (1 / vl + 1 / vr)
+    limit = wm.scrub_limit(mul) + wm.scrub_limit(mur)
+    scrub = -kphi * (w + torque * dt / body.moment) / (1 + kphi * dt / body.moment)
+    scrub = max(-limit, min(limit, scrub))
+    torque += scrub
+    # lateral grip at the end-of-step heading, applied along the mid-step normal
+    turn = (w + torque / body.moment * dt) * dt
+    end, mid = a + turn, a + 0.5 * turn
+    fx = fxl + fxr
+    px = vx + fx * math.cos(mid) / rover.mass * dt
+    py = vy + fx * math.sin(mid) / rover.mass * dt
+    side = px * -math.sin(end) + py * math.cos(end)
+    ky = wm.load_n / wm.slip_lat * (1 / vl + 1 / vr)
+    kd = ky * dt / rover.mass
+    f_lat = -rover.mass / dt * side / math.cos(0.5 * turn) * kd / (1 + kd)
+    fyl = f_lat * (1 / vl) / (1 / vl + 1 / vr)
+    fyr = f_lat - fyl
+    # friction ellipses
+    gl, gr = wm.grip(mul), wm.grip(mur)
+    inv = [1 / max(g, GRIP_FLOOR_N) for g in (*gl, *gr)]
+    sat = (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1 or (fxr * inv[2]) ** 2 + (
+        fyr * inv[3]
+    ) ** 2 > 1
+    if sat:  # a sliding tyre: the tyre law solved with its rim (wheel.slide)
+        side0 = vy * math.cos(a) - vx * math.sin(a)
+        ky1 = wm.load_n / wm.slip_lat
+        hub = (v_fwd - w * rover.half_track, v_fwd + w * rover.half_track)
+        if (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1:
+            fxl, fyl, upl = slide(
+                ul, hub[0], f0l, rl, 1 / sl, (kx, ky1, inv[0], inv[1]), side0, fyl, s
+            )
+        if (fxr * inv[2]) ** 2 + (fyr * inv[3]) ** 2 > 1:
+            fxr, fyr, upr = slide(
+                ur, hub[1], f0r, rr, 1 / sr, (kx, ky1, inv[2], inv[3]), side0, fyr, s
+            )
+        fx = fxl + fxr
+        torque = (fxr - fxl) * rover.half_track + scrub
+        f_lat = fyl + fyr
+    return (
+        fx * math.cos(mid) - f_lat * math.sin(mid),
+        fx * math.sin(mid) + f_lat * math.cos(mid),
+        torque,
+        upl,
+        upr,
+    )
