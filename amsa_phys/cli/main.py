@@ -56,6 +56,7 @@ COMMANDS = {
         "imports",
         "Import an original AMSA model (.amsacore + .amsatemplate) as a world file.",
     ),
+    "view": ("view", "Open the window on a finished run: play, pause, scrub, jump to events."),
 }
 
 

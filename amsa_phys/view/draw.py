@@ -17,7 +17,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..palette import ALERT, rover_colour
+from ..palette import ALERT, COLLISION, LOST_FIX, REFERENCE, rover_colour
+from ..palette import WARN as PALETTE_WARN
 from ..physics.terrain import zone_colours
 from .camera import Camera
 from .pg import font, pygame
@@ -30,10 +31,10 @@ INK = (32, 32, 36)
 MUTED = (110, 110, 116)
 OBSTACLE = (120, 116, 108)
 WHEEL = (40, 40, 44)
-LOST = ALERT
-OK = (44, 160, 44)
-WARN = (240, 170, 30)
-BAD = (214, 39, 40)
+LOST = LOST_FIX.colour
+OK = REFERENCE
+WARN = PALETTE_WARN  # clear of the leader's orange (palette.py)
+BAD = ALERT
 MIN_ROVER_PX = 5.0
 
 
@@ -97,7 +98,9 @@ class Renderer:
             self._zone(surface, camera, zone)
         for ob in frame.obstacles:
             self._obstacle(surface, camera, ob.kind, ob.points, ob.radius)
-        colours = {r.name: rover_colour(i) for i, r in enumerate(frame.rovers)}
+        colours = {
+            r.name: rover_colour(r.index if r.index >= 0 else i) for i, r in enumerate(frame.rovers)
+        }
         for name, trail in frame.trails.items():
             if len(trail) >= 2:
                 pts = _screen(camera, trail)
@@ -112,14 +115,15 @@ class Renderer:
                 px, py = camera.to_screen(*track.fixes[-1])
                 pygame.draw.circle(surface, col, (px, py), 5, 1)
             for x, y in track.lost:
-                px, py = camera.to_screen(x, y)
-                pygame.draw.line(surface, LOST, (px - 4, py - 4), (px + 4, py + 4), 2)
-                pygame.draw.line(surface, LOST, (px - 4, py + 4), (px + 4, py - 4), 2)
+                draw_lost_fix(surface, camera.to_screen(x, y))
+        for x, y in frame.collisions:
+            draw_collision(surface, camera.to_screen(x, y))
         for scan in frame.scans:
             self._scan(surface, camera, scan, colours.get(scan.mount, MUTED))
         self._distance_lines(surface, camera, frame)
         for r in frame.rovers:
             self._rover(surface, camera, r, colours[r.name])
+        self._labels(surface, camera, frame.rovers)
         self._hud(surface, frame, camera, status)
 
     # -- world layer -------------------------------------------------------------------------
@@ -198,10 +202,12 @@ class Renderer:
             d = math.hypot(a.x - b.x, a.y - b.y)
             col = error_colour(d - q.reference, q.tolerance) if q else MUTED
             pa, pb = camera.to_screen(a.x, a.y), camera.to_screen(b.x, b.y)
-            pygame.draw.line(surface, col, pa, pb, 2)
-            label = self.small.render(f"true {d:.1f} m", True, col)
+            # dashed and thin: the trails under it (the leader's orange) show through
+            _dashed(surface, col, pa, pb)
+            label = self.small.render(f"true {d:.1f} m", True, _darker(col))
             mx, my = (pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2
-            surface.blit(label, (mx - label.get_width() / 2, my - label.get_height() - 4))
+            at = (mx - label.get_width() / 2, my - label.get_height() - 4)
+            self._label_box(surface, label, at)
 
     def _rover(
         self, surface: pygame.Surface, camera: Camera, r: RoverPose, colour: tuple[int, int, int]
@@ -234,10 +240,32 @@ class Renderer:
                 k = max(-1.0, min(1.0, power / 100.0))
                 if abs(k) > 0.01:
                     pygame.draw.line(surface, OK if k > 0 else BAD, at(0, wy), at(wl * k, wy), 2)
-        label = self.small.render(r.name, True, INK)
-        px, py = camera.to_screen(r.x, r.y)
-        reach = max(MIN_ROVER_PX, 0.6 * max(r.length, r.width) * camera.scale)
-        surface.blit(label, (px - label.get_width() / 2, py - reach - label.get_height()))
+
+    def _labels(self, surface: pygame.Surface, camera: Camera, rovers: Sequence[RoverPose]) -> None:
+        """Each rover's name above it; a name that would overlap one already placed moves
+        up a line at a time (close rovers, a platoon's column), so every name stays readable.
+        """
+        placed: list[pygame.Rect] = []
+        for r in rovers:
+            label = self.small.render(r.name, True, INK)
+            px, py = camera.to_screen(r.x, r.y)
+            reach = max(MIN_ROVER_PX, 0.6 * max(r.length, r.width) * camera.scale)
+            rect = pygame.Rect(0, 0, label.get_width() + 4, label.get_height())
+            rect.midbottom = (round(px), round(py - reach))
+            for _ in range(len(placed) + 1):
+                if rect.collidelist(placed) < 0:
+                    break
+                rect.move_ip(0, -rect.height)
+            placed.append(rect)
+            self._label_box(surface, label, (rect.x + 2, rect.y))
+
+    @staticmethod
+    def _label_box(surface: pygame.Surface, label: pygame.Surface, at: tuple[float, float]) -> None:
+        """A label on a faint white box, readable over trails and grid."""
+        box = pygame.Surface((label.get_width() + 4, label.get_height()), pygame.SRCALPHA)
+        box.fill((255, 255, 255, 170))
+        surface.blit(box, (at[0] - 2, at[1]))
+        surface.blit(label, at)
 
     # -- HUD ---------------------------------------------------------------------------------
     def _hud(
@@ -339,6 +367,46 @@ def _wrap(text: str, fnt: pygame.font.Font, room: int) -> list[str]:
         line = word
     out.append(line)
     return out
+
+
+def draw_lost_fix(surface: pygame.Surface, at: tuple[float, float]) -> None:
+    """``palette.LOST_FIX``: a red × (the plots' ``x`` marker)."""
+    px, py = at
+    pygame.draw.line(surface, LOST_FIX.colour, (px - 4, py - 4), (px + 4, py + 4), 2)
+    pygame.draw.line(surface, LOST_FIX.colour, (px - 4, py + 4), (px + 4, py - 4), 2)
+
+
+def draw_collision(surface: pygame.Surface, at: tuple[float, float]) -> None:
+    """``palette.COLLISION``: a red diamond with a dark edge (the plots' ``D`` marker)."""
+    px, py = at
+    pts = [(px, py - 6), (px + 6, py), (px, py + 6), (px - 6, py)]
+    pygame.draw.polygon(surface, COLLISION.colour, pts)
+    pygame.draw.polygon(surface, INK, pts, 1)
+
+
+def _dashed(
+    surface: pygame.Surface,
+    colour: tuple[int, int, int],
+    a: tuple[float, float],
+    b: tuple[float, float],
+    dash: float = 8.0,
+) -> None:
+    """A 2 px line from ``a`` to ``b`` drawn as dashes with equal gaps."""
+    length = math.hypot(b[0] - a[0], b[1] - a[1])
+    if length < 1:
+        return
+    n = int(length // (2 * dash)) + 1
+    ux, uy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
+    for k in range(n):
+        s0, s1 = 2 * k * dash, min(length, (2 * k + 1) * dash)
+        pygame.draw.line(
+            surface, colour, (a[0] + ux * s0, a[1] + uy * s0), (a[0] + ux * s1, a[1] + uy * s1), 2
+        )
+
+
+def _darker(colour: tuple[int, int, int]) -> tuple[int, int, int]:
+    """``colour`` at 70 %: text in it stays readable on a white box (amber is not)."""
+    return tuple(int(c * 0.7) for c in colour)  # type: ignore[return-value]
 
 
 def _screen(camera: Camera, points: Sequence[tuple[float, float]]) -> list[list[float]]:

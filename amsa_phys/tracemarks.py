@@ -1,0 +1,81 @@
+"""Marks read back from a finished run's trace: where GPS fixes were lost.
+
+A lost GPS sample publishes nothing, so its consumers (and the trace) keep the stale fix:
+the fix column does not change across one of the GPS's sampling instants. The live window
+counts losses in the running component; a finished run has only its trace, so the replay
+(``amsa-phys view``) and ``trajectory.png`` find them here, the same way, and mark them with
+the same red × as the window and the video (``palette.LOST_FIX``). Pure numpy, no drawing:
+a top-level module because both ``view`` and ``plots`` use it and must not import each other.
+
+Only a GPS that can lose samples (``lostDataGPS`` or ``burstLoss`` above 0 at some point of
+the run) is searched: a noiseless GPS on a parked rover also repeats its fix, and that is not
+a loss.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+#: how far (s) a trace row may sit from a sampling instant and still show that sample
+_EPS_S = 1e-9
+
+
+@dataclass(frozen=True)
+class GpsLink:
+    """One GPS of the world: its path, the rover it measures and its sampling period."""
+
+    path: str
+    rover: str | None
+    period_s: float
+    #: the GPS can lose samples (its loss parameters, anywhere in the run, are above 0)
+    lossy: bool
+
+
+def gps_links(
+    leaves: Mapping[str, Any], changes: Sequence[tuple[str, str, Any]] = ()
+) -> list[GpsLink]:
+    """The GPS of a world (``WorldSpec.leaves``); ``changes`` are (leaf, param, value) set
+    by the scenario or its timeline (a loss switched on at 125 s makes the GPS lossy)."""
+    out = []
+    for path, leaf in leaves.items():
+        if leaf.template.name() != "GPS":
+            continue
+        params = dict(leaf.params)
+        lossy = params.get("lostDataGPS", 0) > 0 or params.get("burstLoss", 0) > 0
+        for who, param, value in changes:
+            if who == path and param in ("lostDataGPS", "burstLoss") and value > 0:
+                lossy = True
+        source = leaf.inputs.get("posX", "")
+        rover = source[: -len(".posX")] if source.endswith(".posX") else None
+        freq = float(leaf.freq) if leaf.freq else 0.0
+        out.append(GpsLink(path, rover, 1.0 / freq if freq > 0 else 0.0, lossy))
+    return out
+
+
+def lost_fix_rows(t: np.ndarray, fx: np.ndarray, fy: np.ndarray, period_s: float) -> np.ndarray:
+    """Rows (indices into ``t``) at which a GPS sampling instant passed without a new fix.
+
+    ``t`` are the trace's times, ``fx``/``fy`` the GPS's published fix. A sampling instant
+    ``k * period_s`` shows in the first row at or after it; the sample was lost when that
+    row's fix equals the previous row's. Instants before the first fix was ever published
+    (a GPS with latency publishes nothing at first) are not losses.
+    """
+    if period_s <= 0 or len(t) < 2:
+        return np.empty(0, dtype=int)
+    changed = (fx[1:] != fx[:-1]) | (fy[1:] != fy[:-1])
+    first = int(np.argmax(changed)) + 1 if changed.any() else len(t)
+    k0 = max(1, math.ceil((t[0] - _EPS_S) / period_s))
+    k1 = math.floor((t[-1] + _EPS_S) / period_s)
+    if k1 < k0:
+        return np.empty(0, dtype=int)
+    instants = np.arange(k0, k1 + 1) * period_s
+    rows = np.searchsorted(t, instants - _EPS_S, side="left")
+    rows = rows[(rows >= 1) & (rows < len(t))]
+    rows = np.unique(rows)
+    stale = (fx[rows] == fx[rows - 1]) & (fy[rows] == fy[rows - 1])
+    return rows[stale & (rows > first)]
