@@ -484,7 +484,13 @@ WindowDriver = Callable[[Simulation, Scenario, "Recorder | None"], "float | None
 def _open_window(sim: Simulation, scenario: Scenario, recorder: Recorder | None) -> float:
     from ..view.window import Window
 
-    return Window(sim, scenario.quality, title=scenario.name, recorder=recorder).run()
+    return Window(
+        sim,
+        scenario.quality,
+        title=scenario.name,
+        recorder=recorder,
+        planned=scenario.planned_bounds,
+    ).run()
 
 
 def _finish_video(recorder: Recorder | None, error: BaseException | None) -> dict[str, Any] | None:

@@ -413,7 +413,7 @@ def _screen(camera: Camera, points: Sequence[tuple[float, float]]) -> list[list[
     """Many world points to pixels at once (numpy: trails hold hundreds of points)."""
     arr = np.asarray(points, dtype=float)
     out = np.empty_like(arr)
-    out[:, 0] = camera.width / 2 + (arr[:, 0] - camera.cx) * camera.scale
+    out[:, 0] = camera.mid_x + (arr[:, 0] - camera.cx) * camera.scale
     out[:, 1] = camera.height / 2 - (arr[:, 1] - camera.cy) * camera.scale
     np.clip(out, -1e5, 1e5, out=out)  # SDL draws garbage for coordinates near int limits
     return out.tolist()

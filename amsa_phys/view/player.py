@@ -17,7 +17,7 @@ import numpy as np
 from .camera import Camera
 from .draw import INK, LOST, MUTED, Renderer
 from .pg import font, pygame
-from .plotpane import Series, SignalPicker, draw_pane
+from .plotpane import SignalPicker, draw_side_panes, picker_key
 from .replay import Event, ReplayScene
 
 SPEEDS = (1 / 16, 1 / 8, 1 / 4, 1 / 2, 1, 2, 4, 8, 16, 32, 64)
@@ -303,49 +303,3 @@ class Player:
             f"{self.t:.2f} s / {float(self.scene.t[-1]):g} s", True, MUTED
         )
         screen.blit(label, (bar.right - label.get_width(), bar.top - label.get_height() - 6))
-
-
-def picker_key(picker: SignalPicker, key: int, text: str) -> bool:
-    """The signal list's keys (the player and the live window share them)."""
-    if key in (pygame.K_g, pygame.K_ESCAPE):
-        picker.visible = False
-    elif key == pygame.K_UP:
-        picker.move(-1)
-    elif key == pygame.K_DOWN:
-        picker.move(1)
-    elif key in (pygame.K_RETURN, pygame.K_KP_ENTER):
-        picker.toggle()
-    elif key == pygame.K_BACKSPACE:
-        picker.backspace()
-    elif text and text.isprintable() and not text.isspace():
-        picker.type_char(text)
-    else:
-        return False
-    return True
-
-
-def draw_side_panes(
-    screen: pygame.Surface,
-    renderer: Renderer,
-    picker: SignalPicker,
-    series: Series,
-    show_help: bool,
-    help_lines: list[str],
-    area: pygame.Rect,
-) -> None:
-    """The plot pane (bottom right), the signal list and the help (right), under the HUD."""
-    top = max(box.bottom for box in renderer.boxes.values()) + 6 if renderer.boxes else 10
-    if picker.picked:
-        w = max(240, area.width * 2 // 5)
-        h = max(120, area.height // 3)
-        rect = pygame.Rect(area.right - w - 10, area.bottom - h - 10, w, h)
-        draw_pane(screen, rect, picker.picked, series, renderer.text_px)
-    if picker.visible:
-        lines = picker.lines()
-        colours = [MUTED] + [INK] * (len(lines) - 1)
-        if picker.message:
-            lines.append(picker.message)
-            colours.append(INK)
-        renderer.panel(screen, lines, colours, (10, top), align_right=True)
-    elif show_help:
-        renderer.panel(screen, help_lines, [INK] * len(help_lines), (10, top), align_right=True)

@@ -77,6 +77,7 @@ class ReplayScene:
         self._gps = self._gps_history()
         self._metric_prefix = self._running_metrics()
         self.events = self._events()
+        self._hits = self._collision_points()
 
     # -- loading -----------------------------------------------------------------------------
     def _xy(self, rover: str) -> np.ndarray:
@@ -135,6 +136,20 @@ class ReplayScene:
         for path, _, _, lost in self._gps:
             out += [Event(float(self.t[r]), "lost fix", f"lost fix {path}") for r in lost]
         return sorted(out, key=lambda e: (e.t, e.kind))
+
+    def _collision_points(self) -> list[tuple[float, tuple[float, float]]]:
+        """Each collision's time and place: the midpoint of the traced rovers it names
+        (``Leader-Follower``) at the row logged then, as ``trajectory.png`` marks it."""
+        out = []
+        for e in self.metrics.get("events") or []:
+            if e.get("kind") != "collision":
+                continue
+            names = [n for n in str(e.get("detail", "")).split("-") if n in self.ranks]
+            if names:
+                row = self.row_at(float(e["t"]))
+                xy = np.mean([self._xy(n)[row] for n in names], axis=0)
+                out.append((float(e["t"]), (float(xy[0]), float(xy[1]))))
+        return out
 
     # -- reading -----------------------------------------------------------------------------
     @property
@@ -230,6 +245,7 @@ class ReplayScene:
             phase_text=self.phase_text(index),
             duration=self.duration,
             pair_lines=self.quality is not None,
+            collisions=[xy for at, xy in self._hits if at <= t],
         )
 
     def phase_text(self, index: int) -> str:
