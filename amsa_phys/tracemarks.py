@@ -15,12 +15,14 @@ a loss.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+#: the GPS parameters that make it drop samples
+LOSS_PARAMS = ("lostDataGPS", "burstLoss")
 #: how far (s) a trace row may sit from a sampling instant and still show that sample
 _EPS_S = 1e-9
 
@@ -36,24 +38,34 @@ class GpsLink:
     lossy: bool
 
 
-def gps_links(
-    leaves: Mapping[str, Any], changes: Sequence[tuple[str, str, Any]] = ()
-) -> list[GpsLink]:
-    """The GPS of a world (``WorldSpec.leaves``); ``changes`` are (leaf, param, value) set
-    by the scenario or its timeline (a loss switched on at 125 s makes the GPS lossy)."""
+def gps_links(leaves: Mapping[str, Any], lossy_also: Iterable[str] = ()) -> list[GpsLink]:
+    """The GPS of a world (``WorldSpec.leaves``); ``lossy_also``: GPS paths the run made
+    lossy (:func:`lossy_in_run`: a loss switched on at 125 s)."""
+    lossy_also = set(lossy_also)
     out = []
     for path, leaf in leaves.items():
         if leaf.template.name() != "GPS":
             continue
         params = dict(leaf.params)
-        lossy = params.get("lostDataGPS", 0) > 0 or params.get("burstLoss", 0) > 0
-        for who, param, value in changes:
-            if who == path and param in ("lostDataGPS", "burstLoss") and value > 0:
-                lossy = True
+        lossy = any(params.get(p, 0) > 0 for p in LOSS_PARAMS) or path in lossy_also
         source = leaf.inputs.get("posX", "")
         rover = source[: -len(".posX")] if source.endswith(".posX") else None
         freq = float(leaf.freq) if leaf.freq else 0.0
         out.append(GpsLink(path, rover, 1.0 / freq if freq > 0 else 0.0, lossy))
+    return out
+
+
+def lossy_in_run(metrics: Mapping[str, Any]) -> set[str]:
+    """Components a run's ``metrics.json`` shows setting a loss parameter above 0 (in a
+    phase's ``set`` or a change inside a phase: ``--set``, the timeline, the window)."""
+    out = set()
+    for phase in metrics.get("phases") or []:
+        sets = [phase.get("set") or {}, *((c.get("set") or {}) for c in phase.get("changes") or [])]
+        for values in sets:
+            for key, value in values.items():
+                leaf, _, param = str(key).rpartition(".")
+                if param in LOSS_PARAMS and isinstance(value, int | float) and value > 0:
+                    out.add(leaf)
     return out
 
 

@@ -83,6 +83,8 @@ class Renderer:
         self.small = font(max(8, self.text_px - 3))
         #: the text boxes of the last frame drawn (``hud``, ``status``), in pixels
         self.boxes: dict[str, pygame.Rect] = {}
+        #: the rovers' name boxes of the last frame, in the frame's rover order
+        self.labels: list[pygame.Rect] = []
 
     def draw(
         self,
@@ -246,6 +248,7 @@ class Renderer:
         up a line at a time (close rovers, a platoon's column), so every name stays readable.
         """
         placed: list[pygame.Rect] = []
+        self.labels = placed  # for tests: where each name went
         for r in rovers:
             label = self.small.render(r.name, True, INK)
             px, py = camera.to_screen(r.x, r.y)

@@ -22,7 +22,7 @@ from ..model.geometry import static_obstacles
 from ..model.scenario import Quality
 from ..model.world import WorldSpec
 from ..palette import rover_names, rover_ranks
-from ..tracemarks import gps_links, lost_fix_rows
+from ..tracemarks import gps_links, lossy_in_run, lost_fix_rows
 from .scene import (
     GPS_POINTS,
     LOST_POINTS,
@@ -98,9 +98,8 @@ class ReplayScene:
 
     def _gps_history(self) -> list[tuple[str, str | None, np.ndarray, np.ndarray]]:
         """Per traced GPS: its path, rover, rows where a new fix appeared, rows of lost fixes."""
-        changes = [(c.leaf, c.param, c.value) for c in _phase_changes(self.phases, self.world)]
         out = []
-        for link in gps_links(self.world.leaves, changes):
+        for link in gps_links(self.world.leaves, lossy_in_run(self.metrics)):
             cx, cy = f"{link.path}.gpsPosX", f"{link.path}.gpsPosY"
             if cx not in self.col or cy not in self.col:
                 continue
@@ -261,24 +260,3 @@ class ReplayScene:
         end = row + 1
         start = int(np.searchsorted(self.t, self.t[row] - span_s, side="left"))
         return self.t[start:end], self.data[start:end, self.col[column]]
-
-
-def _phase_changes(phases: list[dict[str, Any]], world: WorldSpec) -> list[Any]:
-    """The changes metrics.json lists (phase sets and in-phase changes) as Change-likes."""
-
-    @dataclass(frozen=True)
-    class _C:
-        leaf: str
-        param: str
-        value: Any
-
-    out = []
-    for p in phases:
-        sets = dict(p.get("set") or {})
-        for c in p.get("changes") or []:
-            sets.update(c.get("set") or {})
-        for key, value in sets.items():
-            leaf, _, param = key.rpartition(".")
-            if leaf in world.leaves and isinstance(value, int | float):
-                out.append(_C(leaf, param, value))
-    return out

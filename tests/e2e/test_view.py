@@ -1,0 +1,230 @@
+"""``amsa-phys view RUNDIR``: a finished run replayed, driven headless (SDL dummy driver,
+injected keys and mouse, an exact clock), and checked against the run's own trace."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from amsa_phys.cli.main import main
+from amsa_phys.cli.view import load_run
+from amsa_phys.model.scenario import load_scenario
+from amsa_phys.palette import ROVER_COLOURS, rover_colour
+from amsa_phys.plots.distance import read_trace
+from amsa_phys.runs.single import run_scenario
+from amsa_phys.view.pg import pygame
+from amsa_phys.view.player import BIG_STEP_S, Player
+from amsa_phys.view.scene import Scene
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+SCENARIO = ROOT / "tests" / "fixtures" / "mde_short.yaml"
+LOSSY = ["--set", "LeaderGPS.lostDataGPS=30", "--duration", "40"]
+
+
+def press(key: int, mod: int = 0, text: str = "") -> None:
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=key, mod=mod, unicode=text))
+
+
+def click(pos: tuple[int, int]) -> None:
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, button=1, pos=pos))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONUP, button=1, pos=pos))
+
+
+@pytest.fixture(scope="module")
+def rundir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("view") / "run"
+    assert main(["run", str(SCENARIO), "--headless", *LOSSY, "--out", str(out)]) == 0
+    return out
+
+
+@pytest.fixture
+def player(rundir: Path) -> Player:
+    p = Player(load_run(rundir), title="test", size=(800, 480))
+    p.frame(0.0)
+    return p
+
+
+def trace_row(rundir: Path, t: float) -> dict[str, float]:
+    header, data = read_trace(rundir / "trace.csv")
+    i = int(np.flatnonzero(np.isclose(data[:, 0], t))[0])
+    return dict(zip(header, data[i].tolist(), strict=True))
+
+
+def test_keys_scrub_to_an_event_and_the_picture_is_the_trace_there(
+    player: Player, rundir: Path
+) -> None:
+    events = player.scene.events
+    first = events[0]
+    assert first.kind == "lost fix"  # 30 % of the leader's fixes are lost
+    press(pygame.K_n)
+    player.frame(0.0)
+    assert player.t == pytest.approx(first.t)
+    assert player.notice.startswith(f"{first.t:.2f} s: lost fix LeaderGPS")
+    press(pygame.K_n)
+    player.frame(0.0)
+    assert player.t == pytest.approx(events[1].t)
+    press(pygame.K_b)
+    player.frame(0.0)
+    assert player.t == pytest.approx(first.t)
+    # the drawn rovers stand where the trace says, and are drawn there in their colour
+    row = trace_row(rundir, player.t)
+    frame = player.scene.frame(player.row)
+    for r in frame.rovers:
+        assert (r.x, r.y, r.heading) == (
+            row[f"{r.name}.posX"],
+            row[f"{r.name}.posY"],
+            row[f"{r.name}.heading"],
+        )
+        px, py = player.camera.to_screen(r.x, r.y)
+        assert tuple(player.screen.get_at((round(px), round(py))))[:3] == rover_colour(r.index)
+    # shift+right: 5 s on; right: one logged instant; home and end
+    t0 = player.t
+    press(pygame.K_RIGHT, pygame.KMOD_SHIFT)
+    player.frame(0.0)
+    assert player.t == pytest.approx(t0 + BIG_STEP_S)
+    press(pygame.K_RIGHT)
+    player.frame(0.0)
+    assert player.t == pytest.approx(t0 + BIG_STEP_S + 0.05)  # the 20 Hz log
+    press(pygame.K_END)
+    player.frame(0.0)
+    assert player.t == pytest.approx(40.0)
+    press(pygame.K_HOME)
+    player.frame(0.0)
+    assert player.t == 0.0
+
+
+def test_play_runs_at_the_chosen_speed_and_the_slider_seeks(player: Player) -> None:
+    press(pygame.K_SPACE)
+    press(pygame.K_RIGHTBRACKET)  # x2
+    for _ in range(10):
+        player.frame(0.1)  # one wall-clock second
+    assert player.t == pytest.approx(2.0)
+    bar = player.slider
+    click((bar.x + bar.width // 2, bar.centery))
+    player.frame(0.1)
+    assert not player.playing  # a seek pauses
+    assert player.t == pytest.approx(20.0, abs=0.1)
+
+
+def test_phase_keys_jump_to_phase_starts(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    assert main(["run", str(SCENARIO), "--headless", "--duration", "130", "--out", str(out)]) == 0
+    p = Player(load_run(out), title="test", size=(640, 360))
+    press(pygame.K_PAGEDOWN)
+    p.frame(0.0)
+    assert p.t == 125.0
+    assert p.scene.frame(p.row).phase_text.startswith("phase 1 (of 0–1) from 125 s: Kv=0.15")
+    press(pygame.K_PAGEUP)
+    p.frame(0.0)
+    assert "no earlier event" in p.notice
+
+
+def test_plot_pane_draws_a_picked_signal(player: Player) -> None:
+    press(pygame.K_g)
+    for ch in "distance":
+        press(0, text=ch)
+    press(pygame.K_RETURN)
+    press(pygame.K_g)
+    player.frame(0.0)
+    assert player.picker.picked == ["MyDistanceMonitor.distanceFollowerToLeader"]
+    assert not player.picker.visible
+    press(pygame.K_END)
+    player.frame(0.0)
+    t, v = player.scene_series("MyDistanceMonitor.distanceFollowerToLeader", 30.0)
+    assert t[0] == pytest.approx(10.0) and t[-1] == pytest.approx(40.0)
+    assert v[-1] == player.scene.frame(player.row).metrics.value
+
+
+def test_lost_fixes_found_in_the_trace_are_the_live_runs(tmp_path: Path) -> None:
+    """The replay and trajectory.png find lost fixes from the stale fix in the trace; the
+    live window counts them in the running GPS. Both must agree, one by one."""
+    scenario = load_scenario(SCENARIO, ["LeaderGPS.lostDataGPS=30"], duration=40)
+    live: dict[str, int] = {}
+
+    def drive(sim, scenario, recorder):  # type: ignore[no-untyped-def]
+        scene = Scene(sim, scenario.quality)
+        sim.advance(sim.grid.ticks(sim.duration))
+        live.update({g.path: g.lost_total for g in scene.gps})
+
+    out = tmp_path / "run"
+    out.mkdir()
+    run_scenario(scenario, out, window=drive, plot=False)
+    replay = load_run(out)
+    end = replay.frame(replay.rows - 1)
+    assert live["LeaderGPS"] > 20
+    assert {g.path: g.lost_total for g in end.gps} == live
+    lost = [e for e in replay.events if e.kind == "lost fix"]
+    assert len(lost) == live["LeaderGPS"]
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda d: d / "nothing", "no such directory"),
+        (lambda d: (d / "empty").mkdir() or d / "empty", "not a run directory: trace.csv"),
+        (lambda d: _truncated(d), "trace.csv"),
+        (lambda d: _sweep(d), "a sweep directory: view one of its kept runs"),
+    ],
+    ids=["missing", "not-a-run", "truncated-trace", "sweep"],
+)
+def test_bad_rundir_is_one_line_and_exit_2(
+    rundir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    make: object,
+    message: str,
+) -> None:
+    global _SOURCE
+    _SOURCE = rundir
+    target = make(tmp_path)  # type: ignore[operator]
+    assert main(["view", str(target)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert message in err
+
+
+_SOURCE = Path()
+
+
+def _truncated(d: Path) -> Path:
+    out = d / "cut"
+    shutil.copytree(_SOURCE, out)
+    text = (out / "trace.csv").read_bytes()
+    (out / "trace.csv").write_bytes(text[: len(text) // 2])  # a row cut short
+    return out
+
+
+def _sweep(d: Path) -> Path:
+    out = d / "sweep"
+    out.mkdir()
+    (out / "results.csv").write_text("seed\n1\n")
+    return out
+
+
+def test_a_closed_run_says_where_it_was_cut(rundir: Path) -> None:
+    scene = load_run(rundir)
+    scene.metrics["status"] = "closed in the window at t=12.5 s"
+    p = Player(scene, title="test", size=(640, 360))
+    assert "run closed in the window at t=12.5 s" in p.status()
+
+
+def test_colours_follow_the_world_not_the_trace_columns(tmp_path: Path) -> None:
+    """A trace that keeps only the follower still draws it in the follower's blue."""
+    out = tmp_path / "run"
+    keep = "Follower.*,MyDistanceMonitor.*"
+    argv = ["run", str(SCENARIO), "--headless", "--duration", "5", "--out", str(out)]
+    assert main([*argv, "--trace-columns", keep]) == 0
+    scene = load_run(out)
+    assert [r.name for r in scene.rovers(0)] == ["Follower"]
+    assert scene.rovers(0)[0].index == 1
+    p = Player(scene, title="test", size=(640, 360))
+    p.frame(0.0)
+    r = scene.frame(p.row).rovers[0]
+    px, py = p.camera.to_screen(r.x, r.y)
+    assert tuple(p.screen.get_at((round(px), round(py))))[:3] == ROVER_COLOURS[1]
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["status"] == "completed"
