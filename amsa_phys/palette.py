@@ -16,30 +16,31 @@ from dataclasses import dataclass
 
 RGB = tuple[int, int, int]
 
-#: Twenty colours no two alike (matplotlib's tab10, then tab20's dark half of the pairs
-#: it lacks): a 20-car platoon gets 20 colours; Car9 and Car10 no longer reuse the
-#: leader's orange and Car1's blue. Red is left out: it is the alert colour.
+#: Twenty colours no two alike (matplotlib's tab10 and tab20b/c, reordered): a 20-car platoon
+#: gets 20 colours; Car9 and Car10 no longer reuse the leader's orange and Car1's blue. Left
+#: out: red (the alert), the reference's green, the warning's amber, neutral grey (a GPS fix
+#: of an unknown rover) and near-black (the quality signal), so a rover never looks like a mark.
 ROVER_COLOURS: tuple[RGB, ...] = (
     (230, 120, 30),  # first rover (the leader): orange
     (31, 119, 180),  # second (the follower): blue
-    (44, 160, 44),  # green
     (148, 103, 189),  # purple
     (140, 86, 75),  # brown
     (227, 119, 194),  # pink
-    (127, 127, 127),  # grey
     (188, 189, 34),  # olive
     (23, 190, 207),  # cyan
     (57, 59, 121),  # indigo
     (99, 121, 57),  # moss
     (140, 109, 49),  # ochre
     (123, 65, 115),  # plum
-    (82, 84, 163),  # slate blue
     (107, 110, 207),  # periwinkle
+    (0, 128, 128),  # teal
+    (82, 84, 163),  # slate
     (181, 207, 107),  # lime
-    (231, 186, 82),  # sand
     (165, 81, 148),  # orchid
-    (49, 130, 189),  # steel blue
-    (116, 196, 118),  # mint
+    (189, 158, 57),  # khaki
+    (158, 202, 225),  # sky
+    (197, 176, 213),  # lavender
+    (196, 156, 148),  # tan
 )
 #: alerts: lost GPS fixes, collisions, a motor driven backwards
 ALERT: RGB = (214, 39, 40)

@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 
 from ..errors import ConfigError
 from ..model.params import short_repr
-from ..palette import COLLISION, REFERENCE, SIGNAL, hex_colour
+from ..palette import COLLISION, PHASE, REFERENCE, SIGNAL, hex_colour
 from .save import save_png
 
 #: Values beyond this are not drawn (NaN): matplotlib's limits overflow near the float limit.
@@ -150,7 +150,7 @@ def _phase_notes(ax: plt.Axes, phases: list[dict[str, Any]]) -> list[str]:
     for phase in phases:
         start = phase["start"]
         if start > 0:
-            ax.axvline(start, color="0.4", lw=0.8, ls=":")
+            ax.axvline(start, color=hex_colour(PHASE), lw=0.8, ls=":")
         lines = [f"{k.split('.')[-1]}={v}" for k, v in phase["set"].items()]
         if len(lines) > MAX_NOTE_LINES:
             lines = [*lines[: MAX_NOTE_LINES - 1], f"+{len(lines) - MAX_NOTE_LINES + 1} more"]

@@ -180,7 +180,10 @@ def plot_trajectory(
         _draw_roles(ax, paths, view, style)
     else:
         _draw_rovers(ax, paths, view, style)
-    _draw_gps(ax, header, data, view, style, world.get("gps_of", {}), grouped)
+    # a GPS of a rover the trace left out is still drawn in that rover's colour
+    untraced = {r: _style(i, r) for i, r in enumerate(world.get("rovers") or [])}
+    gps_style = style if grouped else {**untraced, **style}
+    _draw_gps(ax, header, data, view, gps_style, world.get("gps_of", {}), grouped)
     _draw_odometry(ax, header, data, view)
     _draw_goals(ax, world.get("goals", []), view)
     _draw_lost_fixes(ax, header, data, view, paths, world.get("gps", []), metrics)

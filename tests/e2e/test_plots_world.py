@@ -158,7 +158,7 @@ def test_trajectory_draws_the_arena_the_collision_and_the_window_colours(
         colours = {ln.get_label(): to_hex(ln.get_color()) for ln in ax.lines}
         assert colours["Leader (true)"] == ORANGE
         assert colours["Follower (true)"] == BLUE
-        (cross,) = [ln for ln in ax.lines if ln.get_marker() == "x" and len(ln.get_xdata())]
+        (cross,) = [ln for ln in ax.lines if ln.get_marker() == "D" and len(ln.get_xdata())]
         x, y = cross.get_xdata()[0], cross.get_ydata()[0]
         assert 47 < x < 50  # the leader's nose at the box
         assert abs(y) < 0.5
