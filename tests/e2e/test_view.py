@@ -135,7 +135,8 @@ def test_plot_pane_draws_a_picked_signal(player: Player) -> None:
     press(pygame.K_END)
     player.frame(0.0)
     t, v = player.scene_series("MyDistanceMonitor.distanceFollowerToLeader", 30.0)
-    assert t[0] == pytest.approx(10.0) and t[-1] == pytest.approx(40.0)
+    assert t[0] == pytest.approx(10.0)
+    assert t[-1] == pytest.approx(40.0)
     assert v[-1] == player.scene.frame(player.row).metrics.value
 
 
@@ -183,7 +184,8 @@ def test_bad_rundir_is_one_line_and_exit_2(
     target = make(tmp_path)  # type: ignore[operator]
     assert main(["view", str(target)]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.count("\n") == 1
+    assert "Traceback" not in err
     assert message in err
 
 
