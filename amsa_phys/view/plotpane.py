@@ -143,7 +143,7 @@ def draw_pane(
     small = font(max(8, text_px - 2))
     plot = rect.inflate(-16, -16)
     legend_h = small.get_linesize() * len(picked)
-    plot.height -= legend_h
+    plot.height -= legend_h + small.get_linesize()  # the legend above, the time span below
     plot.y += legend_h
     if plot.height < 10 or plot.width < 20:
         return
@@ -168,7 +168,7 @@ def draw_pane(
         y += small.get_linesize()
     if math.isfinite(t_end):
         label = small.render(f"last {SPAN_S:g} s to t = {t_end:.2f} s", True, (110, 110, 116))
-        surface.blit(label, (plot.right - label.get_width(), plot.bottom - label.get_height()))
+        surface.blit(label, (plot.right - label.get_width(), plot.bottom + 2))
 
 
 def _polyline(

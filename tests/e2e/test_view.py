@@ -4,8 +4,14 @@ injected keys and mouse, an exact clock), and checked against the run's own trac
 from __future__ import annotations
 
 import json
+import os
 import shutil
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 import pytest
@@ -16,10 +22,12 @@ from amsa_phys.model.scenario import load_scenario
 from amsa_phys.palette import ROVER_COLOURS, rover_colour
 from amsa_phys.plots.distance import read_trace
 from amsa_phys.runs.single import run_scenario
+from amsa_phys.view.draw import INK
 from amsa_phys.view.pg import pygame
-from amsa_phys.view.player import BIG_STEP_S, Player
+from amsa_phys.view.player import BIG_STEP_S, SLIDER_H, Player
 from amsa_phys.view.scene import Scene
 
+T = TypeVar("T")
 ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO = ROOT / "tests" / "fixtures" / "mde_short.yaml"
 LOSSY = ["--set", "LeaderGPS.lostDataGPS=30", "--duration", "40"]
@@ -230,3 +238,112 @@ def test_colours_follow_the_world_not_the_trace_columns(tmp_path: Path) -> None:
     assert tuple(p.screen.get_at((round(px), round(py))))[:3] == ROVER_COLOURS[1]
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["status"] == "completed"
+
+
+# -- a real window: Xvfb, xdotool and ImageMagick's import ------------------------------------
+X_TOOLS = ("Xvfb", "xdotool", "import")
+X_TIMEOUT_S = 60.0  # a deadline for a failure, never a measured time: every wait polls
+
+
+def _poll(what: str, check: Callable[[], T | None]) -> T:
+    """``check()`` until it gives a value (the event waited for), or fail at the deadline."""
+    deadline = time.monotonic() + X_TIMEOUT_S
+    while time.monotonic() < deadline:
+        found = check()
+        if found is not None:
+            return found
+        time.sleep(0.1)
+    raise AssertionError(f"waited {X_TIMEOUT_S:g} s for {what}")
+
+
+@pytest.fixture
+def xdisplay() -> Iterator[str]:
+    if missing := [tool for tool in X_TOOLS if shutil.which(tool) is None]:
+        pytest.skip(f"no {', '.join(missing)} (apt-get install xvfb xdotool imagemagick)")
+    read, write = os.pipe()
+    server = subprocess.Popen(
+        ["Xvfb", "-displayfd", str(write), "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
+        pass_fds=(write,),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    os.close(write)
+    try:
+        with os.fdopen(read) as fh:
+            number = fh.readline().strip()  # Xvfb writes it once it accepts connections
+        assert number.isdigit(), "Xvfb did not start"
+        yield f":{number}"
+    finally:
+        server.terminate()
+        server.wait(timeout=30)
+
+
+def _x(display: str, *argv: str) -> str:
+    env = {**os.environ, "DISPLAY": display}
+    done = subprocess.run(argv, env=env, capture_output=True, text=True, check=False)
+    return done.stdout.strip()
+
+
+def test_view_in_a_real_x_window_scrubs_to_an_event_and_draws_the_traced_pose(
+    rundir: Path, xdisplay: str, tmp_path: Path
+) -> None:
+    """``amsa-phys view`` on Xvfb, keys pressed by xdotool, the window grabbed by import:
+    End then b (the last event before the end), and each rover's pixel is its colour where
+    the trace puts it then (and not where it stood at t = 0)."""
+    size = (800, 480)
+    env = {k: v for k, v in os.environ.items() if k != "SDL_VIDEODRIVER"}
+    env["DISPLAY"] = xdisplay
+    # the console script, as a user runs it: X names the window's class after it
+    script = Path(sys.executable).with_name("amsa-phys")
+    if not script.is_file():
+        pytest.skip("the amsa-phys console script is not installed next to this Python")
+    argv = [str(script), "view", str(rundir), "--size", "800x480"]
+    viewer = subprocess.Popen(argv, env=env, stderr=subprocess.PIPE, text=True)
+    try:
+        window = _poll(
+            "the window", lambda: _x(xdisplay, "xdotool", "search", "--class", "amsa-phys") or None
+        ).splitlines()[0]
+        _x(xdisplay, "xdotool", "windowfocus", "--sync", window)
+        _x(xdisplay, "xdotool", "key", "--window", window, "End", "b")
+        scene = load_run(rundir)
+        target = [e for e in scene.events if e.t < scene.t[-1]][-1]
+        expected = _drawn_at(scene, scene.row_at(target.t), size)
+        # the slider's cursor (ink) stands at the event's time, no longer at the start
+        span = float(scene.t[-1] - scene.t[0])
+        bar_y = size[1] - SLIDER_H + 10 + (SLIDER_H - 20) // 2
+        cursor = (round(12 + (target.t - float(scene.t[0])) / span * (size[0] - 24)), bar_y)
+        shot = tmp_path / "shot.png"
+
+        def matches() -> bool | None:
+            _x(xdisplay, "import", "-window", window, str(shot))
+            if not shot.is_file():
+                return None
+            image = pygame.image.load(str(shot))
+            ok = all(tuple(image.get_at(px))[:3] == colour for px, colour in expected)
+            return True if ok and tuple(image.get_at(cursor))[:3] == INK else None
+
+        _poll(f"the rovers and the slider at t = {target.t:g} s in the real window", matches)
+        image = pygame.image.load(str(shot))
+        assert tuple(image.get_at((12, bar_y)))[:3] != INK  # the cursor left the start
+    finally:
+        viewer.terminate()
+        viewer.wait(timeout=30)
+
+
+def _drawn_at(
+    scene: object, row: int, size: tuple[int, int]
+) -> list[tuple[tuple[int, int], tuple[int, int, int]]]:
+    """Where the paused player draws each rover's centre at ``row``, and in which colour:
+    the camera in fit mode settles at once while paused."""
+    from amsa_phys.view.camera import Camera
+
+    frame = scene.frame(row)  # type: ignore[attr-defined]
+    camera = Camera((size[0], size[1] - SLIDER_H))
+    points = [(r.x, r.y, r.name) for r in frame.rovers]
+    camera.update(points, 1e9)
+    camera.update(points, 1e9)
+    out = []
+    for r in frame.rovers:
+        x, y = camera.to_screen(r.x, r.y)
+        out.append(((round(x), round(y)), rover_colour(r.index)))
+    return out
