@@ -39,22 +39,16 @@ MIN_ROVER_PX = 5.0
 
 
 def error_colour(error: float, tolerance: float) -> tuple[int, int, int]:
-    """Green within the tolerance band, amber up to twice it, then amber to red at three
-    times it. Green is never blended towards amber: halfway between them in RGB is an olive
-    that reads as "fine" on the HUD, so leaving the band switches colour at once."""
+    """Green within the tolerance band, amber up to twice it, red beyond: three colours, never
+    a blend. Green blended towards amber is an olive that reads as "fine"; amber blended
+    towards red is the leader's orange, and the line between the rovers vanished into the
+    leader's trail (``palette.py``)."""
     r = abs(error) / tolerance if tolerance > 0 else (0.0 if error == 0 else math.inf)
     if r <= 1:
         return OK
     if r <= 2:
         return WARN
-    if r >= 3:
-        return BAD
-    k = r - 2
-    return (
-        int(WARN[0] + (BAD[0] - WARN[0]) * k),
-        int(WARN[1] + (BAD[1] - WARN[1]) * k),
-        int(WARN[2] + (BAD[2] - WARN[2]) * k),
-    )
+    return BAD
 
 
 def nice_step(target_m: float) -> float:
@@ -283,7 +277,7 @@ class Renderer:
                 f"measured {m.value:6.2f} m  ref {q.reference:g} ± {q.tolerance:g}  "
                 f"error {err:+.2f} m"
             )
-            colours.append(error_colour(err, q.tolerance))
+            colours.append(_darker(error_colour(err, q.tolerance)))  # readable on white
             rms = m.rms_error
             lines.append(
                 f"max {m.max:.2f} m  min {m.min:.2f} m  rms error "

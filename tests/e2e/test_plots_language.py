@@ -178,3 +178,14 @@ def test_renderer_labels_never_overlap_when_rovers_meet() -> None:
 def test_matplotlib_reads_the_palette_as_drawn(name: str) -> None:
     colour = {"ALERT": ALERT, "SIGNAL": SIGNAL}[name]
     assert tuple(round(c * 255) for c in to_rgb(hex_colour(colour))) == colour
+
+
+def test_the_distance_line_is_never_a_rovers_colour() -> None:
+    """Amber blended toward red passed through the leader's orange: the line between the
+    rovers vanished into the leader's trail. Every error now draws a colour no rover has."""
+    from amsa_phys.view.draw import error_colour
+
+    for k in range(0, 61):
+        colour = error_colour(k / 10, 1.0)
+        for rover in ROVER_COLOURS:
+            assert math.dist(colour, rover) > 60, (k / 10, colour, rover)
