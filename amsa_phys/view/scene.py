@@ -195,6 +195,9 @@ class Scene:
         self.lidars = [p for p, leaf in sim.world.leaves.items() if leaf.template.name() == "Lidar"]
         self.metrics = LiveMetrics()
         self._last_fix: dict[str, tuple[float, float]] = {}
+        #: where collisions happened (the midpoint of the rovers named), as the plots mark them
+        self.collisions: deque[tuple[float, float]] = deque(maxlen=LOST_POINTS)
+        self._events_seen = 0
         # rovers in declaration order: the i-th has the i-th colour, as in the plots
         self._rank = {name: i for i, name in enumerate(rover_names(list(sim.world.buffers)))}
         self.pair_lines = self._between_rovers()
@@ -270,6 +273,13 @@ class Scene:
             if not trail or math.dist(trail[-1], (x, y)) >= TRAIL_STEP_M:
                 trail.append((x, y))
         sim = self.sim
+        for event in sim.events[self._events_seen :]:
+            if event.kind == "collision":
+                named = [where[n] for n in str(event.detail).split("-") if n in where]
+                if named:
+                    xs, ys = zip(*named, strict=True)
+                    self.collisions.append((sum(xs) / len(xs), sum(ys) / len(ys)))
+        self._events_seen = len(sim.events)
         for track in self.gps:
             fix = (values[f"{track.path}.gpsPosX"], values[f"{track.path}.gpsPosY"])
             if self._last_fix.get(track.path) != fix:
@@ -319,6 +329,7 @@ class Scene:
             scans=self.scans(),
             zones=self.zones(),
             pair_lines=self.pair_lines,
+            collisions=list(self.collisions),
         )
 
     def scans(self) -> list[LidarScan]:
