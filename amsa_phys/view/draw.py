@@ -79,6 +79,8 @@ class Renderer:
         self.boxes: dict[str, pygame.Rect] = {}
         #: the rovers' name boxes of the last frame, in the frame's rover order
         self.labels: list[pygame.Rect] = []
+        #: the distance labels of the last frame (names are placed clear of them)
+        self._distance_labels: list[pygame.Rect] = []
 
     def draw(
         self,
@@ -191,6 +193,7 @@ class Renderer:
             pygame.draw.circle(surface, LOST, hit, 2)
 
     def _distance_lines(self, surface: pygame.Surface, camera: Camera, frame: Frame) -> None:
+        self._distance_labels = []
         if not frame.pair_lines:
             return
         q = frame.quality
@@ -203,6 +206,12 @@ class Renderer:
             label = self.small.render(f"true {d:.1f} m", True, _darker(col))
             mx, my = (pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2
             at = (mx - label.get_width() / 2, my - label.get_height() - 4)
+            box = pygame.Rect(
+                round(at[0]) - 2, round(at[1]), label.get_width() + 4, label.get_height()
+            )
+            if box.collidelist(self._distance_labels) >= 0:
+                continue  # a column of close rovers: the line's colour still tells the error
+            self._distance_labels.append(box)
             self._label_box(surface, label, at)
 
     def _rover(
@@ -243,14 +252,15 @@ class Renderer:
         """
         placed: list[pygame.Rect] = []
         self.labels = placed  # for tests: where each name went
+        taken = list(self._distance_labels)  # names never sit on a distance label either
         for r in rovers:
             label = self.small.render(r.name, True, INK)
             px, py = camera.to_screen(r.x, r.y)
             reach = max(MIN_ROVER_PX, 0.6 * max(r.length, r.width) * camera.scale)
             rect = pygame.Rect(0, 0, label.get_width() + 4, label.get_height())
             rect.midbottom = (round(px), round(py - reach))
-            for _ in range(len(placed) + 1):
-                if rect.collidelist(placed) < 0:
+            for _ in range(len(placed) + len(taken) + 1):
+                if rect.collidelist(placed) < 0 and rect.collidelist(taken) < 0:
                     break
                 rect.move_ip(0, -rect.height)
             placed.append(rect)
