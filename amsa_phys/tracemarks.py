@@ -70,24 +70,27 @@ def lossy_in_run(metrics: Mapping[str, Any]) -> set[str]:
 
 
 def lost_fix_rows(t: np.ndarray, fx: np.ndarray, fy: np.ndarray, period_s: float) -> np.ndarray:
-    """Rows (indices into ``t``) at which a GPS sampling instant passed without a new fix.
+    """Rows (indices into ``t``) at which a GPS sample was due but no new fix appeared.
 
-    ``t`` are the trace's times, ``fx``/``fy`` the GPS's published fix. A sampling instant
-    ``k * period_s`` shows in the first row at or after it; the sample was lost when that
-    row's fix equals the previous row's. Instants before the first fix was ever published
-    (a GPS with latency publishes nothing at first) are not losses.
+    ``t`` are the trace's times, ``fx``/``fy`` the GPS's published fix. Between two
+    consecutive new fixes ``gap / period_s - 1`` samples (rounded) were lost, due one period
+    after another from the earlier fix; after the last fix, every period until the trace
+    ends. Counting from the fixes themselves, not from a grid ``k * period_s``, makes the
+    GPS's timer phase (a free-running world draws one) and any constant delivery delay
+    irrelevant. Before the first fix (a GPS with latency publishes nothing at first) nothing
+    counts as lost.
     """
     if period_s <= 0 or len(t) < 2:
         return np.empty(0, dtype=int)
-    changed = (fx[1:] != fx[:-1]) | (fy[1:] != fy[:-1])
-    first = int(np.argmax(changed)) + 1 if changed.any() else len(t)
-    k0 = max(1, math.ceil((t[0] - _EPS_S) / period_s))
-    k1 = math.floor((t[-1] + _EPS_S) / period_s)
-    if k1 < k0:
+    new = np.flatnonzero((fx[1:] != fx[:-1]) | (fy[1:] != fy[:-1])) + 1
+    if not new.size:
         return np.empty(0, dtype=int)
-    instants = np.arange(k0, k1 + 1) * period_s
-    rows = np.searchsorted(t, instants - _EPS_S, side="left")
-    rows = rows[(rows >= 1) & (rows < len(t))]
-    rows = np.unique(rows)
-    stale = (fx[rows] == fx[rows - 1]) & (fy[rows] == fy[rows - 1])
-    return rows[stale & (rows > first)]
+    at = t[new]
+    due: list[float] = []
+    for a, b in zip(at[:-1].tolist(), at[1:].tolist(), strict=True):
+        missed = round((b - a) / period_s) - 1
+        due += [a + k * period_s for k in range(1, missed + 1)]
+    tail = math.floor((float(t[-1]) - float(at[-1])) / period_s + 1e-6)
+    due += [float(at[-1]) + k * period_s for k in range(1, tail + 1)]
+    rows = np.searchsorted(t, np.asarray(due) - _EPS_S, side="left")
+    return rows[rows < len(t)].astype(int)

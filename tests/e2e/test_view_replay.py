@@ -347,3 +347,31 @@ def _drawn_at(
         x, y = camera.to_screen(r.x, r.y)
         out.append(((round(x), round(y)), rover_colour(r.index)))
     return out
+
+
+def test_lost_fixes_are_found_whatever_the_gps_timer_phase(tmp_path: Path) -> None:
+    """A GPS whose timer is shifted (``phase: 0.1``: samples at 0.1, 0.35, ... s) loses the
+    same samples in the trace as in the running component: the losses are counted from the
+    fixes themselves, not from a grid of multiples of the period."""
+    world = (ROOT / "worlds" / "mde_challenge.yaml").read_text()
+    shifted = world.replace(
+        "    template: GPS\n    freq: 4\n", "    template: GPS\n    freq: 4\n    phase: 0.1\n", 1
+    )
+    assert shifted != world
+    (tmp_path / "w.yaml").write_text(shifted)
+    text = SCENARIO.read_text().replace("../../worlds/mde_challenge.yaml", str(tmp_path / "w.yaml"))
+    (tmp_path / "s.yaml").write_text(text)
+    scenario = load_scenario(tmp_path / "s.yaml", ["LeaderGPS.lostDataGPS=30"], duration=30)
+    live: dict[str, int] = {}
+
+    def drive(sim, scenario, recorder):  # type: ignore[no-untyped-def]
+        scene = Scene(sim, scenario.quality)
+        sim.advance(sim.grid.ticks(sim.duration))
+        live.update({g.path: g.lost_total for g in scene.gps})
+
+    out = tmp_path / "run"
+    out.mkdir()
+    run_scenario(scenario, out, window=drive, plot=False)
+    replay = load_run(out)
+    assert live["LeaderGPS"] > 10
+    assert {g.path: g.lost_total for g in replay.frame(replay.rows - 1).gps} == live
