@@ -182,7 +182,8 @@ class Renderer:
     def _scan(
         self, surface: pygame.Surface, camera: Camera, scan: LidarScan, colour: tuple[int, int, int]
     ) -> None:
-        """Lidar beams: a faint ray to each echo and a dot where it hit; no echo, no ray."""
+        """Lidar beams: a faint ray to each echo and a dot (the rover's colour, darker: red is
+        only ever an alert) where it hit; no echo, no ray."""
         origin = camera.to_screen(scan.x, scan.y)
         ray = _tint(colour, 0.6)
         for a, r in zip(scan.angles, scan.ranges, strict=True):
@@ -190,7 +191,7 @@ class Renderer:
                 continue
             hit = camera.to_screen(scan.x + r * math.cos(a), scan.y + r * math.sin(a))
             pygame.draw.line(surface, ray, origin, hit, 1)
-            pygame.draw.circle(surface, LOST, hit, 2)
+            pygame.draw.circle(surface, _darker(colour), hit, 2)  # red is only an alert
 
     def _distance_lines(self, surface: pygame.Surface, camera: Camera, frame: Frame) -> None:
         self._distance_labels = []
