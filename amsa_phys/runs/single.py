@@ -369,11 +369,11 @@ def execute(
         if record is not None:
             from ..view.recorder import Recorder
 
-            recorder = Recorder(sim, record, scenario.quality)
+            recorder = Recorder(sim, record, scenario.quality, scenario.planned_bounds)
         if snapshot is not None:
             from ..view.recorder import Snapshot
 
-            still = Snapshot(sim, snapshot, scenario.quality)
+            still = Snapshot(sim, snapshot, scenario.quality, scenario.planned_bounds)
         if window:
             driver = window if callable(window) else _open_window
             idle = driver(sim, scenario, recorder) or 0.0

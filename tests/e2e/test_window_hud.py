@@ -117,3 +117,31 @@ def test_the_live_plot_pane_samples_a_picked_signal_while_running() -> None:
     assert t[0] == 0.0
     assert t[-1] == pytest.approx(float(w.sim.now))
     assert v[-1] == w.sim.values["FollowerCompass.compassHeading"]
+
+
+def test_the_snapshot_and_video_hud_count_phases_like_the_window(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--duration`` with ``--snapshot``: the still's HUD says what the window's says."""
+    from amsa_phys.cli.main import main
+    from amsa_phys.view import recorder
+
+    seen: list[str] = []
+
+    class Seen(recorder.Snapshot):
+        def capture(self) -> None:
+            seen.append(self.scene.frame().phase_text)
+            super().capture()
+
+    monkeypatch.setattr(recorder, "Snapshot", Seen)
+    png = tmp_path / "still.png"
+    argv = ["run", str(SCENARIO), "--headless", "--duration", "100", "-q", "--no-plot"]
+    assert (
+        main([*argv, "--snapshot", str(png), "--snapshot-at", "1", "--out", str(tmp_path / "r")])
+        == 0
+    )
+    assert png.is_file()
+    assert seen == [
+        "phase 0 (of 0–1) from 0 s: behavior=1, lostDataGPS=0, motorCoef=100, Kv=0.35"
+        " (run stops at 100 s of 500)"
+    ]
