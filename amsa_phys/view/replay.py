@@ -32,6 +32,7 @@ from .scene import (
     GpsTrack,
     LiveMetrics,
     RoverPose,
+    ZoneView,
     phase_line,
 )
 
@@ -78,6 +79,7 @@ class ReplayScene:
         self._metric_prefix = self._running_metrics()
         self.events = self._events()
         self._hits = self._collision_points()
+        self._zones, self._zone_changes = self._zone_history()
 
     # -- loading -----------------------------------------------------------------------------
     def _xy(self, rover: str) -> np.ndarray:
@@ -149,6 +151,43 @@ class ReplayScene:
                 xy = np.mean([self._xy(n)[row] for n in names], axis=0)
                 out.append((float(e["t"]), (float(xy[0]), float(xy[1]))))
         return out
+
+    def _zone_history(
+        self,
+    ) -> tuple[list[ZoneView], list[tuple[float, str, str, float]]]:
+        """The world's friction zones as declared, and every change to their values the
+        run made (phase sets, in-phase and live changes: ``Mud.friction`` at 60 s), so a
+        replayed zone shows the ground as it was at each instant, as the live window does."""
+        zones = [
+            ZoneView(
+                path,
+                tuple((float(x), float(y)) for x, y in leaf.params.get("polygon") or ()),
+                float(leaf.params.get("friction", 0.3)),
+                float(leaf.params.get("rollingResistance", 0.1)),
+            )
+            for path, leaf in self.world.leaves.items()
+            if leaf.template.name() == "frictionZone"
+        ]
+        names = {z.name for z in zones}
+        changes = []
+        for p in self.phases:
+            steps = [(float(p["start"]), p.get("set") or {})]
+            steps += [(float(c["at"]), c.get("set") or {}) for c in p.get("changes") or []]
+            for at, sets in steps:
+                for key, value in sets.items():
+                    leaf, _, param = str(key).rpartition(".")
+                    if leaf in names and param in ("friction", "rollingResistance"):
+                        changes.append((at, leaf, param, float(value)))
+        return zones, sorted(changes, key=lambda c: c[0])
+
+    def zones(self, t: float) -> list[ZoneView]:
+        """The zones with the values in force at ``t``."""
+        now = {z.name: [z.friction, z.rolling_resistance] for z in self._zones}
+        for at, leaf, param, value in self._zone_changes:
+            if at > t:
+                break
+            now[leaf][0 if param == "friction" else 1] = value
+        return [ZoneView(z.name, z.polygon, *now[z.name]) for z in self._zones]
 
     # -- reading -----------------------------------------------------------------------------
     @property
@@ -245,6 +284,7 @@ class ReplayScene:
             duration=self.duration,
             pair_lines=self.quality is not None,
             collisions=[xy for at, xy in self._hits if at <= t],
+            zones=self.zones(t),
         )
 
     def phase_text(self, index: int) -> str:

@@ -375,3 +375,37 @@ def test_lost_fixes_are_found_whatever_the_gps_timer_phase(tmp_path: Path) -> No
     replay = load_run(out)
     assert live["LeaderGPS"] > 10
     assert {g.path: g.lost_total for g in replay.frame(replay.rows - 1).gps} == live
+
+
+def test_replayed_ground_changes_when_the_live_one_did(tmp_path: Path) -> None:
+    """A mud zone whose friction the timeline changes at 5 s: the replay draws the zone with
+    the values the live window showed before and after."""
+    world = (ROOT / "worlds" / "mde_challenge.yaml").read_text()
+    mud = (
+        "components:\n  Mud:\n    template: frictionZone\n"
+        "    params: {friction: 0.45, rollingResistance: 0.05,"
+        " polygon: [[20, -5], [25, -5], [25, 5], [20, 5]]}\n"
+    )
+    (tmp_path / "w.yaml").write_text(world.replace("components:\n", mud, 1))
+    (tmp_path / "s.yaml").write_text(
+        f"world: {tmp_path / 'w.yaml'}\nduration: 8\nseed: 1\n"
+        "timeline:\n  - {at: 5, set: {Mud.friction: 0.1}}\n"
+    )
+    scenario = load_scenario(tmp_path / "s.yaml")
+    live: dict[float, list[tuple[str, float, float]]] = {}
+
+    def drive(sim, scenario, recorder):  # type: ignore[no-untyped-def]
+        scene = Scene(sim, scenario.quality)
+        for t in (3, 8):
+            sim.advance(sim.grid.ticks(sim.duration * t // 8))
+            live[t] = [(z.name, z.friction, z.rolling_resistance) for z in scene.zones()]
+
+    out = tmp_path / "run"
+    out.mkdir()
+    run_scenario(scenario, out, window=drive, plot=False)
+    replay = load_run(out)
+    for t, zones in live.items():
+        shown = replay.frame(replay.row_at(t)).zones
+        assert [(z.name, z.friction, z.rolling_resistance) for z in shown] == zones
+    assert live[3] != live[8]  # the change happened
+    assert replay.frame(0).zones[0].polygon == ((20, -5), (25, -5), (25, 5), (20, 5))
