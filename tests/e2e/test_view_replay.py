@@ -170,49 +170,41 @@ def test_lost_fixes_found_in_the_trace_are_the_live_runs(tmp_path: Path) -> None
     assert len(lost) == live["LeaderGPS"]
 
 
+def _bad(kind: str, run: Path, d: Path) -> Path:
+    """A directory ``view`` must refuse: missing, not a run, a truncated trace, a sweep's."""
+    if kind == "missing":
+        return d / "nothing"
+    out = d / kind
+    if kind == "not-a-run":
+        out.mkdir()
+    elif kind == "truncated-trace":
+        shutil.copytree(run, out)
+        text = (out / "trace.csv").read_bytes()
+        (out / "trace.csv").write_bytes(text[: len(text) // 2])  # a row cut short
+    else:
+        out.mkdir()
+        (out / "results.csv").write_text("seed\n1\n")
+    return out
+
+
 @pytest.mark.parametrize(
-    ("make", "message"),
+    ("kind", "message"),
     [
-        (lambda d: d / "nothing", "no such directory"),
-        (lambda d: (d / "empty").mkdir() or d / "empty", "not a run directory: trace.csv"),
-        (lambda d: _truncated(d), "trace.csv"),
-        (lambda d: _sweep(d), "a sweep directory: view one of its kept runs"),
+        ("missing", "nothing: no such directory"),
+        ("not-a-run", "not-a-run: not a run directory: trace.csv is missing"),
+        ("truncated-trace", "trace.csv:"),
+        ("sweep", "sweep: a sweep directory: view one of its kept runs"),
     ],
     ids=["missing", "not-a-run", "truncated-trace", "sweep"],
 )
 def test_bad_rundir_is_one_line_and_exit_2(
-    rundir: Path,
-    tmp_path: Path,
-    capsys: pytest.CaptureFixture[str],
-    make: object,
-    message: str,
+    rundir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], kind: str, message: str
 ) -> None:
-    global _SOURCE
-    _SOURCE = rundir
-    target = make(tmp_path)  # type: ignore[operator]
-    assert main(["view", str(target)]) == 2
+    assert main(["view", str(_bad(kind, rundir, tmp_path))]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
     assert "Traceback" not in err
     assert message in err
-
-
-_SOURCE = Path()
-
-
-def _truncated(d: Path) -> Path:
-    out = d / "cut"
-    shutil.copytree(_SOURCE, out)
-    text = (out / "trace.csv").read_bytes()
-    (out / "trace.csv").write_bytes(text[: len(text) // 2])  # a row cut short
-    return out
-
-
-def _sweep(d: Path) -> Path:
-    out = d / "sweep"
-    out.mkdir()
-    (out / "results.csv").write_text("seed\n1\n")
-    return out
 
 
 def test_a_closed_run_says_where_it_was_cut(rundir: Path) -> None:
