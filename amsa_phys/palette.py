@@ -44,6 +44,8 @@ ROVER_COLOURS: tuple[RGB, ...] = (
 )
 #: alerts: lost GPS fixes, collisions, a motor driven backwards
 ALERT: RGB = (214, 39, 40)
+#: text and outlines in the window (HUD, names, a collision's edge)
+INK: RGB = (32, 32, 36)
 #: the quality signal (the measured distance) in every plot: near-black, because blue and
 #: orange are rovers (the paper's Fig. 5/6 redrawn use it too)
 SIGNAL: RGB = (38, 38, 38)

@@ -17,17 +17,19 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..palette import ALERT, COLLISION, LOST_FIX, REFERENCE, rover_colour
+from ..palette import ALERT, LOST_FIX, REFERENCE, rover_colour
+from ..palette import INK as PALETTE_INK
 from ..palette import WARN as PALETTE_WARN
 from ..physics.terrain import zone_colours
 from .camera import Camera
+from .marks import darker, dashed, draw_collision, draw_lost_fix
 from .pg import font, pygame
 from .scene import Frame, LidarScan, RoverPose, ZoneView
 
 BACKGROUND = (246, 246, 241)
 GRID_MINOR = (228, 228, 221)
 GRID_MAJOR = (205, 205, 197)
-INK = (32, 32, 36)
+INK = PALETTE_INK
 MUTED = (110, 110, 116)
 OBSTACLE = (120, 116, 108)
 WHEEL = (40, 40, 44)
@@ -191,7 +193,7 @@ class Renderer:
                 continue
             hit = camera.to_screen(scan.x + r * math.cos(a), scan.y + r * math.sin(a))
             pygame.draw.line(surface, ray, origin, hit, 1)
-            pygame.draw.circle(surface, _darker(colour), hit, 2)  # red is only an alert
+            pygame.draw.circle(surface, darker(colour), hit, 2)  # red is only an alert
 
     def _distance_lines(self, surface: pygame.Surface, camera: Camera, frame: Frame) -> None:
         self._distance_labels = []
@@ -203,8 +205,8 @@ class Renderer:
             col = error_colour(d - q.reference, q.tolerance) if q else MUTED
             pa, pb = camera.to_screen(a.x, a.y), camera.to_screen(b.x, b.y)
             # dashed and thin: the trails under it (the leader's orange) show through
-            _dashed(surface, col, pa, pb)
-            label = self.small.render(f"true {d:.1f} m", True, _darker(col))
+            dashed(surface, col, pa, pb)
+            label = self.small.render(f"true {d:.1f} m", True, darker(col))
             mx, my = (pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2
             at = (mx - label.get_width() / 2, my - label.get_height() - 4)
             box = pygame.Rect(
@@ -288,7 +290,7 @@ class Renderer:
                 f"measured {m.value:6.2f} m  ref {q.reference:g} ± {q.tolerance:g}  "
                 f"error {err:+.2f} m"
             )
-            colours.append(_darker(error_colour(err, q.tolerance)))  # readable on white
+            colours.append(darker(error_colour(err, q.tolerance)))  # readable on white
             rms = m.rms_error
             lines.append(
                 f"max {m.max:.2f} m  min {m.min:.2f} m  rms error "
@@ -375,46 +377,6 @@ def _wrap(text: str, fnt: pygame.font.Font, room: int) -> list[str]:
         line = word
     out.append(line)
     return out
-
-
-def draw_lost_fix(surface: pygame.Surface, at: tuple[float, float]) -> None:
-    """``palette.LOST_FIX``: a red × (the plots' ``x`` marker)."""
-    px, py = at
-    pygame.draw.line(surface, LOST_FIX.colour, (px - 4, py - 4), (px + 4, py + 4), 2)
-    pygame.draw.line(surface, LOST_FIX.colour, (px - 4, py + 4), (px + 4, py - 4), 2)
-
-
-def draw_collision(surface: pygame.Surface, at: tuple[float, float]) -> None:
-    """``palette.COLLISION``: a red diamond with a dark edge (the plots' ``D`` marker)."""
-    px, py = at
-    pts = [(px, py - 6), (px + 6, py), (px, py + 6), (px - 6, py)]
-    pygame.draw.polygon(surface, COLLISION.colour, pts)
-    pygame.draw.polygon(surface, INK, pts, 1)
-
-
-def _dashed(
-    surface: pygame.Surface,
-    colour: tuple[int, int, int],
-    a: tuple[float, float],
-    b: tuple[float, float],
-    dash: float = 8.0,
-) -> None:
-    """A 2 px line from ``a`` to ``b`` drawn as dashes with equal gaps."""
-    length = math.hypot(b[0] - a[0], b[1] - a[1])
-    if length < 1:
-        return
-    n = int(length // (2 * dash)) + 1
-    ux, uy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
-    for k in range(n):
-        s0, s1 = 2 * k * dash, min(length, (2 * k + 1) * dash)
-        pygame.draw.line(
-            surface, colour, (a[0] + ux * s0, a[1] + uy * s0), (a[0] + ux * s1, a[1] + uy * s1), 2
-        )
-
-
-def _darker(colour: tuple[int, int, int]) -> tuple[int, int, int]:
-    """``colour`` at 70 %: text in it stays readable on a white box (amber is not)."""
-    return tuple(int(c * 0.7) for c in colour)  # type: ignore[return-value]
 
 
 def _screen(camera: Camera, points: Sequence[tuple[float, float]]) -> list[list[float]]:

@@ -31,7 +31,8 @@ from amsa_phys.palette import (
 from amsa_phys.plots import paper, trajectory
 from amsa_phys.plots.distance import cut_note, distance_figure
 from amsa_phys.runs.plotjob import plot_context
-from amsa_phys.view.draw import Renderer, draw_collision, draw_lost_fix
+from amsa_phys.view.draw import Renderer
+from amsa_phys.view.marks import draw_collision, draw_lost_fix
 from amsa_phys.view.pg import pygame
 
 ROOT = Path(__file__).resolve().parent.parent.parent
