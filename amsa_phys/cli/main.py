@@ -60,6 +60,7 @@ COMMANDS = {
         "adapt",
         "Derive adapt: rules from a context sweep: best parameters per context, on estimators.",
     ),
+    "view": ("view", "Open the window on a finished run: play, pause, scrub, jump to events."),
 }
 
 

@@ -17,6 +17,7 @@ from matplotlib.figure import Figure
 
 from ..errors import ConfigError
 from ..model.params import short_repr
+from ..palette import COLLISION, PHASE, REFERENCE, SIGNAL, hex_colour
 from .adaptmarks import adapt_switches
 from .save import save_png
 
@@ -150,7 +151,7 @@ def _phase_notes(ax: plt.Axes, phases: list[dict[str, Any]]) -> list[str]:
     for phase in phases:
         start = phase["start"]
         if start > 0:
-            ax.axvline(start, color="0.4", lw=0.8, ls=":")
+            ax.axvline(start, color=hex_colour(PHASE), lw=0.8, ls=":")
         lines = [f"{k.split('.')[-1]}={v}" for k, v in phase["set"].items()]
         if len(lines) > MAX_NOTE_LINES:
             lines = [*lines[: MAX_NOTE_LINES - 1], f"+{len(lines) - MAX_NOTE_LINES + 1} more"]
@@ -225,20 +226,44 @@ def _legend_place(ax: plt.Axes, times: list[float]) -> str:
 
 
 def _collisions(ax: plt.Axes, events: list[dict[str, Any]], t: np.ndarray, s: np.ndarray) -> None:
-    """A red cross on the curve at every collision (its detail names who touched)."""
+    """``palette.COLLISION`` on the curve at every collision (its detail names who touched)."""
     at = np.array([e["t"] for e in events if e.get("kind") == "collision"], dtype=float)
     if not at.size:
         return
     ax.plot(
         at,
         np.interp(at, t, s),
-        "x",
-        color="#d62728",
-        ms=9,
-        mew=2,
+        COLLISION.marker,
+        color=hex_colour(COLLISION.colour),
+        mec="k",
+        ms=7,
+        mew=0.8,
+        ls="",
         zorder=5,
         label=f"collision ({at.size})",
     )
+
+
+def cut_note(metrics: dict[str, Any]) -> str:
+    """`` — cut at 42.5 s of 500 s (closed in the window)`` for a run that stopped before
+    its end (the window closed, Ctrl-C, a fault, ``--duration``); empty for a whole run.
+
+    Every plot of the run puts it in its title: a curve that ends at 42.5 s must say that
+    the run ended there, not that the scenario is 42.5 s long.
+    """
+    try:
+        ran = float(metrics.get("simulated", metrics.get("duration", 0)))
+        planned = float(metrics.get("duration", ran))
+    except (TypeError, ValueError):
+        return ""
+    status = str(metrics.get("status") or "completed")
+    if status == "completed" and ran >= planned:
+        return ""
+    why = {"interrupted": "interrupted (Ctrl-C)"}.get(status, status)
+    why = why.split(" at t=")[0]  # "closed in the window at t=42.5 s": the time is said once
+    if why.startswith("fault"):
+        why = "a fault"
+    return f" — cut at {ran:g} s of {planned:g} s ({why})"
 
 
 def plot_distance(
@@ -268,13 +293,14 @@ def distance_figure(
             [t[0], t[-1]],
             ref - tol,
             ref + tol,
-            color="tab:green",
+            color=hex_colour(REFERENCE),
             alpha=0.15,
             label=f"tolerance ±{tol:g} m",
         )
-        ax.axhline(ref, color="tab:green", lw=1.2, ls="--", label=f"reference {ref:g} m")
-        # near-black: blue and orange are the rovers' colours in every other picture
-        ax.plot(t, s, color="0.15", lw=1.2, label=signal)
+        ref_colour = hex_colour(REFERENCE)
+        ax.axhline(ref, color=ref_colour, lw=1.2, ls="--", label=f"reference {ref:g} m")
+        # palette.SIGNAL, near-black: blue and orange are the rovers' colours everywhere
+        ax.plot(t, s, color=hex_colour(SIGNAL), lw=1.2, label=signal)
         top = max(float(np.nanmax(s)) if np.isfinite(s).any() else 0.0, ref + tol)
         lines = _phase_notes(ax, metrics.get("phases", []))
         changes = _inner_changes(ax, metrics.get("phases", []))
@@ -287,7 +313,9 @@ def distance_figure(
         ax.text(0.5, 0.5, "no quality signal", ha="center", transform=ax.transAxes)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("distance (m)")
-    ax.set_title(f"{metrics.get('scenario', '')} (seed {metrics.get('seed', '')})")
+    ax.set_title(
+        f"{metrics.get('scenario', '')} (seed {metrics.get('seed', '')}){cut_note(metrics)}"
+    )
     ax.grid(alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc=_legend_place(ax, changes), fontsize=8)

@@ -23,7 +23,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..palette import ROVER_COLOURS, hex_colour
+from ..palette import ALERT, REFERENCE, SIGNAL, hex_colour
 from .save import save_png
 
 #: How close a project number must be to the paper's to count as reached.
@@ -41,8 +41,10 @@ FIG5: dict[float, dict[str, Any]] = {
 #: Kv = 0.05 from t = 100 s practically stable at 18 m.
 FIG6 = {"peak": 22.0, "plateau": 18.0, "switch": 100.0}
 
-FOLLOWER = hex_colour(ROVER_COLOURS[1])
-GOOD, BAD, MUTED = "#2ca02c", "#d62728", "0.45"
+#: the measured distance: palette.SIGNAL, the colour of the quality signal in distance.png
+#: (it was the follower's blue here and black there)
+FOLLOWER = hex_colour(SIGNAL)
+GOOD, BAD, MUTED = hex_colour(REFERENCE), hex_colour(ALERT), "0.45"
 
 
 @dataclass

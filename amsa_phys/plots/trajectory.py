@@ -36,8 +36,17 @@ from matplotlib.collections import LineCollection
 from matplotlib.patches import Polygon
 
 from ..model.geometry import static_obstacles
-from ..palette import ALERT, ROVER_COLOURS, hex_colour, rover_colour, rover_names
-from .distance import read_trace
+from ..palette import (
+    COLLISION,
+    LOST_FIX,
+    ROVER_COLOURS,
+    hex_colour,
+    rover_colour,
+    rover_names,
+    rover_ranks,
+)
+from ..tracemarks import lossy_in_run, lost_fix_rows
+from .distance import cut_note, read_trace
 from .save import save_png
 from .zones import draw_zones, zones_of_run
 
@@ -165,20 +174,26 @@ def plot_trajectory(
     zones = world["zones"] if "zones" in world else zones_of_run(trace.parent / "scenario.yaml")
     draw_zones(ax, zones, view)  # terrain, from the run (its timeline changes the labels)
     grouped = len(rovers) > GROUP_ABOVE
-    style = role_styles(rovers) if grouped else rover_styles(rovers)
+    ranks = rover_ranks(world.get("rovers") or rovers, rovers)  # the world's order, not the trace's
+    style = role_styles(rovers) if grouped else rover_styles(rovers, ranks)
     if grouped:
         _draw_roles(ax, paths, view, style)
     else:
         _draw_rovers(ax, paths, view, style)
-    _draw_gps(ax, header, data, view, style, world.get("gps_of", {}), grouped)
+    # a GPS of a rover the trace left out is still drawn in that rover's colour
+    untraced = {r: _style(i, r) for i, r in enumerate(world.get("rovers") or [])}
+    gps_style = style if grouped else {**untraced, **style}
+    _draw_gps(ax, header, data, view, gps_style, world.get("gps_of", {}), grouped)
     _draw_odometry(ax, header, data, view)
     _draw_goals(ax, world.get("goals", []), view)
+    _draw_lost_fixes(ax, header, data, view, paths, world.get("gps", []), metrics)
     hits = _collision_points(metrics, data, header, paths)
     if hits.size:
         p = view(hits)
-        ax.plot(p[:, 0], p[:, 1], "x", color=hex_colour(ALERT), ms=9, mew=2, zorder=6)
-        ax.plot([], [], "x", color=hex_colour(ALERT), mew=2, label=f"collision ({len(hits)})")
-    title = f"{metrics.get('scenario', '')}: trajectories (o start, ■ end)"
+        look = {"color": hex_colour(COLLISION.colour), "mec": "k", "mew": 0.8, "ls": ""}
+        ax.plot(p[:, 0], p[:, 1], COLLISION.marker, ms=7, zorder=6, **look)
+        ax.plot([], [], COLLISION.marker, ms=6, label=f"collision ({len(hits)})", **look)
+    title = f"{metrics.get('scenario', '')}: trajectories (o start, ■ end){cut_note(metrics)}"
     if not rovers:
         why = (
             "no positions in the trace"
@@ -229,9 +244,11 @@ def _style(index: int, name: str) -> Style:
     return Style(hex_colour(rover_colour(index)), dash, name)
 
 
-def rover_styles(rovers: list[str]) -> dict[str, Style]:
-    """One style per rover, in declaration order (the window's colours)."""
-    return {r: _style(i, r) for i, r in enumerate(rovers)}
+def rover_styles(rovers: list[str], ranks: dict[str, int] | None = None) -> dict[str, Style]:
+    """One style per rover: the window's colour of its rank among the world's rovers
+    (``ranks``, :func:`~amsa_phys.palette.rover_ranks`; default: its place in ``rovers``)."""
+    ranks = ranks or {r: i for i, r in enumerate(rovers)}
+    return {r: _style(ranks[r], r) for r in rovers}
 
 
 def role_styles(rovers: list[str]) -> dict[str, Style]:
@@ -354,6 +371,37 @@ def _draw_gps(
         ax.plot([], [], "+", color="0.4", label="GPS fixes (a sample)")
     elif len(tracks) > 3:
         ax.plot([], [], "+", color="0.4", label="GPS fixes (the rover's colour)")
+
+
+def _draw_lost_fixes(
+    ax: plt.Axes,
+    header: list[str],
+    data: np.ndarray,
+    view: View,
+    paths: dict[str, np.ndarray],
+    links: list[dict[str, Any]],
+    metrics: dict[str, Any],
+) -> None:
+    """``palette.LOST_FIX`` (a red ×) where each GPS sample was lost, at the measured rover's
+    true position then (``tracemarks``: the same losses the window and the video mark)."""
+    lossy = lossy_in_run(metrics)
+    points = []
+    for link in links:
+        path, rover = link["path"], link.get("rover")
+        cols = (f"{path}.gpsPosX", f"{path}.gpsPosY")
+        if not (link["lossy"] or path in lossy) or rover not in paths or cols[1] not in header:
+            continue
+        fx, fy = data[:, header.index(cols[0])], data[:, header.index(cols[1])]
+        rows = lost_fix_rows(data[:, 0], fx, fy, float(link["period_s"]))
+        points.append(paths[rover][rows])
+    if not points or not sum(len(p) for p in points):
+        return
+    xy = view(np.concatenate(points))
+    colour = hex_colour(LOST_FIX.colour)
+    ax.plot(xy[:, 0], xy[:, 1], LOST_FIX.marker, ls="", color=colour, ms=6, mew=1.5, zorder=6)
+    ax.plot(
+        [], [], LOST_FIX.marker, ls="", color=colour, mew=1.5, label=f"lost GPS fix ({len(xy)})"
+    )
 
 
 def _draw_odometry(ax: plt.Axes, header: list[str], data: np.ndarray, view: View) -> None:

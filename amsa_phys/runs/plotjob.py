@@ -46,6 +46,8 @@ if TYPE_CHECKING:
     from ..model.world import WorldSpec
 
 from ..errors import one_line
+from ..palette import rover_names
+from ..tracemarks import gps_links
 from .pool import die_with_parent
 
 #: How long the parent waits for the child's plots before drawing them itself.
@@ -99,6 +101,10 @@ def plot_context(world: WorldSpec, resolved: Any = None) -> dict[str, Any]:
             key = (goal["x"], goal["y"])
             goals[key] = {**goal, "radius": max(goal["radius"], goals.get(key, goal)["radius"])}
     context = {"physics": world.physics, "gps_of": gps_of, "goals": list(goals.values())}
+    # the world's rovers in order (colours by rank, whatever the trace keeps) and each GPS's
+    # period and loss settings (trajectory.png marks its lost fixes, as the window does)
+    context["rovers"] = rover_names(list(world.buffers))
+    context["gps"] = [vars(link) for link in gps_links(world.leaves)]
     if resolved is not None:  # the run's resolved scenario: its zones go with the job
         from ..plots.zones import zones_of_resolved  # matplotlib-free
 

@@ -369,11 +369,11 @@ def execute(
         if record is not None:
             from ..view.recorder import Recorder
 
-            recorder = Recorder(sim, record, scenario.quality)
+            recorder = Recorder(sim, record, scenario.quality, scenario.planned_bounds)
         if snapshot is not None:
             from ..view.recorder import Snapshot
 
-            still = Snapshot(sim, snapshot, scenario.quality)
+            still = Snapshot(sim, snapshot, scenario.quality, scenario.planned_bounds)
         if window:
             driver = window if callable(window) else _open_window
             idle = driver(sim, scenario, recorder) or 0.0
@@ -484,7 +484,13 @@ WindowDriver = Callable[[Simulation, Scenario, "Recorder | None"], "float | None
 def _open_window(sim: Simulation, scenario: Scenario, recorder: Recorder | None) -> float:
     from ..view.window import Window
 
-    return Window(sim, scenario.quality, title=scenario.name, recorder=recorder).run()
+    return Window(
+        sim,
+        scenario.quality,
+        title=scenario.name,
+        recorder=recorder,
+        planned=scenario.planned_bounds,
+    ).run()
 
 
 def _finish_video(recorder: Recorder | None, error: BaseException | None) -> dict[str, Any] | None:

@@ -30,21 +30,28 @@ class Camera:
         self.mode = "fit"
         self.target: str | None = None  # rover followed in ``follow`` mode
         self._placed = False
+        #: pixels at the left covered by a panel: fit mode frames the rovers beside it
+        self.left = 0
 
     # -- transforms ------------------------------------------------------------------------
     def to_screen(self, x: float, y: float) -> tuple[float, float]:
         """Pixel coordinates of the world point (x, y)."""
         return (
-            self.width / 2 + (x - self.cx) * self.scale,
+            self.mid_x + (x - self.cx) * self.scale,
             self.height / 2 - (y - self.cy) * self.scale,
         )
 
     def to_world(self, px: float, py: float) -> tuple[float, float]:
         """World point under the pixel (px, py)."""
         return (
-            self.cx + (px - self.width / 2) / self.scale,
+            self.cx + (px - self.mid_x) / self.scale,
             self.cy - (py - self.height / 2) / self.scale,
         )
+
+    @property
+    def mid_x(self) -> float:
+        """Pixel column the camera centres on: the middle of the room beside the panel."""
+        return self.left + (self.width - self.left) / 2
 
     # -- following the action --------------------------------------------------------------
     def update(self, points: Sequence[tuple[float, float, str]], dt_sim: float) -> None:
@@ -60,7 +67,8 @@ class Camera:
         ys = [p[1] for p in points]
         span_x = max(max(xs) - min(xs), MIN_SPAN_M)
         span_y = max(max(ys) - min(ys), MIN_SPAN_M * self.height / self.width)
-        scale = min(self.width / span_x, self.height / span_y) / (1 + 2 * MARGIN)
+        room = max(self.width - self.left, self.width // 3)
+        scale = min(room / span_x, self.height / span_y) / (1 + 2 * MARGIN)
         tx, ty = (max(xs) + min(xs)) / 2, (max(ys) + min(ys)) / 2
         if not self._placed:
             self.cx, self.cy, self.scale = tx, ty, scale
@@ -74,7 +82,7 @@ class Camera:
         # never let a rover leave the picture while gliding
         for x, y, _ in points:
             px, py = self.to_screen(x, y)
-            if not (0 <= px <= self.width and 0 <= py <= self.height):
+            if not (self.left <= px <= self.width and 0 <= py <= self.height):
                 self.cx, self.cy, self.scale = tx, ty, scale
                 break
 

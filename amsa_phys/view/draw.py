@@ -17,43 +17,40 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..palette import ALERT, rover_colour
+from ..palette import ALERT, LOST_FIX, REFERENCE, rover_colour
+from ..palette import INK as PALETTE_INK
+from ..palette import WARN as PALETTE_WARN
 from ..physics.terrain import zone_colours
 from .camera import Camera
+from .marks import darker, dashed, draw_collision, draw_lost_fix
 from .pg import font, pygame
 from .scene import Frame, LidarScan, RoverPose, ZoneView
 
 BACKGROUND = (246, 246, 241)
 GRID_MINOR = (228, 228, 221)
 GRID_MAJOR = (205, 205, 197)
-INK = (32, 32, 36)
+INK = PALETTE_INK
 MUTED = (110, 110, 116)
 OBSTACLE = (120, 116, 108)
 WHEEL = (40, 40, 44)
-LOST = ALERT
-OK = (44, 160, 44)
-WARN = (240, 170, 30)
-BAD = (214, 39, 40)
+LOST = LOST_FIX.colour
+OK = REFERENCE
+WARN = PALETTE_WARN  # clear of the leader's orange (palette.py)
+BAD = ALERT
 MIN_ROVER_PX = 5.0
 
 
 def error_colour(error: float, tolerance: float) -> tuple[int, int, int]:
-    """Green within the tolerance band, amber up to twice it, then amber to red at three
-    times it. Green is never blended towards amber: halfway between them in RGB is an olive
-    that reads as "fine" on the HUD, so leaving the band switches colour at once."""
+    """Green within the tolerance band, amber up to twice it, red beyond: three colours, never
+    a blend. Green blended towards amber is an olive that reads as "fine"; amber blended
+    towards red is the leader's orange, and the line between the rovers vanished into the
+    leader's trail (``palette.py``)."""
     r = abs(error) / tolerance if tolerance > 0 else (0.0 if error == 0 else math.inf)
     if r <= 1:
         return OK
     if r <= 2:
         return WARN
-    if r >= 3:
-        return BAD
-    k = r - 2
-    return (
-        int(WARN[0] + (BAD[0] - WARN[0]) * k),
-        int(WARN[1] + (BAD[1] - WARN[1]) * k),
-        int(WARN[2] + (BAD[2] - WARN[2]) * k),
-    )
+    return BAD
 
 
 def nice_step(target_m: float) -> float:
@@ -82,6 +79,10 @@ class Renderer:
         self.small = font(max(8, self.text_px - 3))
         #: the text boxes of the last frame drawn (``hud``, ``status``), in pixels
         self.boxes: dict[str, pygame.Rect] = {}
+        #: the rovers' name boxes of the last frame, in the frame's rover order
+        self.labels: list[pygame.Rect] = []
+        #: the distance labels of the last frame (names are placed clear of them)
+        self._distance_labels: list[pygame.Rect] = []
 
     def draw(
         self,
@@ -97,7 +98,9 @@ class Renderer:
             self._zone(surface, camera, zone)
         for ob in frame.obstacles:
             self._obstacle(surface, camera, ob.kind, ob.points, ob.radius)
-        colours = {r.name: rover_colour(i) for i, r in enumerate(frame.rovers)}
+        colours = {
+            r.name: rover_colour(r.index if r.index >= 0 else i) for i, r in enumerate(frame.rovers)
+        }
         for name, trail in frame.trails.items():
             if len(trail) >= 2:
                 pts = _screen(camera, trail)
@@ -112,14 +115,15 @@ class Renderer:
                 px, py = camera.to_screen(*track.fixes[-1])
                 pygame.draw.circle(surface, col, (px, py), 5, 1)
             for x, y in track.lost:
-                px, py = camera.to_screen(x, y)
-                pygame.draw.line(surface, LOST, (px - 4, py - 4), (px + 4, py + 4), 2)
-                pygame.draw.line(surface, LOST, (px - 4, py + 4), (px + 4, py - 4), 2)
+                draw_lost_fix(surface, camera.to_screen(x, y))
+        for x, y in frame.collisions:
+            draw_collision(surface, camera.to_screen(x, y))
         for scan in frame.scans:
             self._scan(surface, camera, scan, colours.get(scan.mount, MUTED))
         self._distance_lines(surface, camera, frame)
         for r in frame.rovers:
             self._rover(surface, camera, r, colours[r.name])
+        self._labels(surface, camera, frame.rovers)
         self._hud(surface, frame, camera, status)
 
     # -- world layer -------------------------------------------------------------------------
@@ -180,7 +184,8 @@ class Renderer:
     def _scan(
         self, surface: pygame.Surface, camera: Camera, scan: LidarScan, colour: tuple[int, int, int]
     ) -> None:
-        """Lidar beams: a faint ray to each echo and a dot where it hit; no echo, no ray."""
+        """Lidar beams: a faint ray to each echo and a dot (the rover's colour, darker: red is
+        only ever an alert) where it hit; no echo, no ray."""
         origin = camera.to_screen(scan.x, scan.y)
         ray = _tint(colour, 0.6)
         for a, r in zip(scan.angles, scan.ranges, strict=True):
@@ -188,9 +193,10 @@ class Renderer:
                 continue
             hit = camera.to_screen(scan.x + r * math.cos(a), scan.y + r * math.sin(a))
             pygame.draw.line(surface, ray, origin, hit, 1)
-            pygame.draw.circle(surface, LOST, hit, 2)
+            pygame.draw.circle(surface, darker(colour), hit, 2)  # red is only an alert
 
     def _distance_lines(self, surface: pygame.Surface, camera: Camera, frame: Frame) -> None:
+        self._distance_labels = []
         if not frame.pair_lines:
             return
         q = frame.quality
@@ -198,10 +204,18 @@ class Renderer:
             d = math.hypot(a.x - b.x, a.y - b.y)
             col = error_colour(d - q.reference, q.tolerance) if q else MUTED
             pa, pb = camera.to_screen(a.x, a.y), camera.to_screen(b.x, b.y)
-            pygame.draw.line(surface, col, pa, pb, 2)
-            label = self.small.render(f"true {d:.1f} m", True, col)
+            # dashed and thin: the trails under it (the leader's orange) show through
+            dashed(surface, col, pa, pb)
+            label = self.small.render(f"true {d:.1f} m", True, darker(col))
             mx, my = (pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2
-            surface.blit(label, (mx - label.get_width() / 2, my - label.get_height() - 4))
+            at = (mx - label.get_width() / 2, my - label.get_height() - 4)
+            box = pygame.Rect(
+                round(at[0]) - 2, round(at[1]), label.get_width() + 4, label.get_height()
+            )
+            if box.collidelist(self._distance_labels) >= 0:
+                continue  # a column of close rovers: the line's colour still tells the error
+            self._distance_labels.append(box)
+            self._label_box(surface, label, at)
 
     def _rover(
         self, surface: pygame.Surface, camera: Camera, r: RoverPose, colour: tuple[int, int, int]
@@ -234,10 +248,34 @@ class Renderer:
                 k = max(-1.0, min(1.0, power / 100.0))
                 if abs(k) > 0.01:
                     pygame.draw.line(surface, OK if k > 0 else BAD, at(0, wy), at(wl * k, wy), 2)
-        label = self.small.render(r.name, True, INK)
-        px, py = camera.to_screen(r.x, r.y)
-        reach = max(MIN_ROVER_PX, 0.6 * max(r.length, r.width) * camera.scale)
-        surface.blit(label, (px - label.get_width() / 2, py - reach - label.get_height()))
+
+    def _labels(self, surface: pygame.Surface, camera: Camera, rovers: Sequence[RoverPose]) -> None:
+        """Each rover's name above it; a name that would overlap one already placed moves
+        up a line at a time (close rovers, a platoon's column), so every name stays readable.
+        """
+        placed: list[pygame.Rect] = []
+        self.labels = placed  # for tests: where each name went
+        taken = list(self._distance_labels)  # names never sit on a distance label either
+        for r in rovers:
+            label = self.small.render(r.name, True, INK)
+            px, py = camera.to_screen(r.x, r.y)
+            reach = max(MIN_ROVER_PX, 0.6 * max(r.length, r.width) * camera.scale)
+            rect = pygame.Rect(0, 0, label.get_width() + 4, label.get_height())
+            rect.midbottom = (round(px), round(py - reach))
+            for _ in range(len(placed) + len(taken) + 1):
+                if rect.collidelist(placed) < 0 and rect.collidelist(taken) < 0:
+                    break
+                rect.move_ip(0, -rect.height)
+            placed.append(rect)
+            self._label_box(surface, label, (rect.x + 2, rect.y))
+
+    @staticmethod
+    def _label_box(surface: pygame.Surface, label: pygame.Surface, at: tuple[float, float]) -> None:
+        """A label on a faint white box, readable over trails and grid."""
+        box = pygame.Surface((label.get_width() + 4, label.get_height()), pygame.SRCALPHA)
+        box.fill((255, 255, 255, 170))
+        surface.blit(box, (at[0] - 2, at[1]))
+        surface.blit(label, at)
 
     # -- HUD ---------------------------------------------------------------------------------
     def _hud(
@@ -252,7 +290,7 @@ class Renderer:
                 f"measured {m.value:6.2f} m  ref {q.reference:g} ± {q.tolerance:g}  "
                 f"error {err:+.2f} m"
             )
-            colours.append(error_colour(err, q.tolerance))
+            colours.append(darker(error_colour(err, q.tolerance)))  # readable on white
             rms = m.rms_error
             lines.append(
                 f"max {m.max:.2f} m  min {m.min:.2f} m  rms error "
@@ -345,7 +383,7 @@ def _screen(camera: Camera, points: Sequence[tuple[float, float]]) -> list[list[
     """Many world points to pixels at once (numpy: trails hold hundreds of points)."""
     arr = np.asarray(points, dtype=float)
     out = np.empty_like(arr)
-    out[:, 0] = camera.width / 2 + (arr[:, 0] - camera.cx) * camera.scale
+    out[:, 0] = camera.mid_x + (arr[:, 0] - camera.cx) * camera.scale
     out[:, 1] = camera.height / 2 - (arr[:, 1] - camera.cy) * camera.scale
     np.clip(out, -1e5, 1e5, out=out)  # SDL draws garbage for coordinates near int limits
     return out.tolist()

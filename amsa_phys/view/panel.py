@@ -51,6 +51,8 @@ class ParamPanel:
         self.pending: Any = None  # a value stepped with the arrows
         self.text: str | None = None  # a value being typed
         self.message = ""
+        #: the message says a value was refused (drawn in the alert colour)
+        self.refused = False
 
     # -- reading -------------------------------------------------------------------------
     @property
@@ -157,6 +159,7 @@ class ParamPanel:
     def commit(self) -> Change | None:
         """The checked Change for the pending value, or None (message says why)."""
         row = self.row
+        self.refused = True  # until the value passes every check
         if row.fixed:
             self.message = f"{row.key} is fixed once the run has started"
             self.cancel()
@@ -184,6 +187,7 @@ class ParamPanel:
             self.cancel()
             return None
         self.cancel()
+        self.refused = False
         return Change(row.leaf, row.param.name, value)
 
 

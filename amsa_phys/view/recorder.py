@@ -11,6 +11,7 @@ from __future__ import annotations
 import io
 import math
 import sys
+from collections.abc import Sequence
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
@@ -50,14 +51,18 @@ class Recorder:
     """Renders the simulation at each frame time and feeds the encoder."""
 
     def __init__(
-        self, sim: Simulation, options: RecordOptions, quality: Quality | None = None
+        self,
+        sim: Simulation,
+        options: RecordOptions,
+        quality: Quality | None = None,
+        planned: Sequence[Fraction] | None = None,
     ) -> None:
         self.sim = sim
         self.options = options
         self.period = Fraction(options.speedup) / options.fps  # simulated seconds per frame
         self.total = math.ceil(sim.duration / self.period)
         self.index = 0
-        self.scene = Scene(sim, quality)
+        self.scene = Scene(sim, quality, planned)  # the HUD counts the file's phases
         self.camera = Camera(options.size)
         self.renderer = Renderer(options.size)
         self.surfaces = [new_surface(options.size) for _ in range(2)]
@@ -103,12 +108,16 @@ class Snapshot:
     """
 
     def __init__(
-        self, sim: Simulation, options: SnapshotOptions, quality: Quality | None = None
+        self,
+        sim: Simulation,
+        options: SnapshotOptions,
+        quality: Quality | None = None,
+        planned: Sequence[Fraction] | None = None,
     ) -> None:
         self.sim = sim
         self.options = options
         self.at = min(options.at if options.at is not None else sim.duration, sim.duration)
-        self.scene = Scene(sim, quality)
+        self.scene = Scene(sim, quality, planned)  # the HUD counts the file's phases
         self.written: Path | None = None
 
     def next_time(self) -> Fraction | None:

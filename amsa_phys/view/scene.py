@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from fractions import Fraction
 from typing import Any
 
 from ..engine.runner import Simulation
@@ -39,6 +41,8 @@ class RoverPose:
     power_l: float
     power_r: float
     speed: float
+    #: colour index: the rover's rank among the world's rovers (-1: its rank in the frame)
+    index: int = -1
 
 
 @dataclass(frozen=True)
@@ -111,30 +115,46 @@ class Frame:
     zones: list[ZoneView] = field(default_factory=list)
     #: draw a "true distance" line between consecutive rovers (see Scene.pair_lines)
     pair_lines: bool = True
+    #: where collisions happened so far (world metres; the replay knows them from its events)
+    collisions: list[tuple[float, float]] = field(default_factory=list)
 
 
-def describe_phase(sim: Simulation) -> str:
-    """``phase 2/4 from 125 s: Kv=0.15`` — what the HUD prints about the current phase.
+def describe_phase(sim: Simulation, planned: Sequence[Fraction] | None = None) -> str:
+    """``phase 2 (of 0–3) from 125 s: Kv=0.15`` — what the HUD prints about the current phase.
 
-    A live change made in this phase (the window's panel) is in force now and the phase's
-    own value no longer is: it replaces that value in the line and says when it landed
-    (``Kv=0.35 live at 130.2 s``), so the HUD never shows a value the run is not using.
+    A parameter set twice at a phase's start (the scenario's ``set:`` and a ``--set``
+    override) is listed once, with the value in force. A live change made in this phase
+    (the window's panel) is in force now and the phase's own value no longer is: it
+    replaces that value in the line and says when it landed (``Kv=0.35 live at 130.2 s``),
+    so the HUD never shows a value the run is not using. ``planned``: the file's phase
+    starts and duration when ``--duration`` shortened the run (``Scenario.planned_bounds``):
+    the count is then the file's, and the line says where this run stops.
     """
     phase = sim.phases[sim.phase_index]
     live: dict[tuple[str, str], tuple[Any, Any]] = {}
     for at, c in sim.live_changes:
         if at >= phase.at:
             live[(c.leaf, c.param)] = (at, c.value)
-    parts = [f"{c.param}={_short(c.value)}" for c in phase.changes if (c.leaf, c.param) not in live]
+    latest: dict[tuple[str, str], Any] = {}
+    for c in phase.changes:  # the last assignment of a key wins, in its first place
+        latest[(c.leaf, c.param)] = c.value
+    parts = [f"{p}={_short(v)}" for (leaf, p), v in latest.items() if (leaf, p) not in live]
     parts += [f"{p}={_short(v)} live at {float(at):.1f} s" for (_, p), (at, v) in live.items()]
-    sets = ", ".join(parts)
-    label = f" {phase.label}" if phase.label else ""
-    # numbered from 0 like the summary table, describe and expect: {phase: i}
-    last = len(sim.phases) - 1
-    of = f" (of 0–{last})" if last else ""
-    text = f"phase {sim.phase_index}{of}{label} from {float(phase.at):g} s"
-    text = f"{text}: {sets}" if sets else text
+    count = len(planned) - 1 if planned else len(sim.phases)
+    text = phase_line(sim.phase_index, count, phase.label, float(phase.at), parts)
+    if planned and sim.duration < planned[-1]:
+        text += f" (run stops at {float(sim.duration):g} s of {float(planned[-1]):g})"
     return text + adapt_text(sim)
+
+
+def phase_line(index: int, count: int, label: str, start_s: float, sets: Sequence[str]) -> str:
+    """The HUD's phase line from its parts (the live window and the replay word it alike)."""
+    # numbered from 0 like the summary table, describe and expect: {phase: i}
+    of = f" (of 0–{count - 1})" if count > 1 else ""
+    named = f" {label}" if label else ""
+    text = f"phase {index}{of}{named} from {start_s:g} s"
+    joined = ", ".join(sets)
+    return f"{text}: {joined}" if joined else text
 
 
 def adapt_text(sim: Simulation) -> str:
@@ -170,9 +190,16 @@ class Scene:
     still while the run is paused and end equal to its overall block.
     """
 
-    def __init__(self, sim: Simulation, quality: Quality | None = None) -> None:
+    def __init__(
+        self,
+        sim: Simulation,
+        quality: Quality | None = None,
+        planned: Sequence[Fraction] | None = None,
+    ) -> None:
         self.sim = sim
         self.quality = quality
+        #: the file's phase bounds when ``--duration`` shortened the run (the HUD counts them)
+        self.planned = planned
         self.obstacles = static_obstacles(sim.world.physics)
         self.trails: dict[str, deque[tuple[float, float]]] = {}
         self.gps: list[GpsTrack] = []
@@ -183,6 +210,9 @@ class Scene:
         self.lidars = [p for p, leaf in sim.world.leaves.items() if leaf.template.name() == "Lidar"]
         self.metrics = LiveMetrics()
         self._last_fix: dict[str, tuple[float, float]] = {}
+        #: where collisions happened (the midpoint of the rovers named), as the plots mark them
+        self.collisions: deque[tuple[float, float]] = deque(maxlen=LOST_POINTS)
+        self._events_seen = 0
         # rovers in declaration order: the i-th has the i-th colour, as in the plots
         self._rank = {name: i for i, name in enumerate(rover_names(list(sim.world.buffers)))}
         self.pair_lines = self._between_rovers()
@@ -239,6 +269,7 @@ class Scene:
                     r.power_l,
                     r.power_r,
                     r.forward_speed,
+                    index=self._rank.get(r.name, -1),
                 )
             )
         out.sort(key=lambda r: self._rank.get(r.name, len(self._rank)))
@@ -257,6 +288,13 @@ class Scene:
             if not trail or math.dist(trail[-1], (x, y)) >= TRAIL_STEP_M:
                 trail.append((x, y))
         sim = self.sim
+        for event in sim.events[self._events_seen :]:
+            if event.kind == "collision":
+                named = [where[n] for n in str(event.detail).split("-") if n in where]
+                if named:
+                    xs, ys = zip(*named, strict=True)
+                    self.collisions.append((sum(xs) / len(xs), sum(ys) / len(ys)))
+        self._events_seen = len(sim.events)
         for track in self.gps:
             fix = (values[f"{track.path}.gpsPosX"], values[f"{track.path}.gpsPosY"])
             if self._last_fix.get(track.path) != fix:
@@ -301,11 +339,12 @@ class Scene:
             quality=self.quality,
             phase_index=sim.phase_index,
             phase_count=len(sim.phases),
-            phase_text=describe_phase(sim),
+            phase_text=describe_phase(sim, self.planned),
             duration=float(sim.duration),
             scans=self.scans(),
             zones=self.zones(),
             pair_lines=self.pair_lines,
+            collisions=list(self.collisions),
         )
 
     def scans(self) -> list[LidarScan]:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Sequence
 from fractions import Fraction
 
 from ..engine import interrupt
@@ -24,6 +25,7 @@ from .draw import INK, LOST, MUTED, Renderer
 from .drive import advance
 from .panel import ParamPanel
 from .pg import pygame
+from .plotpane import LiveSeries, SignalPicker, draw_side_panes, picker_key
 from .recorder import Recorder
 from .scene import Scene
 
@@ -42,6 +44,8 @@ HELP = [  # every key _key and _panel_key handle
     "  up down     row; pgup pgdn: component",
     "  left right  step the value (shift: fine)",
     "  0-9 . - e   type a value; enter applies, esc drops",
+    "g             plot signals (list: type to filter,",
+    "              enter picks / drops, g closes)",
     "h or F1       this help",
     "q or esc      quit (the outputs are written;",
     "              esc first closes the panel)",
@@ -91,6 +95,7 @@ class Window:
         size: tuple[int, int] = (1280, 720),
         recorder: Recorder | None = None,
         paused: bool = False,
+        planned: Sequence[Fraction] | None = None,
     ) -> None:
         pygame.display.init()
         pygame.font.init()
@@ -99,7 +104,10 @@ class Window:
         self.sim = sim
         self.recorder = recorder
         self.sinks = [recorder] if recorder is not None else []
-        self.scene = Scene(sim, quality)
+        self.scene = Scene(sim, quality, planned)
+        self.picker = SignalPicker(sim.columns)
+        self.series = LiveSeries(self.picker)
+        sim.add_log_listener(self.series)
         self.camera = Camera(size)
         self.renderer = Renderer(size)
         self.panel = ParamPanel(sim)
@@ -191,6 +199,8 @@ class Window:
         panel = self.panel
         if panel.visible and self._panel_key(key, event.unicode, shift):
             return
+        if self.picker.visible and picker_key(self.picker, key, event.unicode):
+            return
         quit_asked, self._quit_asked = self._quit_asked, False
         if key in (pygame.K_q, pygame.K_ESCAPE):
             self.quit(confirmed=quit_asked)
@@ -214,6 +224,9 @@ class Window:
             self.camera.pan(dx, dy)
         elif key in (pygame.K_p, pygame.K_TAB):
             panel.visible = True
+        elif key == pygame.K_g:
+            panel.visible = False
+            self.picker.visible = True
         elif key in (pygame.K_h, pygame.K_F1):
             self.show_help = not self.show_help
 
@@ -268,6 +281,7 @@ class Window:
         """Commit the panel's pending value as a live change at the next instant."""
         if self.finished:
             self.panel.message = "the run has ended; nothing more to change"
+            self.panel.refused = True
             self.panel.cancel()
             return
         change = self.panel.commit()
@@ -318,10 +332,19 @@ class Window:
             colours = [MUTED] + [INK] * (len(lines) - 1)
             if self.panel.message:
                 lines.append(self.panel.message)
-                colours.append(LOST if "fixed" in self.panel.message else MUTED)
+                # a refusal in the alert red, a confirmation in ink: never a faint grey
+                colours.append(LOST if self.panel.refused else INK)
             at = (10, fitting(len(lines)))
-            self.renderer.panel(self.screen, lines, colours, at, align_right=False)
+            box = self.renderer.panel(self.screen, lines, colours, at, align_right=False)
+            # the next frames frame the rovers beside the panel, not under it
+            self.camera.left = box.right
+        else:
+            self.camera.left = 0
         if self.show_help:
             at = (10, fitting(len(HELP)))
             self.renderer.panel(self.screen, HELP, [INK] * len(HELP), at, align_right=True)
+        area = self.screen.get_rect()
+        draw_side_panes(
+            self.screen, self.renderer, self.picker, self.series.series, False, [], area
+        )
         pygame.display.flip()

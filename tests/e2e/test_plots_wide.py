@@ -116,8 +116,9 @@ def test_rovers_past_the_palette_end_still_look_different() -> None:
     looks = {(s.colour, s.linestyle) for s in styles.values()}
     assert len(looks) == 30
     assert styles["Car1.Robot"].linestyle == "-"
-    assert styles["Car10.Robot"].colour == styles["Car1.Robot"].colour  # the palette again,
-    assert styles["Car10.Robot"].linestyle != "-"  # dashed
+    assert styles["Car10.Robot"].colour != styles["Car1.Robot"].colour  # 20 colours first
+    assert styles["Car21.Robot"].colour == styles["Car1.Robot"].colour  # the palette again,
+    assert styles["Car21.Robot"].linestyle != "-"  # dashed
 
 
 def test_the_obstacle_course_goal_is_drawn(tmp_path: Path, monkeypatch: pytest.MonkeyPatch):

@@ -158,7 +158,7 @@ def test_trajectory_draws_the_arena_the_collision_and_the_window_colours(
         colours = {ln.get_label(): to_hex(ln.get_color()) for ln in ax.lines}
         assert colours["Leader (true)"] == ORANGE
         assert colours["Follower (true)"] == BLUE
-        (cross,) = [ln for ln in ax.lines if ln.get_marker() == "x" and len(ln.get_xdata())]
+        (cross,) = [ln for ln in ax.lines if ln.get_marker() == "D" and len(ln.get_xdata())]
         x, y = cross.get_xdata()[0], cross.get_ydata()[0]
         assert 47 < x < 50  # the leader's nose at the box
         assert abs(y) < 0.5
@@ -237,3 +237,26 @@ def test_without_a_quality_signal_no_blank_distance_plot(
     printed = capsys.readouterr().out
     assert f"wrote {out / 'trajectory.png'}\n" in printed
     assert "no distance.png: the scenario has no quality: section" in printed
+
+
+def test_the_window_and_the_replay_mark_the_collision_where_the_plot_does(
+    arena_run: Path,
+) -> None:
+    """The leader drives into the box at x = 50: the live scene (window, video), the replay
+    and trajectory.png all put one collision mark at its nose there."""
+    from amsa_phys.cli.view import load_run
+    from amsa_phys.engine.runner import Simulation
+
+    scenario = load_scenario(arena_run.parent / "arena.yaml")
+    sim = Simulation.from_scenario(scenario)
+    sim.initialize()
+    scene = Scene(sim, scenario.quality)
+    sim.advance(sim.grid.ticks(sim.duration))
+    (live,) = scene.frame().collisions
+    assert 47 < live[0] < 50
+    assert abs(live[1]) < 0.5
+    replay = load_run(arena_run)
+    (hit,) = replay.frame(replay.rows - 1).collisions
+    assert abs(hit[0] - live[0]) < 0.2
+    assert abs(hit[1] - live[1]) < 0.2
+    assert replay.frame(0).collisions == []  # not before it happened

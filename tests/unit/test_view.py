@@ -171,5 +171,5 @@ def test_obstacle_geometry_matches_the_settings() -> None:
 def test_drawing_helpers() -> None:
     assert [nice_step(x) for x in (0.3, 1.0, 1.2, 3.0, 7.0)] == [0.5, 1.0, 2.0, 5.0, 10.0]
     assert error_colour(0.5, 1.0) == error_colour(-1.0, 1.0)  # inside the band: same green
-    assert error_colour(5.0, 1.0) == (214, 39, 40)
-    assert error_colour(1.1, 1.0) == error_colour(2.0, 1.0) == (240, 170, 30)  # amber, not olive
+    assert error_colour(5.0, 1.0) == error_colour(2.5, 1.0) == (214, 39, 40)  # never orange
+    assert error_colour(1.1, 1.0) == error_colour(2.0, 1.0) == (250, 200, 40)  # amber, not olive

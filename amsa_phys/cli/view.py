@@ -1,0 +1,87 @@
+"""Open the window on a finished run: play, pause, scrub, jump to events."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from ..errors import ConfigError, one_line
+from ..model.scenario import load_scenario
+from .plot import read_metrics
+
+RUN_FILES = ("trace.csv", "metrics.json", "scenario.yaml")
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``amsa-phys view``."""
+    p.add_argument(
+        "rundir",
+        help="a run directory (`amsa-phys run --out`, or a sweep's kept run: SWEEP/runs/NAME)",
+    )
+    p.add_argument(
+        "--size",
+        default="1280x720",
+        help="window size in pixels, WIDTHxHEIGHT (default 1280x720)",
+    )
+
+
+def load_run(rundir: Path) -> Any:
+    """The run in ``rundir`` as a :class:`~amsa_phys.view.replay.ReplayScene`.
+
+    Refuses, with one line naming the file, anything that is not a whole run: a missing
+    directory, a sweep's directory (it names its kept runs), a missing file, a truncated
+    trace, metrics that are not a run's, a trace without a row.
+    """
+    from ..plots.distance import read_trace
+    from ..view.replay import ReplayScene
+
+    if not rundir.is_dir():
+        raise ConfigError(
+            "no such directory" if not rundir.exists() else "not a directory", file=rundir
+        )
+    if (rundir / "results.csv").is_file() and not (rundir / "trace.csv").exists():
+        kept = sorted(p.name for p in (rundir / "runs").glob("*") if (p / "trace.csv").is_file())
+        hint = (
+            f" (kept runs: {rundir / 'runs' / kept[0]} ...)"
+            if kept
+            else (" (it kept no run: sweep again with --keep-runs)")
+        )
+        raise ConfigError(f"a sweep directory: view one of its kept runs{hint}", file=rundir)
+    for name in RUN_FILES:
+        if not (rundir / name).is_file():
+            raise ConfigError(f"not a run directory: {name} is missing", file=rundir)
+    metrics = read_metrics(rundir / "metrics.json")
+    columns, data = read_trace(rundir / "trace.csv")
+    if len(data) == 0:
+        raise ConfigError("the trace has no row: nothing to replay", file=rundir / "trace.csv")
+    scenario = load_scenario(rundir / "scenario.yaml")
+    return ReplayScene(columns, data, metrics, scenario.world)
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise ConfigError(f"expected WIDTHxHEIGHT, got {text!r}", key="--size") from None
+    if w < 320 or h < 240:
+        raise ConfigError(f"at least 320x240, got {text!r}", key="--size")
+    return w, h
+
+
+def run(args: argparse.Namespace) -> int:
+    """Replay the run until the window is closed."""
+    size = _size(args.size)
+    scene = load_run(Path(args.rundir))
+    from ..view.player import Player
+    from ..view.window import open_display
+
+    try:
+        open_display()
+    except RuntimeError as exc:
+        raise ConfigError(
+            f"{exc}; `amsa-phys plot` draws the run's pictures without one", key="view"
+        ) from None
+    name = one_line(str(scene.metrics.get("scenario") or Path(args.rundir).name))
+    Player(scene, title=name, size=size).run()
+    return 0

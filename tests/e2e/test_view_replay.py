@@ -1,0 +1,403 @@
+"""``amsa-phys view RUNDIR``: a finished run replayed, driven headless (SDL dummy driver,
+injected keys and mouse, an exact clock), and checked against the run's own trace."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import TypeVar
+
+import numpy as np
+import pytest
+
+from amsa_phys.cli.main import main
+from amsa_phys.cli.view import load_run
+from amsa_phys.model.scenario import load_scenario
+from amsa_phys.palette import ROVER_COLOURS, rover_colour
+from amsa_phys.plots.distance import read_trace
+from amsa_phys.runs.single import run_scenario
+from amsa_phys.view.draw import INK
+from amsa_phys.view.pg import pygame
+from amsa_phys.view.player import BIG_STEP_S, SLIDER_H, Player
+from amsa_phys.view.scene import Scene
+
+T = TypeVar("T")
+ROOT = Path(__file__).resolve().parent.parent.parent
+SCENARIO = ROOT / "tests" / "fixtures" / "mde_short.yaml"
+LOSSY = ["--set", "LeaderGPS.lostDataGPS=30", "--duration", "40"]
+
+
+def press(key: int, mod: int = 0, text: str = "") -> None:
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=key, mod=mod, unicode=text))
+
+
+def click(pos: tuple[int, int]) -> None:
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, button=1, pos=pos))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONUP, button=1, pos=pos))
+
+
+@pytest.fixture(scope="module")
+def rundir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("view") / "run"
+    assert main(["run", str(SCENARIO), "--headless", *LOSSY, "--out", str(out)]) == 0
+    return out
+
+
+@pytest.fixture
+def player(rundir: Path) -> Player:
+    p = Player(load_run(rundir), title="test", size=(800, 480))
+    p.frame(0.0)
+    return p
+
+
+def trace_row(rundir: Path, t: float) -> dict[str, float]:
+    header, data = read_trace(rundir / "trace.csv")
+    i = int(np.flatnonzero(np.isclose(data[:, 0], t))[0])
+    return dict(zip(header, data[i].tolist(), strict=True))
+
+
+def test_keys_scrub_to_an_event_and_the_picture_is_the_trace_there(
+    player: Player, rundir: Path
+) -> None:
+    events = player.scene.events
+    first = events[0]
+    assert first.kind == "lost fix"  # 30 % of the leader's fixes are lost
+    press(pygame.K_n)
+    player.frame(0.0)
+    assert player.t == pytest.approx(first.t)
+    assert player.notice.startswith(f"{first.t:.2f} s: lost fix LeaderGPS")
+    press(pygame.K_n)
+    player.frame(0.0)
+    assert player.t == pytest.approx(events[1].t)
+    press(pygame.K_b)
+    player.frame(0.0)
+    assert player.t == pytest.approx(first.t)
+    # the drawn rovers stand where the trace says, and are drawn there in their colour
+    row = trace_row(rundir, player.t)
+    frame = player.scene.frame(player.row)
+    for r in frame.rovers:
+        assert (r.x, r.y, r.heading) == (
+            row[f"{r.name}.posX"],
+            row[f"{r.name}.posY"],
+            row[f"{r.name}.heading"],
+        )
+        px, py = player.camera.to_screen(r.x, r.y)
+        assert tuple(player.screen.get_at((round(px), round(py))))[:3] == rover_colour(r.index)
+    # shift+right: 5 s on; right: one logged instant; home and end
+    t0 = player.t
+    press(pygame.K_RIGHT, pygame.KMOD_SHIFT)
+    player.frame(0.0)
+    assert player.t == pytest.approx(t0 + BIG_STEP_S)
+    press(pygame.K_RIGHT)
+    player.frame(0.0)
+    assert player.t == pytest.approx(t0 + BIG_STEP_S + 0.05)  # the 20 Hz log
+    press(pygame.K_END)
+    player.frame(0.0)
+    assert player.t == pytest.approx(40.0)
+    press(pygame.K_HOME)
+    player.frame(0.0)
+    assert player.t == 0.0
+
+
+def test_play_runs_at_the_chosen_speed_and_the_slider_seeks(player: Player) -> None:
+    press(pygame.K_SPACE)
+    press(pygame.K_RIGHTBRACKET)  # x2
+    for _ in range(10):
+        player.frame(0.1)  # one wall-clock second
+    assert player.t == pytest.approx(2.0)
+    bar = player.slider
+    click((bar.x + bar.width // 2, bar.centery))
+    player.frame(0.1)
+    assert not player.playing  # a seek pauses
+    assert player.t == pytest.approx(20.0, abs=0.1)
+
+
+def test_phase_keys_jump_to_phase_starts(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    assert main(["run", str(SCENARIO), "--headless", "--duration", "130", "--out", str(out)]) == 0
+    p = Player(load_run(out), title="test", size=(640, 360))
+    press(pygame.K_PAGEDOWN)
+    p.frame(0.0)
+    assert p.t == 125.0
+    assert p.scene.frame(p.row).phase_text.startswith("phase 1 (of 0–1) from 125 s: Kv=0.15")
+    press(pygame.K_PAGEUP)
+    p.frame(0.0)
+    assert "no earlier event" in p.notice
+
+
+def test_plot_pane_draws_a_picked_signal(player: Player) -> None:
+    press(pygame.K_g)
+    for ch in "distance":
+        press(0, text=ch)
+    press(pygame.K_RETURN)
+    press(pygame.K_g)
+    player.frame(0.0)
+    assert player.picker.picked == ["MyDistanceMonitor.distanceFollowerToLeader"]
+    assert not player.picker.visible
+    press(pygame.K_END)
+    player.frame(0.0)
+    t, v = player.scene_series("MyDistanceMonitor.distanceFollowerToLeader", 30.0)
+    assert t[0] == pytest.approx(10.0)
+    assert t[-1] == pytest.approx(40.0)
+    assert v[-1] == player.scene.frame(player.row).metrics.value
+
+
+def test_lost_fixes_found_in_the_trace_are_the_live_runs(tmp_path: Path) -> None:
+    """The replay and trajectory.png find lost fixes from the stale fix in the trace; the
+    live window counts them in the running GPS. Both must agree, one by one."""
+    scenario = load_scenario(SCENARIO, ["LeaderGPS.lostDataGPS=30"], duration=40)
+    live: dict[str, int] = {}
+
+    def drive(sim, scenario, recorder):  # type: ignore[no-untyped-def]
+        scene = Scene(sim, scenario.quality)
+        sim.advance(sim.grid.ticks(sim.duration))
+        live.update({g.path: g.lost_total for g in scene.gps})
+
+    out = tmp_path / "run"
+    out.mkdir()
+    run_scenario(scenario, out, window=drive, plot=False)
+    replay = load_run(out)
+    end = replay.frame(replay.rows - 1)
+    assert live["LeaderGPS"] > 20
+    assert {g.path: g.lost_total for g in end.gps} == live
+    lost = [e for e in replay.events if e.kind == "lost fix"]
+    assert len(lost) == live["LeaderGPS"]
+
+
+def _bad(kind: str, run: Path, d: Path) -> Path:
+    """A directory ``view`` must refuse: missing, not a run, a truncated trace, a sweep's."""
+    if kind == "missing":
+        return d / "nothing"
+    out = d / kind
+    if kind == "not-a-run":
+        out.mkdir()
+    elif kind == "truncated-trace":
+        shutil.copytree(run, out)
+        text = (out / "trace.csv").read_bytes()
+        (out / "trace.csv").write_bytes(text[: len(text) // 2])  # a row cut short
+    else:
+        out.mkdir()
+        (out / "results.csv").write_text("seed\n1\n")
+    return out
+
+
+@pytest.mark.parametrize(
+    ("kind", "message"),
+    [
+        ("missing", "nothing: no such directory"),
+        ("not-a-run", "not-a-run: not a run directory: trace.csv is missing"),
+        ("truncated-trace", "trace.csv:"),
+        ("sweep", "sweep: a sweep directory: view one of its kept runs"),
+    ],
+    ids=["missing", "not-a-run", "truncated-trace", "sweep"],
+)
+def test_bad_rundir_is_one_line_and_exit_2(
+    rundir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], kind: str, message: str
+) -> None:
+    assert main(["view", str(_bad(kind, rundir, tmp_path))]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "Traceback" not in err
+    assert message in err
+
+
+def test_a_closed_run_says_where_it_was_cut(rundir: Path) -> None:
+    scene = load_run(rundir)
+    scene.metrics["status"] = "closed in the window at t=12.5 s"
+    p = Player(scene, title="test", size=(640, 360))
+    assert "run closed in the window at t=12.5 s" in p.status()
+
+
+def test_colours_follow_the_world_not_the_trace_columns(tmp_path: Path) -> None:
+    """A trace that keeps only the follower still draws it in the follower's blue."""
+    out = tmp_path / "run"
+    keep = "Follower.*,MyDistanceMonitor.*"
+    argv = ["run", str(SCENARIO), "--headless", "--duration", "5", "--out", str(out)]
+    assert main([*argv, "--trace-columns", keep]) == 0
+    scene = load_run(out)
+    assert [r.name for r in scene.rovers(0)] == ["Follower"]
+    assert scene.rovers(0)[0].index == 1
+    p = Player(scene, title="test", size=(640, 360))
+    p.frame(0.0)
+    r = scene.frame(p.row).rovers[0]
+    px, py = p.camera.to_screen(r.x, r.y)
+    assert tuple(p.screen.get_at((round(px), round(py))))[:3] == ROVER_COLOURS[1]
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["status"] == "completed"
+
+
+# -- a real window: Xvfb, xdotool and ImageMagick's import ------------------------------------
+X_TOOLS = ("Xvfb", "xdotool", "import")
+X_TIMEOUT_S = 60.0  # a deadline for a failure, never a measured time: every wait polls
+
+
+def _poll(what: str, check: Callable[[], T | None]) -> T:
+    """``check()`` until it gives a value (the event waited for), or fail at the deadline."""
+    deadline = time.monotonic() + X_TIMEOUT_S
+    while time.monotonic() < deadline:
+        found = check()
+        if found is not None:
+            return found
+        time.sleep(0.1)
+    raise AssertionError(f"waited {X_TIMEOUT_S:g} s for {what}")
+
+
+@pytest.fixture
+def xdisplay() -> Iterator[str]:
+    if missing := [tool for tool in X_TOOLS if shutil.which(tool) is None]:
+        pytest.skip(f"no {', '.join(missing)} (apt-get install xvfb xdotool imagemagick)")
+    read, write = os.pipe()
+    server = subprocess.Popen(
+        ["Xvfb", "-displayfd", str(write), "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
+        pass_fds=(write,),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    os.close(write)
+    try:
+        with os.fdopen(read) as fh:
+            number = fh.readline().strip()  # Xvfb writes it once it accepts connections
+        assert number.isdigit(), "Xvfb did not start"
+        yield f":{number}"
+    finally:
+        server.terminate()
+        server.wait(timeout=30)
+
+
+def _x(display: str, *argv: str) -> str:
+    env = {**os.environ, "DISPLAY": display}
+    done = subprocess.run(argv, env=env, capture_output=True, text=True, check=False)
+    return done.stdout.strip()
+
+
+def test_view_in_a_real_x_window_scrubs_to_an_event_and_draws_the_traced_pose(
+    rundir: Path, xdisplay: str, tmp_path: Path
+) -> None:
+    """``amsa-phys view`` on Xvfb, keys pressed by xdotool, the window grabbed by import:
+    End then b (the last event before the end), and each rover's pixel is its colour where
+    the trace puts it then (and not where it stood at t = 0)."""
+    size = (800, 480)
+    env = {k: v for k, v in os.environ.items() if k != "SDL_VIDEODRIVER"}
+    env["DISPLAY"] = xdisplay
+    # the console script, as a user runs it: X names the window's class after it
+    script = Path(sys.executable).with_name("amsa-phys")
+    if not script.is_file():
+        pytest.skip("the amsa-phys console script is not installed next to this Python")
+    argv = [str(script), "view", str(rundir), "--size", "800x480"]
+    viewer = subprocess.Popen(argv, env=env, stderr=subprocess.PIPE, text=True)
+    try:
+        window = _poll(
+            "the window", lambda: _x(xdisplay, "xdotool", "search", "--class", "amsa-phys") or None
+        ).splitlines()[0]
+        _x(xdisplay, "xdotool", "windowfocus", "--sync", window)
+        _x(xdisplay, "xdotool", "key", "--window", window, "End", "b")
+        scene = load_run(rundir)
+        target = [e for e in scene.events if e.t < scene.t[-1]][-1]
+        expected = _drawn_at(scene, scene.row_at(target.t), size)
+        # the slider's cursor (ink) stands at the event's time, no longer at the start
+        span = float(scene.t[-1] - scene.t[0])
+        bar_y = size[1] - SLIDER_H + 10 + (SLIDER_H - 20) // 2
+        cursor = (round(12 + (target.t - float(scene.t[0])) / span * (size[0] - 24)), bar_y)
+        shot = tmp_path / "shot.png"
+
+        def matches() -> bool | None:
+            _x(xdisplay, "import", "-window", window, str(shot))
+            if not shot.is_file():
+                return None
+            image = pygame.image.load(str(shot))
+            ok = all(tuple(image.get_at(px))[:3] == colour for px, colour in expected)
+            return True if ok and tuple(image.get_at(cursor))[:3] == INK else None
+
+        _poll(f"the rovers and the slider at t = {target.t:g} s in the real window", matches)
+        image = pygame.image.load(str(shot))
+        assert tuple(image.get_at((12, bar_y)))[:3] != INK  # the cursor left the start
+    finally:
+        viewer.terminate()
+        viewer.wait(timeout=30)
+
+
+def _drawn_at(
+    scene: object, row: int, size: tuple[int, int]
+) -> list[tuple[tuple[int, int], tuple[int, int, int]]]:
+    """Where the paused player draws each rover's centre at ``row``, and in which colour:
+    the camera in fit mode settles at once while paused."""
+    from amsa_phys.view.camera import Camera
+
+    frame = scene.frame(row)  # type: ignore[attr-defined]
+    camera = Camera((size[0], size[1] - SLIDER_H))
+    points = [(r.x, r.y, r.name) for r in frame.rovers]
+    camera.update(points, 1e9)
+    camera.update(points, 1e9)
+    out = []
+    for r in frame.rovers:
+        x, y = camera.to_screen(r.x, r.y)
+        out.append(((round(x), round(y)), rover_colour(r.index)))
+    return out
+
+
+def test_lost_fixes_are_found_whatever_the_gps_timer_phase(tmp_path: Path) -> None:
+    """A GPS whose timer is shifted (``phase: 0.1``: samples at 0.1, 0.35, ... s) loses the
+    same samples in the trace as in the running component: the losses are counted from the
+    fixes themselves, not from a grid of multiples of the period."""
+    world = (ROOT / "worlds" / "mde_challenge.yaml").read_text()
+    shifted = world.replace(
+        "    template: GPS\n    freq: 4\n", "    template: GPS\n    freq: 4\n    phase: 0.1\n", 1
+    )
+    assert shifted != world
+    (tmp_path / "w.yaml").write_text(shifted)
+    text = SCENARIO.read_text().replace("../../worlds/mde_challenge.yaml", str(tmp_path / "w.yaml"))
+    (tmp_path / "s.yaml").write_text(text)
+    scenario = load_scenario(tmp_path / "s.yaml", ["LeaderGPS.lostDataGPS=30"], duration=30)
+    live: dict[str, int] = {}
+
+    def drive(sim, scenario, recorder):  # type: ignore[no-untyped-def]
+        scene = Scene(sim, scenario.quality)
+        sim.advance(sim.grid.ticks(sim.duration))
+        live.update({g.path: g.lost_total for g in scene.gps})
+
+    out = tmp_path / "run"
+    out.mkdir()
+    run_scenario(scenario, out, window=drive, plot=False)
+    replay = load_run(out)
+    assert live["LeaderGPS"] > 10
+    assert {g.path: g.lost_total for g in replay.frame(replay.rows - 1).gps} == live
+
+
+def test_replayed_ground_changes_when_the_live_one_did(tmp_path: Path) -> None:
+    """A mud zone whose friction the timeline changes at 5 s: the replay draws the zone with
+    the values the live window showed before and after."""
+    world = (ROOT / "worlds" / "mde_challenge.yaml").read_text()
+    mud = (
+        "components:\n  Mud:\n    template: frictionZone\n"
+        "    params: {friction: 0.45, rollingResistance: 0.05,"
+        " polygon: [[20, -5], [25, -5], [25, 5], [20, 5]]}\n"
+    )
+    (tmp_path / "w.yaml").write_text(world.replace("components:\n", mud, 1))
+    (tmp_path / "s.yaml").write_text(
+        f"world: {tmp_path / 'w.yaml'}\nduration: 8\nseed: 1\n"
+        "timeline:\n  - {at: 5, set: {Mud.friction: 0.1}}\n"
+    )
+    scenario = load_scenario(tmp_path / "s.yaml")
+    live: dict[float, list[tuple[str, float, float]]] = {}
+
+    def drive(sim, scenario, recorder):  # type: ignore[no-untyped-def]
+        scene = Scene(sim, scenario.quality)
+        for t in (3, 8):
+            sim.advance(sim.grid.ticks(sim.duration * t // 8))
+            live[t] = [(z.name, z.friction, z.rolling_resistance) for z in scene.zones()]
+
+    out = tmp_path / "run"
+    out.mkdir()
+    run_scenario(scenario, out, window=drive, plot=False)
+    replay = load_run(out)
+    for t, zones in live.items():
+        shown = replay.frame(replay.row_at(t)).zones
+        assert [(z.name, z.friction, z.rolling_resistance) for z in shown] == zones
+    assert live[3] != live[8]  # the change happened
+    assert replay.frame(0).zones[0].polygon == ((20, -5), (25, -5), (25, 5), (20, 5))
