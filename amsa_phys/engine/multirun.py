@@ -153,15 +153,10 @@ def merged_phases(scenarios: Sequence[Scenario]) -> list[Phase]:
     later: dict[Fraction, list[Change]] = {}
     for i, sc in enumerate(scenarios):
         pre = prefix_of(i) + "."
-        first += [_renamed(c, pre) for c in sc.phases[0].changes]
-        points: list[tuple[Fraction, list[Change]]] = []
-        for k, phase in enumerate(sc.phases):
-            if k > 0:
-                points.append((phase.at, phase.changes))
-            points += [(step.at, step.changes) for step in phase.within]
-        points.sort(key=lambda p: p[0])  # stable, as Simulation._change_points
-        for at, changes in points:
-            later.setdefault(at, []).extend(_renamed(c, pre) for c in changes)
+        timeline = sc.timeline
+        first += [_renamed(c, pre) for c in timeline.initial]
+        for point in timeline.points():
+            later.setdefault(point.at, []).extend(_renamed(c, pre) for c in point.changes)
     steps = [Step(at, changes) for at, changes in sorted(later.items())]
     return [Phase(Fraction(0), first, within=steps)]
 

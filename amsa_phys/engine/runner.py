@@ -33,6 +33,7 @@ from ..errors import RunFault
 from ..model.params import short_repr
 from ..model.scenario import Change, Phase, Scenario, traced_columns
 from ..model.template import Template
+from ..model.timeline import Timeline
 from ..model.world import WorldSpec
 from . import batch, interrupt
 from .clock import MAX_EVENTS_PER_CYCLE, TickGrid, hyperperiod
@@ -174,7 +175,9 @@ class Simulation:
         self.world = world
         self.seed = seed
         self.duration = Fraction(duration)
-        self.phases = list(phases) or [Phase(Fraction(0), [])]
+        #: the run's timeline (``model/timeline.py``): the only reader of the phases here
+        self.timeline = Timeline.of(phases, self.duration)
+        self.phases = list(self.timeline.phases)
         self.log_rate = Fraction(log_rate)
         self.shared: dict[str, Any] = {}
         self.events: list[Event] = []
@@ -224,7 +227,7 @@ class Simulation:
     # -- construction -------------------------------------------------------------------
     def _build(self) -> None:
         params = {path: dict(leaf.params) for path, leaf in self.world.leaves.items()}
-        for change in self.phases[0].changes:  # phase 0 values are in force at initialize
+        for change in self.timeline.initial:  # phase 0 values are in force at initialize
             params[change.leaf][change.param] = change.value
         for path in self.world.order:
             leaf = self.world.leaves[path]
@@ -282,7 +285,7 @@ class Simulation:
         leaves = self.world.leaves
         periods = [1 / leaves[p].freq for p in self.world.order]
         periods += [1 / r for r, _, _ in self._hooks] + [1 / self.log_rate]
-        instants = [at for at, _, _ in self._change_points()] + [self.duration]
+        instants = [p.at for p in self.timeline.points()] + [self.duration]
         #: each Leaf's timer phase (0 unless the world gives or draws one): on the grid
         self.timer_phases = run_phases(self.world, self.seed)
         instants += [ph for ph in self.timer_phases.values() if ph]
@@ -353,7 +356,7 @@ class Simulation:
                             groups.append(item)
         self._table = _runs(instants)
         self._end = g.ticks(self.duration)
-        self._points = [(g.ticks(at), i, changes) for at, i, changes in self._change_points()]
+        self._points = [(g.ticks(p.at), p.phase, p.changes) for p in self.timeline.points()]
         self._point_index = 0
         self._next_phase_tick = self._points[0][0] if self._points else math.inf
         # one row of the trace in column order, gathered in C
@@ -462,20 +465,6 @@ class Simulation:
             # after a fault inside a run of physics-only instants ``cursor`` is still the
             # run's start; the instant that failed is ``_tick``, as on the general path
             self._cursor = max(cursor, self._tick)
-
-    def _change_points(self) -> list[tuple[Fraction, int, list[Change]]]:
-        """Every timeline change after t = 0 in time order: (at, phase it belongs to, changes).
-
-        A phase's start and the changes made inside it (``Phase.within``) are applied the
-        same way; only a phase's start moves :attr:`phase_index`.
-        """
-        points = []
-        for i, phase in enumerate(self.phases):
-            if i > 0:
-                points.append((phase.at, i, phase.changes))
-            points += [(step.at, i, step.changes) for step in phase.within]
-        points.sort(key=lambda p: p[0])
-        return points
 
     def _enter_phases(self, tick: int) -> None:
         """Apply what is due at or before ``tick``: deliveries of delayed outputs, then the

@@ -21,6 +21,7 @@ from .rates import MAX_RATE_HZ, MIN_RATE_HZ, cycle_problem
 from .schema import MAX_SEED
 from .suggest import did_you_mean
 from .template import Kind
+from .timeline import Timeline
 from .timing import TIMING_KEYS, check_phase, set_timing
 from .wording import plural
 from .world import WorldSpec, build_world, load_world, resolved_values
@@ -143,6 +144,11 @@ class Scenario:
     #: :func:`traced_columns` for what is kept
     trace_columns: list[str] | None = None
 
+    @property
+    def timeline(self) -> Timeline:
+        """The scenario's phases, duration and planned bounds as one frozen Timeline."""
+        return Timeline.of(self.phases, self.duration, self.planned_bounds)
+
 
 def traced_columns(scenario: Scenario) -> list[str]:
     """The Data buffers the scenario's trace holds, in world order (``model/tracecols``).
@@ -162,12 +168,10 @@ def shorten(scenario: Scenario, duration: Fraction) -> None:
     A shorter run remembers the file's duration, so the phase it stops in is reported as
     cut short (partial) rather than judged as if it were complete.
     """
-    if duration < scenario.duration and scenario.planned_bounds is None:
-        scenario.planned_bounds = [p.at for p in scenario.phases] + [scenario.duration]
-    scenario.duration = duration
-    scenario.phases = [p for p in scenario.phases if p.at < duration]
-    for phase in scenario.phases:
-        phase.within = [s for s in phase.within if s.at < duration]
+    cut = scenario.timeline.cut(duration)
+    scenario.duration = cut.duration
+    scenario.phases = list(cut.phases)
+    scenario.planned_bounds = None if cut.planned is None else list(cut.planned)
 
 
 def load_scenario(

@@ -67,12 +67,10 @@ def unbatchable(scenario: Scenario) -> str | None:
         if template.name() == "frictionZone":
             return f"{path} is a terrain zone (the batch's physics has one ground)"
     robots = {p for p, leaf in world.leaves.items() if leaf.template.name() in _ROBOTS}
-    for i, phase in enumerate(scenario.phases):
-        steps = [phase.changes] if i > 0 else []
-        for changes in [*steps, *(step.changes for step in phase.within)]:
-            for c in changes:
-                if c.leaf in robots:
-                    return f"the timeline changes {c.key} during the run"
+    for point in scenario.timeline.points():
+        for c in point.changes:
+            if c.leaf in robots:
+                return f"the timeline changes {c.key} during the run"
     return None
 
 

@@ -102,10 +102,7 @@ def _metrics(
 ) -> dict[str, Any]:
     completed = status == "completed"
     end = float(scenario.duration) if completed else result.t_end
-    bounds = [float(b) for b in scenario.planned_bounds or []] or [
-        *(float(p.at) for p in scenario.phases),
-        float(scenario.duration),
-    ]
+    bounds = [float(b) for b in scenario.timeline.bounds()]
     q = scenario.quality
     collisions = [e.t for e in result.events if e.kind == "collision"]
     inner = _changes_within(scenario, sim.live_changes)
@@ -193,12 +190,13 @@ def _changes_within(
 ) -> list[dict[str, Any]]:
     """Changes made inside phases (timeline ``new_phase: false`` and live), in time order."""
     out: dict[Fraction, dict[str, Any]] = {}
-    for phase in scenario.phases:
-        for step in phase.within:
-            entry = out.setdefault(step.at, {"at": float(step.at), "set": {}})
-            entry["set"].update({c.key: _jsonable(c.value) for c in step.changes})
-            if step.label:
-                entry["label"] = step.label
+    for step in scenario.timeline.points():
+        if step.starts_phase:
+            continue
+        entry = out.setdefault(step.at, {"at": float(step.at), "set": {}})
+        entry["set"].update({c.key: _jsonable(c.value) for c in step.changes})
+        if step.label:
+            entry["label"] = step.label
     for at, change in live:
         entry = out.setdefault(at, {"at": float(at), "set": {}, "label": "live"})
         entry["set"][change.key] = _jsonable(change.value)

@@ -226,13 +226,14 @@ def deterministic_points(plan: SweepPlan, scenario: Scenario) -> list[tuple[tupl
     out = []
     for combo in itertools.product(*[a.values for a in plan.axes]):
         point = tuple((a.key, v) for a, v in zip(plan.axes, combo, strict=True))
-        changes = list(scenario.phases[0].changes)
+        changes = list(scenario.timeline.initial)
         for key, value in point:
             sets = plan.contexts[value].items() if key == "context" else [(key, value)]
             changes += [resolve_change(k, v, world) for k, v in sets]
         values = {path: dict(leaf.params) for path, leaf in world.leaves.items()}
         random = False
-        for phase_changes in [changes, *(ph.changes for ph in scenario.phases[1:])]:
+        later = [p.changes for p in scenario.timeline.points()]
+        for phase_changes in [changes, *later]:
             for c in phase_changes:
                 values[c.leaf][c.param] = c.value
             if any(_leaf_is_random(world.leaves[path].template, v) for path, v in values.items()):
@@ -342,13 +343,7 @@ def timeline_overlaps(keys: list[str], scenario: Scenario, end: Fraction) -> lis
     """
     out = []
     for key in dict.fromkeys(keys):  # once per key, in order
-        times = []
-        for i, phase in enumerate(scenario.phases):
-            steps = [(phase.at, phase.changes)] if i > 0 else []
-            steps += [(step.at, step.changes) for step in phase.within]
-            times += [
-                at for at, changes in steps if at < end and any(c.key == key for c in changes)
-            ]
+        times = list(scenario.timeline.changes_of(key, before=end))
         if times:
             when = ", ".join(f"{float(t):g}" for t in sorted(times))
             first = min(times)
