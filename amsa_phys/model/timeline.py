@@ -26,12 +26,37 @@ from __future__ import annotations
 import bisect
 import dataclasses
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from fractions import Fraction
-from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:  # scenario.py imports this module; the types are only annotations here
-    from .scenario import Change, Phase
+from .changes import Change
+
+
+@dataclass
+class Step:
+    """Changes made inside a phase without starting a new one, at ``at``.
+
+    A timeline entry with ``new_phase: false`` and a change made live in the window are
+    steps: the phase structure (and so what ``expect: {phase: i}`` means) stays the one the
+    scenario's author wrote, however many changes land inside a phase.
+    """
+
+    at: Fraction
+    changes: list[Change]
+    label: str = ""
+    entry: int | None = None  # index in the file's ``timeline`` (None: made live)
+
+
+@dataclass
+class Phase:
+    """A phase of the scenario: from ``at`` (phase 0 at 0) with the changes made then."""
+
+    at: Fraction
+    changes: list[Change]
+    label: str = ""
+    #: changes inside this phase after its start (``new_phase: false``), in time order
+    within: list[Step] = field(default_factory=list)
+    entry: int | None = None  # index in the file's ``timeline`` (None: phase 0)
 
 
 @dataclass(frozen=True)

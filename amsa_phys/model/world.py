@@ -7,7 +7,7 @@ and the execution order (``dataflow.py``). A world that loads will run.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -19,7 +19,7 @@ from .links import allowed_text, link_allowed
 from .rates import cycle_problem
 from .suggest import did_you_mean
 from .template import BUILTINS, Template, TemplateNotFound, resolve_template
-from .timing import TIMING_KEYS, LeafTiming, set_timing
+from .timing import TIMING_KEYS, LeafTiming, timed
 from .yamlio import KeyPath, YamlDoc, load_yaml
 
 #: The AMSA metamodel's default frequency (``TimeableObject.freq`` in amsaCore.ecore).
@@ -39,7 +39,7 @@ PHYSICS_DEFAULTS: dict[str, Any] = {
 }
 
 
-@dataclass
+@dataclass(frozen=True)
 class LeafSpec:
     """One Leaf component: a template instance with its frequency, parameters and links."""
 
@@ -78,7 +78,7 @@ class BufferSpec:
     initial: Any
 
 
-@dataclass
+@dataclass(frozen=True)
 class WorldSpec:
     """A loaded, checked world."""
 
@@ -107,6 +107,22 @@ class WorldSpec:
     def error(self, keypath: KeyPath, message: str) -> ConfigError:
         """A ConfigError at ``keypath`` (relative to this world) in its source file."""
         return self.source.error((*self.keypath, *keypath), message)
+
+
+def with_leaf(world: WorldSpec, leaf: LeafSpec) -> WorldSpec:
+    """``world`` with its Leaf at ``leaf.path`` replaced by ``leaf`` (in ``leaves`` and in the
+    component tree): a new WorldSpec, the given one untouched (cached scenarios share it)."""
+
+    def swap(node: CompositeSpec) -> CompositeSpec:
+        children: list[LeafSpec | CompositeSpec] = []
+        for child in node.children:
+            if isinstance(child, CompositeSpec):
+                children.append(swap(child))
+            else:
+                children.append(leaf if child.path == leaf.path else child)
+        return replace(node, children=children)
+
+    return replace(world, leaves={**world.leaves, leaf.path: leaf}, root=swap(world.root))
 
 
 def load_world(path: str | Path) -> WorldSpec:
@@ -416,7 +432,7 @@ def _build_leaf(
     for key in TIMING_KEYS:
         if key in body:
             try:
-                set_timing(timing, key, body[key], freq)
+                timing = timed(timing, key, body[key], freq)
             except ValueError as exc:
                 raise err((*kp, key), str(exc)) from None
     return LeafSpec(

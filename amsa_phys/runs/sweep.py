@@ -38,7 +38,7 @@ from ..model.scenario import (
     load_scenario,
     physics_setting,
     resolve_change,
-    shorten,
+    shortened,
     with_physics,
 )
 from ..model.yamlio import parse_value
@@ -325,13 +325,16 @@ def check_axes(axes: list[Axis], scenario: Scenario) -> None:
                 raise ConfigError(str(exc), key=f"--grid {axis.key}") from None
 
 
-def apply_setting(scenario: Scenario, key: str, value: Any) -> None:
-    """Put one grid value into ``scenario``: a parameter at t = 0, or a physics setting."""
+def apply_setting(scenario: Scenario, key: str, value: Any) -> Scenario:
+    """``scenario`` with one grid value: a parameter at t = 0, or a physics setting (a new
+    Scenario; the given one, cached and shared by the process's runs, is untouched)."""
     if key.startswith(PHYSICS_PREFIX):
         nested = physics_setting(key, value, option=f"--grid {key}")
-        scenario.world = with_physics(scenario.world, nested)
-    else:
-        scenario.phases[0].changes.append(resolve_change(key, value, scenario.world))
+        return dataclasses.replace(scenario, world=with_physics(scenario.world, nested))
+    change = resolve_change(key, value, scenario.world)
+    return dataclasses.replace(
+        scenario, phases=list(scenario.timeline.with_initial([change]).phases)
+    )
 
 
 def timeline_overlaps(keys: list[str], scenario: Scenario, end: Fraction) -> list[str]:
@@ -375,7 +378,7 @@ def _shortened(path: str, duration: float | None) -> Scenario:
     """The scenario file's scenario cut to the sweep's ``--duration`` (once per process)."""
     scenario = copy.deepcopy(_cached(path))
     if duration is not None:
-        shorten(scenario, Fraction(str(duration)))
+        scenario = shortened(scenario, Fraction(str(duration)))
     return scenario
 
 
@@ -393,21 +396,17 @@ def job_row(job: Job, error: str = "") -> dict[str, Any]:
 def prepare_job(job: Job) -> Scenario:
     """The scenario of one job: the file's, cut to the sweep's duration, with the job's seed,
     its context's and grid point's values (ValueError or AmsaError if they break a rule)."""
-    base = _shortened(job.scenario, job.duration)
-    # the world and later phases are shared (a run changes neither); the job's settings
-    # go into its own copy of phase 0 (a deep copy per run costs ~2 ms: a batch of 250
+    # the world and later phases are shared (a run changes neither); each setting makes a
+    # new Scenario with its own phase 0 (a deep copy per run costs ~2 ms: a batch of 250
     # runs would spend half a second on it)
-    scenario = copy.copy(base)
-    first = base.phases[0]
-    scenario.phases = [dataclasses.replace(first, changes=list(first.changes)), *base.phases[1:]]
-    scenario.seed = job.seed
+    scenario = dataclasses.replace(_shortened(job.scenario, job.duration), seed=job.seed)
     contexts = dict(job.contexts)
     for key, value in job.point:
         if key == "context":
             for k, v in contexts[value]:
-                apply_setting(scenario, k, v)
+                scenario = apply_setting(scenario, k, v)
         else:
-            apply_setting(scenario, key, value)
+            scenario = apply_setting(scenario, key, value)
     check_phases(scenario, None)  # this point's combination may break a template's rule
     return scenario
 
