@@ -39,7 +39,8 @@ import numpy as np
 #: per-component Python it saves.
 MIN_GROUP = 32
 
-#: Tests switch grouping off to compare with the leaf-by-leaf run.
+#: Deprecated switch, kept until its last writers move to ``Simulation(grouping=False)``
+#: (the ROS simulator, tests/e2e/test_groups.py): grouping is an argument of :func:`plan`.
 ENABLED = True
 
 _COPY = re.compile(r"^(.*?)(\d+)$")
@@ -115,11 +116,13 @@ def plan(
     instants: Sequence[Sequence[Any]],
     keys: dict[str, tuple[Any, ...] | None],
     min_group: int | None = None,
+    enabled: bool = True,
 ) -> list[list[Any]]:
     """Each instant's tasks with the allowed groups merged in (a :class:`Group` per group).
 
     ``keys`` maps a task's path to its :func:`group_key`; groups smaller than ``min_group``
-    (default :data:`MIN_GROUP`) are not formed. Groups that would change what any
+    (default :data:`MIN_GROUP`) are not formed, nor any if not ``enabled`` (the caller's
+    choice: a run compared with its leaf-by-leaf self). Groups that would change what any
     component reads at any instant are dropped everywhere, then the rest re-checked.
     """
     smallest = MIN_GROUP if min_group is None else min_group
@@ -130,7 +133,7 @@ def plan(
         bad: set[tuple[Any, ...]] = set()
         for tasks in instants:
             members: dict[tuple[Any, ...], list[Any]] = {}
-            if ENABLED:
+            if enabled:
                 for t in tasks:
                     key = keys.get(t.path)
                     if key is not None and key not in banned:

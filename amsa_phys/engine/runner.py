@@ -37,15 +37,13 @@ from ..model.timeline import Timeline
 from ..model.world import WorldSpec
 from . import batch, interrupt, schedule
 from .clock import TickGrid
-from .context import Context, Event, RunResult
+from .context import Context, Event, Hook, RunResult
 from .delivery import Deliveries
 from .instants import InstantSource, TimelineSource
 from .log import RunLog
 from .store import BufferStore
 from .tasks import COMPONENT_ERRORS, Steppers, Task
 from .timing import DelayLine, run_phases
-
-Hook = Callable[[], None]
 
 #: Wraps a component as it is built: ``wrap(path, component)`` returns what the engine runs
 #: in its place (the ROS simulator's remote Leaves), see :class:`Simulation`.
@@ -63,6 +61,8 @@ class Simulation:
     ``wrap(path, component)`` and the engine runs what it returns, so a caller that stands
     a component in for another (a remote Leaf, a recorder) does it here rather than by
     replacing entries of :attr:`components` or methods of a component afterwards.
+    ``grouping=False`` steps like copies leaf by leaf (``batch.py``), for a caller whose
+    components must each be called (a ROS node per Leaf) or a test's reference run.
     """
 
     def __init__(
@@ -77,6 +77,7 @@ class Simulation:
         trace: Callable[[float, list[float]], None] | None = None,
         columns: Sequence[str] | None = None,
         wrap: Wrap | None = None,
+        grouping: bool = True,
     ) -> None:
         self.world = world
         self.seed = seed
@@ -96,6 +97,8 @@ class Simulation:
         self._hooks: list[tuple[Fraction, Hook, str]] = []
         self.components: dict[str, Template] = {}
         self._wrap = wrap
+        #: step like copies as arrays (``batch.py``); False: leaf by leaf, as a reference
+        self.grouping = grouping
         self._tick = 0  # the instant being executed, in ticks (``now`` derives from it)
         self._now_override: Fraction | None = None
         self._now_cache: tuple[int, Fraction] = (0, Fraction(0))
@@ -267,7 +270,8 @@ class Simulation:
         each instant's tasks become ``(step, task or group)`` pairs."""
         leaves = self.world.leaves
         keys = {t.path: self._group_key(t, leaves[t.path].freq) for t in self._tasks}
-        planned = batch.plan([i.tasks for i in cycle], keys, self._min_group)
+        enabled = self.grouping and batch.ENABLED
+        planned = batch.plan([i.tasks for i in cycle], keys, self._min_group, enabled)
         self._groups_of: dict[str, list[batch.Group]] = {}
         steppers = self._steppers
         for inst, seq in zip(cycle, planned, strict=True):
@@ -287,12 +291,9 @@ class Simulation:
     # -- running --------------------------------------------------------------------------
     def run(self) -> RunResult:
         """Run to the end of the scenario."""
-        self.advance(self._end_tick())
-        return self.result()
-
-    def _end_tick(self) -> int:
         self.initialize()
-        return self._end
+        self.advance(self._end)
+        return self.result()
 
     @property
     def finished(self) -> bool:

@@ -152,3 +152,29 @@ def test_the_construction_hook_wraps_components_before_initialize(tmp_path: Path
     assert seen == ["A", "R"]
     sim.run()
     assert sim.read("A.count") == 22.0
+
+
+COPIES = """
+components:
+  A: {template: "toys:Source", freq: 10}
+  Car:
+    count: 40
+    components:
+      D: {template: "toys:Divider", freq: 10, inputs: {x: A.count}, params: {k: {from: 1, step: 0.2}}}
+"""
+
+
+def test_grouping_is_an_argument_and_gives_the_same_values(tmp_path: Path) -> None:
+    from amsa_phys.engine import batch
+
+    w = _world(tmp_path, COPIES)
+    grouped = Simulation(w, duration=Fraction(1))
+    single = Simulation(w, duration=Fraction(1), grouping=False)
+    for sim in (grouped, single):
+        sim.run()
+    assert grouped._groups_of
+    assert not single._groups_of
+    names = [f"Car{i}.D.y" for i in range(1, 41)]
+    assert np.allclose(grouped.read_many(names), single.read_many(names), rtol=1e-12)
+    assert grouped.read("Car3.D.y") == pytest.approx(1 / (11 * 1.4))
+    assert batch.ENABLED  # nothing flipped the module's switch
