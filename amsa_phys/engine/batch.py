@@ -30,6 +30,7 @@ from __future__ import annotations
 import operator
 import re
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
 
@@ -96,6 +97,22 @@ def _gather(names: list[str]) -> Callable[[dict[str, float]], tuple[float, ...]]
         name = names[0]
         return lambda values: (values[name],)
     return operator.itemgetter(*names)
+
+
+@dataclass(frozen=True)
+class Grouping:
+    """How a Simulation groups like components (an argument, not a subclass's override).
+
+    ``key(task, freq)`` says which group a task steps in (None: alone); groups smaller than
+    ``min_group`` (None: :data:`MIN_GROUP`) are not formed; nothing is grouped unless
+    ``enabled``. A batch of runs keys by the path within the run and groups at any size.
+    """
+
+    key: Callable[[Any, Fraction], tuple[Any, ...] | None] = field(
+        default_factory=lambda: group_key
+    )
+    min_group: int | None = None
+    enabled: bool = True
 
 
 def group_key(task: Any, freq: Fraction) -> tuple[Any, ...] | None:

@@ -16,7 +16,7 @@ makes each copy the run it would be alone:
   collide with each other and that run's obstacles exactly as alone;
 * its events and quality samples, kept per run, from which its metrics are computed.
 
-Groups are formed at any size (``_min_group = 1``), so a run's arithmetic is the same
+Groups are formed at any size (``Grouping(min_group=1)``), so a run's arithmetic is the same
 whatever batch it lands in: a batched sweep is byte-identical to itself across batch sizes
 and ``-j``. Against the run made alone it can differ only where array arithmetic rounds
 unlike the scalar code (numpy's transcendental functions, see ``engine/batch.py``; on the
@@ -37,6 +37,7 @@ import numpy as np
 
 from ..model.scenario import Change, Phase, Scenario, Step
 from ..model.world import BufferSpec, CompositeSpec, WorldSpec
+from . import batch
 from .rng import component_rng
 from .runner import Context, Event, RunResult, Simulation, _Task
 
@@ -101,8 +102,9 @@ class RunContext(Context):
 
 
 @dataclass
-class RunOutcome:
-    """One run's share of a finished batch: what ``compute_metrics`` needs."""
+class BatchShare:
+    """One run's share of a finished batch: what ``compute_metrics`` needs (not to be
+    confused with ``runs.single.RunOutcome``, what a run wrote to disk)."""
 
     result: RunResult
     live_changes: list[tuple[Fraction, Change]] = field(default_factory=list)
@@ -175,8 +177,6 @@ class MultiRun(Simulation):
     physics steps (``physics/columns.py``).
     """
 
-    _min_group = 1
-
     def __init__(
         self,
         scenarios: Sequence[Scenario],
@@ -197,6 +197,8 @@ class MultiRun(Simulation):
             duration=base.duration,
             phases=merged_phases(self.scenarios),
             log_rate=base.log_rate,
+            grouping=batch.Grouping(self._batch_key, min_group=1),
+            context=MultiRun._run_context,
         )
         self.runs = [RunView(self, sc) for sc in self.scenarios]
         quality = [
@@ -222,11 +224,11 @@ class MultiRun(Simulation):
         self._q_rows.append(self._q_get(values))
         self._q_t.append(t_s)
 
-    def _context(self, path: str) -> Context:
+    def _run_context(self, path: str) -> Context:
         head, _, local = path.partition(".")
         return RunContext(self, path, self.runs[int(head[1:])], local)
 
-    def _group_key(self, task: _Task, freq: Fraction) -> tuple[Any, ...] | None:
+    def _batch_key(self, task: _Task, freq: Fraction) -> tuple[Any, ...] | None:
         cls = type(task.comp)
         if not hasattr(cls, "step_many") or cls.has_arrays() or issubclass(cls, self._ungrouped):
             return None
@@ -246,7 +248,7 @@ class MultiRun(Simulation):
             return k if k < len(self.runs) else None
         return None
 
-    def outcomes(self) -> list[RunOutcome]:
+    def outcomes(self) -> list[BatchShare]:
         """Each run's samples, events and changes so far."""
         t = np.array(self._q_t[: len(self._q_rows)], dtype=np.float64)
         shape = (len(self._q_rows), len(self._q_index))
@@ -258,5 +260,5 @@ class MultiRun(Simulation):
             j = column.get(i)
             samples = table[:, j].copy() if j is not None else np.zeros(0)
             times = t if j is not None else np.zeros(0)
-            out.append(RunOutcome(RunResult(t_end, times, samples, list(run.events))))
+            out.append(BatchShare(RunResult(t_end, times, samples, list(run.events))))
         return out

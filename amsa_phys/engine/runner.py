@@ -62,7 +62,9 @@ class Simulation:
     a component in for another (a remote Leaf, a recorder) does it here rather than by
     replacing entries of :attr:`components` or methods of a component afterwards.
     ``grouping=False`` steps like copies leaf by leaf (``batch.py``), for a caller whose
-    components must each be called (a ROS node per Leaf) or a test's reference run.
+    components must each be called (a ROS node per Leaf) or a test's reference run; a
+    ``batch.Grouping`` says how to group instead. ``context(sim, path)`` makes what each
+    component's ``initialize`` receives (a batch of runs gives each run its own).
     """
 
     def __init__(
@@ -77,7 +79,8 @@ class Simulation:
         trace: Callable[[float, list[float]], None] | None = None,
         columns: Sequence[str] | None = None,
         wrap: Wrap | None = None,
-        grouping: bool = True,
+        grouping: bool | batch.Grouping = True,
+        context: Callable[[Simulation, str], Context] = Context,
     ) -> None:
         self.world = world
         self.seed = seed
@@ -97,8 +100,11 @@ class Simulation:
         self._hooks: list[tuple[Fraction, Hook, str]] = []
         self.components: dict[str, Template] = {}
         self._wrap = wrap
-        #: step like copies as arrays (``batch.py``); False: leaf by leaf, as a reference
-        self.grouping = grouping
+        #: how like copies step as arrays (``batch.py``); False: leaf by leaf, a reference
+        self.grouping = grouping if isinstance(grouping, batch.Grouping) else batch.Grouping()
+        if grouping is False:
+            self.grouping = batch.Grouping(enabled=False)
+        self._new_context = context
         self._tick = 0  # the instant being executed, in ticks (``now`` derives from it)
         self._now_override: Fraction | None = None
         self._now_cache: tuple[int, Fraction] = (0, Fraction(0))
@@ -163,25 +169,12 @@ class Simulation:
         self._initialized = True
         for path, comp in self.components.items():
             try:
-                comp.initialize(self._context(path))
+                comp.initialize(self._new_context(self, path))
             except RunFault:
                 raise
             except COMPONENT_ERRORS as exc:  # a component's own bug or bad configuration
                 raise RunFault(self._who(path), 0, f"initialize failed: {exc!r}") from exc
         self._compile()
-
-    def _context(self, path: str) -> Context:
-        """What ``path``'s ``initialize`` receives (a batch of runs gives each its own)."""
-        return Context(self, path)
-
-    def _group_key(self, task: Task, freq: Fraction) -> tuple[Any, ...] | None:
-        """Which group ``task`` steps in (``engine/batch.py``); a batch of runs keys by the
-        path within the run."""
-        return batch.group_key(task, freq)
-
-    #: Smallest group stepped as arrays (``batch.MIN_GROUP``; a batch of runs groups always,
-    #: so a run's arithmetic does not depend on how many runs share its batch).
-    _min_group: int | None = None
 
     def add_hook(self, rate_hz: Fraction, fn: Hook, name: str) -> None:
         """See :meth:`Context.add_hook`."""
@@ -269,9 +262,10 @@ class Simulation:
         """Like components of repeated Composites step as arrays where that changes no read:
         each instant's tasks become ``(step, task or group)`` pairs."""
         leaves = self.world.leaves
-        keys = {t.path: self._group_key(t, leaves[t.path].freq) for t in self._tasks}
-        enabled = self.grouping and batch.ENABLED
-        planned = batch.plan([i.tasks for i in cycle], keys, self._min_group, enabled)
+        g = self.grouping
+        keys = {t.path: g.key(t, leaves[t.path].freq) for t in self._tasks}
+        enabled = g.enabled and batch.ENABLED
+        planned = batch.plan([i.tasks for i in cycle], keys, g.min_group, enabled)
         self._groups_of: dict[str, list[batch.Group]] = {}
         steppers = self._steppers
         for inst, seq in zip(cycle, planned, strict=True):
