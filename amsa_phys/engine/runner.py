@@ -2,23 +2,25 @@
 
 At every instant the engine does, in this order:
 
-1. apply timeline changes due at that instant (a new phase starts);
+1. apply the changes due at that instant (``_apply_instant``): delayed outputs that arrive
+   then, the timeline's changes (a new phase starts) and any other instant source's
+   (adaptation rules), then live changes made by hand;
 2. run the components due then, in execution order (``model.dataflow``); each reads its
    inputs at its start and publishes its outputs at its end (run-to-completion);
 3. record a trace row if the log is due;
 4. run the hooks due then (the physics advances from t to t + dt).
 
-So a component due at t sees the world as it is at t.
-
-This module is the facade and the hot loop; the engine's other concepts live in rooms of
-their own (``docs/architecture.md``): the buffer store (``store.py``), the schedule compiler
-(``schedule.py``), the tasks and their output checks (``tasks.py``), the delivery heap of
-delayed publications (``delivery.py``), the instant-level changes (``instants.py``: the
-timeline's, and adaptation rules'), and the log (``log.py``). The whole schedule repeats with the
+So a component due at t sees the world as it is at t. The whole schedule repeats with the
 hyperperiod of all rates and is precomputed once as a table of (offset, actions): the loop
 does no scheduling arithmetic per instant, and a run of instants where only the physics step
 is due (four in five at 100 Hz physics with a 20 Hz trace) is one table entry stepped in a
 tight loop.
+
+This module is the facade and the hot loop; the engine's other concepts live in rooms of
+their own (``docs/architecture.md``): the buffer store (``store.py``), the schedule compiler
+(``schedule.py``), the tasks and their output checks (``tasks.py``), the delivery heap of
+delayed publications (``delivery.py``), the instant-level changes (``instants.py``) and the
+log (``log.py``).
 """
 
 from __future__ import annotations
