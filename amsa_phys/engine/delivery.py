@@ -33,11 +33,13 @@ class Deliveries:
         """The tick of the earliest publication in flight (``math.inf``: none)."""
         return self._heap[0][0] if self._heap else math.inf
 
-    def deliver(self, tick: int, values: MutableMapping[str, float]) -> None:
-        """Write every publication due at or before ``tick`` into ``values``, in order."""
+    def deliver(self, tick: int, values: MutableMapping[str, float]) -> float:
+        """Write every publication due at or before ``tick`` into ``values``, in order;
+        return the tick the next one is due (``math.inf``: none), as :meth:`next_due`."""
         heap = self._heap
         while heap and heap[0][0] <= tick:
             values.update(heapq.heappop(heap)[2])
+        return heap[0][0] if heap else math.inf
 
     def in_flight(self, buffer: str) -> int:
         """How many publications of ``buffer`` are sent but not yet visible."""

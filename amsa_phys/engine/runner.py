@@ -120,7 +120,8 @@ class Simulation:
         self.deliveries = Deliveries()
         #: sources of changes at exact instants, the timeline first (``instants.py``)
         self._sources: list[InstantSource] = []
-        self._next_instant_tick: float = math.inf
+        self._next_instant_tick: float = math.inf  # deliveries' or sources', the earliest
+        self._next_source_tick: float = math.inf  # the instant sources' alone
         self._steppers = Steppers(self.values, self._send, self._who)
         self._build()
 
@@ -191,7 +192,8 @@ class Simulation:
         known then) and before the instants concerned run."""
         self.initialize()
         self._sources.append(source)
-        self._next_instant_tick = min(self._next_instant_tick, source.next_tick())
+        self._next_source_tick = min(self._next_source_tick, source.next_tick())
+        self._next_instant_tick = min(self._next_instant_tick, self._next_source_tick)
 
     @property
     def now(self) -> Fraction:
@@ -236,7 +238,8 @@ class Simulation:
         self._table = schedule.runs(cycle)
         self._end = g.ticks(self.duration)
         self._sources.insert(0, TimelineSource(self.timeline, g))
-        self._next_instant_tick = min(s.next_tick() for s in self._sources)
+        self._next_source_tick = min(s.next_tick() for s in self._sources)
+        self._next_instant_tick = min(self._next_source_tick, self.deliveries.next_due())
 
     def _task(self, path: str, g: TickGrid) -> Task:
         """``path``'s Leaf as the schedule runs it, its ports resolved to buffer names."""
@@ -388,23 +391,21 @@ class Simulation:
         ``tick``: deliveries of delayed outputs, then each instant source's changes (the
         timeline's first; ``instants.py``). Afterwards ``_next_instant_tick`` is the next
         tick at which any of them is due, so the hot loop makes one comparison for all."""
-        deliveries = self.deliveries
-        if deliveries:
-            deliveries.deliver(tick, self.values)
-        nxt = deliveries.next_due()
-        for source in self._sources:
-            if source.next_tick() <= tick:
-                for at, phase, changes in source.due(tick):
-                    if phase is not None:
-                        self.phase_index = phase
-                    self._now_override = self.grid.time(at)
-                    try:
-                        for change in changes:
-                            self.apply_change(change)
-                    finally:
-                        self._now_override = None
-            nxt = min(nxt, source.next_tick())
-        self._next_instant_tick = nxt
+        nxt = self.deliveries.deliver(tick, self.values)
+        if self._next_source_tick <= tick:
+            for source in self._sources:
+                if source.next_tick() <= tick:
+                    for at, phase, changes in source.due(tick):
+                        if phase is not None:
+                            self.phase_index = phase
+                        self._now_override = self.grid.time(at)
+                        try:
+                            for change in changes:
+                                self.apply_change(change)
+                        finally:
+                            self._now_override = None
+            self._next_source_tick = min(s.next_tick() for s in self._sources)
+        self._next_instant_tick = min(nxt, self._next_source_tick)
 
     def _send(self, line: DelayLine, writes: list[tuple[str, float]]) -> None:
         """Put a delayed Leaf's publication in flight: visible from ``line.due(now)``."""
