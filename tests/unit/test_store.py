@@ -160,7 +160,8 @@ components:
   Car:
     count: 40
     components:
-      D: {template: "toys:Divider", freq: 10, inputs: {x: A.count}, params: {k: {from: 1, step: 0.2}}}
+      D: {template: "toys:Divider", freq: 10, inputs: {x: A.count},
+          params: {k: {from: 1, step: 0.2}}}
 """
 
 
