@@ -9,6 +9,7 @@ and key of what it refuses.
 
 from __future__ import annotations
 
+import dataclasses
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -111,8 +112,9 @@ def _phases(
         changes, _ = set_changes(entry["set"], ("timeline", i, "set"), doc, world)
         if entry.get("new_phase", True):
             phases.append(Phase(at, changes, entry.get("label", ""), entry=i))
-        else:
-            phases[-1].within.append(Step(at, changes, entry.get("label", ""), entry=i))
+        else:  # a step of the phase so far: a new Phase (they are frozen)
+            step = Step(at, changes, entry.get("label", ""), entry=i)
+            phases[-1] = dataclasses.replace(phases[-1], within=[*phases[-1].within, step])
     return phases, world
 
 

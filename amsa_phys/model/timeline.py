@@ -32,7 +32,7 @@ from fractions import Fraction
 from .changes import Change
 
 
-@dataclass
+@dataclass(frozen=True)
 class Step:
     """Changes made inside a phase without starting a new one, at ``at``.
 
@@ -47,7 +47,7 @@ class Step:
     entry: int | None = None  # index in the file's ``timeline`` (None: made live)
 
 
-@dataclass
+@dataclass(frozen=True)
 class Phase:
     """A phase of the scenario: from ``at`` (phase 0 at 0) with the changes made then."""
 

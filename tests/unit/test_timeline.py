@@ -92,3 +92,17 @@ def test_with_initial_adds_after_the_files_values_without_sharing() -> None:
     assert [c.value for c in more.initial] == [1, 9]
     assert [c.value for c in tl.initial] == [1]
     assert more.points() == tl.points()
+
+
+def test_phases_and_steps_are_frozen() -> None:
+    import dataclasses
+
+    import pytest
+
+    tl = _timeline()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        tl.phases[1].at = F(11)  # type: ignore[misc]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        tl.phases[0].within[0].changes = []  # type: ignore[misc]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        tl.duration = F(1)  # type: ignore[misc]
