@@ -114,7 +114,7 @@ def fused_loop(duration: float, trace: bool = True) -> float:
         sim = Simulation.from_scenario(sc, trace=writer.write)
         sim.initialize()
         values = sim.values
-        row = sim._row
+        row = sim.log.row
         write = writer.write if trace else (lambda t, v: None)
         (hook,) = [fn for _, fn, _ in sim._hooks]
         cycle, log_period = sim._cycle, sim._log_period

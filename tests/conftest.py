@@ -1,7 +1,8 @@
-"""Headless everywhere; the toy templates in tests/toys.py importable as ``toys``."""
+"""Headless everywhere. The toy templates in tests/toys.py are importable as ``toys`` (and
+the golden helpers as ``regenerate``) through pytest's ``pythonpath`` setting in
+pyproject.toml, not through sys.path edits here."""
 
 import os
-import sys
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -9,8 +10,6 @@ import pytest
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("MPLBACKEND", "Agg")
-sys.path.insert(0, str(Path(__file__).parent))
-sys.path.insert(0, str(Path(__file__).parent / "golden"))
 
 ROOT = Path(__file__).resolve().parent.parent
 

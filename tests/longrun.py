@@ -23,7 +23,9 @@ def stop_leftovers() -> None:
 
 
 def start_long_run(out: Path, **popen: object) -> subprocess.Popen[str]:
-    """A 100 000 s run into ``out``, returned once ``trace.csv.tmp`` exists (plus 0.3 s)."""
+    """A 100 000 s run into ``out``, returned once it is running its loop: ``trace.csv.tmp``
+    exists and has grown since it was first seen (rows are being written, so the signal
+    handlers are installed and the run is past its start). Raises if it never gets there."""
     proc = subprocess.Popen(
         [
             sys.executable,
@@ -43,8 +45,16 @@ def start_long_run(out: Path, **popen: object) -> subprocess.Popen[str]:
         **popen,
     )  # type: ignore[call-overload]
     STARTED.append(proc)
-    deadline = time.monotonic() + 30
-    while not (out / "trace.csv.tmp").exists() and time.monotonic() < deadline:
-        time.sleep(0.05)
-    time.sleep(0.3)
-    return proc
+    trace = out / "trace.csv.tmp"
+    first: int | None = None
+    deadline = time.monotonic() + 120  # a bound for a stuck run, not a wait for a fast one
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            raise AssertionError(f"the long run ended early with code {proc.returncode}")
+        size = trace.stat().st_size if trace.exists() else None
+        if size is not None and first is None:
+            first = size
+        elif size is not None and first is not None and size > first:
+            return proc
+        time.sleep(0.02)  # polling an event, not waiting a fixed time
+    raise AssertionError(f"the long run wrote no trace rows into {trace} within 120 s")

@@ -13,7 +13,7 @@ from ..model.scenario import (
     Phase,
     Scenario,
     load_scenario,
-    parse_override,
+    parse_setting,
 )
 from ..model.template import Kind
 from ..model.world import load_world
@@ -80,7 +80,11 @@ def _load(path: str, args: argparse.Namespace) -> Scenario:
             log_rate=args.log_rate,
         )
     world = load_world(path)
-    changes = [c for c in (parse_override(t, world) for t in args.overrides) if c is not None]
+    changes = []
+    for text in args.overrides:
+        change, world = parse_setting(text, world)  # a Leaf's frequency: a new world
+        if change is not None:
+            changes.append(change)
     sensors = [leaf.freq for leaf in world.leaves.values() if leaf.kind is Kind.SENSOR]
     rate = Fraction(str(args.log_rate)) if args.log_rate else Fraction(DEFAULT_LOG_RATE_HZ)
     return Scenario(

@@ -211,7 +211,7 @@ def _kv(scenario: Any) -> float | None:
     for path, leaf in scenario.world.leaves.items():
         if "Kv" in leaf.params and leaf.kind.value == "controller":
             value = leaf.params["Kv"]
-            for change in scenario.phases[0].changes:
+            for change in scenario.timeline.initial:
                 if change.leaf == path and change.param == "Kv":
                     value = change.value
             return float(value)
@@ -229,13 +229,10 @@ def _kv_changes(scenario: Any) -> list[tuple[float, float]]:
         None,
     )
     out = []
-    for phase in scenario.phases:
-        steps = [(phase.at, phase.changes)] if phase.entry is not None else []
-        steps += [(step.at, step.changes) for step in phase.within]
-        for at, changes in steps:
-            for change in changes:
-                if change.leaf == path and change.param == "Kv":
-                    out.append((float(at), float(change.value)))
+    for point in scenario.timeline.points():
+        for change in point.changes:
+            if change.leaf == path and change.param == "Kv":
+                out.append((float(point.at), float(change.value)))
     return out
 
 

@@ -30,6 +30,7 @@ from __future__ import annotations
 import operator
 import re
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
 
@@ -39,7 +40,8 @@ import numpy as np
 #: per-component Python it saves.
 MIN_GROUP = 32
 
-#: Tests switch grouping off to compare with the leaf-by-leaf run.
+#: Deprecated switch, kept until its last writers move to ``Simulation(grouping=False)``
+#: (the ROS simulator, tests/e2e/test_groups.py): grouping is an argument of :func:`plan`.
 ENABLED = True
 
 _COPY = re.compile(r"^(.*?)(\d+)$")
@@ -97,6 +99,22 @@ def _gather(names: list[str]) -> Callable[[dict[str, float]], tuple[float, ...]]
     return operator.itemgetter(*names)
 
 
+@dataclass(frozen=True)
+class Grouping:
+    """How a Simulation groups like components (an argument, not a subclass's override).
+
+    ``key(task, freq)`` says which group a task steps in (None: alone); groups smaller than
+    ``min_group`` (None: :data:`MIN_GROUP`) are not formed; nothing is grouped unless
+    ``enabled``. A batch of runs keys by the path within the run and groups at any size.
+    """
+
+    key: Callable[[Any, Fraction], tuple[Any, ...] | None] = field(
+        default_factory=lambda: group_key
+    )
+    min_group: int | None = None
+    enabled: bool = True
+
+
 def group_key(task: Any, freq: Fraction) -> tuple[Any, ...] | None:
     """What members of one group share; None for a leaf that is no copy of anything."""
     parent, _, name = task.path.rpartition(".")
@@ -115,11 +133,13 @@ def plan(
     instants: Sequence[Sequence[Any]],
     keys: dict[str, tuple[Any, ...] | None],
     min_group: int | None = None,
+    enabled: bool = True,
 ) -> list[list[Any]]:
     """Each instant's tasks with the allowed groups merged in (a :class:`Group` per group).
 
     ``keys`` maps a task's path to its :func:`group_key`; groups smaller than ``min_group``
-    (default :data:`MIN_GROUP`) are not formed. Groups that would change what any
+    (default :data:`MIN_GROUP`) are not formed, nor any if not ``enabled`` (the caller's
+    choice: a run compared with its leaf-by-leaf self). Groups that would change what any
     component reads at any instant are dropped everywhere, then the rest re-checked.
     """
     smallest = MIN_GROUP if min_group is None else min_group
@@ -130,7 +150,7 @@ def plan(
         bad: set[tuple[Any, ...]] = set()
         for tasks in instants:
             members: dict[tuple[Any, ...], list[Any]] = {}
-            if ENABLED:
+            if enabled:
                 for t in tasks:
                     key = keys.get(t.path)
                     if key is not None and key not in banned:

@@ -16,7 +16,7 @@ makes each copy the run it would be alone:
   collide with each other and that run's obstacles exactly as alone;
 * its events and quality samples, kept per run, from which its metrics are computed.
 
-Groups are formed at any size (``_min_group = 1``), so a run's arithmetic is the same
+Groups are formed at any size (``Grouping(min_group=1)``), so a run's arithmetic is the same
 whatever batch it lands in: a batched sweep is byte-identical to itself across batch sizes
 and ``-j``. Against the run made alone it can differ only where array arithmetic rounds
 unlike the scalar code (numpy's transcendental functions, see ``engine/batch.py``; on the
@@ -37,6 +37,7 @@ import numpy as np
 
 from ..model.scenario import Change, Phase, Scenario, Step
 from ..model.world import BufferSpec, CompositeSpec, WorldSpec
+from . import batch
 from .rng import component_rng
 from .runner import Context, Event, RunResult, Simulation, _Task
 
@@ -99,8 +100,9 @@ class RunContext(Context):
 
 
 @dataclass
-class RunOutcome:
-    """One run's share of a finished batch: what ``compute_metrics`` needs."""
+class BatchShare:
+    """One run's share of a finished batch: what ``compute_metrics`` needs (not to be
+    confused with ``runs.single.RunOutcome``, what a run wrote to disk)."""
 
     result: RunResult
     live_changes: list[tuple[Fraction, Change]] = field(default_factory=list)
@@ -151,15 +153,10 @@ def merged_phases(scenarios: Sequence[Scenario]) -> list[Phase]:
     later: dict[Fraction, list[Change]] = {}
     for i, sc in enumerate(scenarios):
         pre = prefix_of(i) + "."
-        first += [_renamed(c, pre) for c in sc.phases[0].changes]
-        points: list[tuple[Fraction, list[Change]]] = []
-        for k, phase in enumerate(sc.phases):
-            if k > 0:
-                points.append((phase.at, phase.changes))
-            points += [(step.at, step.changes) for step in phase.within]
-        points.sort(key=lambda p: p[0])  # stable, as Simulation._change_points
-        for at, changes in points:
-            later.setdefault(at, []).extend(_renamed(c, pre) for c in changes)
+        timeline = sc.timeline
+        first += [_renamed(c, pre) for c in timeline.initial]
+        for point in timeline.points():
+            later.setdefault(point.at, []).extend(_renamed(c, pre) for c in point.changes)
     steps = [Step(at, changes) for at, changes in sorted(later.items())]
     return [Phase(Fraction(0), first, within=steps)]
 
@@ -177,8 +174,6 @@ class MultiRun(Simulation):
     each run steps its own): they step one by one here. ``columns`` takes over the runs'
     physics steps (``physics/columns.py``).
     """
-
-    _min_group = 1
 
     def __init__(
         self,
@@ -200,6 +195,8 @@ class MultiRun(Simulation):
             duration=base.duration,
             phases=merged_phases(self.scenarios),
             log_rate=base.log_rate,
+            grouping=batch.Grouping(self._batch_key, min_group=1),
+            context=MultiRun._run_context,
         )
         self.runs = [RunView(self, sc) for sc in self.scenarios]
         quality = [
@@ -225,11 +222,11 @@ class MultiRun(Simulation):
         self._q_rows.append(self._q_get(values))
         self._q_t.append(t_s)
 
-    def _context(self, path: str) -> Context:
+    def _run_context(self, path: str) -> Context:
         head, _, local = path.partition(".")
         return RunContext(self, path, self.runs[int(head[1:])], local)
 
-    def _group_key(self, task: _Task, freq: Fraction) -> tuple[Any, ...] | None:
+    def _batch_key(self, task: _Task, freq: Fraction) -> tuple[Any, ...] | None:
         cls = type(task.comp)
         if not hasattr(cls, "step_many") or cls.has_arrays() or issubclass(cls, self._ungrouped):
             return None
@@ -249,7 +246,7 @@ class MultiRun(Simulation):
             return k if k < len(self.runs) else None
         return None
 
-    def outcomes(self) -> list[RunOutcome]:
+    def outcomes(self) -> list[BatchShare]:
         """Each run's samples, events and changes so far."""
         t = np.array(self._q_t[: len(self._q_rows)], dtype=np.float64)
         shape = (len(self._q_rows), len(self._q_index))
@@ -261,5 +258,5 @@ class MultiRun(Simulation):
             j = column.get(i)
             samples = table[:, j].copy() if j is not None else np.zeros(0)
             times = t if j is not None else np.zeros(0)
-            out.append(RunOutcome(RunResult(t_end, times, samples, list(run.events))))
+            out.append(BatchShare(RunResult(t_end, times, samples, list(run.events))))
         return out

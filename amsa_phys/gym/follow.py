@@ -169,7 +169,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         new = sum(1 for e in events[self._seen_events :] if e.kind == "collision")
         self._seen_events = len(events)
         self._collisions += new
-        signal = episode.sim.values[self.quality.signal]
+        signal = episode.sim.read(self.quality.signal)
         reward = -abs(signal - self.quality.reference) / self.quality.tolerance
         reward -= self.collision_penalty * new
         reward += 0.0  # -0.0 (no error at all) reads as 0.0
@@ -223,8 +223,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         assert episode is not None
         if episode.done:  # the end: what the component would read now
             leaf = episode.sim.world.leaves[self.path]
-            values = episode.sim.values
-            return np.array([values[leaf.inputs[p]] for p in self.observed], dtype=np.float64)
+            return episode.sim.read_many([leaf.inputs[p] for p in self.observed])
         return np.array([episode.inputs[p] for p in self.observed], dtype=np.float64)
 
     def _info(self) -> dict[str, Any]:
@@ -232,7 +231,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         assert episode is not None
         return {
             "t": float(episode.t),
-            "signal": float(episode.sim.values[self.quality.signal]),
+            "signal": float(episode.sim.read(self.quality.signal)),
             "collisions": self._collisions,
         }
 

@@ -21,7 +21,7 @@ them in ``set:`` (``MyFollowerController.latency: 0``) or ``--set``, never in it
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 from typing import Any
 
@@ -36,7 +36,7 @@ DEFAULT_RESOLUTION = Fraction(1, 1000)
 RANDOM = "random"
 
 
-@dataclass
+@dataclass(frozen=True)
 class LeafTiming:
     """A Leaf's timing: ``phase`` None means 0, or random in a free-running world."""
 
@@ -68,12 +68,14 @@ def seconds(value: Any, what: str, limit: Fraction | None = MAX_DELAY_S) -> Frac
     return out
 
 
-def set_timing(timing: LeafTiming, key: str, value: Any, freq: Fraction) -> None:
-    """Set ``latency``, ``jitter`` or ``phase`` on ``timing``, judged (ValueError if bad)."""
+def timed(timing: LeafTiming, key: str, value: Any, freq: Fraction) -> LeafTiming:
+    """``timing`` with ``latency``, ``jitter`` or ``phase`` set, judged (ValueError if bad).
+
+    A new LeafTiming: a world's Leaf (and so its timing) may be shared by cached scenarios.
+    """
     if key == "phase":
         if value == RANDOM:
-            timing.phase = RANDOM
-            return
+            return replace(timing, phase=RANDOM)
         phase = seconds(value, "a phase (or 'random')", limit=None)
         period = 1 / freq
         if phase >= period:
@@ -81,9 +83,8 @@ def set_timing(timing: LeafTiming, key: str, value: Any, freq: Fraction) -> None
                 f"a phase must be below the period (1/{_num(freq)} Hz = {_num(period)} s), "
                 f"got {value}"
             )
-        timing.phase = phase
-        return
-    setattr(timing, key, seconds(value, f"a {key}"))
+        return replace(timing, phase=phase)
+    return replace(timing, **{key: seconds(value, f"a {key}")})
 
 
 def check_phase(timing: LeafTiming, freq: Fraction) -> str | None:

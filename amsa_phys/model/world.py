@@ -7,7 +7,7 @@ and the execution order (``dataflow.py``). A world that loads will run.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import replace
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -15,98 +15,50 @@ from typing import Any
 from ..errors import ConfigError
 from . import schema
 from .dataflow import execution_order
-from .links import allowed_text, link_allowed
+from .leafbuild import Copy, _build_leaf, _data_buffer, _link_inputs, array_size
 from .rates import cycle_problem
 from .suggest import did_you_mean
-from .template import Template, TemplateNotFound, known_names, resolve_template
-from .timing import TIMING_KEYS, LeafTiming, set_timing
+from .worldspec import (
+    DEFAULT_FREQ_HZ,
+    MAX_COMPONENTS,
+    PHYSICS_DEFAULTS,
+    BufferSpec,
+    CompositeSpec,
+    LeafSpec,
+    WorldSpec,
+)
 from .yamlio import KeyPath, YamlDoc, load_yaml
 
-#: The AMSA metamodel's default frequency (``TimeableObject.freq`` in amsaCore.ecore).
-DEFAULT_FREQ_HZ = 10
-#: Most Leaf components in a world, ``count:`` copies included (checked before any copy is
-#: built: 30 aliases of a ``count: 10000`` Composite would be 300,000 from a 1 KB file).
-MAX_COMPONENTS = 10_000
-
-PHYSICS_DEFAULTS: dict[str, Any] = {
-    "rate": 100,
-    "gravity": 9.81,
-    "ground": {"friction": 0.8, "rolling_resistance": 0.02},
-    "obstacles": [],
-    "walls": None,
-    "max_speed": 100.0,
-    "extent": 100000.0,
-}
-
-
-@dataclass
-class LeafSpec:
-    """One Leaf component: a template instance with its frequency, parameters and links."""
-
-    path: str
-    template: type[Template]
-    template_ref: str
-    freq: Fraction
-    params: dict[str, Any]
-    #: input port -> buffer name (``Producer.path.output``)
-    inputs: dict[str, str]
-    keypath: KeyPath
-    #: transport latency, jitter and timer phase (``model/timing.py``)
-    timing: LeafTiming = field(default_factory=LeafTiming)
-
-    @property
-    def kind(self) -> Any:
-        """The template's kind."""
-        return self.template.kind
+__all__ = [
+    "DEFAULT_FREQ_HZ",
+    "MAX_COMPONENTS",
+    "PHYSICS_DEFAULTS",
+    "BufferSpec",
+    "CompositeSpec",
+    "LeafSpec",
+    "WorldSpec",
+    "array_size",
+    "build_world",
+    "load_world",
+    "resolved_values",
+    "with_leaf",
+]
 
 
-@dataclass
-class CompositeSpec:
-    """A Composite: a named group of components (the root is the system)."""
+def with_leaf(world: WorldSpec, leaf: LeafSpec) -> WorldSpec:
+    """``world`` with its Leaf at ``leaf.path`` replaced by ``leaf`` (in ``leaves`` and in the
+    component tree): a new WorldSpec, the given one untouched (cached scenarios share it)."""
 
-    path: str
-    children: list[LeafSpec | CompositeSpec] = field(default_factory=list)
+    def swap(node: CompositeSpec) -> CompositeSpec:
+        children: list[LeafSpec | CompositeSpec] = []
+        for child in node.children:
+            if isinstance(child, CompositeSpec):
+                children.append(swap(child))
+            else:
+                children.append(leaf if child.path == leaf.path else child)
+        return replace(node, children=children)
 
-
-@dataclass
-class BufferSpec:
-    """A Data buffer: one producer's output, read by any number of consumers."""
-
-    name: str
-    producer: str
-    port: str
-    initial: Any
-
-
-@dataclass
-class WorldSpec:
-    """A loaded, checked world."""
-
-    name: str
-    source: YamlDoc
-    keypath: KeyPath
-    data: dict[str, Any]
-    physics: dict[str, Any]
-    root: CompositeSpec
-    leaves: dict[str, LeafSpec]
-    buffers: dict[str, BufferSpec]
-    order: list[str]
-    schedule: list[str]
-    #: Named Data (``data:``, the AMSA model's Data names): name -> buffer ``Component.output``
-    data_names: dict[str, str] = field(default_factory=dict)
-    #: array outputs: ``Lidar.ranges`` -> its element buffers ``Lidar.ranges[0]``, ...
-    arrays: dict[str, list[str]] = field(default_factory=dict)
-    #: the world's ``timing:`` section (``free_running``, ``resolution``)
-    timing: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def free_running(self) -> bool:
-        """Whether Leaves without their own ``phase`` get a random one."""
-        return bool(self.timing.get("free_running", False))
-
-    def error(self, keypath: KeyPath, message: str) -> ConfigError:
-        """A ConfigError at ``keypath`` (relative to this world) in its source file."""
-        return self.source.error((*self.keypath, *keypath), message)
+    return replace(world, leaves={**world.leaves, leaf.path: leaf}, root=swap(world.root))
 
 
 def load_world(path: str | Path) -> WorldSpec:
@@ -301,209 +253,6 @@ def _composites(node: CompositeSpec) -> list[CompositeSpec]:
         if isinstance(child, CompositeSpec):
             out += _composites(child)
     return out
-
-
-def _data_buffer(
-    name: str,
-    ref: str,
-    leaves: dict[str, LeafSpec],
-    buffers: dict[str, BufferSpec],
-    composites: set[str],
-    err: Any,
-) -> str:
-    """The buffer a ``data:`` name stands for, looked up from the name's Composite outwards.
-
-    ``Team.posX: Leader.posX`` names a Data of Composite ``Team``, so ``Leader`` is found in
-    ``Team`` first, then at the root, as an input's producer would be.
-    """
-    scope = name.rpartition(".")[0]
-    if scope not in composites:
-        raise err(
-            ("data", name), f"{scope!r} is not a Composite (a Data is named NAME or Composite.NAME)"
-        )
-    comp, _, output = ref.rpartition(".")
-    producer = _resolve_scope(name, comp, leaves) if comp else None
-    if producer is None:
-        raise err(("data", name), f"unknown component {comp or ref!r}" + did_you_mean(comp, leaves))
-    buffer = f"{producer.path}.{output}"
-    if buffer not in buffers:
-        outs = [p.name for p in producer.template.outputs]
-        raise err(
-            ("data", name),
-            f"component {producer.path} ({producer.template.name()}) has no output "
-            f"{output!r}" + did_you_mean(output, outs),
-        )
-    return buffer
-
-
-def array_size(leaf: LeafSpec, port: Any) -> int:
-    """The length of array output ``port`` of ``leaf`` (its size parameter's value)."""
-    return int(leaf.params[port.size]) if port.size else 1
-
-
-@dataclass(frozen=True)
-class Copy:
-    """Copy ``i`` (from 1) of a Composite with ``count: N`` — the platoon's cars.
-
-    Copies are named ``<name>1`` .. ``<name>N``. In their Leaves' ``inputs``, ``{i}`` is the
-    copy's number and ``{i-1}`` the previous one's, so ``Car{i-1}.Robot.posX`` is the car
-    ahead; ``first:`` gives copy 1 other inputs (the car ahead of the first is the leader).
-    A numeric parameter may be ``{from: A, step: B}``: A + B (i - 1) in copy i.
-    """
-
-    i: int
-    body: dict[str, Any]
-    keypath: KeyPath
-
-    def inputs(self, leaf_name: str, leaf_body: dict[str, Any]) -> dict[str, str]:
-        """The leaf's inputs in this copy, placeholders filled in."""
-        inputs = dict(leaf_body.get("inputs", {}))
-        if self.i == 1:
-            inputs.update(self.body.get("first", {}).get(leaf_name, {}).get("inputs", {}))
-        return {port: self.fill(ref) for port, ref in inputs.items()}
-
-    def fill(self, text: str) -> str:
-        """``{i}`` and ``{i-1}`` replaced by this copy's numbers."""
-        return text.replace("{i-1}", str(self.i - 1)).replace("{i}", str(self.i))
-
-    def value(self, value: Any) -> Any:
-        """A ``{from, step}`` parameter's value in this copy; anything else unchanged."""
-        if isinstance(value, dict) and set(value) == {"from", "step"}:
-            a, b = value["from"], value["step"]
-            if all(isinstance(v, int | float) and not isinstance(v, bool) for v in (a, b)):
-                return a + b * (self.i - 1)
-        return value
-
-
-def _build_leaf(
-    path: str, body: dict[str, Any], kp: KeyPath, err: Any, copy: Copy | None = None
-) -> LeafSpec:
-    ref = body["template"]
-    try:
-        template = resolve_template(ref)
-    except TemplateNotFound as exc:
-        hint = did_you_mean(ref, known_names()) if ":" not in ref else ""
-        raise err((*kp, "template"), f"{exc}{hint}") from None
-    freq = Fraction(str(body.get("freq", DEFAULT_FREQ_HZ)))
-    declared = {p.name: p for p in template.params}
-    params = {name: p.default for name, p in declared.items()}
-    given: dict[str, str] = {}
-    for written, value in body.get("params", {}).items():
-        name = template.canonical(written)
-        if name not in declared:
-            raise err(
-                (*kp, "params", written),
-                f"unknown parameter of template {template.name()}"
-                + did_you_mean(str(written), [*declared, *template.param_aliases]),
-            )
-        if name in given:
-            raise err(
-                (*kp, "params", written),
-                f"{written} and {given[name]} name the same parameter ({name})",
-            )
-        given[name] = written
-        if copy is not None:
-            value = copy.value(value)
-        try:
-            params[name] = declared[name].coerce(value)
-        except ValueError as exc:
-            raise err((*kp, "params", written), str(exc)) from None
-    try:
-        template.check_params(params)
-    except ValueError as exc:
-        raise err((*kp, "params"), str(exc)) from None
-    timing = LeafTiming()
-    for key in TIMING_KEYS:
-        if key in body:
-            try:
-                set_timing(timing, key, body[key], freq)
-            except ValueError as exc:
-                raise err((*kp, key), str(exc)) from None
-    return LeafSpec(
-        path=path,
-        template=template,
-        template_ref=ref,
-        freq=freq,
-        params=params,
-        inputs={},
-        keypath=kp,
-        timing=timing,
-    )
-
-
-def _link_inputs(
-    leaf: LeafSpec,
-    inputs: dict[str, str],
-    kp: KeyPath,
-    leaves: dict[str, LeafSpec],
-    err: Any,
-    arrays: dict[str, list[str]],
-) -> None:
-    ports = {p.name: p for p in leaf.template.inputs}
-    for port_name, ref in inputs.items():
-        where = (*kp, "inputs", port_name)
-        if port_name not in ports:
-            raise err(
-                where,
-                f"template {leaf.template.name()} has no input {port_name!r}"
-                + did_you_mean(str(port_name), ports),
-            )
-        comp, _, output = ref.rpartition(".")
-        if not comp:
-            raise err(where, f"expected Component.output, got {ref!r}")
-        producer = _resolve_scope(leaf.path, comp, leaves)
-        if producer is None:
-            raise err(where, f"unknown component {comp!r}" + did_you_mean(comp, leaves))
-        outs = {p.name: p for p in producer.template.outputs}
-        base, bracket, _ = output.partition("[")
-        if base not in outs or (bracket and not outs[base].array):
-            raise err(
-                where,
-                f"component {producer.path} ({producer.template.name()}) has no "
-                f"output {output!r}" + did_you_mean(output, outs),
-            )
-        source = f"{producer.path}.{output}"
-        if outs[base].array and bracket:  # one element of an array: a scalar
-            n = len(arrays[f"{producer.path}.{base}"])
-            if source not in arrays[f"{producer.path}.{base}"]:
-                raise err(where, f"{output!r} is not an element of {base} (0..{n - 1})")
-        is_array = outs[base].array and not bracket
-        if is_array != ports[port_name].array:
-            want = "an array" if ports[port_name].array else "one number"
-            got = f"the array {base}" if is_array else f"the number {output}"
-            raise err(
-                where,
-                f"input {port_name} of {leaf.template.name()} takes {want}, "
-                f"{producer.path}.{output} is {got}",
-            )
-        if not link_allowed(producer.kind, leaf.kind):
-            raise err(
-                where,
-                f"link {producer.path} ({producer.kind.value}) -> {leaf.path} "
-                f"({leaf.kind.value}) is not allowed: a {producer.kind.value} may feed "
-                f"only {allowed_text(producer.kind)}",
-            )
-        leaf.inputs[port_name] = source
-    missing = [
-        p for p in ports if p not in leaf.inputs and not getattr(ports[p], "optional", False)
-    ]
-    if missing:
-        raise err(
-            (*kp, "inputs"),
-            f"input {missing[0]!r} of template {leaf.template.name()} is not connected",
-        )
-
-
-def _resolve_scope(consumer: str, ref: str, leaves: dict[str, LeafSpec]) -> LeafSpec | None:
-    """Find ``ref`` from the consumer's enclosing Composite outwards (lexical scoping)."""
-    scope = consumer.split(".")[:-1]
-    while True:
-        candidate = ".".join([*scope, ref])
-        if candidate in leaves:
-            return leaves[candidate]
-        if not scope:
-            return None
-        scope.pop()
 
 
 def _merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:

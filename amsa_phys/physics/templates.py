@@ -219,6 +219,9 @@ _POSE_OUTPUTS = (
 class _Robot(Template):
     rover: DiffDriveRover
     fixed_once_running = frozenset(_BODY_PARAMS)
+    #: a batch builds each run's rover from its parameters at t = 0 (the timeline may not
+    #: change them during a batched run)
+    batch_params_at_start = True
 
     def initialize(self, ctx: Any) -> None:
         self.physics = physics_of(ctx)

@@ -29,6 +29,8 @@ class FrictionZone(Template):
     """
 
     template_name = "frictionZone"
+    #: a zone changes the ground itself: the batch's column physics has one ground
+    shares_physics = False
     kind = Kind.ENVIRONMENT
     params = (
         Param(
@@ -100,6 +102,8 @@ class GradeZone(Template):
     """
 
     template_name = "gradeZone"
+    #: a zone changes the ground itself: the batch's column physics has one ground
+    shares_physics = False
     kind = Kind.ENVIRONMENT
     params = (
         Param("angle", "float", "slope angle (0.1 rad is a 10 % grade)", 0.05, 0.0, 0.8, "rad"),

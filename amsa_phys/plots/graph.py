@@ -3,7 +3,8 @@
 Layout: a component's column is its depth in the dataflow, counting only edges that go forward
 in the execution order (a loop's back edge is drawn but does not push columns); rows keep
 declaration order. DOT output is for Graphviz users; PNG and SVG are drawn with matplotlib so
-no Graphviz install is needed.
+no Graphviz install is needed. What the diagram shows (boxes, links, DOT) is
+``graphmodel.py``; the plane geometry the layout uses is ``graphgeom.py``.
 
 Labels are placed, not just drawn: each link's label (one line per Data buffer) goes at the
 first point along its arrow where its measured extent overlaps no component and no label
@@ -14,8 +15,6 @@ top of each other and of the next column's names.
 
 from __future__ import annotations
 
-import re
-from dataclasses import dataclass, replace
 from pathlib import Path
 
 import matplotlib
@@ -29,174 +28,47 @@ from matplotlib.path import Path as MplPath
 from matplotlib.transforms import Bbox
 
 from ..atomic import write_atomic
-from ..model.timing import RANDOM, LeafTiming
 from ..model.wording import plural
 from ..model.world import WorldSpec
-from ..palette import rover_names
+from .graphgeom import (
+    BOX_H,
+    BOX_W,
+    Point,
+    Segments,
+    _along,
+    _crosses,
+    _hits_box,
+    _overlapping,
+    _quadratic,
+    _rounded,
+)
+from .graphmodel import (
+    KIND_COLOURS,
+    Node,
+    Structure,
+    delay_text,
+    edges,
+    phase_text,
+    structure,
+    to_dot,
+)
 from .save import save_png
-from .trajectory import GROUP_ABOVE, role_styles, rover_styles
 
-KIND_COLOURS = {
-    "environment": "#8dd3c7",
-    "process": "#fdb462",
-    "sensor": "#80b1d3",
-    "actuator": "#fb8072",
-    "controller": "#bebada",
-    "observer": "#d9d9d9",
-}
-
-
-def edges(world: WorldSpec) -> list[tuple[str, str, str]]:
-    """(producer, consumer, label) for every link, label ``output -> port``; a link whose
-    producer has latency or jitter says how late its Data arrive (``+0.75 s``)."""
-    out = []
-    for path, leaf in world.leaves.items():
-        for port, buffer in leaf.inputs.items():
-            producer, _, output = buffer.rpartition(".")
-            label = output if output == port else f"{output}→{port}"
-            if buffer in world.arrays:  # an array link: say how many Data it carries
-                label += f" [{len(world.arrays[buffer])}]"
-            source = world.leaves.get(producer)
-            if source is not None and source.timing.delayed:
-                label += f" {delay_text(source.timing)}"
-            out.append((producer, path, label))
-    return out
-
-
-def delay_text(t: LeafTiming) -> str:
-    """``+0.75 s``, or ``+0.75..0.85 s`` with jitter: how late a Leaf's outputs arrive."""
-    lo = float(t.latency)
-    if not t.jitter:
-        return f"+{lo:g} s"
-    return f"+{lo:g}..{lo + float(t.jitter):g} s"
-
-
-def phase_text(world: WorldSpec, t: LeafTiming) -> str:
-    """`` · phase 0.1 s`` or `` · phase random`` for a Leaf whose timer is shifted."""
-    if t.phase == RANDOM or (t.phase is None and world.free_running):
-        return " · phase random"
-    if t.phase:
-        return f" · phase {float(t.phase):g} s"
-    return ""
-
-
-@dataclass(frozen=True)
-class Node:
-    """A box of the diagram: one component, or every copy of a repeated one (``count``)."""
-
-    name: str
-    template: str
-    kind: str
-    freq: float
-    count: int = 1
-    #: `` · phase 0.1 s`` when the Leaf's timer is shifted (``phase_text``)
-    phase: str = ""
-    #: a rover's colour in the trajectory plot, the window and the video ("" if no rover)
-    rover_colour: str = ""
-
-    @property
-    def subtitle(self) -> str:
-        """``controlledRobot · 4 Hz``, with ``· ×10`` for copies and the timer's phase."""
-        copies = f" · ×{self.count}" if self.count > 1 else ""
-        return f"{self.template} · {self.freq:g} Hz{self.phase}{copies}"
-
-
-@dataclass
-class Structure:
-    """What the diagram shows: boxes and labelled links (``Node.name`` to ``Node.name``)."""
-
-    nodes: dict[str, Node]
-    links: list[tuple[str, str, str]]
-
-
-_COPY = re.compile(r"^(.*?)(\d+)$")
-
-
-def structure(world: WorldSpec, collapse: bool = True) -> Structure:
-    """The world's components and links; with ``collapse``, copies drawn once.
-
-    Copies are leaves of Composites whose names differ only in a trailing number (``count:``
-    makes Car1 .. Car10) with the same template: ``Car{i}.Robot`` stands for all of them. A
-    link between different copies says so (``posX (from i-1)``), and a link that only some
-    copies have names them (``(i=1)``, ``(i=2..10)``).
-    """
-    copy_of: dict[str, tuple[str, int]] = {}  # leaf path -> (node name, copy number)
-    if collapse:
-        members: dict[tuple[str, str, str], list[tuple[int, str]]] = {}
-        for path, leaf in world.leaves.items():
-            parent, _, name = path.rpartition(".")
-            m = _COPY.match(parent)
-            if m:
-                key = (m.group(1), name, leaf.template_ref)
-                members.setdefault(key, []).append((int(m.group(2)), path))
-        for (prefix, name, _), group in members.items():
-            if len(group) > 1:
-                for number, path in group:
-                    copy_of[path] = (f"{prefix}{{i}}.{name}", number)
-    rovers = rover_names(list(world.buffers))
-    looks = role_styles(rovers) if len(rovers) > GROUP_ABOVE else rover_styles(rovers)
-    nodes: dict[str, Node] = {}
-    for path, leaf in world.leaves.items():
-        name = copy_of[path][0] if path in copy_of else path
-        if name in nodes:
-            nodes[name] = replace(nodes[name], count=nodes[name].count + 1)
-        else:
-            kind = leaf.kind.value
-            nodes[name] = Node(
-                name,
-                leaf.template.name(),
-                kind,
-                float(leaf.freq),
-                phase=phase_text(world, leaf.timing),
-                rover_colour=looks[path].colour if path in looks else "",
-            )
-    numbers: dict[str, set[int]] = {}
-    for name, number in copy_of.values():
-        numbers.setdefault(name, set()).add(number)
-    # (from, to, label, copy offset) -> the copy numbers it holds for (of the copy side)
-    held: dict[tuple[str, str, str, int], set[int]] = {}
-    for a, b, label in edges(world):
-        na, ia = copy_of.get(a, (a, None))
-        nb, ib = copy_of.get(b, (b, None))
-        offset = ia - ib if ia is not None and ib is not None else 0
-        side = ib if ib is not None else ia
-        held.setdefault((na, nb, label, offset), set()).update(() if side is None else (side,))
-    links = []
-    for (na, nb, label, offset), which in held.items():
-        notes = [f"from i{offset:+d}"] if offset else []
-        copy_side = nb if nb in numbers else na
-        if which and which != numbers.get(copy_side, which):
-            notes.append(f"i={_numbers_text(which)}")
-        links.append((na, nb, f"{label} ({', '.join(notes)})" if notes else label))
-    return Structure(nodes, links)
-
-
-def _numbers_text(which: set[int]) -> str:
-    """``1``, ``2..10`` or ``1, 3, 5``."""
-    low, high = min(which), max(which)
-    if len(which) == 1:
-        return str(low)
-    if which == set(range(low, high + 1)):
-        return f"{low}..{high}"
-    return ", ".join(str(n) for n in sorted(which))
-
-
-def to_dot(world: WorldSpec, collapse: bool = True) -> str:
-    """The architecture as Graphviz DOT text."""
-    st = structure(world, collapse)
-    lines = [
-        f'digraph "{world.name}" {{',
-        "  rankdir=LR;",
-        '  node [shape=box, style="rounded,filled", fontname="Helvetica"];',
-    ]
-    for name, node in st.nodes.items():
-        copies = f", ×{node.count}" if node.count > 1 else ""
-        label = f"{name}\\n{node.template} ({node.kind}, {node.freq:g} Hz{copies})"
-        lines.append(f'  "{name}" [label="{label}", fillcolor="{KIND_COLOURS[node.kind]}"];')
-    for a, b, label in st.links:
-        lines.append(f'  "{a}" -> "{b}" [label="{label}", fontsize=9];')
-    lines.append("}")
-    return "\n".join(lines) + "\n"
+#: the structure (``graphmodel.py``) is re-exported: callers import it from here
+__all__ = [
+    "KIND_COLOURS",
+    "MAX_BOXES",
+    "SLOW_BOXES",
+    "Node",
+    "Structure",
+    "delay_text",
+    "diagram",
+    "draw",
+    "edges",
+    "phase_text",
+    "structure",
+    "to_dot",
+]
 
 
 def _columns(st: Structure) -> dict[str, int]:
@@ -230,7 +102,6 @@ def _columns(st: Structure) -> dict[str, int]:
     return col
 
 
-BOX_W, BOX_H = 3.0, 0.9  # a component, in data units (0.9 inch each)
 ROW_STEP = 1.6
 LABEL_PT = 7.5  # 6 pt was too small to read at the README's width
 CHAR_W = 0.069  # data units per label character at LABEL_PT, for sizing column gaps
@@ -392,9 +263,6 @@ def _positions(st: Structure, widen: float = 0.0) -> dict[str, tuple[float, floa
     return pos
 
 
-Point = tuple[float, float]
-
-
 def _routes(
     pos: dict[str, Point], links: list[tuple[str, str]]
 ) -> dict[tuple[str, str], list[Point]]:
@@ -437,148 +305,6 @@ def _routes(
         corners = [p0, (x0, lane), (side, lane), (side, y1), (x1 - BOX_W / 2, y1)]
         out[(a, b)] = _rounded(corners, CORNER)
     return out
-
-
-def _quadratic(p0: Point, c: Point, p2: Point, n: int = 40) -> list[Point]:
-    """The quadratic Bezier from ``p0`` to ``p2`` with control ``c`` as ``n + 1`` points."""
-    pts = []
-    for k in range(n + 1):
-        t = k / n
-        u = 1 - t
-        pts.append(
-            (
-                u * u * p0[0] + 2 * u * t * c[0] + t * t * p2[0],
-                u * u * p0[1] + 2 * u * t * c[1] + t * t * p2[1],
-            )
-        )
-    return pts
-
-
-def _rounded(corners: list[Point], r: float) -> list[Point]:
-    """A polyline through ``corners`` with each inner corner rounded (radius about ``r``)."""
-    out = [corners[0]]
-    for prev, here, nxt in zip(corners, corners[1:], corners[2:], strict=False):
-        d_in = max(abs(here[0] - prev[0]), abs(here[1] - prev[1]))
-        d_out = max(abs(nxt[0] - here[0]), abs(nxt[1] - here[1]))
-        k = min(r, d_in / 2, d_out / 2)
-        a = _toward(here, prev, k)
-        b = _toward(here, nxt, k)
-        out += _quadratic(a, here, b, 8)
-    out.append(corners[-1])
-    return out
-
-
-def _toward(p: Point, q: Point, k: float) -> Point:
-    """The point ``k`` from ``p`` toward ``q`` (axis-aligned segments)."""
-    dx, dy = q[0] - p[0], q[1] - p[1]
-    length = max(abs(dx), abs(dy)) or 1.0
-    return (p[0] + dx * k / length, p[1] + dy * k / length)
-
-
-def _hits_box(line: list[Point], centre: Point) -> bool:
-    """Whether the polyline passes through, or within 0.3 of, the box centred at ``centre``.
-
-    The margin keeps an arc from threading the gap between two rows of boxes.
-    """
-    x, y = centre
-    w, h = BOX_W / 2 + 0.3, BOX_H / 2 + 0.3
-    box = Bbox.from_extents(x - w, y - h, x + w, y + h)
-    return _crosses(np.asarray(line), box)
-
-
-def _crosses(line: np.ndarray, box: Bbox) -> bool:
-    """Whether any segment of the polyline ``line`` (N x 2) meets the rectangle ``box``."""
-    a, b = line[:-1], line[1:]
-    near = (  # segments whose own bounding box meets the rectangle: the only candidates
-        (np.minimum(a[:, 0], b[:, 0]) <= box.x1)
-        & (np.maximum(a[:, 0], b[:, 0]) >= box.x0)
-        & (np.minimum(a[:, 1], b[:, 1]) <= box.y1)
-        & (np.maximum(a[:, 1], b[:, 1]) >= box.y0)
-    )
-    return any(_segment_meets(*a[k], *b[k], box) for k in np.flatnonzero(near).tolist())
-
-
-def _segment_meets(x0: float, y0: float, x1: float, y1: float, box: Bbox) -> bool:
-    """Liang-Barsky: does the segment (x0, y0)-(x1, y1) meet ``box``?"""
-    lo, hi = 0.0, 1.0
-    dx, dy = x1 - x0, y1 - y0
-    for p, q in (
-        (-dx, x0 - box.x0),
-        (dx, box.x1 - x0),
-        (-dy, y0 - box.y0),
-        (dy, box.y1 - y0),
-    ):
-        if p == 0:
-            if q < 0:
-                return False
-            continue
-        t = q / p
-        if p < 0:
-            lo = max(lo, t)
-        else:
-            hi = min(hi, t)
-        if lo > hi:
-            return False
-    return True
-
-
-def _along(line: list[Point], t: float) -> Point:
-    """The point a fraction ``t`` of the way along the polyline, by length."""
-    arr = np.asarray(line)
-    seg = np.hypot(*np.diff(arr, axis=0).T)
-    goal = t * seg.sum()
-    k = int(np.searchsorted(np.cumsum(seg), goal))
-    k = min(k, len(seg) - 1)
-    before = seg[:k].sum()
-    f = (goal - before) / seg[k] if seg[k] > 0 else 0.0
-    x, y = arr[k] + f * (arr[k + 1] - arr[k])
-    return (float(x), float(y))
-
-
-class Segments:
-    """Every link's line as one array of segments (display pixels), so a label's place is
-    tested against all of them at once: a per-line Python loop made the expanded 10-car
-    platoon (71 components, 110 links) take 33 s."""
-
-    def __init__(self, lines: list[np.ndarray]) -> None:
-        a = [np.asarray(line, dtype=float)[:-1] for line in lines]
-        b = [np.asarray(line, dtype=float)[1:] for line in lines]
-        self.a = np.concatenate(a) if a else np.empty((0, 2))
-        self.b = np.concatenate(b) if b else np.empty((0, 2))
-        self.owner = np.concatenate([np.full(len(x), k) for k, x in enumerate(a)]) if a else []
-        self.lo = np.minimum(self.a, self.b)
-        self.hi = np.maximum(self.a, self.b)
-
-    def crossing(self, box: Bbox, but: int) -> int:
-        """How many lines other than line ``but`` meet ``box``."""
-        near = (
-            (self.lo[:, 0] <= box.x1)
-            & (self.hi[:, 0] >= box.x0)
-            & (self.lo[:, 1] <= box.y1)
-            & (self.hi[:, 1] >= box.y0)
-            & (self.owner != but)
-        )
-        hit = set()
-        for k in np.flatnonzero(near).tolist():
-            owner = int(self.owner[k])
-            if owner not in hit and _segment_meets(*self.a[k], *self.b[k], box):
-                hit.add(owner)
-        return len(hit)
-
-
-def _overlapping(extent: Bbox, others: np.ndarray) -> int:
-    """How many of ``others`` (N x 4: x0, y0, x1, y1) ``extent`` overlaps (as
-    ``Bbox.overlaps``: touching edges do not count)."""
-    if not len(others):
-        return 0
-    return int(
-        np.count_nonzero(
-            (extent.x0 < others[:, 2])
-            & (others[:, 0] < extent.x1)
-            & (extent.y0 < others[:, 3])
-            & (others[:, 1] < extent.y1)
-        )
-    )
 
 
 def _place_label(

@@ -52,7 +52,8 @@ class Unit:
 
 
 def unbatchable(scenario: Scenario) -> str | None:
-    """Why a batch cannot hold runs of ``scenario`` (None if it can)."""
+    """Why a batch cannot hold runs of ``scenario`` (None if it can), from what each
+    template declares (``Template.batchable``, ``shares_physics``, ``batch_params_at_start``)."""
     world = scenario.world
     if scenario.adapt:
         return "adapt: rules (each run switches its parameters at its own instants)"
@@ -60,26 +61,35 @@ def unbatchable(scenario: Scenario) -> str | None:
         return "free-running timers (each run draws its own phases)"
     for path, leaf in world.leaves.items():
         template = leaf.template
-        if not template.__module__.startswith("amsa_phys.") and not hasattr(template, "step_many"):
+        if not _batchable(template):
             return f"{path} is a user template ({template.name()}) without step_many"
         if leaf.timing.jitter or leaf.timing.phase == RANDOM:
             return f"{path} has random loop timing (jitter or a random phase)"
         if template.has_arrays():
             return f"{path} has array ports (a lidar casts rays in its run's space every scan)"
-        if template.name() in ("frictionZone", "gradeZone"):
+        if not _shares_physics(template):
             return f"{path} is a terrain zone (the batch's physics has one ground)"
-    robots = {p for p, leaf in world.leaves.items() if leaf.template.name() in _ROBOTS}
-    for i, phase in enumerate(scenario.phases):
-        steps = [phase.changes] if i > 0 else []
-        for changes in [*steps, *(step.changes for step in phase.within)]:
-            for c in changes:
-                if c.leaf in robots:
-                    return f"the timeline changes {c.key} during the run"
+    fixed = {p for p, leaf in world.leaves.items() if _params_at_start(leaf.template)}
+    for point in scenario.timeline.points():
+        for c in point.changes:
+            if c.leaf in fixed:
+                return f"the timeline changes {c.key} during the run"
     return None
 
 
-#: Templates of rovers: a batch sets their parameters at t = 0 only.
-_ROBOTS = ("freeRobot", "controlledRobot")
+def _batchable(template: type) -> bool:
+    declared = getattr(template, "batchable", None)
+    if declared is not None:
+        return bool(declared)
+    return template.__module__.startswith("amsa_phys.") or hasattr(template, "step_many")
+
+
+def _shares_physics(template: Any) -> bool:
+    return bool(template.shares_physics)
+
+
+def _params_at_start(template: Any) -> bool:
+    return bool(template.batch_params_at_start)
 
 
 def batch_key(scenario: Scenario) -> str:

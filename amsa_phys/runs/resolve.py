@@ -97,16 +97,12 @@ def resolved_scenario(
             entries[at] = {"set": {}, "label": label, "new_phase": new_phase}
         return entries[at]
 
-    for i, phase in enumerate(scenario.phases):
-        if i > 0:
-            entry(phase.at, phase.label, True)["set"].update(
-                {c.key: _plain(c.value) for c in phase.changes}
-            )
-        for step in phase.within:
-            entry(step.at, step.label, False)["set"].update(
-                {c.key: _plain(c.value) for c in step.changes}
-            )
-    initial = {c.key: _plain(c.value) for c in scenario.phases[0].changes}
+    timeline = scenario.timeline
+    for point in timeline.points():
+        entry(point.at, point.label, point.starts_phase)["set"].update(
+            {c.key: _plain(c.value) for c in point.changes}
+        )
+    initial = {c.key: _plain(c.value) for c in timeline.initial}
     for at, change in extra or []:
         if at == 0:
             initial[change.key] = _plain(change.value)

@@ -8,26 +8,23 @@ directory never holds a half-written file under its final name.
 from __future__ import annotations
 
 import json
-import math
 import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from fractions import Fraction
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
-import numpy as np
 import yaml
 from tqdm import tqdm
 
 from ..atomic import write_atomic
 from ..engine import interrupt
-from ..engine.metrics import block_metrics
 from ..engine.recorder import TraceWriter
-from ..engine.runner import RunResult, Simulation
+from ..engine.runner import Simulation
 from ..errors import Interrupted, OutputError, RunFault, one_line
-from ..model.scenario import Change, Expectation, Scenario, traced_columns
+from ..model.metrics import compute_metrics
+from ..model.scenario import Expectation, Scenario, traced_columns
 from ..view.drive import FrameSink, advance
 from ..view.encoder import EncoderError
 from .expect import describe_bound, describe_what, skip_reason
@@ -50,167 +47,6 @@ class RunOutcome:
     out_dir: Path
     metrics: dict[str, Any]
     simulation: Simulation
-
-
-def compute_metrics(
-    scenario: Scenario,
-    sim: Simulation,
-    result: RunResult,
-    wall_s: float,
-    status: str,
-    idle_s: float = 0.0,
-) -> dict[str, Any]:
-    """The ``metrics.json`` document (design.md) for a run that reached ``result.t_end``.
-
-    A run that stopped before its planned end (``--duration`` shorter than the file's, the
-    window closed, a fault, Ctrl-C) lists only the phases it entered; the phase it stopped
-    in, and the overall block, are marked ``partial``: their checks are skipped, not failed.
-    Changes made inside a phase (``new_phase: false`` entries, live changes from the
-    window) are listed in that phase's ``changes``; they never start a phase of their own,
-    so a session and its replay have the same phases. ``idle_s`` is wall-clock time the
-    window spent paused (or finished, waiting to be closed): not part of the run's speed.
-    Always valid JSON: a metric that is not a finite number (a signal near the float limit
-    overflows ``rms_error``) is written as ``null`` and named in ``nonfinite``.
-    """
-    with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
-        metrics = _metrics(scenario, sim, result, wall_s, status, idle_s)
-    return _finite(metrics)
-
-
-def _finite(metrics: dict[str, Any]) -> dict[str, Any]:
-    """Replace non-finite metric values by None and list where they were."""
-    bad: list[str] = []
-    blocks = [("overall", metrics["overall"])]
-    blocks += [(f"phases[{i}]", p) for i, p in enumerate(metrics["phases"])]
-    for where, block in blocks:
-        for key, value in block.items():
-            if isinstance(value, float) and not math.isfinite(value):
-                block[key] = None
-                bad.append(f"{where}.{key}")
-    if bad:
-        metrics["nonfinite"] = bad
-    return metrics
-
-
-def _metrics(
-    scenario: Scenario,
-    sim: Simulation,
-    result: RunResult,
-    wall_s: float,
-    status: str,
-    idle_s: float,
-) -> dict[str, Any]:
-    completed = status == "completed"
-    end = float(scenario.duration) if completed else result.t_end
-    bounds = [float(b) for b in scenario.planned_bounds or []] or [
-        *(float(p.at) for p in scenario.phases),
-        float(scenario.duration),
-    ]
-    q = scenario.quality
-    collisions = [e.t for e in result.events if e.kind == "collision"]
-    inner = _changes_within(scenario, sim.live_changes)
-    kept = [p for i, p in enumerate(scenario.phases) if i == 0 or float(p.at) < end]
-    phases = []
-    for i, phase in enumerate(kept):
-        last = i + 1 == len(kept)
-        planned_end = bounds[i + 1]
-        p_end = min(planned_end, end) if last else planned_end
-        start = float(phase.at)
-        block: dict[str, Any] = {
-            "start": start,
-            "end": p_end,
-            "set": {c.key: _jsonable(c.value) for c in phase.changes},
-        }
-        if phase.label:
-            block["label"] = phase.label
-        changes = [c for c in inner if start <= c["at"] < p_end or (last and c["at"] == p_end)]
-        if changes:
-            block["changes"] = changes
-        if p_end < planned_end:
-            block["partial"] = True
-        if q is not None and result.samples_t.size:
-            block.update(
-                block_metrics(
-                    result.samples_t,
-                    result.samples_s,
-                    start,
-                    p_end,
-                    q.reference,
-                    q.tolerance,
-                    collisions,
-                    include_end=last,
-                    dwell=q.dwell,
-                )
-            )
-        else:
-            block["collisions"] = sum(
-                1 for t in collisions if start <= t and (t <= p_end if last else t < p_end)
-            )
-        phases.append(block)
-    if q is not None and result.samples_t.size:
-        overall = block_metrics(
-            result.samples_t,
-            result.samples_s,
-            0.0,
-            end,
-            q.reference,
-            q.tolerance,
-            collisions,
-            include_end=True,
-            dwell=q.dwell,
-        )
-    else:
-        overall = {"collisions": len(collisions)}
-    if end < bounds[-1]:
-        overall["partial"] = True
-    busy = wall_s - idle_s
-    return {
-        "scenario": scenario.name,
-        "seed": scenario.seed,
-        "duration": float(scenario.duration),
-        "simulated": result.t_end,
-        "status": status,
-        "quality": (_quality_json(q) if q else None),
-        "overall": overall,
-        "phases": phases,
-        "events": [{"t": e.t, "kind": e.kind, "detail": e.detail} for e in result.events[:1000]],
-        "wall_time_s": round(wall_s, 3),
-        **({"paused_s": round(idle_s, 3)} if idle_s > 0 else {}),
-        "real_time_factor": round(result.t_end / busy, 1) if busy > 0 else None,
-    }
-
-
-def _quality_json(q: Any) -> dict[str, Any]:
-    """The ``quality`` entry of ``metrics.json`` (``dwell`` only when the scenario sets it)."""
-    out = {"signal": q.signal, "reference": q.reference, "tolerance": q.tolerance}
-    if q.dwell is not None:
-        out["dwell"] = q.dwell
-    return out
-
-
-def _changes_within(
-    scenario: Scenario, live: list[tuple[Fraction, Change]]
-) -> list[dict[str, Any]]:
-    """Changes made inside phases (timeline ``new_phase: false`` and live), in time order."""
-    out: dict[Fraction, dict[str, Any]] = {}
-    for phase in scenario.phases:
-        for step in phase.within:
-            entry = out.setdefault(step.at, {"at": float(step.at), "set": {}})
-            entry["set"].update({c.key: _jsonable(c.value) for c in step.changes})
-            if step.label:
-                entry["label"] = step.label
-    for at, change in live:
-        entry = out.setdefault(at, {"at": float(at), "set": {}, "label": "live"})
-        entry["set"][change.key] = _jsonable(change.value)
-    return [out[at] for at in sorted(out)]
-
-
-def _jsonable(value: Any) -> Any:
-    return (
-        [list(v) if isinstance(v, tuple) else v for v in value]
-        if isinstance(value, tuple)
-        else value
-    )
 
 
 def run_scenario(

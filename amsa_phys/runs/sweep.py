@@ -10,10 +10,8 @@ file once per process and copy it per run (no re-parsing per run).
 from __future__ import annotations
 
 import copy
-import csv
 import dataclasses
 import functools
-import io
 import itertools
 import json
 import math
@@ -29,111 +27,33 @@ import numpy as np
 from ..engine import interrupt
 from ..engine.runner import Simulation
 from ..errors import AmsaError, ConfigError
-from ..model.params import short_repr
 from ..model.scenario import (
-    METRICS,
     PHYSICS_PREFIX,
     Scenario,
     check_phases,
     load_scenario,
     physics_setting,
     resolve_change,
-    shorten,
+    shortened,
     with_physics,
 )
 from ..model.yamlio import parse_value
 from .pool import WORKER_LOST, imap_resilient
+
+# results.csv's columns and reader live in results.py; importers of sweep still find them
+from .results import METRIC_KEYS as METRIC_KEYS
+from .results import metric_names as metric_names
+from .results import read_results as read_results
+from .results import unknown_metric as unknown_metric
 from .rundir import prepare_run_dir
 from .single import compute_metrics, run_scenario
 
 T = TypeVar("T")
 R = TypeVar("R")
 
-#: Metric columns written for the overall block and each phase.
-METRIC_KEYS = METRICS
 #: Most runs in one sweep (grid points × seeds): about 14 hours of 50 ms runs on 2 cores.
 #: A larger grid is refused before anything is allocated.
 MAX_RUNS = 1_000_000
-
-
-def metric_names(n_phases: int) -> list[str]:
-    """The metric columns of ``results.csv``: overall, then ``phase<i>.<metric>``."""
-    return [*METRIC_KEYS, *(f"phase{i}.{k}" for i in range(n_phases) for k in METRIC_KEYS)]
-
-
-def unknown_metric(metric: str, n_phases: int) -> str | None:
-    """Why ``metric`` names no column of a sweep with ``n_phases`` phases (None if it does)."""
-    if metric in metric_names(n_phases):
-        return None
-    phases = (
-        f"; or phase<i>.<metric> for i in 0..{n_phases - 1}"
-        if n_phases > 1
-        else "; or phase0.<metric>" * n_phases
-    )
-    return f"unknown metric {metric!r}; known: {', '.join(METRIC_KEYS)}{phases}"
-
-
-def read_results(path: Path) -> tuple[list[dict[str, Any]], list[str]]:
-    """``results.csv`` back as rows and the grid axes (the columns between run and seed_index).
-
-    Axis values that read as numbers become floats (so a numeric axis plots as one), metrics
-    become floats or None (an empty cell: never settled, or the run failed). A file that is
-    not a sweep's results (binary, a column missing, a row of the wrong width, text where a
-    metric belongs) is refused with one line naming the line.
-    """
-    try:
-        text = Path(path).read_bytes().decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ConfigError(
-            f"not a results.csv: not UTF-8 text (byte {exc.start})", file=path
-        ) from None
-    except OSError as exc:
-        raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
-    try:
-        table = list(csv.reader(io.StringIO(text, newline="")))
-    except csv.Error as exc:
-        raise ConfigError(f"not a results.csv: {exc}", file=path) from None
-    fields = table[0] if table else []
-    needed = ("run", "seed_index", "seed", "error")
-    if fields[:1] != ["run"] or any(k not in fields for k in needed):
-        missing = [k for k in needed if k not in fields] or ["run (first)"]
-        raise ConfigError(
-            f"not a sweep's results.csv: no {', '.join(missing)} column", file=path, line=1
-        )
-    axes = fields[1 : fields.index("seed_index")]
-    metrics = fields[fields.index("error") + 1 :]
-    rows = []
-    for line, raw in enumerate(table[1:], start=2):
-        if not raw:
-            continue
-        if len(raw) != len(fields):
-            raise ConfigError(
-                f"not a sweep's results.csv: {len(raw)} cells where the header has {len(fields)}",
-                file=path,
-                line=line,
-            )
-        row: dict[str, Any] = dict(zip(fields, raw, strict=True))
-        for key in axes:
-            row[key] = _number_or_text(row[key])
-        for key in metrics:
-            try:
-                value = float(row[key]) if row[key] else None
-                row[key] = value if value is not None and math.isfinite(value) else None
-            except ValueError:
-                raise ConfigError(
-                    f"not a sweep's results.csv: {key} is {short_repr(row[key])}, not a number",
-                    file=path,
-                    line=line,
-                ) from None
-        rows.append(row)
-    return rows, axes
-
-
-def _number_or_text(text: str) -> Any:
-    try:
-        return float(text)
-    except ValueError:
-        return text
 
 
 @dataclass(frozen=True)
@@ -226,13 +146,14 @@ def deterministic_points(plan: SweepPlan, scenario: Scenario) -> list[tuple[tupl
     out = []
     for combo in itertools.product(*[a.values for a in plan.axes]):
         point = tuple((a.key, v) for a, v in zip(plan.axes, combo, strict=True))
-        changes = list(scenario.phases[0].changes)
+        changes = list(scenario.timeline.initial)
         for key, value in point:
             sets = plan.contexts[value].items() if key == "context" else [(key, value)]
             changes += [resolve_change(k, v, world) for k, v in sets]
         values = {path: dict(leaf.params) for path, leaf in world.leaves.items()}
         random = False
-        for phase_changes in [changes, *(ph.changes for ph in scenario.phases[1:])]:
+        later = [p.changes for p in scenario.timeline.points()]
+        for phase_changes in [changes, *later]:
             for c in phase_changes:
                 values[c.leaf][c.param] = c.value
             if any(_leaf_is_random(world.leaves[path].template, v) for path, v in values.items()):
@@ -324,13 +245,16 @@ def check_axes(axes: list[Axis], scenario: Scenario) -> None:
                 raise ConfigError(str(exc), key=f"--grid {axis.key}") from None
 
 
-def apply_setting(scenario: Scenario, key: str, value: Any) -> None:
-    """Put one grid value into ``scenario``: a parameter at t = 0, or a physics setting."""
+def apply_setting(scenario: Scenario, key: str, value: Any) -> Scenario:
+    """``scenario`` with one grid value: a parameter at t = 0, or a physics setting (a new
+    Scenario; the given one, cached and shared by the process's runs, is untouched)."""
     if key.startswith(PHYSICS_PREFIX):
         nested = physics_setting(key, value, option=f"--grid {key}")
-        scenario.world = with_physics(scenario.world, nested)
-    else:
-        scenario.phases[0].changes.append(resolve_change(key, value, scenario.world))
+        return dataclasses.replace(scenario, world=with_physics(scenario.world, nested))
+    change = resolve_change(key, value, scenario.world)
+    return dataclasses.replace(
+        scenario, phases=list(scenario.timeline.with_initial([change]).phases)
+    )
 
 
 def timeline_overlaps(keys: list[str], scenario: Scenario, end: Fraction) -> list[str]:
@@ -342,13 +266,7 @@ def timeline_overlaps(keys: list[str], scenario: Scenario, end: Fraction) -> lis
     """
     out = []
     for key in dict.fromkeys(keys):  # once per key, in order
-        times = []
-        for i, phase in enumerate(scenario.phases):
-            steps = [(phase.at, phase.changes)] if i > 0 else []
-            steps += [(step.at, step.changes) for step in phase.within]
-            times += [
-                at for at, changes in steps if at < end and any(c.key == key for c in changes)
-            ]
+        times = list(scenario.timeline.changes_of(key, before=end))
         if times:
             when = ", ".join(f"{float(t):g}" for t in sorted(times))
             first = min(times)
@@ -380,7 +298,7 @@ def _shortened(path: str, duration: float | None) -> Scenario:
     """The scenario file's scenario cut to the sweep's ``--duration`` (once per process)."""
     scenario = copy.deepcopy(_cached(path))
     if duration is not None:
-        shorten(scenario, Fraction(str(duration)))
+        scenario = shortened(scenario, Fraction(str(duration)))
     return scenario
 
 
@@ -398,21 +316,17 @@ def job_row(job: Job, error: str = "") -> dict[str, Any]:
 def prepare_job(job: Job) -> Scenario:
     """The scenario of one job: the file's, cut to the sweep's duration, with the job's seed,
     its context's and grid point's values (ValueError or AmsaError if they break a rule)."""
-    base = _shortened(job.scenario, job.duration)
-    # the world and later phases are shared (a run changes neither); the job's settings
-    # go into its own copy of phase 0 (a deep copy per run costs ~2 ms: a batch of 250
+    # the world and later phases are shared (a run changes neither); each setting makes a
+    # new Scenario with its own phase 0 (a deep copy per run costs ~2 ms: a batch of 250
     # runs would spend half a second on it)
-    scenario = copy.copy(base)
-    first = base.phases[0]
-    scenario.phases = [dataclasses.replace(first, changes=list(first.changes)), *base.phases[1:]]
-    scenario.seed = job.seed
+    scenario = dataclasses.replace(_shortened(job.scenario, job.duration), seed=job.seed)
     contexts = dict(job.contexts)
     for key, value in job.point:
         if key == "context":
             for k, v in contexts[value]:
-                apply_setting(scenario, k, v)
+                scenario = apply_setting(scenario, k, v)
         else:
-            apply_setting(scenario, key, value)
+            scenario = apply_setting(scenario, key, value)
     check_phases(scenario, None)  # this point's combination may break a template's rule
     return scenario
 

@@ -17,7 +17,7 @@ import numpy as np
 import pymunk
 import pytest
 
-from amsa_phys.engine import runner
+from amsa_phys.engine import schedule
 from amsa_phys.engine.recorder import TraceWriter, format_rows
 from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import Change, load_scenario
@@ -226,8 +226,8 @@ def test_runs_of_physics_only_instants_change_nothing(
     assert fast[1][1][0] == Fraction(312, 100)  # the live change, at the next instant
     # the same run with every instant its own table entry (no runs)
     monkeypatch.setattr(
-        runner,
-        "_runs",
+        schedule,
+        "runs",
         lambda instants: [
             (i.offset, tuple(i.tasks), i.log, tuple(i.hooks), i.offset, 1) for i in instants
         ],

@@ -30,19 +30,61 @@ LAYER = {
 MODULES = sorted(p for p in PKG.rglob("*.py") if p.parent != PKG)
 
 
-def imported_packages(path: Path) -> set[str]:
-    tree = ast.parse(path.read_text())
-    own = path.relative_to(PKG).parts[0]
+def module_name(path: Path) -> str:
+    """``amsa_phys.ros.runtime.leaf`` for ``amsa_phys/ros/runtime/leaf.py`` (a package's
+    ``__init__.py`` is the package)."""
+    parts = list(path.relative_to(PKG.parent).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+KNOWN = {module_name(p) for p in PKG.rglob("*.py")}
+
+
+def imports_of(path: Path, source: str | None = None, top_level: bool = False) -> set[str]:
+    """The ``amsa_phys`` modules ``path`` imports, relative imports of any depth resolved
+    (``from ...engine import x`` in ``ros/runtime/``), ``from pkg import module`` as the
+    module. ``top_level``: only imports run when the module loads (not those inside
+    functions, nor under ``if TYPE_CHECKING:``) — the ones that can make a circle."""
+    tree = ast.parse(path.read_text() if source is None else source)
+    me = module_name(path)
+    package = me if path.name == "__init__.py" else me.rpartition(".")[0]
+    nodes: list[ast.AST] = []
+
+    def collect(body: list[ast.stmt]) -> None:
+        for node in body:
+            if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+                continue
+            nodes.append(node)
+            for field in ("body", "orelse", "finalbody"):
+                if isinstance(node, ast.If | ast.Try) and hasattr(node, field):
+                    collect(getattr(node, field))
+            for handler in getattr(node, "handlers", []):
+                collect(handler.body)
+
+    if top_level:
+        collect(tree.body)
+    else:
+        nodes = list(ast.walk(tree))
     found = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom) and node.module is not None:
-            if node.level == 2:
-                found.add(node.module.split(".")[0])
-            elif node.level == 0 and node.module.startswith("amsa_phys."):
-                found.add(node.module.split(".")[1])
-        if isinstance(node, ast.ImportFrom) and node.level == 1:
-            found.add(own)
-    return found & set(LAYER)
+    for node in nodes:
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names if a.name.startswith("amsa_phys")}
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - (node.level - 1)]
+                full = ".".join([*base, *([node.module] if node.module else [])])
+            else:
+                full = node.module or ""
+            if full == "amsa_phys" or full.startswith("amsa_phys."):
+                for alias in node.names:
+                    sub = f"{full}.{alias.name}"
+                    found.add(sub if sub in KNOWN else full)
+    return found - {me}
+
+
+def imported_packages(path: Path) -> set[str]:
+    """The layers (``model``, ``engine``, ...) ``path`` imports from."""
+    return {m.split(".")[1] for m in imports_of(path) if m.count(".") >= 1} & set(LAYER)
 
 
 @pytest.mark.parametrize("path", MODULES, ids=[str(p.relative_to(PKG)) for p in MODULES])
@@ -50,6 +92,57 @@ def test_no_upward_or_sideways_imports(path: Path) -> None:
     own = path.relative_to(PKG).parts[0]
     for other in imported_packages(path) - {own}:
         assert LAYER[other] < LAYER[own], f"{path.relative_to(PKG)} imports {other}"
+
+
+def test_relative_imports_of_any_depth_are_seen() -> None:
+    """A three-dot import from ``ros/runtime`` names its layer (the old check missed it)."""
+    path = PKG / "ros" / "runtime" / "leaf.py"
+    code = "from ...engine.runner import Simulation\nfrom ..graph import x\nfrom . import rosio\n"
+    assert imports_of(path, code) == {
+        "amsa_phys.engine.runner",
+        "amsa_phys.ros.graph",
+        "amsa_phys.ros.runtime.rosio",
+    }
+    assert imported_packages(path) >= {"ros"}
+    sideways = PKG / "engine" / "x.py"
+    assert {m.split(".")[1] for m in imports_of(sideways, "from ..runs import sweep\n")} == {"runs"}
+
+
+def circles() -> list[list[str]]:
+    """Groups of modules that import each other when they load (Tarjan's components)."""
+    graph = {module_name(p): imports_of(p, top_level=True) & KNOWN for p in PKG.rglob("*.py")}
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            group = []
+            while True:
+                w = stack.pop()
+                group.append(w)
+                if w == v:
+                    break
+            if len(group) > 1:
+                out.append(sorted(group))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_import_circles_even_inside_a_package() -> None:
+    assert circles() == []
 
 
 def test_only_physics_imports_pymunk() -> None:

@@ -1,0 +1,301 @@
+"""Tasks: one component's step at its instants, and the checks on what it publishes.
+
+A :class:`Task` is a Leaf as the schedule runs it: its inputs and outputs resolved to buffer
+names, its period and timer phase in ticks, its delay line. :class:`Steppers` holds the four
+ways a task steps — the lean scalar path, a Leaf with latency or jitter (its outputs go into
+the delivery heap), a Leaf with array ports, and a group of like copies stepped as arrays
+(``engine/batch.py``) — and every one of them judges a component the same way:
+
+* what its code raises is :data:`COMPONENT_ERRORS` (any exception, and ``sys.exit()``, which
+  would otherwise end the whole program silently); KeyboardInterrupt is the user's and is
+  never caught;
+* what it publishes goes through :func:`checked_writes`, one function with one set of
+  refusals (:data:`OUTPUT_ERRORS`) and one message (:func:`bad_output`): the three copies
+  this replaced had drifted apart. The scalar path (:meth:`Steppers.step`) runs the same
+  loop inlined, because the call alone cost ~2 % of a headless run (CPU time, measured);
+  it uses the same exception set and message, and ``tests/unit/test_tasks.py`` holds the
+  two to the same verdict on every kind of bad output.
+"""
+
+from __future__ import annotations
+
+import math
+from array import array
+from collections.abc import Callable, Mapping, MutableMapping
+from dataclasses import dataclass, field
+from fractions import Fraction
+from itertools import compress
+from typing import Any
+
+import numpy as np
+
+from ..errors import RunFault
+from ..model.params import short_repr
+from ..model.template import Template
+from . import batch
+from .timing import DelayLine
+
+#: What a component's code may raise that is its fault, not the engine's: any exception,
+#: and ``sys.exit()`` (SystemExit), which would otherwise end the whole program with its
+#: code and no message. KeyboardInterrupt is the user's and stays one.
+COMPONENT_ERRORS = (Exception, SystemExit)
+
+#: What judging a published output may raise: not a mapping (AttributeError: no ``items``),
+#: an unknown port (KeyError), not a number (TypeError, ValueError), too large for a float
+#: (OverflowError), or not finite (ValueError, raised here).
+OUTPUT_ERRORS = (KeyError, TypeError, ValueError, OverflowError, AttributeError)
+
+
+@dataclass
+class Task:
+    """A Leaf as the schedule runs it (see the module docstring)."""
+
+    path: str
+    comp: Template
+    period: int
+    inputs: list[tuple[str, str]]
+    targets: dict[str, str]  # output port -> buffer name ("Component.port")
+    #: array ports (a lidar's ranges): port -> element buffer names, in order
+    arrays_in: dict[str, list[str]] = field(default_factory=dict)
+    arrays_out: dict[str, list[str]] = field(default_factory=dict)
+    #: loop timing (``engine/timing.py``): the timer's phase in ticks, and the delay line of
+    #: a Leaf with latency or jitter (None: its outputs are visible at once)
+    phase: int = 0
+    delay: DelayLine | None = None
+    #: a delayed Leaf's own last outputs, which it reads back at once (as its node does)
+    own: dict[str, float] = field(default_factory=dict)
+
+
+def checked_writes(
+    task: Task,
+    out: Any,
+    into: MutableMapping[str, float],
+    now: Fraction,
+    who: Callable[[str], str],
+) -> None:
+    """Put ``task``'s scalar outputs ``out`` into ``into`` by buffer name, each a finite float.
+
+    The one judge of published scalars: anything refused raises the RunFault that names the
+    first bad output (:func:`bad_output`). Outputs before a refused one may already be in
+    ``into``; the fault ends the run, so nothing reads them.
+    """
+    targets = task.targets
+    try:
+        for key, value in out.items():
+            number = float(value)
+            if number - number != 0.0:  # inf or nan
+                raise ValueError
+            into[targets[key]] = number
+    except OUTPUT_ERRORS:
+        raise bad_output(who(task.path), now, targets, out) from None
+
+
+def bad_output(who: str, now: Fraction, targets: Mapping[str, str], out: Any) -> RunFault:
+    """The fault for the first output :func:`checked_writes` refused (a slow path)."""
+    if not isinstance(out, Mapping):
+        return RunFault(
+            who, now, f"do_step must return a mapping of outputs, got {short_repr(out)}"
+        )
+    for key, value in out.items():
+        if key not in targets:
+            return RunFault(who, now, f"published unknown output {short_repr(key)}")
+        try:
+            number = float(value)
+        except OverflowError:
+            return RunFault(who, now, f"output {key} is too large for a float")
+        except (TypeError, ValueError):
+            return RunFault(who, now, f"output {key} is not a number: {short_repr(value)}")
+        if not math.isfinite(number):
+            return RunFault(who, now, f"output {key} is {number}")
+    return RunFault(who, now, f"published invalid outputs {dict(out)!r}")
+
+
+def _is_mask(published: Any, n: int) -> bool:
+    """Whether ``published`` is a boolean array with one entry per copy."""
+    return (
+        isinstance(published, np.ndarray)
+        and published.dtype == np.bool_
+        and published.shape == (n,)
+    )
+
+
+class Steppers:
+    """The ways a task steps, over one run's buffers (see the module docstring).
+
+    ``send(line, writes)`` puts a delayed publication in flight (the delivery heap);
+    ``who(path)`` names a component in a fault.
+    """
+
+    def __init__(
+        self,
+        values: dict[str, float],
+        send: Callable[[DelayLine, list[tuple[str, float]]], None],
+        who: Callable[[str], str],
+    ) -> None:
+        self.values = values
+        self.send = send
+        self.who = who
+
+    def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:
+        """How ``task`` steps: the lean scalar path, array ports, or through its delay line."""
+        if task.arrays_in or task.arrays_out:
+            return self.step_arrays
+        return self.step if task.delay is None else self.step_delayed
+
+    def _call(self, task: Task, now: Fraction, inp: dict[str, Any]) -> Any:
+        try:
+            return task.comp.do_step(now, inp)
+        except RunFault:
+            raise
+        except COMPONENT_ERRORS as exc:  # a component's own bug or bad configuration
+            raise RunFault(self.who(task.path), now, f"do_step raised {exc!r}") from exc
+
+    def step(self, task: Task, now: Fraction) -> None:
+        """Run one component: read its inputs, call ``do_step``, publish its outputs."""
+        values = self.values
+        inp = {port: values[buf] for port, buf in task.inputs}
+        try:
+            out = task.comp.do_step(now, inp)
+        except RunFault:
+            raise
+        except COMPONENT_ERRORS as exc:  # inlined :meth:`_call`: the hot path
+            raise RunFault(self.who(task.path), now, f"do_step raised {exc!r}") from exc
+        if out:  # checked_writes(task, out, values, now, self.who), inlined (module doc)
+            targets = task.targets
+            try:
+                for key, value in out.items():
+                    number = float(value)
+                    if number - number != 0.0:  # inf or nan
+                        raise ValueError
+                    values[targets[key]] = number
+            except OUTPUT_ERRORS:
+                raise bad_output(self.who(task.path), now, targets, out) from None
+
+    def step_delayed(self, task: Task, now: Fraction) -> None:
+        """:meth:`step` for a Leaf with latency or jitter: its outputs go into its delay
+        line instead of the buffers (it reads its own outputs back at once)."""
+        values = self.values
+        own = task.own
+        inp = {port: own.get(buf, values[buf]) for port, buf in task.inputs}
+        try:
+            out = task.comp.do_step(now, inp)
+        except RunFault:
+            raise
+        except COMPONENT_ERRORS as exc:  # inlined :meth:`_call`: once per step of the Leaf
+            raise RunFault(self.who(task.path), now, f"do_step raised {exc!r}") from exc
+        if not out:
+            return
+        writes: dict[str, float] = {}
+        checked_writes(task, out, writes, now, self.who)
+        own.update(writes)
+        assert task.delay is not None
+        self.send(task.delay, list(writes.items()))
+
+    def step_arrays(self, task: Task, now: Fraction) -> None:
+        """:meth:`step` for a leaf with array ports (a lidar and its readers).
+
+        An array input arrives as a float numpy array of its elements; an array output must
+        be a sequence of exactly its length, every element finite, and is published whole
+        (or not at all, if the key is missing). Kept apart so the scalar path stays lean.
+        """
+        values = self.values
+        arrays_in = task.arrays_in
+        inp: dict[str, Any] = {}
+        for port, buf in task.inputs:
+            names = arrays_in.get(port)
+            inp[port] = values[buf] if names is None else np.array([values[n] for n in names])
+        out = self._call(task, now, inp)
+        if not out:
+            return
+        writes: list[tuple[str, float]] = []
+        scalars: dict[str, Any] = {}
+        try:
+            items = list(out.items())
+        except AttributeError:
+            raise bad_output(self.who(task.path), now, task.targets, out) from None
+        for key, value in items:
+            names = task.arrays_out.get(key)
+            if names is None:
+                scalars[key] = value
+                continue
+            writes.extend(
+                zip(names, self._checked_array(task, now, key, value, len(names)), strict=True)
+            )
+        checked: dict[str, float] = {}
+        checked_writes(task, scalars, checked, now, self.who)
+        writes.extend(checked.items())
+        if task.delay is not None:
+            self.send(task.delay, writes)
+        else:
+            values.update(writes)
+
+    def _checked_array(self, task: Task, now: Fraction, key: str, value: Any, n: int) -> list:
+        """An array output as ``n`` finite floats, or the fault that says what is wrong."""
+        try:
+            arr = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise RunFault(
+                self.who(task.path), now, f"output {key} is not numbers: {value!r}"
+            ) from None
+        if arr.shape != (n,):
+            raise RunFault(
+                self.who(task.path), now, f"output {key} has shape {arr.shape}, expected ({n},)"
+            )
+        bad = np.flatnonzero(~np.isfinite(arr))
+        if bad.size:
+            k = int(bad[0])
+            raise RunFault(self.who(task.path), now, f"output {key}[{k}] is {arr[k]}")
+        return arr.tolist()
+
+    def step_group(self, group: batch.Group, now: Fraction) -> None:
+        """Run a group of like components in one call (``engine/batch.py``)."""
+        values = self.values
+        # array('d', tuple) then a view: a third cheaper than np.array on a tuple of floats
+        inp = {port: np.frombuffer(array("d", get(values))) for port, get in group.inputs}
+        who = self.who
+        try:
+            out, published = group.template.step_many(
+                group.comps, now, inp, group.params, group.state
+            )
+        except RunFault:
+            raise
+        except COMPONENT_ERRORS as exc:
+            raise RunFault(who(group.paths[0]), now, f"step_many raised {exc!r}") from exc
+        except (TypeError, ValueError) as exc:  # not a pair (outputs, published)
+            raise RunFault(
+                who(group.paths[0]), now, f"step_many must return (outputs, published): {exc}"
+            ) from exc
+        n = len(group.paths)
+        if not (isinstance(out, Mapping) and (published is None or _is_mask(published, n))):
+            raise RunFault(
+                who(group.paths[0]),
+                now,
+                f"step_many must return (outputs, published) with a mapping of outputs and "
+                f"None or a boolean mask of {n} rows, got ({short_repr(out)}, "
+                f"{short_repr(published)})",
+            )
+        mask = None if published is None else published.tolist()
+        for port, arr in out.items():
+            bufs = group.outputs.get(port)
+            if bufs is None:
+                raise RunFault(
+                    who(group.paths[0]), now, f"published unknown output {short_repr(port)}"
+                )
+            if not (type(arr) is np.ndarray and arr.shape == (n,) and arr.dtype == np.float64):
+                try:
+                    arr = np.broadcast_to(np.asarray(arr, dtype=np.float64), (n,))
+                except (TypeError, ValueError, OverflowError):
+                    raise RunFault(
+                        who(group.paths[0]),
+                        now,
+                        f"output {port} of step_many has shape {np.shape(arr)}, expected "
+                        f"({n},): one number per copy",
+                    ) from None
+            k = batch.first_bad(arr, published)
+            if k is not None:
+                raise RunFault(who(group.paths[k]), now, f"output {port} is {arr[k]}")
+            pairs = zip(bufs, arr.tolist(), strict=True)
+            if group.delay is not None:  # the copies' common latency (no jitter: batch.py)
+                self.send(group.delay, list(pairs if mask is None else compress(pairs, mask)))
+            else:
+                values.update(pairs if mask is None else compress(pairs, mask))

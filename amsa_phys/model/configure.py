@@ -1,0 +1,131 @@
+"""Configuring a loaded scenario: the command line's and the API's options as pure steps.
+
+``configure_scenario`` is a chain: build the file's scenario, then apply each option given —
+seed, duration, log rate, trace columns, ``--set`` overrides — each a function from a
+Scenario to a new Scenario (``dataclasses.replace``), judged like a file value and refused
+with the option's name. Nothing here changes a Scenario, a phase or a world in place: a
+sweep caches and shares them between runs.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from fractions import Fraction
+from typing import Any
+
+from ..errors import ConfigError
+from . import tracecols
+from .changes import PHYSICS_PREFIX, parse_physics_override, parse_setting, with_physics
+from .params import short_repr
+from .rates import MAX_RATE_HZ, MIN_RATE_HZ
+from .scenariobuild import (
+    _cycle_problem,
+    _effective_log_rate,
+    build_scenario,
+    check_phases,
+    trace_problem,
+)
+from .scenariospec import Scenario, shortened
+from .schema import MAX_SEED
+from .yamlio import YamlDoc
+
+
+def configure_scenario(
+    doc: YamlDoc,
+    overrides: list[str] | None = None,
+    seed: int | None = None,
+    duration: float | None = None,
+    log_rate: float | None = None,
+    trace_columns: str | Sequence[str] | None = None,
+) -> Scenario:
+    """``load_scenario`` of a document already parsed (a file, or a mapping given in
+    Python: ``amsa_phys.run``), so both judge the options the same way."""
+    # with overrides, the rules are checked once they are in: a --set may repair the file
+    scenario = build_scenario(doc, check_rules=not overrides)
+    if seed is not None:
+        scenario = with_seed(scenario, seed)
+    if duration is not None:
+        scenario = shortened(scenario, positive_fraction(duration, "--duration"))
+    if log_rate is not None:
+        scenario = with_log_rate(scenario, log_rate)
+    if trace_columns is not None:
+        scenario = with_trace_columns(scenario, trace_columns)
+    if overrides:
+        scenario = with_overrides(scenario, overrides, doc)
+    return dataclasses.replace(
+        scenario, log_rate=_effective_log_rate(scenario.log_rate, scenario.world)
+    )
+
+
+def with_seed(scenario: Scenario, seed: Any) -> Scenario:
+    """``scenario`` with ``--seed``: an integer from 0 to 2**63 - 1."""
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED:
+        raise ConfigError(
+            f"must be an integer from 0 to {MAX_SEED} (2**63 - 1), like seed: in a "
+            f"scenario; got {short_repr(seed)}",
+            key="--seed",
+        )
+    return dataclasses.replace(scenario, seed=seed)
+
+
+def with_log_rate(scenario: Scenario, log_rate: float) -> Scenario:
+    """``scenario`` with ``--log-rate``, in the rates amsa-phys runs and schedulable."""
+    out = dataclasses.replace(scenario, log_rate=positive_fraction(log_rate, "--log-rate"))
+    if not MIN_RATE_HZ <= out.log_rate <= MAX_RATE_HZ:
+        raise ConfigError(
+            f"{log_rate:g} Hz is outside the rates amsa-phys runs "
+            f"({MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} Hz)",
+            key="--log-rate",
+        )
+    why = _cycle_problem(out)
+    if why is not None:
+        raise ConfigError(why, key="--log-rate")
+    return out
+
+
+def with_trace_columns(scenario: Scenario, trace_columns: Any) -> Scenario:
+    """``scenario`` with ``--trace-columns``: glob patterns, each keeping some buffer."""
+    if isinstance(trace_columns, str):
+        patterns = tracecols.parse_patterns(trace_columns)
+    elif isinstance(trace_columns, (list, tuple)) and all(
+        isinstance(p, str) for p in trace_columns
+    ):
+        patterns = list(trace_columns)
+    else:
+        raise ConfigError(
+            "expected glob patterns: a comma-separated string or a list of strings, got "
+            + short_repr(trace_columns),
+            key="--trace-columns",
+        )
+    problem = trace_problem(patterns, list(scenario.world.buffers))
+    if problem is not None:
+        raise ConfigError(problem[1], key="--trace-columns")
+    return dataclasses.replace(scenario, trace_columns=patterns)
+
+
+def with_overrides(scenario: Scenario, overrides: list[str], doc: YamlDoc | None) -> Scenario:
+    """``scenario`` with ``--set`` overrides: physics settings and Leaf frequencies change
+    the world, parameter changes join phase 0 after the file's ``set:``; then the templates'
+    rules are checked along the phases, naming an override as ``--set``."""
+    world = scenario.world
+    added = []
+    for text in overrides:
+        if text.strip().startswith(PHYSICS_PREFIX):
+            world = with_physics(world, parse_physics_override(text))
+            continue
+        change, world = parse_setting(text, world)
+        if change is not None:  # None: a frequency, set on the world's Leaf
+            added.append(change)
+    in_file = len(scenario.timeline.initial)
+    timeline = scenario.timeline.with_initial(added)
+    out = dataclasses.replace(scenario, world=world, phases=list(timeline.phases))
+    check_phases(out, doc, in_file)
+    return out
+
+
+def positive_fraction(value: float, option: str) -> Fraction:
+    """An option's positive finite number, exactly (``Fraction(str(value))``)."""
+    if not value > 0 or value != value or value == float("inf"):
+        raise ConfigError(f"must be a positive finite number, got {value}", key=option)
+    return Fraction(str(value))

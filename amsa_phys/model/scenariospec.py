@@ -1,0 +1,111 @@
+"""A loaded scenario as data: the quality signal, the expectations, the Scenario itself.
+
+Built by ``scenariobuild.py`` from a file, configured by ``configure.py`` (pure transforms:
+each returns a new Scenario), read everywhere else. Its phases are the Timeline's
+(``timeline.py``); its parameter changes are ``changes.py``'s.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+from . import tracecols
+from .adaptrules import RULE_COLUMN, Rule
+from .timeline import Phase, Timeline
+from .world import WorldSpec
+
+DEFAULT_LOG_RATE_HZ = 20
+DEFAULT_TOLERANCE = 1.5
+
+
+@dataclass
+class Quality:
+    """The quality-of-control signal (a Data buffer) and its reference and tolerance."""
+
+    signal: str
+    reference: float
+    tolerance: float
+    #: seconds the signal must stay in the band for ``settling_time`` (None: the default,
+    #: ``engine/metrics.default_dwell`` of each block)
+    dwell: float | None = None
+
+
+@dataclass
+class Expectation:
+    """A bound on a run.
+
+    Either ``metric`` (overall, or of ``phase``) must be ``below`` and/or ``above`` a bound,
+    or every sample of the Data ``trace`` in [``after``, ``before``] must be.
+    """
+
+    metric: str | None
+    phase: int | None
+    below: float | None
+    above: float | None
+    line: int | None
+    trace: str | None = None
+    after: float | None = None
+    before: float | None = None
+
+
+@dataclass
+class Scenario:
+    """A loaded, checked scenario."""
+
+    path: Path
+    name: str
+    world: WorldSpec
+    duration: Fraction
+    seed: int
+    log_rate: Fraction
+    quality: Quality | None
+    phases: list[Phase]
+    expect: list[Expectation] = field(default_factory=list)
+    data: dict[str, Any] = field(default_factory=dict)
+    #: when ``--duration`` shortened the run: the file's phase starts followed by its
+    #: duration. The phase the run stops in (and the run as a whole) is then cut short: its
+    #: metrics are partial and its checks skipped, not judged as if it were complete.
+    planned_bounds: list[Fraction] | None = None
+    #: ``trace_columns:`` glob patterns (None: trace every Data buffer); see
+    #: :func:`traced_columns` for what is kept
+    trace_columns: list[str] | None = None
+    #: ``adapt:`` reconfiguration rules (``model/adaptrules.py``); empty with ``--no-adapt``
+    adapt: list[Rule] = field(default_factory=list)
+
+    @property
+    def timeline(self) -> Timeline:
+        """The scenario's phases, duration and planned bounds as one frozen Timeline."""
+        return Timeline.of(self.phases, self.duration, self.planned_bounds)
+
+
+def traced_columns(scenario: Scenario) -> list[str]:
+    """The Data buffers the scenario's trace holds, in world order (``model/tracecols``).
+
+    The quality signal and every ``expect: {trace: ...}`` column are always kept: the run
+    reads them back.
+    """
+    required = [e.trace for e in scenario.expect if e.trace]
+    if scenario.quality:
+        required.append(scenario.quality.signal)
+    columns = tracecols.selected(scenario.trace_columns, list(scenario.world.buffers), required)
+    return [*columns, RULE_COLUMN] if scenario.adapt else columns
+
+
+def shortened(scenario: Scenario, duration: Fraction) -> Scenario:
+    """``scenario`` run until ``duration`` instead (``--duration``): later changes drop out.
+
+    A shorter run remembers the file's duration, so the phase it stops in is reported as
+    cut short (partial) rather than judged as if it were complete (``Timeline.cut``). A new
+    Scenario: the given one (perhaps cached and shared) is untouched.
+    """
+    cut = scenario.timeline.cut(duration)
+    return dataclasses.replace(
+        scenario,
+        duration=cut.duration,
+        phases=list(cut.phases),
+        planned_bounds=None if cut.planned is None else list(cut.planned),
+    )

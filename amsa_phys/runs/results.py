@@ -1,0 +1,100 @@
+"""A sweep's ``results.csv``: its metric columns, and reading it back (plots, reports).
+
+Split from ``sweep.py``, which writes the file; the metric names come from the one module
+that owns them (``model/metrics.py``).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from pathlib import Path
+from typing import Any
+
+from ..errors import ConfigError
+from ..model.metrics import METRICS
+from ..model.params import short_repr
+
+#: Metric columns written for the overall block and each phase.
+METRIC_KEYS = METRICS
+
+
+def metric_names(n_phases: int) -> list[str]:
+    """The metric columns of ``results.csv``: overall, then ``phase<i>.<metric>``."""
+    return [*METRIC_KEYS, *(f"phase{i}.{k}" for i in range(n_phases) for k in METRIC_KEYS)]
+
+
+def unknown_metric(metric: str, n_phases: int) -> str | None:
+    """Why ``metric`` names no column of a sweep with ``n_phases`` phases (None if it does)."""
+    if metric in metric_names(n_phases):
+        return None
+    phases = (
+        f"; or phase<i>.<metric> for i in 0..{n_phases - 1}"
+        if n_phases > 1
+        else "; or phase0.<metric>" * n_phases
+    )
+    return f"unknown metric {metric!r}; known: {', '.join(METRIC_KEYS)}{phases}"
+
+
+def read_results(path: Path) -> tuple[list[dict[str, Any]], list[str]]:
+    """``results.csv`` back as rows and the grid axes (the columns between run and seed_index).
+
+    Axis values that read as numbers become floats (so a numeric axis plots as one), metrics
+    become floats or None (an empty cell: never settled, or the run failed). A file that is
+    not a sweep's results (binary, a column missing, a row of the wrong width, text where a
+    metric belongs) is refused with one line naming the line.
+    """
+    try:
+        text = Path(path).read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(
+            f"not a results.csv: not UTF-8 text (byte {exc.start})", file=path
+        ) from None
+    except OSError as exc:
+        raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
+    try:
+        table = list(csv.reader(io.StringIO(text, newline="")))
+    except csv.Error as exc:
+        raise ConfigError(f"not a results.csv: {exc}", file=path) from None
+    fields = table[0] if table else []
+    needed = ("run", "seed_index", "seed", "error")
+    if fields[:1] != ["run"] or any(k not in fields for k in needed):
+        missing = [k for k in needed if k not in fields] or ["run (first)"]
+        raise ConfigError(
+            f"not a sweep's results.csv: no {', '.join(missing)} column", file=path, line=1
+        )
+    axes = fields[1 : fields.index("seed_index")]
+    metrics = fields[fields.index("error") + 1 :]
+    rows = []
+    for line, raw in enumerate(table[1:], start=2):
+        if not raw:
+            continue
+        if len(raw) != len(fields):
+            raise ConfigError(
+                f"not a sweep's results.csv: {len(raw)} cells where the header has {len(fields)}",
+                file=path,
+                line=line,
+            )
+        row: dict[str, Any] = dict(zip(fields, raw, strict=True))
+        for key in axes:
+            row[key] = _number_or_text(row[key])
+        for key in metrics:
+            try:
+                value = float(row[key]) if row[key] else None
+                row[key] = value if value is not None and math.isfinite(value) else None
+            except ValueError:
+                raise ConfigError(
+                    f"not a sweep's results.csv: {key} is {short_repr(row[key])}, not a number",
+                    file=path,
+                    line=line,
+                ) from None
+        rows.append(row)
+    return rows, axes
+
+
+def _number_or_text(text: str) -> Any:
+    try:
+        return float(text)
+    except ValueError:
+        return text

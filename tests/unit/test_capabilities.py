@@ -1,0 +1,67 @@
+"""Batch capabilities are what templates declare (issue 32 item 5), not their names."""
+
+from __future__ import annotations
+
+import dataclasses
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+import toys
+
+from amsa_phys.model.scenario import Change, Phase, load_scenario
+from amsa_phys.model.world import with_leaf
+from amsa_phys.runs.batched import unbatchable
+
+SCENARIO = """
+world:
+  components:
+    A: {template: freeRobot, freq: 10}
+    R: {template: "toys:Relay", freq: 10, inputs: {x: A.posX}}
+duration: 2
+"""
+
+
+class Declared(toys.Relay):
+    """A user template without step_many that says a batch may hold it."""
+
+    template_name = "declaredRelay"
+    batchable = True
+
+
+class Zone(toys.Relay):
+    template_name = "zoneRelay"
+    batchable = True
+    shares_physics = False
+
+
+class Fixed(toys.Relay):
+    template_name = "fixedRelay"
+    batchable = True
+    batch_params_at_start = True
+
+
+def _scenario(tmp_path: Path, template: type, change_later: bool = False) -> Any:
+    path = tmp_path / "s.yaml"
+    path.write_text(SCENARIO)
+    sc = load_scenario(path)
+    leaf = dataclasses.replace(sc.world.leaves["R"], template=template)
+    phases = list(sc.phases)
+    if change_later:
+        phases.append(Phase(Fraction(1), [Change("R", "anything", 1.0)]))
+    return dataclasses.replace(sc, world=with_leaf(sc.world, leaf), phases=phases)
+
+
+def test_a_user_template_is_refused_unless_it_declares_itself_batchable(tmp_path: Path) -> None:
+    assert "R is a user template (Relay) without step_many" in str(
+        unbatchable(_scenario(tmp_path, toys.Relay))
+    )
+    assert unbatchable(_scenario(tmp_path, Declared)) is None
+
+
+def test_shares_physics_and_params_at_start_are_read_from_the_template(tmp_path: Path) -> None:
+    assert "terrain zone" in str(unbatchable(_scenario(tmp_path, Zone)))
+    assert unbatchable(_scenario(tmp_path, Fixed)) is None  # no change during the run
+    why = unbatchable(_scenario(tmp_path, Fixed, change_later=True))
+    assert why == "the timeline changes R.anything during the run"
+    assert unbatchable(_scenario(tmp_path, Declared, change_later=True)) is None
