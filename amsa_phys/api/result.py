@@ -67,6 +67,8 @@ class Run:
 
         As ``amsa-phys run`` exits 0 for a run cut short whose checks were skipped, a skipped
         check does not fail: look at :attr:`skipped` to tell "all held" from "none judged".
+        A cut-short check that has already failed for good (a collision under
+        ``collisions below 1``, a maximum past its ``below``) fails.
         """
         return all(c.passed for c in self.checks)
 
