@@ -334,6 +334,12 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
                     f"before ({e['before']:g} s) is earlier than after ({e['after']:g} s): "
                     "the window holds no instant",
                 )
+            if "after" in e and Fraction(str(e["after"])) > duration:
+                raise doc.error(  # it would check nothing and pass (issue 33, 13)
+                    (*kp, "after"),
+                    f"{e['after']:g} s is after the end of the scenario (duration "
+                    f"{float(duration):g} s): the window would never hold a sample",
+                )
             expect.append(
                 Expectation(
                     None,
