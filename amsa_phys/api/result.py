@@ -26,6 +26,7 @@ from ..runs.expect import Check, check_expectations
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import Ended, execute, write_run_files
 from ..runs.suite import input_files
+from .memory import check_trace_memory
 from .source import Source, load
 
 
@@ -125,7 +126,9 @@ def run(
     (see :func:`~amsa_phys.api.source.load`); ``progress=True`` shows the progress bar.
     Errors are the CLI's, raised: :class:`~amsa_phys.errors.ConfigError` for bad input and
     :class:`~amsa_phys.errors.RunFault` for a fault during the run, with the CLI's one-line
-    message; Ctrl-C stops the run between two instants and raises
+    message. The trace is kept in memory: a :class:`~amsa_phys.api.memory.TraceSizeWarning`
+    above ~1 GB, a ConfigError if it could not fit in the machine's memory. Ctrl-C stops
+    the run between two instants and raises
     :class:`~amsa_phys.errors.Interrupted`. A fault or an interrupt carries the run up to
     that instant as the exception's ``run`` attribute (inspect it, or ``save`` it).
     """
@@ -138,7 +141,9 @@ def run(
         trace_columns=trace_columns,
         base_dir=base_dir,
     )
-    memory = TraceMemory(traced_columns(scenario))
+    columns = traced_columns(scenario)
+    check_trace_memory(scenario, columns)  # warn above 1 GB, refuse above the machine's RAM
+    memory = TraceMemory(columns)
     with interrupt.deferred():
         ended = execute(scenario, memory, progress=progress)
         late_stop = interrupt.requested()  # Ctrl-C after the last instant
