@@ -25,9 +25,11 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--paper",
-        choices=("fig5", "fig6"),
+        choices=("fig5", "fig6", "fig6-sensed"),
         help="the paper's Fig. 5 or Fig. 6 redrawn from the runs, beside the paper's numbers "
-        "(-o default: paper_fig5.png / paper_fig6.png)",
+        "(-o default: paper_fig5.png / paper_fig6.png); fig6-sensed: Fig. 6 at 0/10/50/90 %% "
+        "GPS loss, with the distance sensed from GPS beside the paper's true-distance wiring "
+        "(scenarios/paper_fig6_sensed.yaml and paper_fig6.yaml)",
     )
     p.add_argument(
         "-o",
@@ -137,6 +139,8 @@ def _plot_paper(args: argparse.Namespace) -> int:
     """``--paper fig5|fig6``: run (or read) the paper's scenarios and draw the figure."""
     from ..plots import paper  # matplotlib: only once the runs are in
 
+    if args.paper == "fig6-sensed":
+        return _plot_losses(args)
     sources = [Path(s) for s in args.rundir] or _paper_scenarios(args.paper)
     out = Path(args.output) if args.output else Path(f"paper_{args.paper}.png")
     check_output(out, "--output")
@@ -152,9 +156,39 @@ def _plot_paper(args: argparse.Namespace) -> int:
     return 0
 
 
+def _plot_losses(args: argparse.Namespace) -> int:
+    """``--paper fig6-sensed``: each scenario at every GPS loss rate, one panel each."""
+    from ..plots import paperloss  # matplotlib: only once the runs are in
+
+    sources = [Path(s) for s in args.rundir]
+    if not sources:
+        sources = [_paper_scenarios("fig6-sensed")[0], _paper_scenarios("fig6")[0]]
+    for src in sources:
+        if src.is_dir():
+            raise ConfigError(
+                "fig6-sensed runs each scenario at every loss rate: name scenario files",
+                file=src,
+            )
+    out = Path(args.output) if args.output else Path("paper_fig6_sensed.png")
+    check_output(out, "--output")
+    panels = []
+    for src in sources:
+        runs = [
+            (loss, _paper_run(src, [f"LeaderGPS.lostDataGPS={loss}"]))
+            for loss in paperloss.LOSS_RATES
+        ]
+        panels.append((runs[0][1].label, runs))
+    paperloss.fig6_losses(panels, out)
+    count = len(panels) * len(paperloss.LOSS_RATES)
+    print(one_line(f"wrote {out} ({count} runs)"))
+    return 0
+
+
 def _paper_scenarios(figure: str) -> list[Path]:
     """The shipped scenarios of a figure, found under ./scenarios."""
-    pattern = "paper_fig5_kv*.yaml" if figure == "fig5" else "paper_fig6.yaml"
+    pattern = {"fig5": "paper_fig5_kv*.yaml", "fig6-sensed": "paper_fig6_sensed.yaml"}.get(
+        figure, "paper_fig6.yaml"
+    )
     found = sorted(Path("scenarios").glob(pattern))
     if not found:
         raise ConfigError(
@@ -165,8 +199,9 @@ def _paper_scenarios(figure: str) -> list[Path]:
     return found
 
 
-def _paper_run(source: Path) -> Any:
-    """A :class:`~amsa_phys.plots.paper.PaperRun` from a run directory or a scenario file."""
+def _paper_run(source: Path, overrides: list[str] | None = None) -> Any:
+    """A :class:`~amsa_phys.plots.paper.PaperRun` from a run directory or a scenario file
+    (run with ``overrides``, ``--set`` texts)."""
     from ..plots.distance import read_trace
     from ..plots.paper import PaperRun
 
@@ -182,7 +217,7 @@ def _paper_run(source: Path) -> Any:
         from ..engine.tracemem import TraceMemory
         from ..runs.single import execute
 
-        scenario = load_scenario(source)
+        scenario = load_scenario(source, overrides)
         memory = TraceMemory(list(scenario.world.buffers))
         with interrupt.deferred():
             ended = execute(scenario, memory, progress=False)
