@@ -20,6 +20,7 @@ from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import amsa_phys as ap
 from amsa_phys.control.gpsdistance import GpsDistance
@@ -96,3 +97,19 @@ def test_sensed_world_keeps_the_true_distance_as_judge() -> None:
     world = ap.load(SENSED).world
     read = world.leaves["MyFollowerController"].inputs["distanceLeaderFollower"]
     assert read == "MyGpsDistance.distanceFollowerToLeader"
+
+
+def test_plot_fig6_sensed_draws_each_loss_rate(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from amsa_phys.cli.main import main
+
+    out = tmp_path / "f.png"
+    assert main(["plot", "--paper", "fig6-sensed", SENSED, "-o", str(out)]) == 0
+    assert capsys.readouterr().out == f"wrote {out} (4 runs)\n"
+    assert out.read_bytes()[:4] == b"\x89PNG"
+    assert main(["plot", "--paper", "fig6-sensed", str(tmp_path), "-o", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"error: {tmp_path}: fig6-sensed runs each scenario at every loss rate: "
+        "name scenario files\n"
+    )
