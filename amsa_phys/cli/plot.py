@@ -25,11 +25,12 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--paper",
-        choices=("fig5", "fig6", "fig6-sensed"),
+        choices=("fig5", "fig6", "fig6-sensed", "fig5-start"),
         help="the paper's Fig. 5 or Fig. 6 redrawn from the runs, beside the paper's numbers "
         "(-o default: paper_fig5.png / paper_fig6.png); fig6-sensed: Fig. 6 at 0/10/50/90 %% "
         "GPS loss, with the distance sensed from GPS beside the paper's true-distance wiring "
-        "(scenarios/paper_fig6_sensed.yaml and paper_fig6.yaml)",
+        "(scenarios/paper_fig6_sensed.yaml and paper_fig6.yaml); fig5-start: Fig. 5's "
+        "maxima and rms errors against the initial gap between the rovers",
     )
     p.add_argument(
         "-o",
@@ -139,8 +140,10 @@ def _plot_paper(args: argparse.Namespace) -> int:
     """``--paper fig5|fig6``: run (or read) the paper's scenarios and draw the figure."""
     from ..plots import paper  # matplotlib: only once the runs are in
 
-    if args.paper == "fig6-sensed":
-        return _plot_losses(args)
+    if args.paper in ("fig6-sensed", "fig5-start"):
+        from .paperplots import plot_losses, plot_starts
+
+        return plot_losses(args) if args.paper == "fig6-sensed" else plot_starts(args)
     sources = [Path(s) for s in args.rundir] or _paper_scenarios(args.paper)
     out = Path(args.output) if args.output else Path(f"paper_{args.paper}.png")
     check_output(out, "--output")
@@ -153,34 +156,6 @@ def _plot_paper(args: argparse.Namespace) -> int:
             raise ConfigError("Fig. 6 is one run (Kv 0.35, then 0.05)", key="--paper fig6")
         paper.fig6(runs[0], out)
     print(one_line(f"wrote {out} ({len(runs)} run{'s' if len(runs) != 1 else ''})"))
-    return 0
-
-
-def _plot_losses(args: argparse.Namespace) -> int:
-    """``--paper fig6-sensed``: each scenario at every GPS loss rate, one panel each."""
-    from ..plots import paperloss  # matplotlib: only once the runs are in
-
-    sources = [Path(s) for s in args.rundir]
-    if not sources:
-        sources = [_paper_scenarios("fig6-sensed")[0], _paper_scenarios("fig6")[0]]
-    for src in sources:
-        if src.is_dir():
-            raise ConfigError(
-                "fig6-sensed runs each scenario at every loss rate: name scenario files",
-                file=src,
-            )
-    out = Path(args.output) if args.output else Path("paper_fig6_sensed.png")
-    check_output(out, "--output")
-    panels = []
-    for src in sources:
-        runs = [
-            (loss, _paper_run(src, [f"LeaderGPS.lostDataGPS={loss}"]))
-            for loss in paperloss.LOSS_RATES
-        ]
-        panels.append((runs[0][1].label, runs))
-    paperloss.fig6_losses(panels, out)
-    count = len(panels) * len(paperloss.LOSS_RATES)
-    print(one_line(f"wrote {out} ({count} runs)"))
     return 0
 
 
