@@ -121,3 +121,21 @@ def test_a_finished_phase_before_the_cut_is_judged_as_ever() -> None:
     (check,) = check_expectations([Expectation("collisions", 0, None, 0.5, 1)], metrics)
     assert check.verdict == "FAIL"
     assert not check.skipped
+
+
+def test_the_replay_judges_the_failed_check_too(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The resolved scenario.yaml keeps a check the cut run failed for good (it leaves out
+    only the checks the run did not judge), so replaying it fails the same check."""
+    argv = ["run", str(SCENARIO1), "--headless", "--duration", "60", "--no-plot", "-q"]
+    for text in CRASH:
+        argv += ["--set", text]
+    assert main([*argv, "--out", str(tmp_path / "o")]) == 1
+    resolved = (tmp_path / "o" / "scenario.yaml").read_text()
+    assert "metric: collisions" in resolved
+    assert "rms_error" not in resolved.split("\n", 1)[1]  # not judged: left out (named atop)
+    capsys.readouterr()
+    replay = ["run", str(tmp_path / "o" / "scenario.yaml"), "--headless", "--no-plot", "-q"]
+    assert main([*replay, "--out", str(tmp_path / "r")]) == 1
+    assert capsys.readouterr().err == "expect collisions = 1, below 1: FAIL\n"
