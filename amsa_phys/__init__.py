@@ -21,6 +21,7 @@ __version__ = "0.1.0"
 _LAZY = {
     "run": ".api.result",
     "Run": ".api.result",
+    "TraceSizeWarning": ".api.memory",
     "load": ".api.source",
     "validate": ".api.source",
     "AmsaError": ".errors",
@@ -41,6 +42,7 @@ __all__ = [  # noqa: RUF022  grouped as the README lists them
     "__version__",
     "run",
     "Run",
+    "TraceSizeWarning",
     "load",
     "validate",
     "AmsaError",
@@ -58,6 +60,7 @@ __all__ = [  # noqa: RUF022  grouped as the README lists them
 ]
 
 if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eagerly
+    from .api.memory import TraceSizeWarning
     from .api.result import Run, run
     from .api.source import load, validate
     from .errors import AmsaError, ConfigError, ExpectationFailed, Interrupted, RunFault

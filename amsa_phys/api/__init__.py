@@ -5,7 +5,8 @@ exposes these names lazily, so ``import amsa_phys`` stays cheap). See the README
 "From Python".
 """
 
+from .memory import TraceSizeWarning
 from .result import Run, run
 from .source import MAPPING, load, validate
 
-__all__ = ["MAPPING", "Run", "load", "run", "validate"]
+__all__ = ["MAPPING", "Run", "TraceSizeWarning", "load", "run", "validate"]

@@ -27,6 +27,7 @@ from ..runs.expect import Check, check_expectations
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import Ended, execute, write_run_files
 from ..runs.suite import input_files
+from .memory import check_trace_memory
 from .source import Source, load
 
 
@@ -68,6 +69,8 @@ class Run:
 
         As ``amsa-phys run`` exits 0 for a run cut short whose checks were skipped, a skipped
         check does not fail: look at :attr:`skipped` to tell "all held" from "none judged".
+        A cut-short check that has already failed for good (a collision under
+        ``collisions below 1``, a maximum past its ``below``) fails.
         """
         return all(c.passed for c in self.checks)
 
@@ -127,7 +130,9 @@ def run(
     ``progress=True`` shows the progress bar.
     Errors are the CLI's, raised: :class:`~amsa_phys.errors.ConfigError` for bad input and
     :class:`~amsa_phys.errors.RunFault` for a fault during the run, with the CLI's one-line
-    message; Ctrl-C stops the run between two instants and raises
+    message. The trace is kept in memory: a :class:`~amsa_phys.api.memory.TraceSizeWarning`
+    above ~1 GB, a ConfigError if it could not fit in the machine's memory. Ctrl-C stops
+    the run between two instants and raises
     :class:`~amsa_phys.errors.Interrupted`. A fault or an interrupt carries the run up to
     that instant as the exception's ``run`` attribute (inspect it, or ``save`` it).
     ``bag`` also writes the run as a ROS 2 MCAP bag there (``--bag``; an existing file is
@@ -143,7 +148,9 @@ def run(
         base_dir=base_dir,
         adapt=adapt,
     )
-    memory = TraceMemory(traced_columns(scenario))
+    columns = traced_columns(scenario)
+    check_trace_memory(scenario, columns)  # warn above 1 GB, refuse above the machine's RAM
+    memory = TraceMemory(columns)
     recorder = bag_recorder(bag, scenario) if bag is not None else None
     try:
         with interrupt.deferred():

@@ -25,9 +25,10 @@ from typing import Any
 import yaml
 
 from ..errors import ConfigError
+from ..model.params import short_repr
 from ..model.scenario import Scenario, build_scenario, configure_scenario, load_scenario
 from ..model.world import build_world
-from ..model.yamlio import KeyPath, YamlDoc, dotted, load_yaml
+from ..model.yamlio import MAX_DEPTH, MAX_NODES, KeyPath, YamlDoc, dotted, load_yaml
 
 #: What errors in a scenario given as a mapping name instead of a file.
 MAPPING = "<mapping>"
@@ -78,7 +79,7 @@ def _load(
     base_dir: str | os.PathLike[str] | None,
 ) -> Scenario:
     """:func:`load` before ``adapt``."""
-    overrides = [override_text(key, value) for key, value in (set or {}).items()]
+    overrides = [override_text(key, value) for key, value in _set_items(set)]
     seed = _seed(seed)
     dur = None if duration is None else _number(duration, "--duration")
     rate = None if log_rate is None else _number(log_rate, "--log-rate")
@@ -118,6 +119,8 @@ def validate(source: Source, *, base_dir: str | os.PathLike[str] | None = None) 
 
 def mapping_doc(source: Mapping[str, Any], base_dir: str | os.PathLike[str] | None) -> MappingDoc:
     """``source`` as a document of plain YAML values; relative paths against ``base_dir``."""
+    if base_dir is not None and not isinstance(base_dir, (str, os.PathLike)):
+        raise TypeError(f"base_dir= is a directory path, got {type(base_dir).__name__}")
     data = _plain(source, ())
     if not isinstance(data, dict):  # pragma: no cover - a Mapping always gives a dict
         raise ConfigError("expected a mapping", file=MAPPING)
@@ -131,11 +134,27 @@ def override_text(key: Any, value: Any) -> str:
     if not isinstance(key, str) or "=" in key:
         raise ConfigError(f"expected Component.parameter, got {key!r}", key="--set")
     text = yaml.safe_dump(
-        _plain(value, (key,)), default_flow_style=True, width=math.inf, allow_unicode=True
+        _plain(value, (key,), "--set"), default_flow_style=True, width=math.inf, allow_unicode=True
     )
     if text.endswith("\n...\n"):  # a bare scalar document
         text = text[: -len("\n...\n")]
     return f"{key}={text.strip()}"
+
+
+def _set_items(overrides: Any) -> list[tuple[Any, Any]]:
+    """``set=``'s items: a mapping ``{"Comp.param": value}`` (as ``--set Comp.param=value``)."""
+    if overrides is None:
+        return []
+    if not isinstance(overrides, Mapping):
+        hint = ""
+        if isinstance(overrides, (str, list, tuple)):
+            hint = ' (the --set texts "Comp.param=value" become {"Comp.param": value})'
+        raise ConfigError(
+            f'expected a mapping like {{"Comp.param": value}}, got {type(overrides).__name__} '
+            f"{short_repr(overrides)}{hint}",
+            key="--set",
+        )
+    return list(overrides.items())
 
 
 def _seed(seed: Any) -> int | None:
@@ -163,40 +182,85 @@ def _is_numpy(value: Any) -> bool:
     return type(value).__module__ == "numpy" and hasattr(value, "item")
 
 
-def _plain(value: Any, keypath: KeyPath) -> Any:
-    """``value`` with only the types a YAML file can give (dict, list, str, numbers, bool)."""
-    if value is None or isinstance(value, (bool, str)):
-        return value
-    if isinstance(value, int):
-        return int(value)  # an IntEnum is written as its number
-    if isinstance(value, float):
-        return float(value)
-    if isinstance(value, Mapping):
-        out = {}
-        for key, item in value.items():
-            if not isinstance(key, str):
-                raise ConfigError(
-                    f"keys must be strings, got {key!r}", file=MAPPING, key=dotted(keypath)
-                )
-            out[key] = _plain(item, (*keypath, key))
-        return out
-    if isinstance(value, (list, tuple)):
-        return [_plain(v, (*keypath, i)) for i, v in enumerate(value)]
-    if isinstance(value, Fraction):
-        if value.denominator == 1:
-            return int(value)
-        if Fraction(repr(float(value))) == value:
+def _plain(value: Any, keypath: KeyPath, option: str | None = None) -> Any:
+    """``value`` with only the types a YAML file can give (dict, list, str, numbers, bool).
+
+    Bounded as a file is (``model/yamlio.py``): at most ``MAX_DEPTH`` levels and
+    ``MAX_NODES`` values, and a mapping or list that contains itself is refused by name (it
+    would recurse forever: a RecursionError, or an exponential walk of a shared list).
+    """
+    return _Plainer(keypath, option).convert(value, keypath)
+
+
+class _Plainer:
+    """One conversion: counts the values built and knows the containers being walked.
+
+    Errors name ``<mapping>`` and the key path, or the CLI ``option`` (``--set``) and the
+    override's key when converting an argument.
+    """
+
+    def __init__(self, root: KeyPath, option: str | None = None) -> None:
+        self.root = root  # where a "too large" is reported (not deep inside)
+        self.option = option
+        self.nodes = 0
+        self.open: set[int] = set()  # ids of the containers on the current path
+
+    def convert(self, value: Any, keypath: KeyPath) -> Any:
+        self.nodes += 1
+        if self.nodes > MAX_NODES:
+            raise self.error(self.root, f"too large: more than {MAX_NODES:,} values")
+        if len(keypath) > MAX_DEPTH:
+            raise self.error(keypath, f"nesting deeper than {MAX_DEPTH} levels")
+        if isinstance(value, (Mapping, list, tuple)):
+            if id(value) in self.open:
+                raise self.error(keypath, "contains itself (a mapping or list cannot)")
+            self.open.add(id(value))
+            try:
+                return self.container(value, keypath)
+            finally:
+                self.open.discard(id(value))
+        return self.scalar(value, keypath)
+
+    def container(
+        self, value: Mapping[Any, Any] | list[Any] | tuple[Any, ...], keypath: KeyPath
+    ) -> Any:
+        if isinstance(value, Mapping):
+            out = {}
+            for key, item in value.items():
+                if not isinstance(key, str):
+                    raise self.error(keypath, f"keys must be strings, got {short_repr(key)}")
+                out[key] = self.convert(item, (*keypath, key))
+            return out
+        return [self.convert(v, (*keypath, i)) for i, v in enumerate(value)]
+
+    def scalar(self, value: Any, keypath: KeyPath) -> Any:
+        if value is None or isinstance(value, (bool, str)):
+            return value
+        if isinstance(value, int):
+            return int(value)  # an IntEnum is written as its number
+        if isinstance(value, float):
             return float(value)
-        return f"{value.numerator}/{value.denominator}"
-    if isinstance(value, os.PathLike):
-        return os.fspath(value)
-    if _is_numpy(value):
-        if getattr(value, "ndim", 0):
-            return _plain(value.tolist(), keypath)
-        return _plain(value.item(), keypath)
-    raise ConfigError(
-        f"a {type(value).__name__} cannot be written in a scenario "
-        "(use numbers, strings, booleans, lists and mappings)",
-        file=MAPPING,
-        key=dotted(keypath),
-    )
+        if isinstance(value, Fraction):
+            if value.denominator == 1:
+                return int(value)
+            if Fraction(repr(float(value))) == value:
+                return float(value)
+            return f"{value.numerator}/{value.denominator}"
+        if isinstance(value, os.PathLike):
+            return os.fspath(value)
+        if _is_numpy(value):
+            if getattr(value, "ndim", 0):
+                if value.size > MAX_NODES:
+                    raise self.error(self.root, f"too large: more than {MAX_NODES:,} values")
+                return self.convert(value.tolist(), keypath)
+            return self.convert(value.item(), keypath)
+        raise self.error(
+            keypath,
+            f"a {type(value).__name__} cannot be written in a scenario "
+            "(use numbers, strings, booleans, lists and mappings)",
+        )
+
+    def error(self, keypath: KeyPath, message: str) -> ConfigError:
+        if self.option is not None:
+            return ConfigError(message, key=f"{self.option} {dotted(keypath)}")
+        return ConfigError(message, file=MAPPING, key=dotted(keypath))

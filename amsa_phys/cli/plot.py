@@ -25,10 +25,13 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--paper",
-        choices=("fig5", "fig6", "fig7"),
+        choices=("fig5", "fig6", "fig6-sensed", "fig5-start", "fig7"),
         help="the paper's Fig. 5 or Fig. 6 redrawn from the runs, beside the paper's numbers "
-        "(-o default: paper_fig5.png / paper_fig6.png); fig7: the adaptive run of "
-        "scenarios/adaptive.yaml against every fixed Kv",
+        "(-o default: paper_fig5.png / paper_fig6.png); fig6-sensed: Fig. 6 at 0/10/50/90 %% "
+        "GPS loss, with the distance sensed from GPS beside the paper's true-distance wiring "
+        "(scenarios/paper_fig6_sensed.yaml and paper_fig6.yaml); fig5-start: Fig. 5's "
+        "maxima and rms errors against the initial gap between the rovers; fig7: the adaptive "
+        "run of scenarios/adaptive.yaml against every fixed Kv",
     )
     p.add_argument(
         "-o",
@@ -146,6 +149,10 @@ def _plot_paper(args: argparse.Namespace) -> int:
         return plot_fig7(args)
     from ..plots import paper  # matplotlib: only once the runs are in
 
+    if args.paper in ("fig6-sensed", "fig5-start"):
+        from .paperplots import plot_losses, plot_starts
+
+        return plot_losses(args) if args.paper == "fig6-sensed" else plot_starts(args)
     sources = [Path(s) for s in args.rundir] or _paper_scenarios(args.paper)
     out = Path(args.output) if args.output else Path(f"paper_{args.paper}.png")
     check_output(out, "--output")
@@ -163,7 +170,9 @@ def _plot_paper(args: argparse.Namespace) -> int:
 
 def _paper_scenarios(figure: str) -> list[Path]:
     """The shipped scenarios of a figure, found under ./scenarios."""
-    pattern = "paper_fig5_kv*.yaml" if figure == "fig5" else "paper_fig6.yaml"
+    pattern = {"fig5": "paper_fig5_kv*.yaml", "fig6-sensed": "paper_fig6_sensed.yaml"}.get(
+        figure, "paper_fig6.yaml"
+    )
     found = sorted(Path("scenarios").glob(pattern))
     if not found:
         raise ConfigError(
@@ -174,8 +183,9 @@ def _paper_scenarios(figure: str) -> list[Path]:
     return found
 
 
-def _paper_run(source: Path) -> Any:
-    """A :class:`~amsa_phys.plots.paper.PaperRun` from a run directory or a scenario file."""
+def _paper_run(source: Path, overrides: list[str] | None = None) -> Any:
+    """A :class:`~amsa_phys.plots.paper.PaperRun` from a run directory or a scenario file
+    (run with ``overrides``, ``--set`` texts)."""
     from ..plots.distance import read_trace
     from ..plots.paper import PaperRun
 
@@ -191,7 +201,7 @@ def _paper_run(source: Path) -> Any:
         from ..engine.tracemem import TraceMemory
         from ..runs.single import execute
 
-        scenario = load_scenario(source)
+        scenario = load_scenario(source, overrides)
         memory = TraceMemory(list(scenario.world.buffers))
         with interrupt.deferred():
             ended = execute(scenario, memory, progress=False)

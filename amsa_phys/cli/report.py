@@ -66,7 +66,7 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
     if metrics["overall"].get("partial"):
         print(
             f"(cut): the run stopped at t={metrics['simulated']:g} s, inside this block; "
-            "its checks are skipped",
+            "its checks are skipped unless already failed (a count or maximum past its bound)",
             file=stream,
         )
     q = metrics.get("quality")

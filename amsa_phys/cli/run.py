@@ -11,7 +11,7 @@ from ..bag import BagRecorder
 from ..engine import interrupt
 from ..errors import ConfigError, one_line
 from ..model.scenario import Scenario, load_scenario, traced_columns
-from ..model.tracecols import estimate_trace_bytes
+from ..model.tracecols import LARGE_TRACE_BYTES, estimate_trace_bytes, size_text
 from ..runs.expect import check_expectations
 from ..runs.plotjob import PlotJob
 from ..runs.rundir import default_run_dir, prepare_run_dir
@@ -118,10 +118,6 @@ def _run(
     return 0 if all(c.passed for c in checks) else 1
 
 
-#: Above this estimated size a run says how large its trace will be before it starts.
-LARGE_TRACE_BYTES = 1_000_000_000
-
-
 def warn_if_trace_is_large(scenario: Scenario) -> None:
     """One line on stderr before a run whose trace will pass ~1 GB (a wide, long run), with
     the two options that shrink it, so nobody finds a full disk an hour later."""
@@ -131,7 +127,7 @@ def warn_if_trace_is_large(scenario: Scenario) -> None:
     if size >= LARGE_TRACE_BYTES:
         print(
             one_line(
-                f"amsa-phys: note: trace.csv will be about {size / 1e9:.1f} GB "
+                f"amsa-phys: note: trace.csv will be {size_text(size)} "
                 f"({len(columns):,} columns at {rate:g} Hz for {duration:g} s); "
                 "--trace-columns or --log-rate make it smaller"
             ),

@@ -23,12 +23,14 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
+from ..api.memory import check_trace_memory
 from ..api.source import Source, load
 from ..engine.tracemem import TraceMemory
 from ..errors import ConfigError
 from ..model.scenario import Scenario
 from ..model.suggest import did_you_mean
 from ..model.template import Kind
+from . import args
 from .episode import Episode
 
 
@@ -71,8 +73,15 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
                 f"unknown render mode {render_mode!r}; amsa_phys/Follow-v0 renders 'rgb_array'",
                 key="render_mode",
             )
+        controller = args.component(controller)
+        actions = args.names(actions, "actions")
+        size = args.render_size(render_size)
+        self.action_scale = args.finite_number(action_scale, "action_scale", positive=True)
+        self.collision_penalty = args.finite_number(
+            collision_penalty, "collision_penalty", positive=False
+        )
         self._source = scenario
-        self._options = {"duration": duration, "set": dict(set or {}), "log_rate": log_rate}
+        self._options = {"duration": duration, "set": set, "log_rate": log_rate}
         self._base_dir = base_dir
         self._scenario = self._load({})
         world = self._scenario.world
@@ -104,14 +113,12 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
                 )
         if not self.acted:
             raise ConfigError(f"{self.path} has no output to act on", key="actions")
-        self.action_scale = float(action_scale)
-        self.collision_penalty = float(collision_penalty)
         self.period = 1 / leaf.freq
         self.metadata = {**self.metadata, "render_fps": float(leaf.freq)}
         self.observation_space = spaces.Box(-np.inf, np.inf, (len(self.observed),), np.float64)
         self.action_space = spaces.Box(-1.0, 1.0, (len(self.acted),), np.float64)
         self.render_mode = render_mode
-        self.render_size = (int(render_size[0]), int(render_size[1]))
+        self.render_size = size
         self.record_trace = record_trace
         self._episode: Episode | None = None
         self._memory: TraceMemory | None = None
@@ -129,16 +136,16 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         by the last ``reset(seed=...)``). ``options={"set": {"Comp.param": v}}`` changes
         parameters at t = 0 for this episode (on top of the constructor's ``set``).
         """
+        seed = args.seed(seed)
+        extra = args.reset_set(options)
         super().reset(seed=seed)
         episode_seed = seed if seed is not None else int(self.np_random.integers(0, 2**31 - 1))
         scenario = self._scenario
-        extra = dict((options or {}).get("set") or {})
-        unknown = sorted(set((options or {}).keys()) - {"set"})
-        if unknown:
-            raise ConfigError(f"unknown reset option {unknown[0]!r}; known: set", key="options")
         if extra:
             scenario = self._load(extra)
         scenario = dataclasses.replace(scenario, seed=episode_seed)
+        if self.record_trace:  # warn above 1 GB, refuse above the machine's memory
+            check_trace_memory(scenario, list(scenario.world.buffers))
         self.close()
         self._memory = TraceMemory(list(scenario.world.buffers)) if self.record_trace else None
         trace = self._memory.write if self._memory is not None else None
@@ -213,7 +220,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         return load(
             self._source,
             duration=opts["duration"],
-            set={**opts["set"], **extra_set},
+            set=_merged(opts["set"], extra_set),
             log_rate=opts["log_rate"],
             base_dir=self._base_dir,
         )
@@ -234,6 +241,14 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
             "signal": float(episode.sim.read(self.quality.signal)),
             "collisions": self._collisions,
         }
+
+
+def _merged(given: Any, extra: Mapping[str, Any]) -> Any:
+    """The constructor's ``set`` with a reset's on top (a wrong ``set`` is left for
+    ``load`` to refuse, naming it ``--set`` as ``amsa_phys.run`` does)."""
+    if given is None:
+        return dict(extra)
+    return {**given, **extra} if isinstance(given, Mapping) else given
 
 
 def _default_controller(scenario: Scenario) -> str:

@@ -50,7 +50,7 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
         log_rate=Fraction(str(data.get("log_rate", DEFAULT_LOG_RATE_HZ))),
         quality=quality,
         phases=phases,
-        expect=_expectations(doc, data, world, len(phases), quality),
+        expect=_expectations(doc, data, world, len(phases), quality, duration),
         data=data,
         trace_columns=_trace_patterns(doc, data, world),
         adapt=load_rules(doc, data.get("adapt", []), world),
@@ -140,7 +140,12 @@ def _quality(doc: YamlDoc, data: dict[str, Any], world: WorldSpec) -> Quality | 
 
 
 def _expectations(
-    doc: YamlDoc, data: dict[str, Any], world: WorldSpec, phases: int, quality: Quality | None
+    doc: YamlDoc,
+    data: dict[str, Any],
+    world: WorldSpec,
+    phases: int,
+    quality: Quality | None,
+    duration: Fraction,
 ) -> list[Expectation]:
     """``expect:``: bounds on metrics (overall or of a phase) or on a trace's samples."""
     expect = []
@@ -161,6 +166,12 @@ def _expectations(
                     (*kp, "before"),
                     f"before ({e['before']:g} s) is earlier than after ({e['after']:g} s): "
                     "the window holds no instant",
+                )
+            if "after" in e and Fraction(str(e["after"])) > duration:
+                raise doc.error(  # it would check nothing and pass (issue 33, 13)
+                    (*kp, "after"),
+                    f"{e['after']:g} s is after the end of the scenario (duration "
+                    f"{float(duration):g} s): the window would never hold a sample",
                 )
             expect.append(
                 Expectation(

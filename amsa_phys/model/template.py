@@ -214,6 +214,7 @@ BUILTINS: dict[str, str] = {
     "GoalMonitor": "amsa_phys.control.monitor:GoalMonitor",
     "ReactiveAvoider": "amsa_phys.control.avoider:ReactiveAvoider",
     "DistanceMonitor": "amsa_phys.control.monitor:DistanceMonitor",
+    "GpsDistance": "amsa_phys.control.gpsdistance:GpsDistance",
     "NormalizePower": "amsa_phys.control.normalize:NormalizePower",
     "FollowerController": "amsa_phys.control.follower:FollowerController",
     "ConstantPower": "amsa_phys.control.constant:ConstantPower",

@@ -12,16 +12,19 @@ so the same selection always gives the same file.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from fnmatch import fnmatchcase
 
 from .suggest import did_you_mean
 
 __all__ = [
+    "LARGE_TRACE_BYTES",
     "estimate_trace_bytes",
     "no_match_message",
     "parse_patterns",
     "selected",
+    "size_text",
     "unmatched",
 ]
 
@@ -30,6 +33,10 @@ __all__ = [
 #: MDE world (positions and headings with 17 digits). The estimate leans high: a user warned
 #: of 1.2 GB that turns out 1.1 is better served than the other way round.
 BYTES_PER_VALUE = 18
+
+#: Above this estimated size a run says how large its trace will be before it starts (the
+#: CLI for ``trace.csv``, ``amsa_phys.run`` for the trace it keeps in memory).
+LARGE_TRACE_BYTES = 1_000_000_000
 
 
 def parse_patterns(text: str) -> list[str]:
@@ -68,7 +75,23 @@ def no_match_message(pattern: str, columns: Sequence[str]) -> str:
     return f"{pattern!r} matches no Data buffer" + did_you_mean(pattern, columns)
 
 
-def estimate_trace_bytes(n_columns: int, rate_hz: float, duration_s: float) -> int:
-    """A rough size of a trace of ``n_columns`` at ``rate_hz`` for ``duration_s``."""
-    rows = int(rate_hz * duration_s) + 1
-    return rows * (n_columns + 1) * BYTES_PER_VALUE
+def estimate_trace_bytes(
+    n_columns: int, rate_hz: float, duration_s: float, bytes_per_value: float = BYTES_PER_VALUE
+) -> float:
+    """A rough size of a trace of ``n_columns`` at ``rate_hz`` for ``duration_s``.
+
+    A float, computed in floats: the schema accepts any finite duration (``--duration
+    1e308``), whose row count no longer fits a float, and an estimate must never be the
+    thing that fails (issue 33, 12). Beyond the float range the answer is ``inf``, which
+    compares and prints (:func:`size_text`) like any other size.
+    """
+    rows = float(rate_hz) * float(duration_s) + 1.0
+    return rows * (n_columns + 1) * bytes_per_value
+
+
+def size_text(n_bytes: float) -> str:
+    """A size for a person: ``about 1.2 GB``, ``about 3.7e+12 GB``, ``over 1e+299 GB``."""
+    if not math.isfinite(n_bytes):
+        return "over 1e+299 GB"
+    gb = n_bytes / 1e9
+    return f"about {gb:.1f} GB" if gb < 1e6 else f"about {gb:.2g} GB"

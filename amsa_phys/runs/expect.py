@@ -105,7 +105,12 @@ def check_expectations(
             continue
         why = skip_reason(e, metrics)
         if why is not None:
-            checks.append(Check(e, None, True, skipped=True, why=why))
+            broken = already_broken(e, metrics)
+            if broken is None:
+                checks.append(Check(e, None, True, skipped=True, why=why))
+            else:
+                value, note = broken
+                checks.append(Check(e, value, False, note=note))
             continue
         block = metrics["overall"] if e.phase is None else metrics["phases"][e.phase]
         value = block.get(e.metric)
@@ -123,7 +128,8 @@ def skip_reason(e: Expectation, metrics: dict[str, Any]) -> str | None:
 
     A phase the run never reached, or a block the run stopped inside (``--duration`` shorter
     than the file's, the window closed early), is not judged: the bound is about the whole
-    phase, and half a phase would fail (or pass) for the wrong reason.
+    phase, and half a phase would fail (or pass) for the wrong reason -- unless it has already
+    failed for good (:func:`already_broken`), which the caller checks.
     """
     if e.trace is not None:
         return None
@@ -135,6 +141,48 @@ def skip_reason(e: Expectation, metrics: dict[str, Any]) -> str | None:
         what = "the run" if e.phase is None else f"phase {e.phase}"
         return f"{what} was cut short at t={reached:g} s"
     return None
+
+
+#: Metrics that can only move one way as a block goes on, and the bound they can only break
+#: for good: a count of collisions and a maximum only grow (``below``), a minimum only
+#: shrinks (``above``). ``max_after_approach`` is a maximum once the first approach has
+#: happened (None before it: nothing is known yet).
+MONOTONE = {
+    "collisions": "below",
+    "max_distance": "below",
+    "max_after_approach": "below",
+    "min_distance": "above",
+}
+
+
+def already_broken(e: Expectation, metrics: dict[str, Any]) -> tuple[float, str] | None:
+    """``(value, note)`` if a check of a block the run stopped inside has already failed.
+
+    The rest of a cut-short block could not have repaired a monotone metric: 1 collision
+    at t = 9.7 s is a failed ``collisions below 1`` however the run would have gone on, so
+    that check is FAIL, not skipped (a skipped check passes). Any other partial check stays
+    skipped (:func:`skip_reason`).
+    """
+    if e.metric not in MONOTONE or e.trace is not None:
+        return None
+    if e.phase is not None and e.phase >= len(metrics["phases"]):
+        return None  # never reached: nothing measured
+    block = metrics["overall"] if e.phase is None else metrics["phases"][e.phase]
+    value = block.get(e.metric)
+    if not block.get("partial") or value is None:
+        return None
+    side = MONOTONE[e.metric]
+    bound = e.below if side == "below" else e.above
+    if bound is None:
+        return None
+    broken = value >= bound if side == "below" else value <= bound
+    if not broken:
+        return None
+    reached = metrics.get("simulated", 0.0)
+    why = {"collisions": "a count", "min_distance": "a minimum"}.get(e.metric, "a maximum")
+    why += " only grows" if side == "below" else " only shrinks"
+    note = f"already broken when the run was cut short at t={reached:g} s: {why}"
+    return float(value), note
 
 
 def _read(trace: Path | tuple[list[str], np.ndarray] | None) -> tuple[list[str], np.ndarray]:

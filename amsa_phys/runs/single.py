@@ -27,7 +27,7 @@ from ..model.metrics import compute_metrics
 from ..model.scenario import Expectation, Scenario, traced_columns
 from ..view.drive import FrameSink, advance
 from ..view.encoder import EncoderError
-from .expect import describe_bound, describe_what, skip_reason
+from .expect import already_broken, describe_bound, describe_what, skip_reason
 from .plotjob import PlotJob, plot_context
 from .resolve import resolved_scenario
 
@@ -249,7 +249,15 @@ def execute(
         if picture is not None:
             metrics["snapshot"] = {"path": str(picture), "t": float(still.at)}
     stopped_early = window and not sim.finished and error is None and sim.now > 0
-    drop = [e for e in scenario.expect if skip_reason(e, metrics) is not None]
+    end = sim.now if stopped_early else scenario.duration
+    # left out of the replay: the checks this run did not judge (one it failed for good it
+    # did judge), and windows starting after the replay's end, which its loader refuses
+    drop = [
+        e
+        for e in scenario.expect
+        if (skip_reason(e, metrics) is not None and already_broken(e, metrics) is None)
+        or (e.after is not None and e.after > end)
+    ]
     resolved = resolved_scenario(
         scenario,
         extra=sim.live_changes,

@@ -161,51 +161,105 @@ def test_keep_runs_writes_each_run_directory(tmp_path: Path) -> None:
     assert "MyFollowerController.Kv: 0.2" in (runs[1] / "scenario.yaml").read_text()
 
 
+class Terminal:
+    """A pseudo-terminal for a child's stderr, read without blocking.
+
+    On a terminal the sweep shows its progress bar (tqdm), which moves off ``0/N`` only
+    once the parent has *received* a finished row: the one observable event that says
+    "some rows are in". A file or a fixed wait cannot say it (results.csv is written at
+    the end; a batch's run directories exist before the parent has its rows).
+    """
+
+    def __init__(self) -> None:
+        import fcntl
+        import pty
+        import struct
+        import termios
+
+        self.master, self.child_end = pty.openpty()
+        # a 0-column terminal (a new pty's size) gets an empty bar: give it 24 x 120
+        fcntl.ioctl(self.child_end, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 120, 0, 0))
+        self.text = ""
+
+    def read(self) -> str:
+        """Everything the child wrote so far (never blocks)."""
+        import os
+        import select
+
+        while select.select([self.master], [], [], 0)[0]:
+            try:
+                data = os.read(self.master, 65536)
+            except OSError:  # EIO: the child closed its end
+                break
+            if not data:
+                break
+            self.text += data.decode("utf-8", "replace")
+        return self.text
+
+    def close(self) -> None:
+        import os
+
+        os.close(self.master)
+
+
 @pytest.mark.parametrize("how", ["sigint-group", "sigterm"])
 def test_ctrl_c_keeps_every_finished_row(tmp_path: Path, how: str) -> None:
+    import os
+    import re
     import signal
     import subprocess
     import sys
-    import time
+
+    from longrun import wait_until
 
     out = tmp_path / "int"
-    proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "amsa_phys",
-            "sweep",
-            str(SCEN),
-            "--range",
-            "MyFollowerController.Kv=0.01:0.4:2000",
-            "--duration",
-            "60",
-            "-j",
-            "2",
-            # batches of 25 runs (~0.5 s each): some are done at 4 s, most are not
-            "--batch-size",
-            "25",
-            "--out",
-            str(out),
-        ],
-        stderr=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-    )
-    time.sleep(4)
-    import os
-
+    terminal = Terminal()
+    with open(tmp_path / "stdout.txt", "w") as stdout:
+        proc = subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "amsa_phys",
+                "sweep",
+                str(SCEN),
+                "--range",
+                "MyFollowerController.Kv=0.01:0.4:2000",
+                "--duration",
+                "60",
+                "-j",
+                "2",
+                # batches of 25 runs (~0.5 s each): the sweep is stopped once the first
+                # batch's rows are in, long before the 80 batches are
+                "--batch-size",
+                "25",
+                "--out",
+                str(out),
+            ],
+            stdin=subprocess.DEVNULL,
+            stdout=stdout,
+            stderr=terminal.child_end,
+            text=True,
+            start_new_session=True,
+        )
+    os.close(terminal.child_end)
+    some_rows = re.compile(r"\b[1-9][0-9]*/2000\b")  # the bar past 0/2000
     try:
+        wait_until(
+            "the sweep received a finished batch",
+            lambda: some_rows.search(terminal.read()) is not None,
+            proc,
+        )
         if how == "sigterm":
             proc.terminate()
         else:
             os.killpg(proc.pid, signal.SIGINT)  # like a terminal's Ctrl-C: the whole group
-        _, err = proc.communicate(timeout=60)
+        proc.wait(timeout=120)  # bounds a hang only
+        err = terminal.read()
     finally:  # a hung sweep must not outlive the test with its workers
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
+        terminal.close()
     assert proc.returncode == 130, err
     assert "sweep interrupted" in err
     table = rows(out)
