@@ -73,7 +73,8 @@ def _one_line(text: str) -> str:
 def xml_text(text: str) -> str:
     """Character data: ``&<>`` escaped; characters XML 1.0 cannot hold at all become ``?``."""
     text = re.sub(r"[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff\ud800-\udfff]", "?", str(text))
-    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    text = text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    return text.replace("\r", "&#13;")  # a parser would read a raw CR as a newline
 
 
 def xml_attr(text: str) -> str:
@@ -86,7 +87,7 @@ def xml_attr(text: str) -> str:
     if "$(" in text:
         raise ConfigError(f"{text!r} holds '$(' which roslaunch would evaluate; rename it")
     out = xml_text(text).replace('"', "&quot;")
-    return out.replace("\n", "&#10;").replace("\r", "&#13;").replace("\t", "&#9;")
+    return out.replace("\n", "&#10;").replace("\t", "&#9;")
 
 
 def xml_comment(text: str) -> str:
