@@ -173,7 +173,8 @@ def test_shell_word_is_one_word(value: str) -> None:
 @pytest.mark.parametrize("value", VALUES, ids=IDS)
 def test_markdown_code_and_text_stay_on_one_line(value: str) -> None:
     for text in (quote.md_code(value), quote.md_text(value)):
-        assert "\n" not in text and "\r" not in text
+        assert "\n" not in text
+        assert "\r" not in text
     assert quote.md_code(value).count("`") == 2
 
 
