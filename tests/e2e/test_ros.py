@@ -306,3 +306,95 @@ def test_ctrl_c_stops_every_node_and_keeps_the_outputs(
     assert len(rows) > 10 * 20  # at least the 10 s before the phase
     n = min(len(rows), len(ref))
     assert rows[:n] == ref[:n]
+
+
+def _rosparam(launch: Launch, *args: str) -> str:
+    """``rosparam ARGS`` in the launch's network namespace; its output."""
+    done = subprocess.run(
+        ["nsenter", "-t", str(launch.proc.pid), "-n", "rosparam", *args],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "ROS_MASTER_URI": "http://localhost:11311"},
+    )
+    assert done.returncode == 0, done.stderr
+    return done.stdout.strip()
+
+
+def _same_run(out: Path, ref: Path) -> None:
+    assert (out / "trace.csv").read_bytes() == (ref / "trace.csv").read_bytes()
+    assert _metrics(out) == _metrics(ref)
+    assert (out / "scenario.yaml").read_text() == (ref / "scenario.yaml").read_text()
+
+
+def test_an_edited_params_file_is_what_runs_and_what_is_recorded(
+    workspace: Path, launcher: Callable[..., Launch], tmp_path: Path
+) -> None:
+    """Issue 33 item 7: Kv edited in config/*_params.yaml ran, but scenario.yaml said 0.1.
+    The run now equals ``amsa-phys run --set MyFollowerController.Kv=0.2``, records included."""
+    params = workspace / "src" / PKG / "config" / "ros_short_params.yaml"
+    original = params.read_text()
+    edited = original.replace(
+        "MyFollowerController:\n  Kv: 0.1\n", "MyFollowerController:\n  Kv: 0.2\n"
+    )
+    assert edited != original
+    out = workspace / "edited"
+    params.write_text(edited)
+    try:
+        text = launcher(workspace, "ros_short.launch", f"out:={out}", "plots:=false").finish()
+    finally:
+        params.write_text(original)
+    assert "completed" in text, text[-3000:]
+    assert "MyFollowerController.Kv=0.2 (parameter server)" in text
+    ref = tmp_path / "ref"
+    argv = ["run", str(SCENARIO), "--headless", "--out", str(ref), "-q", "--no-plot"]
+    assert main([*argv, "--set", "MyFollowerController.Kv=0.2"]) == 0
+    _same_run(out, ref)
+
+
+def test_duration_argument_cuts_the_run_as_run_duration_does(
+    workspace: Path, launcher: Callable[..., Launch], tmp_path: Path
+) -> None:
+    """``duration:=12.5`` stops inside phase 1: partial, its checks skipped, as ``run``
+    (the ROS simulator had its own cut, which judged the cut phase as if complete)."""
+    out = workspace / "cut"
+    text = launcher(
+        workspace, "ros_short.launch", f"out:={out}", "plots:=false", "duration:=12.5"
+    ).finish()
+    assert "completed, simulated 12.5 s" in text, text[-3000:]
+    ref = tmp_path / "ref"
+    argv = ["run", str(SCENARIO), "--headless", "--out", str(ref), "-q", "--no-plot"]
+    assert main([*argv, "--duration", "12.5"]) == 0
+    _same_run(out, ref)
+    phases = json.loads((out / "metrics.json").read_text())["phases"]
+    assert [p.get("partial") for p in phases] == [None, True]  # the cut phase: not judged
+
+
+def test_free_mode_live_edits_are_events_and_refused_ones_are_put_back(
+    workspace: Path, launcher: Callable[..., Launch]
+) -> None:
+    """A ``rosparam set`` of a node's parameter is an event of the run; a refused value does
+    not stay on the parameter server. Waits for each effect, then stops with Ctrl-C."""
+    out = workspace / "live"
+    launch = launcher(
+        workspace,
+        "ros_short.launch",
+        f"out:={out}",
+        "plots:=false",
+        "mode:=free",
+        "duration:=3600",
+    )
+    assert launch.read_until("running ros_short"), "".join(launch.lines)[-3000:]
+    kv = "/MyFollowerController/Kv"
+    _rosparam(launch, "set", kv, "99")  # above the template's maximum (10)
+    while _rosparam(launch, "get", kv) == "99":  # put back by whoever judges it first
+        assert launch.proc.poll() is None, "".join(launch.lines)[-3000:]
+    assert float(_rosparam(launch, "get", kv)) == 0.1
+    _rosparam(launch, "set", kv, "0.2")
+    assert launch.read_until("live change MyFollowerController.Kv=0.2"), "".join(launch.lines)
+    os.killpg(launch.proc.pid, signal.SIGINT)
+    launch.finish()
+    events = json.loads((out / "metrics.json").read_text())["events"]
+    live = [e["detail"] for e in events if e["kind"] == "live change"]
+    assert live[0] == "MyFollowerController.Kv=0.2"
+    assert not any("99" in e["detail"] for e in events)
+    assert "MyFollowerController.Kv" in (out / "scenario.yaml").read_text().split("timeline")[1]
