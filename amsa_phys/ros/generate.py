@@ -18,10 +18,8 @@ by :func:`check_names`.
 
 from __future__ import annotations
 
-import importlib.util
 import re
 import stat
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -30,7 +28,6 @@ from .. import __version__
 from ..engine.timing import run_phases
 from ..errors import ConfigError
 from ..model.scenario import Scenario
-from ..model.template import BUILTINS
 from ..model.world import WorldSpec
 from ..runs.resolve import resolved_scenario
 from ..runs.rundir import unique_names
@@ -38,7 +35,7 @@ from . import names
 from .cppnode import check_cpp_ports, cmake_targets, cpp_bodies, cpp_node, hz
 from .graph import RosGraph, classify
 from .launchxml import launch_xml
-from .quote import Code, check_name, cmake_arg, fill, py_comment, py_string, yaml_comment, yaml_dump
+from .quote import Code, check_name, cmake_arg, fill, py_string, yaml_comment, yaml_dump
 from .readme import readme
 
 FILES = Path(__file__).parent / "files"
@@ -119,11 +116,8 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
     for path in cpp:
         check_cpp_ports(world.leaves[path], bodies[world.leaves[path].template.name()])
     source = ", ".join(Path(s).name for s in sources)
-    python = sys.executable
     files: dict[str, str] = {}
     executable: set[str] = set()
-
-    extra = _extra_path(world)
 
     def node(script: str, title: str, doc: str, module: str, args: Code) -> None:
         rel = f"nodes/{script}.py"
@@ -133,10 +127,8 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
             doc=doc,
             version=__version__,
             source=source,
-            python=python,
             module=Code(module),
             args=args,
-            extra_path=extra,
         )
         executable.add(rel)
 
@@ -191,7 +183,7 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         python_nodes=Code("\n".join(f"  {cmake_arg(f)}" for f in python_nodes)),
         cpp_targets=cmake_targets(cpp),
     )
-    files["README.md"] = readme(graph, pkg, source, launches, mode, cpp, python)
+    files["README.md"] = readme(graph, pkg, source, launches, mode, cpp)
     for rel, text in files.items():
         target = out / rel
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -206,29 +198,6 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         cpp,
         sorted(files),
     )
-
-
-def _extra_path(world: WorldSpec) -> Code:
-    """The user templates' module directories on ``sys.path`` (built-ins need nothing).
-
-    Every node loads the whole scenario, so every node needs every template importable.
-    """
-    lines = []
-    for ref in sorted({leaf.template_ref for leaf in world.leaves.values()} - set(BUILTINS)):
-        module = ref.partition(":")[0]
-        spec = importlib.util.find_spec(module)
-        if spec is None or spec.origin is None:
-            continue
-        root = Path(spec.origin).resolve().parent
-        for _ in range(module.count(".") + (1 if spec.origin.endswith("__init__.py") else 0)):
-            root = root.parent
-        line = f"sys.path.insert(0, {py_string(str(root))})  # {py_comment(ref)}"
-        if line not in lines:
-            lines.append(line)
-    if not lines:
-        return Code("")
-    head = "\n# user templates, imported from where they were found at export time\n"
-    return Code(head + "\n".join(lines) + "\n")
 
 
 def _leaf_doc(graph: RosGraph, path: str) -> str:

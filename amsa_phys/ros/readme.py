@@ -59,11 +59,23 @@ writes the outputs so far.
 
 ## Which Python
 
-The nodes import amsa-phys, so they run in the Python that exported the package:
-@@{python:md_code} (override with the environment variable `AMSA_PHYS_PYTHON`). catkin's
-relays start them with Debian's `python3` (which has `rospy`); each script then records where
-`rospy` lives and re-executes itself with that Python, which appends ROS's Python packages
-after its own.
+The Python nodes import amsa-phys in the Python that runs them: catkin's relays start them
+with the `python3` catkin was built with (`-DPYTHON_EXECUTABLE`, the one that has `rospy`).
+On the target (a robot, another machine) install the exporting version there:
+
+    python3 -m pip install amsa-phys==@@{version:md_text}
+
+(another version may step the templates differently, and lockstep would no longer reproduce
+`amsa-phys run` byte for byte). Where amsa-phys lives in a Python of its own (a venv), name
+it: `export AMSA_PHYS_PYTHON=/path/to/venv/bin/python` before `roslaunch`; each script then
+notes where `rospy` lives and re-executes itself with that Python, which appends ROS's
+Python packages after its own. Nothing in this package names a path of the machine that
+exported it: the workspace can be copied or moved (rebuild it there, or install it with
+`catkin_make install` and source `install/setup.bash`). User templates (`module:Class`)
+must be importable by that Python too (installed, or on `PYTHONPATH`). `package.xml`
+declares the dependency as the rosdep key `python3-amsa-phys-pip`; rosdep resolves it with
+a rule of your own (`python3-amsa-phys-pip: {ubuntu: {pip: {packages: [amsa-phys]}}}`) or
+install it with pip as above.
 
 ## Nodes, topics, parameters
 
@@ -90,7 +102,6 @@ def readme(
     launches: list[str],
     mode: str,
     cpp: list[str],
-    python: str,
 ) -> str:
     """The package's README.md."""
     world = graph.world
@@ -114,7 +125,6 @@ def readme(
         launches=Code(", ".join(md_code(x) for x in launches)),
         mode=mode,
         cpp_arg=Code(", `cpp`" if cpp else ""),
-        python=python,
         local=Code(", ".join(md_code(p) for p in local) or "none"),
         rows=Code("\n".join(rows)),
     )

@@ -82,6 +82,7 @@ class Launch:
         script = ws / "launch.sh"
         env = {k: v for k, v in os.environ.items() if not k.startswith("ROS") and k != "PYTHONPATH"}
         env["AMSA_ROS_TEST"] = self.token
+        env["AMSA_PHYS_PYTHON"] = sys.executable  # the package names no Python of its own
         env["ROS_HOME"] = str(ws / "roshome")
         env["PWD"] = str(ws)
         self.proc = subprocess.Popen(
@@ -398,3 +399,40 @@ def test_free_mode_live_edits_are_events_and_refused_ones_are_put_back(
     assert live[0] == "MyFollowerController.Kv=0.2"
     assert not any("99" in e["detail"] for e in events)
     assert "MyFollowerController.Kv" in (out / "scenario.yaml").read_text().split("timeline")[1]
+
+
+def test_a_moved_workspace_still_reproduces_the_run(
+    tmp_path: Path, reference: Path, launcher: Callable[..., Launch]
+) -> None:
+    """Issue 26: the package names no path of the machine that made it. Built and installed
+    (``catkin_make install``), the workspace is moved to another directory (the original
+    path is gone) and launched from there with the target's Python settings only: lockstep
+    still reproduces ``amsa-phys run`` byte for byte."""
+    ws = tmp_path / "made" / "ws"
+    assert main(["export", "ros", str(SCENARIO), "-o", str(ws / "src" / PKG)]) == 0
+    build = subprocess.run(
+        ["catkin_make", "install", "-C", str(ws), "-DPYTHON_EXECUTABLE=/usr/bin/python3"],
+        cwd=ws,
+        capture_output=True,
+        text=True,
+        env={**{k: v for k, v in os.environ.items() if k != "PYTHONPATH"}, "PWD": str(ws)},
+    )
+    assert build.returncode == 0, build.stdout[-3000:] + build.stderr[-3000:]
+    moved = tmp_path / "elsewhere" / "ws"
+    moved.parent.mkdir()
+    ws.rename(moved)
+    shutil.rmtree(moved / "build")  # only the installed package is used
+    shutil.rmtree(moved / "devel")
+    (moved / "launch.sh").write_text(
+        "set -e\nip link set lo up\n"
+        f"export ROS_LOG_DIR={moved}/roshome/log ROS_MASTER_URI=http://localhost:11311\n"
+        "export ROS_HOSTNAME=localhost ROS_DISTRO=${ROS_DISTRO:-debian}\n"
+        f"source {moved}/install/setup.bash\n"
+        f'exec roslaunch {PKG} "$@"\n'
+    )
+    out = moved / "run"
+    text = launcher(moved, "ros_short.launch", f"out:={out}", "plots:=false").finish()
+    assert "completed" in text, text[-3000:]
+    assert not (tmp_path / "made" / "ws").exists()
+    assert (out / "trace.csv").read_bytes() == (reference / "trace.csv").read_bytes()
+    assert _metrics(out) == _metrics(reference)

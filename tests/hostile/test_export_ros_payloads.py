@@ -17,6 +17,7 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -101,7 +102,12 @@ def test_payloads_never_run_at_catkin_make_or_roslaunch(
             stderr=subprocess.STDOUT,
             text=True,
             cwd=tmp_path,
-            env={**_no_ros_env(), "ROS_HOME": str(ws / "roshome"), "PWD": str(tmp_path)},
+            env={
+                **_no_ros_env(),
+                "ROS_HOME": str(ws / "roshome"),
+                "PWD": str(tmp_path),
+                "AMSA_PHYS_PYTHON": sys.executable,
+            },
             start_new_session=True,
         )
         try:
