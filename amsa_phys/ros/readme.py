@@ -92,6 +92,16 @@ Framework topics: `/clock`, `/amsa/step/LEAF` and `/amsa/done/LEAF` (lockstep re
 answers, `std_msgs/String`), `/amsa/phase` (the scenario node's announcements),
 `/amsa/ready` (start-up handshake: ROS 1 drops what is published before a subscriber
 connects, so the run starts once every publisher has all its subscribers).
+
+## Your own node
+
+A node of your own may replace a Leaf's node (same name in the launch file). It must subscribe
+to the Leaf's input topics and publish its outputs (`std_msgs/Float64`), and in free mode step
+on simulated time (`use_sim_time` is set). It need not announce itself on `/amsa/ready` nor
+read its parameters: in free mode the simulator waits for it by its topics (each output
+connected to the simulator, with the subscribers the graph expects). Lockstep needs the step
+protocol (`/amsa/step/LEAF`, `/amsa/done/LEAF`: see `include/PKG/amsa_leaf_node.h` where a C++
+node exists, or amsa-phys's `ros/runtime/leaf.py`) and the announcement.
 """
 
 

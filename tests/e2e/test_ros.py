@@ -436,3 +436,69 @@ def test_a_moved_workspace_still_reproduces_the_run(
     assert not (tmp_path / "made" / "ws").exists()
     assert (out / "trace.csv").read_bytes() == (reference / "trace.csv").read_bytes()
     assert _metrics(out) == _metrics(reference)
+
+
+#: A user's own node standing in for MyDistanceMonitor: plain rospy, no amsa-phys, and no
+#: ``/amsa/ready`` announcement (it only subscribes, steps on simulated time and publishes).
+USER_MONITOR = """#!/usr/bin/python3
+import math
+import rospy
+from std_msgs.msg import Float64
+
+rospy.init_node("MyDistanceMonitor")
+pos = {}
+for key in ("Leader/posX", "Leader/posY", "Follower/posX", "Follower/posY"):
+    rospy.Subscriber("/" + key, Float64, lambda m, k=key: pos.__setitem__(k, m.data))
+pub = rospy.Publisher("/MyDistanceMonitor/distanceFollowerToLeader", Float64, queue_size=10)
+rate = rospy.Rate(4)  # simulated time (use_sim_time)
+while not rospy.is_shutdown():
+    if len(pos) == 4:
+        dx = pos["Leader/posX"] - pos["Follower/posX"]
+        dy = pos["Leader/posY"] - pos["Follower/posY"]
+        pub.publish(Float64(math.hypot(dx, dy)))
+    try:
+        rate.sleep()
+    except rospy.ROSInterruptException:
+        break
+"""
+
+
+def test_free_mode_waits_for_a_user_node_by_its_topics(
+    workspace: Path, reference: Path, launcher: Callable[..., Launch]
+) -> None:
+    """Issue 26: a node that does not announce itself on /amsa/ready made a free-mode run
+    abort after 120 s. Here a user's monitor node replaces the generated one; the run starts
+    once its topic is connected, completes, and keeps the follower in the in-process bounds."""
+    pkg = workspace / "src" / PKG
+    script = pkg / "user_monitor.py"
+    launch_file = pkg / "launch" / "ros_short_user.launch"
+    script.write_text(USER_MONITOR)
+    script.chmod(0o755)
+    original = (pkg / "launch" / "ros_short.launch").read_text()
+    mine = (
+        '  <node pkg="mdeChallenge" name="MyDistanceMonitor" required="true"'
+        ' type="MyDistanceMonitor.py"/>'
+    )
+    assert mine in original
+    launch_file.write_text(
+        original.replace(mine, mine.replace("MyDistanceMonitor.py", "user_monitor.py"))
+    )
+    out = workspace / "user-node"
+    try:
+        launch = launcher(
+            workspace,
+            "ros_short_user.launch",
+            f"out:={out}",
+            "plots:=false",
+            "mode:=free",
+            "speed:=4",
+        )
+        text = launch.finish()
+    finally:
+        script.unlink()
+        launch_file.unlink()
+    assert "running ros_short (free)" in text, text[-3000:]
+    assert "completed" in text, text[-3000:]
+    free, ref = _metrics(out), _metrics(reference)
+    for key, bound in FREE_BOUNDS.items():
+        assert abs(free["overall"][key] - ref["overall"][key]) < bound, key

@@ -34,7 +34,7 @@ from ...runs.rundir import default_run_dir, prepare_run_dir
 from ...runs.single import run_scenario
 from .. import names
 from ..graph import RosGraph
-from . import records, rosio
+from . import readiness, records, rosio
 from .config import NodeConfig, load_config
 
 
@@ -82,14 +82,14 @@ class Link:
         }
         self.step_pubs = {}
         self.subs = []
+        self.data_subs: dict[str, Any] = {}
         for path in self.graph.remote:
             for b in self.graph.outputs(path):
                 self.received[b] = [0, float(world.buffers[b].initial)]
-                self.subs.append(
-                    rospy.Subscriber(
-                        names.topic(b), Float64, self._on_data, callback_args=b, tcp_nodelay=True
-                    )
+                self.data_subs[b] = rospy.Subscriber(
+                    names.topic(b), Float64, self._on_data, callback_args=b, tcp_nodelay=True
                 )
+                self.subs.append(self.data_subs[b])
             if self.lockstep:
                 self.replies[path] = None
                 self.step_pubs[path] = self.gate.publisher(names.step_topic(path), String, 1)
@@ -133,10 +133,32 @@ class Link:
 
     # -- start ------------------------------------------------------------------------------
     def wait_ready(self, timeout: float) -> list[str]:
-        """Wait for every node's ready message and our own publishers' subscribers."""
-        missing = self.gate.wait(timeout, also=lambda: self.expected_ready <= self.ready)
-        nodes = sorted(self.expected_ready - self.ready)
+        """Wait for every node and our own publishers' subscribers.
+
+        A node is ready when it says so on ``/amsa/ready`` (every generated node does, once
+        its publishers have all their subscribers). In free mode a node that does not (a
+        user's own node) is ready once its topics are: each output it publishes is connected
+        to this process and has as many subscribers registered with the master as the graph
+        expects. In lockstep every Leaf node must answer step requests, so it must be ours
+        or speak the protocol, and say so.
+        """
+        waiting: set[str] = set(self.expected_ready)
+
+        def ready() -> bool:
+            waiting.difference_update(self.ready)
+            if waiting and not self.lockstep:
+                subscribers = readiness.registered_subscribers(self.rospy)
+                waiting.difference_update(
+                    [n for n in waiting if n in self.graph.remote and self._up(n, subscribers)]
+                )
+            return not waiting
+
+        missing = self.gate.wait(timeout, also=ready)
+        nodes = sorted(waiting)
         return ([f"node /{n.replace('.', '/')}" for n in nodes] + missing) if missing else []
+
+    def _up(self, path: str, subscribers: dict[str, int]) -> bool:
+        return readiness.topics_up(self.graph, self.data_subs, path, subscribers)
 
     def attach(self, sim: Simulation) -> None:
         """The simulation whose values free mode updates and whose events remote Leaves add."""
