@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import errno
+import os
 from fractions import Fraction
 from pathlib import Path
 
@@ -100,14 +102,15 @@ def _load(path: str, args: argparse.Namespace) -> Scenario:
 
 
 def _ros(args: argparse.Namespace, out: Path) -> int:
-    from ..ros.generate import generate
+    from ..ros.generate import check_names, generate
 
     scenarios = [_load(f, args) for f in args.files]
+    check_names(scenarios, list(args.files))  # before anything is written
     inputs = [p for s in scenarios for p in input_files(s)]
     staged = staged_dir(out, args.force, inputs)
     try:
         package = generate(scenarios, list(args.files), args.mode, staged)
-        commit_staged(staged, out)
+        _commit(staged, out, args.force)
     except BaseException:
         discard_staged(staged)
         raise
@@ -135,9 +138,32 @@ def _amsa(args: argparse.Namespace, out: Path) -> int:
     try:
         (staged / exported.core_name).write_text(exported.core_text)
         (staged / exported.template_name).write_text(exported.template_text)
-        commit_staged(staged, out)
+        _commit(staged, out, args.force)
     except BaseException:
         discard_staged(staged)
         raise
     print(f"wrote {out / exported.core_name} and {out / exported.template_name}")
     return 0
+
+
+def _commit(staged: Path, out: Path, force: bool) -> None:
+    """Put the staged tree in place; without ``--force`` never replace what appeared meanwhile.
+
+    The output was checked (absent or empty) before generating, but another export may have
+    created it since. Without ``--force`` one ``rename`` does it: the kernel renames a
+    directory only onto nothing or an empty directory, so of concurrent exports exactly one
+    wins and the others fail here (exit 2) instead of silently replacing it.
+    """
+    if force:
+        commit_staged(staged, out)
+        return
+    try:
+        os.rename(staged, out)
+    except OSError as exc:
+        if exc.errno in (errno.EEXIST, errno.ENOTEMPTY, errno.ENOTDIR, errno.EISDIR):
+            raise ConfigError(
+                "was created by someone else while exporting (use --force to replace it)",
+                key="-o",
+                file=out,
+            ) from None
+        raise ConfigError(f"cannot write: {exc.strerror}", key="-o", file=out) from None

@@ -20,6 +20,14 @@ def add_args(p: argparse.ArgumentParser) -> None:
         metavar="FILE",
         help="the AMSA template file (.amsatemplate; default: the one the model names)",
     )
+    p.add_argument(
+        "--template-module",
+        action="append",
+        default=[],
+        metavar="MODULE",
+        help="a Python module the model names as a template's implementation (mypkg.rovers): "
+        "import it (import never imports code a file names unless told to); repeatable",
+    )
     p.add_argument("-o", "--out", required=True, metavar="WORLD.yaml", help="the world to write")
     p.add_argument("--force", action="store_true", help="replace an existing WORLD.yaml")
 
@@ -36,7 +44,7 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("is a directory, expected a world file name", key="-o", file=out)
     if (out.exists() or out.is_symlink()) and not args.force:
         raise ConfigError("exists (use --force to replace it)", key="-o", file=out)
-    imported = import_model(model, templates)
+    imported = import_model(model, templates, args.template_module)
     tmp = out.with_name(f".{out.name}.tmp-{os.getpid()}")
     try:
         try:
@@ -44,7 +52,16 @@ def run(args: argparse.Namespace) -> int:
             tmp.write_text(imported.text)
         except OSError as exc:
             raise ConfigError(f"cannot write: {exc.strerror}", key="-o", file=out) from None
-        world = load_world(tmp)  # the world must validate before it gets its name
+        try:
+            world = load_world(tmp)  # the world must validate before it gets its name
+        except ConfigError as exc:  # name the model, not the temporary file (removed below)
+            where = f"line {exc.line} of " if exc.line else ""
+            key = f"{exc.key}: " if exc.key else ""
+            raise ConfigError(
+                f"the world it imports to does not load ({where}the world {out.name}: "
+                f"{key}{exc.message})",
+                file=model,
+            ) from None
         os.replace(tmp, out)
     finally:
         tmp.unlink(missing_ok=True)

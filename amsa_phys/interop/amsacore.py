@@ -16,11 +16,13 @@ modules) travel in an ``xmi:Extension extender="amsa-phys"`` element, which EMF 
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
+from ..model.schema import NAME
 from .xmlsafe import Element, parse_file
 
 AMSA_NS = "http://com.merconcept/AMSA"
@@ -29,6 +31,7 @@ XSI_NS = "http://www.w3.org/2001/XMLSchema-instance"
 XSI_TYPE = f"{{{XSI_NS}}}type"
 XMI_ID = f"{{{XMI_NS}}}id"
 EXTENDER = "amsa-phys"
+_NAME = re.compile(NAME)
 
 
 @dataclass
@@ -74,15 +77,18 @@ class Model:
 
 def read_model(path: Path) -> Model:
     """Parse and resolve an AMSA model file; a one-line ConfigError on anything wrong."""
-    root = parse_file(path, "AMSA XMI")
-    if root.tag != f"{{{AMSA_NS}}}AMSAFramework":
-        raise ConfigError(
-            f"is not an AMSA model: the root element is {_show(root.tag)}, expected "
-            f"AMSA:AMSAFramework of namespace {AMSA_NS}",
-            file=path,
-            line=root.line,
-        )
+    root = parse_file(path, "AMSA XMI", _check_root)
     return _Reader(path, root).read()
+
+
+def _check_root(root: Element) -> str | None:
+    """Judged on the root's start tag, before the rest of the file is parsed."""
+    if root.tag != f"{{{AMSA_NS}}}AMSAFramework":
+        return (
+            f"is not an AMSA model: the root element is {_show(root.tag)}, expected "
+            f"AMSA:AMSAFramework of namespace {AMSA_NS}"
+        )
+    return None
 
 
 def _show(tag: str) -> str:
@@ -97,6 +103,9 @@ class _Reader:
         self.ids: dict[str, Element] = {}
         self.parent: dict[int, Element] = {}
         self.owner: dict[int, str] = {}  # element -> path of the component it is
+        #: element -> its children by feature (tag), built once per element a path walks
+        #: through: resolving N references is linear, not N x the children of the root
+        self.features: dict[int, dict[str, list[Element]]] = {}
         self._index(root)
 
     def _index(self, elem: Element) -> None:
@@ -141,9 +150,16 @@ class _Reader:
         return next(c for c in leaf.elem.children if c.local == "inputs" and c.get("name") == port)
 
     def _name(self, elem: Element, what: str) -> str:
+        """The element's name: one a world file can hold (the importer writes it as a key)."""
         name = elem.get("name")
         if not name:
             raise self.error(elem, f"{what} without a name")
+        if not _NAME.match(name):
+            raise self.error(
+                elem,
+                f"{what} is named {name!r}: amsa-phys names are a letter or _, then letters, "
+                "digits and _; rename it in the model",
+            )
         return name
 
     def _composite(
@@ -220,6 +236,15 @@ class _Reader:
             path, elem, template, href, elem.get("freq"), priority, params, inputs, outputs
         )
 
+    def _feature(self, elem: Element) -> dict[str, list[Element]]:
+        table = self.features.get(id(elem))
+        if table is None:
+            table = {}
+            for child in elem.children:
+                table.setdefault(child.local, []).append(child)
+            self.features[id(elem)] = table
+        return table
+
     def resolve(self, ref: str, at: Element) -> Element:
         """The element a reference names, or a ConfigError naming the dangling reference."""
         target = ref.strip()
@@ -244,7 +269,7 @@ class _Reader:
                 raise self.error(
                     at, f"dangling reference {ref!r}: bad index {index_text!r}"
                 ) from None
-            matches = [c for c in elem.children if c.local == feature]
+            matches = self._feature(elem).get(feature, [])
             if index >= len(matches) or index < 0:
                 raise self.error(
                     at,

@@ -25,6 +25,7 @@ from pathlib import Path
 
 from ..errors import ConfigError
 from ..model.template import Template
+from ..model.yamlio import read_regular_file
 
 #: The parameter types of an amsa-phys template, as a template file spells them.
 TYPE_WORDS = {
@@ -79,14 +80,11 @@ class TemplateDecl:
 
 def read_templates(path: Path) -> dict[str, TemplateDecl]:
     """Every template declared in ``path``, by name; a one-line ConfigError if malformed."""
+    data = read_regular_file(path, MAX_BYTES, "an AMSA template file")
     try:
-        if path.stat().st_size > MAX_BYTES:
-            raise ConfigError(f"is larger than {MAX_BYTES} bytes", file=path)
-        text = path.read_text(encoding="utf-8")
+        text = data.decode("utf-8")
     except UnicodeDecodeError:
         raise ConfigError("is not a UTF-8 text file (expected AMSA templates)", file=path) from None
-    except OSError as exc:
-        raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
     return parse_templates(text, path)
 
 

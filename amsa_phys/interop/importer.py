@@ -10,7 +10,10 @@ the real value (``set: {MyFollowerController.Kv: 0.35, MyNormalizePower.freq: 4}
 
 from __future__ import annotations
 
+import json
 import math
+import re
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -53,12 +56,19 @@ class Imported:
     warnings: list[Warning_] = field(default_factory=list)
 
 
-def import_model(model_path: Path, templates_path: Path | None = None) -> Imported:
-    """Read an AMSA model and write it as a world (text); see the module docstring."""
+def import_model(
+    model_path: Path, templates_path: Path | None = None, modules: Sequence[str] = ()
+) -> Imported:
+    """Read an AMSA model and write it as a world (text); see the module docstring.
+
+    A model may say that a template is implemented by a user's Python module
+    (``mypkg.rovers:Tracked``). Import never imports code a file names: such a module is
+    imported only if the user names it in ``modules`` (``--template-module``).
+    """
     model = read_model(model_path)
     tpath = templates_path or _templates_file(model)
     decls = read_templates(tpath)
-    return _Importer(model, tpath, decls).run()
+    return _Importer(model, tpath, decls, set(modules)).run()
 
 
 def _templates_file(model: Model) -> Path:
@@ -77,8 +87,11 @@ def _templates_file(model: Model) -> Path:
 
 
 class _Importer:
-    def __init__(self, model: Model, tpath: Path, decls: dict[str, TemplateDecl]) -> None:
+    def __init__(
+        self, model: Model, tpath: Path, decls: dict[str, TemplateDecl], modules: set[str]
+    ) -> None:
         self.model = model
+        self.modules = modules
         self.tpath = tpath
         self.decls = decls
         self.warnings: list[Warning_] = []
@@ -121,6 +134,14 @@ class _Importer:
                 f"{', '.join(BUILTINS)})",
                 file=self.tpath,
                 line=decl.line,
+            )
+        module = ref.partition(":")[0]
+        if ref not in BUILTINS and module not in self.modules:
+            raise self.err(
+                leaf.elem.line,
+                f"template {name} is implemented by {ref!r}, Python code the model names: "
+                "import never imports a module a file names; if you trust it, give "
+                f"--template-module {module}",
             )
         try:
             cls = resolve_template(ref)
@@ -291,9 +312,9 @@ class _Importer:
         manual = not self.model.root.auto_scheduling or any(
             not c.auto_scheduling for c in _composites(self.model.root)
         )
+        position = {p: i for i, p in enumerate(leaves)}
         if manual and listed:
-            index = list(leaves)
-            return sorted(listed, key=lambda p: (-leaves[p].priority, index.index(p)))
+            return sorted(listed, key=lambda p: (-leaves[p].priority, position[p]))
 
         class _Spec:
             def __init__(self, inputs: dict[str, str]) -> None:
@@ -310,10 +331,9 @@ class _Importer:
         except ConfigError as exc:
             loop = exc.message.split(";")[0]
         kinds = {p: self.classes[leaves[p].template].kind for p in leaves}
-        index = list(leaves)
         order = sorted(
             (p for p in leaves if kinds[p] in AUTO_ORDER),
-            key=lambda p: (AUTO_ORDER.index(kinds[p]), index.index(p)),
+            key=lambda p: (AUTO_ORDER.index(kinds[p]), position[p]),
         )
         words = ", ".join(k.value for k in AUTO_ORDER)
         self.warn(
@@ -362,8 +382,8 @@ class _Importer:
         named = {n: b for n, (b, _) in model.data.items() if n not in unnamed}
         if named:
             lines.append("data:                     # the model's Data, by name")
-            for name, buffer in named.items():
-                lines.append(f"  {name}: {buffer}")
+            for name, buffer in named.items():  # names checked by amsacore: NAME(.NAME)*
+                lines.append(f"  {name}: {_scalar(buffer)}")
         lines.append("components:")
         lines += self._components(model.root, bodies, 1)
         if schedule:
@@ -398,7 +418,7 @@ class _Importer:
             if "inputs" in body:
                 out.append(f"{pad}  inputs:")
                 for k, v in body["inputs"].items():
-                    out.append(f"{pad}    {k}: {v}")
+                    out.append(f"{pad}    {k}: {_scalar(v)}")
         return out
 
 
@@ -414,8 +434,28 @@ def _commented(line: str, note: str | None) -> str:
     return f"{line}  # {note}" if note else line
 
 
+_PLAIN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+_PLAIN_WORDS = {"true", "false", "yes", "no", "on", "off", "null", "y", "n", "~"}
+
+
 def _scalar(value: Any) -> str:
-    """``value`` as one line of YAML flow text (exact floats: PyYAML writes their repr)."""
+    """``value`` as one line of YAML flow text (exact floats: PyYAML writes their repr).
+
+    Numbers and plain names (the bulk of a model) are written directly; anything else goes
+    through PyYAML's safe dumper, which quotes and escapes what needs it (a newline in a
+    name cannot add a key). One dumper per value costs ~50 us: a 2,000-component model has
+    ~50,000 values.
+    """
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float) and "e" not in (text := repr(value)) and "." in text:
+        return text  # (YAML 1.1 reads 1e+20 as text: PyYAML's dumper writes 1.0e+20)
+    if isinstance(value, str) and _PLAIN.match(value) and value.lower() not in _PLAIN_WORDS:
+        return value
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=True)  # double-quoted: one line, no tag
     if isinstance(value, tuple):
         value = [list(v) if isinstance(v, tuple) else v for v in value]
     text = yaml.safe_dump(value, default_flow_style=True, width=1 << 20)

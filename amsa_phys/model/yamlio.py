@@ -197,6 +197,17 @@ def load_yaml(path: str | Path) -> YamlDoc:
     check is refused too.
     """
     path = Path(path)
+    return parse_yaml(read_regular_file(path, MAX_FILE_BYTES, "a YAML file"), path)
+
+
+def read_regular_file(path: Path, max_bytes: int, expected: str) -> bytes:
+    """The bytes of ``path`` if it is a regular file of at most ``max_bytes``; else one line.
+
+    The one check every loader of a user's file uses (YAML, AMSA models and templates): the
+    file is opened without blocking and checked through its descriptor, so a FIFO or a device
+    (``/dev/zero`` never ends) is refused even if swapped in after a check, and never more
+    than ``max_bytes`` are read, even from a file that grows meanwhile.
+    """
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
     except FileNotFoundError:
@@ -206,14 +217,14 @@ def load_yaml(path: str | Path) -> YamlDoc:
     try:
         st = os.fstat(fd)
         if stat.S_ISDIR(st.st_mode):
-            raise ConfigError("is a directory, expected a YAML file", file=path)
+            raise ConfigError(f"is a directory, expected {expected}", file=path)
         if not stat.S_ISREG(st.st_mode):
             raise ConfigError(
-                f"is not a regular file (a {_file_kind(st.st_mode)}), expected a YAML file",
+                f"is not a regular file (a {_file_kind(st.st_mode)}), expected {expected}",
                 file=path,
             )
-        if st.st_size > MAX_FILE_BYTES:
-            raise ConfigError(_too_large(st.st_size), file=path)
+        if st.st_size > max_bytes:
+            raise ConfigError(_too_large(st.st_size, max_bytes), file=path)
         chunks = []
         size = 0
         while True:  # never more than the limit, even if the file grows while read
@@ -221,14 +232,14 @@ def load_yaml(path: str | Path) -> YamlDoc:
             if not chunk:
                 break
             size += len(chunk)
-            if size > MAX_FILE_BYTES:
-                raise ConfigError(_too_large(size), file=path)
+            if size > max_bytes:
+                raise ConfigError(_too_large(size, max_bytes), file=path)
             chunks.append(chunk)
     except OSError as exc:
         raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
     finally:
         os.close(fd)
-    return parse_yaml(b"".join(chunks), path)
+    return b"".join(chunks)
 
 
 def _file_kind(mode: int) -> str:
@@ -241,11 +252,8 @@ def _file_kind(mode: int) -> str:
     return "special file"
 
 
-def _too_large(size: int) -> str:
-    return (
-        f"file too large ({size / 2**20:.1f} MiB or more; the limit is "
-        f"{MAX_FILE_BYTES // 2**20} MiB)"
-    )
+def _too_large(size: int, limit: int = MAX_FILE_BYTES) -> str:
+    return f"file too large ({size / 2**20:.1f} MiB or more; the limit is {limit / 2**20:g} MiB)"
 
 
 def parse_yaml(raw: bytes | str, path: str | Path, max_nodes: int = MAX_NODES) -> YamlDoc:

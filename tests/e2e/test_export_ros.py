@@ -5,7 +5,10 @@
 
 from __future__ import annotations
 
+import os
 import py_compile
+import subprocess
+import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -161,3 +164,52 @@ def test_a_world_with_an_array_port_is_refused_in_one_line(
     assert "Scanner.ranges is an array port (31 values)" in err
     assert not out.exists()
     assert list(tmp_path.iterdir()) == []
+
+
+def test_no_path_of_the_exporting_machine_in_any_generated_file(tmp_path: Path) -> None:
+    """Issue 26: every Python node re-executed itself with the exporting venv's interpreter,
+    by an absolute path: copied to a robot, nothing started. No generated file may name the
+    venv, the interpreter, the project, the home directory or where the package was written."""
+    out = tmp_path / "ws" / "src" / "mdeChallenge"
+    assert main(["export", "ros", str(SCENARIO), "-o", str(out)]) == 0
+    machine = {
+        str(ROOT),
+        sys.prefix,
+        sys.exec_prefix,
+        sys.executable,
+        os.path.realpath(sys.executable),
+        str(Path.home()),
+        str(tmp_path),
+    }
+    files = [p for p in out.rglob("*") if p.is_file() and p.name != ".amsa-phys-run"]
+    assert len(files) > 10
+    for path in files:
+        text = path.read_text()
+        for where in machine:
+            assert where not in text, (path.name, where)
+
+
+@pytest.mark.skipif(not Path("/usr/bin/python3").exists(), reason="no system python3")
+def test_a_node_without_amsa_phys_says_what_to_install(tmp_path: Path) -> None:
+    """Run by a Python that lacks amsa-phys (and no AMSA_PHYS_PYTHON), a node exits with one
+    line saying what to do, instead of starting anything."""
+    probe = subprocess.run(
+        ["/usr/bin/python3", "-c", "import amsa_phys"], capture_output=True, cwd=tmp_path
+    )
+    if probe.returncode == 0:
+        pytest.skip("the system python3 has amsa-phys")
+    out = tmp_path / "pkg"
+    assert main(["export", "ros", str(SCENARIO), "-o", str(out)]) == 0
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("AMSA_PHYS", "PYTHON"))}
+    done = subprocess.run(
+        ["/usr/bin/python3", str(out / "nodes" / "MyFollowerController.py")],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+    )
+    assert done.returncode == 1
+    assert done.stderr.strip() == (
+        "error: /usr/bin/python3 cannot import amsa_phys: install amsa-phys into it "
+        "(pip install amsa-phys) or set AMSA_PHYS_PYTHON to a Python that has it"
+    )

@@ -226,9 +226,11 @@ class LeafNode:
             self.raw[p.name] = raw
             kind, text = self._reload(p.name, cached=True)
             if kind != "done":
-                self.rospy.logerr(
-                    f"{names.param(self.path, p.name)}: {text}; keeping {self.params[p.name]!r}"
-                )
+                old = rosio.ros_value(self.params[p.name])
+                self.rospy.logerr(f"{names.param(self.path, p.name)}: {text}; keeping {old!r}")
+                # the server shows the value in use, not the refused one
+                self.rospy.set_param(names.param(self.path, p.name), old)
+                self.raw[p.name] = old
 
 
 def _same(a: Any, b: Any) -> bool:

@@ -27,14 +27,14 @@ from typing import Any
 
 from ...engine import batch, interrupt
 from ...engine.runner import Simulation
-from ...errors import AmsaError, ConfigError, Interrupted, RunFault
+from ...errors import AmsaError, Interrupted, RunFault
 from ...model.scenario import Change, Scenario, traced_columns
 from ...runs.expect import check_expectations
 from ...runs.rundir import default_run_dir, prepare_run_dir
 from ...runs.single import run_scenario
 from .. import names
 from ..graph import RosGraph
-from . import rosio
+from . import readiness, records, rosio
 from .config import NodeConfig, load_config
 
 
@@ -82,14 +82,14 @@ class Link:
         }
         self.step_pubs = {}
         self.subs = []
+        self.data_subs: dict[str, Any] = {}
         for path in self.graph.remote:
             for b in self.graph.outputs(path):
                 self.received[b] = [0, float(world.buffers[b].initial)]
-                self.subs.append(
-                    rospy.Subscriber(
-                        names.topic(b), Float64, self._on_data, callback_args=b, tcp_nodelay=True
-                    )
+                self.data_subs[b] = rospy.Subscriber(
+                    names.topic(b), Float64, self._on_data, callback_args=b, tcp_nodelay=True
                 )
+                self.subs.append(self.data_subs[b])
             if self.lockstep:
                 self.replies[path] = None
                 self.step_pubs[path] = self.gate.publisher(names.step_topic(path), String, 1)
@@ -133,10 +133,32 @@ class Link:
 
     # -- start ------------------------------------------------------------------------------
     def wait_ready(self, timeout: float) -> list[str]:
-        """Wait for every node's ready message and our own publishers' subscribers."""
-        missing = self.gate.wait(timeout, also=lambda: self.expected_ready <= self.ready)
-        nodes = sorted(self.expected_ready - self.ready)
+        """Wait for every node and our own publishers' subscribers.
+
+        A node is ready when it says so on ``/amsa/ready`` (every generated node does, once
+        its publishers have all their subscribers). In free mode a node that does not (a
+        user's own node) is ready once its topics are: each output it publishes is connected
+        to this process and has as many subscribers registered with the master as the graph
+        expects. In lockstep every Leaf node must answer step requests, so it must be ours
+        or speak the protocol, and say so.
+        """
+        waiting: set[str] = set(self.expected_ready)
+
+        def ready() -> bool:
+            waiting.difference_update(self.ready)
+            if waiting and not self.lockstep:
+                subscribers = readiness.registered_subscribers(self.rospy)
+                waiting.difference_update(
+                    [n for n in waiting if n in self.graph.remote and self._up(n, subscribers)]
+                )
+            return not waiting
+
+        missing = self.gate.wait(timeout, also=ready)
+        nodes = sorted(waiting)
         return ([f"node /{n.replace('.', '/')}" for n in nodes] + missing) if missing else []
+
+    def _up(self, path: str, subscribers: dict[str, int]) -> bool:
+        return readiness.topics_up(self.graph, self.data_subs, path, subscribers)
 
     def attach(self, sim: Simulation) -> None:
         """The simulation whose values free mode updates and whose events remote Leaves add."""
@@ -326,12 +348,13 @@ class RosSimulation(Simulation):
             for name, value in values.items():
                 setattr(comp.p, name, value)
             comp.do_step = link.publishing(path, comp.do_step)  # type: ignore[method-assign]
-        # the parameter cache's values for the Leaves stepped here, as last seen (free mode:
-        # a change of the cache is an edit; timeline changes are applied apart, at their instant)
+        # the parameter cache's values of every Leaf, as last seen (free mode: a change of the
+        # cache is an edit, recorded as an event whether the Leaf steps here or in its node;
+        # timeline changes are applied apart, at their instant)
         self.seen = {
-            (path, name): rosio.ros_value(value)
-            for path in graph.local
-            for name, value in vars(self.components[path].p).items()
+            (path, p.name): rosio.fetch_param(link.rospy, names.param(path, p.name))
+            for path in scenario.world.leaves
+            for p in graph.leaf(path).template.params
         }
         self.live: list[Change] = []  # live edits queued, not yet applied
         if not link.lockstep:
@@ -352,11 +375,13 @@ class RosSimulation(Simulation):
         super().apply_change(Change(change.leaf, change.param, value))
 
     def _live_params(self) -> None:
-        """Free mode: a ``rosparam set`` of a Leaf stepped here lands at the next instant.
+        """Free mode: a ``rosparam set`` lands at the next instant, recorded.
 
         Judged like the window's live changes (type, range, rules between parameters;
         parameters only ``initialize`` reads are refused); a refused value is one line in the
-        log and the old value stays. Applied changes are events, and in ``scenario.yaml``.
+        log, the old value stays and is put back on the parameter server. Applied changes are
+        events, and in ``scenario.yaml``; a Leaf that is a node takes the value at its own
+        next step (judged the same way there), this process records it.
         """
         rospy = self.link.rospy
         for (path, name), seen in self.seen.items():
@@ -374,13 +399,17 @@ class RosSimulation(Simulation):
                 value = leaf.template.param(name).coerce(raw)
                 leaf.template.check_params({**vars(self.components[path].p), name: value})
             except ValueError as exc:
-                rospy.logerr(f"{names.param(path, name)}: {exc}; keeping the old value")
+                old = rosio.ros_value(getattr(self.components[path].p, name))
+                rospy.logerr(f"{names.param(path, name)}: {exc}; keeping {old!r}")
+                rospy.set_param(names.param(path, name), old)  # the server shows what runs
+                self.seen[(path, name)] = old
                 continue
             if value == getattr(self.components[path].p, name):
                 continue  # the scenario node's own change, applied at its instant already
             change = Change(path, name, value)
             self.live.append(change)
-            self.apply_live(change)
+            at = self.apply_live(change)
+            print(f"{names.SIMULATOR}: live change {change.key}={value} at t={float(at):g} s")
 
 
 def main() -> None:
@@ -391,9 +420,11 @@ def main() -> None:
     try:
         cfg = load_config(rospy)
         scenario = cfg.scenario
+        for change in records.fold_server_values(rospy, scenario):
+            print(f"amsa_simulator: {change.key}={change.value} (parameter server)", flush=True)
         duration = str(rospy.get_param("~duration", "") or "")
         if duration:
-            _shorten(scenario, duration)
+            records.cut(scenario, duration)
         out = str(rospy.get_param("~out", "") or "")
         root = Path(str(rospy.get_param("~runs", "") or os.environ.get("PWD", "."))) / "runs"
         out_dir = Path(out) if out else default_run_dir(scenario.name, root)
@@ -436,18 +467,6 @@ def main() -> None:
         code = exc.exit_code
     rospy.signal_shutdown("the run is over")
     sys.exit(code)
-
-
-def _shorten(scenario: Scenario, text: str) -> None:
-    """``duration:=S``: run for S simulated seconds (the timeline is cut there)."""
-    try:
-        duration = Fraction(text)
-    except (ValueError, ZeroDivisionError):
-        raise ConfigError(f"expected seconds, got {text!r}", key="duration:=") from None
-    if duration <= 0:
-        raise ConfigError(f"must be > 0, got {text}", key="duration:=")
-    scenario.duration = duration
-    scenario.phases = [p for p in scenario.phases if p.at < duration]
 
 
 def _summary(metrics: dict[str, Any], out_dir: Path) -> None:
