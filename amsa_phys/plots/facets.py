@@ -156,7 +156,7 @@ def plot_facets(
             )
             flat[p].plot(k, j - 0.25, marker="*", ms=10, color="gold", mec="k", ls="none")
             best_text = f"{x_axis}={_label(xs[k])}, {y_axis}={_label(ys[j])}"
-        if image is not None:
+        if image is not None and finite.size:  # no scale when every cell says "never"
             fig.colorbar(image, ax=flat[:n], label=f"{metric} (seed mean; lowest ★)", shrink=0.9)
         for ax in flat[:n]:
             ax.set_xticks(_ticks(len(xs)), [_label(xs[t]) for t in _ticks(len(xs))])
@@ -172,6 +172,19 @@ def plot_facets(
             m = mean[have]
             err = [np.maximum(0.0, m - spread[i, 0][have]), np.maximum(0.0, spread[i, 1][have] - m)]
             ax.errorbar(pos, m, yerr=err, marker="o", ms=3, capsize=2)
+            for k, count in enumerate(never[i, 0]):
+                if count:  # runs that never reached the metric: said above their x
+                    ax.annotate(
+                        f"{count} never",
+                        (positions[k], 1.0),
+                        xycoords=("data", "axes fraction"),
+                        xytext=(0, -3),
+                        textcoords="offset points",
+                        ha="center",
+                        va="top",
+                        fontsize=6.5,
+                        color=NEVER_COLOUR,
+                    )
             ax.grid(alpha=0.3)
         if best is not None:
             p, _, k = (int(v) for v in best)
