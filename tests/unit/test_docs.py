@@ -48,3 +48,16 @@ def test_the_manual_builds_strictly(tmp_path: Path) -> None:
     assert '<a href="#amsa_phys.errors.ConfigError"><code>ConfigError</code></a>' in api
     assert (tmp_path / "site" / "assets" / "paper_fig5.png").is_file()
     assert not (tmp_path / "site" / "hooks.py").exists()
+
+
+def test_every_object_the_api_page_documents_is_a_name_of_ap() -> None:
+    """The page says `import amsa_phys as ap` gives every name on it (headings show the short
+    name): each ``::: module.Name`` but the received InitContext and the errors module."""
+    import amsa_phys as ap
+
+    page = (ROOT / "docs" / "reference" / "api.md").read_text()
+    names = re.findall(r"^::: ([\w.]+)$", page, flags=re.M)
+    assert "amsa_phys.api.result.run" in names
+    short = [n.rpartition(".")[2] for n in names if n != "amsa_phys.errors"]
+    missing = [n for n in short if n != "InitContext" and not hasattr(ap, n)]
+    assert not missing, f"not importable as ap.NAME: {missing}"
