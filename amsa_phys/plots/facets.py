@@ -15,6 +15,7 @@ the title says so), and if that axis alone has too many values every k-th is sho
 from __future__ import annotations
 
 import math
+import textwrap
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
@@ -206,12 +207,20 @@ def plot_facets(
         p = int(best[0])
         where = ", ".join(f"{a}={_label(v)}" for a, v in zip(facet_axes, keys[p], strict=True))
         best_text = f"★ best: {best_text}, {where}"
+        # equal values (axes that did not matter in these runs): the star marks the first,
+        # and the title says the others are as good rather than implying one winner
+        ties = int(np.count_nonzero(np.isclose(finite, finite.min(), rtol=1e-9, atol=0.0))) - 1
+        if ties:
+            best_text += f" (tied with {ties} other grid point{'s' if ties > 1 else ''})"
     lines = [title, *left_out_text(rows, ok, metric).splitlines()[1:]]
     if notes:
         lines.append("; ".join(notes))
     if best_text:
         lines.append(best_text)
-    full = "\n".join(lines)
+    # wrapped to the figure's width: a best point of three long axis names ran off both
+    # edges of a two-panel figure (~5.4 pt a character at 9 pt)
+    chars = max(40, int(fig.get_figwidth() * 72 / 5.4))
+    full = "\n".join(textwrap.fill(line, chars) for line in lines)
     fig.suptitle(full, fontsize=9)
     name = scenario if scenario is not None else title.split("\n")[0].rpartition(": ")[0]
     return save_png(fig, out, metadata={"Title": full, SCENARIO_KEY: name})
