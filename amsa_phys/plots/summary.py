@@ -104,7 +104,11 @@ def plot_summary(
                 )
             )
             ax.plot(i, j - 0.25, marker="*", ms=13, color="gold", mec="k", ls="none", zorder=4)
-            ax.set_title(f"★ best: {axes[0]}={xs[i]:g}, {axes[1]}={ys[j]:g}", fontsize=9)
+            finite = grid[np.isfinite(grid)]
+            ties = int(np.count_nonzero(np.isclose(finite, finite.min(), rtol=1e-9, atol=0.0)))
+            tied = f" (tied with {ties - 1} other grid point{'s' if ties > 2 else ''})"
+            best = f"★ best: {axes[0]}={xs[i]:g}, {axes[1]}={ys[j]:g}"
+            ax.set_title(best + (tied if ties > 1 else ""), fontsize=9)
         ax.set_xticks(range(len(xs)), [f"{x:g}" for x in xs])
         ax.set_yticks(range(len(ys)), [f"{y:g}" for y in ys])
         ax.set_xlabel(axes[0])

@@ -1,4 +1,5 @@
-"""A sweep in which no run settled still draws its grid, every point saying "never".
+"""Summary cases found trying sweeps as a user: a sweep in which no run settled still draws
+its grid, every point saying "never"; a tied best says it is tied.
 
 Found trying the small multiples as a user: a 30 s sweep of three axes (nothing settles in
 30 s), ``amsa-phys plot DIR --metric settling_time`` printed "drawn as 'never'" and the
@@ -69,3 +70,22 @@ def test_every_grid_point_says_never(
         assert not [ax for ax in fig.axes if ax.get_label() == "<colorbar>"]  # no scale
     finally:
         plt.close(fig)
+
+
+def test_a_two_axis_heatmap_says_when_its_best_is_tied(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An axis that did not matter ties the best across its values: the title says so."""
+    rows = [
+        {"K": k, "m": m, "seed": 0, "error": "", "rms_error": abs(k - 0.2) + 1.0}
+        for k in (0.1, 0.2, 0.3)
+        for m in (40, 70)
+    ]
+    caught: list[Any] = []
+    monkeypatch.setattr(summary, "save_png", lambda fig, out, **kw: caught.append(fig) or out)
+    summary.plot_summary(rows, ["K", "m"], "rms_error", tmp_path / "s.png", "sweep")
+    try:
+        title = caught[0].axes[0].get_title()
+        assert "★ best: K=0.2, m=40 (tied with 1 other grid point)" in title
+    finally:
+        plt.close(caught[0])
