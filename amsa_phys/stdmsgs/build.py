@@ -81,7 +81,7 @@ def deviation_variance(params: Mapping[str, Any]) -> float:
 
     The deviation is an error like the turn-on bias (fixed for a heading, unknown to the
     receiver), which the covariance includes: left out, a compass with ~1° of deviation
-    and 0.5° of noise claimed a variance a fifth of its real mean square error.
+    and 0.5° of noise (the MDE world's) stated 7.6e-5 rad², a third of its real 2.5e-4.
     """
     return sum(float(params.get(f"deviation{k}", 0.0)) ** 2 for k in "BCDE") / 2
 
