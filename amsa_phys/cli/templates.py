@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import ConfigError, one_line
-from ..model.plugins import installed
+from ..model import plugins as plugin_registry
 from ..model.suggest import did_you_mean
 from ..model.template import BUILTINS, TemplateNotFound, known_names, resolve_template
 
@@ -27,13 +27,13 @@ def origin(name: str) -> str:
         return "built-in"
     if ":" in name:
         return f"module {name.partition(':')[0]}"
-    found = installed().get(name, [])
+    found = plugin_registry.installed().get(name, [])
     return ", ".join(f"plugin {p.target} from {p.distribution}" for p in found) or "unknown"
 
 
 def run(args: argparse.Namespace) -> int:
     """Print each template (built-ins, then installed plugins), saying where it comes from."""
-    plugins = installed()
+    plugins = plugin_registry.installed()
     names = [args.name] if args.name else [*BUILTINS, *(n for n in plugins if n not in BUILTINS)]
     for name in names:
         try:
@@ -42,13 +42,16 @@ def run(args: argparse.Namespace) -> int:
             if not args.name:  # one broken plugin does not hide the rest of the library
                 print(one_line(f"{name} (not loadable: {exc}) [{origin(name)}]"))
                 continue
+            if name in plugins:  # the name is right: its package is what fails, say which
+                raise ConfigError(f"{origin(name)}: {exc}", key="templates") from None
             hint = did_you_mean(name, known_names()) if ":" not in name else ""
             extra = [n for n in plugins if n not in BUILTINS]
             known = "" if hint else f"; built-in: {', '.join(BUILTINS)}"
-            if extra and not hint:
-                known += f"; plugins: {', '.join(extra)}"
+            if not hint:
+                known += f"; plugins: {', '.join(extra) if extra else 'none installed'}"
             raise ConfigError(f"{exc}{hint}{known}", key="templates") from None
-        print(one_line(f"{t.name()} ({t.kind.value}): {t.describe()} [{origin(name)}]"))
+        # the name a world writes (a plugin's registered name, not its class's name)
+        print(one_line(f"{name} ({t.kind.value}): {t.describe()} [{origin(name)}]"))
         for direction, ports in (("in ", t.inputs), ("out", t.outputs)):
             for port in ports:
                 # an array port: out ranges[beams] (one Data per element), in ranges[]

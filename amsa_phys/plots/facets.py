@@ -15,6 +15,7 @@ the title says so), and if that axis alone has too many values every k-th is sho
 from __future__ import annotations
 
 import math
+import textwrap
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
@@ -156,7 +157,7 @@ def plot_facets(
             )
             flat[p].plot(k, j - 0.25, marker="*", ms=10, color="gold", mec="k", ls="none")
             best_text = f"{x_axis}={_label(xs[k])}, {y_axis}={_label(ys[j])}"
-        if image is not None:
+        if image is not None and finite.size:  # no scale when every cell says "never"
             fig.colorbar(image, ax=flat[:n], label=f"{metric} (seed mean; lowest ★)", shrink=0.9)
         for ax in flat[:n]:
             ax.set_xticks(_ticks(len(xs)), [_label(xs[t]) for t in _ticks(len(xs))])
@@ -172,6 +173,19 @@ def plot_facets(
             m = mean[have]
             err = [np.maximum(0.0, m - spread[i, 0][have]), np.maximum(0.0, spread[i, 1][have] - m)]
             ax.errorbar(pos, m, yerr=err, marker="o", ms=3, capsize=2)
+            for k, count in enumerate(never[i, 0]):
+                if count:  # runs that never reached the metric: said above their x
+                    ax.annotate(
+                        f"{count} never",
+                        (positions[k], 1.0),
+                        xycoords=("data", "axes fraction"),
+                        xytext=(0, -3),
+                        textcoords="offset points",
+                        ha="center",
+                        va="top",
+                        fontsize=6.5,
+                        color=NEVER_COLOUR,
+                    )
             ax.grid(alpha=0.3)
         if best is not None:
             p, _, k = (int(v) for v in best)
@@ -193,12 +207,20 @@ def plot_facets(
         p = int(best[0])
         where = ", ".join(f"{a}={_label(v)}" for a, v in zip(facet_axes, keys[p], strict=True))
         best_text = f"★ best: {best_text}, {where}"
+        # equal values (axes that did not matter in these runs): the star marks the first,
+        # and the title says the others are as good rather than implying one winner
+        ties = int(np.count_nonzero(np.isclose(finite, finite.min(), rtol=1e-9, atol=0.0))) - 1
+        if ties:
+            best_text += f" (tied with {ties} other grid point{'s' if ties > 1 else ''})"
     lines = [title, *left_out_text(rows, ok, metric).splitlines()[1:]]
     if notes:
         lines.append("; ".join(notes))
     if best_text:
         lines.append(best_text)
-    full = "\n".join(lines)
+    # wrapped to the figure's width: a best point of three long axis names ran off both
+    # edges of a two-panel figure (~5.4 pt a character at 9 pt)
+    chars = max(40, int(fig.get_figwidth() * 72 / 5.4))
+    full = "\n".join(textwrap.fill(line, chars) for line in lines)
     fig.suptitle(full, fontsize=9)
     name = scenario if scenario is not None else title.split("\n")[0].rpartition(": ")[0]
     return save_png(fig, out, metadata={"Title": full, SCENARIO_KEY: name})

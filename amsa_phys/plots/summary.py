@@ -60,13 +60,16 @@ def plot_summary(
     :data:`BAND_SEEDS` seeds on, where bars would hide how the seeds spread).
     """
     ok = [r for r in rows if r.get(metric) is not None and not r.get("error")]
-    numeric_axes = [a for a in axes if _numeric([r[a] for r in ok])]
-    if ok and len(axes) >= 3:
+    # what is drawn: the runs with a value and those that never reached it ("never"), so a
+    # sweep where no run settled still shows its grid, every cell saying "never"
+    drawn = ok + nevers(rows, metric)
+    numeric_axes = [a for a in axes if _numeric([r[a] for r in drawn])]
+    if drawn and len(axes) >= 3:
         from .facets import plot_facets
 
         return plot_facets(rows, ok, axes, numeric_axes, metric, out, title, scenario)
     fig, ax = plt.subplots(figsize=(8, 5), dpi=100)
-    if not ok or not axes:
+    if not drawn or not axes:
         ax.text(0.5, 0.5, "no completed runs to plot", ha="center", transform=ax.transAxes)
     elif len(axes) == 2 and len(numeric_axes) == 2:
         # every grid point gets a cell, those without a value too (drawn grey, "none")
@@ -101,14 +104,19 @@ def plot_summary(
                 )
             )
             ax.plot(i, j - 0.25, marker="*", ms=13, color="gold", mec="k", ls="none", zorder=4)
-            ax.set_title(f"★ best: {axes[0]}={xs[i]:g}, {axes[1]}={ys[j]:g}", fontsize=9)
+            finite = grid[np.isfinite(grid)]
+            ties = int(np.count_nonzero(np.isclose(finite, finite.min(), rtol=1e-9, atol=0.0)))
+            tied = f" (tied with {ties - 1} other grid point{'s' if ties > 2 else ''})"
+            best = f"★ best: {axes[0]}={xs[i]:g}, {axes[1]}={ys[j]:g}"
+            ax.set_title(best + (tied if ties > 1 else ""), fontsize=9)
         ax.set_xticks(range(len(xs)), [f"{x:g}" for x in xs])
         ax.set_yticks(range(len(ys)), [f"{y:g}" for y in ys])
         ax.set_xlabel(axes[0])
         ax.set_ylabel(axes[1])
-        bar = fig.colorbar(im, ax=ax, label=f"{metric} (seed mean; lowest ★)")
-        if is_count(metric):
-            bar.ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+        if np.isfinite(grid).any():  # no scale to show when every cell says "never"
+            bar = fig.colorbar(im, ax=ax, label=f"{metric} (seed mean; lowest ★)")
+            if is_count(metric):
+                bar.ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     else:
         x_axis = numeric_axes[0] if numeric_axes else axes[0]
         others = [a for a in axes if a != x_axis]
@@ -117,7 +125,7 @@ def plot_summary(
         )
         for r in ok:
             groups[tuple(r[a] for a in others)][r[x_axis]].append(float(r[metric]))
-        most = max(len(v) for by_x in groups.values() for v in by_x.values())
+        most = max((len(v) for by_x in groups.values() for v in by_x.values()), default=1)
         band = spread == "band" or (spread == "auto" and most >= BAND_SEEDS)
         for key, by_x in groups.items():
             xs = sorted(by_x, key=lambda v: (str(type(v)), v))
@@ -145,7 +153,7 @@ def plot_summary(
         never_at: dict[Any, int] = defaultdict(int)
         for r in nevers(rows, metric):
             never_at[r[x_axis]] += 1
-        labels = sorted({r[x_axis] for r in ok}, key=str)
+        labels = sorted({r[x_axis] for r in drawn}, key=str)
         for x, count in sorted(never_at.items(), key=lambda kv: str(kv[0])):
             at = x if _numeric([x]) else (labels.index(x) if x in labels else None)
             if at is not None:  # at the top edge of the plot, above its x
@@ -160,7 +168,7 @@ def plot_summary(
                     fontsize=7,
                     color=NEVER_COLOUR,
                 )
-        if not _numeric([r[x_axis] for r in ok]):
+        if not _numeric([r[x_axis] for r in drawn]):
             ax.set_xticks(range(len(labels)), [str(v) for v in labels])
         ax.set_xlabel(x_axis)
         ax.set_ylabel(
@@ -176,7 +184,8 @@ def plot_summary(
             ax.set_ylim(min(low, -0.25), max(high, 1.25))
             ax.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        if groups:  # no line when every run said "never"
+            ax.legend(fontsize=8)
     title += left_out_text(rows, ok, metric)
     if ax.get_title():  # the heatmap's best cell
         title += "\n" + ax.get_title()

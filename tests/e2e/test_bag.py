@@ -243,9 +243,16 @@ def test_obstacle_course_scan_imu_odometry(tmp_path: Path) -> None:
     beams = [header.index(f"Scanner.ranges[{k}]") for k in range(31)]
     for t, m in scans:
         want = np.float32(trace[row[t], beams])  # float32[] in LaserScan
+        want[want >= np.float32(12.0)] = np.inf  # no echo: range_max in the trace, REP 117's +inf
         assert np.array_equal(np.array(m.ranges, dtype=np.float32), want)
+        assert m.range_max == 12.0
         assert m.angle_min < 0 < m.angle_max
         assert m.angle_increment == pytest.approx((m.angle_max - m.angle_min) / 30, rel=1e-6)
+    # every beam is a hit inside [range_min, range_max] or +inf: none sits on the outer arc
+    hits = np.concatenate([np.array(m.ranges) for _, m in scans])
+    assert np.isinf(hits).any()
+    assert not (hits == 12.0).any()
+    assert (hits[np.isfinite(hits)] >= 0.15).all()
     imus = [(t, m) for topic, t, m in msgs if topic == "/Rover/Imu/imu"]
     assert imus
     for t, m in imus:

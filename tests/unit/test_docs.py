@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -42,5 +43,21 @@ def test_the_manual_builds_strictly(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr[-3000:]
     api = (tmp_path / "site" / "reference" / "api" / "index.html").read_text()
     assert "do_step" in api  # mkdocstrings read the Template's docstrings
+    # the docstrings' Sphinx roles are links, not ":class:" printed before the name
+    assert not re.search(r":(meth|func|class|attr|data):<code>", api)
+    assert '<a href="#amsa_phys.errors.ConfigError"><code>ConfigError</code></a>' in api
     assert (tmp_path / "site" / "assets" / "paper_fig5.png").is_file()
     assert not (tmp_path / "site" / "hooks.py").exists()
+
+
+def test_every_object_the_api_page_documents_is_a_name_of_ap() -> None:
+    """The page says `import amsa_phys as ap` gives every name on it (headings show the short
+    name): each ``::: module.Name`` but the received InitContext and the errors module."""
+    import amsa_phys as ap
+
+    page = (ROOT / "docs" / "reference" / "api.md").read_text()
+    names = re.findall(r"^::: ([\w.]+)$", page, flags=re.M)
+    assert "amsa_phys.api.result.run" in names
+    short = [n.rpartition(".")[2] for n in names if n != "amsa_phys.errors"]
+    missing = [n for n in short if n != "InitContext" and not hasattr(ap, n)]
+    assert not missing, f"not importable as ap.NAME: {missing}"

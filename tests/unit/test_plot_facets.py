@@ -100,3 +100,44 @@ def test_a_three_axis_summary_is_written_without_warnings(tmp_path: Path) -> Non
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "1 of 36 runs have no rms_error" in png_text(out)["Title"]
     assert summary.scenario_of(out) == "t"
+
+
+def test_a_tied_best_says_so(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """An axis that did not matter (every value gives the same metric) ties the best cell
+    across its values: the title must not name one of them as the winner alone."""
+    axes = {"K": [0.1, 0.3, 0.5], "m": [40, 70], "c": [1, 2]}
+    rows = [
+        {**r, "rms_error": round(r["rms_error"] - 0.01 * abs(r["c"] - 2), 6)}
+        for r in _rows(axes, seeds=1)
+    ]
+    # now c does not matter: K=0.3, m=70 is best at c=1 and c=2 alike
+    fig = _draw(rows, list(axes), tmp_path, monkeypatch)
+    try:
+        assert "★ best: K=0.3, m=70, c=1 (tied with 1 other grid point)" in fig._suptitle.get_text()
+    finally:
+        plt.close(fig)
+
+
+def test_a_long_title_stays_inside_the_figure(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Three long axis names in the best point's line ran off both edges of the figure."""
+    names = {
+        "K": "MyFollowerController.Kv",
+        "m": "MyFollowerController.Kw",
+        "c": "physics.ground.friction",
+    }
+    rows = [
+        {names[a]: v for a, v in r.items() if a in names}
+        | {k: r[k] for k in ("seed", "error", "rms_error")}
+        for r in _rows({"K": [0.1, 0.3], "m": [40, 70], "c": [2]})
+    ]
+    fig = _draw(rows, list(names.values()), tmp_path, monkeypatch)
+    try:
+        fig.canvas.draw()
+        box = fig._suptitle.get_window_extent()
+        assert box.x0 >= 0
+        assert box.x1 <= fig.bbox.width
+        assert "physics.ground.friction=2" in fig._suptitle.get_text()
+    finally:
+        plt.close(fig)
