@@ -213,3 +213,20 @@ def test_a_node_without_amsa_phys_says_what_to_install(tmp_path: Path) -> None:
         "error: /usr/bin/python3 cannot import amsa_phys: install amsa-phys into it "
         "(pip install amsa-phys) or set AMSA_PHYS_PYTHON to a Python that has it"
     )
+
+
+def test_a_scenario_with_adapt_rules_is_refused_not_exported_without_them(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scenario = ROOT / "scenarios" / "adaptive.yaml"
+    assert main(["export", "ros", str(scenario), "-o", str(tmp_path / "pkg")]) == 2
+    err = capsys.readouterr().err
+    line = next(
+        i for i, t in enumerate(scenario.read_text().splitlines(), 1) if t.startswith("adapt:")
+    )
+    assert err == (
+        f"error: {scenario}:{line}: adapt: rules are not exported to ROS yet (the package would "
+        "run without them); export the scenario without its adapt: section, or run it with "
+        "amsa-phys run\n"
+    )
+    assert not (tmp_path / "pkg").exists()
