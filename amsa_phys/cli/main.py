@@ -33,7 +33,8 @@ COMMANDS = {
     ),
     "templates": (
         "templates",
-        "List the template library: kind, ports and parameters of every built-in template.",
+        "List the template library: kind, ports and parameters of every built-in and plugin "
+        "template.",
     ),
     "plot": (
         "plot",

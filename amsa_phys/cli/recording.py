@@ -102,8 +102,14 @@ def _target(name: str, formats: tuple[str, ...], flag: str, force: bool) -> Path
     """An output file we may write: known extension, existing writable directory, no clobber."""
     path = Path(name)
     if path.suffix.lower() not in formats:
+        hint = ""
+        if path.suffix.lower() == ".bag" and ".mcap" in formats:
+            hint = (
+                " (for a ROS 1 .bag, write the .mcap and convert it: "
+                "rosbags-convert --src run.mcap --dst run.bag)"
+            )
         raise ConfigError(
-            f"unknown format {path.suffix or '(none)'!r}; use " + " or ".join(formats),
+            f"unknown format {path.suffix or '(none)'!r}; use " + " or ".join(formats) + hint,
             key=flag,
             file=path,
         )

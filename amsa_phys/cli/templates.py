@@ -1,6 +1,8 @@
-"""List the template library: kind, ports and parameters of every built-in template."""
-# (the module docstring's first line is the command's help; plugins are listed too, with
-# where each template comes from)
+"""List the template library: kind, ports and parameters of every built-in and plugin
+template.
+
+Each line ends with where the template comes from (built-in, or the installed plugin package).
+"""
 
 from __future__ import annotations
 

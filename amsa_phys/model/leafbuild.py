@@ -98,7 +98,11 @@ def _build_leaf(
     try:
         template = resolve_template(ref)
     except TemplateNotFound as exc:
-        hint = did_you_mean(ref, known_names()) if ":" not in ref else ""
+        known = known_names()
+        # a registered name that failed to load needs no "did you mean" (it is the name)
+        hint = did_you_mean(ref, known) if ":" not in ref and ref not in known else ""
+        if ":" not in ref and not hint and ref not in known:
+            hint = " (no built-in template and no installed plugin has that name)"
         raise err((*kp, "template"), f"{exc}{hint}") from None
     freq = Fraction(str(body.get("freq", DEFAULT_FREQ_HZ)))
     declared = {p.name: p for p in template.params}

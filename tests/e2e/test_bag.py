@@ -306,7 +306,10 @@ def test_existing_bag_is_refused_without_force(
     assert "x.mcap: --bag: file exists (use --force to replace it)" in capsys.readouterr().err
     assert bag.read_bytes() == b"keep"
     assert main(["run", str(FIXTURE), "--headless", "--bag", str(tmp_path / "x.bag")]) == 2
-    assert "unknown format '.bag'; use .mcap" in capsys.readouterr().err
+    assert capsys.readouterr().err.endswith(
+        "unknown format '.bag'; use .mcap (for a ROS 1 .bag, write the .mcap and convert it: "
+        "rosbags-convert --src run.mcap --dst run.bag)\n"
+    )
     with pytest.raises(ap.ConfigError, match=r"x\.mcap: bag: file exists"):
         ap.run(FIXTURE, duration=1, bag=bag)
 

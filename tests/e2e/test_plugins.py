@@ -141,3 +141,31 @@ def test_a_built_in_name_is_never_a_plugin(monkeypatch: pytest.MonkeyPatch) -> N
     assert resolve_template("GPS").__module__ == "amsa_phys.sensors.gps"
     with pytest.raises(TemplateNotFound, match="unknown template 'Nope'"):
         resolve_template("Nope")
+
+
+def test_a_world_naming_a_broken_plugin_gets_no_did_you_mean_of_itself(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from amsa_phys.cli.main import main
+
+    broken = plugins.Plugin("Broken", "no_such_module_xyz:Broken", "broken-rovers")
+    monkeypatch.setattr(plugins, "installed", lambda: {"Broken": [broken]})
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text("world:\n  components:\n    C: {template: Broken}\nduration: 1\n")
+    assert main(["validate", str(scenario)]) == 2
+    err = capsys.readouterr().err
+    assert "cannot import module 'no_such_module_xyz'" in err
+    assert "did you mean" not in err
+
+
+def test_a_name_nothing_registers_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from amsa_phys.cli.main import main
+
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text("world:\n  components:\n    C: {template: Qwxzy}\nduration: 1\n")
+    assert main(["validate", str(scenario)]) == 2
+    assert capsys.readouterr().err.endswith(
+        "unknown template 'Qwxzy' (no built-in template and no installed plugin has that name)\n"
+    )
