@@ -10,6 +10,7 @@ value). :func:`cut` is ``duration:=S``, the same cut as ``amsa-phys run --durati
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from fractions import Fraction
 from typing import Any
@@ -40,6 +41,7 @@ def fold_server_values(rospy: Any, scenario: Scenario) -> list[Change]:
     """
     start = start_values(scenario)
     phase0 = scenario.phases[0]
+    changes = list(phase0.changes)
     folded = []
     for path, leaf in scenario.world.leaves.items():
         for name, value in rosio.read_params(rospy, leaf).items():
@@ -47,8 +49,10 @@ def fold_server_values(rospy: Any, scenario: Scenario) -> list[Change]:
             if _same(value, old):
                 continue
             change = Change(path, name, value)
-            phase0.changes = [c for c in phase0.changes if c.key != change.key] + [change]
+            changes = [c for c in changes if c.key != change.key] + [change]
             folded.append(change)
+    if folded:  # phases are frozen: phase 0 is replaced, never edited
+        scenario.phases = [dataclasses.replace(phase0, changes=changes), *scenario.phases[1:]]
     return folded
 
 
