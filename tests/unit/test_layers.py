@@ -20,6 +20,7 @@ LAYER = {
     "view": 3,
     "runs": 4,
     "ros": 5,
+    "falsify": 5,
     "cli": 6,
     "api": 6,
     "gym": 7,
