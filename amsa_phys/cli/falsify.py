@@ -13,7 +13,7 @@ from tqdm import tqdm
 from ..engine import interrupt
 from ..errors import ConfigError, Interrupted, one_line
 from ..falsify.objective import Objective, build_objective
-from ..falsify.outputs import headline, write_results, write_worst
+from ..falsify.outputs import describe_value, headline, write_results, write_worst
 from ..falsify.search import Progress, Settings, search
 from ..falsify.space import build_space
 from ..model.scenario import load_scenario
@@ -103,6 +103,17 @@ def run(args: argparse.Namespace) -> int:
     )
     progress = Progress()
     interrupted = False
+
+    def said(generation: int) -> None:  # a line per generation, above the progress bar
+        k = progress.worst()
+        worst = describe_value(progress.verdicts[k].value) if k is not None else "none"
+        tqdm.write(
+            f"generation {generation} done: {len(progress.rows)} runs, worst "
+            f"{objective.label} {worst}",
+            file=sys.stderr,
+        )
+
+    progress.on_generation = said
     try:
         with (
             interrupt.sigterm_as_ctrl_c(),

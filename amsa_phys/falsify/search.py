@@ -16,7 +16,7 @@ order. Same seed, same points, same rows, whatever the executor or ``-j``.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -61,6 +61,8 @@ class Progress:
     rows: list[dict[str, Any]] = field(default_factory=list)
     verdicts: list[Verdict] = field(default_factory=list)
     score_of: dict[tuple[tuple[str, Any], ...], float] = field(default_factory=dict)
+    #: called with the generation's number once its runs are all in (a progress line)
+    on_generation: Callable[[int], None] | None = None
 
     def add(
         self, row: dict[str, Any], verdict: Verdict, point: tuple[tuple[str, Any], ...]
@@ -243,3 +245,5 @@ def _evaluate(
             row["robustness"] = verdict.value
         progress.add(row, verdict, points[i])
         yield row
+    if progress.on_generation is not None:
+        progress.on_generation(generation)

@@ -104,16 +104,23 @@ def _numeric_dim(text: str, scenario: Scenario) -> Dim:
         raise ConfigError(
             "a physics setting splits batches by value: search it with --grid", key=option
         )
+    leaf_path, _, name = key.rpartition(".")
+    leaf = scenario.world.leaves.get(leaf_path)
     try:
-        change = resolve_change(key, lo, scenario.world)
-        resolve_change(key, hi, scenario.world)
-    except ValueError as exc:
-        raise ConfigError(str(exc), key=option) from None
-    param = scenario.world.leaves[change.leaf].template.param(change.param)
+        param = leaf.template.param(leaf.template.canonical(name)) if leaf else None
+    except KeyError:
+        param = None
+    if param is None or param.name in leaf.template.size_params():
+        try:  # resolve_change says what is wrong, with a did-you-mean
+            resolve_change(key, 0, scenario.world)
+        except ValueError as exc:
+            raise ConfigError(str(exc), key=option) from None
+        raise ConfigError("not a parameter a run can set", key=option)
     if param.type not in ("int", "float"):
         raise ConfigError(
-            f"a {param.type} parameter ({param.range_text()}) is not a range: give its "
-            "values with --grid",
+            f"{param.name} is not a number ({param.type}"
+            + (f": {param.range_text()}" if param.range_text() else "")
+            + "): give its values with --grid",
             key=option,
         )
     if param.type == "int":
@@ -122,7 +129,12 @@ def _numeric_dim(text: str, scenario: Scenario) -> Dim:
                 f"an integer parameter needs two integers in {lo:g}:{hi:g}", key=option
             )
         lo, hi = math.ceil(lo), math.floor(hi)
-    return Dim(key, param.type, float(lo), float(hi))
+    for bound in (lo, hi):  # the template's min and max
+        try:
+            param.coerce(bound)
+        except ValueError as exc:
+            raise ConfigError(str(exc), key=option) from None
+    return Dim(key, str(param.type), float(lo), float(hi))
 
 
 def build_space(scenario: Scenario, ranges: list[str], grids: list[str]) -> Space:
