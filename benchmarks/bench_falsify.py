@@ -90,8 +90,15 @@ def run_config(config: str, name: str, seed: int, budget: int) -> tuple[float, f
     popsize = 12 if config == "cma12" else None
     optimizer = "random" if config == "random" else "cma"
     settings = Settings(
-        base.scenario, budget, seed, base.run_seed, base.duration, "batch", 1,
-        optimizer=optimizer, popsize=popsize,
+        base.scenario,
+        budget,
+        seed,
+        base.run_seed,
+        base.duration,
+        "batch",
+        1,
+        optimizer=optimizer,
+        popsize=popsize,
     )
     t0 = time.process_time()
     if config == "tpe":

@@ -130,7 +130,11 @@ class _Cma:
             kwargs["c_space"] = [len(d.choices) for d in self.cats]
         if n:
             kwargs["mean"] = np.array([mean[i] for i in self.cont + self.ints])
+            # sigma * I: without ``cov`` the library scales each axis by the mean's distance
+            # to its nearer bound, so a start near an edge (a worst case often is) gets a
+            # step a hundredth of the box's and never leaves that corner's neighbourhood
             kwargs["sigma"] = SIGMA0
+            kwargs["cov"] = np.eye(n)
         self.opt = self._cls(**kwargs)
         self.popsize = self.opt.population_size
 
