@@ -69,6 +69,11 @@ class Space:
         """Every dimension, numeric first: the column order of results.csv."""
         return (*self.numeric, *self.categorical)
 
+    def encode(self, point: tuple[tuple[str, Any], ...]) -> list[float]:
+        """The unit-box coordinates of a point's numeric settings (decode's inverse)."""
+        values = dict(point)
+        return [(float(values[d.key]) - d.lo) / (d.hi - d.lo) for d in self.numeric]
+
     def decode(self, u: list[float], cats: list[int]) -> tuple[tuple[str, Any], ...]:
         """Settings from a unit-box vector and one choice index per categorical axis."""
         out = [(d.key, d.value(x)) for d, x in zip(self.numeric, u, strict=True)]
