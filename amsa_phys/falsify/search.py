@@ -43,6 +43,10 @@ STALL_GENERATIONS = 4
 STALL_TOL = 1e-4
 #: Random points a restart chooses its start among (the one farthest from every run).
 RESTART_CANDIDATES = 256
+#: A generation of fewer points runs in this process, not on a local worker pool: starting
+#: the pool (processes, imports, the scenario loaded in each) costs more than a handful of
+#: batched runs, and a search starts one per generation. Rows are the same either way.
+SMALL_GENERATION = 32
 OPTIMIZERS = ("cma", "random")
 
 
@@ -258,12 +262,13 @@ def _evaluate(
 ) -> Iterator[dict[str, Any]]:
     """One generation as one ``evaluate`` call; rows numbered on from the previous ones."""
     offset = len(progress.rows)
+    small = settings.executor == "batch" and len(points) < SMALL_GENERATION
     rows = evaluate(
         settings.scenario,
         [(p, settings.run_seed) for p in points],
         duration=settings.duration,
         executor=settings.executor,
-        workers=settings.workers,
+        workers=1 if small else settings.workers,
         scheduler=settings.scheduler,
     )
     for row in rows:
