@@ -231,3 +231,28 @@ def test_interrupt_keeps_every_finished_row(tmp_path: Path, how: str) -> None:
     assert all(r["error"] == "" and r["rms_error"] for r in table)
     assert (out / "worst.yaml").exists()
     assert (out / "convergence.png").exists()
+
+
+def test_grid_axes_are_searched_as_categories(tmp_path: Path) -> None:
+    out = tmp_path / "c"
+    args = [
+        "--range",
+        "Leader.cruisePower=3:12",
+        "--grid",
+        "Leader.behavior=1,3",
+        "--grid",
+        "LeaderGPS.lostDataGPS=0,30,60",
+        "--budget",
+        "20",
+        "--duration",
+        "10",
+        "-j",
+        "1",
+    ]
+    assert main(["falsify", str(RESONANCE), *args, "--out", str(out)]) == 0
+    table = rows(out / "results.csv")
+    assert len(table) == 20
+    assert {r["Leader.behavior"] for r in table} == {"1", "3"}
+    assert {r["LeaderGPS.lostDataGPS"] for r in table} == {"0", "30", "60"}
+    assert all(3 <= float(r["Leader.cruisePower"]) <= 12 for r in table)
+    assert "Leader.behavior:" in (out / "worst.yaml").read_text()
