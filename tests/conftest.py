@@ -24,3 +24,18 @@ def _no_leftover_long_runs() -> Iterator[None]:
     from longrun import stop_leftovers
 
     stop_leftovers()
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    """``--runslow``: also run the tests marked slow (or set AMSA_RUNSLOW=1)."""
+    parser.addoption("--runslow", action="store_true", help="run tests marked slow")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Skip ``@pytest.mark.slow`` tests unless asked for."""
+    if config.getoption("--runslow") or os.environ.get("AMSA_RUNSLOW") == "1":
+        return
+    skip = pytest.mark.skip(reason="slow: run with --runslow or AMSA_RUNSLOW=1")
+    for item in items:
+        if "slow" in item.keywords:
+            item.add_marker(skip)

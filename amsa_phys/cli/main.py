@@ -45,6 +45,10 @@ COMMANDS = {
         "sweep",
         "Exhaustive exploration: a parameter grid × seeds in parallel, on this machine or Dask.",
     ),
+    "falsify": (
+        "falsify",
+        "Falsification: search a box of context parameters for the worst case with CMA-ES.",
+    ),
     "graph": (
         "graph",
         "Draw the architecture of a world or scenario, components coloured by kind.",

@@ -23,6 +23,7 @@ LAYER = {
     "adapt": 5,
     "ros": 5,
     "bag": 5.5,  # a run as an MCAP bag: engine, stdmsgs; used by cli/ and api/
+    "falsify": 5,
     "cli": 6,
     "api": 6,
     "gym": 7,
