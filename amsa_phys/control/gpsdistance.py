@@ -16,20 +16,19 @@ cascade whose second stage is the follower law.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Mapping, Sequence
-from fractions import Fraction
-from typing import Any
-
-from ..engine import libm
-from ..model.template import Kind, Port, Template
+from ..model.template import Kind, Port
+from .monitor import DistanceMonitor
 
 
-class GpsDistance(Template):
-    """Euclidean distance between the leader's and the follower's GPS fixes."""
+class GpsDistance(DistanceMonitor):
+    """Euclidean distance between the leader's and the follower's GPS fixes.
+
+    The same arithmetic as :class:`DistanceMonitor` (inherited: ``do_step`` and
+    ``step_many``), fed with fixes instead of true positions; a controller stage, not a
+    sensor, because one sensor may not feed another in this architecture.
+    """
 
     kind = Kind.CONTROLLER
-    uses_random = False
     inputs = (
         Port("xLeader", 0.0, "leader x (GPS fix)", "m"),
         Port("yLeader", 0.0, "leader y (GPS fix)", "m"),
@@ -37,20 +36,3 @@ class GpsDistance(Template):
         Port("yFollower", 0.0, "follower y (GPS fix)", "m"),
     )
     outputs = (Port("distanceFollowerToLeader", 0.0, "distance between the two fixes", "m"),)
-
-    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
-        """The paper's doStep: one distance, from the latest fixes (stale if one was lost)."""
-        return {
-            "distanceFollowerToLeader": math.hypot(
-                inp["xLeader"] - inp["xFollower"], inp["yLeader"] - inp["yFollower"]
-            )
-        }
-
-    @classmethod
-    def step_many(
-        cls, comps: Sequence[Any], t: Fraction, inp: Mapping[str, Any], p: Any, state: Any
-    ) -> tuple[Mapping[str, Any], None]:
-        """``do_step`` for many copies at once (``engine/batch.py``), bit for bit."""
-        dx = inp["xLeader"] - inp["xFollower"]
-        dy = inp["yLeader"] - inp["yFollower"]
-        return {"distanceFollowerToLeader": libm.hypot(dx, dy)}, None
