@@ -90,25 +90,23 @@ class Observer:
         """The observation of one raw input vector (float64, within ``low``..``high``)."""
         if self.mode == "absolute":
             return raw
-        out = np.empty(len(self.names), dtype=np.float64)
-        k = 0
+        values = raw.tolist()  # a handful of floats: plain Python beats numpy per element
+        out: list[float] = []
         if self.own is not None:
             ox, oy, oh = self.own
-            c, s = math.cos(raw[oh]), math.sin(raw[oh])
+            c, s = math.cos(values[oh]), math.sin(values[oh])
+            x0, y0, scale = values[ox], values[oy], self.range_m
             for ix, iy in self.relative:
-                dx, dy = raw[ix] - raw[ox], raw[iy] - raw[oy]
-                out[k] = (c * dx + s * dy) / self.range_m
-                out[k + 1] = (-s * dx + c * dy) / self.range_m
-                k += 2
+                dx, dy = values[ix] - x0, values[iy] - y0
+                out += ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale)
         for i, unit in self.rest:
-            v = float(raw[i])
+            v = values[i]
             if unit == "m":
-                out[k] = v / self.range_m
+                out.append(v / self.range_m)
             elif unit == "m/s":
-                out[k] = v / self.speed_mps
+                out.append(v / self.speed_mps)
             elif unit == "rad":
-                out[k] = ((v + math.pi) % (2 * math.pi) - math.pi) / math.pi
+                out.append(((v + math.pi) % (2 * math.pi) - math.pi) / math.pi)
             else:
-                out[k] = math.tanh(v)
-            k += 1
-        return np.clip(out, -1.0, 1.0, out=out)
+                out.append(math.tanh(v))
+        return np.array([min(1.0, max(-1.0, v)) for v in out], dtype=np.float64)
