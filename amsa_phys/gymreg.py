@@ -22,6 +22,8 @@ from typing import Any
 
 #: The environments this package registers (id -> entry point).
 ENVIRONMENTS = {"amsa_phys/Follow-v0": "amsa_phys.gym.follow:FollowEnv"}
+#: Each one's own vector env (``make_vec(..., vectorization_mode="vector_entry_point")``)
+VECTOR = {"amsa_phys/Follow-v0": "amsa_phys.gym.vector:FollowVecEnv"}
 _lock = threading.Lock()
 
 
@@ -29,7 +31,12 @@ def register(gymnasium: ModuleType) -> None:
     """Register every environment not yet in Gymnasium's registry (safe to call twice)."""
     for env_id, entry in ENVIRONMENTS.items():
         if env_id not in gymnasium.registry:
-            gymnasium.register(id=env_id, entry_point=entry, nondeterministic=False)
+            gymnasium.register(
+                id=env_id,
+                entry_point=entry,
+                vector_entry_point=VECTOR.get(env_id),
+                nondeterministic=False,
+            )
 
 
 class _Loader(importlib.abc.Loader):

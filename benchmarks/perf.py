@@ -17,7 +17,8 @@ compare. Targets (issue "Performance"):
 * plots never slow the run: a 200-rover, 30 s run with plots <= 1.3x the same run without;
 * start-up (issue 29): the whole ``run --headless`` process of scenario1 (300 s), CPU of the
   process and its children, <= 15x ``python -c pass`` without plots and <= 40x with plots;
-* the Gymnasium env (issue 29): >= 20,000 steps/s (one env, constant action);
+* the Gymnasium env (issue 29): >= 20,000 steps/s (one env, constant action); the vector env
+  >= 50,000 env-steps/s with 1,000 envs;
 * batched sweeps (``bench_batch.py``): 1,000 runs of scenario1 <= 5 s on 2 cores and >= 10x
   the process pool; 10,000 runs <= 60 s with RSS <= 1.5x that of 1,000.
 """
@@ -163,6 +164,21 @@ def gym_env(reps: int) -> None:
         rates.append(steps / (time.process_time() - t0))
     env.close()
     report("gym env steps/s (CPU)", med(rates), ">= 20000", statistics.median(rates) >= 20000)
+    from amsa_phys.gym.vector import FollowVecEnv
+
+    for n in (100, 1000):
+        vec_rates = []
+        for i in range(reps):
+            vec = FollowVecEnv(n, str(SCENARIO1), duration=300)
+            vec.reset(seed=i)
+            actions = np.full((n, 2), 0.5)
+            t0 = time.process_time()
+            for _ in range(40):
+                vec.step(actions)
+            vec_rates.append(n * 40 / (time.process_time() - t0))
+            vec.close()
+        ok = statistics.median(vec_rates) >= 50000
+        report(f"vector env, {n} envs: env-steps/s", med(vec_rates), ">= 50000", ok)
 
 
 # -- platoon scaling --------------------------------------------------------------------------
