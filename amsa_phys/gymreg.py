@@ -12,10 +12,8 @@ numpy, pymunk, the engine) is imported only by ``make``, through the entry point
 
 from __future__ import annotations
 
-import importlib.abc
 import importlib.machinery
 import sys
-import threading
 from collections.abc import Sequence
 from types import ModuleType
 from typing import Any
@@ -24,7 +22,6 @@ from typing import Any
 ENVIRONMENTS = {"amsa_phys/Follow-v0": "amsa_phys.gym.follow:FollowEnv"}
 #: Each one's own vector env (``make_vec(..., vectorization_mode="vector_entry_point")``)
 VECTOR = {"amsa_phys/Follow-v0": "amsa_phys.gym.vector:FollowVecEnv"}
-_lock = threading.Lock()
 
 
 def register(gymnasium: ModuleType) -> None:
@@ -39,8 +36,10 @@ def register(gymnasium: ModuleType) -> None:
             )
 
 
-class _Loader(importlib.abc.Loader):
-    """Gymnasium's own loader, then :func:`register` once the module has executed."""
+class _Loader:
+    """Gymnasium's own loader, then :func:`register` once the module has executed (not an
+    ``importlib.abc`` subclass: that module imports tempfile and random, 6 ms on every
+    ``import amsa_phys``)."""
 
     def __init__(self, inner: Any) -> None:
         self.inner = inner
@@ -53,7 +52,7 @@ class _Loader(importlib.abc.Loader):
         register(module)
 
 
-class _AfterGymnasium(importlib.abc.MetaPathFinder):
+class _AfterGymnasium:
     """Finds nothing itself: wraps Gymnasium's spec so that its import ends registered."""
 
     def find_spec(
@@ -69,8 +68,8 @@ class _AfterGymnasium(importlib.abc.MetaPathFinder):
 
 
 def _remove_finder() -> None:
-    with _lock:
-        sys.meta_path[:] = [f for f in sys.meta_path if not isinstance(f, _AfterGymnasium)]
+    # no lock (threading is another import): both callers run under an import lock
+    sys.meta_path[:] = [f for f in sys.meta_path if not isinstance(f, _AfterGymnasium)]
 
 
 def install() -> None:
@@ -79,6 +78,5 @@ def install() -> None:
     if gymnasium is not None and hasattr(gymnasium, "registry"):
         register(gymnasium)
         return
-    with _lock:
-        if not any(isinstance(f, _AfterGymnasium) for f in sys.meta_path):
-            sys.meta_path.insert(0, _AfterGymnasium())
+    if not any(isinstance(f, _AfterGymnasium) for f in sys.meta_path):
+        sys.meta_path.insert(0, _AfterGymnasium())
