@@ -71,6 +71,11 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
     from .runs.single import run_scenario
 
 
+from .gymreg import install as _install_gym  # noqa: E402  (light: no gymnasium, no numpy)
+
+_install_gym()  # gymnasium.make("amsa_phys/Follow-v0") after import amsa_phys (gymreg.py)
+
+
 def __getattr__(name: str) -> Any:
     """Import a public name on first use and keep it (later lookups are plain attributes)."""
     module = _LAZY.get(name)

@@ -15,6 +15,10 @@ compare. Targets (issue "Performance"):
 * sweeps: speed-up from -j 1 to -j N >= 0.9 N;
 * memory: peak RSS of a 1-hour run and of a 1-hour recording within 1.5x of a 1-minute one;
 * plots never slow the run: a 200-rover, 30 s run with plots <= 1.3x the same run without;
+* start-up (issue 29): the whole ``run --headless`` process of scenario1 (300 s), CPU of the
+  process and its children, <= 15x ``python -c pass`` without plots and <= 40x with plots;
+* the Gymnasium env (issue 29): >= 20,000 steps/s (one env, constant action); the vector env
+  >= 50,000 env-steps/s with 1,000 envs;
 * batched sweeps (``bench_batch.py``): 1,000 runs of scenario1 <= 5 s on 2 cores and >= 10x
   the process pool; 10,000 runs <= 60 s with RSS <= 1.5x that of 1,000.
 """
@@ -103,6 +107,78 @@ def process(reps: int) -> None:
             subprocess.run(argv, check=False, capture_output=True)
             walls.append(time.perf_counter() - t0)
     report("amsa-phys run process, s", med(walls), "< 1.5", statistics.median(walls) < 1.5)
+
+
+def _child_cpu(argv: list[str]) -> float:
+    """CPU seconds (user + system) of one process and everything it forked."""
+    before = os.times()
+    subprocess.run(argv, check=False, capture_output=True)
+    after = os.times()
+    return (after.children_user - before.children_user) + (
+        after.children_system - before.children_system
+    )
+
+
+def startup(reps: int) -> None:
+    """Whole-process CPU of ``run --headless`` over that of ``python -c pass``, interleaved."""
+    bare, no_plot, with_plot = [], [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        for i in range(reps):
+            argv = [sys.executable, "-m", "amsa_phys", "run", str(SCENARIO1), "--headless"]
+            argv += ["--duration", "300", "-q"]
+            bare.append(_child_cpu([sys.executable, "-c", "pass"]))
+            no_plot.append(_child_cpu([*argv, "--no-plot", "--out", f"{tmp}/n{i}"]))
+            with_plot.append(_child_cpu([*argv, "--out", f"{tmp}/p{i}"]))
+    r_no = [n / b for n, b in zip(no_plot, bare, strict=True)]
+    r_with = [w / b for w, b in zip(with_plot, bare, strict=True)]
+    report(
+        "run process CPU / python -c pass",
+        f"{med(r_no)}; {statistics.median(no_plot):.3f} s",
+        "<= 15",
+        statistics.median(r_no) <= 15,
+    )
+    report(
+        "same with plots / python -c pass",
+        f"{med(r_with)}; {statistics.median(with_plot):.3f} s",
+        "<= 40",
+        statistics.median(r_with) <= 40,
+    )
+
+
+def gym_env(reps: int) -> None:
+    """Steps a second of ``amsa_phys/Follow-v0`` (scenario1, constant action)."""
+    import numpy as np
+
+    from amsa_phys.gym import FollowEnv
+
+    rates = []
+    env = FollowEnv(str(SCENARIO1), duration=300)
+    action = np.array([0.5, 0.5])
+    for i in range(reps):
+        env.reset(seed=i)
+        steps, truncated = 0, False
+        t0 = time.process_time()
+        while not truncated:
+            *_, truncated, _ = env.step(action)
+            steps += 1
+        rates.append(steps / (time.process_time() - t0))
+    env.close()
+    report("gym env steps/s (CPU)", med(rates), ">= 20000", statistics.median(rates) >= 20000)
+    from amsa_phys.gym.vector import FollowVecEnv
+
+    for n in (100, 1000):
+        vec_rates = []
+        for i in range(reps):
+            vec = FollowVecEnv(n, str(SCENARIO1), duration=300)
+            vec.reset(seed=i)
+            actions = np.full((n, 2), 0.5)
+            t0 = time.process_time()
+            for _ in range(40):
+                vec.step(actions)
+            vec_rates.append(n * 40 / (time.process_time() - t0))
+            vec.close()
+        ok = statistics.median(vec_rates) >= 50000
+        report(f"vector env, {n} envs: env-steps/s", med(vec_rates), ">= 50000", ok)
 
 
 # -- platoon scaling --------------------------------------------------------------------------
@@ -247,6 +323,8 @@ TARGETS: dict[str, Callable[[int], None]] = {
     # issue 19: compiled step vs pure, process, --help, 1,000-rover platoon (bench_compiled.py)
     "compiled": lambda reps: bench_compiled.run_all(reps, report),
     "batched": batched,
+    "startup": startup,  # issue 29: whole process vs python -c pass
+    "gym": gym_env,
 }
 
 

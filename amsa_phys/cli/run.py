@@ -7,7 +7,6 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..bag import BagRecorder
 from ..engine import interrupt
 from ..errors import ConfigError, one_line
 from ..model.scenario import Scenario, load_scenario, traced_columns
@@ -21,7 +20,8 @@ from .options import add_bag, add_no_adapt, add_output, add_scenario_overrides, 
 from .recording import _target, add_recording, recording_options, snapshot_options
 from .report import print_summary
 
-if TYPE_CHECKING:  # pygame is imported only by runs that draw
+if TYPE_CHECKING:  # pygame is imported only by runs that draw, mcap only by --bag
+    from ..bag import BagRecorder
     from ..view.recorder import RecordOptions, SnapshotOptions
 
 
@@ -91,7 +91,11 @@ def _run(
     bag_path = _target(args.bag, (".mcap",), "--bag", args.force) if args.bag else None
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
     prepare_run_dir(out, args.force, inputs=input_files(scenario))
-    bag = BagRecorder(bag_path, scenario) if bag_path is not None else None
+    bag: BagRecorder | None = None
+    if bag_path is not None:  # mcap and the message tables (~60 ms) only for --bag
+        from ..bag import BagRecorder
+
+        bag = BagRecorder(bag_path, scenario)
     try:
         with interrupt.sigterm_as_ctrl_c():
             outcome = run_scenario(

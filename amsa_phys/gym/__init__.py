@@ -1,9 +1,9 @@
 """Gymnasium environments (extra ``amsa-phys[gym]``), registered as ``amsa_phys/...``.
 
-``import amsa_phys.gym`` registers them; ``gymnasium.make("amsa_phys.gym:amsa_phys/Follow-v0",
-scenario=...)`` imports this module itself (Gymnasium 1.x has no entry-point plugin
-mechanism any more: the ``module:`` prefix of the id is how a package's environments are
-found without an explicit import).
+``import amsa_phys`` registers them already (``amsa_phys/gymreg.py``: at once if Gymnasium is
+imported, else when it is), so ``gymnasium.make("amsa_phys/Follow-v0")`` needs no other
+import; Gymnasium 1.x has no entry-point plugin group any more. Importing this module
+registers them too, and ``gymnasium.make("amsa_phys.gym:amsa_phys/Follow-v0")`` imports it.
 """
 
 from __future__ import annotations
@@ -15,13 +15,9 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
         f"amsa_phys.gym needs gymnasium ({exc}); install it with: pip install 'amsa-phys[gym]'"
     ) from None
 
+from ..gymreg import ENVIRONMENTS, register
 from .follow import FollowEnv
 
-#: The environments this package registers (id -> entry point).
-ENVIRONMENTS = {"amsa_phys/Follow-v0": "amsa_phys.gym.follow:FollowEnv"}
-
-for _id, _entry in ENVIRONMENTS.items():
-    if _id not in gymnasium.registry:
-        gymnasium.register(id=_id, entry_point=_entry, nondeterministic=False)
+register(gymnasium)
 
 __all__ = ["ENVIRONMENTS", "FollowEnv"]

@@ -17,11 +17,13 @@ import dataclasses
 import os
 from collections.abc import Mapping, Sequence
 from fractions import Fraction
+from pathlib import Path
 from typing import Any
 
 import gymnasium
 import numpy as np
 from gymnasium import spaces
+from gymnasium.utils import EzPickle
 
 from ..api.memory import check_trace_memory
 from ..api.source import Source, load
@@ -32,13 +34,20 @@ from ..model.suggest import did_you_mean
 from ..model.template import Kind
 from . import args
 from .episode import Episode
+from .observe import Observer
+
+#: ``gymnasium.make("amsa_phys/Follow-v0")`` with no scenario: the paper's degraded context
+DEFAULT_SCENARIO = Path(__file__).with_name("data") / "follow.yaml"
 
 
-class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
+class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
     """A scenario as a Gymnasium environment whose agent replaces one component.
 
     Args:
-        scenario: a scenario file or mapping (as ``amsa_phys.run`` takes).
+        scenario: a scenario file or mapping (as ``amsa_phys.run`` takes); default the
+            packaged ``gym/data/follow.yaml`` (the paper's degraded context, 120 s).
+        observation: ``"relative"`` (default: robot-relative, normalised to [-1, 1],
+            ``gym/observe.py``) or ``"absolute"`` (the raw inputs, unbounded).
         controller: the Leaf the agent replaces (default: the scenario's only controller).
         actions: the outputs the agent sets (default: those another component reads).
         action_scale: an action ``a`` in [-1, 1] publishes ``a * action_scale`` (default 100:
@@ -46,16 +55,21 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
             downstream clamps, as it clamps the replaced controller.
         collision_penalty: subtracted from the reward per new collision.
         duration, set, log_rate, base_dir: as for ``amsa_phys.run`` (the CLI's options).
-        render_mode: ``None`` or ``"rgb_array"``; render_size: (width, height) in pixels.
+        render_mode: ``None``, ``"rgb_array"`` or ``"human"`` (a window, paced to
+            ``render_fps``); render_size: (width, height) in pixels.
         record_trace: keep the episode's trace in memory (:meth:`trace`), as ``run`` does.
+
+    Pickling (``EzPickle``) keeps the constructor's arguments, not the episode in progress:
+    an unpickled environment is a fresh one, to ``reset()`` before stepping.
     """
 
-    metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 4}  # noqa: RUF012
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array", "human"], "render_fps": 4}  # noqa: RUF012
 
     def __init__(
         self,
-        scenario: Source,
+        scenario: Source | None = None,
         *,
+        observation: str = "relative",
         controller: str | None = None,
         actions: Sequence[str] | None = None,
         action_scale: float = 100.0,
@@ -68,11 +82,30 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         render_size: tuple[int, int] = (640, 360),
         record_trace: bool = False,
     ) -> None:
+        EzPickle.__init__(
+            self,
+            scenario,
+            observation=observation,
+            controller=controller,
+            actions=actions,
+            action_scale=action_scale,
+            collision_penalty=collision_penalty,
+            duration=duration,
+            set=set,
+            log_rate=log_rate,
+            base_dir=base_dir,
+            render_mode=render_mode,
+            render_size=render_size,
+            record_trace=record_trace,
+        )
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ConfigError(
-                f"unknown render mode {render_mode!r}; amsa_phys/Follow-v0 renders 'rgb_array'",
+                f"unknown render mode {render_mode!r}; amsa_phys/Follow-v0 renders "
+                "'rgb_array' or 'human'",
                 key="render_mode",
             )
+        if scenario is None:
+            scenario = DEFAULT_SCENARIO
         controller = args.component(controller)
         actions = args.names(actions, "actions")
         size = args.render_size(render_size)
@@ -98,7 +131,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
                 key="controller",
             )
         leaf = world.leaves[self.path]
-        self.observed = [p.name for p in leaf.template.inputs if p.name in leaf.inputs]
+        ports = [p for p in leaf.template.inputs if p.name in leaf.inputs]
+        self.observed = [p.name for p in ports]
         if not self.observed:
             raise ConfigError(
                 f"{self.path} reads no input: the agent would observe nothing", key="controller"
@@ -115,7 +149,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
             raise ConfigError(f"{self.path} has no output to act on", key="actions")
         self.period = 1 / leaf.freq
         self.metadata = {**self.metadata, "render_fps": float(leaf.freq)}
-        self.observation_space = spaces.Box(-np.inf, np.inf, (len(self.observed),), np.float64)
+        self.observer = Observer(ports, observation)
+        self.observation_space = spaces.Box(self.observer.low, self.observer.high, dtype=np.float64)
         self.action_space = spaces.Box(-1.0, 1.0, (len(self.acted),), np.float64)
         self.render_mode = render_mode
         self.render_size = size
@@ -156,6 +191,12 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
             from .render import FrameSource
 
             self._frames = FrameSource(self._episode.sim, self.quality, self.render_size)
+        elif self.render_mode == "human":
+            from .human import HumanView
+
+            fps = float(self.metadata["render_fps"])
+            self._frames = HumanView(self._episode.sim, self.quality, self.render_size, fps)
+            self._frames.show([f"agent: {self.path}"])
         info = self._info()
         info["seed"] = episode_seed
         return self._observation(), info
@@ -172,6 +213,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         episode.step({name: float(v) * scale for name, v in zip(self.acted, a, strict=True)})
         if self._frames is not None:
             self._frames.sample()
+            if self.render_mode == "human":
+                self._frames.show([f"agent: {self.path}"])
         events = episode.sim.events
         new = sum(1 for e in events[self._seen_events :] if e.kind == "collision")
         self._seen_events = len(events)
@@ -186,8 +229,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
 
     def render(self) -> np.ndarray | None:  # type: ignore[override]
         """The current picture (``render_mode="rgb_array"``), ``(height, width, 3)`` uint8."""
-        if self._frames is None or self._episode is None:
-            return None
+        if self._frames is None or self._episode is None or self.render_mode != "rgb_array":
+            return None  # "human" draws at every step (Gymnasium's convention)
         status = [f"agent: {self.path}"]
         return self._frames.draw(status)  # type: ignore[no-any-return]
 
@@ -195,6 +238,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         """Stop the episode's worker thread (safe to call twice)."""
         if self._episode is not None:
             self._episode.close()
+        if self._frames is not None and hasattr(self._frames, "close"):
+            self._frames.close()
         self._frames = None
 
     def __del__(self) -> None:
@@ -230,8 +275,10 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         assert episode is not None
         if episode.done:  # the end: what the component would read now
             leaf = episode.sim.world.leaves[self.path]
-            return episode.sim.read_many([leaf.inputs[p] for p in self.observed])
-        return np.array([episode.inputs[p] for p in self.observed], dtype=np.float64)
+            raw = episode.sim.read_many([leaf.inputs[p] for p in self.observed])
+        else:
+            raw = np.array([episode.inputs[p] for p in self.observed], dtype=np.float64)
+        return self.observer(raw)
 
     def _info(self) -> dict[str, Any]:
         episode = self._episode

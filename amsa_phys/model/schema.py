@@ -8,17 +8,19 @@ parameter names, links) are judged afterwards by the world and scenario builders
 
 from __future__ import annotations
 
+import importlib
 import math
 import sys
-from typing import Any
-
-import jsonschema
+from typing import TYPE_CHECKING, Any
 
 from .adaptrules import SCHEMA as ADAPT
 from .params import short_repr, yaml_type
 from .rates import MAX_RATE_HZ, MIN_PHYSICS_RATE_HZ, MIN_RATE_HZ
 from .suggest import did_you_mean
 from .yamlio import KeyPath, YamlDoc
+
+if TYPE_CHECKING:  # imported only to word an error: ~50-100 ms of imports off the run path
+    import jsonschema
 
 NAME = r"^[A-Za-z_][A-Za-z0-9_]*$"
 #: The largest seed: numpy's seed tree takes any non-negative integer, files stay int64.
@@ -285,6 +287,10 @@ def validate(data: Any, schema: dict[str, Any], doc: YamlDoc, prefix: KeyPath = 
         if isinstance(value, int):
             raise doc.error(bad, f"number too large ({too_large(value)})")
         raise doc.error(bad, "expected a finite number, got NaN or infinity")
+    if _precompiled_accepts(data, schema):
+        return
+    import jsonschema  # the judge and the words of every refusal (model/shapegen.py)
+
     validator = jsonschema.Draft202012Validator(schema)
     errors = list(validator.iter_errors(data))
     if not errors:
@@ -292,6 +298,23 @@ def validate(data: Any, schema: dict[str, Any], doc: YamlDoc, prefix: KeyPath = 
     located = [_locate(err, prefix) for err in _leaves(errors)]
     keypath, message = min(located, key=lambda km: (doc.line(km[0]) or 0, -len(km[0])))
     raise doc.error(keypath, message)
+
+
+def _precompiled_accepts(data: Any, schema: dict[str, Any]) -> bool:
+    """True when the generated check of ``schema`` (``model/shapes``) accepts ``data``.
+
+    False for a rejected file and for a schema without a generated check: jsonschema then
+    decides and words the error, so this can only make a valid file cheaper.
+    """
+    name = _SHAPE_NAMES.get(id(schema))
+    if name is None:
+        return False
+    check = importlib.import_module(f".shapes.{name}", __package__).validate
+    try:
+        check(data)
+    except ValueError:  # fastjsonschema's JsonSchemaValueException
+        return False
+    return True
 
 
 def _leaves(errors: list[jsonschema.ValidationError]) -> list[jsonschema.ValidationError]:
@@ -396,3 +419,13 @@ def _first_nonfinite(data: Any, path: KeyPath) -> KeyPath | None:
             if found is not None:
                 return found
     return None
+
+
+def _shape_names() -> dict[int, str]:
+    from .adaptrules import FILE
+
+    return {id(WORLD): "world", id(SCENARIO): "scenario", id(PHYSICS): "physics", id(FILE): "rules"}
+
+
+#: id of a schema -> its generated check (``python -m amsa_phys.model.shapegen``)
+_SHAPE_NAMES = _shape_names()

@@ -1,0 +1,112 @@
+"""Observations an RL agent can learn from: robot-relative, normalised, with finite bounds.
+
+The agent reads what the replaced component reads (its inputs, in port order). Those are
+world coordinates in metres, an absolute heading in radians, speeds: unbounded, and a
+policy trained on them learns where the world's origin is rather than how to follow. The
+default view (``observation="relative"``) is therefore built from the ports' declared units
+and names, for any template that follows the project's naming (``xLeader``/``yLeader``,
+``headingFollower``):
+
+- the robot's own frame is the ``x<Name>``/``y<Name>`` pair whose ``<Name>`` matches the one
+  ``heading<Name>`` input (unit ``rad``); the own position and heading are consumed by it;
+- every other position pair becomes (forward, left) in that frame, divided by ``range_m`` and
+  clipped to [-1, 1] (``<Name>.forward``, ``<Name>.left``);
+- other metres: divided by ``range_m``, clipped; m/s: divided by ``speed_mps``, clipped; other
+  angles: wrapped to [-pi, pi) and divided by pi; anything else: ``tanh`` (monotone, bounded).
+
+So every element lies in [-1, 1]. ``observation="absolute"`` keeps the raw inputs (bounds
+infinite), as before.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError
+
+MODES = ("relative", "absolute")
+
+
+class Observer:
+    """Maps the component's raw inputs (port order) to the agent's observation."""
+
+    def __init__(
+        self,
+        ports: Sequence[Any],
+        mode: str = "relative",
+        range_m: float = 50.0,
+        speed_mps: float = 10.0,
+    ) -> None:
+        if mode not in MODES:
+            raise ConfigError(
+                f"unknown observation {mode!r}; expected one of: {', '.join(MODES)}",
+                key="observation",
+            )
+        self.mode = mode
+        self.raw_names = [p.name for p in ports]
+        if mode == "absolute":
+            self.names = list(self.raw_names)
+            self.low = np.full(len(ports), -np.inf)
+            self.high = np.full(len(ports), np.inf)
+            return
+        index = {p.name: i for i, p in enumerate(ports)}
+        unit = {p.name: p.unit for p in ports}
+        pairs = {
+            p.name[1:]: (index[p.name], index["y" + p.name[1:]])
+            for p in ports
+            if p.name.startswith("x") and unit.get("y" + p.name[1:]) == "m" and p.unit == "m"
+        }
+        headings = [p.name[len("heading") :] for p in ports if p.name.startswith("heading")]
+        own = headings[0] if len(headings) == 1 and headings[0] in pairs else None
+        used: set[int] = set()
+        self.own: tuple[int, int, int] | None = None
+        self.relative: list[tuple[int, int]] = []
+        self.names = []
+        if own is not None:
+            ox, oy = pairs.pop(own)
+            oh = index["heading" + own]
+            self.own = (ox, oy, oh)
+            used |= {ox, oy, oh}
+            for name, (ix, iy) in pairs.items():
+                self.relative.append((ix, iy))
+                self.names += [f"{name}.forward", f"{name}.left"]
+                used |= {ix, iy}
+        self.rest: list[tuple[int, str]] = []
+        for p in ports:
+            i = index[p.name]
+            if i not in used:
+                self.rest.append((i, p.unit))
+                self.names.append(p.name)
+        self.range_m = range_m
+        self.speed_mps = speed_mps
+        self.low = np.full(len(self.names), -1.0)
+        self.high = np.full(len(self.names), 1.0)
+
+    def __call__(self, raw: np.ndarray) -> np.ndarray:
+        """The observation of one raw input vector (float64, within ``low``..``high``)."""
+        if self.mode == "absolute":
+            return raw
+        values = raw.tolist()  # a handful of floats: plain Python beats numpy per element
+        out: list[float] = []
+        if self.own is not None:
+            ox, oy, oh = self.own
+            c, s = math.cos(values[oh]), math.sin(values[oh])
+            x0, y0, scale = values[ox], values[oy], self.range_m
+            for ix, iy in self.relative:
+                dx, dy = values[ix] - x0, values[iy] - y0
+                out += ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale)
+        for i, unit in self.rest:
+            v = values[i]
+            if unit == "m":
+                out.append(v / self.range_m)
+            elif unit == "m/s":
+                out.append(v / self.speed_mps)
+            elif unit == "rad":
+                out.append(((v + math.pi) % (2 * math.pi) - math.pi) / math.pi)
+            else:
+                out.append(math.tanh(v))
+        return np.array([min(1.0, max(-1.0, v)) for v in out], dtype=np.float64)

@@ -1,0 +1,128 @@
+"""``amsa_phys/FollowVec-v0``: N agents in N runs of one scenario, in one process.
+
+A ``gymnasium.vector.VectorEnv`` over one batched simulation (``gym/vecepisode.py``): every
+sub-environment is the episode :class:`~amsa_phys.gym.follow.FollowEnv` gives with the same
+seed (same observation, reward, end), but the N runs are stepped together — one thread
+handoff per vector step. Gymnasium 1.x's ``NEXT_STEP`` autoreset: all sub-environments
+reach the scenario's duration at the same step (one duration for all); the ``step`` after
+that starts new episodes (seeds drawn from the env's generator) and returns their first
+observations with reward 0 and ``terminated = truncated = False``, ignoring the action.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium
+import numpy as np
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector.utils import batch_space
+
+from ..errors import ConfigError
+from . import args
+from .follow import FollowEnv
+from .vecepisode import VecEpisode
+
+
+class FollowVecEnv(gymnasium.vector.VectorEnv):
+    """``num_envs`` FollowEnv episodes stepped as one batch (arguments as FollowEnv's)."""
+
+    metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}  # noqa: RUF012
+
+    def __init__(self, num_envs: int = 1, scenario: Any = None, **kwargs: Any) -> None:
+        if not isinstance(num_envs, int) or isinstance(num_envs, bool) or num_envs < 1:
+            raise ConfigError(
+                f"num_envs must be a whole number >= 1, got {num_envs!r}", key="num_envs"
+            )
+        if kwargs.get("render_mode") is not None or kwargs.get("record_trace"):
+            raise ConfigError(
+                "the vector env neither renders nor records traces; use FollowEnv",
+                key="render_mode" if kwargs.get("render_mode") is not None else "record_trace",
+            )
+        self.single = FollowEnv(scenario, **kwargs)  # validates every argument, once
+        self.num_envs = num_envs
+        self.single_observation_space = self.single.observation_space
+        self.single_action_space = self.single.action_space
+        self.observation_space = batch_space(self.single_observation_space, num_envs)
+        self.action_space = batch_space(self.single_action_space, num_envs)
+        self.metadata = {**self.metadata, "render_fps": self.single.metadata["render_fps"]}
+        self._episode: VecEpisode | None = None
+        self._seen = np.zeros(num_envs, dtype=np.int64)
+        self._autoreset = False
+
+    def reset(
+        self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """New episodes; ``seed`` an int (env ``i`` gets ``seed + i``) or one seed each."""
+        if options:
+            raise ConfigError("the vector env takes no reset options", key="options")
+        if isinstance(seed, list | tuple):
+            if len(seed) != self.num_envs:
+                raise ConfigError(f"expected {self.num_envs} seeds, got {len(seed)}", key="seed")
+            seeds = [args.seed(s) for s in seed]
+            super().reset(seed=seeds[0])
+        else:
+            base = args.seed(seed)
+            super().reset(seed=base)
+            seeds = [None if base is None else base + i for i in range(self.num_envs)]
+        return self._start(seeds)
+
+    def _start(self, seeds: list[int | None]) -> tuple[np.ndarray, dict[str, Any]]:
+        drawn = [s if s is not None else int(self.np_random.integers(0, 2**31 - 1)) for s in seeds]
+        self.close_extras()
+        single = self.single
+        self._episode = VecEpisode(single._scenario, single.path, drawn, single.observed)
+        self._seen = np.zeros(self.num_envs, dtype=np.int64)
+        self._autoreset = False
+        info = self._info()
+        info["seed"] = np.array(drawn)
+        return self._observations(), info
+
+    def step(
+        self, actions: Any
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """One period of the replaced component in every run (NEXT_STEP autoreset)."""
+        if self._episode is None:
+            raise gymnasium.error.ResetNeeded("call reset() before step()")
+        n = self.num_envs
+        if self._autoreset:  # the previous step ended every episode: start new ones
+            obs, info = self._start([None] * n)
+            zeros = np.zeros(n, dtype=bool)
+            return obs, np.zeros(n), zeros, zeros.copy(), info
+        a = np.asarray(actions, dtype=np.float64).reshape(n, -1)
+        acted = self.single.acted
+        if a.shape != (n, len(acted)):
+            raise ValueError(f"expected actions of shape ({n}, {len(acted)}), got {a.shape}")
+        scale = self.single.action_scale
+        episode = self._episode
+        episode.step({name: a[:, j] * scale for j, name in enumerate(acted)})
+        collisions = episode.collisions()
+        new = collisions - self._seen
+        self._seen = collisions
+        q = self.single.quality
+        reward = -np.abs(episode.signals(q.signal) - q.reference) / q.tolerance
+        reward = reward - self.single.collision_penalty * new + 0.0
+        truncated = np.full(n, episode.done)
+        self._autoreset = episode.done
+        return self._observations(), reward, np.zeros(n, dtype=bool), truncated, self._info()
+
+    def _observations(self) -> np.ndarray:
+        episode = self._episode
+        assert episode is not None
+        raw = episode.final_inputs() if episode.done else episode.inputs
+        observer = self.single.observer
+        return np.stack([observer(row) for row in raw])
+
+    def _info(self) -> dict[str, Any]:
+        episode = self._episode
+        assert episode is not None
+        return {
+            "t": np.full(self.num_envs, float(episode.t)),
+            "signal": episode.signals(self.single.quality.signal),
+            "collisions": self._seen.copy(),
+        }
+
+    def close_extras(self, **kwargs: Any) -> None:
+        """Stop the batch's worker thread."""
+        if self._episode is not None:
+            self._episode.close()

@@ -1,0 +1,114 @@
+"""``FollowVecEnv``: N episodes as one batched simulation, each the single env's episode."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+gymnasium = pytest.importorskip("gymnasium", reason="the gym extra is not installed")
+
+import amsa_phys as ap  # noqa: E402
+from amsa_phys.gym import FollowEnv  # noqa: E402
+from amsa_phys.gym.vector import FollowVecEnv  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+SCENARIO2 = str(ROOT / "scenarios" / "scenario2.yaml")
+SCENARIO1 = str(ROOT / "scenarios" / "scenario1.yaml")
+
+
+@pytest.mark.parametrize("observation", ["relative", "absolute"])
+def test_vector_env_equals_single_envs_step_for_step(observation: str) -> None:
+    seeds = [11, 12, 13]
+    vec = FollowVecEnv(3, SCENARIO2, duration=6, observation=observation)
+    obs, info = vec.reset(seed=seeds)
+    assert info["seed"].tolist() == seeds
+    actions = np.random.default_rng(1).uniform(-1, 1, size=(24, 3, 2))
+    v_obs, v_rew, v_trunc = [obs], [], []
+    for a in actions:
+        obs, reward, terminated, truncated, _ = vec.step(a)
+        assert not terminated.any()
+        v_obs.append(obs)
+        v_rew.append(reward)
+        v_trunc.append(truncated)
+    vec.close()
+    assert v_trunc[-1].all()
+    assert not np.array(v_trunc[:-1]).any()  # 6 s at 4 Hz: the 24th step ends it
+    for i, seed in enumerate(seeds):
+        single = FollowEnv(SCENARIO2, duration=6, observation=observation)
+        s_obs, _ = single.reset(seed=seed)
+        np.testing.assert_array_equal(v_obs[0][i], s_obs)
+        for k, a in enumerate(actions):
+            s_obs, s_rew, _, s_trunc, _ = single.step(a[i])
+            np.testing.assert_array_equal(v_obs[k + 1][i], s_obs)  # bit for bit
+            assert v_rew[k][i] == s_rew
+            assert v_trunc[k][i] == s_trunc
+        single.close()
+    # the random leader: the seeds make different episodes
+    assert not np.array_equal(v_obs[-1][0], v_obs[-1][1])
+
+
+def test_collisions_cost_the_run_that_collides() -> None:
+    # full power from 15 m behind a straight leader rams it: the same step as alone
+    vec = FollowVecEnv(2, SCENARIO1, duration=60)
+    vec.reset(seed=[1, 2])
+    single = FollowEnv(SCENARIO1, duration=60)
+    single.reset(seed=1)
+    for _ in range(240):
+        _, reward, _, _, info = vec.step(np.array([[1.0, 1.0], [0.0, 0.0]]))
+        _, s_reward, _, _, s_info = single.step(np.array([1.0, 1.0]))
+        assert reward[0] == s_reward
+        if s_info["collisions"]:
+            break
+    assert info["collisions"].tolist() == [s_info["collisions"], 0]
+    assert info["collisions"][0] >= 1
+    vec.close()
+    single.close()
+
+
+def test_next_step_autoreset() -> None:
+    vec = FollowVecEnv(2, SCENARIO1, duration=1)
+    assert vec.metadata["autoreset_mode"] is gymnasium.vector.AutoresetMode.NEXT_STEP
+    vec.reset(seed=5)
+    truncated = np.zeros(2, dtype=bool)
+    steps = 0
+    while not truncated.any():
+        _, _, _, truncated, info = vec.step(np.zeros((2, 2)))
+        steps += 1
+    assert steps == 4
+    assert truncated.all()
+    assert info["t"].tolist() == [1.0, 1.0]
+    # the next step starts new episodes: first observations, reward 0, no end, t = 0
+    obs, reward, terminated, truncated, info = vec.step(np.ones((2, 2)))
+    assert reward.tolist() == [0.0, 0.0]
+    assert not terminated.any()
+    assert not truncated.any()
+    assert info["t"].tolist() == [0.0, 0.0]
+    assert vec.observation_space.contains(obs)
+    _, _, _, _, info = vec.step(np.zeros((2, 2)))
+    assert info["t"].tolist() == [0.25, 0.25]  # and they run on
+    vec.close()
+
+
+def test_make_vec_uses_it_and_an_int_seed_seeds_each_env() -> None:
+    import amsa_phys.gym  # noqa: F401  (registration)
+
+    envs = gymnasium.make_vec(
+        "amsa_phys/Follow-v0", num_envs=2, vectorization_mode="vector_entry_point", duration=2
+    )
+    assert isinstance(envs.unwrapped, FollowVecEnv)
+    _, info = envs.reset(seed=7)
+    assert info["seed"].tolist() == [7, 8]
+    assert envs.observation_space.shape == (2, 3)
+    envs.close()
+
+
+def test_bad_arguments() -> None:
+    with pytest.raises(ap.ConfigError, match="num_envs"):
+        FollowVecEnv(0, SCENARIO1)
+    vec = FollowVecEnv(2, SCENARIO1, duration=1)
+    with pytest.raises(ap.ConfigError, match="expected 2 seeds"):
+        vec.reset(seed=[1])
+    with pytest.raises(gymnasium.error.ResetNeeded):
+        vec.step(np.zeros((2, 2)))
