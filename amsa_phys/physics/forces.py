@@ -53,6 +53,9 @@ from .wheel import (
 INV_SLIP_SPEED_MIN = 1.0 / SLIP_SPEED_MIN
 #: Grip below this (N) counts as this: a zero friction gives a zero force, not 1/0.
 GRIP_FLOOR_N = 1e-9
+#: A drive wheel's relative load never falls below this (a lifted wheel keeps a trace of
+#: grip rather than a 1/0)
+LOAD_FLOOR = 1e-9
 
 
 class Folded(NamedTuple):
@@ -77,6 +80,11 @@ class Folded(NamedTuple):
     ky_dt_m: float  # ky dt / m
     neg_m_dt: float  # -m / dt
     mass: float  # m: a slope's pull is m g
+    xfer: (
+        float  # load transfer: a drive wheel's relative load lost per N of drive force, z / (2 L N)
+    )
+    kmax: float  # the drive wheels' largest relative load: the caster lifted
+    inv_g2: float  # 1 / g^2: a slope's cos from its pull
 
 
 def fold(rover: DiffDriveRover, dt: float) -> Folded:
@@ -104,6 +112,9 @@ def fold(rover: DiffDriveRover, dt: float) -> Folded:
         ky_dt_m=w.load_n / w.slip_lat * dt / rover.mass,
         neg_m_dt=-rover.mass / dt,
         mass=rover.mass,
+        xfer=w.com_height_m / (2.0 * w.wheelbase_m * w.load_n) if w.load_n > 0.0 else 0.0,
+        kmax=w.lifted_load_n / w.load_n if w.load_n > 0.0 else 1.0,
+        inv_g2=1.0 / (w.gravity * w.gravity) if w.gravity > 0.0 else 0.0,
     )
 
 
@@ -313,6 +324,9 @@ def rover_step(
         ky_dt_m,
         neg_m_dt,
         mass,
+        xfer,
+        kmax,
+        inv_g2,
         sc,
     ) = plan
     vmin = SLIP_SPEED_MIN
@@ -414,6 +428,37 @@ def rover_step(
         f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
     fyl = f_lat * ivl / isum
     fyr = f_lat - fyl
+    if xfer != 0.0:
+        # load transfer: the drive force at the ground, below the centre of mass, moves load
+        # between the drive wheels and the caster, k = N'/N = 1 - z F / (2 L N cos); the
+        # force is first capped at the traction it can have with the load it leaves
+        # (|F| <= G k(F): G / (1 +- z G / (2 L N cos))), so that a tyre sliding at its limit
+        # sees its own load
+        cs = math.sqrt(1.0 - (gax * gax + gay * gay) * inv_g2) if sloped else 1.0
+        ax = xfer / cs
+        aa = ax if ax > 0.0 else -ax
+        gsum = 1.0 / ixl + 1.0 / ixr
+        ftot = fxl + fxr
+        if ftot * ax > 0.0:
+            lim = gsum / (1.0 + aa * gsum)
+        elif aa * gsum < 1.0:
+            lim = gsum / (1.0 - aa * gsum)
+        else:
+            lim = ftot if ftot > 0.0 else -ftot
+        if ftot > lim:
+            ftot = lim
+        elif ftot < -lim:
+            ftot = -lim
+        k = 1.0 - ax * ftot
+        if k > kmax:
+            k = kmax
+        elif k < LOAD_FLOOR:
+            k = LOAD_FLOOR
+        ik = 1.0 / k
+        ixl = ixl * ik
+        iyl = iyl * ik
+        ixr = ixr * ik
+        iyr = iyr * ik
     # friction ellipse per wheel: a tyre the gripping solve puts beyond it slides, and the
     # tyre law is solved with its rim instead (wheel.slide)
     t1 = fxl * ixl

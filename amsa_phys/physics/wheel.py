@@ -94,6 +94,13 @@ class WheelModel:
     lateral_coef: float = 1.0
     rolling_coef: float = 1.0
     patch_radius_m: float = 0.0
+    #: load transfer (``drive_load_n``): centre of mass's height, the signed distance from
+    #: the caster to the drive axle along the heading, and the load on one drive wheel when
+    #: the caster is lifted (half the weight); 0 height: no transfer
+    com_height_m: float = 0.0
+    wheelbase_m: float = 1.0
+    lifted_load_n: float = 0.0
+    gravity: float = 9.81
 
     # -- driver ---------------------------------------------------------------------------
     def command(self, power_pct: float) -> float:
