@@ -113,7 +113,7 @@ def fold(rover: DiffDriveRover, dt: float) -> Folded:
         neg_m_dt=-rover.mass / dt,
         mass=rover.mass,
         xfer=w.com_height_m / (2.0 * w.wheelbase_m * w.load_n) if w.load_n > 0.0 else 0.0,
-        kmax=w.lifted_load_n / w.load_n if w.load_n > 0.0 else 1.0,
+        kmax=w.half_weight_n / w.load_n if w.load_n > 0.0 else 1.0,
         inv_g2=1.0 / (w.gravity * w.gravity) if w.gravity > 0.0 else 0.0,
     )
 

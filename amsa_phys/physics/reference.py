@@ -113,4 +113,4 @@ def load_factor(wm: WheelModel, force: float, grip: float) -> float:
     else:
         cap = abs(force)
     f = max(-cap, min(cap, force))
-    return max(LOAD_FLOOR, min(wm.lifted_load_n / wm.load_n, 1 - a * f))
+    return max(LOAD_FLOOR, min(wm.half_weight_n / wm.load_n, 1 - a * f))

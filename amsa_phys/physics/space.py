@@ -400,7 +400,7 @@ def wheel_model(p: Any, gravity: float) -> WheelModel:
         patch_radius_m=p.patchRadius,
         com_height_m=p.comHeight,
         wheelbase_m=span,
-        lifted_load_n=p.mass * gravity / 2,
+        half_weight_n=p.mass * gravity / 2,
         gravity=gravity,
     )
 

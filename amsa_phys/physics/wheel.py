@@ -94,12 +94,14 @@ class WheelModel:
     lateral_coef: float = 1.0
     rolling_coef: float = 1.0
     patch_radius_m: float = 0.0
-    #: load transfer (``drive_load_n``): centre of mass's height, the signed distance from
-    #: the caster to the drive axle along the heading, and the load on one drive wheel when
-    #: the caster is lifted (half the weight); 0 height: no transfer
+    #: load transfer (``forces.rover_step``): the centre of mass's height (0: no transfer)
+    #: and the signed distance from the caster to the drive axle along the heading
     com_height_m: float = 0.0
     wheelbase_m: float = 1.0
-    lifted_load_n: float = 0.0
+    #: m g / 2: a drive wheel's load with the caster lifted, and its share of the whole
+    #: base's rolling resistance (the caster's drag reaches the ground through the drive
+    #: tyres of a rigid base, so it is carried at their rims); 0: ``load_n``
+    half_weight_n: float = 0.0
     gravity: float = 9.81
 
     # -- driver ---------------------------------------------------------------------------
@@ -122,8 +124,11 @@ class WheelModel:
 
     # -- ground ---------------------------------------------------------------------------
     def resistance(self, crr: float) -> float:
-        """``R = Crr rollingCoef N + jointFriction / r`` (N at the rim) on ground ``crr``."""
-        return crr * self.rolling_coef * self.load_n + self.joint_friction_n
+        """``R = Crr rollingCoef m g / 2 + jointFriction / r`` (N at the rim) on ground ``crr``:
+        each drive wheel carries half the rolling resistance of the whole base, the caster's
+        included (``half_weight_n``), whatever share of the weight the caster bears."""
+        rolling = self.half_weight_n if self.half_weight_n > 0.0 else self.load_n
+        return crr * self.rolling_coef * rolling + self.joint_friction_n
 
     def grip(self, mu: float) -> tuple[float, float]:
         """Longitudinal and lateral force limits (N): the friction ellipse's half-axes."""
