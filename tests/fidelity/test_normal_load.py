@@ -18,6 +18,9 @@ carrying m g / 2, no transfer) fails it.
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -153,3 +156,26 @@ def test_the_compiled_and_the_pure_step_agree_with_load_transfer(
     for name in runs[0]:
         assert (runs[0][name] == runs[1][name]).all(), name
     assert abs(runs[0]["Rover.yawRate"]).max() > 0.5  # it did turn
+
+
+def test_a_geometry_statics_cannot_stand_on_is_refused_with_one_line(tmp_path: Path) -> None:
+    """Axle and caster on one side of the centre of mass: one of them would pull the ground."""
+    scen = tmp_path / "w.yaml"
+    scen.write_text(
+        "duration: 1\nworld:\n  components:\n    Rover:\n      template: controlledRobot\n"
+        "      freq: 10\n      params: {axleOffset: 0.1, casterOffset: 0.3}\n"
+    )
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg"}
+    out = subprocess.run(
+        [sys.executable, "-m", "amsa_phys", "run", str(scen), "--headless"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env=env,
+        check=False,
+    )
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1
+    assert "w.yaml:7" in lines[0]
+    assert "casterOffset" in lines[0]
