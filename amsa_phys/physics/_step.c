@@ -36,13 +36,13 @@ typedef void (*space_step_fn)(void *, double);
 enum {
     P_KP, P_C, P_FMAX, P_MW, P_BB, P_BBE, P_E, P_E2, P_KX, P_H, P_TURN_K, P_DT_I, P_DT_M,
     P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, P_KY, P_MASS, P_XFER, P_KMAX, P_INV_G2,
-    PLAN_WIDTH
+    P_C_EXP, PLAN_WIDTH
 };
 
 static const char *const plan_fields[PLAN_WIDTH] = {
     "kp", "c", "f_max", "mw", "big_b", "big_be", "e", "e2", "kx", "half_track", "turn_k",
     "dt_i", "dt_m", "sphi", "ky_dt_m", "neg_m_dt", "big_bc", "ky", "mass", "xfer", "kmax",
-    "inv_g2",
+    "inv_g2", "c_exp",
 };
 
 #define SLIP_SPEED_MIN 0.1
@@ -340,8 +340,8 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double ivr = vr > vmin ? 1.0 / vr : (vr < -vmin ? -1.0 / vr : ivmin);
     double kl = kx * ivl;
     double kr = kx * ivr;
-    double f0l = kp * st->drives[k];
-    double f0r = kp * st->drives[st->n + k];
+    double f0l = kp * st->drives[k] - p[P_C_EXP] * ul;
+    double f0r = kp * st->drives[st->n + k] - p[P_C_EXP] * ur;
     double fxl, fxr, upl, upr;
     double pu[2] = {ul, ur}, pv[2] = {vl, vr}, pf0[2] = {f0l, f0r}, pres[2] = {rl, rr};
     double pk[2] = {kl, kr}, pair[4];

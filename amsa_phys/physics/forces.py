@@ -85,6 +85,7 @@ class Folded(NamedTuple):
     )
     kmax: float  # the drive wheels' largest relative load: the caster lifted
     inv_g2: float  # 1 / g^2: a slope's cos from its pull
+    c_exp: float  # the back-EMF's explicit part (wheel.emf_implicitness)
 
 
 def fold(rover: DiffDriveRover, dt: float) -> Folded:
@@ -115,6 +116,7 @@ def fold(rover: DiffDriveRover, dt: float) -> Folded:
         xfer=w.com_height_m / (2.0 * w.wheelbase_m * w.load_n) if w.load_n > 0.0 else 0.0,
         kmax=w.half_weight_n / w.load_n if w.load_n > 0.0 else 1.0,
         inv_g2=1.0 / (w.gravity * w.gravity) if w.gravity > 0.0 else 0.0,
+        c_exp=s.c_exp,
     )
 
 
@@ -327,6 +329,7 @@ def rover_step(
         xfer,
         kmax,
         inv_g2,
+        c_exp,
         sc,
     ) = plan
     vmin = SLIP_SPEED_MIN
@@ -351,8 +354,9 @@ def rover_step(
     ivr = 1.0 / vr if vr > vmin else (-1.0 / vr if vr < -vmin else ivmin)
     kl = kx * ivl
     kr = kx * ivr
-    f0l = kp * drive_l
-    f0r = kp * drive_r
+    # the motor's force at rest less the back-EMF's explicit part (wheel.emf_implicitness)
+    f0l = kp * drive_l - c_exp * ul
+    f0r = kp * drive_r - c_exp * ur
     rigid = False
     if ul == 0.0 and ur == 0.0:
         # a parked rover (wheel.held): the tyres hold the body against still rims; the

@@ -43,6 +43,7 @@ def reference_forces(
     sl, sr = slip_speed(vl), slip_speed(vr)
     (mul, crl), (mur, crr) = ground
     f0l, f0r = wm.drive_force(rover.power_l), wm.drive_force(rover.power_r)
+    f0l, f0r = f0l - s.c_exp * rims[0], f0r - s.c_exp * rims[1]  # wheel.emf_implicitness
     rl, rr = wm.resistance(crl), wm.resistance(crr)
     ul, ur = rims
     fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kx / sl, kx / sr), s)

@@ -213,6 +213,34 @@ class StepConstants:
     big_bc: float
     e: float
     e2: float
+    #: the back-EMF's explicit part, ``(1 - theta) c`` (``emf_implicitness``): the callers
+    #: take ``c_exp u`` off the motor's force at rest, ``c`` above is the implicit ``theta c``
+    c_exp: float = 0.0
+
+
+def emf_implicitness(w: WheelModel, dt: float, mass: float) -> float:
+    """``theta``: the share of the back-EMF taken at the step's end (the rest at its start).
+
+    Backward Euler (``theta = 1``) damps the body's motor time constant ``tau = M / c``
+    (``M = m / 2 + J / r^2`` a wheel's share of the rolling mass) too slowly by
+    ``~dt / (2 tau)``: 2.3 % at 100 Hz for the default rover, so a coast-down stopped 2-4 %
+    late. ``theta = (x - 1 + e^-x) / (x (1 - e^-x))`` with ``x = c dt / M`` makes the step's
+    decay factor ``(1 - (1 - theta) x) / (1 + theta x)`` the exact ``e^-x`` for that mode
+    (``~1/2 + x / 12``); steady states (top speed, roll-back, climb) are the same for every
+    ``theta``. A rim spinning alone (its tyre sliding) has the much faster mode
+    ``y = c dt / J_r``: ``theta >= 1 - 1/y`` keeps its factor non-negative (no ringing).
+    """
+    c = w.back_emf()
+    x = c * dt / (0.5 * mass + w.rim_mass_kg)
+    if x < 1e-3:
+        theta = 0.5 + x / 12.0
+    else:
+        ex = math.exp(-x)
+        theta = (x - 1.0 + ex) / (x * (1.0 - ex))
+    y = c * dt / w.rim_mass_kg
+    if y > 1.0:
+        theta = max(theta, 1.0 - 1.0 / y)
+    return min(theta, 1.0)
 
 
 def step_constants(
@@ -220,7 +248,8 @@ def step_constants(
 ) -> StepConstants:
     """Fold a wheel's parameters for a step of ``dt`` on a body of ``mass`` and ``moment``."""
     mw = w.rim_mass_kg / dt
-    c = w.back_emf()
+    theta = emf_implicitness(w, dt, mass)
+    c = theta * w.back_emf()
     return StepConstants(
         mw=mw,
         c=c,
@@ -229,6 +258,7 @@ def step_constants(
         big_bc=1.0 / mw,
         e=dt * (1.0 / mass + half_track * half_track / moment),
         e2=dt * (1.0 / mass - half_track * half_track / moment),
+        c_exp=(1.0 - theta) * w.back_emf(),
     )
 
 
