@@ -41,11 +41,13 @@ Integration, per physics step ``dt`` (semi-implicit, one pass; only a sliding ty
 found by bisection, :func:`slide`): the rim's speed
 and the tyre force are solved together by backward Euler on the linear part —
 
-    rim:   M_w (u+ - u) / dt = F0 - c u+ - R_dir - F_x        (M_w = J / r^2, c = F_stall / v_free)
+    rim:   M_w (u+ - u) / dt = F0 - c (theta u+ + (1 - theta) u) - R_dir - F_x
+                                                  (M_w = J / r^2, c = F_stall / v_free)
     body:  v+ = v + E F_x + E2 F_x'                           (F_x' the other wheel's force)
     tyre:  F_x = k (u+ - v+)                                  (k = N / (c_x max(|v|, v_min)))
 
-with ``E = dt (1/m + h^2/I)`` and ``E2 = dt (1/m - h^2/I)`` (a wheel's force moves its own hub
+with ``E = dt (1/m + h^2/I)`` and ``E2 = dt (1/m - h^2/I)``; ``theta`` (about 1/2,
+:func:`emf_implicitness`) makes the body's motor time constant decay at its exact rate (a wheel's force moves its own hub
 and, through the body's yaw, the other one) — a 2 × 2 linear system for the two tyre forces
 (:func:`wheel_pair`). Backward Euler is exact for that linear system, stable at any
 stiffness, and turns into the rigid no-slip constraint as ``k`` grows (``v -> 0``). The
