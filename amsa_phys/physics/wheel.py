@@ -46,19 +46,19 @@ and the tyre force are solved together by backward Euler on the linear part —
     body:  v+ = v + E F_x + E2 F_x'                           (F_x' the other wheel's force)
     tyre:  F_x = k (u+ - v+)                                  (k = N / (c_x max(|v|, v_min)))
 
-with ``E = dt (1/m + h^2/I)`` and ``E2 = dt (1/m - h^2/I)``; ``theta`` (about 1/2,
-:func:`emf_implicitness`) makes the body's motor time constant decay at its exact rate (a wheel's force moves its own hub
-and, through the body's yaw, the other one) — a 2 × 2 linear system for the two tyre forces
-(:func:`wheel_pair`). Backward Euler is exact for that linear system, stable at any
-stiffness, and turns into the rigid no-slip constraint as ``k`` grows (``v -> 0``). The
-nonlinear pieces are then applied as projections: the rim may not reverse through zero
-against its resistance (it sticks instead, if the resistance can hold it), the motor force is
-clamped by the current limit (the rim is then re-solved without back-EMF) — in these rare
-branches each wheel is solved alone (:func:`rim_and_tyre`), the other's force from the joint
-pass taken as known. A tyre that this gripping solve puts beyond its friction ellipse
-*slides*: its force is then the tyre law itself, solved together with its rim by
-:func:`slide` (scaling the gripping solve's forces onto the ellipse instead made a drift
-depend on the physics step, issue 31).
+with ``E = dt (1/m + h^2/I)`` and ``E2 = dt (1/m - h^2/I)`` (a wheel's force moves its own hub
+and, through the body's yaw, the other one; ``theta``, about 1/2, from
+:func:`emf_implicitness`, makes the body's motor time constant decay at its exact rate) — a 2 ×
+2 linear system for the two tyre forces (:func:`wheel_pair`). Backward Euler is exact for that
+linear system, stable at any stiffness, and turns into the rigid no-slip constraint as ``k``
+grows (``v -> 0``). The nonlinear pieces are then applied as projections: the rim may not
+reverse through zero against its resistance (it sticks instead, if the resistance can hold it),
+the motor force is clamped by the current limit (the rim is then re-solved without back-EMF) —
+in these rare branches each wheel is solved alone (:func:`rim_and_tyre`), the other's force
+from the joint pass taken as known. A tyre that this gripping solve puts beyond its friction
+ellipse *slides*: its force is then the tyre law itself, solved together with its rim by
+:func:`slide` (scaling the gripping solve's forces onto the ellipse instead made a drift depend
+on the physics step, issue 31).
 """
 
 from __future__ import annotations
