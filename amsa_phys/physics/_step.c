@@ -419,12 +419,20 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double fyr = f_lat - fyl;
     /* load transfer (forces.rover_step says why) */
     const double xfer = p[P_XFER];
-    if (xfer != 0.0) {
+    double ftot = fxl + fxr;
+    double d = xfer * ftot > 0.0 ? xfer * ftot : -(xfer * ftot);
+    if (sloped)
+        d = d / sqrt(1.0 - (gax * gax + gay * gay) * p[P_INV_G2]);
+    double t1 = fxl * ixl;
+    double t2 = fyl * iyl;
+    double t3 = fxr * ixr;
+    double t4 = fyr * iyr;
+    double room = d < 1.0 ? (1.0 - d) * (1.0 - d) : 0.0;
+    if (xfer != 0.0 && (t1 * t1 + t2 * t2 > room || t3 * t3 + t4 * t4 > room)) {
         double cs = sloped ? sqrt(1.0 - (gax * gax + gay * gay) * p[P_INV_G2]) : 1.0;
         double ax = xfer / cs;
         double aa = ax > 0.0 ? ax : -ax;
         double gsum = 1.0 / ixl + 1.0 / ixr;
-        double ftot = fxl + fxr;
         double lim;
         if (ftot * ax > 0.0)
             lim = gsum / (1.0 + aa * gsum);
@@ -446,12 +454,12 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
         iyl = iyl * ik;
         ixr = ixr * ik;
         iyr = iyr * ik;
+        t1 = fxl * ixl;
+        t2 = fyl * iyl;
+        t3 = fxr * ixr;
+        t4 = fyr * iyr;
     }
     /* friction ellipse */
-    double t1 = fxl * ixl;
-    double t2 = fyl * iyl;
-    double t3 = fxr * ixr;
-    double t4 = fyr * iyr;
     int sat_l = t1 * t1 + t2 * t2 > 1.0;
     int sat_r = t3 * t3 + t4 * t4 > 1.0;
     if (sat_l || sat_r) {

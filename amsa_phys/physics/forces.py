@@ -432,7 +432,19 @@ def rover_step(
         f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
     fyl = f_lat * ivl / isum
     fyr = f_lat - fyl
-    if xfer != 0.0:
+    ftot = fxl + fxr
+    # skip the transfer when no tyre can reach its ellipse whatever load it moves: k >= 1 - d
+    # (d = |a F| bounds the change), so a tyre within (1 - d)^2 of the static ellipse stays
+    # inside (the transfer's load only enters the ellipse and the slide)
+    d = xfer * ftot if xfer * ftot > 0.0 else -(xfer * ftot)
+    if sloped:
+        d = d / math.sqrt(1.0 - (gax * gax + gay * gay) * inv_g2)
+    t1 = fxl * ixl
+    t2 = fyl * iyl
+    t3 = fxr * ixr
+    t4 = fyr * iyr
+    room = (1.0 - d) * (1.0 - d) if d < 1.0 else 0.0
+    if xfer != 0.0 and (t1 * t1 + t2 * t2 > room or t3 * t3 + t4 * t4 > room):
         # load transfer: the drive force at the ground, below the centre of mass, moves load
         # between the drive wheels and the caster, k = N'/N = 1 - z F / (2 L N cos); the
         # force is first capped at the traction it can have with the load it leaves
@@ -442,7 +454,6 @@ def rover_step(
         ax = xfer / cs
         aa = ax if ax > 0.0 else -ax
         gsum = 1.0 / ixl + 1.0 / ixr
-        ftot = fxl + fxr
         if ftot * ax > 0.0:
             lim = gsum / (1.0 + aa * gsum)
         elif aa * gsum < 1.0:
@@ -463,12 +474,12 @@ def rover_step(
         iyl = iyl * ik
         ixr = ixr * ik
         iyr = iyr * ik
+        t1 = fxl * ixl
+        t2 = fyl * iyl
+        t3 = fxr * ixr
+        t4 = fyr * iyr
     # friction ellipse per wheel: a tyre the gripping solve puts beyond it slides, and the
     # tyre law is solved with its rim instead (wheel.slide)
-    t1 = fxl * ixl
-    t2 = fyl * iyl
-    t3 = fxr * ixr
-    t4 = fyr * iyr
     sat_l = t1 * t1 + t2 * t2 > 1.0
     sat_r = t3 * t3 + t4 * t4 > 1.0
     if sat_l or sat_r:
