@@ -35,15 +35,19 @@ typedef void (*space_step_fn)(void *, double);
  * it knows every one. Add a constant here and in plan_fields together. */
 enum {
     P_KP, P_C, P_FMAX, P_MW, P_BB, P_BBE, P_E, P_E2, P_KX, P_H, P_TURN_K, P_DT_I, P_DT_M,
-    P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, P_KY, P_MASS, PLAN_WIDTH
+    P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, P_KY, P_MASS, P_XFER, P_KMAX, P_INV_G2,
+    P_C_EXP, PLAN_WIDTH
 };
 
 static const char *const plan_fields[PLAN_WIDTH] = {
     "kp", "c", "f_max", "mw", "big_b", "big_be", "e", "e2", "kx", "half_track", "turn_k",
-    "dt_i", "dt_m", "sphi", "ky_dt_m", "neg_m_dt", "big_bc", "ky", "mass",
+    "dt_i", "dt_m", "sphi", "ky_dt_m", "neg_m_dt", "big_bc", "ky", "mass", "xfer", "kmax",
+    "inv_g2", "c_exp",
 };
 
 #define SLIP_SPEED_MIN 0.1
+/* forces.LOAD_FLOOR: a drive wheel's smallest relative load */
+#define LOAD_FLOOR 1e-9
 #define N_BUFFERS 7
 /* The nine ground terms of a rover (forces.ground_list's order) and where a batch's (9, n)
  * ground array keeps each (fleet._GROUND_ROWS); both exported and checked at import. */
@@ -313,8 +317,10 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     const StepConstants sc = {mw, c, fmax, bb, p[P_BIG_BC], e, e2};
     const double vmin = SLIP_SPEED_MIN, ivmin = 1.0 / SLIP_SPEED_MIN;
     const Py_ssize_t *go = st->ground_off;
-    const double ixl = g[go[0]], iyl = g[go[1]], rl = g[go[2]];
-    const double ixr = g[go[3]], iyr = g[go[4]], rr = g[go[5]], ts = g[go[6]];
+    double ixl = g[go[0]], iyl = g[go[1]];
+    const double rl = g[go[2]];
+    double ixr = g[go[3]], iyr = g[go[4]];
+    const double rr = g[go[5]], ts = g[go[6]];
 
     double angle = state[2], vx = state[3], vy = state[4], w = state[5];
     const double gax = g[go[7]], gay = g[go[8]];
@@ -334,8 +340,8 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double ivr = vr > vmin ? 1.0 / vr : (vr < -vmin ? -1.0 / vr : ivmin);
     double kl = kx * ivl;
     double kr = kx * ivr;
-    double f0l = kp * st->drives[k];
-    double f0r = kp * st->drives[st->n + k];
+    double f0l = kp * st->drives[k] - p[P_C_EXP] * ul;
+    double f0r = kp * st->drives[st->n + k] - p[P_C_EXP] * ur;
     double fxl, fxr, upl, upr;
     double pu[2] = {ul, ur}, pv[2] = {vl, vr}, pf0[2] = {f0l, f0r}, pres[2] = {rl, rr};
     double pk[2] = {kl, kr}, pair[4];
@@ -411,11 +417,49 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
                          : neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd);
     double fyl = f_lat * ivl / isum;
     double fyr = f_lat - fyl;
-    /* friction ellipse */
+    /* load transfer (forces.rover_step says why) */
+    const double xfer = p[P_XFER];
+    double ftot = fxl + fxr;
+    double d = xfer * ftot > 0.0 ? xfer * ftot : -(xfer * ftot);
+    if (sloped)
+        d = d / sqrt(1.0 - (gax * gax + gay * gay) * p[P_INV_G2]);
     double t1 = fxl * ixl;
     double t2 = fyl * iyl;
     double t3 = fxr * ixr;
     double t4 = fyr * iyr;
+    double room = d < 1.0 ? (1.0 - d) * (1.0 - d) : 0.0;
+    if (xfer != 0.0 && (t1 * t1 + t2 * t2 > room || t3 * t3 + t4 * t4 > room)) {
+        double cs = sloped ? sqrt(1.0 - (gax * gax + gay * gay) * p[P_INV_G2]) : 1.0;
+        double ax = xfer / cs;
+        double aa = ax > 0.0 ? ax : -ax;
+        double gsum = 1.0 / ixl + 1.0 / ixr;
+        double lim;
+        if (ftot * ax > 0.0)
+            lim = gsum / (1.0 + aa * gsum);
+        else if (aa * gsum < 1.0)
+            lim = gsum / (1.0 - aa * gsum);
+        else
+            lim = ftot > 0.0 ? ftot : -ftot;
+        if (ftot > lim)
+            ftot = lim;
+        else if (ftot < -lim)
+            ftot = -lim;
+        double k = 1.0 - ax * ftot;
+        if (k > p[P_KMAX])
+            k = p[P_KMAX];
+        else if (k < LOAD_FLOOR)
+            k = LOAD_FLOOR;
+        double ik = 1.0 / k;
+        ixl = ixl * ik;
+        iyl = iyl * ik;
+        ixr = ixr * ik;
+        iyr = iyr * ik;
+        t1 = fxl * ixl;
+        t2 = fyl * iyl;
+        t3 = fxr * ixr;
+        t4 = fyr * iyr;
+    }
+    /* friction ellipse */
     int sat_l = t1 * t1 + t2 * t2 > 1.0;
     int sat_r = t3 * t3 + t4 * t4 > 1.0;
     if (sat_l || sat_r) {

@@ -53,6 +53,9 @@ from .wheel import (
 INV_SLIP_SPEED_MIN = 1.0 / SLIP_SPEED_MIN
 #: Grip below this (N) counts as this: a zero friction gives a zero force, not 1/0.
 GRIP_FLOOR_N = 1e-9
+#: A drive wheel's relative load never falls below this (a lifted wheel keeps a trace of
+#: grip rather than a 1/0)
+LOAD_FLOOR = 1e-9
 
 
 class Folded(NamedTuple):
@@ -77,6 +80,12 @@ class Folded(NamedTuple):
     ky_dt_m: float  # ky dt / m
     neg_m_dt: float  # -m / dt
     mass: float  # m: a slope's pull is m g
+    xfer: (
+        float  # load transfer: a drive wheel's relative load lost per N of drive force, z / (2 L N)
+    )
+    kmax: float  # the drive wheels' largest relative load: the caster lifted
+    inv_g2: float  # 1 / g^2: a slope's cos from its pull
+    c_exp: float  # the back-EMF's explicit part (wheel.emf_implicitness)
 
 
 def fold(rover: DiffDriveRover, dt: float) -> Folded:
@@ -104,6 +113,10 @@ def fold(rover: DiffDriveRover, dt: float) -> Folded:
         ky_dt_m=w.load_n / w.slip_lat * dt / rover.mass,
         neg_m_dt=-rover.mass / dt,
         mass=rover.mass,
+        xfer=w.com_height_m / (2.0 * w.wheelbase_m * w.load_n) if w.load_n > 0.0 else 0.0,
+        kmax=w.half_weight_n / w.load_n if w.load_n > 0.0 else 1.0,
+        inv_g2=1.0 / (w.gravity * w.gravity) if w.gravity > 0.0 else 0.0,
+        c_exp=s.c_exp,
     )
 
 
@@ -313,6 +326,10 @@ def rover_step(
         ky_dt_m,
         neg_m_dt,
         mass,
+        xfer,
+        kmax,
+        inv_g2,
+        c_exp,
         sc,
     ) = plan
     vmin = SLIP_SPEED_MIN
@@ -337,8 +354,9 @@ def rover_step(
     ivr = 1.0 / vr if vr > vmin else (-1.0 / vr if vr < -vmin else ivmin)
     kl = kx * ivl
     kr = kx * ivr
-    f0l = kp * drive_l
-    f0r = kp * drive_r
+    # the motor's force at rest less the back-EMF's explicit part (wheel.emf_implicitness)
+    f0l = kp * drive_l - c_exp * ul
+    f0r = kp * drive_r - c_exp * ur
     rigid = False
     if ul == 0.0 and ur == 0.0:
         # a parked rover (wheel.held): the tyres hold the body against still rims; the
@@ -414,12 +432,54 @@ def rover_step(
         f_lat = neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd)
     fyl = f_lat * ivl / isum
     fyr = f_lat - fyl
-    # friction ellipse per wheel: a tyre the gripping solve puts beyond it slides, and the
-    # tyre law is solved with its rim instead (wheel.slide)
+    ftot = fxl + fxr
+    # skip the transfer when no tyre can reach its ellipse whatever load it moves: k >= 1 - d
+    # (d = |a F| bounds the change), so a tyre within (1 - d)^2 of the static ellipse stays
+    # inside (the transfer's load only enters the ellipse and the slide)
+    d = xfer * ftot if xfer * ftot > 0.0 else -(xfer * ftot)
+    if sloped:
+        d = d / math.sqrt(1.0 - (gax * gax + gay * gay) * inv_g2)
     t1 = fxl * ixl
     t2 = fyl * iyl
     t3 = fxr * ixr
     t4 = fyr * iyr
+    room = (1.0 - d) * (1.0 - d) if d < 1.0 else 0.0
+    if xfer != 0.0 and (t1 * t1 + t2 * t2 > room or t3 * t3 + t4 * t4 > room):
+        # load transfer: the drive force at the ground, below the centre of mass, moves load
+        # between the drive wheels and the caster, k = N'/N = 1 - z F / (2 L N cos); the
+        # force is first capped at the traction it can have with the load it leaves
+        # (|F| <= G k(F): G / (1 +- z G / (2 L N cos))), so that a tyre sliding at its limit
+        # sees its own load
+        cs = math.sqrt(1.0 - (gax * gax + gay * gay) * inv_g2) if sloped else 1.0
+        ax = xfer / cs
+        aa = ax if ax > 0.0 else -ax
+        gsum = 1.0 / ixl + 1.0 / ixr
+        if ftot * ax > 0.0:
+            lim = gsum / (1.0 + aa * gsum)
+        elif aa * gsum < 1.0:
+            lim = gsum / (1.0 - aa * gsum)
+        else:
+            lim = ftot if ftot > 0.0 else -ftot
+        if ftot > lim:
+            ftot = lim
+        elif ftot < -lim:
+            ftot = -lim
+        k = 1.0 - ax * ftot
+        if k > kmax:
+            k = kmax
+        elif k < LOAD_FLOOR:
+            k = LOAD_FLOOR
+        ik = 1.0 / k
+        ixl = ixl * ik
+        iyl = iyl * ik
+        ixr = ixr * ik
+        iyr = iyr * ik
+        t1 = fxl * ixl
+        t2 = fyl * iyl
+        t3 = fxr * ixr
+        t4 = fyr * iyr
+    # friction ellipse per wheel: a tyre the gripping solve puts beyond it slides, and the
+    # tyre law is solved with its rim instead (wheel.slide)
     sat_l = t1 * t1 + t2 * t2 > 1.0
     sat_r = t3 * t3 + t4 * t4 > 1.0
     if sat_l or sat_r:

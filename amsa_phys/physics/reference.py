@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import math
 
-from .forces import GRIP_FLOOR_N
+from .forces import GRIP_FLOOR_N, LOAD_FLOOR
 from .rover import DiffDriveRover
-from .wheel import TORSION, slide, slip_speed, step_constants, wheel_pair
+from .wheel import TORSION, WheelModel, slide, slip_speed, step_constants, wheel_pair
 
 
 def reference_forces(
@@ -43,6 +43,7 @@ def reference_forces(
     sl, sr = slip_speed(vl), slip_speed(vr)
     (mul, crl), (mur, crr) = ground
     f0l, f0r = wm.drive_force(rover.power_l), wm.drive_force(rover.power_r)
+    f0l, f0r = f0l - s.c_exp * rims[0], f0r - s.c_exp * rims[1]  # wheel.emf_implicitness
     rl, rr = wm.resistance(crl), wm.resistance(crr)
     ul, ur = rims
     fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kx / sl, kx / sr), s)
@@ -66,9 +67,11 @@ def reference_forces(
     f_lat = -rover.mass / dt * side / math.cos(0.5 * turn) * kd / (1 + kd)
     fyl = f_lat * (1 / vl) / (1 / vl + 1 / vr)
     fyr = f_lat - fyl
-    # friction ellipses
+    # friction ellipses, on the load the drive force leaves the drive wheels
     gl, gr = wm.grip(mul), wm.grip(mur)
     inv = [1 / max(g, GRIP_FLOOR_N) for g in (*gl, *gr)]
+    k = load_factor(wm, fxl + fxr, 1 / inv[0] + 1 / inv[2])
+    inv = [i / k for i in inv]
     sat = (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1 or (fxr * inv[2]) ** 2 + (
         fyr * inv[3]
     ) ** 2 > 1
@@ -94,3 +97,21 @@ def reference_forces(
         upl,
         upr,
     )
+
+
+def load_factor(wm: WheelModel, force: float, grip: float) -> float:
+    """A drive wheel's load over its static load under drive force ``force`` (N, both
+    wheels) on the flat: pitch balance about the centre of mass gives
+    ``N = N0 - z F / (2 L)``; ``F`` first capped at the traction ``|F| <= grip N / N0`` the
+    load it leaves allows; between the load floor and the caster lifted (m g / 2)."""
+    if wm.com_height_m == 0.0:
+        return 1.0
+    a = wm.com_height_m / (2 * wm.wheelbase_m * wm.load_n)
+    if force * a > 0:
+        cap = grip / (1 + abs(a) * grip)
+    elif abs(a) * grip < 1:
+        cap = grip / (1 - abs(a) * grip)
+    else:
+        cap = abs(force)
+    f = max(-cap, min(cap, force))
+    return max(LOAD_FLOOR, min(wm.half_weight_n / wm.load_n, 1 - a * f))

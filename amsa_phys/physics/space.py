@@ -375,9 +375,14 @@ def wheel_model(p: Any, gravity: float) -> WheelModel:
     """A rover's wheel model from its template parameters (``templates.ROVER_PARAMS``).
 
     Torques become forces at the ground (divided by the wheel radius) and the wheel's
-    inertia a mass at the rim (``J / r^2``); the normal load is ``m g / 2`` per wheel.
+    inertia a mass at the rim (``J / r^2``). The normal load is shared by statics between the
+    two drive wheels (axle ``axleOffset`` ahead of the centre of mass) and the caster
+    (``casterOffset``): moments about the centre of mass give each drive wheel
+    ``m g (-x_c) / (2 (x_a - x_c))`` at rest on the flat, the caster the rest.
     """
     r = p.wheelRadius
+    x_a, x_c = p.axleOffset, p.casterOffset
+    span = x_a - x_c
     return WheelModel(
         stall_force_n=p.stallForce,
         free_speed_mps=p.freeSpeed,
@@ -386,13 +391,17 @@ def wheel_model(p: Any, gravity: float) -> WheelModel:
         deadband_pct=p.deadband,
         joint_friction_n=p.jointFriction / r,
         rim_mass_kg=p.wheelInertia / (r * r),
-        load_n=p.mass * gravity / 2,
+        load_n=p.mass * gravity * -x_c / (2 * span),
         slip_long=p.slipComplianceLongitudinal,
         slip_lat=p.slipComplianceLateral,
         traction_coef=p.tractionCoef,
         lateral_coef=p.lateralCoef,
         rolling_coef=p.rollingCoef,
         patch_radius_m=p.patchRadius,
+        com_height_m=p.comHeight,
+        wheelbase_m=span,
+        half_weight_n=p.mass * gravity / 2,
+        gravity=gravity,
     )
 
 

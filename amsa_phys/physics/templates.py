@@ -155,7 +155,49 @@ ROVER_PARAMS: tuple[Param, ...] = (
         5.0,
     ),
     Param("rollingCoef", "float", "rolling resistance, times the ground's", 1.0, 0.0, 20.0),
+    Param(
+        "axleOffset",
+        "float",
+        "drive axle's position ahead of the centre of mass (negative: behind); with "
+        "casterOffset it shares the weight between the drive wheels and the caster by statics",
+        0.05,
+        -10.0,
+        10.0,
+        "m",
+    ),
+    Param(
+        "casterOffset",
+        "float",
+        "caster's contact point ahead of the centre of mass (negative: behind); on the other "
+        "side of the centre of mass from the axle",
+        -0.3,
+        -10.0,
+        10.0,
+        "m",
+    ),
+    Param(
+        "comHeight",
+        "float",
+        "centre of mass's height above the ground: drive and braking forces move load between "
+        "the drive wheels and the caster (load transfer)",
+        0.2,
+        0.0,
+        10.0,
+        "m",
+    ),
 )
+
+
+def check_geometry(values: Mapping[str, Any]) -> None:
+    """Refuse a drive axle and caster that cannot carry the body: statics needs the centre
+    of mass between them (or over the axle), else one of them would pull the ground."""
+    axle = values.get("axleOffset", 0.05)
+    caster = values.get("casterOffset", -0.3)
+    if caster == 0.0 or axle * caster > 0.0:
+        raise ValueError(
+            f"casterOffset {caster:g} m and axleOffset {axle:g} m must lie on opposite sides "
+            "of the centre of mass (the caster not on it)"
+        )
 
 
 def rover_params(**overrides: Any) -> ParamValues:
@@ -181,6 +223,9 @@ _WHEEL_PARAMS = {
     "tractionCoef",
     "lateralCoef",
     "rollingCoef",
+    "axleOffset",
+    "casterOffset",
+    "comHeight",
 }
 #: Parameters fixed once the body exists.
 _BODY_PARAMS = {
@@ -222,6 +267,11 @@ class _Robot(Template):
     #: a batch builds each run's rover from its parameters at t = 0 (the timeline may not
     #: change them during a batched run)
     batch_params_at_start = True
+
+    @classmethod
+    def check_params(cls, values: Mapping[str, Any]) -> None:
+        """Refuse a geometry statics cannot stand on (``check_geometry``)."""
+        check_geometry(values)
 
     def initialize(self, ctx: Any) -> None:
         self.physics = physics_of(ctx)
@@ -371,6 +421,7 @@ class FreeRobot(_Robot):
         which looks like a physics bug rather than the missing list it is."""
         if values.get("behavior") == BEHAVIORS["waypoints"] and not values.get("waypoints"):
             raise ValueError("behavior 5 (waypoints) needs at least one point in waypoints")
+        super().check_params(values)
 
     def initialize(self, ctx: Any) -> None:
         self.check_params(self.p.as_dict())

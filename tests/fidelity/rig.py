@@ -68,3 +68,23 @@ def drive(
         cols[name] = data[:, i + 1]
     assert sim.now == Fraction(str(duration))
     return cols, sim
+
+
+#: A base whose drive axle passes under the centre of mass, the centre of mass on the ground:
+#: each drive wheel carries m g / 2, the caster nothing, no load transfer. For checks whose
+#: subject is not the normal load (tyre slip curves, contacts, sub-steps, the IMU, the sliding
+#: tyre's convergence) and whose closed forms take N = m g / 2; ``test_normal_load.py`` holds
+#: the default geometry to its own closed forms.
+ON_AXLE = {"axleOffset": 0.0, "comHeight": 0.0}
+
+
+def traction_accel(mu: float, robot: dict[str, Any] | None = None, g: float = 9.81) -> float:
+    """Closed form: a launch limited by the tyres on ground ``mu`` accelerates at
+    ``2 mu N0 / (m (1 + mu z / L))`` (statics share ``N0 = m g (-x_c) / (2 L)``, ``L = x_a -
+    x_c``; the launch's force moves ``z F / L`` from the drive axle to the caster)."""
+    from amsa_phys.physics.templates import rover_params
+
+    p = rover_params(**(robot or {}))
+    span = p.axleOffset - p.casterOffset
+    n0 = p.mass * g * -p.casterOffset / (2 * span)
+    return 2 * mu * n0 / (p.mass * (1 + mu * p.comHeight / span))

@@ -33,7 +33,11 @@ def test_a_rover_pushing_on_a_wall_rests_within_5_mm_of_it(
     front = tr["Rover.posX"] + 0.4
     assert abs(tr["Rover.speed"][-1]) < 1e-6  # at rest, the motors still pushing at full power
     assert abs(front[-1] - WALL_SURFACE) <= 0.005  # pymunk's default slop: 3.3 cm inside
-    assert (front - WALL_SURFACE).max() < 0.01  # the impact itself sinks in less than 1 cm
+    # the impact itself sinks in at most one step's travel (Chipmunk finds the overlap at the
+    # end of the step: where in the step the wall is met is the luck of the step grid; the
+    # MDE rover meets it at 4.8 m/s, 4.8 cm a step) plus the slop, and is pushed out
+    impact = float(np.abs(tr["Rover.speed"]).max()) * 0.01
+    assert (front - WALL_SURFACE).max() < impact + 0.002
     assert [e.detail for e in sim.events if e.kind == "collision"] == ["Rover-wall"]
 
 

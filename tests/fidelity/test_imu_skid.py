@@ -11,10 +11,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from rig import drive
+from rig import ON_AXLE, drive
 
 #: The drift of ``test_step_independence``: the outer wheel spins, the inner one is dragged.
-HOT = {"stallForce": 600.0, "freeSpeed": 6.0, "maxWheelTorque": 40.0}
+HOT = {"stallForce": 600.0, "freeSpeed": 6.0, "maxWheelTorque": 40.0, **ON_AXLE}
 SETTLED = 3.0  # s: the drift is steady from here (it settles within ~2 s)
 
 

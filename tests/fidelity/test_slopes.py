@@ -1,6 +1,7 @@
 """Slopes (issue 31, item 2): a ``gradeZone`` pulls a rover downhill with ``m g sin(angle)``
 and carries ``m g cos(angle)``. Closed forms, default rover on a 0.02 rolling-resistance
-ground, per wheel (N the flat load m g / 2, R(θ) = Crr N cos θ + jointFriction / r the rim's
+ground, per drive wheel (N = m g / 2 its share of the pull and of the base's rolling resistance, the
+caster's included; R(θ) = Crr N cos θ + jointFriction / r the rim's
 resistance, c = F_stall / v_free the back-EMF, F0 the motor's force at rest):
 
 * it **holds** at rest while N sin θ <= R(θ): the breakaway angle θ* solves N sin θ* = R(θ*);
@@ -32,11 +33,12 @@ def resistance(angle: float) -> float:
 
 
 def breakaway_angle() -> float:
-    """θ* with N sin θ* = R(θ*), by bisection (the pull rises, the resistance falls)."""
+    """θ* with (m g / 2) sin θ* = R(θ*), by bisection (the pull rises, the resistance falls):
+    the drive wheels carry the whole pull (the caster rolls), each half of it."""
     lo, hi = 0.0, 0.5
     for _ in range(100):
         mid = 0.5 * (lo + hi)
-        if WHEEL.load_n * math.sin(mid) > resistance(mid):
+        if WHEEL.half_weight_n * math.sin(mid) > resistance(mid):
             hi = mid
         else:
             lo = mid
@@ -84,7 +86,7 @@ def test_mutation_hold_check_fails_above_the_breakaway(tmp_path: Path) -> None:
 def rollback_error(tmp_path: Path) -> float:
     angle = 0.1
     tr = on_slope(tmp_path, angle, 0.0, 6.0)
-    u = (resistance(angle) - WHEEL.load_n * math.sin(angle)) / WHEEL.back_emf()
+    u = (resistance(angle) - WHEEL.half_weight_n * math.sin(angle)) / WHEEL.back_emf()
     assert u < -0.1
     return abs(float(tr["Rover.wheelSpeedL"][-1]) / u - 1)
 
@@ -92,7 +94,7 @@ def rollback_error(tmp_path: Path) -> float:
 def climb_error(tmp_path: Path) -> float:
     angle, power = 0.05, 80.0
     tr = on_slope(tmp_path, angle, power, 6.0)
-    pull = WHEEL.load_n * math.sin(angle)
+    pull = WHEEL.half_weight_n * math.sin(angle)
     u = (WHEEL.drive_force(power) - resistance(angle) - pull) / WHEEL.back_emf()
     assert WHEEL.drive_force(power) - WHEEL.back_emf() * u < WHEEL.max_force_n
     return abs(float(tr["Rover.wheelSpeedL"][-1]) / u - 1)

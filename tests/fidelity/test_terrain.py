@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from rig import drive
+from rig import drive, traction_accel
 
 import amsa_phys.physics.fleet as fleet
 from amsa_phys.engine.runner import Simulation
@@ -73,8 +73,9 @@ def test_top_speed_in_a_zone_follows_its_rolling_resistance(tmp_path: Path) -> N
 
 
 def test_mud_from_the_timeline_caps_the_grip(tmp_path: Path) -> None:
-    """A rover far stronger than its tyres: a = mu g in the zone, 0.8 g until t = 1, when the
-    zone turns to ice, 0.1 g from then on."""
+    """A rover far stronger than its tyres: at its traction limit on the zone's mu (its
+    closed form ``rig.traction_accel``), on mu 0.8 until t = 1, when the zone turns to ice,
+    on 0.1 from then on."""
     robot = {"stallForce": 2000.0, "freeSpeed": 20.0, "maxWheelTorque": 15.0}
     tr, sim = zoned_drive(
         tmp_path,
@@ -90,8 +91,8 @@ def test_mud_from_the_timeline_caps_the_grip(tmp_path: Path) -> None:
     accel = np.diff(tr["Rover.speed"]) / np.diff(t)
     before = (t[1:] > 0.2) & (t[1:] <= 1.0)
     after = t[1:] > 1.05
-    assert np.abs(accel[before] - 0.8 * G).max() < 1e-6 * G
-    assert np.abs(accel[after] - 0.1 * G).max() < 1e-6 * G
+    assert np.abs(accel[before] - traction_accel(0.8, robot, G)).max() < 1e-6 * G
+    assert np.abs(accel[after] - traction_accel(0.1, robot, G)).max() < 1e-6 * G
     # the encoders see the wheels spin up on the ice
     assert (tr["Rover.wheelSpeedL"] - tr["Rover.speed"])[-1] > 1.0
     assert sim.shared["physics"].terrain.zones[0].friction == 0.1

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pymunk
 import pytest
-from rig import drive
+from rig import ON_AXLE, drive
 
 from amsa_phys.physics import space
 from amsa_phys.physics.space import resolvable_speed
@@ -23,6 +23,8 @@ from amsa_phys.physics.space import resolvable_speed
 WALL_X = 3.0
 #: Small and fast: 0.1 x 0.05 m, 8 m/s no-load speed, strong enough to reach it in ~1 s.
 DART = {
+    **ON_AXLE,
+    "casterOffset": -0.04,
     "length": 0.1,
     "width": 0.05,
     "track": 0.04,

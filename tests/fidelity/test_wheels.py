@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from rig import drive
+from rig import ON_AXLE, drive
 
 from amsa_phys.physics import forces
 from amsa_phys.physics.space import wheel_model
@@ -121,6 +121,7 @@ def slip_curve(tmp_path: Path, sim_compliance: float) -> tuple[np.ndarray, np.nd
         "freeSpeed": 30.0,
         "maxWheelTorque": 2.0,
         "slipComplianceLongitudinal": sim_compliance,
+        **ON_AXLE,  # the load below is m g / 2
     }
     steps = [{"at": 0.5 * i, "set": {"Rover.maxWheelTorque": 2.0 + 2.0 * i}} for i in range(1, 6)]
     tr, _ = drive(
