@@ -11,6 +11,7 @@ value). :func:`cut` is ``duration:=S``, the same cut as ``amsa-phys run --durati
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from fractions import Fraction
 from typing import Any
 
@@ -39,7 +40,7 @@ def fold_server_values(rospy: Any, scenario: Scenario) -> list[Change]:
     byte).
     """
     start = start_values(scenario)
-    phase0 = scenario.phases[0]
+    changes = list(scenario.phases[0].changes)
     folded = []
     for path, leaf in scenario.world.leaves.items():
         for name, value in rosio.read_params(rospy, leaf).items():
@@ -47,8 +48,12 @@ def fold_server_values(rospy: Any, scenario: Scenario) -> list[Change]:
             if _same(value, old):
                 continue
             change = Change(path, name, value)
-            phase0.changes = [c for c in phase0.changes if c.key != change.key] + [change]
+            changes = [c for c in changes if c.key != change.key] + [change]
             folded.append(change)
+    if folded:  # phases are frozen: phase 0 is a new one
+        phases = list(scenario.phases)
+        phases[0] = replace(phases[0], changes=changes)
+        scenario.phases = type(scenario.phases)(phases)
     return folded
 
 
