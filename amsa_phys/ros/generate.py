@@ -31,7 +31,7 @@ from ..model.scenario import Scenario
 from ..model.world import WorldSpec
 from ..runs.resolve import resolved_scenario
 from ..runs.rundir import unique_names
-from . import names
+from . import boundary, names
 from .cppnode import check_cpp_ports, cmake_targets, cpp_bodies, cpp_node, hz
 from .graph import RosGraph, classify
 from .launchxml import launch_xml
@@ -145,6 +145,15 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         "Applies the scenario's timeline to the parameter server at the phases' instants\n"
         "(simulated time, /clock) and announces each phase on /amsa/phase.",
         "scenario",
+        Code(""),
+    )
+    node(
+        boundary.NODE,
+        f"{boundary.NODE}: the robot boundary of {pkg}.",
+        "Publishes the standard messages (NavSatFix, Imu, Odometry, LaserScan, /tf,\n"
+        "JointState wheel commands) from the data topics; with sim:=false, turns the robot\n"
+        "drivers' messages into the data topics the controller side reads.",
+        "boundary",
         Code(""),
     )
     for path in graph.remote:
