@@ -156,6 +156,16 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         "boundary",
         Code(""),
     )
+    adapt = any(s.adapt for s in scenarios)
+    if adapt:
+        node(
+            "amsa_adapt",
+            f"amsa_adapt: the adapt: rules of {pkg} on a robot (sim:=false).",
+            "Reads the estimators' topics and sets the rules' parameters on the parameter\n"
+            "server when a rule fires (with the simulator, the rules fire inside it).",
+            "adapt",
+            Code(""),
+        )
     for path in graph.remote:
         leaf = world.leaves[path]
         node(
@@ -174,7 +184,9 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
     for scenario, fname in zip(scenarios, unique_names(s.name for s in scenarios), strict=True):
         files[f"config/{fname}.yaml"] = yaml_dump(resolved_scenario(scenario))
         files[f"config/{fname}_params.yaml"] = _params_yaml(scenario)
-        files[f"launch/{fname}.launch"] = launch_xml(graph, pkg, fname, mode, cpp, source)
+        files[f"launch/{fname}.launch"] = launch_xml(
+            graph, pkg, fname, mode, cpp, source, adapt=bool(scenario.adapt)
+        )
         launches.append(f"{fname}.launch")
     python_nodes = sorted(f for f in files if f.startswith("nodes/"))
     files["package.xml"] = _fill(

@@ -66,9 +66,16 @@ _COMMON = 'pkg="@@{pkg:xml_attr}" name="@@{base:xml_attr}"@@{ns:code} required="
 
 
 def launch_xml(
-    graph: RosGraph, pkg: str, fname: str, mode: str, cpp: list[str], source: str
+    graph: RosGraph,
+    pkg: str,
+    fname: str,
+    mode: str,
+    cpp: list[str],
+    source: str,
+    adapt: bool = False,
 ) -> str:
-    """The launch file of the scenario whose config files are ``config/FNAME*.yaml``."""
+    """The launch file of the scenario whose config files are ``config/FNAME*.yaml``
+    (``adapt``: it has ``adapt:`` rules, run by the adapt node when ``sim:=false``)."""
     data_topics = " ".join(graph.data_topics())
     local = [p for p in graph.world.leaves if p in graph.local]
     lines = [
@@ -102,6 +109,15 @@ def launch_xml(
             boundary=boundary.NODE,
         )
     )
+    if adapt:
+        lines.append(
+            fill(
+                "  <!-- adapt: rules (sim:=false; with the simulator they fire inside it) -->\n"
+                '  <node unless="$(arg sim)" pkg="@@{pkg:xml_attr}" type="amsa_adapt.py"'
+                ' name="amsa_adapt" required="true" output="screen"/>',
+                pkg=pkg,
+            )
+        )
     side = boundary.plan(graph).controller
     for path in graph.remote:
         leaf = graph.leaf(path)

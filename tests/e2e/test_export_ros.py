@@ -224,18 +224,19 @@ def test_a_node_without_amsa_phys_says_what_to_install(tmp_path: Path) -> None:
     )
 
 
-def test_a_scenario_with_adapt_rules_is_refused_not_exported_without_them(
+def test_a_scenario_with_adapt_rules_exports_them(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    """Issue 27 item 5: the rules travel in the package's scenario (the simulator fires them)
+    and, for sim:=false, an adapt node is launched in the simulator's place."""
     scenario = ROOT / "scenarios" / "adaptive.yaml"
-    assert main(["export", "ros", str(scenario), "-o", str(tmp_path / "pkg")]) == 2
-    err = capsys.readouterr().err
-    line = next(
-        i for i, t in enumerate(scenario.read_text().splitlines(), 1) if t.startswith("adapt:")
-    )
-    assert err == (
-        f"error: {scenario}:{line}: adapt: rules are not exported to ROS yet (the package would "
-        "run without them); export the scenario without its adapt: section, or run it with "
-        "amsa-phys run\n"
-    )
-    assert not (tmp_path / "pkg").exists()
+    pkg = tmp_path / "pkg"
+    assert main(["export", "ros", str(scenario), "-o", str(pkg)]) == 0
+    config = yaml.safe_load((pkg / "config" / "adaptive.yaml").read_text())
+    assert [r["set"] for r in config["adapt"]] == [
+        r.changes and {c.key: c.value for c in r.changes} for r in load_scenario(scenario).adapt
+    ]
+    launch = ET.parse(pkg / "launch" / "adaptive.launch").getroot()
+    node = next(n for n in launch.iter("node") if n.get("name") == "amsa_adapt")
+    assert node.get("unless") == "$(arg sim)"
+    py_compile.compile(str(pkg / "nodes" / "amsa_adapt.py"), doraise=True)

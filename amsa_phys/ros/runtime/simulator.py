@@ -329,6 +329,9 @@ class RosSimulation(Simulation):
             quality_signal=q,
             trace=trace,
             columns=traced_columns(scenario),
+            # adapt: rules fire here, at the engine's exact instants (both modes); a change is
+            # put on the parameter server before the Leaf is told (apply_change)
+            adapt=scenario.adapt,
             # remote Leaves and publishing local ones stand in for the world's (standins.py)
             wrap=stand_ins(link, lambda: self.now),
             # every Leaf is called on its own: a node per Leaf, a topic per output
@@ -337,6 +340,8 @@ class RosSimulation(Simulation):
         self.link = link
         link.attach(self)
         graph = link.graph
+        #: the adapt rules' changes (the very objects the engine applies when one fires)
+        self.rule_changes = {id(c) for rule in scenario.adapt for c in rule.changes}
         # the parameter cache's values of every Leaf, as last seen (free mode: a change of the
         # cache is an edit, recorded as an event whether the Leaf steps here or in its node;
         # timeline changes are applied apart, at their instant)
@@ -360,6 +365,10 @@ class RosSimulation(Simulation):
 
     def apply_change(self, change: Change) -> None:
         """A timeline change, with the value the scenario node put on the parameter server."""
+        if id(change) in self.rule_changes:  # an adapt: rule fired at this instant
+            rosio.set_param(self.link.rospy, change.leaf, change.param, change.value)
+            super().apply_change(change)
+            return
         for i, queued in enumerate(self.live):
             if queued is change:  # a live edit (free mode), already judged
                 del self.live[i]
