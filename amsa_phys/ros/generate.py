@@ -180,6 +180,7 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         files[f"src/{names.script(path)}.cpp"] = cpp_node(graph, path, pkg, source, bodies)
     if cpp:
         files[f"include/{pkg}/amsa_leaf_node.h"] = (FILES / "amsa_leaf_node.h").read_text()
+        files[f"include/{pkg}/amsa_pymath.h"] = (FILES / "amsa_pymath.h").read_text()
     launches = []
     for scenario, fname in zip(scenarios, unique_names(s.name for s in scenarios), strict=True):
         files[f"config/{fname}.yaml"] = yaml_dump(resolved_scenario(scenario))

@@ -271,7 +271,9 @@ def test_free_mode_live_edits_are_events_and_refused_ones_are_put_back(
     _rosparam(launch, "set", kv, "99")  # above the template's maximum (10)
     while _rosparam(launch, "get", kv) == "99":  # put back by whoever judges it first
         assert launch.proc.poll() is None, "".join(launch.lines)[-3000:]
-    assert float(_rosparam(launch, "get", kv)) == 0.1
+    # the value in force: 0.1, or 0.05 if the timeline's t = 10 change landed meanwhile (a
+    # loaded machine's rosparam calls take seconds)
+    assert float(_rosparam(launch, "get", kv)) in (0.1, 0.05)
     _rosparam(launch, "set", kv, "0.2")
     assert launch.read_until("live change MyFollowerController.Kv=0.2"), "".join(launch.lines)
     os.killpg(launch.proc.pid, signal.SIGINT)

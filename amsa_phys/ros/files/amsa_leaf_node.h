@@ -22,6 +22,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <cstdio>
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -29,6 +30,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "amsa_pymath.h"  // Python's hypot and float % for the C++ bodies
 
 namespace amsa {
 
