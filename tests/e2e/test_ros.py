@@ -359,14 +359,12 @@ def test_free_mode_waits_for_a_user_node_by_its_topics(
     script.write_text(USER_MONITOR)
     script.chmod(0o755)
     original = (pkg / "launch" / "ros_short.launch").read_text()
-    mine = (
-        '  <node if="$(arg sim)" pkg="mdeChallenge" name="MyDistanceMonitor" required="true"'
-        ' type="MyDistanceMonitor.py"/>'
-    )
-    assert mine in original
-    launch_file.write_text(
-        original.replace(mine, mine.replace("MyDistanceMonitor.py", "user_monitor.py"))
-    )
+    common = 'pkg="mdeChallenge" name="MyDistanceMonitor" required="true"'
+    when = "$(eval arg('sim') and {}arg('cpp'))"
+    cpp = f'  <node if="{when.format("")}" {common} type="MyDistanceMonitor_cpp"/>\n'
+    py = f'  <node if="{when.format("not ")}" {common} type="MyDistanceMonitor.py"/>'
+    assert cpp + py in original
+    launch_file.write_text(original.replace(cpp + py, f'  <node {common} type="user_monitor.py"/>'))
     out = workspace / "user-node"
     try:
         launch = launcher(
