@@ -133,12 +133,7 @@ class BoundaryNode:
             for b in o.wanted:
                 readers.setdefault(b, []).append(o)
         self.readers = readers
-        self.subs = [
-            rospy.Subscriber(
-                names.topic(b), self.Float64, self._on_data, callback_args=b, tcp_nodelay=True
-            )
-            for b in readers
-        ]
+        self.subs: list[Any] = []
         self.data_pubs: dict[str, Any] = {}
         if not self.sim:
             for src in self.plan.inbound:
@@ -146,6 +141,24 @@ class BoundaryNode:
                     self.data_pubs[b] = rosio.make_publisher(rospy, names.topic(b), self.Float64)
                 cls = self.classes[src.role.msg]
                 self.subs.append(rospy.Subscriber(src.topic, cls, self._on_std, callback_args=src))
+
+    def listen(self) -> None:
+        """Subscribe to the data topics the outbound streams read.
+
+        With the simulator, only once ``/clock`` runs: every node waits at start until each
+        of its publishers has exactly the subscribers the graph counts, and a subscriber of
+        ours counted in a consumer's place would let a producer publish before that
+        consumer is connected (its lockstep step would then wait forever for a lost message).
+        """
+        if self.sim:
+            Clock = rosio.msgs()[2]
+            self.rospy.wait_for_message(names.CLOCK, Clock)
+        self.subs += [
+            self.rospy.Subscriber(
+                names.topic(b), self.Float64, self._on_data, callback_args=b, tcp_nodelay=True
+            )
+            for b in self.readers
+        ]
 
     def _on_data(self, msg: Any, buffer: str) -> None:
         with self.lock:
@@ -220,6 +233,11 @@ def main() -> None:
         rosio.fail(rospy, f"{NODE}: {exc}")
         return
     if node.sim:
+        try:
+            node.listen()
+        except rospy.ROSInterruptException:
+            return  # the launch ended before the run started
         rospy.spin()
     else:
+        node.listen()
         node.run_clock(speed)
