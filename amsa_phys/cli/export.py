@@ -105,15 +105,6 @@ def _ros(args: argparse.Namespace, out: Path) -> int:
     from ..ros.generate import check_names, generate
 
     scenarios = [_load(f, args) for f in args.files]
-    for scenario, name in zip(scenarios, args.files, strict=True):
-        if scenario.adapt:  # the package would run without them: refuse, never drop silently
-            raise ConfigError(
-                "rules are not exported to ROS yet (the package would run without them); "
-                "export the scenario without its adapt: section, or run it with amsa-phys run",
-                file=name,
-                line=load_yaml(name).line(("adapt",)),
-                key="adapt",
-            )
     check_names(scenarios, list(args.files))  # before anything is written
     inputs = [p for s in scenarios for p in input_files(s)]
     staged = staged_dir(out, args.force, inputs)

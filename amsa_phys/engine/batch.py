@@ -40,10 +40,6 @@ import numpy as np
 #: per-component Python it saves.
 MIN_GROUP = 32
 
-#: Deprecated switch, kept until its last writers move to ``Simulation(grouping=False)``
-#: (the ROS simulator, tests/e2e/test_groups.py): grouping is an argument of :func:`plan`.
-ENABLED = True
-
 _COPY = re.compile(r"^(.*?)(\d+)$")
 
 

@@ -277,8 +277,7 @@ class Simulation:
         leaves = self.world.leaves
         g = self.grouping
         keys = {t.path: g.key(t, leaves[t.path].freq) for t in self._tasks}
-        enabled = g.enabled and batch.ENABLED
-        planned = batch.plan([i.tasks for i in cycle], keys, g.min_group, enabled)
+        planned = batch.plan([i.tasks for i in cycle], keys, g.min_group, g.enabled)
         self._groups_of: dict[str, list[batch.Group]] = {}
         steppers = self._steppers
         for inst, seq in zip(cycle, planned, strict=True):

@@ -31,7 +31,7 @@ from ..model.scenario import Scenario
 from ..model.world import WorldSpec
 from ..runs.resolve import resolved_scenario
 from ..runs.rundir import unique_names
-from . import names
+from . import boundary, names
 from .cppnode import check_cpp_ports, cmake_targets, cpp_bodies, cpp_node, hz
 from .graph import RosGraph, classify
 from .launchxml import launch_xml
@@ -147,6 +147,25 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         "scenario",
         Code(""),
     )
+    node(
+        boundary.NODE,
+        f"{boundary.NODE}: the robot boundary of {pkg}.",
+        "Publishes the standard messages (NavSatFix, Imu, Odometry, LaserScan, /tf,\n"
+        "JointState wheel commands) from the data topics; with sim:=false, turns the robot\n"
+        "drivers' messages into the data topics the controller side reads.",
+        "boundary",
+        Code(""),
+    )
+    adapt = any(s.adapt for s in scenarios)
+    if adapt:
+        node(
+            "amsa_adapt",
+            f"amsa_adapt: the adapt: rules of {pkg} on a robot (sim:=false).",
+            "Reads the estimators' topics and sets the rules' parameters on the parameter\n"
+            "server when a rule fires (with the simulator, the rules fire inside it).",
+            "adapt",
+            Code(""),
+        )
     for path in graph.remote:
         leaf = world.leaves[path]
         node(
@@ -161,11 +180,14 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         files[f"src/{names.script(path)}.cpp"] = cpp_node(graph, path, pkg, source, bodies)
     if cpp:
         files[f"include/{pkg}/amsa_leaf_node.h"] = (FILES / "amsa_leaf_node.h").read_text()
+        files[f"include/{pkg}/amsa_pymath.h"] = (FILES / "amsa_pymath.h").read_text()
     launches = []
     for scenario, fname in zip(scenarios, unique_names(s.name for s in scenarios), strict=True):
         files[f"config/{fname}.yaml"] = yaml_dump(resolved_scenario(scenario))
         files[f"config/{fname}_params.yaml"] = _params_yaml(scenario)
-        files[f"launch/{fname}.launch"] = launch_xml(graph, pkg, fname, mode, cpp, source)
+        files[f"launch/{fname}.launch"] = launch_xml(
+            graph, pkg, fname, mode, cpp, source, adapt=bool(scenario.adapt)
+        )
         launches.append(f"{fname}.launch")
     python_nodes = sorted(f for f in files if f.startswith("nodes/"))
     files["package.xml"] = _fill(

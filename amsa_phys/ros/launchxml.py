@@ -9,7 +9,7 @@ roslaunch's rosparam loader reads as YAML, as double-quoted YAML scalars.
 from __future__ import annotations
 
 from .. import __version__
-from . import names
+from . import boundary, names
 from .cppnode import hz
 from .graph import RosGraph
 from .quote import Code, fill, yaml_scalar
@@ -25,13 +25,17 @@ _ARGS = """\
   <arg name="speed" default="1.0" doc="free mode: simulated seconds per wall second"/>
   <arg name="duration" default="" doc="simulated seconds to run (default: the scenario's)"/>
   <arg name="plots" default="true" doc="draw distance.png and trajectory.png"/>
-  <arg name="timeout" default="60" doc="seconds to wait for a node before giving up"/>"""
+  <arg name="timeout" default="60" doc="seconds to wait for a node before giving up"/>
+  <arg name="sim" default="true" doc="false: the controller side alone, in free mode, for a real\
+ robot whose drivers publish the standard topics (see README.md)"/>"""
 
 _HEAD = """\
   <param name="/use_sim_time" value="true"/>
   <group ns="amsa">
     <param name="scenario" value="$(find @@{pkg:xml_attr})/config/@@{fname:xml_attr}.yaml"/>
-    <param name="mode" value="$(arg mode)"/>
+    <param if="$(arg sim)" name="mode" value="$(arg mode)"/>
+    <param unless="$(arg sim)" name="mode" value="free"/>
+    <param name="sim" type="bool" value="$(arg sim)"/>
     <param name="bag" type="bool" value="$(eval arg('bag') != '')"/>
     <param name="timeout" type="double" value="$(arg timeout)"/>
     <rosparam param="local">@@{local:xml_text}</rosparam>
@@ -39,16 +43,22 @@ _HEAD = """\
   <rosparam command="load" file="$(find @@{pkg:xml_attr})/config/@@{fname:xml_attr}_params.yaml"/>
 
   <!-- the physics (@@{local_names:xml_comment}) and /clock; writes the run directory -->
-  <node pkg="@@{pkg:xml_attr}" type="@@{simulator:xml_attr}.py" name="@@{simulator:xml_attr}"\
- required="true" output="screen">
+  <node if="$(arg sim)" pkg="@@{pkg:xml_attr}" type="@@{simulator:xml_attr}.py"\
+ name="@@{simulator:xml_attr}" required="true" output="screen">
     <param name="out" value="$(arg out)"/>
     <param name="force" type="bool" value="$(arg force)"/>
     <param name="speed" type="double" value="$(arg speed)"/>
     <param name="duration" type="str" value="$(arg duration)"/>
     <param name="plots" type="bool" value="$(arg plots)"/>
   </node>
-  <node pkg="@@{pkg:xml_attr}" type="@@{scenario:xml_attr}.py" name="@@{scenario:xml_attr}"\
- required="true" output="screen"/>
+  <node if="$(arg sim)" pkg="@@{pkg:xml_attr}" type="@@{scenario:xml_attr}.py"\
+ name="@@{scenario:xml_attr}" required="true" output="screen"/>
+  <!-- the robot boundary: standard messages (sim:=false: from the robot's drivers in, and
+       /clock from the wall clock) -->
+  <node pkg="@@{pkg:xml_attr}" type="@@{boundary:xml_attr}.py" name="@@{boundary:xml_attr}"\
+ output="screen">
+    <param name="speed" type="double" value="$(arg speed)"/>
+  </node>
 """
 
 _LEAF = "  <!-- @@{path:xml_comment}: @@{tname:xml_comment}, @@{hz:xml_comment} Hz -->"
@@ -56,9 +66,16 @@ _COMMON = 'pkg="@@{pkg:xml_attr}" name="@@{base:xml_attr}"@@{ns:code} required="
 
 
 def launch_xml(
-    graph: RosGraph, pkg: str, fname: str, mode: str, cpp: list[str], source: str
+    graph: RosGraph,
+    pkg: str,
+    fname: str,
+    mode: str,
+    cpp: list[str],
+    source: str,
+    adapt: bool = False,
 ) -> str:
-    """The launch file of the scenario whose config files are ``config/FNAME*.yaml``."""
+    """The launch file of the scenario whose config files are ``config/FNAME*.yaml``
+    (``adapt``: it has ``adapt:`` rules, run by the adapt node when ``sim:=false``)."""
     data_topics = " ".join(graph.data_topics())
     local = [p for p in graph.world.leaves if p in graph.local]
     lines = [
@@ -89,8 +106,19 @@ def launch_xml(
             local_names=", ".join(local) or "no Leaf",
             simulator=names.SIMULATOR,
             scenario=names.SCENARIO,
+            boundary=boundary.NODE,
         )
     )
+    if adapt:
+        lines.append(
+            fill(
+                "  <!-- adapt: rules (sim:=false; with the simulator they fire inside it) -->\n"
+                '  <node unless="$(arg sim)" pkg="@@{pkg:xml_attr}" type="amsa_adapt.py"'
+                ' name="amsa_adapt" required="true" output="screen"/>',
+                pkg=pkg,
+            )
+        )
+    side = boundary.plan(graph).controller
     for path in graph.remote:
         leaf = graph.leaf(path)
         parent, _, base = path.rpartition(".")
@@ -99,11 +127,16 @@ def launch_xml(
         common = fill(_COMMON, pkg=pkg, base=base, ns=ns)
         script = names.script(path)
         node = '  <node @@{when:code}@@{c:code} type="@@{t:xml_attr}"/>'
+        # sim:=false runs the controller side only (boundary.py); the rest is the simulator's
+        sim = "True" if path in side else "arg('sim')"
         if path in cpp:
-            lines.append(fill(node, when=Code('if="$(arg cpp)" '), c=common, t=f"{script}_cpp"))
-            lines.append(fill(node, when=Code('unless="$(arg cpp)" '), c=common, t=f"{script}.py"))
+            cpp_on = Code(f"if=\"$(eval {sim} and arg('cpp'))\" ")
+            cpp_off = Code(f"if=\"$(eval {sim} and not arg('cpp'))\" ")
+            lines.append(fill(node, when=cpp_on, c=common, t=f"{script}_cpp"))
+            lines.append(fill(node, when=cpp_off, c=common, t=f"{script}.py"))
         else:
-            lines.append(fill(node, when=Code(""), c=common, t=f"{script}.py"))
+            when = Code("" if path in side else 'if="$(arg sim)" ')
+            lines.append(fill(node, when=when, c=common, t=f"{script}.py"))
     lines += [
         "",
         "  <!-- bag:=FILE.bag records every Data topic (connected before the run starts) -->",

@@ -20,6 +20,7 @@ SIMULATOR = "amsa_simulator"
 SCENARIO = "amsa_scenario"
 #: Names a top-level component may not take (the framework's nodes and namespaces).
 RESERVED = {"amsa", SIMULATOR, SCENARIO, "clock", "rosout", "rosout_agg", "amsa_bag"}
+RESERVED.update({"amsa_boundary", "amsa_adapt"})  # the boundary and adapt nodes
 
 CLOCK = "/clock"
 READY = "/amsa/ready"

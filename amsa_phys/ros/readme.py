@@ -56,6 +56,13 @@ writes the outputs so far.
   simulated time at `speed` x the wall clock. Not reproducible: the metrics come close to
   the in-process run's, the trace does not match it. Parameters may be changed while it
   runs (`rosparam set /MyFollowerController/Kv 0.2`): each node checks the template's range.
+- **sim:=false**: the controller side alone, in free mode, for a real robot: no simulator,
+  scenario node or sensor model. `amsa_boundary` turns the drivers' standard messages
+  (`sensor_msgs/NavSatFix`, `sensor_msgs/Imu`, `nav_msgs/Odometry`, `sensor_msgs/LaserScan`
+  on the topics listed by `rostopic list` in a simulated run; a NO_FIX fix is dropped) into
+  the data topics, publishes the wheel commands as `sensor_msgs/JointState` (effort = power
+  in %) and `/clock` from the wall clock. With the simulator it publishes the same standard
+  messages (and `/tf`) from the run, stamped with simulated time.
 
 ## Which Python
 

@@ -48,11 +48,20 @@ def test_package_has_a_node_per_leaf_a_topic_per_data_a_parameter_per_parameter(
     assert manifest.findtext("name") == "mdeChallenge"  # named after the root component
     launch = ET.parse(pkg / "launch" / "ros_short.launch").getroot()
     nodes = {n.get("name"): n for n in launch.iter("node")}
-    assert set(nodes) == {"amsa_simulator", "amsa_scenario", *REMOTE, "amsa_bag"}
-    assert all(n.get("required") == "true" for k, n in nodes.items() if k != "amsa_bag")
+    assert set(nodes) == {"amsa_simulator", "amsa_scenario", *REMOTE, "amsa_bag", "amsa_boundary"}
+    # the boundary's standard messages are for onlookers: without them the run still runs
+    optional = {"amsa_bag", "amsa_boundary"}
+    assert all(n.get("required") == "true" for k, n in nodes.items() if k not in optional)
+    # sim:=false runs the controller side alone; here the controller reads the monitor's
+    # true distance, which no robot measures: nothing of this world runs without the sim
+    assert all(
+        "arg('sim')" in (n.get("if") or "") or n.get("if") == "$(arg sim)"
+        for k, n in nodes.items()
+        if k in {"amsa_simulator", "amsa_scenario", *REMOTE}
+    )
     args = {a.get("name"): a.get("default") for a in launch.iter("arg")}
     assert args["mode"] == "free"  # --mode sets the launch files' default
-    assert {"out", "bag", "speed", "duration", "cpp", "force", "plots"} <= set(args)
+    assert {"out", "bag", "speed", "duration", "cpp", "force", "plots", "sim"} <= set(args)
     # the C++ route for the template with a C++ body, its Python twin otherwise
     types = [n.get("type") for n in launch.iter("node") if n.get("name") == "MyNormalizePower"]
     assert types == ["MyNormalizePower_cpp", "MyNormalizePower.py"]
@@ -215,18 +224,19 @@ def test_a_node_without_amsa_phys_says_what_to_install(tmp_path: Path) -> None:
     )
 
 
-def test_a_scenario_with_adapt_rules_is_refused_not_exported_without_them(
+def test_a_scenario_with_adapt_rules_exports_them(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    """Issue 27 item 5: the rules travel in the package's scenario (the simulator fires them)
+    and, for sim:=false, an adapt node is launched in the simulator's place."""
     scenario = ROOT / "scenarios" / "adaptive.yaml"
-    assert main(["export", "ros", str(scenario), "-o", str(tmp_path / "pkg")]) == 2
-    err = capsys.readouterr().err
-    line = next(
-        i for i, t in enumerate(scenario.read_text().splitlines(), 1) if t.startswith("adapt:")
-    )
-    assert err == (
-        f"error: {scenario}:{line}: adapt: rules are not exported to ROS yet (the package would "
-        "run without them); export the scenario without its adapt: section, or run it with "
-        "amsa-phys run\n"
-    )
-    assert not (tmp_path / "pkg").exists()
+    pkg = tmp_path / "pkg"
+    assert main(["export", "ros", str(scenario), "-o", str(pkg)]) == 0
+    config = yaml.safe_load((pkg / "config" / "adaptive.yaml").read_text())
+    assert [r["set"] for r in config["adapt"]] == [
+        r.changes and {c.key: c.value for c in r.changes} for r in load_scenario(scenario).adapt
+    ]
+    launch = ET.parse(pkg / "launch" / "adaptive.launch").getroot()
+    node = next(n for n in launch.iter("node") if n.get("name") == "amsa_adapt")
+    assert node.get("unless") == "$(arg sim)"
+    py_compile.compile(str(pkg / "nodes" / "amsa_adapt.py"), doraise=True)

@@ -77,13 +77,11 @@ def platoon(tmp_path: Path, **car_edits: Any) -> Path:
 
 
 def run(scen: Path, grouped: bool) -> tuple[Simulation, np.ndarray]:
-    batch.ENABLED = grouped
-    try:
-        rows: list[list[float]] = []
-        sim = Simulation.from_scenario(load_scenario(scen), trace=lambda t, v: rows.append([t, *v]))
-        sim.run()
-    finally:
-        batch.ENABLED = True
+    rows: list[list[float]] = []
+    sim = Simulation.from_scenario(
+        load_scenario(scen), trace=lambda t, v: rows.append([t, *v]), grouping=grouped
+    )
+    sim.run()
     return sim, np.array(rows)
 
 
@@ -188,15 +186,11 @@ def test_a_fault_in_a_group_names_the_copy_and_the_time(tmp_path: Path) -> None:
     scen = tmp_path / "s.yaml"
     scen.write_text("world: w.yaml\nduration: 5\ntimeline:\n  - {at: 1.5, set: {Box13.Div.k: 0}}\n")
     for grouped in (True, False):
-        batch.ENABLED = grouped
-        try:
-            sim = Simulation.from_scenario(load_scenario(scen))
-            sim.initialize()
-            assert ("Div" in groups(sim)) is grouped
-            with pytest.raises(RunFault) as exc:
-                sim.run()
-        finally:
-            batch.ENABLED = True
+        sim = Simulation.from_scenario(load_scenario(scen), grouping=grouped)
+        sim.initialize()
+        assert ("Div" in groups(sim)) is grouped
+        with pytest.raises(RunFault) as exc:
+            sim.run()
         assert exc.value.component.startswith("Box13.Div")
         assert exc.value.t == 1.5
         assert "output y is inf" in exc.value.cause

@@ -12,7 +12,6 @@ Skipped, with the reason, where ROS, catkin, unshare or root is missing.
 
 from __future__ import annotations
 
-import contextlib
 import csv
 import json
 import os
@@ -20,13 +19,13 @@ import shutil
 import signal
 import subprocess
 import sys
-import threading
 import time
-import uuid
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+import ros_launch
+from ros_launch import Launch, build_workspace, ros_missing
 
 from amsa_phys.cli.main import main
 from amsa_phys.model.scenario import load_scenario
@@ -34,7 +33,6 @@ from amsa_phys.model.scenario import load_scenario
 ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO = ROOT / "tests" / "fixtures" / "ros_short.yaml"
 PKG = "mdeChallenge"
-LAUNCH_TIMEOUT = 120  # s of wall time before a launch is declared hung (and killed)
 
 #: Free mode against the in-process run (same scenario and seed), in metres. Free mode's
 #: latency differs (each node samples its inputs at its own timer's phase instead of the
@@ -44,130 +42,14 @@ LAUNCH_TIMEOUT = 120  # s of wall time before a launch is declared hung (and kil
 FREE_BOUNDS = {"max_distance": 1.0, "final_distance": 1.0, "mean_error": 0.5}
 
 
-def _ros_missing() -> str | None:
-    for tool in ("roslaunch", "catkin_make", "rosbag", "unshare", "nsenter", "ip"):
-        if shutil.which(tool) is None:
-            return f"{tool} is not installed (ROS 1 from Debian: see .ci/run)"
-    if os.geteuid() != 0:
-        return "unshare -n (a private network for roscpp) needs root"
-    probe = subprocess.run(["unshare", "-n", "true"], capture_output=True)
-    if probe.returncode != 0:
-        return "unshare -n is not permitted here"
-    return None
-
-
-pytestmark = pytest.mark.skipif(_ros_missing() is not None, reason=str(_ros_missing()))
-
-
-def _leftovers(token: str) -> list[int]:
-    """Processes whose environment holds ``token`` (ours, whatever session they made)."""
-    found = []
-    for entry in Path("/proc").iterdir():
-        if not entry.name.isdigit():
-            continue
-        try:
-            env = (entry / "environ").read_bytes()
-        except OSError:
-            continue
-        if f"AMSA_ROS_TEST={token}".encode() in env.split(b"\0"):
-            found.append(int(entry.name))
-    return found
-
-
-class Launch:
-    """One roslaunch of the package in its own network namespace and process group."""
-
-    def __init__(self, ws: Path, launch: str, *args: str) -> None:
-        self.token = uuid.uuid4().hex
-        script = ws / "launch.sh"
-        env = {k: v for k, v in os.environ.items() if not k.startswith("ROS") and k != "PYTHONPATH"}
-        env["AMSA_ROS_TEST"] = self.token
-        env["AMSA_PHYS_PYTHON"] = sys.executable  # the package names no Python of its own
-        env["ROS_HOME"] = str(ws / "roshome")
-        env["PWD"] = str(ws)
-        self.proc = subprocess.Popen(
-            ["unshare", "-n", "bash", str(script), launch, *args],
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-            env=env,
-            start_new_session=True,
-        )
-        self.lines: list[str] = []
-        self.watchdog = threading.Timer(LAUNCH_TIMEOUT, self.kill)
-        self.watchdog.daemon = True
-        self.watchdog.start()
-
-    def kill(self) -> None:
-        """End the launch and anything it started (by process id)."""
-        for pid in [self.proc.pid, *_leftovers(self.token)]:
-            with contextlib.suppress(ProcessLookupError):
-                os.kill(pid, signal.SIGKILL)
-
-    def read_until(self, marker: str) -> bool:
-        """Read output lines until one contains ``marker`` (False at the end of output)."""
-        assert self.proc.stdout is not None
-        for line in self.proc.stdout:
-            self.lines.append(line)
-            if marker in line:
-                return True
-        return False
-
-    def finish(self) -> str:
-        """Wait for the end; the whole output. Fails if a process outlived roslaunch."""
-        assert self.proc.stdout is not None
-        self.lines += self.proc.stdout.readlines()
-        self.proc.wait()
-        self.watchdog.cancel()
-        left = _leftovers(self.token)
-        if left:
-            names = [Path(f"/proc/{p}/cmdline").read_bytes()[:80] for p in left]
-            self.kill()
-            pytest.fail(f"processes left running after roslaunch exited: {names}")
-        return "".join(self.lines)
-
-
-@pytest.fixture
-def launcher() -> Iterator[Callable[..., Launch]]:
-    """Start launches; whatever a failing test leaves running is ended at teardown."""
-    started: list[Launch] = []
-
-    def start(ws: Path, launch: str, *args: str) -> Launch:
-        started.append(Launch(ws, launch, *args))
-        return started[-1]
-
-    yield start
-    for launch in started:
-        launch.watchdog.cancel()
-        launch.kill()
-        launch.proc.wait()
+pytestmark = pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing()))
+launcher = ros_launch.launcher  # the fixture
 
 
 @pytest.fixture(scope="module")
 def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The exported package, built with catkin in a fresh workspace."""
-    ws = tmp_path_factory.mktemp("ws")
-    assert main(["export", "ros", str(SCENARIO), "-o", str(ws / "src" / PKG)]) == 0
-    t0 = time.perf_counter()
-    build = subprocess.run(
-        # Debian's python3 for catkin's own scripts (a venv's lacks catkin_pkg)
-        ["catkin_make", "-C", str(ws), "-DPYTHON_EXECUTABLE=/usr/bin/python3"],
-        cwd=ws,
-        capture_output=True,
-        text=True,
-        env={**{k: v for k, v in os.environ.items() if k != "PYTHONPATH"}, "PWD": str(ws)},
-    )
-    assert build.returncode == 0, build.stdout[-3000:] + build.stderr[-3000:]
-    print(f"catkin_make: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
-    (ws / "launch.sh").write_text(
-        "set -e\n"
-        "ip link set lo up\n"  # the namespace's loopback: the only interface ROS sees
-        f"export ROS_LOG_DIR={ws}/roshome/log ROS_MASTER_URI=http://localhost:11311\n"
-        "export ROS_HOSTNAME=localhost ROS_DISTRO=${ROS_DISTRO:-debian}\n"
-        f"source {ws}/devel/setup.bash\n"
-        f'exec roslaunch {PKG} "$@"\n'
-    )
-    return ws
+    return build_workspace(tmp_path_factory.mktemp("ws"), SCENARIO, PKG)
 
 
 @pytest.fixture(scope="module")
@@ -389,7 +271,9 @@ def test_free_mode_live_edits_are_events_and_refused_ones_are_put_back(
     _rosparam(launch, "set", kv, "99")  # above the template's maximum (10)
     while _rosparam(launch, "get", kv) == "99":  # put back by whoever judges it first
         assert launch.proc.poll() is None, "".join(launch.lines)[-3000:]
-    assert float(_rosparam(launch, "get", kv)) == 0.1
+    # the value in force: 0.1, or 0.05 if the timeline's t = 10 change landed meanwhile (a
+    # loaded machine's rosparam calls take seconds)
+    assert float(_rosparam(launch, "get", kv)) in (0.1, 0.05)
     _rosparam(launch, "set", kv, "0.2")
     assert launch.read_until("live change MyFollowerController.Kv=0.2"), "".join(launch.lines)
     os.killpg(launch.proc.pid, signal.SIGINT)
@@ -475,14 +359,12 @@ def test_free_mode_waits_for_a_user_node_by_its_topics(
     script.write_text(USER_MONITOR)
     script.chmod(0o755)
     original = (pkg / "launch" / "ros_short.launch").read_text()
-    mine = (
-        '  <node pkg="mdeChallenge" name="MyDistanceMonitor" required="true"'
-        ' type="MyDistanceMonitor.py"/>'
-    )
-    assert mine in original
-    launch_file.write_text(
-        original.replace(mine, mine.replace("MyDistanceMonitor.py", "user_monitor.py"))
-    )
+    common = 'pkg="mdeChallenge" name="MyDistanceMonitor" required="true"'
+    when = "$(eval arg('sim') and {}arg('cpp'))"
+    cpp = f'  <node if="{when.format("")}" {common} type="MyDistanceMonitor_cpp"/>\n'
+    py = f'  <node if="{when.format("not ")}" {common} type="MyDistanceMonitor.py"/>'
+    assert cpp + py in original
+    launch_file.write_text(original.replace(cpp + py, f'  <node {common} type="user_monitor.py"/>'))
     out = workspace / "user-node"
     try:
         launch = launcher(

@@ -22,6 +22,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <cstdio>
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -29,6 +30,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "amsa_pymath.h"  // Python's hypot and float % for the C++ bodies
 
 namespace amsa {
 
@@ -78,6 +81,8 @@ class LeafNode {
     std::string mode = "lockstep";
     bool bag = false;
     ros::param::get("/amsa/mode", mode);
+    bool sim = true;
+    ros::param::get("/amsa/sim", sim);
     ros::param::get("/amsa/bag", bag);
     double timeout = 60.0;
     ros::param::get("/amsa/timeout", timeout);
@@ -109,7 +114,8 @@ class LeafNode {
     auto wake = [this](const ros::SingleSubscriberPublisher&) { notify(); };
     for (const OutputPort& o : outputs_) {
       pubs_.push_back(nh.advertise<std_msgs::Float64>(o.topic, 1000, wake, ros::SubscriberStatusCallback()));
-      want_.push_back(o.subscribers + (bag ? 1 : 0));
+      // sim:=false (the controller side alone): no simulator to wait for, start at once
+      want_.push_back(sim ? o.subscribers + (bag ? 1 : 0) : 0);
     }
     lockstep_ = mode == "lockstep";
     if (lockstep_) {

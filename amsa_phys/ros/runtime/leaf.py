@@ -34,6 +34,7 @@ from typing import Any
 from ...engine.timing import leaf_phase
 from ...errors import AmsaError, ConfigError
 from .. import names
+from ..boundary import SIM_PARAM
 from ..graph import NodeContext
 from . import rosio
 from .config import load_config
@@ -78,8 +79,12 @@ class LeafNode:
             for b in self.buffers
         ]
         self.gate = rosio.Gate(rospy)
+        # sim:=false (the controller side alone, ros/boundary.py): no simulator to wait for;
+        # free mode needs no handshake, so the node starts at once
+        sim = bool(rospy.get_param(SIM_PARAM, True))
         self.pubs = [
-            self.gate.publisher(names.topic(b), Float64, graph.subscribers(b)) for b in self.outputs
+            self.gate.publisher(names.topic(b), Float64, graph.subscribers(b) if sim else 0)
+            for b in self.outputs
         ]
         if cfg.mode == "lockstep":
             self.done = self.gate.publisher(names.done_topic(path), String, 1)

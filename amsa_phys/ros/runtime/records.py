@@ -10,8 +10,8 @@ value). :func:`cut` is ``duration:=S``, the same cut as ``amsa-phys run --durati
 
 from __future__ import annotations
 
-import dataclasses
 import math
+from dataclasses import replace
 from fractions import Fraction
 from typing import Any
 
@@ -40,8 +40,7 @@ def fold_server_values(rospy: Any, scenario: Scenario) -> list[Change]:
     byte).
     """
     start = start_values(scenario)
-    phase0 = scenario.phases[0]
-    changes = list(phase0.changes)
+    changes = list(scenario.phases[0].changes)
     folded = []
     for path, leaf in scenario.world.leaves.items():
         for name, value in rosio.read_params(rospy, leaf).items():
@@ -51,8 +50,10 @@ def fold_server_values(rospy: Any, scenario: Scenario) -> list[Change]:
             change = Change(path, name, value)
             changes = [c for c in changes if c.key != change.key] + [change]
             folded.append(change)
-    if folded:  # phases are frozen: phase 0 is replaced, never edited
-        scenario.phases = [dataclasses.replace(phase0, changes=changes), *scenario.phases[1:]]
+    if folded:  # phases are frozen: phase 0 is a new one
+        phases = list(scenario.phases)
+        phases[0] = replace(phases[0], changes=changes)
+        scenario.phases = type(scenario.phases)(phases)
     return folded
 
 

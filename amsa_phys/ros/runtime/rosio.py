@@ -199,3 +199,9 @@ def fail(rospy: Any, message: str, code: int = 2) -> None:
         rospy.signal_shutdown(message)
     finally:
         sys.exit(code)
+
+
+def set_param(rospy: Any, path: str, name: str, value: Any) -> None:
+    """Put a Leaf's parameter on the server (an ``adapt:`` rule's change): its node reads it
+    from there (lockstep: when asked; free: at its next step)."""
+    rospy.set_param(names.param(path, name), ros_value(value))

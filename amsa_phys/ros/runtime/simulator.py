@@ -25,7 +25,7 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from ...engine import batch, interrupt
+from ...engine import interrupt
 from ...engine.runner import Simulation
 from ...errors import AmsaError, Interrupted, RunFault
 from ...model.scenario import Change, Scenario, traced_columns
@@ -36,6 +36,7 @@ from .. import names
 from ..graph import RosGraph
 from . import readiness, records, rosio
 from .config import NodeConfig, load_config
+from .standins import stand_ins
 
 
 class RemoteError(Exception):
@@ -62,7 +63,9 @@ class Link:
         self.cond = threading.Condition()
         self.gate = rosio.Gate(rospy, self.cond)
         world = self.graph.world
-        self.values: dict[str, float] | None = None  # the engine's, in free mode
+        #: free mode: the outputs nodes published since the loop last took them (buffer ->
+        #: latest value); the loop's own thread writes them into the engine (:meth:`take`)
+        self.fresh: dict[str, float] = {}
         self.sim: Simulation | None = None
         self.published = dict.fromkeys(world.buffers, 0)
         self.received: dict[str, list[Any]] = {}
@@ -112,8 +115,8 @@ class Link:
             r = self.received[buffer]
             r[0] += 1
             r[1] = msg.data
-            if self.values is not None:
-                self.values[buffer] = msg.data  # free mode: the latest value is the value
+            if not self.lockstep:
+                self.fresh[buffer] = msg.data  # free mode: the latest value is the value
             self.cond.notify_all()
 
     def _on_done(self, msg: Any, path: str) -> None:
@@ -163,8 +166,22 @@ class Link:
     def attach(self, sim: Simulation) -> None:
         """The simulation whose values free mode updates and whose events remote Leaves add."""
         self.sim = sim
-        if not self.lockstep:
-            self.values = sim.values
+
+    def take(self) -> None:
+        """Free mode: what the nodes published since the last call, into the engine.
+
+        Called by the loop's own thread (a hook, between the components' steps), through
+        :meth:`Simulation.write`: a rospy thread never touches the engine's buffers (the
+        loop holds the store's lock through a whole ``advance``, so a callback that wrote
+        would wait until the run ends).
+        """
+        sim = self.sim
+        if sim is None or not self.fresh:
+            return
+        with self.cond:
+            fresh, self.fresh = self.fresh, {}
+        for buffer, value in fresh.items():
+            sim.write(buffer, value)
 
     # -- waiting ----------------------------------------------------------------------------
     def _wait(self, ready: Callable[[], bool], who: str, t: Fraction, what: str) -> None:
@@ -249,27 +266,24 @@ class Link:
             raise ValueError(head[2] if len(head) > 2 else "refused")
 
     # -- local Leaves --------------------------------------------------------------------------
-    def publishing(self, path: str, do_step: Callable[..., Any]) -> Callable[..., Any]:
-        """``do_step`` of a Leaf stepped here, publishing its outputs on their topics."""
+    def publisher_of(self, path: str) -> Callable[[Mapping[str, Any]], None]:
+        """What publishes the outputs of a Leaf stepped here on their topics."""
         ports = [(b.rpartition(".")[2], b) for b in self.graph.outputs(path)]
         pubs = self.data_pubs
         Float64 = self.Float64
         published = self.published
 
-        def step(t: Fraction, inp: Mapping[str, Any]) -> Any:
-            out = do_step(t, inp)
-            if out:
-                for port, b in ports:
-                    if port in out:
-                        try:
-                            number = float(out[port])
-                        except (TypeError, ValueError):
-                            continue  # the engine reports it
-                        pubs[b].publish(Float64(number))
-                        published[b] += 1
-            return out
+        def publish(out: Mapping[str, Any]) -> None:
+            for port, b in ports:
+                if port in out:
+                    try:
+                        number = float(out[port])
+                    except (TypeError, ValueError):
+                        continue  # the engine reports it
+                    pubs[b].publish(Float64(number))
+                    published[b] += 1
 
-        return step
+        return publish
 
     # -- time and the timeline ---------------------------------------------------------------
     def publish_clock(self, t: Fraction) -> None:
@@ -301,27 +315,6 @@ class Link:
         return rosio.read_param(self.rospy, change.leaf, leaf.template.param(change.param))
 
 
-class RemoteLeaf:
-    """In the engine, a Leaf that is a node: stepping it is asking its node to step."""
-
-    def __init__(self, path: str, p: Any, link: Link, sim: RosSimulation) -> None:
-        self.path = path
-        self.p = p
-        self.link = link
-        self.sim = sim
-
-    def initialize(self, ctx: Any) -> None:
-        """The node initialized itself."""
-
-    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
-        """A round trip to the node (lockstep); nothing (free)."""
-        return self.link.step(self.path, t)
-
-    def on_param_change(self, name: str, value: Any) -> None:
-        """The node re-reads the parameter now."""
-        self.link.reload(self.path, name, self.sim.now)
-
-
 class RosSimulation(Simulation):
     """The engine with remote Leaves, parameters from the server, ``/clock`` published."""
 
@@ -336,18 +329,19 @@ class RosSimulation(Simulation):
             quality_signal=q,
             trace=trace,
             columns=traced_columns(scenario),
+            # adapt: rules fire here, at the engine's exact instants (both modes); a change is
+            # put on the parameter server before the Leaf is told (apply_change)
+            adapt=scenario.adapt,
+            # remote Leaves and publishing local ones stand in for the world's (standins.py)
+            wrap=stand_ins(link, lambda: self.now),
+            # every Leaf is called on its own: a node per Leaf, a topic per output
+            grouping=False,
         )
         self.link = link
         link.attach(self)
         graph = link.graph
-        for path in graph.remote:
-            self.components[path] = RemoteLeaf(path, self.components[path].p, link, self)  # type: ignore[assignment]
-        for path in sorted(graph.local):
-            comp = self.components[path]
-            values = rosio.read_params(link.rospy, graph.leaf(path))
-            for name, value in values.items():
-                setattr(comp.p, name, value)
-            comp.do_step = link.publishing(path, comp.do_step)  # type: ignore[method-assign]
+        #: the adapt rules' changes (the very objects the engine applies when one fires)
+        self.rule_changes = {id(c) for rule in scenario.adapt for c in rule.changes}
         # the parameter cache's values of every Leaf, as last seen (free mode: a change of the
         # cache is an edit, recorded as an event whether the Leaf steps here or in its node;
         # timeline changes are applied apart, at their instant)
@@ -361,11 +355,20 @@ class RosSimulation(Simulation):
             rate = (
                 Fraction(str(scenario.world.physics["rate"])) if graph.local else scenario.log_rate
             )
-            self.add_hook(rate, lambda: link.pace(self.now), "ros clock")
+            self.add_hook(rate, self._pace, "ros clock")
             self.add_hook(scenario.log_rate, self._live_params, "ros parameters")
+
+    def _pace(self) -> None:
+        """Free mode: hold to the wall clock, then take what the nodes published meanwhile."""
+        self.link.pace(self.now)
+        self.link.take()
 
     def apply_change(self, change: Change) -> None:
         """A timeline change, with the value the scenario node put on the parameter server."""
+        if id(change) in self.rule_changes:  # an adapt: rule fired at this instant
+            rosio.set_param(self.link.rospy, change.leaf, change.param, change.value)
+            super().apply_change(change)
+            return
         for i, queued in enumerate(self.live):
             if queued is change:  # a live edit (free mode), already judged
                 del self.live[i]
@@ -429,7 +432,6 @@ def main() -> None:
         root = Path(str(rospy.get_param("~runs", "") or os.environ.get("PWD", "."))) / "runs"
         out_dir = Path(out) if out else default_run_dir(scenario.name, root)
         prepare_run_dir(out_dir, bool(rospy.get_param("~force", False)), flag="out:=")
-        batch.ENABLED = False  # a Leaf stepped here publishes per call (no array groups)
         link = Link(rospy, cfg)
         link.speed = float(rospy.get_param("~speed", 1.0))
         if not link.speed > 0 or math.isinf(link.speed):

@@ -1,0 +1,243 @@
+"""The boundary node: AMSA data topics to standard ROS messages and back (``ros/boundary.py``).
+
+Out (both sides): a stream's message is built by ``stdmsgs.build`` — the very builders of
+the MCAP bag, so covariances come from the sensor's noise model the same way — once every
+field of it has a new value since the last message (a Leaf publishes all of its outputs
+at a step, each on its topic; a GPS that lost its fix publishes nothing, so no NavSatFix
+either). Stamped with ``rospy.Time.now()``: simulated time (``/clock``).
+
+In (``sim:=false``): a message on a sensor stream's topic becomes the data topics of its
+fields (a NavSatFix's latitude and longitude back to the plane's x and y at the same
+origin; a fix with status NO_FIX is dropped, as a lost fix), and this node publishes
+``/clock`` from the wall clock (times ``speed:=``), since no simulator does: every node
+of the package steps on ``/clock`` (``use_sim_time``), so a real robot's drivers stamp
+with it too.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections.abc import Mapping
+from typing import Any
+
+from ...errors import AmsaError
+from ...stdmsgs import DEFAULT_ORIGIN, Context, Source, build, geodetic_to_enu, quaternion_yaw
+from ...stdmsgs.build import transform
+from .. import names
+from ..boundary import NODE, SIM_PARAM, plan
+from . import rosio
+from .config import load_config
+
+#: NavSatStatus.STATUS_NO_FIX: a fix the receiver says it does not have
+NO_FIX = -1
+
+#: ``/clock`` period with ``sim:=false`` (wall seconds): finer than any Leaf's period
+CLOCK_PERIOD = 0.005
+
+
+def ros1_classes() -> dict[str, Any]:
+    """ROS 1 message classes by ``pkg/Type`` (Debian's python3-sensor-msgs and friends)."""
+    rosio.ros()  # puts ROS's Python packages on the path
+    from nav_msgs.msg import Odometry
+    from sensor_msgs.msg import Imu, JointState, LaserScan, NavSatFix
+    from tf2_msgs.msg import TFMessage
+
+    return {
+        "sensor_msgs/NavSatFix": NavSatFix,
+        "sensor_msgs/Imu": Imu,
+        "nav_msgs/Odometry": Odometry,
+        "sensor_msgs/LaserScan": LaserScan,
+        "sensor_msgs/JointState": JointState,
+        "tf2_msgs/TFMessage": TFMessage,
+    }
+
+
+def fill(rospy: Any, msg: Any, fields: Mapping[str, Any]) -> Any:
+    """A ROS 1 message from ``stdmsgs``'s dict of a ROS 2 message (same fields but the
+    stamp: ROS 2's ``{sec, nanosec}`` is ROS 1's ``rospy.Time``)."""
+    for key, value in fields.items():
+        if key == "stamp":
+            msg.stamp = rospy.Time(value["sec"], value["nanosec"])
+        elif isinstance(value, Mapping):
+            fill(rospy, getattr(msg, key), value)
+        else:
+            setattr(msg, key, value)
+    return msg
+
+
+class Outbound:
+    """One stream published from the data topics (see the module docstring)."""
+
+    def __init__(self, node: BoundaryNode, src: Source) -> None:
+        self.node = node
+        self.src = src
+        self.cls = node.classes[src.role.msg]
+        self.pub = rosio.make_publisher(node.rospy, src.topic, self.cls)
+        leaf = node.graph.leaf(src.leaf)
+        #: the noise model's parameters as the launch set them (the covariances' source)
+        self.params = rosio.read_params(node.rospy, leaf)
+        self.period = 1 / float(leaf.freq)
+        self.fresh: set[str] = set()
+        self.wanted = set(buffers_of(src))
+
+    def got(self, buffer: str) -> None:
+        """A field's buffer has a new value (the node's lock is held)."""
+        self.fresh.add(buffer)
+        if self.fresh >= self.wanted:
+            self.fresh.clear()
+            self.publish()
+
+    def publish(self) -> None:
+        rospy = self.node.rospy
+        now = rospy.Time.now()
+        ctx = Context((now.secs, now.nsecs), now.to_sec(), self.period, self.node.origin)
+        values = self.node.values
+        msg = build(self.src, values, self.params, ctx)
+        self.pub.publish(fill(rospy, self.cls(), msg))
+        if self.src.role.name == "Pose":
+            fields = {k: values[b] for k, b in self.src.buffers.items() if isinstance(b, str)}
+            tf = fill(rospy, self.node.TransformStamped(), transform(self.src, fields, ctx))
+            self.node.tf_pub.publish(self.node.classes["tf2_msgs/TFMessage"]([tf]))
+
+
+class BoundaryNode:
+    """The boundary of the package's world (``ros/boundary.py`` says which streams)."""
+
+    def __init__(self, rospy: Any) -> None:
+        self.rospy = rospy
+        cfg = load_config(rospy)
+        self.graph = cfg.graph
+        self.sim = bool(rospy.get_param(SIM_PARAM, True))
+        self.plan = plan(self.graph)
+        self.classes = ros1_classes()
+        from geometry_msgs.msg import TransformStamped
+
+        self.TransformStamped = TransformStamped
+        self.Float64 = rosio.msgs()[0]
+        self.origin = DEFAULT_ORIGIN
+        self.lock = threading.Lock()
+        world = self.graph.world
+        self.values: dict[str, float] = {b: float(s.initial) for b, s in world.buffers.items()}
+        self.tf_pub = rosio.make_publisher(rospy, "/tf", self.classes["tf2_msgs/TFMessage"])
+        inbound = {s.leaf for s in self.plan.inbound}
+        out = [
+            s
+            for s in self.plan.sources
+            if self.sim or (s.role.name == "WheelCommand" and s.leaf not in inbound)
+        ]
+        self.outbound = [Outbound(self, s) for s in out]
+        readers: dict[str, list[Outbound]] = {}
+        for o in self.outbound:
+            for b in o.wanted:
+                readers.setdefault(b, []).append(o)
+        self.readers = readers
+        self.subs: list[Any] = []
+        self.data_pubs: dict[str, Any] = {}
+        if not self.sim:
+            for src in self.plan.inbound:
+                for b in buffers_of(src):
+                    self.data_pubs[b] = rosio.make_publisher(rospy, names.topic(b), self.Float64)
+                cls = self.classes[src.role.msg]
+                self.subs.append(rospy.Subscriber(src.topic, cls, self._on_std, callback_args=src))
+
+    def listen(self) -> None:
+        """Subscribe to the data topics the outbound streams read.
+
+        With the simulator, only once ``/clock`` runs: every node waits at start until each
+        of its publishers has exactly the subscribers the graph counts, and a subscriber of
+        ours counted in a consumer's place would let a producer publish before that
+        consumer is connected (its lockstep step would then wait forever for a lost message).
+        """
+        if self.sim:
+            Clock = rosio.msgs()[2]
+            self.rospy.wait_for_message(names.CLOCK, Clock)
+        self.subs += [
+            self.rospy.Subscriber(
+                names.topic(b), self.Float64, self._on_data, callback_args=b, tcp_nodelay=True
+            )
+            for b in self.readers
+        ]
+
+    def _on_data(self, msg: Any, buffer: str) -> None:
+        with self.lock:
+            self.values[buffer] = msg.data
+            for o in self.readers[buffer]:
+                o.got(buffer)
+
+    def _on_std(self, msg: Any, src: Source) -> None:
+        """A driver's message on a sensor stream: its fields on their data topics."""
+        fields = read_fields(src, msg, self.origin)
+        if fields is None:
+            return
+        for name, value in fields.items():
+            buf = src.buffers[name]
+            if isinstance(buf, tuple):
+                for b, v in zip(buf, value, strict=False):
+                    self.data_pubs[b].publish(self.Float64(v))
+            else:
+                self.data_pubs[buf].publish(self.Float64(value))
+
+    def run_clock(self, speed: float) -> None:
+        """``sim:=false``: ``/clock`` = wall seconds since start times ``speed``."""
+        Clock = rosio.msgs()[2]
+        pub = rosio.make_publisher(self.rospy, names.CLOCK, Clock, latch=True)
+        wall0 = time.monotonic()
+        while not self.rospy.is_shutdown():
+            ns = int((time.monotonic() - wall0) * speed * 1e9)
+            pub.publish(Clock(self.rospy.Time(ns // 10**9, ns % 10**9)))
+            time.sleep(CLOCK_PERIOD)  # the clock's own tick: pacing is this node's job
+
+
+def buffers_of(src: Source) -> list[str]:
+    """Every Data buffer a stream's fields read (an array field's elements, in order)."""
+    out: list[str] = []
+    for buf in src.buffers.values():
+        out.extend(buf if isinstance(buf, tuple) else [buf])
+    return out
+
+
+def read_fields(src: Source, msg: Any, origin: tuple[float, float]) -> dict[str, Any] | None:
+    """A standard message's fields as the stream's Leaf outputs them (None: drop it)."""
+    role = src.role.name
+    if role == "NavSatFix":
+        if msg.status.status <= NO_FIX:
+            return None  # a lost fix: the GPS Leaf publishes nothing either
+        x, y = geodetic_to_enu(msg.latitude, msg.longitude, origin)
+        return {"x": x, "y": y}
+    if role == "Heading":
+        return {"yaw": quaternion_yaw(msg.orientation)}
+    if role == "Imu":
+        acc = msg.linear_acceleration
+        return {"gyro_z": msg.angular_velocity.z, "accel_x": acc.x, "accel_y": acc.y}
+    if role == "Odometry":
+        pose = msg.pose.pose
+        return {"x": pose.position.x, "y": pose.position.y, "yaw": quaternion_yaw(pose.orientation)}
+    if role == "LaserScan":
+        far = msg.range_max
+        return {"ranges": [far if math.isinf(r) or r > far else r for r in msg.ranges]}
+    return None
+
+
+def main() -> None:
+    """The boundary node's entry point."""
+    rospy = rosio.ros()
+    rospy.init_node(NODE)
+    try:
+        node = BoundaryNode(rospy)
+        speed = float(rospy.get_param("~speed", 1.0))
+        if not speed > 0 or math.isinf(speed):
+            raise AmsaError(f"speed:= must be a positive number, got {speed}")
+    except AmsaError as exc:
+        rosio.fail(rospy, f"{NODE}: {exc}")
+        return
+    if node.sim:
+        try:
+            node.listen()
+        except rospy.ROSInterruptException:
+            return  # the launch ended before the run started
+        rospy.spin()
+    else:
+        node.listen()
+        node.run_clock(speed)

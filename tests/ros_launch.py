@@ -1,0 +1,149 @@
+"""Launching an exported ROS package in a test: a private network, no process left behind.
+
+Shared by ``tests/e2e/test_ros*.py``. Every launch runs in a private network namespace
+(``unshare -n``: roscpp listens on all interfaces) and every process it starts carries a
+token in its environment, so a test can prove none is left behind (and end stragglers by
+their id).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+import uuid
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from amsa_phys.cli.main import main
+
+LAUNCH_TIMEOUT = 120  # s of wall time before a launch is declared hung (and killed)
+
+
+def ros_missing() -> str | None:
+    for tool in ("roslaunch", "catkin_make", "rosbag", "unshare", "nsenter", "ip"):
+        if shutil.which(tool) is None:
+            return f"{tool} is not installed (ROS 1 from Debian: see .ci/run)"
+    if os.geteuid() != 0:
+        return "unshare -n (a private network for roscpp) needs root"
+    probe = subprocess.run(["unshare", "-n", "true"], capture_output=True)
+    if probe.returncode != 0:
+        return "unshare -n is not permitted here"
+    return None
+
+
+def _leftovers(token: str) -> list[int]:
+    """Processes whose environment holds ``token`` (ours, whatever session they made)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            env = (entry / "environ").read_bytes()
+        except OSError:
+            continue
+        if f"AMSA_ROS_TEST={token}".encode() in env.split(b"\0"):
+            found.append(int(entry.name))
+    return found
+
+
+class Launch:
+    """One roslaunch of the package in its own network namespace and process group."""
+
+    def __init__(self, ws: Path, launch: str, *args: str) -> None:
+        self.token = uuid.uuid4().hex
+        script = ws / "launch.sh"
+        env = {k: v for k, v in os.environ.items() if not k.startswith("ROS") and k != "PYTHONPATH"}
+        env["AMSA_ROS_TEST"] = self.token
+        env["AMSA_PHYS_PYTHON"] = sys.executable  # the package names no Python of its own
+        env["ROS_HOME"] = str(ws / "roshome")
+        env["PWD"] = str(ws)
+        self.proc = subprocess.Popen(
+            ["unshare", "-n", "bash", str(script), launch, *args],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            env=env,
+            start_new_session=True,
+        )
+        self.lines: list[str] = []
+        self.watchdog = threading.Timer(LAUNCH_TIMEOUT, self.kill)
+        self.watchdog.daemon = True
+        self.watchdog.start()
+
+    def kill(self) -> None:
+        """End the launch and anything it started (by process id)."""
+        for pid in [self.proc.pid, *_leftovers(self.token)]:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+
+    def read_until(self, marker: str) -> bool:
+        """Read output lines until one contains ``marker`` (False at the end of output)."""
+        assert self.proc.stdout is not None
+        for line in self.proc.stdout:
+            self.lines.append(line)
+            if marker in line:
+                return True
+        return False
+
+    def finish(self) -> str:
+        """Wait for the end; the whole output. Fails if a process outlived roslaunch."""
+        assert self.proc.stdout is not None
+        self.lines += self.proc.stdout.readlines()
+        self.proc.wait()
+        self.watchdog.cancel()
+        left = _leftovers(self.token)
+        if left:
+            names = [Path(f"/proc/{p}/cmdline").read_bytes()[:80] for p in left]
+            self.kill()
+            pytest.fail(f"processes left running after roslaunch exited: {names}")
+        return "".join(self.lines)
+
+
+@pytest.fixture
+def launcher() -> Iterator[Callable[..., Launch]]:
+    """Start launches; whatever a failing test leaves running is ended at teardown."""
+    started: list[Launch] = []
+
+    def start(ws: Path, launch: str, *args: str) -> Launch:
+        started.append(Launch(ws, launch, *args))
+        return started[-1]
+
+    yield start
+    for launch in started:
+        launch.watchdog.cancel()
+        launch.kill()
+        launch.proc.wait()
+
+
+def build_workspace(ws: Path, scenario: Path, pkg: str) -> Path:
+    """``scenario`` exported as package ``pkg`` in ``ws/src``, built with catkin; ``ws``
+    gets ``launch.sh`` (``bash launch.sh NAME.launch ARGS``, run by :class:`Launch`)."""
+    assert main(["export", "ros", str(scenario), "-o", str(ws / "src" / pkg)]) == 0
+    t0 = time.perf_counter()
+    build = subprocess.run(
+        # Debian's python3 for catkin's own scripts (a venv's lacks catkin_pkg)
+        ["catkin_make", "-C", str(ws), "-DPYTHON_EXECUTABLE=/usr/bin/python3"],
+        cwd=ws,
+        capture_output=True,
+        text=True,
+        env={**{k: v for k, v in os.environ.items() if k != "PYTHONPATH"}, "PWD": str(ws)},
+    )
+    assert build.returncode == 0, build.stdout[-3000:] + build.stderr[-3000:]
+    print(f"catkin_make: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+    (ws / "launch.sh").write_text(
+        "set -e\n"
+        "ip link set lo up\n"  # the namespace's loopback: the only interface ROS sees
+        f"export ROS_LOG_DIR={ws}/roshome/log ROS_MASTER_URI=http://localhost:11311\n"
+        "export ROS_HOSTNAME=localhost ROS_DISTRO=${ROS_DISTRO:-debian}\n"
+        f"source {ws}/devel/setup.bash\n"
+        f'exec roslaunch {pkg} "$@"\n'
+    )
+    return ws
