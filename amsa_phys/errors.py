@@ -6,6 +6,7 @@ line. Any other exception is a bug and keeps its traceback.
 
 from __future__ import annotations
 
+import re
 from fractions import Fraction
 from pathlib import Path
 
@@ -34,14 +35,73 @@ class ConfigError(AmsaError):
         self.file = str(file) if file is not None else None
         self.line = line
         self.key = key
+        #: which front end the message is worded for: "cli" (flags) or "api" (arguments)
+        self.front = "cli"
         super().__init__(str(self))
+
+    @property
+    def option(self) -> str | None:
+        """The command-line option the error is about (``--set``), if any.
+
+        Library code names an option the way the CLI spells it (``key="--set Comp.param"``,
+        ``key="--duration"``); the flag is the parameter, and :meth:`worded_for_api` words
+        it for the Python API instead.
+        """
+        if self.key and self.key.startswith("--"):
+            return self.key.partition(" ")[0]
+        return None
+
+    def worded_for_api(self) -> ConfigError:
+        """Word this error for ``amsa_phys.run``/``load`` (``set=``, ``duration=``); returns it.
+
+        The API's front door calls this on the way out, so a Python user reads the argument
+        they passed, not a flag they never typed; the CLI keeps the default wording.
+        """
+        self.front = "api"
+        self.args = (str(self),)
+        return self
 
     def __str__(self) -> str:
         where = ""
         if self.file is not None:
             where = self.file + (f":{self.line}" if self.line is not None else "") + ": "
-        key = f"{self.key}: " if self.key else ""
-        return one_line(f"{where}{key}{self.message}")
+        key, message = self.key, self.message
+        if self.front == "api":
+            key, message = _api_key(key), _API_FLAG.sub(lambda m: API_WORDS[m[0]], message)
+        key = f"{key}: " if key else ""
+        return one_line(f"{where}{key}{message}")
+
+
+#: a CLI option -> how the Python API (``amsa_phys.run``, ``load``, ``Run.save``) spells it:
+#: the one table both front ends' wording comes from
+API_WORDS = {
+    "--set": "set=",
+    "--duration": "duration=",
+    "--seed": "seed=",
+    "--log-rate": "log_rate=",
+    "--trace-columns": "trace_columns=",
+    "--no-adapt": "adapt=False",
+    "--bag": "bag=",
+    "--out": "out=",
+    "--force": "force=True",
+}
+_API_FLAG = re.compile(r"(?<![\w-])(" + "|".join(map(re.escape, API_WORDS)) + r")(?![\w-])")
+
+
+def _api_key(key: str | None) -> str | None:
+    """``--set Comp.param`` -> ``set={"Comp.param": ...}``, ``--duration`` -> ``duration=``."""
+    if not key or not key.startswith("--"):
+        return key
+    flag, _, rest = key.partition(" ")
+    word = API_WORDS.get(flag)
+    if word is None:  # an option the API does not have: as the CLI says it
+        return key
+    if not rest:
+        return word
+    if flag == "--set":
+        quoted = rest.replace("\\", "\\\\").replace('"', '\\"')
+        return f'{word}{{"{quoted}": ...}}'  # as the user wrote it: set={"Comp.param": value}
+    return f"{word} {rest}"
 
 
 def one_line(text: str) -> str:

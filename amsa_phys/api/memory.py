@@ -23,6 +23,7 @@ from collections.abc import Sequence
 from ..errors import ConfigError, one_line
 from ..model.scenario import Scenario, traced_columns
 from ..model.tracecols import LARGE_TRACE_BYTES, estimate_trace_bytes, size_text
+from .source import api_errors
 
 #: Bytes a traced value takes in memory (``engine/tracemem.py``: packed doubles).
 BYTES_IN_MEMORY = 8
@@ -40,6 +41,7 @@ def physical_memory_bytes() -> int | None:
         return None
 
 
+@api_errors
 def check_trace_memory(
     scenario: Scenario,
     columns: Sequence[str] | None = None,

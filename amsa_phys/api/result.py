@@ -28,7 +28,7 @@ from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import Ended, execute, write_run_files
 from ..runs.suite import input_files
 from .memory import check_trace_memory
-from .source import Source, load
+from .source import Source, api_errors, load
 
 
 class Run:
@@ -80,6 +80,7 @@ class Run:
         run never logged), each with ``why``."""
         return [c for c in self.checks if c.skipped]
 
+    @api_errors
     def save(
         self, out: str | os.PathLike[str] | None = None, *, force: bool = False, plot: bool = True
     ) -> Path:
@@ -110,6 +111,7 @@ class Run:
         )
 
 
+@api_errors
 def run(
     source: Source,
     *,

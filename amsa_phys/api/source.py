@@ -14,13 +14,14 @@ a value is judged the same way and an error is the same one-line message. Two ch
 
 from __future__ import annotations
 
+import functools
 import math
 import operator
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from fractions import Fraction
 from pathlib import Path
-from typing import Any
+from typing import Any, ParamSpec, TypeVar
 
 import yaml
 
@@ -35,6 +36,28 @@ MAPPING = "<mapping>"
 
 Source = str | os.PathLike[str] | Mapping[str, Any]
 
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
+
+
+def api_errors(func: Callable[_P, _R]) -> Callable[_P, _R]:
+    """``func`` with its ConfigErrors worded for Python: ``set={"Comp.param": ...}``,
+    ``duration=``, not the CLI's ``--set``/``--duration`` (``ConfigError.worded_for_api``).
+
+    The loader names an option as the CLI spells it; this is the API's front door saying
+    it the way a Python user passed it. Rewording twice (``run`` calls ``load``) is harmless.
+    """
+
+    @functools.wraps(func)
+    def worded(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+        try:
+            return func(*args, **kwargs)
+        except ConfigError as err:
+            err.worded_for_api()
+            raise
+
+    return worded
+
 
 class MappingDoc(YamlDoc):
     """A scenario given as a Python mapping: errors name ``<mapping>`` and the key path."""
@@ -44,6 +67,7 @@ class MappingDoc(YamlDoc):
         return ConfigError(message, file=MAPPING, key=dotted(keypath))
 
 
+@api_errors
 def load(
     source: Source,
     *,
@@ -96,6 +120,7 @@ def _load(
     raise TypeError(f"expected a scenario file path or a mapping, got {type(source).__name__}")
 
 
+@api_errors
 def validate(source: Source, *, base_dir: str | os.PathLike[str] | None = None) -> str:
     """Check a world or a scenario (file or mapping) as ``amsa-phys validate`` does.
 
@@ -148,7 +173,7 @@ def _set_items(overrides: Any) -> list[tuple[Any, Any]]:
     if not isinstance(overrides, Mapping):
         hint = ""
         if isinstance(overrides, (str, list, tuple)):
-            hint = ' (the --set texts "Comp.param=value" become {"Comp.param": value})'
+            hint = ' (the command line\'s "Comp.param=value" is {"Comp.param": value} here)'
         raise ConfigError(
             f'expected a mapping like {{"Comp.param": value}}, got {type(overrides).__name__} '
             f"{short_repr(overrides)}{hint}",
@@ -261,6 +286,7 @@ class _Plainer:
         )
 
     def error(self, keypath: KeyPath, message: str) -> ConfigError:
-        if self.option is not None:
-            return ConfigError(message, key=f"{self.option} {dotted(keypath)}")
+        if self.option is not None:  # the override's key, then where inside its value
+            inside = f"{dotted(keypath[1:])}: " if keypath[1:] else ""
+            return ConfigError(inside + message, key=f"{self.option} {keypath[0]}")
         return ConfigError(message, file=MAPPING, key=dotted(keypath))

@@ -141,19 +141,34 @@ def test_relative_world_of_a_mapping_resolves_against_the_cwd_by_default(
     )
 
 
+KVV = 'set={"MyFollowerController.Kvv": ...}'
 CLI_ERRORS = [
-    (["--set", "MyFollowerController.Kvv=0.2"], {"set": {"MyFollowerController.Kvv": 0.2}}),
-    (["--set", "MyFollowerController.Kv=-1"], {"set": {"MyFollowerController.Kv": -1}}),
-    (["--set", "Leader.behavior=flying"], {"set": {"Leader.behavior": "flying"}}),
-    (["--set", "LeaderGPS.lostDataGPS=true"], {"set": {"LeaderGPS.lostDataGPS": True}}),
-    (["--set", "Nobody.x=1"], {"set": {"Nobody.x": 1}}),
-    (["--duration", "-5"], {"duration": -5}),
-    (["--log-rate", "0"], {"log_rate": 0}),
+    (["--set", "MyFollowerController.Kvv=0.2"], {"set": {"MyFollowerController.Kvv": 0.2}}, KVV),
+    (
+        ["--set", "MyFollowerController.Kv=-1"],
+        {"set": {"MyFollowerController.Kv": -1}},
+        'set={"MyFollowerController.Kv": ...}',
+    ),
+    (
+        ["--set", "Leader.behavior=flying"],
+        {"set": {"Leader.behavior": "flying"}},
+        'set={"Leader.behavior": ...}',
+    ),
+    (
+        ["--set", "LeaderGPS.lostDataGPS=true"],
+        {"set": {"LeaderGPS.lostDataGPS": True}},
+        'set={"LeaderGPS.lostDataGPS": ...}',
+    ),
+    (["--set", "Nobody.x=1"], {"set": {"Nobody.x": 1}}, 'set={"Nobody.x": ...}'),
+    (["--duration", "-5"], {"duration": -5}, "duration="),
+    (["--log-rate", "0"], {"log_rate": 0}, "log_rate="),
+    (["--seed", "-1"], {"seed": -1}, "seed="),
+    (["--trace-columns", "Nobody.*"], {"trace_columns": "Nobody.*"}, "trace_columns="),
 ]
 
 
 @pytest.mark.parametrize(
-    ("argv", "kwargs"),
+    ("argv", "kwargs", "argument"),
     CLI_ERRORS,
     ids=[
         "unknown-param",
@@ -163,18 +178,31 @@ CLI_ERRORS = [
         "unknown-comp",
         "duration",
         "log-rate",
+        "seed",
+        "trace-columns",
     ],
 )
-def test_errors_are_the_cli_messages(
-    argv: list[str], kwargs: dict[str, object], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+def test_errors_are_the_cli_messages_naming_the_api_argument(
+    argv: list[str],
+    kwargs: dict[str, object],
+    argument: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
+    """The same message from both front ends, each naming what its user typed: the CLI its
+    flag (``--set Comp.param``), the API its argument (``set={"Comp.param": ...}``)."""
     code = main(["run", str(SCENARIO2), "--headless", "--out", str(tmp_path / "o"), *argv])
     cli = capsys.readouterr().err.strip()
     assert code == 2
     with pytest.raises(ap.ConfigError) as err:
         ap.run(SCENARIO2, **kwargs)  # type: ignore[arg-type]
-    assert f"error: {err.value}" == cli
+    api = str(err.value)
     assert err.value.exit_code == 2
+    flag = argv[0] + (" " + argv[1].partition("=")[0] if argv[0] == "--set" else "")
+    assert cli.startswith(f"error: {flag}: "), cli
+    reason = cli.removeprefix(f"error: {flag}: ")
+    assert api == f"{argument}: {reason}"
+    assert "--" not in api
 
 
 def test_a_bad_file_raises_the_cli_message(capsys: pytest.CaptureFixture[str]) -> None:
@@ -268,15 +296,19 @@ def test_save_follows_the_run_directory_rules(tmp_path: Path) -> None:
     (mine / "notes.txt").write_text("keep me")
     with pytest.raises(ap.ConfigError) as err:
         run.save(mine)
-    # a directory the user made: --force would not help, so the first message says so
+    # a directory the user made: force=True would not help, so the first message says so
+    # (in the API's words: save's arguments, not the CLI's --out and --force)
     assert str(err.value) == (
-        f"{mine}: --out: directory exists and was not made by amsa-phys (no .amsa-phys-run in "
-        "it); --force replaces only run directories: choose a new one"
+        f"{mine}: out=: directory exists and was not made by amsa-phys (no .amsa-phys-run in "
+        "it); force=True replaces only run directories: choose a new one"
     )
     with pytest.raises(ap.ConfigError, match="was not made by amsa-phys"):
         run.save(mine, force=True)
     ours = run.save(tmp_path / "ours", plot=False)
-    with pytest.raises(ap.ConfigError, match=r"is not empty \(use --force to replace it\)"):
+    with pytest.raises(
+        ap.ConfigError,
+        match=r"out=: directory exists and is not empty \(use force=True to replace it\)$",
+    ):
         run.save(ours)
     assert (mine / "notes.txt").read_text() == "keep me"
     out = run.save(tmp_path / "r", plot=False)

@@ -189,7 +189,7 @@ def test_renders_with_the_projects_renderer() -> None:
         ({"observation": "polar"}, "observation: unknown observation 'polar'"),
         (
             {"set": {"MyFollowerController.Kvv": 1}},
-            "--set MyFollowerController.Kvv: unknown parameter",
+            'set={"MyFollowerController.Kvv": ...}: unknown parameter',
         ),
     ],
     ids=["controller", "actions", "render-mode", "observation", "set"],

@@ -135,5 +135,5 @@ def test_a_pattern_in_the_wrong_case_is_named_with_what_it_would_match(
 
 
 def test_the_api_refuses_patterns_that_are_not_strings() -> None:
-    with pytest.raises(amsa_phys.ConfigError, match="--trace-columns: expected glob patterns"):
+    with pytest.raises(amsa_phys.ConfigError, match=r"^trace_columns=: expected glob patterns"):
         amsa_phys.run(SHORT, duration=1, trace_columns=5)  # type: ignore[arg-type]

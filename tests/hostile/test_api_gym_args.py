@@ -55,17 +55,17 @@ KV = "MyFollowerController.Kv"
 API_CASES: dict[str, tuple[Callable[[], Any], str]] = {
     "set-list": (
         lambda: ap.run(SCENARIO, set=[f"{KV}=0.2"]),
-        f"--set: expected a mapping like {{\"Comp.param\": value}}, got list ['{KV}=0.2'] "
-        '(the --set texts "Comp.param=value" become {"Comp.param": value})',
+        f"set=: expected a mapping like {{\"Comp.param\": value}}, got list ['{KV}=0.2'] "
+        '(the command line\'s "Comp.param=value" is {"Comp.param": value} here)',
     ),
     "set-string": (
         lambda: ap.run(SCENARIO, set=f"{KV}=0.2"),
-        f"--set: expected a mapping like {{\"Comp.param\": value}}, got str '{KV}=0.2' "
-        '(the --set texts "Comp.param=value" become {"Comp.param": value})',
+        f"set=: expected a mapping like {{\"Comp.param\": value}}, got str '{KV}=0.2' "
+        '(the command line\'s "Comp.param=value" is {"Comp.param": value} here)',
     ),
     "set-value-contains-itself": (
         lambda: ap.run(SCENARIO, set={KV: _cycle()["set"]}),
-        f"--set {KV}.Leader.behavior.set: contains itself (a mapping or list cannot)",
+        f'set={{"{KV}": ...}}: Leader.behavior.set: contains itself (a mapping or list cannot)',
     ),
     "mapping-contains-itself": (
         lambda: ap.run(_cycle()),
@@ -79,10 +79,10 @@ API_CASES: dict[str, tuple[Callable[[], Any], str]] = {
         lambda: ap.run({"world": "w.yaml", "duration": 5, "set": {"A.b": _shared()}}),
         "<mapping>: too large: more than 500,000 values",
     ),
-    "seed-2**64": (lambda: ap.run(SCENARIO, seed=2**64), "--seed: " + SEED_RANGE + str(2**64)),
+    "seed-2**64": (lambda: ap.run(SCENARIO, seed=2**64), "seed=: " + SEED_RANGE + str(2**64)),
     "duration-nan": (
         lambda: ap.run(SCENARIO, duration=math.nan),
-        "--duration: must be a positive finite number, got nan",
+        "duration=: must be a positive finite number, got nan",
     ),
 }
 
@@ -102,7 +102,7 @@ def test_api_base_dir_of_a_wrong_type_is_a_type_error() -> None:
 
 
 MEMORY = re.compile(
-    r"--duration: the trace kept in memory would be about 4160\.0 GB \(25 columns at 20 Hz "
+    r"duration=: the trace kept in memory would be about 4160\.0 GB \(25 columns at 20 Hz "
     r"for 1e\+09 s\), more than this machine's memory \(about [0-9.e+]+ GB\); shorten "
     r"duration=, lower log_rate= or narrow trace_columns=, or use `amsa-phys run`, which "
     r"streams the trace to a file"
@@ -200,8 +200,8 @@ ENV_CASES: dict[str, tuple[Callable[[], Any], str]] = {
     ),
     "set-list": (
         lambda: _env(set=["a=b"]),
-        "--set: expected a mapping like {\"Comp.param\": value}, got list ['a=b'] "
-        '(the --set texts "Comp.param=value" become {"Comp.param": value})',
+        "set=: expected a mapping like {\"Comp.param\": value}, got list ['a=b'] "
+        '(the command line\'s "Comp.param=value" is {"Comp.param": value} here)',
     ),
     "reset-seed-2**64": (lambda: _reset({}, seed=2**64), "seed: " + SEED_RANGE + str(2**64)),
     "reset-seed-2**63": (lambda: _reset({}, seed=2**63), "seed: " + SEED_RANGE + str(2**63)),
@@ -239,7 +239,7 @@ def test_env_largest_seed_and_picture_are_accepted() -> None:
 def test_env_keeping_a_trace_longer_than_memory_is_refused_at_reset() -> None:
     env = _env(duration=1e9, record_trace=True)
     try:
-        with pytest.raises(ConfigError, match=r"^--duration: the trace kept in memory would be"):
+        with pytest.raises(ConfigError, match=r"^duration=: the trace kept in memory would be"):
             env.reset(seed=1)
     finally:
         env.close()
