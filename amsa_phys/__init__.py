@@ -22,6 +22,7 @@ _LAZY = {
     "run": ".api.result",
     "Run": ".api.result",
     "TraceSizeWarning": ".api.memory",
+    "OverrideWarning": ".runs.overrides",
     "load": ".api.source",
     "validate": ".api.source",
     "AmsaError": ".errors",
@@ -43,6 +44,7 @@ __all__ = [  # noqa: RUF022  grouped as the README lists them
     "run",
     "Run",
     "TraceSizeWarning",
+    "OverrideWarning",
     "load",
     "validate",
     "AmsaError",
@@ -68,6 +70,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
     from .model.scenario import load_scenario
     from .model.template import Kind, Port, Template
     from .model.world import load_world
+    from .runs.overrides import OverrideWarning
     from .runs.single import run_scenario
 
 

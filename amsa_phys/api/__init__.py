@@ -5,8 +5,9 @@ exposes these names lazily, so ``import amsa_phys`` stays cheap). See the README
 "From Python".
 """
 
+from ..runs.overrides import OverrideWarning
 from .memory import TraceSizeWarning
 from .result import Run, run
 from .source import MAPPING, load, validate
 
-__all__ = ["MAPPING", "Run", "TraceSizeWarning", "load", "run", "validate"]
+__all__ = ["MAPPING", "OverrideWarning", "Run", "TraceSizeWarning", "load", "run", "validate"]

@@ -18,6 +18,8 @@ import functools
 import math
 import operator
 import os
+import sys
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from fractions import Fraction
 from pathlib import Path
@@ -30,6 +32,7 @@ from ..model.params import short_repr
 from ..model.scenario import Scenario, build_scenario, configure_scenario, load_scenario
 from ..model.world import build_world
 from ..model.yamlio import MAX_DEPTH, MAX_NODES, KeyPath, YamlDoc, dotted, load_yaml
+from ..runs.overrides import OverrideWarning, timeline_notes
 
 #: What errors in a scenario given as a mapping name instead of a file.
 MAPPING = "<mapping>"
@@ -109,15 +112,29 @@ def _load(
     rate = None if log_rate is None else _number(log_rate, "--log-rate")
     if isinstance(source, Mapping):
         doc = mapping_doc(source, base_dir)
-        return configure_scenario(doc, overrides, seed, dur, rate, trace_columns)
-    if isinstance(source, (str, os.PathLike)):
+        scenario = configure_scenario(doc, overrides, seed, dur, rate, trace_columns)
+    elif isinstance(source, (str, os.PathLike)):
         if base_dir is not None:
             raise TypeError(
                 "base_dir= is for a scenario given as a mapping; "
                 "a file's relative paths resolve against the file"
             )
-        return load_scenario(source, overrides, seed, dur, rate, trace_columns)
-    raise TypeError(f"expected a scenario file path or a mapping, got {type(source).__name__}")
+        scenario = load_scenario(source, overrides, seed, dur, rate, trace_columns)
+    else:
+        raise TypeError(f"expected a scenario file path or a mapping, got {type(source).__name__}")
+    for note in timeline_notes(scenario, overrides, "set="):  # as the CLI's warning: lines
+        warnings.warn(note, OverrideWarning, stacklevel=caller_level())
+    return scenario
+
+
+def caller_level() -> int:
+    """The ``stacklevel`` that points a warning at the user's line: the first frame outside
+    this package (``run`` -> ``load`` -> here, or a Gymnasium env's constructor)."""
+    package = str(Path(__file__).resolve().parent.parent)
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_code.co_filename.startswith(package):
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 @api_errors

@@ -12,6 +12,7 @@ from ..errors import ConfigError, one_line
 from ..model.scenario import Scenario, load_scenario, traced_columns
 from ..model.tracecols import LARGE_TRACE_BYTES, estimate_trace_bytes, size_text
 from ..runs.expect import check_expectations
+from ..runs.overrides import timeline_notes
 from ..runs.plotjob import PlotJob
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
@@ -81,6 +82,8 @@ def _run(
     )
     if args.no_adapt:
         scenario.adapt = []  # as if the file had no adapt: section
+    for note in timeline_notes(scenario, args.overrides, "--set"):  # as the sweep warns
+        print(one_line(f"warning: {note}"), file=sys.stderr)
     if snapshot is not None and snapshot.at is not None and snapshot.at > scenario.duration:
         raise ConfigError(
             f"{float(snapshot.at):g} s is after the run's end ({float(scenario.duration):g} s); "

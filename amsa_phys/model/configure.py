@@ -110,18 +110,40 @@ def with_overrides(scenario: Scenario, overrides: list[str], doc: YamlDoc | None
     rules are checked along the phases, naming an override as ``--set``."""
     world = scenario.world
     added = []
+    given: dict[str, tuple[str, Any]] = {}  # what each override set, to refuse a conflict
     for text in overrides:
         if text.strip().startswith(PHYSICS_PREFIX):
-            world = with_physics(world, parse_physics_override(text))
+            physics = parse_physics_override(text)
+            world = with_physics(world, physics)
+            _refuse_conflict(given, text.partition("=")[0].strip(), text, physics)
             continue
         change, world = parse_setting(text, world)
         if change is not None:  # None: a frequency, set on the world's Leaf
             added.append(change)
+            _refuse_conflict(given, change.key, text, change.value)
+        else:
+            key, _, raw = text.partition("=")
+            _refuse_conflict(given, key.strip(), text, raw.strip())
     in_file = len(scenario.timeline.initial)
     timeline = scenario.timeline.with_initial(added)
     out = dataclasses.replace(scenario, world=world, phases=list(timeline.phases))
     check_phases(out, doc, in_file)
     return out
+
+
+def _refuse_conflict(given: dict[str, tuple[str, Any]], key: str, text: str, value: Any) -> None:
+    """Refuse a second ``--set`` of ``key`` with another value, naming both.
+
+    A scenario file refuses a key given twice; ``--set X=1 --set X=2`` (or a parameter and
+    its alias) is the same slip on the command line, and taking the last silently hides
+    which value the run used. The same value twice is harmless and accepted.
+    """
+    first = given.setdefault(key, (text, value))
+    if first[1] != value or type(first[1]) is not type(value):
+        raise ConfigError(
+            f"set twice, {first[0].strip()!r} and {text.strip()!r}: give one value",
+            key=f"--set {key}",
+        )
 
 
 def positive_fraction(value: float, option: str) -> Fraction:

@@ -164,8 +164,8 @@ def test_an_input_error_has_no_debug_hint(capsys: pytest.CaptureFixture[str]) ->
 def test_describe_lists_a_set_key_once_with_the_value_in_force(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    argv = ["describe", str(SCENARIO1)]
-    argv += ["--set", "MyFollowerController.Kv=0.2", "--set", "MyFollowerController.Kv=0.3"]
+    argv = ["describe", str(SCENARIO1)]  # the file's set: gives Kv 0.35
+    argv += ["--set", "MyFollowerController.Kv=0.3"]
     assert main(argv) == 0
     phase0 = next(
         line for line in capsys.readouterr().out.splitlines() if line.startswith("phase 0 ")
