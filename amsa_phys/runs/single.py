@@ -28,6 +28,7 @@ from ..view.drive import FrameSink, advance
 from ..view.encoder import EncoderError
 from .expect import already_broken, describe_bound, describe_what, skip_reason
 from .plotjob import PlotJob, plot_context
+from .provenance import provenance
 from .resolve import resolved_scenario
 
 if TYPE_CHECKING:  # pygame is imported only by runs that draw
@@ -241,6 +242,7 @@ def execute(
     video = _finish_video(recorder, error)
     result = sim.result()
     metrics = compute_metrics(scenario, sim, result, wall, status, idle_s=idle)
+    metrics.update(provenance(sim))  # which code and which physics step made this run
     if video is not None:
         metrics["video"] = video
     if still is not None:
