@@ -10,6 +10,9 @@ import numpy as np
 
 from ..model.scenario import Expectation
 
+#: how a trace check that saw no logged sample begins its note
+NO_SAMPLE = "no sample"
+
 
 @dataclass
 class Check:
@@ -50,14 +53,19 @@ class Check:
     @property
     def verdict(self) -> str:
         """pass, FAIL, skipped, or "no sample" (a trace window the run never logged)."""
-        if self.value is None and self.note.startswith("checked no sample"):
+        if self.value is None and self.note.startswith(NO_SAMPLE):
             return "no sample" if self.skipped else "FAIL"
         return "skipped" if self.skipped else ("pass" if self.passed else "FAIL")
 
     def describe(self) -> str:
-        """``max_distance (phase 1) = 24.3, below 26: pass``."""
+        """``max_distance (phase 1) = 24.3, below 26: pass``.
+
+        A check that judged nothing leads with its verdict and says why once, as a skipped
+        metric does: ``Comp.out in [3, 4] s: skipped (no sample: the window starts after
+        the run's end at t=2 s)``.
+        """
         if self.value is None and self.note:
-            return f"{self.what}: {self.note}: {self.verdict}"
+            return f"{self.what}: {'skipped' if self.skipped else 'FAIL'} ({self.note})"
         if self.skipped:
             return f"{self.what}: skipped ({self.why})"
         note = f" ({self.note})" if self.note else ""
@@ -217,9 +225,9 @@ def _trace_check(
     values = data[mask, header.index(e.trace)]
     if values.size == 0:
         if e.after is not None and e.after > end:
-            note = f"checked no sample (the window starts after the run's end at t={end:g} s)"
+            note = f"{NO_SAMPLE}: the window starts after the run's end at t={end:g} s"
             return Check(e, None, True, skipped=True, note=note)
-        note = "checked no sample (no logged instant in the window: widen it or raise log_rate)"
+        note = f"{NO_SAMPLE}: no logged instant in the window; widen it or raise log_rate"
         return Check(e, None, False, note=note)
     past_end = e.before is None or e.before > end
     note = f"checked up to the run's end at t={end:g} s" if past_end and e.before else ""

@@ -337,13 +337,14 @@ def test_a_trace_window_that_checks_nothing_is_refused_or_said_so(
         "the window; held until then)" in lines
     )
     assert (
-        "expect Leader.posX in [3, 4] s: checked no sample (the window starts after the "
-        "run's end at t=2 s): no sample" in lines
+        "expect Leader.posX in [3, 4] s: skipped (no sample: the window starts after the "
+        "run's end at t=2 s)" in lines
     )
     assert (
-        "expect Leader.posX in [0.51, 0.52] s: checked no sample (no logged instant in the "
-        "window: widen it or raise log_rate): FAIL" in lines
+        "expect Leader.posX in [0.51, 0.52] s: FAIL (no sample: no logged instant in the "
+        "window; widen it or raise log_rate)" in lines
     )
+    assert all(line.count("sample") <= 1 for line in lines)  # said once, not "...: no sample"
 
 
 def test_an_error_about_a_file_never_shows_what_the_file_holds(

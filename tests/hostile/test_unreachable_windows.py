@@ -88,6 +88,6 @@ def test_cut_off_by_duration_only_is_skipped_as_before(
     argv = ["run", str(path), "--headless", "-q", "--no-plot", "--duration", "2"]
     assert main([*argv, "--out", str(tmp_path / "o")]) == 0
     assert capsys.readouterr().out.splitlines()[-1] == (
-        "expect Leader.posX in [1e+06, end] s: checked no sample "
-        "(the window starts after the run's end at t=2 s): no sample"
+        "expect Leader.posX in [1e+06, end] s: skipped "
+        "(no sample: the window starts after the run's end at t=2 s)"
     )
