@@ -62,7 +62,14 @@ def plot_facets(
     ``rows`` are every run (grid points without a value are drawn grey), ``ok`` the runs
     with a value of ``metric``; ``numeric_axes`` the axes whose values are all numbers.
     """
-    from .summary import NEVER_COLOUR, SCENARIO_KEY, left_out_text, nevers, text_colour_on
+    from .summary import (
+        NEVER_COLOUR,
+        SCENARIO_KEY,
+        left_out_text,
+        mark_nevers,
+        nevers,
+        text_colour_on,
+    )
 
     def count(axis: str) -> int:
         return len({r[axis] for r in rows})
@@ -173,19 +180,9 @@ def plot_facets(
             m = mean[have]
             err = [np.maximum(0.0, m - spread[i, 0][have]), np.maximum(0.0, spread[i, 1][have] - m)]
             ax.errorbar(pos, m, yerr=err, marker="o", ms=3, capsize=2)
-            for k, count in enumerate(never[i, 0]):
-                if count:  # runs that never reached the metric: said above their x
-                    ax.annotate(
-                        f"{count} never",
-                        (positions[k], 1.0),
-                        xycoords=("data", "axes fraction"),
-                        xytext=(0, -3),
-                        textcoords="offset points",
-                        ha="center",
-                        va="top",
-                        fontsize=6.5,
-                        color=NEVER_COLOUR,
-                    )
+            # runs that never reached the metric: marked above their x, inside the panel
+            marks = [(float(positions[k]), int(c)) for k, c in enumerate(never[i, 0]) if c]
+            mark_nevers(ax, marks, fontsize=6.5)
             ax.grid(alpha=0.3)
         if best is not None:
             p, _, k = (int(v) for v in best)

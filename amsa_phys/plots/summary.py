@@ -154,20 +154,12 @@ def plot_summary(
         for r in nevers(rows, metric):
             never_at[r[x_axis]] += 1
         labels = sorted({r[x_axis] for r in drawn}, key=str)
+        marks = []
         for x, count in sorted(never_at.items(), key=lambda kv: str(kv[0])):
             at = x if _numeric([x]) else (labels.index(x) if x in labels else None)
-            if at is not None:  # at the top edge of the plot, above its x
-                ax.annotate(
-                    f"{count} never",
-                    (at, 1.0),
-                    xycoords=("data", "axes fraction"),
-                    xytext=(0, -3),
-                    textcoords="offset points",
-                    ha="center",
-                    va="top",
-                    fontsize=7,
-                    color=NEVER_COLOUR,
-                )
+            if at is not None:
+                marks.append((float(at), count))
+        mark_nevers(ax, marks)
         if not _numeric([r[x_axis] for r in drawn]):
             ax.set_xticks(range(len(labels)), [str(v) for v in labels])
         ax.set_xlabel(x_axis)
@@ -196,6 +188,35 @@ def plot_summary(
 
 #: the colour "never" is written in (a dark red: the run did not reach the metric)
 NEVER_COLOUR = "#a01010"
+
+
+def mark_nevers(ax: plt.Axes, marks: list[tuple[float, int]], fontsize: float = 8) -> None:
+    """Runs that never reached the metric, drawn in the plot above their x: a hollow ▼ on
+    the top edge and ``N never`` under it, in :data:`NEVER_COLOUR`.
+
+    The marks are data on the x axis (a line in the axes' x transform), so autoscaling
+    widens the x range to hold them: a grid point where no run settled has no line point,
+    and its note (an annotation, which autoscaling ignores) fell outside the axes (hidden, and
+    ``tight_layout`` warned on the terminal that it could not fit the figure).
+    """
+    if not marks:
+        return
+    xs = [x for x, _ in marks]
+    edge = ax.get_xaxis_transform()  # x in data, y in axes fraction
+    ax.plot(xs, [0.985] * len(xs), transform=edge, ls="none", marker="v", ms=8, mfc="none")
+    ax.lines[-1].set(mec=NEVER_COLOUR, mew=1.6, clip_on=False, label="_never")
+    for x, count in marks:
+        ax.text(
+            x,
+            0.95,
+            f"{count} never",
+            transform=edge,
+            ha="center",
+            va="top",
+            fontsize=fontsize,
+            fontweight="bold",
+            color=NEVER_COLOUR,
+        )
 
 
 def nevers(rows: list[dict[str, Any]], metric: str) -> list[dict[str, Any]]:
