@@ -401,3 +401,63 @@ def test_replayed_ground_changes_when_the_live_one_did(tmp_path: Path) -> None:
         assert [(z.name, z.friction, z.rolling_resistance) for z in shown] == zones
     assert live[3] != live[8]  # the change happened
     assert replay.frame(0).zones[0].polygon == ((20, -5), (25, -5), (25, 5), (20, 5))
+
+
+def test_a_run_quit_from_a_real_window_says_in_its_plots_where_it_was_cut(
+    xdisplay: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``amsa-phys run`` in a window on Xvfb, q pressed by xdotool once the run has logged
+    a few instants: exit 0, ``metrics.json`` says it was closed in the window, both plots
+    are written, and their titles say where the 500 s scenario was cut (issue 30, 8)."""
+    from amsa_phys.plots import distance, trajectory
+
+    env = {k: v for k, v in os.environ.items() if k != "SDL_VIDEODRIVER"}
+    env["DISPLAY"] = xdisplay
+    script = Path(sys.executable).with_name("amsa-phys")
+    if not script.is_file():
+        pytest.skip("the amsa-phys console script is not installed next to this Python")
+    out = tmp_path / "run"
+    argv = [str(script), "run", str(SCENARIO), "--out", str(out), "-q"]
+    runner = subprocess.Popen(argv, env=env, stderr=subprocess.PIPE, text=True)
+    try:
+        window = _poll(
+            "the window", lambda: _x(xdisplay, "xdotool", "search", "--class", "amsa-phys") or None
+        ).splitlines()[0]
+
+        shots = [tmp_path / "a.png", tmp_path / "b.png"]
+
+        def moving() -> bool | None:  # two grabs differ: the clock and the rovers advance
+            for shot in shots:
+                _x(xdisplay, "import", "-window", window, str(shot))
+            if not all(shot.is_file() for shot in shots):
+                return None
+            a, b = (pygame.image.tobytes(pygame.image.load(str(s)), "RGB") for s in shots)
+            return True if a != b else None
+
+        _poll("the run to advance in its window", moving)
+        _x(xdisplay, "xdotool", "key", "--window", window, "q")
+        _err = runner.communicate(timeout=X_TIMEOUT_S)[1]
+    finally:
+        if runner.poll() is None:
+            runner.terminate()
+            runner.wait(timeout=30)
+    assert runner.returncode == 0, _err
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["status"].startswith("closed in the window at t=")
+    ran = metrics["simulated"]
+    assert 0 < ran < 500
+    assert (out / "distance.png").is_file()
+    assert (out / "trajectory.png").is_file()
+    titles: list[str] = []
+
+    def keep_title(fig: object, path: Path, **kw: object) -> Path:
+        titles.append(fig.axes[0].get_title())  # type: ignore[attr-defined]
+        return path
+
+    monkeypatch.setattr(distance, "save_png", keep_title)
+    monkeypatch.setattr(trajectory, "save_png", keep_title)
+    distance.plot_distance(out / "trace.csv", metrics, tmp_path / "d.png")
+    trajectory.plot_trajectory(out / "trace.csv", metrics, tmp_path / "t.png")
+    cut = f" — cut at {ran:g} s of 500 s (closed in the window)"
+    assert len(titles) == 2
+    assert all(title.endswith(cut) for title in titles), titles
