@@ -59,8 +59,9 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
             ``render_fps``); render_size: (width, height) in pixels.
         record_trace: keep the episode's trace in memory (:meth:`trace`), as ``run`` does.
 
-    Pickling (``EzPickle``) keeps the constructor's arguments, not the episode in progress:
-    an unpickled environment is a fresh one, to ``reset()`` before stepping.
+    Pickling (``EzPickle``) keeps the constructor's arguments and the registry's ``spec``,
+    not the episode in progress: an unpickled environment is a fresh one, to ``reset()``
+    before stepping.
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array", "human"], "render_fps": 4}  # noqa: RUF012
@@ -241,6 +242,18 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         if self._frames is not None and hasattr(self._frames, "close"):
             self._frames.close()
         self._frames = None
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The constructor's arguments (``EzPickle``) and the registry's ``spec``."""
+        return {**EzPickle.__getstate__(self), "spec": self.spec}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """A fresh env from the arguments, keeping ``spec``: ``gymnasium.make`` set it on
+        this instance, not in the arguments, and a worker's ``env.spec.id`` must still be
+        ``amsa_phys/Follow-v0`` (plain attribute pickling, as CartPole's, keeps it too)."""
+        spec = state.pop("spec", None)
+        EzPickle.__setstate__(self, state)
+        self.spec = spec
 
     def __del__(self) -> None:
         episode = getattr(self, "_episode", None)

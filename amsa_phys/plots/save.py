@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import warnings
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -27,7 +28,12 @@ def save_png(
     """
     if margins is None:
         if fig.get_layout_engine() is None:
-            fig.tight_layout()
+            # a label too wide to fit: matplotlib keeps its default layout and says "Tight
+            # layout not applied"; the picture is still written, and the terminal is for
+            # amsa-phys's own messages (issue 30, item 5: no library warning reaches it)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                fig.tight_layout()
     else:
         left, bottom, right, top = margins
         fig.subplots_adjust(left=left, bottom=bottom, right=right, top=top)

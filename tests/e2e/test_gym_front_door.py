@@ -60,10 +60,12 @@ def test_the_packaged_world_is_the_repositorys() -> None:
 def test_default_env_passes_check_env_without_any_warning() -> None:
     from gymnasium.utils.env_checker import check_env
 
-    env = gymnasium.make("amsa_phys/Follow-v0", duration=10)
     with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+        warnings.simplefilter("always")  # from make on: its passive checker warns too
+        env = gymnasium.make("amsa_phys/Follow-v0", duration=10)
         check_env(env.unwrapped)
+        env.reset(seed=1)
+        env.step(env.action_space.sample())  # through the wrappers make adds
     env.close()
     assert [str(w.message) for w in caught] == []
     box = env.observation_space
@@ -107,6 +109,19 @@ def test_pickled_env_is_a_fresh_env_with_the_same_arguments() -> None:
     np.testing.assert_array_equal(again, obs)
     step, *_ = clone.step(np.array([0.3, 0.2]))
     np.testing.assert_array_equal(step, first)
+    env.close()
+    clone.close()
+
+
+def test_an_env_from_make_pickles_with_its_wrappers() -> None:
+    """What vector envs and multiprocessing send to workers: ``gym.make``'s env, wrapped."""
+    env = gymnasium.make("amsa_phys/Follow-v0", duration=5)
+    obs, _ = env.reset(seed=3)
+    clone = pickle.loads(pickle.dumps(env))
+    again, _ = clone.reset(seed=3)
+    np.testing.assert_array_equal(again, obs)
+    assert clone.spec is not None
+    assert clone.spec.id == "amsa_phys/Follow-v0"
     env.close()
     clone.close()
 

@@ -102,3 +102,16 @@ def test_small_multiples_mark_never_settled_runs_inside_each_panel(
         assert shown >= 1  # every Kv = 0.35 run is said somewhere in the panels
     finally:
         plt.close(fig)
+
+
+def test_a_figure_too_wide_to_lay_out_is_saved_without_a_library_warning(tmp_path: Path) -> None:
+    from amsa_phys.plots.save import save_png
+
+    fig, ax = plt.subplots(figsize=(4, 3))
+    ax.plot([0, 1], [0, 1])
+    ax.set_ylabel("a label far too long to fit " * 40, rotation=0)  # tight_layout gives up
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        out = save_png(fig, tmp_path / "wide.png")
+    assert [str(w.message) for w in caught] == []
+    assert out.stat().st_size > 0

@@ -97,6 +97,15 @@ def test_an_installed_plugin_runs_by_its_short_name(installed_plugin: None, tmp_
     lines = (tmp_path / "r" / "trace.csv").read_text().splitlines()
     assert lines[0] == "t,C.count"
     assert float(lines[-1].split(",")[1]) == 15.0  # 5 steps (t = 0, 0.5, ..., 2) × gain 3
+    # the installed module named as module:Class works the same, still without PYTHONPATH
+    scenario.write_text(
+        scenario.read_text().replace("TinyCounter", "tiny_rovers_plugin:TinyCounter")
+    )
+    done = _cli(tmp_path, "run", str(scenario), "--headless", "--out", str(tmp_path / "m"), "-q")
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "m" / "trace.csv").read_bytes() == (
+        tmp_path / "r" / "trace.csv"
+    ).read_bytes()
 
 
 def test_templates_lists_where_each_template_comes_from(
