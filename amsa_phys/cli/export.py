@@ -5,10 +5,11 @@ from __future__ import annotations
 import argparse
 import errno
 import os
+import sys
 from fractions import Fraction
 from pathlib import Path
 
-from ..errors import ConfigError
+from ..errors import ConfigError, one_line
 from ..interop.exporter import export_world
 from ..model.scenario import (
     DEFAULT_LOG_RATE_HZ,
@@ -20,6 +21,7 @@ from ..model.scenario import (
 from ..model.template import Kind
 from ..model.world import load_world
 from ..model.yamlio import load_yaml
+from ..runs.overrides import timeline_notes
 from ..runs.rundir import commit_staged, discard_staged, staged_dir
 from ..runs.suite import input_files
 from .options import add_scenario_overrides
@@ -74,13 +76,16 @@ def _load(path: str, args: argparse.Namespace) -> Scenario:
     """A scenario file, or a bare world as a scenario with no timeline."""
     doc = load_yaml(path)
     if isinstance(doc.data, dict) and "world" in doc.data:
-        return load_scenario(
+        scenario = load_scenario(
             path,
             overrides=args.overrides,
             seed=args.seed,
             duration=args.duration,
             log_rate=args.log_rate,
         )
+        for note in timeline_notes(scenario, args.overrides, "--set"):  # as `run` warns
+            print(one_line(f"warning: {note}"), file=sys.stderr)
+        return scenario
     world = load_world(path)
     changes = []
     for text in args.overrides:

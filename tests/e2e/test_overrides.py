@@ -82,3 +82,10 @@ def test_a_parameter_and_its_alias_in_one_set_mapping_are_refused() -> None:
         'set={"LeaderGPS.stddev": ...}: set twice, '
         "'LeaderGPS.noise=1' and 'LeaderGPS.stddev=2': give one value"
     )
+
+
+def test_export_ros_warns_as_run_does(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The exported package runs the same timeline: the same note, before it is written."""
+    argv = ["export", "ros", str(SCENARIO2), "-o", str(tmp_path / "pkg"), "--set", f"{KV}=0.2"]
+    assert main(argv) == 0
+    assert capsys.readouterr().err.splitlines() == ["warning: " + LATER.format(option="--set")]
