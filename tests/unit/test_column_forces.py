@@ -19,7 +19,8 @@ import pytest
 from amsa_phys.physics import bodyio, compiled
 from amsa_phys.physics.bodyio import BodyIO
 from amsa_phys.physics.columns import _ColumnIO
-from amsa_phys.physics.forces import FewRovers, ground_list
+from amsa_phys.physics.fewrovers import FewRovers
+from amsa_phys.physics.forces import ground_list
 from amsa_phys.physics.step_path import PURE_ENV, extension
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))

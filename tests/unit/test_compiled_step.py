@@ -24,7 +24,8 @@ import yaml
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.physics import compiled, fleet
 from amsa_phys.physics.bodyio import BodyIO
-from amsa_phys.physics.forces import FewRovers, ground_list
+from amsa_phys.physics.fewrovers import FewRovers
+from amsa_phys.physics.forces import ground_list
 from amsa_phys.physics.space import PhysicsWorld
 from amsa_phys.physics.step_path import PURE_ENV, extension
 from amsa_phys.runs.single import run_scenario
