@@ -25,7 +25,8 @@ from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.physics import compiled
 from amsa_phys.physics.bodyio import BodyIO
-from amsa_phys.physics.forces import FewRovers, ground_list
+from amsa_phys.physics.fewrovers import FewRovers
+from amsa_phys.physics.forces import ground_list
 from amsa_phys.physics.reference import reference_forces
 from amsa_phys.physics.rover import DiffDriveRover
 from amsa_phys.physics.space import wheel_model

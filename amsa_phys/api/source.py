@@ -29,7 +29,13 @@ import yaml
 
 from ..errors import ConfigError
 from ..model.params import short_repr
-from ..model.scenario import Scenario, build_scenario, configure_scenario, load_scenario
+from ..model.scenario import (
+    Scenario,
+    build_scenario,
+    configure_scenario,
+    load_scenario,
+    without_adapt,
+)
 from ..model.world import build_world
 from ..model.yamlio import MAX_DEPTH, MAX_NODES, KeyPath, YamlDoc, dotted, load_yaml
 from ..runs.overrides import OverrideWarning, timeline_notes
@@ -91,9 +97,7 @@ def load(
     :class:`~amsa_phys.errors.ConfigError`.
     """
     scenario = _load(source, seed, duration, set, log_rate, trace_columns, base_dir)
-    if not adapt:
-        scenario.adapt = []  # as if the scenario had no adapt: section
-    return scenario
+    return scenario if adapt else without_adapt(scenario)
 
 
 def _load(

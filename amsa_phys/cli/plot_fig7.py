@@ -8,7 +8,7 @@ from pathlib import Path
 from ..engine import interrupt
 from ..engine.tracemem import TraceMemory
 from ..errors import ConfigError, one_line
-from ..model.scenario import Scenario, load_scenario, traced_columns
+from ..model.scenario import Scenario, load_scenario, traced_columns, without_adapt
 from ..runs.rundir import check_output
 from ..runs.single import execute
 
@@ -35,10 +35,10 @@ def plot_fig7(args: argparse.Namespace) -> int:
 
     def one(value: float | None) -> Fig7Run:
         s: Scenario = (
-            scenario if value is None else load_scenario(source, overrides=[f"{key}={value}"])
+            scenario
+            if value is None
+            else without_adapt(load_scenario(source, overrides=[f"{key}={value}"]))
         )
-        if value is not None:
-            s.adapt = []
         memory = TraceMemory(traced_columns(s))
         with interrupt.deferred():
             ended = execute(s, memory, progress=False)

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from ..engine import interrupt
 from ..errors import ConfigError, one_line
-from ..model.scenario import Scenario, load_scenario, traced_columns
+from ..model.scenario import Scenario, load_scenario, traced_columns, without_adapt
 from ..model.tracecols import LARGE_TRACE_BYTES, estimate_trace_bytes, size_text
 from ..runs.expect import check_expectations
 from ..runs.overrides import timeline_notes
@@ -81,7 +81,7 @@ def _run(
         trace_columns=args.trace_columns,
     )
     if args.no_adapt:
-        scenario.adapt = []  # as if the file had no adapt: section
+        scenario = without_adapt(scenario)
     for note in timeline_notes(scenario, args.overrides, "--set"):  # as the sweep warns
         print(one_line(f"warning: {note}"), file=sys.stderr)
     if snapshot is not None and snapshot.at is not None and snapshot.at > scenario.duration:

@@ -13,7 +13,6 @@ parameter changes and settings (``changes.py``), the phases and their flattening
 from __future__ import annotations
 
 from collections.abc import Sequence
-from fractions import Fraction
 from pathlib import Path
 
 from .changes import (
@@ -40,6 +39,7 @@ from .scenariospec import (
     Scenario,
     shortened,
     traced_columns,
+    without_adapt,
 )
 from .timeline import Phase, Step, Timeline
 from .world import WorldSpec
@@ -70,10 +70,10 @@ __all__ = [
     "resolve_change",
     "set_changes",
     "set_frequency",
-    "shorten",
     "shortened",
     "traced_columns",
     "with_physics",
+    "without_adapt",
     "written_values",
 ]
 
@@ -88,15 +88,6 @@ def load_scenario(
 ) -> Scenario:
     """Load a scenario; command-line overrides are judged like file values."""
     return configure_scenario(load_yaml(path), overrides, seed, duration, log_rate, trace_columns)
-
-
-def shorten(scenario: Scenario, duration: Fraction) -> None:
-    """:func:`shortened` in place, for callers that still hold one Scenario object (the ROS
-    simulator). New code uses :func:`shortened`; the phases are new objects either way."""
-    cut = shortened(scenario, duration)
-    scenario.duration = cut.duration
-    scenario.phases = cut.phases
-    scenario.planned_bounds = cut.planned_bounds
 
 
 def parse_override(text: str, world: WorldSpec) -> Change | None:

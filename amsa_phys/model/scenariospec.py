@@ -22,7 +22,7 @@ DEFAULT_LOG_RATE_HZ = 20
 DEFAULT_TOLERANCE = 1.5
 
 
-@dataclass
+@dataclass(frozen=True)
 class Quality:
     """The quality-of-control signal (a Data buffer) and its reference and tolerance."""
 
@@ -34,7 +34,7 @@ class Quality:
     dwell: float | None = None
 
 
-@dataclass
+@dataclass(frozen=True)
 class Expectation:
     """A bound on a run.
 
@@ -52,9 +52,17 @@ class Expectation:
     before: float | None = None
 
 
-@dataclass
+@dataclass(frozen=True)
 class Scenario:
-    """A loaded, checked scenario."""
+    """A loaded, checked scenario.
+
+    Frozen, its sequences tuples: a sweep caches one Scenario and shares it between its
+    runs, the ROS simulator and the window hold theirs for a whole session, so a change is
+    a new Scenario (``dataclasses.replace``; ``configure.py``'s ``with_*`` functions,
+    :func:`shortened`, :func:`without_adapt`), never an edit that another holder would see.
+    Lists given to the constructor are stored as tuples. ``data`` is the file's parsed
+    document, read (``sweep:``) but never written.
+    """
 
     path: Path
     name: str
@@ -63,18 +71,27 @@ class Scenario:
     seed: int
     log_rate: Fraction
     quality: Quality | None
-    phases: list[Phase]
-    expect: list[Expectation] = field(default_factory=list)
+    phases: tuple[Phase, ...]
+    expect: tuple[Expectation, ...] = ()
     data: dict[str, Any] = field(default_factory=dict)
     #: when ``--duration`` shortened the run: the file's phase starts followed by its
     #: duration. The phase the run stops in (and the run as a whole) is then cut short: its
     #: metrics are partial and its checks skipped, not judged as if it were complete.
-    planned_bounds: list[Fraction] | None = None
+    planned_bounds: tuple[Fraction, ...] | None = None
     #: ``trace_columns:`` glob patterns (None: trace every Data buffer); see
     #: :func:`traced_columns` for what is kept
-    trace_columns: list[str] | None = None
+    trace_columns: tuple[str, ...] | None = None
     #: ``adapt:`` reconfiguration rules (``model/adaptrules.py``); empty with ``--no-adapt``
-    adapt: list[Rule] = field(default_factory=list)
+    adapt: tuple[Rule, ...] = ()
+
+    def __post_init__(self) -> None:
+        # a list given by the builder or a caller becomes a tuple: nobody can append to the
+        # phases or the expectations of a Scenario someone else holds
+        # (a replace passes tuples already: only a list costs a copy, ~1 µs a sweep's job)
+        for name in ("phases", "expect", "adapt", "planned_bounds", "trace_columns"):
+            value = getattr(self, name)
+            if value is not None and type(value) is not tuple:
+                object.__setattr__(self, name, tuple(value))
 
     @property
     def timeline(self) -> Timeline:
@@ -104,8 +121,10 @@ def shortened(scenario: Scenario, duration: Fraction) -> Scenario:
     """
     cut = scenario.timeline.cut(duration)
     return dataclasses.replace(
-        scenario,
-        duration=cut.duration,
-        phases=list(cut.phases),
-        planned_bounds=None if cut.planned is None else list(cut.planned),
+        scenario, duration=cut.duration, phases=cut.phases, planned_bounds=cut.planned
     )
+
+
+def without_adapt(scenario: Scenario) -> Scenario:
+    """``scenario`` as if it had no ``adapt:`` section (``--no-adapt``, ``adapt=False``)."""
+    return dataclasses.replace(scenario, adapt=())

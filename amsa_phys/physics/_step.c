@@ -4,8 +4,8 @@
  * Why: in a headless run the Python force model, the body reads and writes and the step's
  * Python layer were two thirds of the loop; this file does the same work in one call.
  *
- * Same numbers, bit for bit: every expression below is forces.py's (FewRovers.apply and the
- * rare branches in wheel.py), written in the same order with C doubles. CPython's floats are
+ * Same numbers, bit for bit: every expression below is forces.py's (rover_step, which
+ * fewrovers.FewRovers.apply calls, and the rare branches in wheel.py), written in the same order with C doubles. CPython's floats are
  * C doubles and its math.sin/cos/sqrt are libm's, so with no reassociation and no FMA
  * contraction (built with -ffp-contract=off, no -ffast-math) each result is the same double.
  * Keep it that way: change forces.py and this file together (the tests compare the traces).

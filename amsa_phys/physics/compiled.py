@@ -1,6 +1,6 @@
 """The compiled physics step (``_step.c``), when it was built: the same step, ~2.5x cheaper.
 
-``FewRovers`` (forces.py) spends a headless run's step in Python: the wheel model, the body
+``FewRovers`` (fewrovers.py) spends a headless run's step in Python: the wheel model, the body
 reads and writes and pymunk's step wrapper. ``CompiledFewRovers`` and ``CompiledFleet`` keep
 those classes' Python API (state, rims, kinematics, refresh, set_ground, ...) and hand each
 step to one C call that does all of it, calling Chipmunk through function pointers taken from
@@ -24,8 +24,9 @@ from typing import Any
 import numpy as np
 
 from .bodyio import STATE, BodyIO, locked_step, substeps
+from .fewrovers import FewRovers
 from .fleet import _GROUND_ROWS, Fleet
-from .forces import FewRovers, Folded, fold
+from .forces import Folded, fold
 from .rover import DiffDriveRover
 from .step_path import describe, extension
 from .wheel import SLIP_SPEED_MIN, step_constants

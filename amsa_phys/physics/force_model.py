@@ -4,7 +4,7 @@ A physics world hands its rovers to a *force model*, which owns their wheel stat
 speeds), the ground terms under each wheel and the bodies' state read after each step, and
 advances them one physics step at a time. Five classes implement it:
 
-* ``forces.FewRovers``: plain floats, one rover after the other (the pure path);
+* ``fewrovers.FewRovers``: plain floats, one rover after the other (the pure path);
 * ``fleet.Fleet``: the same arithmetic over arrays of many rovers (40 and more, and a
   batch's columns without the extension);
 * ``compiled.CompiledFewRovers``, ``compiled.CompiledFleet``: the same APIs with the whole
@@ -30,7 +30,7 @@ import numpy as np
 
 from . import compiled, fleet
 from .bodyio import BodyIO
-from .forces import FewRovers
+from .fewrovers import FewRovers
 from .rover import DiffDriveRover
 
 

@@ -1,7 +1,7 @@
 """A differential-drive rover: one pymunk rigid body driven by two wheels with spinning rims.
 
 The wheels sit on the axle through the centre of mass at ±track/2 (body-frame y); a caster
-(not modelled: frictionless) carries the rest. Each step ``forces.py`` (or ``fleet.py``, for
+(not modelled: frictionless) carries the rest. Each step ``fewrovers.py`` (or ``fleet.py``, for
 many rovers) turns the body's velocity, the rims' spin and the commanded powers into the
 body's total force and torque and the rims' new spin; pymunk integrates the body and resolves
 collisions. Nothing teleports the body: sideways sliding is removed by a tyre force, not by

@@ -122,19 +122,6 @@ class SweepPlan:
         return out
 
 
-#: ``is_random`` of templates whose module another branch owns (physics/templates.py): a
-#: free robot draws from the seed only in behaviour 4 (random), a controlled robot never.
-_ROBOT_RANDOMNESS: dict[str, Any] = {
-    "freeRobot": lambda values: values["behavior"] == 4,
-    "controlledRobot": lambda values: False,
-}
-
-
-def _leaf_is_random(template: Any, values: dict[str, Any]) -> bool:
-    rule = _ROBOT_RANDOMNESS.get(template.name())
-    return bool(rule(values) if rule is not None else template.is_random(values))
-
-
 def deterministic_points(plan: SweepPlan, scenario: Scenario) -> list[tuple[tuple[str, Any], ...]]:
     """The grid points at which nothing random runs, so every seed gives the same run.
 
@@ -156,7 +143,7 @@ def deterministic_points(plan: SweepPlan, scenario: Scenario) -> list[tuple[tupl
         for phase_changes in [changes, *later]:
             for c in phase_changes:
                 values[c.leaf][c.param] = c.value
-            if any(_leaf_is_random(world.leaves[path].template, v) for path, v in values.items()):
+            if any(world.leaves[path].template.is_random(v) for path, v in values.items()):
                 random = True
                 break
         if not random:

@@ -15,13 +15,13 @@ import os
 import signal
 import subprocess
 import sys
-import time
 from collections import Counter, defaultdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from longrun import wait_until
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from rosbags.highlevel import AnyReader
@@ -272,12 +272,11 @@ def test_ctrl_c_leaves_a_finalised_bag(tmp_path: Path) -> None:
     proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
     try:
         tmp = bag.with_name(bag.name + ".tmp")
-        deadline = time.monotonic() + 60
-        # wait for the event: the first 1 MiB chunk reached the file
-        while time.monotonic() < deadline and proc.poll() is None:
-            if tmp.exists() and tmp.stat().st_size > 1024 * 1024:
-                break
-            time.sleep(0.05)
+        wait_until(  # the event, asserted: a run that exits or hangs first fails here
+            "the first 1 MiB chunk reached the bag",
+            lambda: tmp.exists() and tmp.stat().st_size > 1024 * 1024,
+            proc,
+        )
         proc.send_signal(signal.SIGINT)
         _, err = proc.communicate(timeout=60)
     finally:

@@ -78,8 +78,7 @@ def test_the_resonance_examples_worst_lies_inside_the_box() -> None:
 def test_the_grid_fixture_is_what_the_grid_gives(name: str) -> None:
     """Recompute the grid (fig5: 2,197 runs, minutes) and compare it with the fixture;
     after a change of the dynamics: ``python tests/falsify_grids.py`` regenerates it."""
-    sys.path.insert(0, str(ROOT / "tests"))
-    from falsify_grids import grid_worst
+    from falsify_grids import grid_worst  # tests/ is on pytest's pythonpath
 
     fresh = grid_worst(name, os.cpu_count() or 1)
     stored = GRIDS[name]["worst"]

@@ -8,6 +8,7 @@ tests/e2e/test_paper_figures.py's.
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +23,7 @@ SCENARIOS = Path(__file__).resolve().parent.parent.parent / "scenarios"
 
 def settled_metrics(name: str, kv: float) -> dict[str, Any]:
     sc = load_scenario(SCENARIOS / name, overrides=[f"MyFollowerController.Kv={kv}"], duration=200)
-    sc.phases = sc.phases[:1]
+    sc = dataclasses.replace(sc, phases=sc.phases[:1])
     r = Simulation.from_scenario(sc).run()
     return block_metrics(
         r.samples_t, r.samples_s, 100.0, 200.0, 15.0, 1.5, [e.t for e in r.events], include_end=True

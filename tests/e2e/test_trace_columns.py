@@ -120,7 +120,7 @@ def test_the_file_takes_the_options_comma_string_too(tmp_path: Path) -> None:
         f"world: {ROOT / 'worlds' / 'mde_challenge.yaml'}\nduration: 1\n"
         'trace_columns: "Leader.pos?, Follower.posX"\n'
     )
-    assert load_scenario(scen).trace_columns == ["Leader.pos?", "Follower.posX"]
+    assert load_scenario(scen).trace_columns == ("Leader.pos?", "Follower.posX")
 
 
 def test_a_pattern_in_the_wrong_case_is_named_with_what_it_would_match(

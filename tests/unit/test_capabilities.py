@@ -11,6 +11,7 @@ import toys
 
 from amsa_phys.model.scenario import Change, Phase, load_scenario
 from amsa_phys.model.world import with_leaf
+from amsa_phys.physics.templates import ControlledRobot, FreeRobot
 from amsa_phys.runs.batched import unbatchable
 
 SCENARIO = """
@@ -65,3 +66,16 @@ def test_shares_physics_and_params_at_start_are_read_from_the_template(tmp_path:
     why = unbatchable(_scenario(tmp_path, Fixed, change_later=True))
     assert why == "the timeline changes R.anything during the run"
     assert unbatchable(_scenario(tmp_path, Declared, change_later=True)) is None
+
+
+def test_the_robots_say_when_they_are_random() -> None:
+    """``sweep`` once named the robots to know this; they declare it now (``is_random``),
+    so a grid point with a random leader is not reported as giving every seed one run."""
+    assert [FreeRobot.is_random({"behavior": b}) for b in (1, 2, 3, 4, 5)] == [
+        False,
+        False,
+        False,
+        True,
+        False,
+    ]
+    assert not ControlledRobot.is_random({})

@@ -10,20 +10,16 @@ refused, not read out of bounds.
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
+from regimes import DT, every_regime
 
 from amsa_phys.physics import bodyio, compiled
 from amsa_phys.physics.bodyio import BodyIO
 from amsa_phys.physics.columns import _ColumnIO
-from amsa_phys.physics.forces import FewRovers, ground_list
+from amsa_phys.physics.fewrovers import FewRovers
+from amsa_phys.physics.forces import ground_list
 from amsa_phys.physics.step_path import PURE_ENV, extension
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_fast_paths import DT, every_regime
 
 built = pytest.mark.skipif(
     extension() is None, reason="the compiled step was not built (no C compiler at install)"

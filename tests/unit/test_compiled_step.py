@@ -20,17 +20,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from regimes import DT, every_regime
 
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.physics import compiled, fleet
 from amsa_phys.physics.bodyio import BodyIO
-from amsa_phys.physics.forces import FewRovers, ground_list
+from amsa_phys.physics.fewrovers import FewRovers
+from amsa_phys.physics.forces import ground_list
 from amsa_phys.physics.space import PhysicsWorld
 from amsa_phys.physics.step_path import PURE_ENV, extension
 from amsa_phys.runs.single import run_scenario
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_fast_paths import DT, every_regime
 
 ROOT = Path(__file__).resolve().parents[2]
 SHIPPED = sorted((ROOT / "scenarios").glob("*.yaml"))

@@ -23,7 +23,7 @@ def test_each_option_is_a_new_scenario_and_the_given_one_is_untouched() -> None:
     assert faster.log_rate == 40
     assert base.log_rate != 40
     traced = with_trace_columns(base, "Leader.*")
-    assert traced.trace_columns == ["Leader.*"]
+    assert traced.trace_columns == ("Leader.*",)
     assert base.trace_columns is None
     first = list(base.timeline.initial)
     more = with_overrides(base, ["MyFollowerController.Kv=0.2", "LeaderGPS.freq=8"], None)

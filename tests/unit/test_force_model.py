@@ -15,8 +15,9 @@ import pytest
 
 from amsa_phys.physics import compiled, fleet
 from amsa_phys.physics.bodyio import BodyIO
+from amsa_phys.physics.fewrovers import FewRovers
 from amsa_phys.physics.force_model import ForceModel, make_force_model
-from amsa_phys.physics.forces import FewRovers, ground_list
+from amsa_phys.physics.forces import ground_list
 from amsa_phys.physics.rover import DiffDriveRover
 from amsa_phys.physics.space import wheel_model
 from amsa_phys.physics.step_path import PURE_ENV, extension

@@ -13,6 +13,8 @@ from amsa_phys.model.changes import set_frequency
 from amsa_phys.model.metrics import METRICS, block_metrics
 from amsa_phys.model.scenario import load_scenario, shortened
 from amsa_phys.model.world import load_world
+from amsa_phys.runs import sweep
+from amsa_phys.runs.resolve import resolved_scenario
 from amsa_phys.runs.sweep import Job, apply_setting, prepare_job
 
 ROOT = Path(__file__).resolve().parent.parent.parent
@@ -71,6 +73,41 @@ def test_two_jobs_of_one_cached_scenario_do_not_see_each_others_values() -> None
     assert [c.value for c in a.timeline.initial if c.param == "Kv"] == [0.35, 0.1]
     assert [c.value for c in b.timeline.initial if c.param == "Kv"] == [0.35, 0.3]
     assert (a.seed, b.seed) == (1, 2)
+
+
+def test_a_scenario_is_frozen_down_to_its_sequences() -> None:
+    scenario = load_scenario(SCEN)
+    for name, value in (("seed", 3), ("duration", Fraction(1)), ("phases", ())):
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            setattr(scenario, name, value)
+    with pytest.raises(AttributeError):  # a tuple: nobody appends to a shared one
+        scenario.phases.append(scenario.phases[0])  # type: ignore[attr-defined]
+    with pytest.raises(AttributeError):
+        scenario.expect.append(None)  # type: ignore[attr-defined]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        scenario.quality.reference = 1.0  # type: ignore[union-attr,misc]
+    # a list given to the constructor (the builder's, a user's replace) is stored as a tuple
+    again = dataclasses.replace(scenario, phases=list(scenario.phases), trace_columns=["*"])
+    assert isinstance(again.phases, tuple)
+    assert again.trace_columns == ("*",)
+
+
+def test_runs_of_a_sweep_leave_its_cached_scenario_as_loaded() -> None:
+    def job(i: int, point: tuple[tuple[str, object], ...]) -> Job:
+        return Job(i, str(SCEN), point, 0, i + 1, (), 3.0)
+
+    shared = sweep._shortened(str(SCEN), 3.0)  # what every job of this process starts from
+    before = resolved_scenario(shared)
+    phases = shared.phases
+    rows = [
+        sweep.run_job(job(0, (("MyFollowerController.Kv", 0.1),))),
+        sweep.run_job(job(1, (("MyFollowerController.Kv", 0.3), ("physics.gravity", 3.0)))),
+    ]
+    assert [r["error"] for r in rows] == ["", ""]
+    assert sweep._shortened(str(SCEN), 3.0) is shared  # the cache was used, not reloaded
+    assert resolved_scenario(shared) == before  # world, parameters, timeline, expectations
+    assert shared.phases is phases
+    assert shared.seed == load_scenario(SCEN).seed
 
 
 def test_every_metric_name_is_computed_and_no_other() -> None:

@@ -16,7 +16,7 @@ from fractions import Fraction
 from typing import Any
 
 from ...errors import ConfigError
-from ...model.scenario import Change, Scenario, shorten
+from ...model.scenario import Change, Scenario, shortened
 from . import rosio
 
 
@@ -32,12 +32,12 @@ def start_values(scenario: Scenario) -> dict[tuple[str, str], Any]:
     return values
 
 
-def fold_server_values(rospy: Any, scenario: Scenario) -> list[Change]:
+def fold_server_values(rospy: Any, scenario: Scenario) -> tuple[Scenario, list[Change]]:
     """Make the parameter server's values at the start the scenario's phase-0 values.
 
     Each value is judged as a file value is (type, range, rules between parameters). Returns
-    the changes made (none when nobody edited anything: the run is then the file's, byte for
-    byte).
+    the scenario to run (a new one: Scenario is frozen) and the changes made (none when
+    nobody edited anything: the run is then the file's, byte for byte).
     """
     start = start_values(scenario)
     changes = list(scenario.phases[0].changes)
@@ -50,11 +50,10 @@ def fold_server_values(rospy: Any, scenario: Scenario) -> list[Change]:
             change = Change(path, name, value)
             changes = [c for c in changes if c.key != change.key] + [change]
             folded.append(change)
-    if folded:  # phases are frozen: phase 0 is a new one
-        phases = list(scenario.phases)
-        phases[0] = replace(phases[0], changes=changes)
-        scenario.phases = type(scenario.phases)(phases)
-    return folded
+    if not folded:
+        return scenario, folded
+    phase0 = replace(scenario.phases[0], changes=changes)  # phases are frozen: a new one
+    return replace(scenario, phases=(phase0, *scenario.phases[1:])), folded
 
 
 def _same(a: Any, b: Any) -> bool:
@@ -63,8 +62,8 @@ def _same(a: Any, b: Any) -> bool:
     return type(a) is type(b) and a == b
 
 
-def cut(scenario: Scenario, text: str) -> None:
-    """``duration:=S``: what ``amsa-phys run --duration S`` does (``model.scenario.shorten``):
+def cut(scenario: Scenario, text: str) -> Scenario:
+    """``duration:=S``: what ``amsa-phys run --duration S`` does (``model.scenario.shortened``):
     the run stops at S, later changes drop out, the phase it stops in is partial."""
     try:
         seconds = float(text)
@@ -72,4 +71,4 @@ def cut(scenario: Scenario, text: str) -> None:
         raise ConfigError(f"expected seconds, got {text!r}", key="duration:=") from None
     if not seconds > 0 or math.isinf(seconds):
         raise ConfigError(f"must be a positive finite number, got {text}", key="duration:=")
-    shorten(scenario, Fraction(str(seconds)))
+    return shortened(scenario, Fraction(str(seconds)))

@@ -422,12 +422,12 @@ def main() -> None:
     code = 0
     try:
         cfg = load_config(rospy)
-        scenario = cfg.scenario
-        for change in records.fold_server_values(rospy, scenario):
+        scenario, folded = records.fold_server_values(rospy, cfg.scenario)
+        for change in folded:
             print(f"amsa_simulator: {change.key}={change.value} (parameter server)", flush=True)
         duration = str(rospy.get_param("~duration", "") or "")
         if duration:
-            records.cut(scenario, duration)
+            scenario = records.cut(scenario, duration)
         out = str(rospy.get_param("~out", "") or "")
         root = Path(str(rospy.get_param("~runs", "") or os.environ.get("PWD", "."))) / "runs"
         out_dir = Path(out) if out else default_run_dir(scenario.name, root)

@@ -1,0 +1,212 @@
+"""``freeRobot``: the rover that drives itself (the Leader) by one of five behaviours.
+
+Kind *environment*: it reads no Data; the paper's "the leader may have different behaviors"
+are its ``behavior`` parameter (straight, circle, speed changes, random, waypoints). Its body,
+parameters and pose are the robots' common base (``robots.Robot``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from ..model.params import Param
+from ..model.template import Kind
+from .robots import POSE_OUTPUTS, ControlledRobot, Robot
+from .rover import wrap_angle
+from .roverparams import ROVER_PARAMS
+from .wheel import scrub_moment
+
+BEHAVIORS = {"straight": 1, "circle": 2, "speedChanges": 3, "random": 4, "waypoints": 5}
+
+
+class FreeRobot(Robot):
+    """The free rover (the Leader): a physical rover driven by its own behaviour.
+
+    Behaviours: 1 straight at ``cruisePower``; 2 a circle of ``circleRadius``; 3 straight with
+    the power cycling through 100 %, 50 %, 150 %, 100 % of ``cruisePower`` every
+    ``changePeriod`` s; 4 a random trajectory: every ``changePeriod`` s a new heading (within
+    ±``randomTurn`` of the current one) and speed (50–120 % of cruise) drawn from the seed;
+    5 ``waypoints`` in order, then stop. Headings are held by a proportional steering law
+    (``steerGain`` % of differential power per radian, forward power times cos(error)). The
+    circle's wheel powers come from the rover's own wheel model, so the radius is as asked.
+    """
+
+    template_name = "freeRobot"
+    kind = Kind.ENVIRONMENT
+    outputs = POSE_OUTPUTS
+    params = (
+        Param(
+            "behavior",
+            "enum",
+            "trajectory: 1 straight, 2 circle, 3 straight with speed "
+            "changes, 4 random, 5 waypoints",
+            1,
+            choices=(1, 2, 3, 4, 5),
+            aliases=BEHAVIORS,
+        ),
+        Param("cruisePower", "float", "wheel power when cruising", 22.0, -100.0, 100.0, "%"),
+        Param(
+            "circleRadius",
+            "float",
+            "radius of behaviour 2 (positive: counter-clockwise)",
+            20.0,
+            -1e4,
+            1e4,
+            "m",
+        ),
+        Param(
+            "changePeriod",
+            "float",
+            "seconds between changes (behaviours 3 and 4)",
+            30.0,
+            0.5,
+            1e5,
+            "s",
+        ),
+        Param(
+            "randomTurn", "float", "largest heading change of behaviour 4", 1.2, 0.0, math.pi, "rad"
+        ),
+        Param(
+            "steerGain",
+            "float",
+            "differential power per radian of heading error",
+            40.0,
+            0.0,
+            1000.0,
+            "%/rad",
+        ),
+        Param("waypoints", "points", "[[x, y], ...] for behaviour 5", ()),
+        Param(
+            "waypointRadius",
+            "float",
+            "distance at which a waypoint counts as reached",
+            1.0,
+            0.01,
+            1e4,
+            "m",
+        ),
+        *ROVER_PARAMS,
+    )
+
+    @classmethod
+    def is_random(cls, values: Mapping[str, Any]) -> bool:
+        """Only behaviour 4 (random) draws from the seed (``sweep`` asks, for its grid)."""
+        return values.get("behavior") == BEHAVIORS["random"]
+
+    @classmethod
+    def check_params(cls, values: Mapping[str, Any]) -> None:
+        """Refuse behaviour 5 without a waypoint: the leader would stand still all run,
+        which looks like a physics bug rather than the missing list it is."""
+        if values.get("behavior") == BEHAVIORS["waypoints"] and not values.get("waypoints"):
+            raise ValueError("behavior 5 (waypoints) needs at least one point in waypoints")
+        super().check_params(values)
+
+    def initialize(self, ctx: Any) -> None:
+        self.check_params(self.p.as_dict())
+        super().initialize(ctx)
+        self.rng = ctx.rng
+        self.target_heading = self.p.heading
+        self.speed_factor = 1.0
+        self.next_change = Fraction(0)
+        self.waypoint = 0
+
+    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+        """The paper's doStep: choose wheel powers by the behaviour, publish the pose."""
+        left, right = self._behaviour(t)
+        self.rover.set_power(left, right)
+        return self._pose()
+
+    @classmethod
+    def step_many(
+        cls,
+        comps: Sequence[FreeRobot],
+        t: Fraction,
+        inp: Mapping[str, Any],
+        p: Any,
+        state: dict[str, Any],
+    ) -> tuple[Mapping[str, Any], None]:
+        """``do_step`` for many copies at once (a batched sweep's leaders): each copy's
+        behaviour as alone, the powers and poses as arrays (``ControlledRobot.step_many``)."""
+        straight = p.behavior == 1  # behaviour 1 is the cruise power on both wheels
+        if straight.all():
+            left = right = p.cruisePower
+        else:
+            powers = np.array(
+                [
+                    (cp, cp) if s else c._behaviour(t)
+                    for c, s, cp in zip(
+                        comps, straight.tolist(), p.cruisePower.tolist(), strict=True
+                    )
+                ],
+                dtype=np.float64,
+            )
+            left, right = powers[:, 0], powers[:, 1]
+        return ControlledRobot.step_many(
+            comps,  # type: ignore[arg-type]
+            t,
+            {"powerL": left, "powerR": right},
+            p,
+            state,
+        )
+
+    def _behaviour(self, t: Fraction) -> tuple[float, float]:
+        p = self.p
+        cruise = p.cruisePower
+        b = p.behavior
+        if b == 2:
+            # wheel speeds v (1 -+ h / r) for the cruise speed v, each converted back to the
+            # power that holds it (so rolling resistance does not shrink the circle)
+            return self._circle(cruise, p.circleRadius or 1e9)
+        if b == 1:
+            return cruise, cruise
+        if t >= self.next_change:
+            self.next_change = t + Fraction(str(p.changePeriod))
+            if b == 3:
+                cycle = (1.0, 0.5, 1.5, 1.0)
+                self.speed_factor = cycle[int(t / Fraction(str(p.changePeriod))) % 4]
+            elif b == 4:
+                self.target_heading = self.rover.kinematics()[2] + self.rng.uniform(
+                    -p.randomTurn, p.randomTurn
+                )
+                self.speed_factor = float(self.rng.uniform(0.5, 1.2))
+        if b == 3:
+            return cruise * self.speed_factor, cruise * self.speed_factor
+        if b == 5:
+            return self._waypoints(cruise)
+        return self._steer(cruise * self.speed_factor, self.target_heading)
+
+    def _circle(self, cruise: float, radius: float) -> tuple[float, float]:
+        """Wheel powers for a circle of ``radius`` at the cruise speed, from the rover's own
+        wheel model: hub speeds ``v (1 -+ h / r)``, each wheel also pushing against the
+        tyres' scrub moment (so neither rolling resistance nor scrub widens the circle)."""
+        wheel = self.rover.wheel
+        terrain = self.physics.terrain
+        crr, mu = terrain.rolling_resistance, terrain.friction
+        h = self.rover.half_track
+        v = wheel.steady_speed(cruise, crr)
+        v_l, v_r = v * (1 - h / radius), v * (1 + h / radius)
+        push = scrub_moment(v / radius, v_l, v_r, wheel, mu, mu) / (2 * h)
+        return wheel.power_for_speed(v_l, crr, push), wheel.power_for_speed(v_r, crr, -push)
+
+    def _steer(self, power: float, heading: float) -> tuple[float, float]:
+        """Hold ``heading``: forward power falls with cos(error), so a large error turns the
+        rover nearly in place instead of orbiting its target."""
+        err = wrap_angle(heading - self.rover.kinematics()[2])
+        diff = self.p.steerGain * err
+        forward = power * max(0.0, math.cos(err))
+        return forward - diff, forward + diff
+
+    def _waypoints(self, cruise: float) -> tuple[float, float]:
+        points = self.p.waypoints
+        x, y = self.rover.kinematics()[:2]
+        while self.waypoint < len(points):
+            wx, wy = points[self.waypoint]
+            if math.hypot(wx - x, wy - y) > self.p.waypointRadius:
+                return self._steer(cruise, math.atan2(wy - y, wx - x))
+            self.waypoint += 1
+        return 0.0, 0.0

@@ -1,0 +1,129 @@
+"""The robot templates' common base and ``controlledRobot``, the rover driven by Data.
+
+``controlledRobot`` (the Follower, kind *process*) takes its wheel powers from Data and
+publishes its true pose; :class:`Robot` is what it shares with ``freeRobot``
+(``freerobot.py``): the rover in the run's pymunk world, the parameters that may change mid-run
+and the pose outputs. The physics advances between steps at ``physics.rate``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+from ..model.template import Kind, Port, Template
+from .rover import DiffDriveRover, wrap_angle
+from .roverparams import BODY_PARAMS, ROVER_PARAMS, WHEEL_PARAMS, check_geometry
+from .space import physics_of
+
+#: What both robots publish each step: the true pose, speeds and the rims' speeds.
+POSE_OUTPUTS = (
+    Port("posX", 0.0, "true x position", "m"),
+    Port("posY", 0.0, "true y position", "m"),
+    Port("heading", 0.0, "true heading in [-pi, pi)", "rad"),
+    Port("speed", 0.0, "signed speed along the heading", "m/s"),
+    Port("yawRate", 0.0, "angular velocity", "rad/s"),
+    Port(
+        "wheelSpeedL",
+        0.0,
+        "left wheel rim speed omega*r (what an encoder measures: includes tyre slip)",
+        "m/s",
+    ),
+    Port(
+        "wheelSpeedR",
+        0.0,
+        "right wheel rim speed omega*r (what an encoder measures: includes tyre slip)",
+        "m/s",
+    ),
+)
+
+
+class Robot(Template):
+    """What both robot templates share: a rover in the run's physics world, its parameters
+    (:data:`roverparams.ROVER_PARAMS`) and its true pose as outputs."""
+
+    rover: DiffDriveRover
+    fixed_once_running = frozenset(BODY_PARAMS)
+    #: a rover's outputs are its body's: deterministic (``freeRobot`` draws in behaviour 4)
+    uses_random = False
+    #: a batch builds each run's rover from its parameters at t = 0 (the timeline may not
+    #: change them during a batched run)
+    batch_params_at_start = True
+
+    @classmethod
+    def check_params(cls, values: Mapping[str, Any]) -> None:
+        """Refuse a geometry statics cannot stand on (``check_geometry``)."""
+        check_geometry(values)
+
+    def initialize(self, ctx: Any) -> None:
+        self.physics = physics_of(ctx)
+        self.rover = self.physics.add_rover(self.path, self.p)
+
+    def on_param_change(self, name: str, value: Any) -> None:
+        if name in WHEEL_PARAMS:
+            self.physics.update_wheel(self.rover, self.p)
+        elif name in BODY_PARAMS:
+            raise ValueError(f"{name} is fixed once the run has started")
+
+    def _pose(self) -> dict[str, float]:
+        x, y, a, vx, vy, w = self.rover.kinematics()
+        left, right = self.rover.wheel_speeds()
+        return {
+            "posX": x,
+            "posY": y,
+            "heading": wrap_angle(a),
+            "speed": vx * math.cos(a) + vy * math.sin(a),
+            "yawRate": w,
+            "wheelSpeedL": left,
+            "wheelSpeedR": right,
+        }
+
+
+class ControlledRobot(Robot):
+    """The controlled rover (the Follower): wheel powers in %, true pose out."""
+
+    template_name = "controlledRobot"
+    kind = Kind.PROCESS
+    inputs = (
+        Port("powerL", 0.0, "left wheel power", "%"),
+        Port("powerR", 0.0, "right wheel power", "%"),
+    )
+    outputs = POSE_OUTPUTS
+    params = ROVER_PARAMS
+
+    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+        """The paper's doStep: apply the commanded powers, publish the pose."""
+        self.rover.set_power(inp["powerL"], inp["powerR"])
+        return self._pose()
+
+    @classmethod
+    def step_many(
+        cls,
+        comps: Sequence[ControlledRobot],
+        t: Fraction,
+        inp: Mapping[str, Any],
+        p: Any,
+        state: dict[str, Any],
+    ) -> tuple[Mapping[str, Any], None]:
+        """``do_step`` for many copies at once (``engine/batch.py``)."""
+        physics = comps[0].physics
+        if "index" not in state:
+            state["index"] = physics.index_of([c.rover for c in comps])
+        if "rovers" not in state:
+            state["rovers"] = [c.rover for c in comps]
+        physics.set_powers(state["rovers"], state["index"], inp["powerL"], inp["powerR"])
+        x, y, a, vx, vy, w = physics.kinematics_array(state["index"]).T
+        left, right = physics.rim_array(state["index"]).T
+        return {
+            "posX": x,
+            "posY": y,
+            "heading": (a + math.pi) % (2 * math.pi) - math.pi,
+            "speed": vx * np.cos(a) + vy * np.sin(a),
+            "yawRate": w,
+            "wheelSpeedL": left,
+            "wheelSpeedR": right,
+        }, None
