@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -110,18 +111,35 @@ def process(reps: int) -> None:
 
 
 def _child_cpu(argv: list[str]) -> float:
-    """CPU seconds (user + system) of one process and everything it forked."""
-    before = os.times()
+    """CPU seconds (user + system) of one process and everything it forked.
+
+    From ``getrusage`` (microseconds), not ``os.times`` (clock ticks: 10 ms, half of a
+    ``python -c pass``, so the ratios moved by 0.5x with the rounding alone).
+    """
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     subprocess.run(argv, check=False, capture_output=True)
-    after = os.times()
-    return (after.children_user - before.children_user) + (
-        after.children_system - before.children_system
-    )
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def _compile_package() -> None:
+    """Byte-compile the package, as installing a wheel does: an editable install in an
+    environment with PYTHONDONTWRITEBYTECODE=1 otherwise compiles every module from source
+    in every measured process (+90 ms a run: the 19-22x measured before issue 29's work)."""
+    import compileall
+
+    compileall.compile_dir(str(ROOT / "amsa_phys"), quiet=1)
 
 
 def startup(reps: int) -> None:
-    """Whole-process CPU of ``run --headless`` over that of ``python -c pass``, interleaved."""
-    bare, no_plot, with_plot = [], [], []
+    """Whole-process CPU of ``run --headless`` over that of ``python -c pass``, interleaved.
+
+    Also the plot child's share (with plots - without) against its floor: importing
+    numpy, ``matplotlib.figure`` and the Agg canvas in a bare process, less numpy alone.
+    """
+    _compile_package()
+    bare, no_plot, with_plot, mpl, np_only = [], [], [], [], []
+    mpl_code = "import numpy, matplotlib.figure, matplotlib.backends.backend_agg"
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(reps):
             argv = [sys.executable, "-m", "amsa_phys", "run", str(SCENARIO1), "--headless"]
@@ -129,6 +147,8 @@ def startup(reps: int) -> None:
             bare.append(_child_cpu([sys.executable, "-c", "pass"]))
             no_plot.append(_child_cpu([*argv, "--no-plot", "--out", f"{tmp}/n{i}"]))
             with_plot.append(_child_cpu([*argv, "--out", f"{tmp}/p{i}"]))
+            np_only.append(_child_cpu([sys.executable, "-c", "import numpy"]))
+            mpl.append(_child_cpu([sys.executable, "-c", mpl_code]))
     r_no = [n / b for n, b in zip(no_plot, bare, strict=True)]
     r_with = [w / b for w, b in zip(with_plot, bare, strict=True)]
     report(
@@ -142,6 +162,14 @@ def startup(reps: int) -> None:
         f"{med(r_with)}; {statistics.median(with_plot):.3f} s",
         "<= 40",
         statistics.median(r_with) <= 40,
+    )
+    child = statistics.median(with_plot) - statistics.median(no_plot)
+    floor = statistics.median(mpl) - statistics.median(np_only)
+    print(
+        f"info  plot child {child:.3f} s CPU (with plots - without); its floor, importing "
+        f"matplotlib.figure + Agg beside numpy: {floor:.3f} s; python -c pass "
+        f"{statistics.median(bare):.3f} s",
+        flush=True,
     )
 
 
