@@ -131,7 +131,9 @@ def _child(jobs: Connection, parent_end: Connection, parent_pid: int) -> None:
     parent_end.close()  # so that the parent's exit is an end of file here
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with contextlib.suppress(Exception):  # on failure the parent draws (and reports)
-        import matplotlib.pyplot  # noqa: F401  the import this process exists for
+        # the import this process exists for: matplotlib's Figure and Agg canvas, never
+        # pyplot (its backend machinery is another ~20 ms the two plots do not use)
+        from matplotlib.backends import backend_agg  # noqa: F401
 
         from ..plots import distance, trajectory  # noqa: F401
     try:

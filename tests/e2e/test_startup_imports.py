@@ -72,3 +72,23 @@ def test_the_command_line_keeps_blas_to_one_thread_unless_told(tmp_path: Path) -
 
     assert said({}) == "1"
     assert said({"OPENBLAS_NUM_THREADS": "2"}) == "2"  # the user's choice stands
+
+
+def test_a_runs_plots_are_drawn_without_pyplot(tmp_path: Path) -> None:
+    # the plot child imports matplotlib's Figure and Agg canvas only: pyplot's backend
+    # machinery is start-up the two default plots do not use
+    out = tmp_path / "r"
+    argv = [sys.executable, "-m", "amsa_phys", "run", str(SCENARIO), "--headless", "-q"]
+    subprocess.run([*argv, "--no-plot", "--out", str(out), "--duration", "5"], check=True)
+    code = (
+        "import json, sys\n"
+        "from pathlib import Path\n"
+        "from amsa_phys.runs.plotjob import draw_run_plots\n"
+        f"out = Path({str(out)!r})\n"
+        "metrics = json.loads((out / 'metrics.json').read_text())\n"
+        "made = draw_run_plots(out / 'trace.csv', metrics, out / 'd.png', out / 't.png')\n"
+        "print(len(made), 'matplotlib.pyplot' in sys.modules)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.stdout.split() == ["2", "False"], done.stderr
+    assert (out / "d.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
