@@ -35,6 +35,7 @@ import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("MPLBACKEND", "Agg")
@@ -179,10 +180,10 @@ def gym_env(reps: int) -> None:
 
     from amsa_phys.gym import FollowEnv
 
-    rates = []
+    rates, floor = [], []
     env = FollowEnv(str(SCENARIO1), duration=300)
     action = np.array([0.5, 0.5])
-    for i in range(reps):
+    for i in range(reps):  # interleaved with its floor, so machine load hits both alike
         env.reset(seed=i)
         steps, truncated = 0, False
         t0 = time.process_time()
@@ -190,8 +191,15 @@ def gym_env(reps: int) -> None:
             *_, truncated, _ = env.step(action)
             steps += 1
         rates.append(steps / (time.process_time() - t0))
+        floor.append(_gym_floor(env))
     env.close()
     report("gym env steps/s (CPU)", med(rates), ">= 20000", statistics.median(rates) >= 20000)
+    share = [r / f for r, f in zip(rates, floor, strict=True)]
+    print(
+        f"info  its floor, the engine alone with a constant component in the agent's place: "
+        f"{med(floor)} env-steps/s; env / floor {med(share)}",
+        flush=True,
+    )
     from amsa_phys.gym.vector import FollowVecEnv
 
     for n in (100, 1000):
@@ -207,6 +215,26 @@ def gym_env(reps: int) -> None:
             vec.close()
         ok = statistics.median(vec_rates) >= 50000
         report(f"vector env, {n} envs: env-steps/s", med(vec_rates), ">= 50000", ok)
+
+
+def _gym_floor(env: Any) -> float:
+    """Env-steps a second of the env's scenario run by the engine alone, the agent's
+    component replaced by one that publishes a constant action (no agent, no exchange):
+    the rate no single env over this engine can beat."""
+    import dataclasses
+
+    from amsa_phys.gym.episode import stand_in
+
+    scenario = env._scenario
+    leaf = scenario.world.leaves[env.path]
+    out = dict.fromkeys(env.acted, 50.0)
+    const = dataclasses.replace(leaf, template=stand_in(leaf.template, lambda t, inp: out))
+    world = dataclasses.replace(scenario.world, leaves={**scenario.world.leaves, env.path: const})
+    sim = Simulation.from_scenario(dataclasses.replace(scenario, world=world))
+    sim.initialize()
+    t0 = time.process_time()
+    sim.run()
+    return float(scenario.duration) / env.period / (time.process_time() - t0)
 
 
 # -- platoon scaling --------------------------------------------------------------------------
