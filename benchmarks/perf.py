@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -34,6 +35,7 @@ import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("MPLBACKEND", "Agg")
@@ -110,18 +112,35 @@ def process(reps: int) -> None:
 
 
 def _child_cpu(argv: list[str]) -> float:
-    """CPU seconds (user + system) of one process and everything it forked."""
-    before = os.times()
+    """CPU seconds (user + system) of one process and everything it forked.
+
+    From ``getrusage`` (microseconds), not ``os.times`` (clock ticks: 10 ms, half of a
+    ``python -c pass``, so the ratios moved by 0.5x with the rounding alone).
+    """
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     subprocess.run(argv, check=False, capture_output=True)
-    after = os.times()
-    return (after.children_user - before.children_user) + (
-        after.children_system - before.children_system
-    )
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def _compile_package() -> None:
+    """Byte-compile the package, as installing a wheel does: an editable install in an
+    environment with PYTHONDONTWRITEBYTECODE=1 otherwise compiles every module from source
+    in every measured process (+90 ms a run: the 19-22x measured before issue 29's work)."""
+    import compileall
+
+    compileall.compile_dir(str(ROOT / "amsa_phys"), quiet=1)
 
 
 def startup(reps: int) -> None:
-    """Whole-process CPU of ``run --headless`` over that of ``python -c pass``, interleaved."""
-    bare, no_plot, with_plot = [], [], []
+    """Whole-process CPU of ``run --headless`` over that of ``python -c pass``, interleaved.
+
+    Also the plot child's share (with plots - without) against its floor: importing
+    numpy, ``matplotlib.figure`` and the Agg canvas in a bare process, less numpy alone.
+    """
+    _compile_package()
+    bare, no_plot, with_plot, mpl, np_only = [], [], [], [], []
+    mpl_code = "import numpy, matplotlib.figure, matplotlib.backends.backend_agg"
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(reps):
             argv = [sys.executable, "-m", "amsa_phys", "run", str(SCENARIO1), "--headless"]
@@ -129,6 +148,8 @@ def startup(reps: int) -> None:
             bare.append(_child_cpu([sys.executable, "-c", "pass"]))
             no_plot.append(_child_cpu([*argv, "--no-plot", "--out", f"{tmp}/n{i}"]))
             with_plot.append(_child_cpu([*argv, "--out", f"{tmp}/p{i}"]))
+            np_only.append(_child_cpu([sys.executable, "-c", "import numpy"]))
+            mpl.append(_child_cpu([sys.executable, "-c", mpl_code]))
     r_no = [n / b for n, b in zip(no_plot, bare, strict=True)]
     r_with = [w / b for w, b in zip(with_plot, bare, strict=True)]
     report(
@@ -143,6 +164,14 @@ def startup(reps: int) -> None:
         "<= 40",
         statistics.median(r_with) <= 40,
     )
+    child = statistics.median(with_plot) - statistics.median(no_plot)
+    floor = statistics.median(mpl) - statistics.median(np_only)
+    print(
+        f"info  plot child {child:.3f} s CPU (with plots - without); its floor, importing "
+        f"matplotlib.figure + Agg beside numpy: {floor:.3f} s; python -c pass "
+        f"{statistics.median(bare):.3f} s",
+        flush=True,
+    )
 
 
 def gym_env(reps: int) -> None:
@@ -151,10 +180,10 @@ def gym_env(reps: int) -> None:
 
     from amsa_phys.gym import FollowEnv
 
-    rates = []
+    rates, floor = [], []
     env = FollowEnv(str(SCENARIO1), duration=300)
     action = np.array([0.5, 0.5])
-    for i in range(reps):
+    for i in range(reps):  # interleaved with its floor, so machine load hits both alike
         env.reset(seed=i)
         steps, truncated = 0, False
         t0 = time.process_time()
@@ -162,8 +191,15 @@ def gym_env(reps: int) -> None:
             *_, truncated, _ = env.step(action)
             steps += 1
         rates.append(steps / (time.process_time() - t0))
+        floor.append(_gym_floor(env))
     env.close()
     report("gym env steps/s (CPU)", med(rates), ">= 20000", statistics.median(rates) >= 20000)
+    share = [r / f for r, f in zip(rates, floor, strict=True)]
+    print(
+        f"info  its floor, the engine alone with a constant component in the agent's place: "
+        f"{med(floor)} env-steps/s; env / floor {med(share)}",
+        flush=True,
+    )
     from amsa_phys.gym.vector import FollowVecEnv
 
     for n in (100, 1000):
@@ -179,6 +215,26 @@ def gym_env(reps: int) -> None:
             vec.close()
         ok = statistics.median(vec_rates) >= 50000
         report(f"vector env, {n} envs: env-steps/s", med(vec_rates), ">= 50000", ok)
+
+
+def _gym_floor(env: Any) -> float:
+    """Env-steps a second of the env's scenario run by the engine alone, the agent's
+    component replaced by one that publishes a constant action (no agent, no exchange):
+    the rate no single env over this engine can beat."""
+    import dataclasses
+
+    from amsa_phys.gym.episode import stand_in
+
+    scenario = env._scenario
+    leaf = scenario.world.leaves[env.path]
+    out = dict.fromkeys(env.acted, 50.0)
+    const = dataclasses.replace(leaf, template=stand_in(leaf.template, lambda t, inp: out))
+    world = dataclasses.replace(scenario.world, leaves={**scenario.world.leaves, env.path: const})
+    sim = Simulation.from_scenario(dataclasses.replace(scenario, world=world))
+    sim.initialize()
+    t0 = time.process_time()
+    sim.run()
+    return float(scenario.duration) / env.period / (time.process_time() - t0)
 
 
 # -- platoon scaling --------------------------------------------------------------------------

@@ -8,8 +8,6 @@ import sys
 from fractions import Fraction
 from pathlib import Path
 
-from tqdm import tqdm
-
 from ..engine import interrupt
 from ..errors import ConfigError, Interrupted, one_line
 from ..falsify.objective import Objective, build_objective
@@ -21,6 +19,7 @@ from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.suite import input_files
 from ..runs.sweep import MAX_RUNS, timeline_overlaps, unknown_metric
 from .options import add_jobs
+from .progress import bar as progress_bar
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -104,10 +103,12 @@ def run(args: argparse.Namespace) -> int:
     progress = Progress()
     interrupted = False
 
+    bar = progress_bar(args.budget, "run")
+
     def said(generation: int) -> None:  # a line per generation, above the progress bar
         k = progress.worst()
         worst = describe_value(progress.verdicts[k].value) if k is not None else "none"
-        tqdm.write(
+        type(bar).write(
             f"generation {generation} done: {len(progress.rows)} runs, worst "
             f"{objective.label} {worst}",
             file=sys.stderr,
@@ -118,7 +119,7 @@ def run(args: argparse.Namespace) -> int:
         with (
             interrupt.sigterm_as_ctrl_c(),
             interrupt.deferred(),
-            tqdm(total=args.budget, unit="run", disable=not sys.stderr.isatty()) as bar,
+            bar,
         ):
             for _ in search(space, objective, settings, progress):
                 bar.update(1)

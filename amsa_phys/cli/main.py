@@ -21,6 +21,13 @@ from typing import Any, Literal, NoReturn
 from .. import __version__
 from ..errors import AmsaError, one_line
 
+# One BLAS thread unless the user chose otherwise, set before any command imports numpy.
+# numpy's OpenBLAS starts a thread per core at import, and they spin for a while: ~45 ms
+# CPU of an ``amsa-phys run`` (a sixth of it), for no use, since nothing in a run is a
+# large matrix product. Sweep and plot workers inherit it: N processes never contend with
+# N more BLAS threads each.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 #: command -> (its module in this package, its one-line help: the module docstring's first
 #: line, which a test keeps equal). Modules are imported only for the command that runs:
 #: ``amsa-phys --help`` must not pay for numpy, jsonschema, pymunk or matplotlib.

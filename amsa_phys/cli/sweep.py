@@ -11,8 +11,6 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from tqdm import tqdm
-
 from ..atomic import write_atomic
 from ..engine import interrupt
 from ..errors import ConfigError, Interrupted, one_line
@@ -36,6 +34,7 @@ from ..runs.sweep import (
     unknown_metric,
 )
 from .options import add_jobs
+from .progress import bar as progress_bar
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -190,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
         with (
             interrupt.sigterm_as_ctrl_c(),
             interrupt.deferred(),
-            tqdm(total=len(jobs), unit="run", disable=not sys.stderr.isatty()) as bar,
+            progress_bar(len(jobs), "run") as bar,
         ):
             for row in source:
                 rows.append(row)

@@ -9,10 +9,12 @@ registers them too, and ``gymnasium.make("amsa_phys.gym:amsa_phys/Follow-v0")`` 
 from __future__ import annotations
 
 try:
+    import greenlet  # noqa: F401  the episode's coroutine (gym/episode.py)
     import gymnasium
 except ImportError as exc:  # pragma: no cover - exercised only without the extra
     raise ImportError(
-        f"amsa_phys.gym needs gymnasium ({exc}); install it with: pip install 'amsa-phys[gym]'"
+        f"amsa_phys.gym needs gymnasium and greenlet ({exc}); install them with: "
+        "pip install 'amsa-phys[gym]'"
     ) from None
 
 from ..gymreg import ENVIRONMENTS, register

@@ -1,14 +1,19 @@
-"""One episode: the scenario runs in a worker thread that pauses where the agent steps.
+"""One episode: the scenario runs in a greenlet that pauses where the agent steps.
 
-Why a thread: the agent *replaces* a component, so it must act exactly where that component
-would — in the middle of an instant, after the components ordered before it have run and
-before those after it (which may read its outputs in the same instant). The engine calls a
-component (``do_step``) from deep inside its loop; Gymnasium's agent calls ``step`` from the
-outside. A thread lets the engine call out and *wait*: the stand-in component
-(:func:`stand_in`) hands its inputs to the agent and blocks until the agent's outputs come
-back. Nothing else runs meanwhile (the two threads strictly alternate through two queues), so
-the run is exactly the run the replaced component would have had, instant for instant and
-bit for bit, and as deterministic.
+Why a coroutine: the agent *replaces* a component, so it must act exactly where that
+component would — in the middle of an instant, after the components ordered before it have
+run and before those after it (which may read its outputs in the same instant). The engine
+calls a component (``do_step``) from deep inside its loop; Gymnasium's agent calls ``step``
+from the outside. The run therefore lives on a stack of its own that can be suspended: the
+stand-in component (:func:`stand_in`) hands its inputs to the agent and is resumed with the
+agent's outputs. Nothing else runs meanwhile, so the run is exactly the run the replaced
+component would have had, instant for instant and bit for bit, and as deterministic.
+
+That stack was a worker thread with two queues until issue 29: each env-step then paid two
+thread hand-offs (a futex wake-up and a GIL transfer each, ~11 us CPU per round trip and
+more on a busy machine), a sixth of the step. A greenlet (the package made for exactly this:
+gevent and SQLAlchemy's asyncio bridge switch stacks with it) switches in ~1 us, in the
+same thread, so the episode belongs to the thread that reset it.
 
 At the final instant (``t`` = the duration) the episode is over: the stand-in publishes
 nothing there (its outputs keep the last action) and the agent gets the final observation.
@@ -16,24 +21,26 @@ nothing there (its outputs keep the last action) and the agent gets the final ob
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
-import queue
-import threading
+import sys
 from collections.abc import Callable, Mapping
 from fractions import Fraction
 from typing import Any
+
+import greenlet
 
 from ..engine.runner import Simulation
 from ..model.scenario import Scenario
 from ..model.template import Template
 
-#: How long ``close`` waits for the worker to leave (it is a daemon thread either way).
+#: How long the vector env's ``close`` waits for its worker thread to leave (``vecepisode.py``)
 JOIN_TIMEOUT_S = 10.0
 
 
 class _Stop(BaseException):
-    """Ends the worker from inside the stand-in's step (not an Exception: the engine must
-    not turn it into a RunFault)."""
+    """Ends the run from inside the stand-in's step (not an Exception: the engine must not
+    turn it into a RunFault)."""
 
 
 _STOP = object()
@@ -66,6 +73,7 @@ class Episode:
     After construction (and after each :meth:`step`) the run is paused at the agent's next
     instant: :attr:`t` is its time and :attr:`inputs` what the component reads there; or
     the run has ended (:attr:`done`). A fault in the run is raised by the call that meets it.
+    The episode belongs to the thread that made it: a greenlet switches only within one.
     """
 
     def __init__(
@@ -83,55 +91,58 @@ class Episode:
         self.t = Fraction(0)
         self.inputs: dict[str, float] = {}
         self.done = False
-        self._to_sim: queue.SimpleQueue[Any] = queue.SimpleQueue()
-        self._to_agent: queue.SimpleQueue[tuple[str, Any, Any]] = queue.SimpleQueue()
-        self._thread = threading.Thread(target=self._main, name=f"amsa-phys {path}", daemon=True)
-        self._thread.start()
-        self._wait()
+        self._agent = greenlet.getcurrent()
+        self._run = greenlet.greenlet(self._main, parent=self._agent)
+        self._answer(self._run.switch())
 
-    # -- the worker thread ----------------------------------------------------------------
-    def _main(self) -> None:
+    # -- the run's greenlet ---------------------------------------------------------------
+    def _main(self) -> tuple[str, Any, Any]:
         try:
             self.sim.run()
         except _Stop:
-            return
-        except BaseException as exc:  # handed to the agent's thread, raised there
-            self._to_agent.put(("error", exc, None))
-            return
-        self._to_agent.put(("done", None, None))
+            return ("stopped", None, None)
+        return ("done", None, None)  # an exception goes to the parent: raised by switch()
 
     def _exchange(self, t: Fraction, inp: Mapping[str, float]) -> Mapping[str, float]:
         if t >= self.end:
             return {}  # the episode ended: publish nothing, keep the last action
-        self._to_agent.put(("ask", t, dict(inp)))
-        answer = self._to_sim.get()
+        answer = self._agent.switch(("ask", t, inp))
         if answer is _STOP:
             raise _Stop
         return answer  # type: ignore[no-any-return]
 
-    # -- the agent's thread ---------------------------------------------------------------
-    def _wait(self) -> None:
-        kind, a, b = self._to_agent.get()
+    # -- the agent's side -----------------------------------------------------------------
+    def _answer(self, message: tuple[str, Any, Any]) -> None:
+        kind, a, b = message
         if kind == "ask":
             self.t, self.inputs = a, b
-        elif kind == "done":
-            self.done = True
-            self.t = self.end
         else:
             self.done = True
-            raise a
+            self.t = self.end
 
     def step(self, outputs: Mapping[str, float]) -> None:
         """Publish ``outputs`` as the component's, run to the agent's next instant (or end)."""
         if self.done:
             raise RuntimeError("the episode has ended")
-        self._to_sim.put(dict(outputs))
-        self._wait()
+        try:
+            message = self._run.switch(outputs)
+        except greenlet.error as exc:  # greenlets switch only within their thread
+            raise RuntimeError(
+                f"step() must be called from the thread that called reset() ({exc})"
+            ) from None
+        except BaseException:  # the run's fault (or Ctrl-C inside it) ends the episode
+            self.done = True
+            raise
+        self._answer(message)
 
     def close(self) -> None:
-        """Stop the worker (it leaves at the instant it is paused at)."""
-        if self._thread.is_alive():
-            if not self.done:
-                self._to_sim.put(_STOP)
-            self._thread.join(JOIN_TIMEOUT_S)
+        """Stop the run (it leaves at the instant it is paused at); safe to call twice.
+
+        From another thread, or while the interpreter shuts down, the paused run cannot be
+        resumed to leave: it is dropped as it is (greenlet unwinds it when it is collected)."""
+        run = self._run
         self.done = True
+        if run.dead or greenlet.getcurrent() is not self._agent or sys.is_finalizing():
+            return
+        with contextlib.suppress(_Stop, greenlet.error):
+            run.switch(_STOP)

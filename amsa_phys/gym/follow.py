@@ -125,6 +125,10 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
                 key="scenario",
             )
         self.quality = self._scenario.quality
+        #: the reward's terms, looked up once (step reads them every period)
+        self._signal = self.quality.signal
+        self._reference = self.quality.reference
+        self._tolerance = self.quality.tolerance
         self.path = controller if controller is not None else _default_controller(self._scenario)
         if self.path not in world.leaves:
             raise ConfigError(
@@ -153,6 +157,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         self.observer = Observer(ports, observation)
         self.observation_space = spaces.Box(self.observer.low, self.observer.high, dtype=np.float64)
         self.action_space = spaces.Box(-1.0, 1.0, (len(self.acted),), np.float64)
+        self._action_shape = (len(self.acted),)
         self.render_mode = render_mode
         self.render_size = size
         self.record_trace = record_trace
@@ -203,30 +208,44 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         return self._observation(), info
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        """Publish ``action * action_scale`` as the component's outputs; run one period."""
+        """Publish ``action * action_scale`` as the component's outputs; run one period.
+
+        The per-step path is lean on purpose (issue 29: it was a third of an env-step): the
+        usual action (a float64 array of the right shape) skips the conversion, the quality
+        signal is read once for the reward and the info, and the observation is built from
+        the inputs the episode already holds.
+        """
         episode = self._episode
         if episode is None or episode.done:
             raise gymnasium.error.ResetNeeded("call reset() before step(): the episode has ended")
-        a = np.asarray(action, dtype=np.float64).reshape(-1)
-        if a.shape != (len(self.acted),):
+        if type(action) is np.ndarray and action.dtype == np.float64 and action.ndim == 1:
+            a = action
+        else:
+            a = np.asarray(action, dtype=np.float64).reshape(-1)
+        if a.shape != self._action_shape:
             raise ValueError(f"expected an action of shape ({len(self.acted)},), got {a.shape}")
         scale = self.action_scale
-        episode.step({name: float(v) * scale for name, v in zip(self.acted, a, strict=True)})
+        episode.step({name: v * scale for name, v in zip(self.acted, a.tolist(), strict=True)})
         if self._frames is not None:
             self._frames.sample()
             if self.render_mode == "human":
                 self._frames.show([f"agent: {self.path}"])
-        events = episode.sim.events
-        new = sum(1 for e in events[self._seen_events :] if e.kind == "collision")
-        self._seen_events = len(events)
-        self._collisions += new
-        signal = episode.sim.read(self.quality.signal)
-        reward = -abs(signal - self.quality.reference) / self.quality.tolerance
+        sim = episode.sim
+        new = 0
+        if len(sim.events) > self._seen_events:
+            events = sim.events
+            new = sum(1 for e in events[self._seen_events :] if e.kind == "collision")
+            self._seen_events = len(events)
+            self._collisions += new
+        signal = sim.read(self._signal)
+        reward = -abs(signal - self._reference) / self._tolerance
         reward -= self.collision_penalty * new
         reward += 0.0  # -0.0 (no error at all) reads as 0.0
-        if episode.done and self._memory is not None:
+        done = episode.done
+        if done and self._memory is not None:
             self._memory.close()
-        return self._observation(), float(reward), False, episode.done, self._info()
+        info = {"t": float(episode.t), "signal": float(signal), "collisions": self._collisions}
+        return self._observation(), float(reward), False, done, info
 
     def render(self) -> np.ndarray | None:  # type: ignore[override]
         """The current picture (``render_mode="rgb_array"``), ``(height, width, 3)`` uint8."""
@@ -236,7 +255,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         return self._frames.draw(status)  # type: ignore[no-any-return]
 
     def close(self) -> None:
-        """Stop the episode's worker thread (safe to call twice)."""
+        """End the episode in progress and the window, if any (safe to call twice)."""
         if self._episode is not None:
             self._episode.close()
         if self._frames is not None and hasattr(self._frames, "close"):
@@ -254,11 +273,6 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         spec = state.pop("spec", None)
         EzPickle.__setstate__(self, state)
         self.spec = spec
-
-    def __del__(self) -> None:
-        episode = getattr(self, "_episode", None)
-        if episode is not None:
-            episode.close()
 
     # -- extras ----------------------------------------------------------------------------
     @property
@@ -288,10 +302,11 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         assert episode is not None
         if episode.done:  # the end: what the component would read now
             leaf = episode.sim.world.leaves[self.path]
-            raw = episode.sim.read_many([leaf.inputs[p] for p in self.observed])
+            values = episode.sim.read_many([leaf.inputs[p] for p in self.observed]).tolist()
         else:
-            raw = np.array([episode.inputs[p] for p in self.observed], dtype=np.float64)
-        return self.observer(raw)
+            inputs = episode.inputs
+            values = [inputs[p] for p in self.observed]
+        return self.observer.of_values(values)
 
     def _info(self) -> dict[str, Any]:
         episode = self._episode

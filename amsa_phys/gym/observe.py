@@ -90,7 +90,14 @@ class Observer:
         """The observation of one raw input vector (float64, within ``low``..``high``)."""
         if self.mode == "absolute":
             return raw
-        values = raw.tolist()  # a handful of floats: plain Python beats numpy per element
+        return self.of_values(raw.tolist())
+
+    def of_values(self, values: list[float]) -> np.ndarray:
+        """:meth:`__call__` of the raw inputs as a list of floats (port order): the env's
+        per-step path, which has them as floats already (a handful of them: plain Python
+        beats numpy per element, and each unit's rule was chosen once, in ``__init__``)."""
+        if self.mode == "absolute":
+            return np.array(values, dtype=np.float64)
         out: list[float] = []
         if self.own is not None:
             ox, oy, oh = self.own
@@ -109,4 +116,8 @@ class Observer:
                 out.append(((v + math.pi) % (2 * math.pi) - math.pi) / math.pi)
             else:
                 out.append(math.tanh(v))
-        return np.array([min(1.0, max(-1.0, v)) for v in out], dtype=np.float64)
+        # min(1, max(-1, v)) spelled out: the same value (NaN too: -1), a third the time
+        return np.array(
+            [v if -1.0 <= v <= 1.0 else (1.0 if v > 1.0 else -1.0) for v in out],
+            dtype=np.float64,
+        )

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from typing import Any
 
-import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
 
 COLOR = "tab:red"
 
@@ -26,7 +26,7 @@ def switch_text(detail: str) -> str:
 
 
 def adapt_switches(
-    ax: plt.Axes, events: list[dict[str, Any]], t: np.ndarray, s: np.ndarray, color: str = COLOR
+    ax: Axes, events: list[dict[str, Any]], t: np.ndarray, s: np.ndarray, color: str = COLOR
 ) -> int:
     """Mark every rule switch of ``events`` on the curve (t, s); returns how many."""
     switches = [e for e in events if e.get("kind") == "adapt"]

@@ -11,8 +11,9 @@ from typing import Any
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..errors import ConfigError
@@ -140,7 +141,7 @@ MARGINS = (0.065, 0.11, 0.985, 0.92)  # left, bottom, right, top: fixed, so the 
 AXES_HEIGHT_PT = FIG_H_IN * (MARGINS[3] - MARGINS[1]) * 72
 
 
-def _phase_notes(ax: plt.Axes, phases: list[dict[str, Any]]) -> list[str]:
+def _phase_notes(ax: Axes, phases: list[dict[str, Any]]) -> list[str]:
     """Mark each phase's start and write what it set, one change a line, at the top.
 
     One change a line keeps a note as narrow as its longest change, so it fits in its phase
@@ -174,7 +175,7 @@ def _phase_notes(ax: plt.Axes, phases: list[dict[str, Any]]) -> list[str]:
     return tallest
 
 
-def _inner_changes(ax: plt.Axes, phases: list[dict[str, Any]]) -> list[float]:
+def _inner_changes(ax: Axes, phases: list[dict[str, Any]]) -> list[float]:
     """Mark changes made inside a phase (live in the window, ``new_phase: false``): a dashed
     line and what was set, upright along the bottom so it never meets the phase notes; one
     legend entry for them all. Returns their times (the legend is kept off them)."""
@@ -213,7 +214,7 @@ def _inner_changes(ax: plt.Axes, phases: list[dict[str, Any]]) -> list[float]:
 LEGEND_PLACES = (("lower right", 0.6, 1.0), ("lower left", 0.0, 0.4), ("lower center", 0.3, 0.7))
 
 
-def _legend_place(ax: plt.Axes, times: list[float]) -> str:
+def _legend_place(ax: Axes, times: list[float]) -> str:
     """The first of :data:`LEGEND_PLACES` whose span holds no live-change label (those
     stand upright along the bottom, just left of their line); "lower right" when every
     span has one (the labels are drawn over the legend then)."""
@@ -225,7 +226,7 @@ def _legend_place(ax: plt.Axes, times: list[float]) -> str:
     return LEGEND_PLACES[0][0]
 
 
-def _collisions(ax: plt.Axes, events: list[dict[str, Any]], t: np.ndarray, s: np.ndarray) -> None:
+def _collisions(ax: Axes, events: list[dict[str, Any]], t: np.ndarray, s: np.ndarray) -> None:
     """``palette.COLLISION`` on the curve at every collision (its detail names who touched)."""
     at = np.array([e["t"] for e in events if e.get("kind") == "collision"], dtype=float)
     if not at.size:
@@ -282,7 +283,9 @@ def distance_figure(
     header, data = read_trace(trace, keep)
     quality = metrics.get("quality") or {}
     signal = quality.get("signal")
-    fig, ax = plt.subplots(figsize=(10, FIG_H_IN), dpi=100)
+    fig = Figure(figsize=(10, FIG_H_IN), dpi=100)  # not pyplot's: the child never imports it
+    FigureCanvasAgg(fig)  # the canvas pyplot would give it (callers draw and measure on it)
+    ax = fig.subplots()
     changes: list[float] = []
     if signal in header and data.size and abs(float(quality["reference"])) < PLOTTABLE:
         t = data[:, 0]

@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import io
+import sys
 import warnings
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
 from ..atomic import write_atomic
+
+#: zlib level of the PNGs: 1 encodes a run's two plots in ~2/3 of the time of the default 6
+#: (~25 ms less CPU in the plot child) for files 10-18 % larger (~45 KB); same pixels.
+PNG_LEVEL = 1
 
 
 def save_png(
@@ -25,6 +29,8 @@ def save_png(
     extra layout pass (~60 ms a figure, a tenth of a headless run's process time). A figure
     made with a layout engine of its own (``layout="constrained"``) keeps it.
     ``metadata``: PNG text chunks (``Title``...), read back by :func:`png_text`.
+    A figure made without pyplot (the run's plots: the plot child never imports it) needs no
+    closing; one made with it is closed here.
     """
     if margins is None:
         if fig.get_layout_engine() is None:
@@ -38,8 +44,9 @@ def save_png(
         left, bottom, right, top = margins
         fig.subplots_adjust(left=left, bottom=bottom, right=right, top=top)
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata=metadata)
-    plt.close(fig)
+    fig.savefig(buf, format="png", metadata=metadata, pil_kwargs={"compress_level": PNG_LEVEL})
+    if "matplotlib.pyplot" in sys.modules:  # a pyplot figure is kept by pyplot until closed
+        sys.modules["matplotlib.pyplot"].close(fig)
     write_atomic(out, buf.getvalue())
     return out
 

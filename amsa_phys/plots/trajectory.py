@@ -30,9 +30,11 @@ from typing import Any
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
+from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 
 from ..model.geometry import static_obstacles
@@ -104,7 +106,7 @@ def choose_view(paths: list[np.ndarray]) -> View:
     return View((float(start[0]), float(start[1])), (float(u[0]), float(u[1])), lateral=True)
 
 
-def draw_static_world(ax: plt.Axes, physics: dict[str, Any] | None, view: View) -> bool:
+def draw_static_world(ax: Axes, physics: dict[str, Any] | None, view: View) -> bool:
     """Walls and obstacles (whatever the world's ``physics:`` holds), under everything else.
 
     Each shape is turned into plot coordinates through ``view`` as a polygon or a line, so a
@@ -169,7 +171,9 @@ def plot_trajectory(
     physics = world.get("physics")
     arena = bool(static_obstacles(physics or {}))  # obstacles or walls: show them to scale
     view = View() if arena else choose_view(list(paths.values()))
-    fig, ax = plt.subplots(figsize=(10, 4.8) if view.lateral else (7, 6), dpi=100)
+    fig = Figure(figsize=(10, 4.8) if view.lateral else (7, 6), dpi=100)  # no pyplot
+    FigureCanvasAgg(fig)
+    ax = fig.subplots()
     draw_static_world(ax, physics, view)
     zones = world["zones"] if "zones" in world else zones_of_run(trace.parent / "scenario.yaml")
     draw_zones(ax, zones, view)  # terrain, from the run (its timeline changes the labels)
@@ -266,7 +270,7 @@ def role_styles(rovers: list[str]) -> dict[str, Style]:
 
 
 def _draw_rovers(
-    ax: plt.Axes, paths: dict[str, np.ndarray], view: View, style: dict[str, Style]
+    ax: Axes, paths: dict[str, np.ndarray], view: View, style: dict[str, Style]
 ) -> None:
     """Each rover's path, start and end as lines of its own (a few rovers: every point)."""
     first = next(iter(paths), None)
@@ -288,7 +292,7 @@ def _draw_rovers(
 
 
 def _draw_roles(
-    ax: plt.Axes, paths: dict[str, np.ndarray], view: View, style: dict[str, Style]
+    ax: Axes, paths: dict[str, np.ndarray], view: View, style: dict[str, Style]
 ) -> None:
     """A wide run: one LineCollection per role, its paths thinned to what a figure shows.
 
@@ -334,7 +338,7 @@ def _thin(xy: np.ndarray, most: int) -> np.ndarray:
 
 
 def _draw_gps(
-    ax: plt.Axes,
+    ax: Axes,
     header: list[str],
     data: np.ndarray,
     view: View,
@@ -374,7 +378,7 @@ def _draw_gps(
 
 
 def _draw_lost_fixes(
-    ax: plt.Axes,
+    ax: Axes,
     header: list[str],
     data: np.ndarray,
     view: View,
@@ -404,7 +408,7 @@ def _draw_lost_fixes(
     )
 
 
-def _draw_odometry(ax: plt.Axes, header: list[str], data: np.ndarray, view: View) -> None:
+def _draw_odometry(ax: Axes, header: list[str], data: np.ndarray, view: View) -> None:
     """Dead-reckoning tracks, dashed grey; more than three share one legend entry."""
     odometry = [c[: -len(".odomX")] for c in header if c.endswith(".odomX")]
     odometry = [c for c in odometry if f"{c}.odomY" in header]
@@ -419,7 +423,7 @@ def _draw_odometry(ax: plt.Axes, header: list[str], data: np.ndarray, view: View
         ax.plot([], [], "--", lw=1.2, color="0.3", label="dead reckoning")
 
 
-def _draw_goals(ax: plt.Axes, goals: list[dict[str, float]], view: View) -> None:
+def _draw_goals(ax: Axes, goals: list[dict[str, float]], view: View) -> None:
     """Each goal a rover steers to (``plot_context``): a star, and its radius if it has one."""
     for i, goal in enumerate(goals):
         x, y = float(goal["x"]), float(goal["y"])
@@ -442,7 +446,7 @@ def _draw_goals(ax: plt.Axes, goals: list[dict[str, float]], view: View) -> None
         )
 
 
-def _lateral_axes(ax: plt.Axes, pts: np.ndarray) -> None:
+def _lateral_axes(ax: Axes, pts: np.ndarray) -> None:
     """Limits and labels of the lateral-offset view (data, not the obstacles, set them)."""
     along, across = pts[:, 0], pts[:, 1]
     pad = 0.03 * float(np.ptp(along))

@@ -33,22 +33,22 @@ Decisions:
 from __future__ import annotations
 
 import contextlib
-import multiprocessing
 import os
 import signal
 import sys
 import warnings
-from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # multiprocessing (~8 ms of imports) only when a child is forked
+    import multiprocessing.process
+    from multiprocessing.connection import Connection
+
     from ..model.world import WorldSpec
 
 from ..errors import one_line
 from ..palette import rover_names
 from ..tracemarks import gps_links
-from .pool import die_with_parent
 
 #: How long the parent waits for the child's plots before drawing them itself.
 TIMEOUT_S = 60.0
@@ -125,11 +125,15 @@ def _goal_of(params: dict[str, Any]) -> dict[str, float] | None:
 
 def _child(jobs: Connection, parent_end: Connection, parent_pid: int) -> None:
     """The child's life: import, wait for one job, draw it, report."""
+    from .pool import die_with_parent
+
     die_with_parent(parent_pid)  # a SIGKILLed parent takes its plotter along at once
     parent_end.close()  # so that the parent's exit is an end of file here
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with contextlib.suppress(Exception):  # on failure the parent draws (and reports)
-        import matplotlib.pyplot  # noqa: F401  the import this process exists for
+        # the import this process exists for: matplotlib's Figure and Agg canvas, never
+        # pyplot (its backend machinery is another ~20 ms the two plots do not use)
+        from matplotlib.backends import backend_agg  # noqa: F401
 
         from ..plots import distance, trajectory  # noqa: F401
     try:
@@ -162,6 +166,8 @@ class PlotJob:
         for stream in (sys.stdout, sys.stderr):  # else the child re-flushes their buffers
             if stream is not None:
                 stream.flush()
+        import multiprocessing
+
         try:
             ctx = multiprocessing.get_context("fork")
             parent_end, child_end = ctx.Pipe()
