@@ -239,6 +239,8 @@ ALLOWED_WRITES = {
     ("gymreg.py", "sys.meta_path[:]"),
     # Debian's rospy lives outside the venv; appended after it, only if rospy is missing
     ("ros/runtime/rosio.py", "sys.path"),
+    # the CLI entry point: one BLAS thread unless the user chose, before numpy is imported
+    ("cli/main.py", "os.environ"),
 }
 
 
