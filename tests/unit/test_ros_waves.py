@@ -48,6 +48,38 @@ def test_a_simulator_leaf_still_due_at_the_instant_blocks_its_readers() -> None:
     assert wave(g, due, "LeaderGPS") == ["LeaderGPS"]
 
 
+def test_a_writer_waits_for_an_earlier_reader_of_the_wave() -> None:
+    # a loop cut by the schedule: the actuator before the controller it reads. Without
+    # latency, the controller's new command must not reach the actuator's node before it
+    # stepped on the old one; through the latency, it may (the node keeps the old message)
+    due = ["MyNormalizePower", "MyFollowerController"]
+    g = _graph("MyFollowerController.latency=0")
+    assert wave(g, due, "MyNormalizePower") == ["MyNormalizePower"]
+    assert wave(_graph(), due, "MyNormalizePower") == due
+
+
+def test_a_writer_waits_for_a_reader_due_before_it_even_outside_the_wave() -> None:
+    # the controller (not in the wave: it reads LeaderGPS, stepping now) is asked later; a
+    # FollowerGPS due after it must not publish before the controller read the old fix
+    g = _graph()
+    due = ["LeaderGPS", "MyFollowerController", "FollowerGPS"]
+    assert wave(g, due, "LeaderGPS") == ["LeaderGPS"]
+
+
+def test_the_platoon_steps_its_actuators_together() -> None:
+    world = load_scenario(ROOT / "scenarios" / "platoon.yaml").world
+    g = RosGraph.of(world, classify(world))
+    due = list(world.order)
+    cars = [f"Car{k}" for k in range(1, 11)]
+    assert wave(g, due, "Car1.Drive") == [f"{c}.Drive" for c in cars]
+    # then each car's controller alone (the actuators, asked already, are not asked again),
+    # and its sensors once it has stepped on their older values
+    drives = {f"{c}.Drive" for c in cars}
+    assert [p for p in wave(g, due, "Car1.Pilot") if p not in drives] == ["Car1.Pilot"]
+    sensors = [p for p in wave(g, due, "Car1.Gps") if p not in drives]
+    assert sensors == [f"Car1.{s}" for s in ("Gps", "AheadGps", "Compass", "Gap")]
+
+
 def test_only_leaves_due_at_the_instant_are_asked() -> None:
     g = _graph()
     due = ["Leader", "LeaderGPS", "MyDistanceMonitor"]

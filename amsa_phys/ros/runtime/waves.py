@@ -11,7 +11,13 @@ inputs are fixed (a *wave*); the nodes step in parallel, and the engine, reachin
 them in its order, takes the answer that is waiting.
 
 A Leaf's inputs are *not* fixed if it reads an output of a Leaf due between the one stepped
-now (included) and itself whose publications are visible at once. A producer with latency
+now (included) and itself whose publications are visible at once. And a Leaf whose own
+publications are visible at once does not join a wave if a node due between the one stepped
+now (included) and itself reads them, in the wave or not: that reader (the schedule cut a
+loop there) must step on the older message, and a node holds its reader to the exact count
+of messages, so the new one must not reach it first. In the platoon (each car's actuator
+scheduled before its controller, the controller before its sensors) the ten actuators form
+one wave, then each car's controller and its four sensors two more. A producer with latency
 or jitter does not count: what its reader sees now is what was sent earlier and is no
 longer in flight (``published - in_flight``), a number its step leaves unchanged (its new
 message goes in flight, never visible at the same instant). In scenario1 the four sensors
@@ -35,14 +41,27 @@ def wave(graph: RosGraph, due: Sequence[str], start: str) -> list[str]:
     """
     remote = set(graph.remote)
     pending: set[str] = set()  # buffers a Leaf due later at this instant can still write
+    read: set[str] = set()  # buffers the nodes due from ``start`` on read, up to here
     out: list[str] = []
     for path in due[due.index(start) :]:
+        inputs = graph.input_buffers(path)
+        outputs = graph.outputs(path)
+        delayed = graph.leaf(path).timing.delayed
         if path in remote and (
-            path == start or not any(b in pending for b in graph.input_buffers(path))
+            path == start
+            or (
+                not any(b in pending for b in inputs)
+                # a node due before this one (asked now or later) reads what this one
+                # writes at once: it must step on the older message first (a loop the
+                # schedule cut), and a node holds its reader to the exact count
+                and (delayed or not any(b in read for b in outputs))
+            )
         ):
             out.append(path)
-        if not graph.leaf(path).timing.delayed:
-            pending.update(graph.outputs(path))
+        if path in remote:
+            read.update(inputs)
+        if not delayed:
+            pending.update(outputs)
     return out
 
 
