@@ -2,7 +2,10 @@
 
 * scenario1 (500 s) in lockstep: the simulator's own run time (``simulated 500 s in X s``, its
   loop, without roscore and process start-up) against the in-process run's loop
-  (``metrics.json`` ``wall_time_s``), and launch to done;
+  (``metrics.json`` ``wall_time_s``), launch to done (the difference is start-up and exit),
+  and the CPU seconds of every process of the launch (on a shared machine the run time
+  follows the load; the CPU does much less); with ``waves:=false`` (one node at a time, the
+  protocol before waves) and ``waves:=true`` alternated, in one sitting;
 * the platoon world's launch: the peak of the summed resident memory of every process the
   launch started (sampled from ``/proc`` every 0.2 s), and its run time.
 
@@ -35,6 +38,8 @@ from amsa_phys.cli.main import main
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIO1 = ROOT / "scenarios" / "scenario1.yaml"
 PLATOON = ROOT / "worlds" / "platoon.yaml"
+#: CPU seconds of the last :func:`launch`'s processes
+LAST_CPU_S = 0.0
 
 
 def _env(token: str, ws: Path) -> dict[str, str]:
@@ -53,6 +58,15 @@ def _ours(token: str) -> list[int]:
                 if f"AMSA_ROS_BENCH={token}".encode() in env:
                     found.append(int(entry.name))
     return found
+
+
+def _cpu_s(pids: list[int], seen: dict[int, float]) -> None:
+    """Note each process's CPU seconds so far (user + system) into ``seen``."""
+    tck = os.sysconf("SC_CLK_TCK")
+    for pid in pids:
+        with contextlib.suppress(OSError, IndexError, ValueError):
+            fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+            seen[pid] = (int(fields[11]) + int(fields[12])) / tck
 
 
 def _rss_kib(pids: list[int]) -> int:
@@ -89,14 +103,22 @@ def build(scenario: Path, ws: Path, *extra: str) -> str:
 
 
 def launch(ws: Path, launch_file: str, *args: str) -> tuple[float, float, int, str]:
-    """Launch to done: wall seconds, the simulator's run seconds, peak summed RSS (KiB)."""
+    """Launch to done: wall seconds, the simulator's run seconds, peak summed RSS (KiB).
+
+    ``LAST_CPU_S`` is then the CPU seconds every process of the launch used (sampled: a
+    process's last 0.2 s may be missed).
+    """
+    global LAST_CPU_S
     token = uuid.uuid4().hex
     peak = [0]
+    cpu: dict[int, float] = {}
     stop = threading.Event()
 
     def sample() -> None:
         while not stop.is_set():
-            peak[0] = max(peak[0], _rss_kib(_ours(token)))
+            pids = _ours(token)
+            peak[0] = max(peak[0], _rss_kib(pids))
+            _cpu_s(pids, cpu)
             stop.wait(0.2)
 
     sampler = threading.Thread(target=sample, daemon=True)
@@ -119,6 +141,7 @@ def launch(ws: Path, launch_file: str, *args: str) -> tuple[float, float, int, s
             with contextlib.suppress(ProcessLookupError):
                 os.kill(pid, signal.SIGKILL)
     wall = time.perf_counter() - t0
+    LAST_CPU_S = sum(cpu.values())
     m = re.search(r"simulated [\d.]+ s in ([\d.]+) s", text)
     assert m is not None, text[-3000:]
     return wall, float(m.group(1)), peak[0], text
@@ -129,6 +152,7 @@ def main_bench() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", default="500", help="scenario1's simulated seconds")
     parser.add_argument("--platoon-duration", default="20", help="the platoon's seconds")
+    parser.add_argument("--repeat", type=int, default=2, help="launches of each protocol")
     args = parser.parse_args()
     missing = [t for t in ("roslaunch", "catkin_make", "unshare") if shutil.which(t) is None]
     if missing or os.geteuid() != 0:
@@ -142,19 +166,32 @@ def main_bench() -> None:
         loop = json.loads((ref / "metrics.json").read_text())["wall_time_s"]
         ws = root / "ws1"
         build(SCENARIO1, ws)
-        wall, run, rss, _ = launch(
-            ws,
-            "scenario1.launch",
-            f"out:={ws / 'out'}",
-            "plots:=false",
-            f"duration:={args.duration}",
-        )
-        same = (ws / "out" / "trace.csv").read_bytes() == (ref / "trace.csv").read_bytes()
+        cpu0 = time.process_time()
+        with contextlib.redirect_stdout(io.StringIO()):
+            assert main([*argv, "--duration", args.duration, "--out", str(root / "ref2")]) == 0
+        ref_cpu = time.process_time() - cpu0
         print(f"scenario1 {args.duration} s, in-process loop        {loop:.3f} s")
-        print(f"scenario1 lockstep: simulator's run                {run:.3f} s ({run / loop:.1f}x)")
-        print(f"scenario1 lockstep: launch to done                 {wall:.1f} s")
-        print(f"scenario1 lockstep: peak memory of the launch      {rss / 1024:.0f} MiB")
-        print(f"scenario1 lockstep: trace byte-identical           {same}")
+        print(f"scenario1 in-process: CPU of the whole run         {ref_cpu:.2f} s")
+        # waves:=false is the protocol before waves (one node at a time); alternated, best of
+        # --repeat, since the machine is shared
+        for _ in range(args.repeat):
+            for waves in ("false", "true"):
+                wall, run, rss, _ = launch(
+                    ws,
+                    "scenario1.launch",
+                    f"out:={ws / 'out'}",
+                    "plots:=false",
+                    f"duration:={args.duration}",
+                    f"waves:={waves}",
+                    "force:=true",
+                )
+                same = (ws / "out" / "trace.csv").read_bytes() == (ref / "trace.csv").read_bytes()
+                print(
+                    f"scenario1 lockstep waves:={waves:5}: run {run:.3f} s ({run / loop:.1f}x), "
+                    f"launch to done {wall:.1f} s (start-up and exit {wall - run:.1f} s), "
+                    f"CPU of the launch {LAST_CPU_S:.1f} s, peak memory {rss / 1024:.0f} MiB, "
+                    f"trace byte-identical {same}"
+                )
         ws = root / "ws2"
         build(PLATOON, ws, "--duration", args.platoon_duration)
         wall, run, rss, _ = launch(ws, "platoon.launch", f"out:={ws / 'out'}", "plots:=false")

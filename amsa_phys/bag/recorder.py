@@ -11,12 +11,16 @@ live parameters) and the events so far. From that it writes:
   its instants fall on the trace's, as with the default rates; a Leaf's transport latency
   later), stamped with that step's instant; a sample the Leaf reports lost (its ``lost``
   counter, kept by GPS, Compass and Lidar) writes no message, as the sensor publishes none;
-* ``/tf`` (``tf2_msgs/msg/TFMessage``): each robot's pose in ``map`` at its own instants;
+* ``/tf`` (``tf2_msgs/msg/TFMessage``): each robot's true pose, ``<robot>/odom`` ->
+  ``<robot>/base_link``, at its own instants, and ``/tf_static`` once at the start: ``map`` ->
+  ``<robot>/odom``, the identity (REP 105's tree; ``stdmsgs/build.py`` says why);
 * ``/amsa/events`` (``amsa_msgs/msg/Event``): phase starts with their ``set``, changes inside
   a phase, and the run's events (collisions, live changes...), at their own instants.
 
 Every time in the bag (``header.stamp``, MCAP ``log_time`` and ``publish_time``) is
-simulated time in nanoseconds from the run's start: the bag of a scenario and seed is
+simulated time in nanoseconds from the run's start, as ``/clock`` in the exported ROS
+package: the first messages are stamped 0 (1 January 1970 to a viewer showing dates; the
+bag's ``amsa-phys`` metadata says ``time: simulated``). So the bag of a scenario and seed is
 byte-identical from run to run.
 """
 
@@ -40,6 +44,7 @@ from ..stdmsgs import (
     data_topic,
     fields_of,
     find_sources,
+    static_transform,
     transform,
 )
 from ..stdmsgs.names import unique
@@ -47,6 +52,7 @@ from .writer import _DOUBLE, BagWriter, scalar_prefix, split_ns
 
 EVENTS_TOPIC = "/amsa/events"
 TF_TOPIC = "/tf"
+TF_STATIC_TOPIC = "/tf_static"
 SCALAR = "amsa_msgs/Scalar"
 EVENT = "amsa_msgs/Event"
 TF = "tf2_msgs/TFMessage"
@@ -135,11 +141,15 @@ class BagRecorder:
                 "duration_s": repr(float(sc.duration)),
                 "origin_lat_lon": f"{self.origin[0]!r},{self.origin[1]!r}",
                 "amsa_phys": __version__,
+                "time": "simulated: nanoseconds since the run's start (stamps from 0)",
             },
         )
-        taken = {EVENTS_TOPIC, TF_TOPIC}
+        taken = {EVENTS_TOPIC, TF_TOPIC, TF_STATIC_TOPIC}
         w.channel(EVENTS_TOPIC, EVENT)
         w.channel(TF_TOPIC, TF)
+        robots = [s for s in self.sources if s.role.name == "Pose"]
+        if robots:
+            w.channel(TF_STATIC_TOPIC, TF)
         leaves = sc.world.leaves
         for src in self.sources:
             cid = w.channel(src.topic, src.role.msg)
@@ -159,6 +169,11 @@ class BagRecorder:
         grid = sim.grid
         if not self._ready:  # the grid and timer phases exist once the run is initialised
             self._ready = True
+            robots = [st.src for st in self._streams if st.src.role.name == "Pose"]
+            if robots:
+                stamp = split_ns(ns_of(sim.now))
+                tfs = {"transforms": [static_transform(src, stamp) for src in robots]}
+                w.write(TF_STATIC_TOPIC, TF, tfs, ns_of(sim.now))
             for st in self._streams:
                 st.period = grid.ticks(1 / st.freq)
                 st.phase = grid.ticks(Fraction(sim.timer_phases.get(st.src.leaf, 0)))

@@ -26,6 +26,8 @@ _ARGS = """\
   <arg name="duration" default="" doc="simulated seconds to run (default: the scenario's)"/>
   <arg name="plots" default="true" doc="draw distance.png and trajectory.png"/>
   <arg name="timeout" default="60" doc="seconds to wait for a node before giving up"/>
+  <arg name="waves" default="true" doc="lockstep: ask together the nodes of an instant whose\
+ inputs are fixed (false: one at a time, for comparison)"/>
   <arg name="sim" default="true" doc="false: the controller side alone, in free mode, for a real\
  robot whose drivers publish the standard topics (see README.md)"/>"""
 
@@ -50,6 +52,7 @@ _HEAD = """\
     <param name="speed" type="double" value="$(arg speed)"/>
     <param name="duration" type="str" value="$(arg duration)"/>
     <param name="plots" type="bool" value="$(arg plots)"/>
+    <param name="waves" type="bool" value="$(arg waves)"/>
   </node>
   <node if="$(arg sim)" pkg="@@{pkg:xml_attr}" type="@@{scenario:xml_attr}.py"\
  name="@@{scenario:xml_attr}" required="true" output="screen"/>

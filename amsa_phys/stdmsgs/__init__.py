@@ -8,7 +8,16 @@ the robots' poses for ``/tf``) with its topic and frames; :func:`build` makes on
 from the Data values; :func:`msgdef` gives each type's ROS 2 definition text.
 """
 
-from .build import Context, build, fields_of, transform, variance
+from .build import (
+    GRAVITY,
+    Context,
+    build,
+    fields_of,
+    odom_frame,
+    static_transform,
+    transform,
+    variance,
+)
 from .defs import msgdef, schema_name
 from .geo import DEFAULT_ORIGIN, enu_to_geodetic, geodetic_to_enu, quaternion_yaw, yaw_quaternion
 from .names import data_topic, ros_path
@@ -16,6 +25,7 @@ from .roles import ROLES, WORLD_FRAME, Role, Source, find_sources
 
 __all__ = [
     "DEFAULT_ORIGIN",
+    "GRAVITY",
     "ROLES",
     "WORLD_FRAME",
     "Context",
@@ -28,9 +38,11 @@ __all__ = [
     "find_sources",
     "geodetic_to_enu",
     "msgdef",
+    "odom_frame",
     "quaternion_yaw",
     "ros_path",
     "schema_name",
+    "static_transform",
     "transform",
     "variance",
     "yaw_quaternion",

@@ -8,8 +8,18 @@ bias_stddev²``) + Gauss-Markov bias (stationary ``σ²T/2``, or the random walk
 T = 0) + quantisation (``precision²/12``). A template without these parameters gets
 covariance type UNKNOWN (NavSatFix) or zeros.
 
-The world is a plane: roll, pitch and altitude are exactly zero, so their variances are 0;
-the IMU model has no gravity (``sensors/imu.py``), so ``linear_acceleration.z`` is 0.
+The world is a plane: roll, pitch and altitude are exactly zero, so their variances are 0.
+An accelerometer measures specific force, so a level IMU at rest reads +g upwards (REP 145):
+``linear_acceleration.z`` is standard gravity, exactly (the model has no vertical axis, so
+no noise on it either); x and y are the model's (``sensors/imu.py``, which leaves gravity
+out of the plane: on a slope a real IMU would also show its projection there).
+
+Wheel odometry states the covariance its noise model gives it over time
+(:func:`odometry_pose_variances`); a robot's ground truth (the ``Pose`` role) is exact, so
+its covariance is zero. Frames follow REP 105 per robot: ``map`` -> ``<robot>/odom``
+(identity, on ``/tf_static``: the world knows no localisation error to correct) ->
+``<robot>/base_link`` (the true pose, on ``/tf``); a wheel odometry's own estimate is its
+``nav_msgs/Odometry`` in ``<robot>/odom``.
 """
 
 from __future__ import annotations
@@ -19,6 +29,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from .geo import enu_to_geodetic, yaw_quaternion
+from .names import ros_path
 from .roles import Source
 
 Msg = dict[str, Any]
@@ -29,6 +40,8 @@ COVARIANCE_TYPE_UNKNOWN = 0
 COVARIANCE_TYPE_DIAGONAL_KNOWN = 2
 #: REP 145: a covariance whose first element is -1 says "this part is not provided".
 NOT_PROVIDED = (-1.0, *([0.0] * 8))
+#: Standard gravity (m/s²): what a level accelerometer at rest reads on z (REP 145).
+GRAVITY = 9.80665
 
 
 def header(stamp: tuple[int, int], frame_id: str) -> Msg:
@@ -110,41 +123,114 @@ def imu(src: Source, v: Mapping[str, Any], p: Mapping[str, Any], ctx: Context) -
         "orientation_covariance": list(NOT_PROVIDED),
         "angular_velocity": _vec(z=v["gyro_z"]),
         "angular_velocity_covariance": _diag3(0.0, 0.0, g),
-        "linear_acceleration": _vec(v["accel_x"], v["accel_y"]),
+        "linear_acceleration": _vec(v["accel_x"], v["accel_y"], GRAVITY),
         "linear_acceleration_covariance": _diag3(a, a, 0.0),
     }
 
 
-def _odometry(src: Source, ctx: Context, x: float, y: float, yaw: float, v: float, w: float) -> Msg:
+def _odometry(
+    src: Source,
+    ctx: Context,
+    x: float,
+    y: float,
+    yaw: float,
+    v: float,
+    w: float,
+    pose_cov: list[float] | None = None,
+) -> Msg:
     return {
         "header": header(ctx.stamp, src.frame_id),
         "child_frame_id": src.child_frame_id,
         "pose": {
             "pose": {"position": _vec(x, y), "orientation": yaw_quaternion(yaw)},
-            "covariance": [0.0] * 36,
+            "covariance": pose_cov if pose_cov is not None else [0.0] * 36,
         },
         "twist": {"twist": {"linear": _vec(v), "angular": _vec(z=w)}, "covariance": [0.0] * 36},
     }
 
 
+def odometry_pose_variances(
+    p: Mapping[str, Any], t_s: float, period_s: float
+) -> tuple[float, float]:
+    """Variances of dead reckoning's travel (centre of the axle) and yaw after ``t_s`` s.
+
+    Each wheel's travel is the sum of its speed readings times the period (``sensors/
+    odometry.py``), so a reading's white error (noise and quantisation, variance ``q`` in
+    (m/s)²) adds up as a random walk, ``q * period * t`` in m², and its constant error
+    (turn-on bias; the wandering bias taken at its stationary variance, ``b``) grows with
+    time, ``b * t²``. The wheels' errors are independent: the centre's travel has half a
+    wheel's variance, the yaw ``(r - l) / track`` twice a wheel's over ``track²``.
+    """
+    white = float(p.get("stddev", 0.0)) ** 2 + float(p.get("precision", 0.0)) ** 2 / 12
+    bias = (variance(p, "", t_s) or 0.0) - white
+    wheel = white * period_s * t_s + bias * t_s * t_s
+    track = float(p.get("track", 0.0)) or 1.0
+    return wheel / 2, 2 * wheel / (track * track)
+
+
+def odometry_pose_cov(v: Mapping[str, Any], p: Mapping[str, Any], ctx: Context) -> list[float]:
+    """The 6x6 pose covariance of wheel odometry from its noise model.
+
+    The yaw's variance ``Y`` is :func:`odometry_pose_variances`'. The position's comes
+    mostly from that yaw error, carried over the distance: for a path of length ``d`` at
+    constant speed with the yaw error a random walk, ``d² Y / 3`` across the path and
+    ``d² Y² / 12`` along it (the second-order shortening), plus the travel's own variance
+    along it. ``d`` and the direction are the straight line from the odometry frame's
+    start (``x``, ``y``) to the pose: exact for a straight drive, an underestimate of the
+    distance after turns. The configured wheel-radius errors (``scaleError*``) are a
+    miscalibration, not noise, and are not included.
+    """
+    travel, yaw = odometry_pose_variances(p, ctx.t_s, ctx.period_s)
+    dx, dy = v["x"] - float(p.get("x", 0.0)), v["y"] - float(p.get("y", 0.0))
+    d2 = dx * dx + dy * dy
+    along = travel + d2 * yaw * yaw / 12
+    across = d2 * yaw / 3
+    phi = math.atan2(dy, dx) if d2 > 0 else v["yaw"]
+    c, s = math.cos(phi), math.sin(phi)
+    cov = [0.0] * 36
+    cov[0] = along * c * c + across * s * s
+    cov[7] = along * s * s + across * c * c
+    cov[1] = cov[6] = (along - across) * c * s
+    cov[35] = yaw
+    return cov
+
+
 def odometry(src: Source, v: Mapping[str, Any], p: Mapping[str, Any], ctx: Context) -> Msg:
-    """``nav_msgs/Odometry`` of dead reckoning: the pose (the template gives no twist)."""
-    return _odometry(src, ctx, v["x"], v["y"], v["yaw"], 0.0, 0.0)
+    """``nav_msgs/Odometry`` of dead reckoning: the pose in the robot's ``odom`` frame, with
+    the covariance its noise model gives (the template gives no twist: zeros)."""
+    cov = odometry_pose_cov(v, p, ctx)
+    return _odometry(src, ctx, v["x"], v["y"], v["yaw"], 0.0, 0.0, cov)
 
 
 def ground_truth(src: Source, v: Mapping[str, Any], p: Mapping[str, Any], ctx: Context) -> Msg:
-    """``nav_msgs/Odometry`` of a robot's true pose and (body-frame) twist."""
+    """``nav_msgs/Odometry`` of a robot's true pose and (body-frame) twist: exact, so its
+    covariance is zero."""
     return _odometry(
         src, ctx, v["x"], v["y"], v["yaw"], v.get("speed", 0.0), v.get("yaw_rate", 0.0)
     )
 
 
+def odom_frame(src: Source) -> str:
+    """The REP 105 ``odom`` frame of the robot ``src`` belongs to (itself, if a robot)."""
+    return f"{ros_path(src.robot or src.leaf)}/odom"
+
+
 def transform(src: Source, v: Mapping[str, Any], ctx: Context) -> Msg:
-    """A ``geometry_msgs/TransformStamped`` from the world frame to a robot's base."""
+    """A ``geometry_msgs/TransformStamped`` from the robot's ``odom`` frame to its base
+    (the true pose: ``map`` -> ``odom`` is the identity, :func:`static_transform`)."""
     return {
-        "header": header(ctx.stamp, src.frame_id),
+        "header": header(ctx.stamp, odom_frame(src)),
         "child_frame_id": src.child_frame_id,
         "transform": {"translation": _vec(v["x"], v["y"]), "rotation": yaw_quaternion(v["yaw"])},
+    }
+
+
+def static_transform(src: Source, stamp: tuple[int, int]) -> Msg:
+    """``map`` -> the robot's ``odom`` frame: the identity (for ``/tf_static``)."""
+    return {
+        "header": header(stamp, src.frame_id),
+        "child_frame_id": odom_frame(src),
+        "transform": {"translation": _vec(), "rotation": yaw_quaternion(0.0)},
     }
 
 

@@ -176,8 +176,10 @@ def find_sources(world: WorldSpec) -> list[Source]:
             topic = f"/{ros_path(leaf.path)}/{role.suffix}"
         topic = unique(topic, taken)
         base = f"{ros_path(robot)}/base_link" if robot else f"{ros_path(leaf.path)}/base_link"
-        if role.name in ("Pose", "Odometry"):
+        if role.name == "Pose":  # the truth, in the world's frame
             frame, child = WORLD_FRAME, base
+        elif role.name == "Odometry":  # dead reckoning, in the robot's odom frame (REP 105)
+            frame, child = f"{ros_path(robot or leaf.path)}/odom", base
         else:
             frame, child = base, ""
         sources.append(Source(role, leaf.path, fields, robot, topic, frame, child))

@@ -40,6 +40,7 @@ NS = 1_000_000_000
 MDE_TOPICS = {
     "/amsa/events": "amsa_msgs/msg/Event",
     "/tf": "tf2_msgs/msg/TFMessage",
+    "/tf_static": "tf2_msgs/msg/TFMessage",
     "/Leader/ground_truth/odom": "nav_msgs/msg/Odometry",
     "/Follower/ground_truth/odom": "nav_msgs/msg/Odometry",
     "/Follower/wheel_cmd": "sensor_msgs/msg/JointState",

@@ -4,7 +4,9 @@ Out (both sides): a stream's message is built by ``stdmsgs.build`` — the very 
 the MCAP bag, so covariances come from the sensor's noise model the same way — once every
 field of it has a new value since the last message (a Leaf publishes all of its outputs
 at a step, each on its topic; a GPS that lost its fix publishes nothing, so no NavSatFix
-either). Stamped with ``rospy.Time.now()``: simulated time (``/clock``).
+either). Stamped with ``rospy.Time.now()``: simulated time (``/clock``). The tf tree is REP 105's
+per robot, as in the bag: ``map`` -> ``<robot>/odom`` (identity, latched on ``/tf_static``)
+-> ``<robot>/base_link`` (the true pose, on ``/tf``).
 
 In (``sim:=false``): a message on a sensor stream's topic becomes the data topics of its
 fields (a NavSatFix's latitude and longitude back to the plane's x and y at the same
@@ -24,7 +26,7 @@ from typing import Any
 
 from ...errors import AmsaError
 from ...stdmsgs import DEFAULT_ORIGIN, Context, Source, build, geodetic_to_enu, quaternion_yaw
-from ...stdmsgs.build import transform
+from ...stdmsgs.build import static_transform, transform
 from .. import names
 from ..boundary import NODE, SIM_PARAM, plan
 from . import rosio
@@ -128,6 +130,13 @@ class BoundaryNode:
             if self.sim or (s.role.name == "WheelCommand" and s.leaf not in inbound)
         ]
         self.outbound = [Outbound(self, s) for s in out]
+        robots = [o.src for o in self.outbound if o.src.role.name == "Pose"]
+        if robots:  # REP 105: map -> <robot>/odom, the identity, latched once
+            self.tf_static = rosio.make_publisher(
+                rospy, "/tf_static", self.classes["tf2_msgs/TFMessage"], latch=True
+            )
+            tfs = [fill(rospy, TransformStamped(), static_transform(r, (0, 0))) for r in robots]
+            self.tf_static.publish(self.classes["tf2_msgs/TFMessage"](tfs))
         readers: dict[str, list[Outbound]] = {}
         for o in self.outbound:
             for b in o.wanted:

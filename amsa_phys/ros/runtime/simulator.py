@@ -28,7 +28,7 @@ from typing import Any
 from ...engine import interrupt
 from ...engine.runner import Simulation
 from ...errors import AmsaError, Interrupted, RunFault
-from ...model.scenario import Change, Scenario, traced_columns
+from ...model.scenario import Change
 from ...runs.expect import check_expectations
 from ...runs.rundir import default_run_dir, prepare_run_dir
 from ...runs.single import run_scenario
@@ -36,7 +36,8 @@ from .. import names
 from ..graph import RosGraph
 from . import readiness, records, rosio
 from .config import NodeConfig, load_config
-from .standins import stand_ins
+from .rossim import RosSimulation
+from .waves import DueAt, wave
 
 
 class RemoteError(Exception):
@@ -74,6 +75,10 @@ class Link:
         self.phase_acked = 0
         self.phase_asked = 0
         self.seq = 0
+        #: lockstep: the Leaves asked and not yet answered (path -> instant, sequence number)
+        self.asked: dict[str, tuple[Fraction, str]] = {}
+        self.waves = True
+        self.due: DueAt | None = None
         self.last_clock = -1
         self.wall0: float | None = None
         self.speed = 1.0
@@ -206,13 +211,22 @@ class Link:
                 self.cond.wait(min(left, 0.2))
 
     # -- lockstep requests -------------------------------------------------------------------
-    def _request(self, path: str, verb: str, args: str, t: Fraction, what: str) -> list[str]:
-        """Send ``VERB SEQ ARGS`` to a node, wait for its answer; ``[kind, seq, text]``."""
+    def _ask(self, path: str, verb: str, args: str, t: Fraction) -> None:
+        """Send ``VERB SEQ ARGS`` to a node; :meth:`_answer` waits for its answer."""
         self.seq += 1
         seq = str(self.seq)
         with self.cond:
             self.replies[path] = None
+        self.asked[path] = (t, seq)
         self.step_pubs[path].publish(self.String(f"{verb} {seq} {args}"))
+
+    def _answer(self, path: str, t: Fraction, what: str) -> list[str]:
+        """Wait for a node's answer to what it was asked; ``[kind, seq, text]``.
+
+        The events the Leaf recorded come with its answer and are recorded now, when the
+        engine steps it (in a wave the answer may have arrived earlier).
+        """
+        _, seq = self.asked.pop(path)
 
         def answered() -> bool:
             reply = self.replies[path]
@@ -227,18 +241,51 @@ class Link:
                 self.sim.record_event(kind, detail)
         return reply[0].split(" ", 2)
 
-    def step(self, path: str, t: Fraction) -> dict[str, float]:
-        """One step of a remote Leaf at ``t``: its outputs as its node published them."""
-        if not self.lockstep:
-            return {}
-        self.publish_clock(t)
+    def _request(self, path: str, verb: str, args: str, t: Fraction, what: str) -> list[str]:
+        """Ask a node and wait for its answer."""
+        self._ask(path, verb, args, t)
+        return self._answer(path, t, what)
+
+    def _counts(self, path: str) -> str:
+        """How many messages of each input a remote Leaf sees now: every message so far, less
+        a delayed producer's still in flight."""
         sim = self.sim
-        # what the Leaf sees: every message so far, less a delayed producer's in flight
-        counts = " ".join(
+        return " ".join(
             str(self.published[b] - (sim.in_flight(b) if sim is not None else 0))
             for b in self.graph.input_buffers(path)
         )
-        head = self._request(path, "step", f"{t.numerator} {t.denominator} {counts}", t, "a step")
+
+    def _wave(self, path: str, t: Fraction) -> list[str]:
+        """``path`` and the remote Leaves of this instant that can be asked with it
+        (``waves.py``); ``[path]`` alone with ``waves:=false``."""
+        sim = self.sim
+        if not self.waves or sim is None:
+            return [path]
+        if self.due is None:
+            grid, leaves = sim.grid, self.graph.world.leaves
+            self.due = DueAt(
+                self.graph.world.order,
+                lambda p: grid.ticks(1 / Fraction(leaves[p].freq)),
+                lambda p: grid.ticks(Fraction(sim.timer_phases.get(p, 0))),
+            )
+        due = self.due.at(sim.grid.ticks(t))
+        return wave(self.graph, due, path) if path in due else [path]
+
+    def step(self, path: str, t: Fraction) -> dict[str, float]:
+        """One step of a remote Leaf at ``t``: its outputs as its node published them.
+
+        The first remote Leaf of a wave asks every node of the wave at once (each with
+        the counts of what it sees now); the others find their answer waiting.
+        """
+        if not self.lockstep:
+            return {}
+        self.publish_clock(t)
+        asked = self.asked.get(path)
+        if asked is None or asked[0] != t:
+            for p in self._wave(path, t):
+                if p == path or p not in self.asked:  # once an instant: asked is a step
+                    self._ask(p, "step", f"{t.numerator} {t.denominator} {self._counts(p)}", t)
+        head = self._answer(path, t, "a step")
         kind, text = head[0], head[2] if len(head) > 2 else ""
         who = f"{path} ({self.graph.leaf(path).template.name()})"
         if kind == "error":
@@ -255,6 +302,15 @@ class Link:
             t,
             "its outputs",
         )
+        extra = [b for b in got if self.received[b][0] != self.published[b]]
+        if extra:  # a node that stepped more often than asked: what it sees is no longer known
+            b = extra[0]
+            raise RunFault(
+                who,
+                t,
+                f"{self.received[b][0]} messages on {names.topic(b)}, {self.published[b]} "
+                "answered steps (a step asked twice, or another publisher on the topic)",
+            )
         return {b.rpartition(".")[2]: self.received[b][1] for b in got}
 
     def reload(self, path: str, name: str, t: Fraction) -> None:
@@ -315,106 +371,6 @@ class Link:
         return rosio.read_param(self.rospy, change.leaf, leaf.template.param(change.param))
 
 
-class RosSimulation(Simulation):
-    """The engine with remote Leaves, parameters from the server, ``/clock`` published."""
-
-    def __init__(self, scenario: Scenario, trace: Any, link: Link) -> None:
-        q = scenario.quality.signal if scenario.quality else None
-        super().__init__(
-            scenario.world,
-            seed=scenario.seed,
-            duration=scenario.duration,
-            phases=scenario.phases,
-            log_rate=scenario.log_rate,
-            quality_signal=q,
-            trace=trace,
-            columns=traced_columns(scenario),
-            # adapt: rules fire here, at the engine's exact instants (both modes); a change is
-            # put on the parameter server before the Leaf is told (apply_change)
-            adapt=scenario.adapt,
-            # remote Leaves and publishing local ones stand in for the world's (standins.py)
-            wrap=stand_ins(link, lambda: self.now),
-            # every Leaf is called on its own: a node per Leaf, a topic per output
-            grouping=False,
-        )
-        self.link = link
-        link.attach(self)
-        graph = link.graph
-        #: the adapt rules' changes (the very objects the engine applies when one fires)
-        self.rule_changes = {id(c) for rule in scenario.adapt for c in rule.changes}
-        # the parameter cache's values of every Leaf, as last seen (free mode: a change of the
-        # cache is an edit, recorded as an event whether the Leaf steps here or in its node;
-        # timeline changes are applied apart, at their instant)
-        self.seen = {
-            (path, p.name): rosio.fetch_param(link.rospy, names.param(path, p.name))
-            for path in scenario.world.leaves
-            for p in graph.leaf(path).template.params
-        }
-        self.live: list[Change] = []  # live edits queued, not yet applied
-        if not link.lockstep:
-            rate = (
-                Fraction(str(scenario.world.physics["rate"])) if graph.local else scenario.log_rate
-            )
-            self.add_hook(rate, self._pace, "ros clock")
-            self.add_hook(scenario.log_rate, self._live_params, "ros parameters")
-
-    def _pace(self) -> None:
-        """Free mode: hold to the wall clock, then take what the nodes published meanwhile."""
-        self.link.pace(self.now)
-        self.link.take()
-
-    def apply_change(self, change: Change) -> None:
-        """A timeline change, with the value the scenario node put on the parameter server."""
-        if id(change) in self.rule_changes:  # an adapt: rule fired at this instant
-            rosio.set_param(self.link.rospy, change.leaf, change.param, change.value)
-            super().apply_change(change)
-            return
-        for i, queued in enumerate(self.live):
-            if queued is change:  # a live edit (free mode), already judged
-                del self.live[i]
-                super().apply_change(change)
-                return
-        value = self.link.phase_value(self.phase_index, self.now, change)
-        super().apply_change(Change(change.leaf, change.param, value))
-
-    def _live_params(self) -> None:
-        """Free mode: a ``rosparam set`` lands at the next instant, recorded.
-
-        Judged like the window's live changes (type, range, rules between parameters;
-        parameters only ``initialize`` reads are refused); a refused value is one line in the
-        log, the old value stays and is put back on the parameter server. Applied changes are
-        events, and in ``scenario.yaml``; a Leaf that is a node takes the value at its own
-        next step (judged the same way there), this process records it.
-        """
-        rospy = self.link.rospy
-        for (path, name), seen in self.seen.items():
-            try:
-                raw = rospy.get_param_cached(names.param(path, name))
-            except KeyError:
-                continue
-            if raw == seen:
-                continue
-            self.seen[(path, name)] = raw
-            leaf = self.link.graph.leaf(path)
-            try:
-                if name in leaf.template.fixed_once_running:
-                    raise ValueError("is read only when the run starts")
-                value = leaf.template.param(name).coerce(raw)
-                leaf.template.check_params({**vars(self.components[path].p), name: value})
-            except ValueError as exc:
-                old = rosio.ros_value(getattr(self.components[path].p, name))
-                rospy.logerr(f"{names.param(path, name)}: {exc}; keeping {old!r}")
-                rospy.set_param(names.param(path, name), old)  # the server shows what runs
-                self.seen[(path, name)] = old
-                continue
-            if value == getattr(self.components[path].p, name):
-                continue  # the scenario node's own change, applied at its instant already
-            change = Change(path, name, value)
-            self.live.append(change)
-            at = self.apply_live(change)
-            print(f"{names.SIMULATOR}: live change {change.key}={value} at t={float(at):g} s")
-
-
 def main() -> None:
     """The simulator node's entry point."""
     rospy = rosio.ros()
@@ -434,6 +390,7 @@ def main() -> None:
         prepare_run_dir(out_dir, bool(rospy.get_param("~force", False)), flag="out:=")
         link = Link(rospy, cfg)
         link.speed = float(rospy.get_param("~speed", 1.0))
+        link.waves = bool(rospy.get_param("~waves", True))
         if not link.speed > 0 or math.isinf(link.speed):
             raise AmsaError(f"speed:= must be a positive number, got {link.speed}")
         ready_timeout = float(rospy.get_param("~ready_timeout", 120.0))
