@@ -63,21 +63,27 @@ def accel(tmp_path: Path, robot: dict[str, Any], t0: float, t1: float, **kw: Any
     return float(np.polyfit(t[sel], v[sel], 1)[0])
 
 
-def launch_error(tmp_path: Path, robot: dict[str, Any]) -> float:
+def launch_error(
+    tmp_path: Path, robot: dict[str, Any], model: dict[str, Any] | None = None
+) -> float:
     """Relative error of a full-power launch on ice against the traction limit's closed form
-    with load transfer, the tyres sliding (40 N of motor against ~7 N of grip)."""
+    with load transfer, the tyres sliding (40 N of motor against ~7 N of grip). ``model``
+    (the mutation tests) changes the simulated rover's geometry, not the closed form's."""
     p = rover_params(**robot)
     x_a, x_c, z = p.axleOffset, p.casterOffset, p.comHeight
     big_l = x_a - x_c
     want = 2 * MU * static_load(x_a, x_c) / (MASS * (1 + MU * z / big_l))
-    got = accel(tmp_path, robot, 0.2, 1.0, physics=ice())
+    got = accel(tmp_path, {**robot, **(model or {})}, 0.2, 1.0, physics=ice())
     return got / want - 1
 
 
-def braking_error(tmp_path: Path, robot: dict[str, Any]) -> float:
+def braking_error(
+    tmp_path: Path, robot: dict[str, Any], model: dict[str, Any] | None = None
+) -> float:
     """Relative error of a locked-wheel stop on ice (the shorted motors brake with up to
     40 N against ~7 N of grip) against the closed form: moving at ~1.4 m/s on good ground,
-    then the ground turns to ice and the power to 0 at t = 3 s."""
+    then the ground turns to ice and the power to 0 at t = 3 s (``model`` as in
+    :func:`launch_error`)."""
     p = rover_params(**robot)
     x_a, x_c, z = p.axleOffset, p.casterOffset, p.comHeight
     big_l = x_a - x_c
@@ -94,7 +100,15 @@ def braking_error(tmp_path: Path, robot: dict[str, Any]) -> float:
         }
     }
     timeline = [{"at": 3, "set": {"Ice.friction": MU, "Ctl.left": 0, "Ctl.right": 0}}]
-    got = accel(tmp_path, robot, 3.3, 4.5, physics=ice(0.8), extra=zone, timeline=timeline)
+    got = accel(
+        tmp_path,
+        {**robot, **(model or {})},
+        3.3,
+        4.5,
+        physics=ice(0.8),
+        extra=zone,
+        timeline=timeline,
+    )
     return got / want - 1
 
 
@@ -116,6 +130,28 @@ def test_a_locked_wheel_stop_decelerates_with_the_transferred_load(
     tmp_path: Path, robot: dict[str, Any]
 ) -> None:
     assert abs(braking_error(tmp_path, robot)) < 0.01
+
+
+#: The mutants the docstring names, as the simulated rover's geometry: the old model (each
+#: drive wheel m g / 2: the axle under the centre of mass, on the ground) and the statics
+#: without the transfer (the centre of mass on the ground).
+MUTANTS = {
+    "m g / 2 a wheel": {"axleOffset": 0.0, "comHeight": 0.0},
+    "no transfer": {"comHeight": 0.0},
+}
+
+
+@pytest.mark.parametrize("model", MUTANTS.values(), ids=MUTANTS.keys())
+@pytest.mark.parametrize("robot", GEOMETRIES.values(), ids=GEOMETRIES.keys())
+def test_mutation_traction_checks_fail_with_the_old_load(
+    tmp_path: Path, robot: dict[str, Any], model: dict[str, Any]
+) -> None:
+    # measured 13-38 % off with m g / 2 a wheel, 2.9-3.8 % without the transfer (real: 1e-5)
+    for sub in ("launch", "braking"):
+        (tmp_path / sub).mkdir()
+    launch = launch_error(tmp_path / "launch", robot, model)
+    braking = braking_error(tmp_path / "braking", robot, model)
+    assert max(abs(launch), abs(braking)) > 0.01, (launch, braking)
 
 
 def test_the_compiled_and_the_pure_step_agree_with_load_transfer(

@@ -114,6 +114,62 @@ def test_mutation_coast_down_timing_fails_with_backward_euler_on_the_motor(
     assert abs(stop) > 0.02
 
 
+#: Coast-downs with the default, compliant tyres (no closed form: the tyres slip while the
+#: motors brake): the default rover (current-limited braking), a current limit that never
+#: binds, a strong and a weak motor.
+COASTS = [{}, {"maxWheelTorque": 100.0}, {"stallForce": 200.0}, {"stallForce": 60.0}]
+
+
+def coast_stop(tmp_path: Path, rate: int, robot: dict[str, float]) -> float:
+    """When a coast-down from 80 % power falls through 1 mm/s (s after the motors go to 0),
+    logged at every physics step and interpolated between steps, so that the step grid's
+    1.4 % at 100 Hz does not hide what the integration does."""
+    tmp_path.mkdir(exist_ok=True)
+    tr, _ = drive(
+        tmp_path,
+        80,
+        80,
+        3,
+        robot=robot,
+        physics={"rate": rate},
+        timeline=[{"at": 2, "set": {"Ctl.left": 0, "Ctl.right": 0}}],
+        rate_hz=rate,
+    )
+    sel = tr["t"] >= 2
+    t, v = tr["t"][sel] - 2, tr["Rover.speed"][sel]
+    i = int(np.argmax(v <= 1e-3))
+    assert v[0] > 1.0  # a coast-down from speed
+    assert i > 0  # that stops within the run
+    return float(t[i - 1] + (v[i - 1] - 1e-3) / (v[i - 1] - v[i]) * (t[i] - t[i - 1]))
+
+
+def coast_stop_errors(tmp_path: Path) -> list[float]:
+    """Relative error of the stop time at 100 Hz against 3,200 Hz, per rover of COASTS."""
+    return [
+        coast_stop(tmp_path / f"run{i}", 100, robot) / coast_stop(tmp_path / f"ref{i}", 3200, robot)
+        - 1
+        for i, robot in enumerate(COASTS)
+    ]
+
+
+def test_coast_down_stop_time_does_not_depend_on_the_physics_rate(tmp_path: Path) -> None:
+    # issue 31 item 1's target: within 2 % of a fine-step reference (it was +6 %); measured
+    # +0.28 %, +0.45 %, +0.31 % and +0.28 % (backward Euler on the motor: +1.3 % to +2.4 %).
+    # Not "at rest": once the rims stick, the slip-rate tyre's last ~0.3 mm/s decays in a
+    # ~1 ms mode that backward Euler at 100 Hz ends in 3 steps, so the first step at exactly
+    # zero speed is +1.8 % to +3.2 % late at 100 Hz (the rims stop within 0.7 %).
+    errs = coast_stop_errors(tmp_path)
+    assert max(abs(e) for e in errs) < 0.02, errs
+
+
+def test_mutation_coast_down_stop_check_fails_with_backward_euler_on_the_motor(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(wheel, "emf_implicitness", lambda *a: 1.0)
+    errs = coast_stop_errors(tmp_path)
+    assert max(abs(e) for e in errs) > 0.02, errs
+
+
 def test_no_energy_gain_while_coasting(tmp_path: Path) -> None:
     tr, _ = drive(
         tmp_path, 30, 90, 20, timeline=[{"at": 8, "set": {"Ctl.left": 0, "Ctl.right": 0}}]

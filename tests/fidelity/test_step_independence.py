@@ -6,10 +6,10 @@ one through the 1 kg rim, the lateral one through the 30 kg body), whose ratio d
 the step and the masses. A steady drift's yaw rate moved by 12 % between 100 and 1,600 Hz.
 ``wheel.slide`` solves the tyre law with the rim instead. These tests hold the steady drift
 and the convergence of a skid's pose to the targets of the issue; each has a mutation test
-that runs the old scheme (:func:`old_slide`) and shows it fails. (A straight spin-up on ice
-is not here: its peak slip speed is within 1.05 % of a 3,200 Hz run with the old scheme
-and the new alike, a pure longitudinal slip having no direction to get wrong, so a test of
-it could not tell them apart.)
+that runs the old scheme (:func:`old_slide`) and shows it fails. A straight spin-up's peak
+slip is held to its target too (at the bottom); the old scheme passes that one as well (within
+1 %: a pure longitudinal slip has no direction to get wrong), so its mutation test breaks the
+sliding tyre's rim solve instead.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ import pytest
 from rig import ON_AXLE, drive
 
 from amsa_phys.physics import forces
-from amsa_phys.physics.wheel import StepConstants, rim_and_tyre
+from amsa_phys.physics.wheel import StepConstants, rim_and_tyre, slide
 
 #: A rover whose motors out-pull its tyres (600 N stall force a wheel, 40 N m current limit):
 #: left/right power 60/20 % spins the outer wheel and drags the inner one, a steady drift.
@@ -158,3 +158,68 @@ def test_a_skid_pose_converges_with_order_one_with_load_transfer(tmp_path: Path)
     # load onto the drive axle, capped at the traction it allows each step; still first order
     order, _ = skid_order(tmp_path, {})
     assert order >= 0.9
+
+
+# -- spin-up peak slip ----------------------------------------------------------------------------
+#: (ground friction, rover) of the spin-ups: the default rover on ice and on snow-like ground
+#: (its 40 N current limit against 6-13 N of grip), the 600 N-stall rover on wet ground.
+SPIN_UPS = [(0.05, {}), (0.1, {}), (0.3, HOT)]
+
+
+def peak_slip(tmp_path: Path, rate: int, mu: float, robot: dict[str, Any]) -> float:
+    """The largest slip speed, rim minus ground (m/s), of a full-power launch from rest on
+    ground ``mu``, sampled at 400 Hz (every step at 100-400 Hz, every eighth at 3,200 Hz: the
+    peak is a flat maximum ~0.05-0.09 s in, which that sampling moves by < 3e-5 of itself)."""
+    tmp_path.mkdir(exist_ok=True)
+    tr, _ = drive(
+        tmp_path, 100, 100, 0.5, robot=robot, physics={"rate": rate, **ground(mu)}, rate_hz=400
+    )
+    slip = np.maximum(tr["Rover.wheelSpeedL"], tr["Rover.wheelSpeedR"]) - tr["Rover.speed"]
+    return float(slip.max())
+
+
+def spin_up_errors(tmp_path: Path) -> list[tuple[float, float]]:
+    """(peak slip at 3,200 Hz, relative error of the peak at 100 Hz against it), per spin-up."""
+    out = []
+    for i, (mu, robot) in enumerate(SPIN_UPS):
+        ref = peak_slip(tmp_path / f"ref{i}", 3200, mu, robot)
+        out.append((ref, peak_slip(tmp_path / f"run{i}", 100, mu, robot) / ref - 1))
+    return out
+
+
+def test_a_spin_up_peak_slip_does_not_depend_on_the_physics_rate(tmp_path: Path) -> None:
+    # target 3 % (issue 31 item 1: -12 % reported, not reproduced on this model); measured
+    # +0.08 %, +0.16 % and +0.20 %. The peak is the rim at its plateau less the body's speed,
+    # so the rim's fast mode barely enters: backward or forward Euler on the back-EMF moves it
+    # by at most -0.9 % and +1.8 % (not caught here; the coast-down tests catch the former).
+    runs = spin_up_errors(tmp_path)
+    assert min(ref for ref, _ in runs) > 1.0, runs  # 1.3-5.5 m/s of slip: the wheels spin
+    assert max(abs(err) for _, err in runs) < 0.03, runs
+
+
+def rim_not_resolved(
+    u: float,
+    v: float,
+    f0: float,
+    res: float,
+    ivs: float,
+    tyre: tuple[float, float, float, float],
+    side: float,
+    fy_cap: float,
+    s: StepConstants,
+) -> tuple[float, float, float]:
+    """A mutant of ``wheel.slide``: the tyre's forces of the slide, but the rim's next speed of
+    the gripping solve (as if the tyre held): the rim is dragged along with the ground."""
+    fx, fy, _ = slide(u, v, f0, res, ivs, tyre, side, fy_cap, s)
+    _, up = rim_and_tyre(u, v, f0, res, tyre[0] * ivs, s)
+    return fx, fy, up
+
+
+def test_mutation_spin_up_check_fails_when_the_sliding_rim_is_not_solved(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # measured +132 %, +52 % and +23 % (and a peak slip of 1-60 cm/s, not 1.3-5.5 m/s)
+    monkeypatch.setattr(forces, "slide", rim_not_resolved)
+    monkeypatch.setenv("AMSA_PHYS_PURE", "1")
+    runs = spin_up_errors(tmp_path)
+    assert max(abs(err) for _, err in runs) > 0.03, runs
