@@ -3,9 +3,9 @@
 The convention (docs/development.md, "Examples in the docs"): a fenced ```` ```python ```` block
 is run as a script, and each ``$ `` line of a ```` ```console ```` block as a shell command
 (a line ending in ``\\`` continues it; lines without ``$ `` are the output shown). They run in
-order, page by page, in a scratch copy of the project's ``scenarios/``, ``worlds/`` and
-``examples/`` (so an example may write ``runs/...`` or even ``scenarios/rules/...``). An HTML
-comment on the line before a block changes how it runs:
+order, page by page, in a scratch copy of the project's ``scenarios/``, ``worlds/``,
+``examples/`` and ``docs/examples/`` (so an example may write ``runs/...`` or even
+``scenarios/rules/...``). An HTML comment on the line before a block changes how it runs:
 
 - ``<!-- docs-test: skip REASON -->``: shown, not run (a ROS launch on a robot, an install);
 - ``<!-- docs-test: sub "OLD" "NEW" -->``: run with OLD replaced by NEW (a shorter duration or
@@ -38,7 +38,7 @@ PAGES = [
 FENCE = re.compile(r"^([ \t]*)```[ \t]*([\w+-]*)[^\n]*\n(.*?)^\1```[ \t]*$", re.M | re.S)
 MARK = re.compile(r"<!--\s*docs-test:\s*(.*?)\s*-->")
 #: the folders an example may read (copied, so one that writes into them changes nothing)
-TREE = ("scenarios", "worlds", "examples")
+TREE = ("scenarios", "worlds", "examples", "docs/examples")
 
 
 @dataclass

@@ -7,6 +7,7 @@ import re
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 from amsa_phys.cli import reference
 
@@ -61,3 +62,55 @@ def test_every_object_the_api_page_documents_is_a_name_of_ap() -> None:
     short = [n.rpartition(".")[2] for n in names if n != "amsa_phys.errors"]
     missing = [n for n in short if n != "InitContext" and not hasattr(ap, n)]
     assert not missing, f"not importable as ap.NAME: {missing}"
+
+
+def _assets_command() -> Any:
+    """The docs' own script (``docs/make_assets.py``), loaded by its path."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("make_assets", ROOT / "docs" / "make_assets.py")
+    assert spec is not None
+    assert spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_every_picture_is_shown_and_made_by_the_assets_command() -> None:
+    """Each picture in assets/ has a recipe in docs/make_assets.py, and each is shown by the
+    README or a page of the manual (no stale picture, no picture without its command)."""
+    recipes = set(_assets_command().RECIPES)
+    on_disk = {p.name for p in (ROOT / "assets").glob("*.png")}
+    pages = [ROOT / "README.md", *(ROOT / "docs").rglob("*.md")]
+    shown = {m for p in pages for m in re.findall(r"assets/([\w.-]+\.png)", p.read_text())}
+    assert on_disk == recipes, (
+        f"pictures without a recipe or recipes without a picture: {on_disk ^ recipes}"
+    )
+    assert shown == recipes, f"shown but not made, or made but not shown: {shown ^ recipes}"
+
+
+def test_the_assets_command_lists_and_makes_a_picture(tmp_path: Path) -> None:
+    script = [sys.executable, str(ROOT / "docs" / "make_assets.py")]
+    listed = subprocess.run([*script, "--list"], capture_output=True, text=True, check=True)
+    lines = listed.stdout.splitlines()
+    assert len(lines) == len(_assets_command().RECIPES)
+    assert (
+        "mde_architecture.png: amsa-phys graph worlds/mde_challenge.yaml"
+        " -o assets/mde_architecture.png" in lines
+    )
+    done = subprocess.run(
+        [*script, "mde_architecture.png", "--out", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    made = (tmp_path / "mde_architecture.png").read_bytes()
+    assert made.startswith(b"\x89PNG\r\n\x1a\n")
+    assert (
+        made == (ROOT / "assets" / "mde_architecture.png").read_bytes()
+    )  # the recipe is the shipped picture's
+    assert [p.name for p in tmp_path.iterdir()] == ["mde_architecture.png"]  # nothing staged left
+    bad = subprocess.run([*script, "nope.png"], capture_output=True, text=True, check=False)
+    assert bad.returncode == 2
+    assert "unknown picture nope.png" in bad.stderr
