@@ -45,7 +45,8 @@ class GoalPilot(Template):
         if distance < p.radius:
             if not self.arrived:
                 self.arrived = True
-                self.ctx.record_event("arrived", f"{self.path} within {p.radius} m at t={t} s")
+                where = f"{self.path} within {p.radius} m at t={float(t)} s"
+                self.ctx.record_event("arrived", where)
             return {"LeftPower": 0.0, "RightPower": 0.0}
         error = math.atan2(dy, dx) - inp["heading"]
         error = (error + math.pi) % (2 * math.pi) - math.pi  # wrapped to [-pi, pi)

@@ -73,7 +73,7 @@ class Example:
 
     def prepared(self, text: str) -> str:
         for old, new in self.subs:
-            assert old in text, f"{self.id}: docs-test sub {old!r} not found in the block"
+            assert old in self.code, f"{self.id}: docs-test sub {old!r} not found in the block"
             text = text.replace(old, new)
         return text
 
@@ -97,8 +97,23 @@ def _options(example: Example, spec: str) -> None:
             raise ValueError(f"{example.id}: unknown docs-test option {word!r} in {spec!r}")
 
 
+#: a pymdownx.snippets inclusion: ``--8<-- "PATH"`` on a line, or PATH between two ``--8<--``
+SNIPPET = re.compile(r'^--8<-- "([^"]+)"$|^--8<--\n(.*?)\n--8<--$', re.M | re.S)
+
+
+def _expand(body: str) -> str:
+    """A block's text as the site shows it: snippets replaced by the files they name."""
+
+    def included(m: re.Match[str]) -> str:
+        names = [m.group(1)] if m.group(1) else m.group(2).split()
+        return "".join((ROOT / n).read_text() for n in names).rstrip("\n")
+
+    return SNIPPET.sub(included, body)
+
+
 def blocks(page: Path) -> list[tuple[int, str, str, str]]:
-    """(line, language, body dedented, the text just before) of every fenced block."""
+    """(line, language, body dedented and snippets expanded, the text just before) of every
+    fenced block."""
     text = page.read_text()
     found = []
     for m in FENCE.finditer(text):
@@ -110,7 +125,7 @@ def blocks(page: Path) -> list[tuple[int, str, str, str]]:
                 for ln in body.splitlines(keepends=True)
             )
         before = text[: m.start()].rstrip().rsplit("\n", 1)[-1]
-        found.append((line, lang, body, before))
+        found.append((line, lang, _expand(body), before))
     return found
 
 
