@@ -114,3 +114,63 @@ def test_the_assets_command_lists_and_makes_a_picture(tmp_path: Path) -> None:
     bad = subprocess.run([*script, "nope.png"], capture_output=True, text=True, check=False)
     assert bad.returncode == 2
     assert "unknown picture nope.png" in bad.stderr
+
+
+def _manual_text() -> list[str]:
+    """The hand-written documentation, line by line: README and docs/ but the generated CLI
+    reference (which lists everything by construction) and the incoming drafts."""
+    pages = [ROOT / "README.md", *(ROOT / "docs").rglob("*.md")]
+    keep = [p for p in pages if "_incoming" not in p.parts and p.name != "cli.md"]
+    return [line for p in keep for line in p.read_text().splitlines()]
+
+
+def _schema_keys(node: Any, out: set[str]) -> set[str]:
+    if isinstance(node, dict):
+        for key, value in node.items():
+            if key == "properties":
+                out.update(value)
+            _schema_keys(value, out)
+    elif isinstance(node, list):
+        for value in node:
+            _schema_keys(value, out)
+    return out
+
+
+def test_every_yaml_key_is_documented_in_the_manual() -> None:
+    """Every key a world or a scenario may hold is written in code style somewhere in the
+    README or the manual (its table: docs/scenarios.md), so a new key cannot land undocumented."""
+    from amsa_phys.model import schema
+
+    keys = _schema_keys(schema.WORLD, set()) | _schema_keys(schema.SCENARIO, set())
+    assert {"physics", "timeline", "trace_columns", "free_running", "new_phase"} <= keys
+    code = " ".join(c for line in _manual_text() for c in re.findall(r"`([^`]+)`", line))
+    missing = sorted(k for k in keys if not re.search(rf"(?<!\w){re.escape(k)}(?!\w)", code))
+    assert not missing, f"YAML keys the manual never names: {missing}"
+
+
+def test_every_command_and_option_is_documented_in_the_manual() -> None:
+    """Every subcommand appears as `amsa-phys NAME` and every option (by one of its spellings)
+    in the hand-written pages, not only in the generated reference."""
+    import argparse
+
+    from amsa_phys.cli.main import build_parser
+
+    text = "\n".join(_manual_text())
+    missing = []
+
+    def walk(parser: argparse.ArgumentParser, prefix: str) -> None:
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    if f"{prefix} {name}" not in text:
+                        missing.append(f"{prefix} {name}")
+                    walk(sub, f"{prefix} {name}")
+            elif action.option_strings and action.dest not in ("help",):
+                spelt = [
+                    o for o in action.option_strings if re.search(rf"{re.escape(o)}(?![\w-])", text)
+                ]
+                if not spelt:
+                    missing.append(f"{prefix} {'/'.join(action.option_strings)}")
+
+    walk(build_parser(), "amsa-phys")
+    assert len(missing) < 1, f"commands or options the manual never names: {missing}"
