@@ -82,7 +82,7 @@ def test_every_picture_is_shown_and_made_by_the_assets_command() -> None:
     recipes = set(_assets_command().RECIPES)
     on_disk = {p.name for p in (ROOT / "assets").glob("*.png")}
     pages = [ROOT / "README.md", *(ROOT / "docs").rglob("*.md")]
-    shown = {m for p in pages for m in re.findall(r"assets/([\w.-]+\.png)", p.read_text())}
+    shown = {m for p in pages for m in re.findall(r"\]\(assets/([\w.-]+\.png)\)", p.read_text())}
     assert on_disk == recipes, (
         f"pictures without a recipe or recipes without a picture: {on_disk ^ recipes}"
     )
