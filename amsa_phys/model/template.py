@@ -69,10 +69,25 @@ class ParamValues:
 
 
 class InitContext(Protocol):
-    """What ``initialize`` receives from the engine (see ``engine.runner.Context``)."""
+    """What ``initialize`` receives from the engine (``engine.context.Context``).
+
+    Attributes:
+        rng: the Leaf's own ``numpy.random.Generator``, keyed by the scenario's seed and the
+            Leaf's path (split it by purpose with ``rng.spawn(n)``).
+        path: the Leaf's dotted path in the world.
+        world: the loaded world (read only): ``world.leaves[path]`` gives a Leaf's template,
+            parameters and input links.
+
+    ``shared(name, factory)`` returns the run's service ``name`` (the physics world), made by
+    ``factory(sim)`` on first request; ``add_hook(rate_hz, fn, name)`` calls ``fn()`` at
+    ``rate_hz`` after the components due at the same instant (only during ``initialize``);
+    ``record_event(kind, detail)`` records an event at the current simulated time. The manual's
+    tutorial "Your first template" describes each, and how a batch or a ROS node differs.
+    """
 
     rng: Any
     path: str
+    world: Any
 
     def shared(self, name: str, factory: Any) -> Any: ...
 

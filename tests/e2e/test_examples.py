@@ -98,11 +98,17 @@ def test_the_templates_step_many_agrees_with_do_step() -> None:
                 assert many[port][i] == pytest.approx(value, rel=1e-12, abs=1e-9)
 
 
-def test_the_readme_shows_the_example_template_as_it_is() -> None:
-    readme = (ROOT / "README.md").read_text()
+def test_the_manual_shows_the_example_template_as_it_is() -> None:
+    """The README or a page of the manual (docs/templates.md today) shows the file's code."""
+    pages = [ROOT / "README.md", *(ROOT / "docs").rglob("*.md")]
     source = (TEMPLATE_DIR / "pd_follower.py").read_text()
     code = source.split('"""\n\n', 1)[1]  # the module without its docstring
-    assert f"```python\n{code}```" in readme
+    shown = [
+        p.name
+        for p in pages
+        if "_incoming" not in p.parts and f"```python\n{code}```" in p.read_text()
+    ]
+    assert shown, "no page of the README or docs/ shows examples/user_template/pd_follower.py"
 
 
 def test_a_template_without_a_valid_kind_lists_the_kinds(
