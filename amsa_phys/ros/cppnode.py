@@ -93,6 +93,9 @@ def cpp_node(graph: RosGraph, path: str, pkg: str, source: str, bodies: dict[str
         tname=leaf.template.name(),
         freq=hz(leaf.freq),
         header=f"{pkg}/amsa_leaf_node.h",  # pkg is [A-Za-z][A-Za-z0-9_]*: nothing to escape
+        noise_header=f"{pkg}/amsa_noise.h",
+        rng_header=f"{pkg}/amsa_rng.h",
+        path_key=path,
         freq_num=freq.numerator,
         freq_den=freq.denominator,
         topics=Code(sep.join(topics)),

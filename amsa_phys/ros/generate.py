@@ -181,12 +181,14 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
     if cpp:
         files[f"include/{pkg}/amsa_leaf_node.h"] = (FILES / "amsa_leaf_node.h").read_text()
         files[f"include/{pkg}/amsa_pymath.h"] = (FILES / "amsa_pymath.h").read_text()
+        for header in ("amsa_noise.h", "amsa_rng.h", "amsa_ziggurat.h"):  # the sensors' noise
+            files[f"include/{pkg}/{header}"] = (FILES / header).read_text()
     launches = []
     for scenario, fname in zip(scenarios, unique_names(s.name for s in scenarios), strict=True):
         files[f"config/{fname}.yaml"] = yaml_dump(resolved_scenario(scenario))
         files[f"config/{fname}_params.yaml"] = _params_yaml(scenario)
         files[f"launch/{fname}.launch"] = launch_xml(
-            graph, pkg, fname, mode, cpp, source, adapt=bool(scenario.adapt)
+            graph, pkg, fname, mode, cpp, source, adapt=bool(scenario.adapt), seed=scenario.seed
         )
         launches.append(f"{fname}.launch")
     python_nodes = sorted(f for f in files if f.startswith("nodes/"))
