@@ -3,6 +3,11 @@
 // CPython's math module calls them), so a C++ sensor's readings have the Python's very bits.
 #pragma once
 #include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "amsa_rng.h"
 
 namespace amsa {
 
@@ -26,5 +31,58 @@ inline void gauss_markov(double sigma, double tau, double dt, double* phi, doubl
 inline double quantise(double value, double precision) {
   return std::floor(value / precision + 0.5) * precision;
 }
+
+// noise.Channel: the SDFormat noise of one quantity with ``axes`` components, from two
+// streams spawned off ``rng`` (white noise; biases: the turn-on draws, the Gauss-Markov
+// start, then one innovation per axis per step), drawn in the Python's order.
+// ``param(name)`` reads the channel's parameter ``prefix + name`` (the node's p()).
+class Channel {
+ public:
+  Channel(Generator& rng, std::size_t axes) : axes_(axes) {
+    std::vector<Generator> split = rng.spawn(2);
+    white_ = std::make_unique<Generator>(split[0]);
+    bias_ = std::make_unique<Generator>(split[1]);
+    for (std::size_t k = 0; k < axes; ++k) z_.push_back(bias_->standard_normal());  // TurnOn
+    for (std::size_t k = 0; k < axes; ++k) sign_.push_back(bias_->random() < 0.5 ? -1.0 : 1.0);
+    for (std::size_t k = 0; k < axes; ++k) gm_start_.push_back(bias_->standard_normal());
+    b_.assign(axes, 0.0);
+  }
+
+  // Channel.apply: ``values`` (one per axis) measured at ``now``, with the parameters
+  // mean, stddev, bias_mean, bias_stddev, dynamic_bias_*, precision given in that order.
+  template <typename Param>
+  std::vector<double> apply(const std::vector<double>& values, double now, Param param) {
+    const double sigma = param("dynamic_bias_stddev");
+    const double tau = param("dynamic_bias_correlation_time");
+    std::vector<double> g;
+    for (std::size_t k = 0; k < axes_; ++k) g.push_back(bias_->standard_normal());
+    if (!started_) {
+      const double s0 = stationary_std(sigma, tau);
+      for (std::size_t k = 0; k < axes_; ++k) b_[k] = s0 * gm_start_[k];
+    } else {
+      double phi = 1.0, q = 0.0;
+      gauss_markov(sigma, tau, now - t_prev_, &phi, &q);
+      for (std::size_t k = 0; k < axes_; ++k) b_[k] = phi * b_[k] + q * g[k];
+    }
+    started_ = true;
+    t_prev_ = now;
+    const double mean = param("mean"), bm = param("bias_mean"), bs = param("bias_stddev");
+    const double std = param("stddev"), prec = param("precision");
+    std::vector<double> out;
+    for (std::size_t k = 0; k < axes_; ++k) {
+      const double off = mean + sign_[k] * (bm + bs * z_[k]) + b_[k];
+      const double v = values[k] + off + std * white_->standard_normal();
+      out.push_back(prec > 0 ? quantise(v, prec) : v);
+    }
+    return out;
+  }
+
+ private:
+  std::size_t axes_;
+  std::unique_ptr<Generator> white_, bias_;
+  std::vector<double> z_, sign_, gm_start_, b_;
+  double t_prev_ = 0.0;
+  bool started_ = false;
+};
 
 }  // namespace amsa
