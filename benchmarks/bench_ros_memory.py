@@ -119,19 +119,25 @@ def main_bench() -> None:
     """Measure and print."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", default="20", help="the platoon's simulated seconds")
+    parser.add_argument(
+        "--workspace", type=Path, help="a workspace this script built before (skips the build)"
+    )
     args = parser.parse_args()
     missing = [t for t in ("roslaunch", "catkin_make", "unshare") if shutil.which(t) is None]
     if missing or os.geteuid() != 0:
         sys.exit(f"needs ROS 1, unshare and root (missing: {missing or 'root'})")
     with tempfile.TemporaryDirectory() as tmp:
-        ws = Path(tmp) / "ws"
-        t0 = time.perf_counter()
-        build(PLATOON, ws, "--duration", args.duration)
-        print(f"platoon: export and catkin_make                 {time.perf_counter() - t0:.0f} s")
+        ws = args.workspace or Path(tmp) / "ws"
+        if args.workspace is None:
+            t0 = time.perf_counter()
+            build(PLATOON, ws, "--duration", args.duration)
+            print(f"platoon: export and catkin_make             {time.perf_counter() - t0:.0f} s")
         traces = []
         for cpp in ("true", "false"):
             out = ws / f"out_{cpp}"
-            rss, pss, split, wall = measure(ws, f"out:={out}", "plots:=false", f"cpp:={cpp}")
+            rss, pss, split, wall = measure(
+                ws, f"out:={out}", "plots:=false", "force:=true", f"cpp:={cpp}"
+            )
             traces.append((out / "trace.csv").read_bytes())
             print(f"platoon {args.duration} s lockstep, cpp:={cpp}: peak memory (summed)")
             print(f"  RSS {rss / 1024:6.0f} MiB, PSS {pss / 1024:6.0f} MiB; at the RSS peak:")

@@ -3,13 +3,20 @@
 ``tests/fixtures/ros_nodes.yaml`` runs every template with a C++ body (``ros/files/cpp/``):
 the MDE loop (GPS, Compass, DistanceMonitor, FollowerController, NormalizePower), the
 context estimators (GPSLossMonitor on a lossy leader GPS, MotorMonitor on worn motors,
-LeaderMonitor on a turning leader), and an open-loop cart (ConstantPower) whose GPS and
-compass use every noise term (turn-on bias, random-walk and Gauss-Markov biases, latency,
-bursts and losses) and whose GoalMonitor's inputs are written in another order than the
-template's; the timeline changes parameters of the new nodes inside the run. Lockstep must
-reproduce the in-process run byte for byte with the C++ nodes (the default) and with their
-Python twins (``cpp:=false``). Skipped, with the reason, where ROS, catkin, unshare or root
-is missing.
+LeaderMonitor on a turning leader), and an open-loop cart (ConstantPower) whose GPS,
+compass, IMU (with the pose and a lever arm) and wheel odometry use every noise term
+(turn-on bias, random-walk and Gauss-Markov biases, latency, bursts and losses,
+quantisation), with a GpsDistance on its fix and a GoalMonitor whose inputs are written in
+another order than the template's; the timeline changes parameters of the new nodes inside
+the run. Lockstep must reproduce the in-process run byte for byte with the C++ nodes (the
+default) and with their Python twins (``cpp:=false``). Mutation-checked, each mutation
+changing its own columns of the trace: a flipped turn-on sign in the GPS and in the compass,
+a MotorMonitor edge window keeping its first segment, LeaderMonitor taking its fixes 1 ns
+late, GPSLossMonitor's window judged full 2 ns late, the IMU's lever arm with the wrong
+sign, the odometry's chord along the old heading, ConstantPower's left power from
+``right``, GoalMonitor's x from ``goalY``. Skipped, with the reason, where ROS, catkin,
+unshare or root is missing. (catkin_make of its 17 C++ nodes takes minutes on a loaded
+machine: each is an executable of its own compiled against roscpp's headers.)
 """
 
 from __future__ import annotations
