@@ -25,12 +25,25 @@ def cpp_bodies() -> dict[str, str]:
     return {p.stem: p.read_text() for p in sorted((FILES / "cpp").glob("*.inc"))}
 
 
+def _names(text: str) -> list[str]:
+    """``a,b`` as ``["a", "b"]``, and an empty list as ``[]`` (ConstantPower has no inputs)."""
+    return [n for n in text.split(",") if n]
+
+
+def has_cpp(leaf: LeafSpec, bodies: dict[str, str]) -> bool:
+    """Whether ``leaf`` runs as a C++ node: its template has a body and every input port is
+    linked (the body indexes ``in[]`` by the template's ports; an optional port left
+    unlinked, as an IMU without the pose, would shift them: such a Leaf stays in Python)."""
+    ports = [p.name for p in leaf.template.inputs]
+    return leaf.template.name() in bodies and all(p in leaf.inputs for p in ports)
+
+
 def check_cpp_ports(leaf: LeafSpec, body: str) -> None:
     """A C++ body names the ports it indexes: they must be the template's, in order."""
     m = re.match(r"// ports: in=(\S*) out=(\S*)", body)
     want_in = [p.name for p in leaf.template.inputs]
     want_out = [p.name for p in leaf.template.outputs]
-    if m is None or m.group(1).split(",") != want_in or m.group(2).split(",") != want_out:
+    if m is None or _names(m.group(1)) != want_in or _names(m.group(2)) != want_out:
         raise ConfigError(
             f"the C++ body of {leaf.template.name()} does not match its ports",
             key=f"component {leaf.path}",
@@ -60,7 +73,8 @@ def cpp_node(graph: RosGraph, path: str, pkg: str, source: str, bodies: dict[str
         for b in buffers
     ]
     inputs = []
-    for port, buffer in leaf.inputs.items():
+    for port in [p.name for p in leaf.template.inputs]:  # the body's order, not the YAML's
+        buffer = leaf.inputs[port]
         index = buffers.index(buffer) if buffer in buffers else -(1 + outputs.index(buffer))
         inputs.append(f"{{{cpp_string(port)}, {index}}}")
     outs = [
@@ -93,6 +107,10 @@ def cpp_node(graph: RosGraph, path: str, pkg: str, source: str, bodies: dict[str
         tname=leaf.template.name(),
         freq=hz(leaf.freq),
         header=f"{pkg}/amsa_leaf_node.h",  # pkg is [A-Za-z][A-Za-z0-9_]*: nothing to escape
+        noise_header=f"{pkg}/amsa_noise.h",
+        rng_header=f"{pkg}/amsa_rng.h",
+        window_header=f"{pkg}/amsa_window.h",
+        path_key=path,
         freq_num=freq.numerator,
         freq_den=freq.denominator,
         topics=Code(sep.join(topics)),

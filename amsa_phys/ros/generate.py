@@ -32,7 +32,7 @@ from ..model.world import WorldSpec
 from ..runs.resolve import resolved_scenario
 from ..runs.rundir import unique_names
 from . import boundary, names
-from .cppnode import check_cpp_ports, cmake_targets, cpp_bodies, cpp_node, hz
+from .cppnode import check_cpp_ports, cmake_targets, cpp_bodies, cpp_node, has_cpp, hz
 from .graph import RosGraph, classify
 from .launchxml import launch_xml
 from .quote import Code, check_name, cmake_arg, fill, py_string, yaml_comment, yaml_dump
@@ -112,7 +112,7 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
     local = classify(world, scenarios[0].seed)
     graph = RosGraph.of(world, local)
     bodies = cpp_bodies()
-    cpp = [p for p in graph.remote if world.leaves[p].template.name() in bodies]
+    cpp = [p for p in graph.remote if has_cpp(world.leaves[p], bodies)]
     for path in cpp:
         check_cpp_ports(world.leaves[path], bodies[world.leaves[path].template.name()])
     source = ", ".join(Path(s).name for s in sources)
@@ -181,12 +181,14 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
     if cpp:
         files[f"include/{pkg}/amsa_leaf_node.h"] = (FILES / "amsa_leaf_node.h").read_text()
         files[f"include/{pkg}/amsa_pymath.h"] = (FILES / "amsa_pymath.h").read_text()
+        for header in ("amsa_noise.h", "amsa_rng.h", "amsa_ziggurat.h", "amsa_window.h"):
+            files[f"include/{pkg}/{header}"] = (FILES / header).read_text()
     launches = []
     for scenario, fname in zip(scenarios, unique_names(s.name for s in scenarios), strict=True):
         files[f"config/{fname}.yaml"] = yaml_dump(resolved_scenario(scenario))
         files[f"config/{fname}_params.yaml"] = _params_yaml(scenario)
         files[f"launch/{fname}.launch"] = launch_xml(
-            graph, pkg, fname, mode, cpp, source, adapt=bool(scenario.adapt)
+            graph, pkg, fname, mode, cpp, source, adapt=bool(scenario.adapt), seed=scenario.seed
         )
         launches.append(f"{fname}.launch")
     python_nodes = sorted(f for f in files if f.startswith("nodes/"))

@@ -40,6 +40,7 @@ _HEAD = """\
     <param name="sim" type="bool" value="$(arg sim)"/>
     <param name="bag" type="bool" value="$(eval arg('bag') != '')"/>
     <param name="timeout" type="double" value="$(arg timeout)"/>
+    <param name="seed" type="str" value="@@{seed:xml_attr}"/>
     <rosparam param="local">@@{local:xml_text}</rosparam>
   </group>
   <rosparam command="load" file="$(find @@{pkg:xml_attr})/config/@@{fname:xml_attr}_params.yaml"/>
@@ -76,9 +77,11 @@ def launch_xml(
     cpp: list[str],
     source: str,
     adapt: bool = False,
+    seed: int = 0,
 ) -> str:
     """The launch file of the scenario whose config files are ``config/FNAME*.yaml``
-    (``adapt``: it has ``adapt:`` rules, run by the adapt node when ``sim:=false``)."""
+    (``adapt``: it has ``adapt:`` rules, run by the adapt node when ``sim:=false``; ``seed``:
+    the scenario's, ``/amsa/seed``, read by the C++ sensors for their random streams)."""
     data_topics = " ".join(graph.data_topics())
     local = [p for p in graph.world.leaves if p in graph.local]
     lines = [
@@ -110,6 +113,7 @@ def launch_xml(
             simulator=names.SIMULATOR,
             scenario=names.SCENARIO,
             boundary=boundary.NODE,
+            seed=str(seed),
         )
     )
     if adapt:

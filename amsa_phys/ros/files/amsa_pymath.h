@@ -3,6 +3,8 @@
 #pragma once
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace amsa {
 
@@ -76,6 +78,16 @@ inline double py_mod(double vx, double wx) {
     mod = std::copysign(0.0, wx);
   }
   return mod;
+}
+
+// Python's round(x, 6) (Objects/floatobject.c double_round): the decimal string correctly
+// rounded to 6 places (ties to even on the exact binary value, as glibc's printf and
+// CPython's dtoa both do), read back.
+inline double py_round6(double x) {
+  if (!std::isfinite(x)) return x;
+  char buf[400];
+  std::snprintf(buf, sizeof buf, "%.6f", x);
+  return std::strtod(buf, nullptr);
 }
 
 }  // namespace amsa

@@ -1,0 +1,86 @@
+"""The C++ nodes of every shipped template that has one, in lockstep, against ``amsa-phys run``.
+
+``tests/fixtures/ros_nodes.yaml`` runs every template with a C++ body (``ros/files/cpp/``):
+the MDE loop (GPS, Compass, DistanceMonitor, FollowerController, NormalizePower), the
+context estimators (GPSLossMonitor on a lossy leader GPS, MotorMonitor on worn motors,
+LeaderMonitor on a turning leader), and an open-loop cart (ConstantPower) whose GPS,
+compass, IMU (with the pose and a lever arm) and wheel odometry use every noise term
+(turn-on bias, random-walk and Gauss-Markov biases, latency, bursts and losses,
+quantisation), with a GpsDistance on its fix and a GoalMonitor whose inputs are written in
+another order than the template's; the timeline changes parameters of the new nodes inside
+the run. Lockstep must reproduce the in-process run byte for byte with the C++ nodes (the
+default) and with their Python twins (``cpp:=false``). Mutation-checked, each mutation
+changing its own columns of the trace: a flipped turn-on sign in the GPS and in the compass,
+a MotorMonitor edge window keeping its first segment, LeaderMonitor taking its fixes 1 ns
+late, GPSLossMonitor's window judged full 2 ns late, the IMU's lever arm with the wrong
+sign, the odometry's chord along the old heading, ConstantPower's left power from
+``right``, GoalMonitor's x from ``goalY``. Skipped, with the reason, where ROS, catkin,
+unshare or root is missing. (catkin_make of its 17 C++ nodes takes minutes on a loaded
+machine: each is an executable of its own compiled against roscpp's headers.)
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+import ros_launch
+from ros_launch import Launch, build_workspace, ros_missing
+
+from amsa_phys.cli.main import main
+from amsa_phys.model.scenario import load_scenario
+from amsa_phys.ros import names
+from amsa_phys.ros.cppnode import cpp_bodies, has_cpp
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+SCENARIO = ROOT / "tests" / "fixtures" / "ros_nodes.yaml"
+PKG = "rosNodes"
+
+pytestmark = pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing()))
+launcher = ros_launch.launcher  # the fixture
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The exported package, built with catkin in a fresh workspace."""
+    return build_workspace(tmp_path_factory.mktemp("ws"), SCENARIO, PKG)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """``amsa-phys run`` of the same scenario, in-process."""
+    out = tmp_path_factory.mktemp("ref") / "run"
+    assert main(["run", str(SCENARIO), "--headless", "--out", str(out), "-q", "--no-plot"]) == 0
+    return out
+
+
+def _metrics(path: Path) -> dict:
+    data = json.loads((path / "metrics.json").read_text())
+    for key in ("wall_time_s", "real_time_factor"):  # the only fields a wall clock sets
+        data.pop(key)
+    return data
+
+
+def test_the_fixture_runs_every_cpp_template_as_a_cpp_node(workspace: Path) -> None:
+    world = load_scenario(SCENARIO).world
+    bodies = cpp_bodies()
+    ran = {leaf.template.name() for leaf in world.leaves.values() if has_cpp(leaf, bodies)}
+    assert ran == set(bodies)
+    binaries = workspace / "devel" / "lib" / PKG
+    for path, leaf in world.leaves.items():
+        if has_cpp(leaf, bodies):
+            assert (binaries / f"{names.script(path)}_cpp").is_file(), path
+
+
+@pytest.mark.parametrize("cpp", ["true", "false"])
+def test_lockstep_reproduces_the_run_with_cpp_nodes_and_without(
+    workspace: Path, reference: Path, launcher: Callable[..., Launch], cpp: str
+) -> None:
+    out = workspace / f"lockstep_cpp_{cpp}"
+    launch = launcher(workspace, "ros_nodes.launch", f"out:={out}", "plots:=false", f"cpp:={cpp}")
+    text = launch.finish()
+    assert "completed" in text, text[-3000:]
+    assert (out / "trace.csv").read_bytes() == (reference / "trace.csv").read_bytes()
+    assert _metrics(out) == _metrics(reference)
