@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import errno
 import os
 import sys
@@ -11,12 +12,12 @@ from pathlib import Path
 
 from ..errors import ConfigError, one_line
 from ..interop.exporter import export_world
+from ..model.configure import with_overrides
 from ..model.scenario import (
     DEFAULT_LOG_RATE_HZ,
     Phase,
     Scenario,
     load_scenario,
-    parse_setting,
 )
 from ..model.template import Kind
 from ..model.world import load_world
@@ -87,23 +88,23 @@ def _load(path: str, args: argparse.Namespace) -> Scenario:
             print(one_line(f"warning: {note}"), file=sys.stderr)
         return scenario
     world = load_world(path)
-    changes = []
-    for text in args.overrides:
-        change, world = parse_setting(text, world)  # a Leaf's frequency: a new world
-        if change is not None:
-            changes.append(change)
-    sensors = [leaf.freq for leaf in world.leaves.values() if leaf.kind is Kind.SENSOR]
     rate = Fraction(str(args.log_rate)) if args.log_rate else Fraction(DEFAULT_LOG_RATE_HZ)
-    return Scenario(
+    bare = Scenario(
         path=Path(path),
         name=world.name,
         world=world,
         duration=Fraction(str(args.duration or WORLD_DURATION)),
         seed=args.seed or 0,
-        log_rate=max([rate, *sensors]),
+        log_rate=rate,
         quality=None,
-        phases=[Phase(Fraction(0), changes)],
+        phases=[Phase(Fraction(0), [])],
     )
+    # the scenario's own path for --set: physics settings, frequencies, and a key set twice
+    # refused in one line (as `run` and a scenario file do)
+    scenario = with_overrides(bare, list(args.overrides), None)
+    world = scenario.world  # a frequency set by --set counts for the log rate
+    sensors = [leaf.freq for leaf in world.leaves.values() if leaf.kind is Kind.SENSOR]
+    return dataclasses.replace(scenario, log_rate=max([rate, *sensors]))
 
 
 def _ros(args: argparse.Namespace, out: Path) -> int:

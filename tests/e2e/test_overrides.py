@@ -89,3 +89,21 @@ def test_export_ros_warns_as_run_does(tmp_path: Path, capsys: pytest.CaptureFixt
     argv = ["export", "ros", str(SCENARIO2), "-o", str(tmp_path / "pkg"), "--set", f"{KV}=0.2"]
     assert main(argv) == 0
     assert capsys.readouterr().err.splitlines() == ["warning: " + LATER.format(option="--set")]
+
+
+def test_export_ros_of_a_bare_world_refuses_a_parameter_set_twice(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A bare world goes through the same --set path as a scenario: no silent last value,
+    and a single --set reaches the package's parameters."""
+    world = ROOT / "worlds" / "mde_challenge.yaml"
+    argv = ["export", "ros", str(world), "-o", str(tmp_path / "twice")]
+    assert main([*argv, "--set", f"{KV}=0.1", "--set", f"{KV}=0.2"]) == 2
+    assert capsys.readouterr().err == (
+        f"error: --set {KV}: set twice, '{KV}=0.1' and '{KV}=0.2': give one value\n"
+    )
+    assert not (tmp_path / "twice").exists()
+    once = ["export", "ros", str(world), "-o", str(tmp_path / "once"), "--set", f"{KV}=0.125"]
+    assert main(once) == 0
+    params = (tmp_path / "once" / "config" / "mdeChallenge_params.yaml").read_text()
+    assert "Kv: 0.125" in params
