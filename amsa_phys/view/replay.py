@@ -280,19 +280,34 @@ class ReplayScene:
             quality=self.quality,
             phase_index=index,
             phase_count=len(self.phases),
-            phase_text=self.phase_text(index),
+            phase_text=self.phase_text(index, t),
             duration=self.duration,
             pair_lines=self.quality is not None,
             collisions=[xy for at, xy in self._hits if at <= t],
             zones=self.zones(t),
         )
 
-    def phase_text(self, index: int) -> str:
-        """The HUD's phase line, as the live window words it."""
+    def phase_text(self, index: int, t: float | None = None) -> str:
+        """The HUD's phase line at time ``t``, as the live window words it: the phase's
+        values, each changed inside the phase by ``t`` (timeline or live) replaced by the
+        value in force and when it landed (``Kv=0.15 at 20.0 s``, ``live at`` for the window's)."""
         if not self.phases:
             return "phase 0"
         p = self.phases[index]
-        sets = [f"{k.rpartition('.')[2]}={v}" for k, v in (p.get("set") or {}).items()]
+        inside: dict[str, tuple[float, object, str]] = {}
+        for c in p.get("changes") or []:
+            if t is None or float(c["at"]) <= t:
+                how = "live at" if c.get("label") == "live" else "at"
+                for k, v in (c.get("set") or {}).items():
+                    inside[k] = (float(c["at"]), v, how)
+        sets = [
+            f"{k.rpartition('.')[2]}={v}"
+            for k, v in (p.get("set") or {}).items()
+            if k not in inside
+        ]
+        sets += [
+            f"{k.rpartition('.')[2]}={v} {how} {at:.1f} s" for k, (at, v, how) in inside.items()
+        ]
         return phase_line(index, len(self.phases), p.get("label", ""), float(p["start"]), sets)
 
     def series(self, column: str, row: int, span_s: float) -> tuple[np.ndarray, np.ndarray]:

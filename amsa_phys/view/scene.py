@@ -126,20 +126,27 @@ def describe_phase(sim: Simulation, planned: Sequence[Fraction] | None = None) -
     override) is listed once, with the value in force. A live change made in this phase
     (the window's panel) is in force now and the phase's own value no longer is: it
     replaces that value in the line and says when it landed (``Kv=0.35 live at 130.2 s``),
-    so the HUD never shows a value the run is not using. ``planned``: the file's phase
-    starts and duration when ``--duration`` shortened the run (``Scenario.planned_bounds``):
+    and so does a timeline step that starts no phase (``new_phase: false``) once applied
+    (``Kv=0.15 at 20.0 s``): the HUD never shows a value the run is not using. ``planned``:
+    the file's phase starts and duration when ``--duration`` shortened the run (``Scenario.planned_bounds``):
     the count is then the file's, and the line says where this run stops.
     """
     phase = sim.phases[sim.phase_index]
-    live: dict[tuple[str, str], tuple[Any, Any]] = {}
+    live: dict[tuple[str, str], tuple[Any, Any, str]] = {}
+    # changes made inside this phase and already in force: the timeline's
+    # ``new_phase: false`` steps, then the window's live changes (in time order)
+    for point in sim.timeline.points():
+        if phase.at < point.at <= sim.now and not point.starts_phase:
+            for c in point.changes:
+                live[(c.leaf, c.param)] = (point.at, c.value, "at")
     for at, c in sim.live_changes:
         if at >= phase.at:
-            live[(c.leaf, c.param)] = (at, c.value)
+            live[(c.leaf, c.param)] = (at, c.value, "live at")
     latest: dict[tuple[str, str], Any] = {}
     for c in phase.changes:  # the last assignment of a key wins, in its first place
         latest[(c.leaf, c.param)] = c.value
     parts = [f"{p}={_short(v)}" for (leaf, p), v in latest.items() if (leaf, p) not in live]
-    parts += [f"{p}={_short(v)} live at {float(at):.1f} s" for (_, p), (at, v) in live.items()]
+    parts += [f"{p}={_short(v)} {how} {float(at):.1f} s" for (_, p), (at, v, how) in live.items()]
     count = len(planned) - 1 if planned else len(sim.phases)
     text = phase_line(sim.phase_index, count, phase.label, float(phase.at), parts)
     if planned and sim.duration < planned[-1]:

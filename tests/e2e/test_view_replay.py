@@ -461,3 +461,35 @@ def test_a_run_quit_from_a_real_window_says_in_its_plots_where_it_was_cut(
     cut = f" — cut at {ran:g} s of 500 s (closed in the window)"
     assert len(titles) == 2
     assert all(title.endswith(cut) for title in titles), titles
+
+
+def test_hud_shows_the_value_in_force_after_a_change_inside_a_phase(tmp_path: Path) -> None:
+    """A timeline step with ``new_phase: false`` changes Kv inside phase 0: from then on the
+    live window's HUD and the replay's say the new value and when it landed, never the
+    phase's old one (a stale HUD showed Kv=0.35 at t = 40 s after Kv=0.15 at 20 s)."""
+    world = (Path(__file__).resolve().parents[2] / "worlds" / "mde_challenge.yaml").as_posix()
+    scen = tmp_path / "inside.yaml"
+    scen.write_text(
+        f"world: {world}\nduration: 40\nseed: 1\n"
+        "set: {MyFollowerController.Kv: 0.35}\n"
+        "timeline:\n  - {at: 20, set: {MyFollowerController.Kv: 0.15}, new_phase: false}\n"
+    )
+    from amsa_phys.engine.runner import Simulation
+    from amsa_phys.view.scene import describe_phase
+
+    sim = Simulation.from_scenario(load_scenario(scen))
+    sim.initialize()
+    sim.advance(sim.grid.ticks(10))
+    assert describe_phase(sim).endswith(": Kv=0.35")
+    sim.advance(sim.grid.ticks(30))
+    line = describe_phase(sim)
+    assert "Kv=0.15 at 20.0 s" in line
+    assert "Kv=0.35" not in line
+    out = tmp_path / "run"
+    assert main(["run", str(scen), "--headless", "-q", "--no-plot", "--out", str(out)]) == 0
+    p = Player(load_run(out), title="test", size=(640, 360))
+    early = p.scene.frame(int(np.searchsorted(p.scene.t, 10.0))).phase_text
+    late = p.scene.frame(len(p.scene.t) - 1).phase_text
+    assert early.endswith(": Kv=0.35")
+    assert "Kv=0.15 at 20.0 s" in late
+    assert "Kv=0.35" not in late
