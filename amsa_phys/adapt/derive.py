@@ -72,6 +72,14 @@ def derive(
     tuned = [a for a in axes if a not in context_axes]
     if not tuned:
         raise ConfigError("no tuned axis: every axis is a context", file=results)
+    if not context_axes:
+        # one context only: there is nothing for a rule to tell apart (a Kv-only sweep)
+        raise ConfigError(
+            f"no context axis: the sweep's axes ({', '.join(axes)}) are all tuned; sweep a "
+            "'context' axis (the scenario's sweep.contexts) or a parameter an estimator "
+            "watches, so rules have contexts to tell apart",
+            file=results,
+        )
     base = _base_values(scenario)
     cells: dict[tuple[Any, ...], Cell] = {}
     scores: dict[tuple[Any, ...], dict[tuple[Any, ...], list[float]]] = {}

@@ -251,3 +251,25 @@ def test_sweeps_of_adaptive_runs_batched_equal_pool(tmp_path: Path) -> None:
         assert main([*argv, "-j", "1", "--executor", executor, "--out", str(out)]) == 0
         rows.append((out / "results.csv").read_text())
     assert rows[0] == rows[1]
+
+
+def test_adapt_on_a_sweep_without_a_context_axis_is_refused(tmp_path: Path, capsys) -> None:
+    """A Kv-only sweep has one context: nothing for a rule to tell apart. The command says so
+    in one line (exit 2) instead of printing an empty cell and writing ``adapt: []``."""
+    sweep = tmp_path / "sweep"
+    sweep.mkdir()
+    rows = (FIXTURE / "results.csv").read_text().splitlines()
+    header = rows[0].split(",")
+    keep = [i for i, name in enumerate(header) if name != "context"]
+    nominal = [r for r in rows[1:] if "nominal" in r.split(",")]
+    sweep.joinpath("results.csv").write_text(
+        "\n".join(",".join(r.split(",")[i] for i in keep) for r in [rows[0], *nominal]) + "\n"
+    )
+    out = tmp_path / "rules.yaml"
+    argv = ["adapt", str(sweep), "--scenario", str(FIXTURE / "sweep.yaml"), "-o", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "results.csv" in err
+    assert "no context axis" in err
+    assert not out.exists()
