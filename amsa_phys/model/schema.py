@@ -347,6 +347,12 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
             for key in inst:
                 if str(key) not in known and did_you_mean(str(key), [missing]):
                     return (*path, key), f"unknown key (did you mean {missing}?)"
+        if not path and missing == "world" and isinstance(inst, dict) and "components" in inst:
+            # a world file where a scenario is wanted (``run worlds/x.yaml``): say which is which
+            return path, (
+                "missing required key 'world': this is a world file (it has 'components'); "
+                "a scenario names it (world: FILE) — see scenarios/*.yaml"
+            )
         return path, f"missing required key '{missing}'"
     if kind == "type":
         want = err.validator_value

@@ -72,3 +72,16 @@ def test_a_headless_run_imports_no_jsonschema_tqdm_or_mcap(tmp_path: Path) -> No
         [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=tmp_path
     )
     assert out.stdout.strip().splitlines()[-1] == "[]", out.stdout
+
+
+def test_a_world_file_given_where_a_scenario_is_wanted_says_so(capsys) -> None:
+    """``run worlds/x.yaml``: the one line names the file and says it is a world, which a
+    scenario names, instead of only "missing required key 'world'"."""
+    from amsa_phys.cli.main import main
+
+    world = Path(__file__).resolve().parents[2] / "worlds" / "mde_challenge.yaml"
+    assert main(["run", str(world), "--headless", "--no-plot"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert f"{world}:" in err
+    assert "this is a world file" in err
