@@ -21,6 +21,29 @@ def _dwell_text(q: dict[str, Any]) -> str:
     return "10 s (a tenth of a shorter block)" if dwell is None else f"{dwell:g} s"
 
 
+#: adapt switches listed in the summary; the rest are counted (all are in metrics.json)
+SHOWN_SWITCHES = 5
+
+
+def adapt_line(switches: list[dict[str, Any]]) -> str:
+    """``adapt: 3 switches: at 40.1 s rule 2 (random leader): Kv=0.25; ...`` — the rules that
+    fired, as live changes are shown in the table (the values without their estimates)."""
+    parts = []
+    for e in switches[:SHOWN_SWITCHES]:
+        rule, _, rest = str(e.get("detail", "")).partition(": ")
+        sets = rest.rsplit(" (", 1)[0]
+        short = ", ".join(
+            p.split("=", 1)[0].rsplit(".", 1)[-1] + "=" + p.split("=", 1)[-1]
+            for p in sets.split(", ")
+            if p
+        )
+        parts.append(f"at {float(e['t']):g} s {rule}: {short}")
+    more = len(switches) - SHOWN_SWITCHES
+    tail = f"; {more} more in metrics.json's events" if more > 0 else ""
+    n = len(switches)
+    return f"adapt: {n} switch{'es' if n != 1 else ''}: " + "; ".join(parts) + tail
+
+
 def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> None:
     """Per-phase metrics, the overall line, speed and where the files are."""
     cols = (
@@ -63,6 +86,9 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
     for r in rows:
         text = "  ".join(v.ljust(w) for v, w in zip(r, widths, strict=True)).rstrip()
         print(one_line(text), file=stream)
+    switches = [e for e in metrics.get("events") or [] if e.get("kind") == "adapt"]
+    if switches:
+        print(one_line(adapt_line(switches)), file=stream)
     if metrics["overall"].get("partial"):
         print(
             f"(cut): the run stopped at t={metrics['simulated']:g} s, inside this block; "

@@ -273,3 +273,25 @@ def test_adapt_on_a_sweep_without_a_context_axis_is_refused(tmp_path: Path, caps
     assert "results.csv" in err
     assert "no context axis" in err
     assert not out.exists()
+
+
+def test_run_prints_the_rules_that_fired(tmp_path: Path, capsys) -> None:
+    """The terminal summary names each adapt switch, as the table names live changes."""
+    scenario = ROOT / "scenarios" / "adaptive.yaml"
+    argv = ["run", str(scenario), "--headless", "--no-plot", "--duration", "100"]
+    assert main([*argv, "--out", str(tmp_path / "run")]) == 0
+    out = capsys.readouterr().out
+    line = next(x for x in out.splitlines() if x.startswith("adapt:"))
+    assert line.startswith("adapt: 2 switches: at 40.1 s rule 2 (random leader): Kv=0.25; ")
+    assert "at 57.1 s rule 1 (nominal): Kv=0.15" in line
+    assert main([*argv, "--no-adapt", "--out", str(tmp_path / "off")]) == 0
+    assert "adapt:" not in capsys.readouterr().out
+
+
+def test_the_adapt_line_counts_what_it_does_not_show() -> None:
+    from amsa_phys.cli.report import adapt_line
+
+    events = [{"t": float(i), "detail": f"rule {i} (r): Leaf.Kv={i} (Est.x=1)"} for i in range(7)]
+    line = adapt_line(events)
+    assert line.startswith("adapt: 7 switches: at 0 s rule 0 (r): Kv=0; at 1 s")
+    assert line.endswith("; 2 more in metrics.json's events")
