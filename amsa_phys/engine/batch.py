@@ -27,7 +27,6 @@ run leaf by leaf to ~1e-12, not bit for bit (the tests hold it to that).
 
 from __future__ import annotations
 
-import operator
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -68,18 +67,27 @@ class ParamArrays:
 
 
 class Group:
-    """Members of one group, with their inputs and outputs resolved to buffer names."""
+    """Members of one group, each port resolved to the members' positions in the store.
+
+    A port's positions are a :data:`Columns`: a slice when they are evenly spaced (copies
+    of one Composite in a single run; one leaf across the runs of a batch, consecutive), a
+    fancy index otherwise; either way a whole port moves in one numpy call.
+    """
 
     def __init__(self, tasks: Sequence[Any]) -> None:
         self.tasks = list(tasks)
         self.paths = [t.path for t in tasks]
         self.comps = [t.comp for t in tasks]
         self.template = type(self.comps[0])
-        first = dict(tasks[0].inputs)
-        self.inputs: list[tuple[str, Callable[[dict[str, float]], tuple[float, ...]]]] = [
-            (port, _gather([dict(t.inputs)[port] for t in tasks])) for port in first
+        first = dict(tasks[0].reads)
+        #: input port -> where the members' values sit in the store
+        self.inputs: list[tuple[str, Columns]] = [
+            (port, columns([dict(t.reads)[port] for t in tasks])) for port in first
         ]
-        self.outputs = {port: [t.targets[port] for t in tasks] for port in tasks[0].targets}
+        #: output port -> the members' positions, as a list (a delayed group's writes)
+        self.targets = {port: [t.writes[port] for t in tasks] for port in tasks[0].writes}
+        #: output port -> the same positions as a slice or index array
+        self.outputs = {port: columns(at) for port, at in self.targets.items()}
         self.params = ParamArrays(self.comps)
         #: the members' common delay line (they share one latency and have no jitter)
         self.delay = tasks[0].delay
@@ -87,12 +95,19 @@ class Group:
         self.state: dict[str, Any] = {}
 
 
-def _gather(names: list[str]) -> Callable[[dict[str, float]], tuple[float, ...]]:
-    """The values of ``names`` as a tuple (``itemgetter`` of one name gives a bare value)."""
-    if len(names) == 1:
-        name = names[0]
-        return lambda values: (values[name],)
-    return operator.itemgetter(*names)
+#: Where a group's port sits in the store's array: a slice, or an index array.
+Columns = slice | np.ndarray
+
+
+def columns(positions: Sequence[int]) -> Columns:
+    """``positions`` as a slice if evenly spaced and increasing (a view, no index array),
+    else as an index array."""
+    n = len(positions)
+    first = positions[0]
+    step = positions[1] - first if n > 1 else 1
+    if step > 0 and all(positions[k] == first + k * step for k in range(n)):
+        return slice(first, first + n * step, step)
+    return np.array(positions, dtype=np.intp)
 
 
 @dataclass(frozen=True)

@@ -96,12 +96,16 @@ class Simulation:
         self.log_rate = Fraction(log_rate)
         self.shared: dict[str, Any] = {}
         self.events: list[Event] = []
-        #: every buffer's value (``store.py``); read from outside with :meth:`read`
-        self.store = BufferStore({n: b.initial for n, b in world.buffers.items()}, world.arrays)
-        self.values: dict[str, float] = self.store.values
+        initial = {n: b.initial for n, b in world.buffers.items()}
+        if adapt:
+            initial[RULE_COLUMN] = 0.0
+        #: every buffer's value, one float64 array (``store.py``); read with :meth:`read`
+        self.store = BufferStore(initial, world.arrays)
+        #: the same values by name (a view: tests and listeners speak names)
+        self.values = self.store.values
         #: the buffers of a trace row, in order (all of them unless ``trace_columns:`` chose)
         self.columns = list(world.buffers) if columns is None else list(columns)
-        self.log = RunLog(self.columns, trace, quality_signal)
+        self.log = RunLog(self.columns, trace, quality_signal, self.store.at, self.values)
         self._hooks: list[tuple[Fraction, Hook, str]] = []
         self.components: dict[str, Template] = {}
         self._wrap = wrap
@@ -125,11 +129,9 @@ class Simulation:
         self._sources: list[InstantSource] = []
         self._next_instant_tick: float = math.inf  # deliveries' or sources', the earliest
         self._next_source_tick: float = math.inf  # the instant sources' alone
-        self._steppers = Steppers(self.values, self._send, self._who)
+        self._steppers = Steppers(self.store.data, self._send, self._who, self.store.col)
         #: ``adapt:`` rules (``engine/adapt.py``), asked at every instant with components
         self._adapt = AdaptRules(adapt, self._param_value) if adapt else None
-        if adapt:
-            self.values[RULE_COLUMN] = 0.0
         self._build()
 
     @classmethod
@@ -269,6 +271,7 @@ class Simulation:
         task.phase = g.ticks(self.timer_phases[path])
         if leaf.timing.delayed:
             task.delay = DelayLine(leaf, g.tick, self.seed)
+        task.bind(self.store.at)
         return task
 
     def _plan_groups(self, cycle: list[schedule.Instant]) -> None:
@@ -332,7 +335,7 @@ class Simulation:
         table = self._table
         end = self._end
         cursor = self._cursor
-        record, values = self.log.record, self.values
+        record, values = self.log.record, self.store.data
         num, den = self._tick_num, self._tick_den
         try:
             while cursor <= until:
@@ -400,7 +403,7 @@ class Simulation:
         ``tick``: deliveries of delayed outputs, then each instant source's changes (the
         timeline's first; ``instants.py``). Afterwards ``_next_instant_tick`` is the next
         tick at which any of them is due, so the hot loop makes one comparison for all."""
-        nxt = self.deliveries.deliver(tick, self.values)
+        nxt = self.deliveries.deliver(tick, self.store.data)
         if self._next_source_tick <= tick:
             for source in self._sources:
                 if source.next_tick() <= tick:
@@ -416,7 +419,7 @@ class Simulation:
             self._next_source_tick = min(s.next_tick() for s in self._sources)
         self._next_instant_tick = min(nxt, self._next_source_tick)
 
-    def _send(self, line: DelayLine, writes: list[tuple[str, float]]) -> None:
+    def _send(self, line: DelayLine, writes: list[tuple[int, float]]) -> None:
         """Put a delayed Leaf's publication in flight: visible from ``line.due(now)``."""
         due = line.due(self._tick)
         self.deliveries.push(due, writes)
@@ -426,7 +429,7 @@ class Simulation:
     def in_flight(self, buffer: str) -> int:
         """How many publications of ``buffer`` are sent but not yet visible (the ROS
         simulator tells a node which message its reader sees by this)."""
-        return self.deliveries.in_flight(buffer)
+        return self.deliveries.in_flight(self.store.at(buffer))
 
     def add_log_listener(self, fn: Callable[[float, dict[str, float]], None]) -> None:
         """Call ``fn(t_s, values)`` at every logged instant, after the trace row.
