@@ -142,13 +142,13 @@ def group_key(task: Any, freq: Fraction) -> tuple[Any, ...] | None:
 
 def plan(
     instants: Sequence[Sequence[Any]],
-    keys: dict[str, tuple[Any, ...] | None],
+    keys: dict[tuple[int, str], tuple[Any, ...] | None],
     min_group: int | None = None,
     enabled: bool = True,
 ) -> list[list[Any]]:
     """Each instant's tasks with the allowed groups merged in (a :class:`Group` per group).
 
-    ``keys`` maps a task's path to its :func:`group_key`; groups smaller than ``min_group``
+    ``keys`` maps a task's :func:`ident` to its :func:`group_key`; groups smaller than ``min_group``
     (default :data:`MIN_GROUP`) are not formed, nor any if not ``enabled`` (the caller's
     choice: a run compared with its leaf-by-leaf self). Groups that would change what any
     component reads at any instant are dropped everywhere, then the rest re-checked.
@@ -163,7 +163,7 @@ def plan(
             members: dict[tuple[Any, ...], list[Any]] = {}
             if enabled:
                 for t in tasks:
-                    key = keys.get(t.path)
+                    key = keys.get(ident(t))
                     if key is not None and key not in banned:
                         members.setdefault(key, []).append(t)
             groups = {k: v for k, v in members.items() if len(v) >= smallest}
@@ -187,7 +187,7 @@ def _merged(
             seq.append(t)
         elif key not in placed:
             placed.add(key)
-            paths = tuple(m.path for m in groups[key])
+            paths = tuple(ident(m) for m in groups[key])
             if paths not in cache:
                 cache[paths] = Group(groups[key])
             seq.append(cache[paths])
@@ -197,30 +197,37 @@ def _merged(
 def _breaks(
     tasks: Sequence[Any],
     seq: Sequence[Any],
-    keys: dict[str, tuple[Any, ...] | None],
+    keys: dict[tuple[int, str], tuple[Any, ...] | None],
     groups: dict[tuple[Any, ...], list[Any]],
 ) -> set[tuple[Any, ...]]:
-    """Group keys whose merging would change a read at this instant."""
-    pos = {t.path: i for i, t in enumerate(tasks)}
-    slot: dict[str, int] = {}
+    """Group keys whose merging would change a read at this instant (a reader reads the
+    writers of its own run)."""
+    pos = {ident(t): i for i, t in enumerate(tasks)}
+    slot: dict[tuple[int, str], int] = {}
     for i, item in enumerate(seq):
-        for path in item.paths if isinstance(item, Group) else [item.path]:
-            slot[path] = i
+        for t in item.tasks if isinstance(item, Group) else [item]:
+            slot[ident(t)] = i
     bad: set[tuple[Any, ...]] = set()
     for r in tasks:
+        me = ident(r)
         for _, buf in r.inputs:
-            w = buf.rpartition(".")[0]
-            if w not in pos or w == r.path or tasks[pos[w]].delay is not None:
+            w = (r.run, buf.rpartition(".")[0])
+            if w not in pos or w == me or tasks[pos[w]].delay is not None:
                 continue  # a delayed writer's outputs are never read in the same instant
-            before = pos[w] < pos[r.path]
-            same = slot[w] == slot[r.path]
-            if (not before) if same else ((slot[w] < slot[r.path]) == before):
+            before = pos[w] < pos[me]
+            same = slot[w] == slot[me]
+            if (not before) if same else ((slot[w] < slot[me]) == before):
                 continue
-            for path in (w, r.path):
+            for path in (w, me):
                 key = keys.get(path)
                 if key in groups:
                     bad.add(key)  # type: ignore[arg-type]
     return bad
+
+
+def ident(task: Any) -> tuple[int, str]:
+    """What tells tasks apart: (run, path); the runs of a batch share their paths."""
+    return (task.run, task.path)
 
 
 def first_bad(arr: np.ndarray, published: np.ndarray | None) -> int | None:

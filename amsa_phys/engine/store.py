@@ -39,8 +39,12 @@ from __future__ import annotations
 import threading
 from array import array
 from collections.abc import Iterable, Iterator, Mapping, MutableMapping, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..model.world import WorldSpec
 
 
 class BufferStore:
@@ -69,6 +73,20 @@ class BufferStore:
         self.values = NamedValues(self, 0)
         #: held while instants execute; outside writers take it too (one owner: here)
         self.lock = threading.RLock()
+
+    @classmethod
+    def of_worlds(cls, worlds: Sequence[WorldSpec], extra: Sequence[str] = ()) -> BufferStore:
+        """The store of a batch of runs of ``worlds`` (one world per run, one structure),
+        each buffer at its world's initial value; ``extra`` buffers (the rule column of
+        ``adapt:``) start at 0 in every run."""
+        first = worlds[0]
+        initial = {n: b.initial for n, b in first.buffers.items()}
+        initial.update((name, 0.0) for name in extra)
+        store = cls(initial, first.arrays, runs=len(worlds))
+        for run, world in enumerate(worlds[1:], 1):
+            for name, buf in world.buffers.items():
+                store.data[store.at(name, run)] = float(buf.initial)
+        return store
 
     @property
     def names(self) -> list[str]:
@@ -157,3 +175,27 @@ class NamedValues(MutableMapping[str, float]):
 
     def __contains__(self, name: object) -> bool:
         return name in self._index
+
+
+class ReadAPI:
+    """The public read API of a simulation over its :attr:`store` (``Simulation``'s)."""
+
+    store: BufferStore
+
+    def read(self, buffer: str, run: int = 0) -> float:
+        """The current value of Data ``buffer`` (``Component.port``) in run ``run``; safe
+        from any thread, and never waits (the module docstring says why)."""
+        return self.store.read(buffer, run)
+
+    def read_many(self, buffers: Sequence[str], run: int = 0) -> np.ndarray:
+        """The current values of ``buffers`` as one float64 array, read together."""
+        return self.store.read_many(buffers, run)
+
+    def column(self, buffer: str) -> np.ndarray:
+        """Data ``buffer`` in every run of a batch, in run order (a copy)."""
+        return self.store.column(buffer)
+
+    def write(self, buffer: str, value: float) -> None:
+        """Set Data ``buffer`` from outside the loop (another thread); visible from the next
+        instant, never in the middle of one."""
+        self.store.write(buffer, value)

@@ -114,6 +114,14 @@ def checked_writes(
         raise bad_output(who(task.path), now, targets, out) from None
 
 
+def in_run(fault: RunFault, run: int | None) -> RunFault:
+    """``fault`` marked as run ``run``'s, unless already marked: a batch (``multirun.py``)
+    makes that run alone, which says what went wrong; unmarked, no one run is to blame."""
+    if getattr(fault, "run", None) is None:
+        fault.run = run  # type: ignore[attr-defined]
+    return fault
+
+
 def bad_output(who: str, now: Fraction, targets: Mapping[str, Any], out: Any) -> RunFault:
     """The fault for the first output :func:`checked_writes` refused (a slow path)."""
     if not isinstance(out, Mapping):
@@ -328,7 +336,8 @@ class Steppers:
                     ) from None
             k = batch.first_bad(arr, published)
             if k is not None:
-                raise RunFault(who(group.paths[k]), now, f"output {port} is {arr[k]}")
+                fault = RunFault(who(group.paths[k]), now, f"output {port} is {arr[k]}")
+                raise in_run(fault, group.tasks[k].run)
             if group.delay is not None:  # the copies' common latency (no jitter: batch.py)
                 pairs = zip(group.targets[port], arr.tolist(), strict=True)
                 mask = None if published is None else published.tolist()
