@@ -16,6 +16,8 @@ import math
 from collections.abc import MutableMapping
 from typing import Any
 
+import numpy as np
+
 
 class Deliveries:
     """Publications in flight: (due tick, sequence number, [(buffer, value), ...])."""
@@ -36,16 +38,35 @@ class Deliveries:
         """The tick of the earliest publication in flight (``math.inf``: none)."""
         return self._heap[0][0] if self._heap else math.inf
 
-    def deliver(self, tick: int, values: MutableMapping[Any, float] | Any) -> float:
+    def deliver(
+        self, tick: int, values: MutableMapping[Any, float] | Any, col: np.ndarray | None = None
+    ) -> float:
         """Write every publication due at or before ``tick`` into ``values`` (the store's
         array), in order; return the tick the next one is due (``math.inf``: none), as
-        :meth:`next_due`."""
+        :meth:`next_due`. A group's publication is whole columns, ``(positions, array)``
+        with positions a slice or an index array, written through ``col`` (the store's
+        numpy view) in one call."""
         heap = self._heap
         while heap and heap[0][0] <= tick:
             for at, value in heapq.heappop(heap)[2]:
-                values[at] = value
+                if col is None or type(at) is int:
+                    values[at] = value
+                else:
+                    col[at] = value
         return heap[0][0] if heap else math.inf
 
     def in_flight(self, buffer: Any) -> int:
         """How many publications of ``buffer`` are sent but not yet visible."""
-        return sum(1 for _, _, writes in self._heap for b, _ in writes if b == buffer)
+        return sum(
+            1
+            for _, _, writes in self._heap
+            for at, _ in writes
+            if (at == buffer if type(at) is not slice and np.ndim(at) == 0 else _holds(at, buffer))
+        )
+
+
+def _holds(at: slice | np.ndarray, position: Any) -> bool:
+    """Whether a column write to ``at`` writes ``position``."""
+    if type(at) is slice:
+        return type(position) is int and position in range(at.start, at.stop, at.step or 1)
+    return bool((at == position).any())

@@ -23,7 +23,8 @@ class RunLog:
     """Trace, quality samples and listeners of one run (see the module docstring).
 
     ``at(name)`` is a buffer's position in the store's array (identity for a dict by
-    name); ``named`` is the same values by name, what listeners receive.
+    name); ``named`` is the same values by name, what listeners receive; ``col`` the store's
+    numpy view, from which a writer with ``packed_rows`` takes its rows.
     """
 
     def __init__(
@@ -33,6 +34,7 @@ class RunLog:
         quality: str | None,
         at: Callable[[str], Any] = lambda name: name,
         named: Mapping[str, float] | None = None,
+        col: np.ndarray | None = None,
     ) -> None:
         self.columns = list(columns)
         self.named = named
@@ -48,6 +50,12 @@ class RunLog:
         self.row: Callable[[Any], Sequence[float]] = (
             operator.itemgetter(*cols) if len(cols) > 1 else lambda v: [v[c] for c in cols]
         )
+        if col is not None and getattr(trace, "packed_rows", False):
+            # a writer that stores packed doubles (``tracemem.py``) takes the row as one
+            # float64 array: copied from the store's array in C, no float object per value
+            where = np.array(cols, dtype=np.intp)
+            take = col.take
+            self.row = lambda _values: take(where)
 
     def record(self, t_s: float, values: Any) -> None:
         """Log the instant at ``t_s`` seconds from ``values`` (the store's array): trace

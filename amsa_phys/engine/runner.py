@@ -113,7 +113,9 @@ class Simulation(ReadAPI):
         self.values = self.store.values
         #: the buffers of a trace row, in order (all of them unless ``trace_columns:`` chose)
         self.columns = list(world.buffers) if columns is None else list(columns)
-        self.log = RunLog(self.columns, trace, quality_signal, self.store.at, self.values)
+        self.log = RunLog(
+            self.columns, trace, quality_signal, self.store.at, self.values, self.store.col
+        )
         self._hooks: list[tuple[Fraction, Hook, str]] = []
         #: each run's components by path (one dict for a single run)
         self.members: list[dict[str, Template]] = [{} for _ in self.timelines]
@@ -370,7 +372,7 @@ class Simulation(ReadAPI):
         ``tick``: deliveries of delayed outputs, then each instant source's changes (the
         timeline's first; ``instants.py``). Afterwards ``_next_instant_tick`` is the next
         tick at which any of them is due, so the hot loop makes one comparison for all."""
-        nxt = self.deliveries.deliver(tick, self.store.data)
+        nxt = self.deliveries.deliver(tick, self.store.data, self.store.col)
         if self._next_source_tick <= tick:
             for source in self._sources:
                 if source.next_tick() <= tick:

@@ -24,7 +24,6 @@ from array import array
 from collections.abc import Callable, Mapping, MutableMapping
 from dataclasses import dataclass, field
 from fractions import Fraction
-from itertools import compress
 from typing import Any
 
 import numpy as np
@@ -339,9 +338,12 @@ class Steppers:
                 fault = RunFault(who(group.paths[k]), now, f"output {port} is {arr[k]}")
                 raise in_run(fault, group.tasks[k].run)
             if group.delay is not None:  # the copies' common latency (no jitter: batch.py)
-                pairs = zip(group.targets[port], arr.tolist(), strict=True)
-                mask = None if published is None else published.tolist()
-                self.send(group.delay, list(pairs if mask is None else compress(pairs, mask)))
+                # whole columns in flight (a copy: the template may reuse its array)
+                if published is None:
+                    self.send(group.delay, [(at, arr.copy())])
+                else:
+                    where = np.asarray(group.targets[port], dtype=np.intp)[published]
+                    self.send(group.delay, [(where, arr[published])])
             elif published is None:
                 col[at] = arr
             elif type(at) is slice:
