@@ -113,21 +113,21 @@ class MultiRun(Simulation):
     ``scenarios`` must share duration, log rate and world structure (``runs/batched.py``
     checks that before it puts them in one batch). ``ungrouped`` names templates whose
     ``step_many`` needs all members in one shared service (the robots' physics world, when
-    each run steps its own): they step one by one here. ``columns`` takes over the runs'
-    physics steps (``physics/columns.py``).
+    each run steps its own), or says so of an initialized component: they step one by one.
+    ``columns`` takes over the runs' physics steps (``physics/columns.py``).
     """
 
     def __init__(
         self,
         scenarios: Sequence[Scenario],
-        ungrouped: Collection[type] = (),
+        ungrouped: Collection[type] | Callable[[Any], bool] = (),
         columns: Any = None,
     ) -> None:
         self.scenarios = list(scenarios)
         #: the batch's column physics (``physics/columns.py``), which takes over every
         #: run's physics step; None: each run's world steps its own Space
         self.column_physics = columns
-        self._ungrouped = tuple(ungrouped)
+        self._ungrouped = ungrouped if callable(ungrouped) else tuple(ungrouped)
         base = self.scenarios[0]
         self.runs: list[RunView] = [RunView(self, sc) for sc in self.scenarios]
         super().__init__(
@@ -167,7 +167,10 @@ class MultiRun(Simulation):
 
     def _batch_key(self, task: Task, freq: Fraction) -> tuple[Any, ...] | None:
         cls = type(task.comp)
-        if not hasattr(cls, "step_many") or cls.has_arrays() or issubclass(cls, self._ungrouped):
+        if not hasattr(cls, "step_many") or cls.has_arrays():
+            return None
+        alone = self._ungrouped
+        if alone(task.comp) if callable(alone) else issubclass(cls, alone):
             return None
         delay = task.delay
         if delay is not None and delay.draw is not None:

@@ -61,6 +61,12 @@ def stand_in_many(original: type[Template], exchange: ExchangeMany) -> type[Temp
     return Agents
 
 
+def _holds_physics(comp: Any) -> bool:
+    """Whether ``comp`` holds its run's physics world (a robot: its ``step_many`` would
+    command every run's rovers through the first one's world)."""
+    return getattr(comp, "physics", None) is not None
+
+
 class VecEpisode:
     """``len(seeds)`` runs of ``scenario`` with the agent in place of the Leaf ``path``.
 
@@ -77,10 +83,10 @@ class VecEpisode:
         agent = dataclasses.replace(leaf, template=stand_in_many(leaf.template, self._exchange))
         world = dataclasses.replace(world, leaves={**world.leaves, path: agent})
         scenarios = [dataclasses.replace(scenario, world=world, seed=int(s)) for s in seeds]
-        # every other component steps one by one, as in a single run: the runs' robots live
-        # in separate Spaces, and each run's arithmetic is then exactly the single env's
-        others = {lf.template for p, lf in world.leaves.items() if p != path}
-        self.sim = MultiRun(scenarios, ungrouped=tuple(others))
+        # the runs' robots live in separate Spaces (contacts are each run's own): a component
+        # that holds its run's physics world steps one by one; the others step as groups
+        # over the store's columns, with each run's own streams and arithmetic
+        self.sim = MultiRun(scenarios, ungrouped=_holds_physics)
         #: each run's agent (by identity) -> its run
         self._run_of = {id(m[path]): r for r, m in enumerate(self.sim.members)}
         self.n = len(scenarios)
