@@ -20,7 +20,11 @@ compare. Targets (issue "Performance"):
 * the Gymnasium env (issue 29): >= 20,000 steps/s (one env, constant action); the vector env
   >= 50,000 env-steps/s with 1,000 envs;
 * batched sweeps (``bench_batch.py``): 1,000 runs of scenario1 <= 5 s on 2 cores and >= 10x
-  the process pool; 10,000 runs <= 60 s with RSS <= 1.5x that of 1,000.
+  the process pool; 10,000 runs <= 60 s with RSS <= 1.5x that of 1,000;
+* the engine (``bench_engine.py``, issues 29 and 32): batched sweep >= 5x the process pool
+  for scenario1 and scenario2 at 1,000 runs of 60 s, 1,000 scenario2 runs <= 5 s; the
+  1,000-rover platoon >= 40x real time with the cost per rover-step flat from 200 to 1,000
+  rovers; the API run of scenario1; the vector env >= 50,000 env-steps/s at 1,000 envs.
 """
 
 from __future__ import annotations
@@ -43,6 +47,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import bench_batch
 import bench_compiled
+import bench_engine
 import bench_plots
 import bench_record
 import bench_run
@@ -381,6 +386,9 @@ TARGETS: dict[str, Callable[[int], None]] = {
     "batched": batched,
     "startup": startup,  # issue 29: whole process vs python -c pass
     "gym": gym_env,
+    # issues 29/32: the column store and the run axis (bench_engine.py): batched vs pool for
+    # scenario1 and scenario2, the 1,000-rover platoon, the API run, the vector env
+    "engine": lambda reps: [bench_engine.TARGETS[n](reps) for n in bench_engine.TARGETS],
 }
 
 

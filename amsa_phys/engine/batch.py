@@ -27,7 +27,6 @@ run leaf by leaf to ~1e-12, not bit for bit (the tests hold it to that).
 
 from __future__ import annotations
 
-import operator
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -68,18 +67,27 @@ class ParamArrays:
 
 
 class Group:
-    """Members of one group, with their inputs and outputs resolved to buffer names."""
+    """Members of one group, each port resolved to the members' positions in the store.
+
+    A port's positions are a :data:`Columns`: a slice when they are evenly spaced (copies
+    of one Composite in a single run; one leaf across the runs of a batch, consecutive), a
+    fancy index otherwise; either way a whole port moves in one numpy call.
+    """
 
     def __init__(self, tasks: Sequence[Any]) -> None:
         self.tasks = list(tasks)
         self.paths = [t.path for t in tasks]
         self.comps = [t.comp for t in tasks]
         self.template = type(self.comps[0])
-        first = dict(tasks[0].inputs)
-        self.inputs: list[tuple[str, Callable[[dict[str, float]], tuple[float, ...]]]] = [
-            (port, _gather([dict(t.inputs)[port] for t in tasks])) for port in first
+        first = dict(tasks[0].reads)
+        #: input port -> where the members' values sit in the store
+        self.inputs: list[tuple[str, Columns]] = [
+            (port, columns([dict(t.reads)[port] for t in tasks])) for port in first
         ]
-        self.outputs = {port: [t.targets[port] for t in tasks] for port in tasks[0].targets}
+        #: output port -> the members' positions, as a list (a delayed group's writes)
+        self.targets = {port: [t.writes[port] for t in tasks] for port in tasks[0].writes}
+        #: output port -> the same positions as a slice or index array
+        self.outputs = {port: columns(at) for port, at in self.targets.items()}
         self.params = ParamArrays(self.comps)
         #: the members' common delay line (they share one latency and have no jitter)
         self.delay = tasks[0].delay
@@ -87,12 +95,19 @@ class Group:
         self.state: dict[str, Any] = {}
 
 
-def _gather(names: list[str]) -> Callable[[dict[str, float]], tuple[float, ...]]:
-    """The values of ``names`` as a tuple (``itemgetter`` of one name gives a bare value)."""
-    if len(names) == 1:
-        name = names[0]
-        return lambda values: (values[name],)
-    return operator.itemgetter(*names)
+#: Where a group's port sits in the store's array: a slice, or an index array.
+Columns = slice | np.ndarray
+
+
+def columns(positions: Sequence[int]) -> Columns:
+    """``positions`` as a slice if evenly spaced and increasing (a view, no index array),
+    else as an index array."""
+    n = len(positions)
+    first = positions[0]
+    step = positions[1] - first if n > 1 else 1
+    if step > 0 and all(positions[k] == first + k * step for k in range(n)):
+        return slice(first, first + n * step, step)
+    return np.array(positions, dtype=np.intp)
 
 
 @dataclass(frozen=True)
@@ -127,13 +142,13 @@ def group_key(task: Any, freq: Fraction) -> tuple[Any, ...] | None:
 
 def plan(
     instants: Sequence[Sequence[Any]],
-    keys: dict[str, tuple[Any, ...] | None],
+    keys: dict[tuple[int, str], tuple[Any, ...] | None],
     min_group: int | None = None,
     enabled: bool = True,
 ) -> list[list[Any]]:
     """Each instant's tasks with the allowed groups merged in (a :class:`Group` per group).
 
-    ``keys`` maps a task's path to its :func:`group_key`; groups smaller than ``min_group``
+    ``keys`` maps a task's :func:`ident` to its :func:`group_key`; groups smaller than ``min_group``
     (default :data:`MIN_GROUP`) are not formed, nor any if not ``enabled`` (the caller's
     choice: a run compared with its leaf-by-leaf self). Groups that would change what any
     component reads at any instant are dropped everywhere, then the rest re-checked.
@@ -148,7 +163,7 @@ def plan(
             members: dict[tuple[Any, ...], list[Any]] = {}
             if enabled:
                 for t in tasks:
-                    key = keys.get(t.path)
+                    key = keys.get(ident(t))
                     if key is not None and key not in banned:
                         members.setdefault(key, []).append(t)
             groups = {k: v for k, v in members.items() if len(v) >= smallest}
@@ -172,7 +187,7 @@ def _merged(
             seq.append(t)
         elif key not in placed:
             placed.add(key)
-            paths = tuple(m.path for m in groups[key])
+            paths = tuple(ident(m) for m in groups[key])
             if paths not in cache:
                 cache[paths] = Group(groups[key])
             seq.append(cache[paths])
@@ -182,30 +197,37 @@ def _merged(
 def _breaks(
     tasks: Sequence[Any],
     seq: Sequence[Any],
-    keys: dict[str, tuple[Any, ...] | None],
+    keys: dict[tuple[int, str], tuple[Any, ...] | None],
     groups: dict[tuple[Any, ...], list[Any]],
 ) -> set[tuple[Any, ...]]:
-    """Group keys whose merging would change a read at this instant."""
-    pos = {t.path: i for i, t in enumerate(tasks)}
-    slot: dict[str, int] = {}
+    """Group keys whose merging would change a read at this instant (a reader reads the
+    writers of its own run)."""
+    pos = {ident(t): i for i, t in enumerate(tasks)}
+    slot: dict[tuple[int, str], int] = {}
     for i, item in enumerate(seq):
-        for path in item.paths if isinstance(item, Group) else [item.path]:
-            slot[path] = i
+        for t in item.tasks if isinstance(item, Group) else [item]:
+            slot[ident(t)] = i
     bad: set[tuple[Any, ...]] = set()
     for r in tasks:
+        me = ident(r)
         for _, buf in r.inputs:
-            w = buf.rpartition(".")[0]
-            if w not in pos or w == r.path or tasks[pos[w]].delay is not None:
+            w = (r.run, buf.rpartition(".")[0])
+            if w not in pos or w == me or tasks[pos[w]].delay is not None:
                 continue  # a delayed writer's outputs are never read in the same instant
-            before = pos[w] < pos[r.path]
-            same = slot[w] == slot[r.path]
-            if (not before) if same else ((slot[w] < slot[r.path]) == before):
+            before = pos[w] < pos[me]
+            same = slot[w] == slot[me]
+            if (not before) if same else ((slot[w] < slot[me]) == before):
                 continue
-            for path in (w, r.path):
+            for path in (w, me):
                 key = keys.get(path)
                 if key in groups:
                     bad.add(key)  # type: ignore[arg-type]
     return bad
+
+
+def ident(task: Any) -> tuple[int, str]:
+    """What tells tasks apart: (run, path); the runs of a batch share their paths."""
+    return (task.run, task.path)
 
 
 def first_bad(arr: np.ndarray, published: np.ndarray | None) -> int | None:

@@ -38,9 +38,11 @@ class Context:
     importing each other's modules. ``add_hook`` registers a subsystem step at its own rate.
     """
 
-    def __init__(self, sim: Simulation, path: str) -> None:
+    def __init__(self, sim: Simulation, path: str, run: int = 0) -> None:
         self._sim = sim
         self.path = path
+        #: the run of a batch the component belongs to (``multirun.py``); 0 alone
+        self.run = run
         self.rng = component_rng(sim.seed, path)
         self.world = sim.world
 

@@ -42,13 +42,18 @@ class InstantSource(Protocol):
 
 
 class TimelineSource:
-    """The timeline's points after t = 0 as an instant source, on the run's tick grid."""
+    """The timeline's points after t = 0 as an instant source, on the run's tick grid.
 
-    def __init__(self, timeline: Timeline, grid: TickGrid) -> None:
+    ``run`` is the run of a batch whose components the changes are for (``multirun.py``);
+    a source without that attribute changes run 0, the single run.
+    """
+
+    def __init__(self, timeline: Timeline, grid: TickGrid, run: int = 0) -> None:
         self._points: list[Batch] = [
             (grid.ticks(p.at), p.phase, p.changes) for p in timeline.points()
         ]
         self._i = 0
+        self.run = run
 
     def next_tick(self) -> float:
         """See :meth:`InstantSource.next_tick`."""

@@ -1,55 +1,74 @@
 """The run's log: trace rows, quality samples and log listeners at every logged instant.
 
 At each instant the schedule marks for logging (``log_rate``), the log writes one trace row
-(the chosen columns, in order, gathered in C by ``itemgetter``), appends the quality
-signal's sample, then calls the listeners (the window's trails, live metrics) with the same
-values: the very samples ``metrics.json`` is computed from, whatever the frame rate.
+(the chosen columns, in order, gathered in C by ``itemgetter`` from the store's array),
+appends the quality signal's sample, then calls the listeners (the window's trails, live
+metrics) with the same values by name: the very samples ``metrics.json`` is computed from,
+whatever the frame rate.
 """
 
 from __future__ import annotations
 
 import operator
 from array import array
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
-Listener = Callable[[float, dict[str, float]], None]
+Listener = Callable[[float, Mapping[str, float]], None]
 
 
 class RunLog:
-    """Trace, quality samples and listeners of one run (see the module docstring)."""
+    """Trace, quality samples and listeners of one run (see the module docstring).
+
+    ``at(name)`` is a buffer's position in the store's array (identity for a dict by
+    name); ``named`` is the same values by name, what listeners receive; ``col`` the store's
+    numpy view, from which a writer with ``packed_rows`` takes its rows.
+    """
 
     def __init__(
         self,
         columns: Sequence[str],
         trace: Callable[[float, list[float]], None] | None,
         quality: str | None,
+        at: Callable[[str], Any] = lambda name: name,
+        named: Mapping[str, float] | None = None,
+        col: np.ndarray | None = None,
     ) -> None:
         self.columns = list(columns)
+        self.named = named
         self._trace = trace
-        self._quality = quality
+        self._quality = None if quality is None else at(quality)
         # quality samples as packed doubles: a 1-hour run logs 72,000 of each, 1 MiB as
         # arrays instead of ~5 MiB of float objects in lists
         self._samples_t = array("d")
         self._samples_s = array("d")
         self.listeners: list[Listener] = []
-        cols = self.columns
+        cols = [at(c) for c in self.columns]
         #: one row of the trace in column order, gathered in C
-        self.row: Callable[[dict[str, float]], Sequence[float]] = (
+        self.row: Callable[[Any], Sequence[float]] = (
             operator.itemgetter(*cols) if len(cols) > 1 else lambda v: [v[c] for c in cols]
         )
+        if col is not None and getattr(trace, "packed_rows", False):
+            # a writer that stores packed doubles (``tracemem.py``) takes the row as one
+            # float64 array: copied from the store's array in C, no float object per value
+            where = np.array(cols, dtype=np.intp)
+            take = col.take
+            self.row = lambda _values: take(where)
 
-    def record(self, t_s: float, values: dict[str, float]) -> None:
-        """Log the instant at ``t_s`` seconds: trace row, quality sample, listeners."""
+    def record(self, t_s: float, values: Any) -> None:
+        """Log the instant at ``t_s`` seconds from ``values`` (the store's array): trace
+        row, quality sample, listeners (given the values by name)."""
         if self._trace is not None:
             self._trace(t_s, self.row(values))  # type: ignore[arg-type]
         if self._quality is not None:
             self._samples_t.append(t_s)
             self._samples_s.append(values[self._quality])
         if self.listeners:
+            named = values if self.named is None else self.named
             for listener in self.listeners:
-                listener(t_s, values)
+                listener(t_s, named)
 
     def samples(self) -> tuple[np.ndarray, np.ndarray]:
         """The quality samples so far: (times, values), of equal length."""

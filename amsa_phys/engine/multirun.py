@@ -1,20 +1,24 @@
-"""Many runs of one scenario as columns of one simulation (``amsa-phys sweep --executor batch``).
+"""Many runs of one scenario as rows of one simulation (``amsa-phys sweep --executor batch``).
 
 A sweep's runs differ only in parameter values set at t = 0 and in their seed; their worlds
-have the same components, rates and timeline instants. :class:`MultiRun` builds one world
-that holds every run as a renamed copy of the scenario's root (``R0.Leader``,
-``R1.Leader``, ...), so the engine's grouping (``engine/batch.py``) steps like components
-of all runs in one ``step_many`` call, keyed by the component's path *within* its run. What
-makes each copy the run it would be alone:
+have the same components, rates and timeline instants. :class:`MultiRun` steps them as one
+:class:`~amsa_phys.engine.runner.Simulation` with an integer *run axis*: the buffer store
+holds one row per run in every column (``store.py``), there is one task per (Leaf, run),
+and the engine's grouping (``engine/batch.py``) steps the runs' copies of a Leaf in one
+``step_many`` call whose inputs and outputs are the Leaf's columns, read and written in
+place. Nothing is renamed: every run's components keep their paths. What makes each run the
+run it would be alone:
 
-* its random streams: a component's stream is keyed by (run's seed, path within the run),
-  exactly :func:`rng.component_rng` of the run alone;
-* its parameters and timeline: the run's t = 0 values build its components, its later
-  changes are applied to its own components at their instants;
+* its random streams: a component's stream is keyed by (run's seed, path), exactly
+  :func:`rng.component_rng` of the run alone;
+* its parameters and timeline: the run's own world and t = 0 values build its components,
+  its later changes are applied to its own components at their instants;
 * its shared services: ``ctx.shared`` is per run, so each run has its own physics world
   (its own pymunk Space, see :class:`RunView`): runs never touch, and rovers of one run
   collide with each other and that run's obstacles exactly as alone;
-* its events and quality samples, kept per run, from which its metrics are computed.
+* its events and quality samples, kept per run, from which its metrics are computed;
+* its faults: a fault is marked with its run (``tasks.in_run``), which ``run_batch`` then
+  makes alone.
 
 Groups are formed at any size (``Grouping(min_group=1)``), so a run's arithmetic is the same
 whatever batch it lands in: a batched sweep is byte-identical to itself across batch sizes
@@ -26,25 +30,19 @@ pure path also the numpy force model): ~1e-13 in the rovers' distance over a run
 
 from __future__ import annotations
 
-import operator
 from array import array
 from collections.abc import Callable, Collection, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
 
 import numpy as np
 
-from ..model.scenario import Change, Phase, Scenario, Step
-from ..model.world import BufferSpec, CompositeSpec, WorldSpec
+from ..model.scenario import Change, Scenario
 from . import batch
 from .rng import component_rng
-from .runner import Context, Event, RunResult, Simulation, _Task
-
-
-def prefix_of(index: int) -> str:
-    """The name of run ``index``'s copy of the root in the batch's world."""
-    return f"R{index}"
+from .runner import Context, Event, RunResult, Simulation
+from .tasks import Task
 
 
 class RunView:
@@ -81,12 +79,13 @@ class RunView:
 class RunContext(Context):
     """A component's ``initialize`` context inside a batch: its run's streams and services."""
 
-    def __init__(self, sim: MultiRun, path: str, run: RunView, local: str) -> None:
+    def __init__(self, sim: MultiRun, path: str, run: int) -> None:
         self._sim = sim
         self.path = path
-        self.rng = component_rng(run.seed, local)  # the stream the run alone gives ``local``
-        self.world = sim.world
-        self._run = run
+        self.run = run
+        self._run = sim.runs[run]
+        self.rng = component_rng(self._run.seed, path)  # the stream the run alone gives
+        self.world = self._run.world
 
     def shared(self, name: str, factory: Callable[[Any], Any]) -> Any:
         """The run's own shared service ``name`` (each run has its own physics world)."""
@@ -108,143 +107,83 @@ class BatchShare:
     live_changes: list[tuple[Fraction, Change]] = field(default_factory=list)
 
 
-def merged_world(worlds: Sequence[WorldSpec]) -> WorldSpec:
-    """One world holding ``worlds`` (of the same structure) as renamed copies of the root.
-
-    The execution order is component-major (``R0.Leader, R1.Leader, ..., R0.Follower, ...``):
-    within each run the world's own order, so every read sees what it sees alone.
-    """
-    base = worlds[0]
-    leaves = {}
-    buffers = {}
-    arrays = {}
-    for i, world in enumerate(worlds):
-        pre = prefix_of(i) + "."
-        for path, leaf in world.leaves.items():
-            leaves[pre + path] = replace(
-                leaf,
-                path=pre + path,
-                inputs={port: pre + buf for port, buf in leaf.inputs.items()},
-            )
-        for name, buf in world.buffers.items():
-            buffers[pre + name] = BufferSpec(pre + name, pre + buf.producer, buf.port, buf.initial)
-        for name, elements in world.arrays.items():
-            arrays[pre + name] = [pre + e for e in elements]
-    order = [prefix_of(i) + "." + path for path in base.order for i in range(len(worlds))]
-    return replace(
-        base,
-        root=CompositeSpec(path=""),
-        leaves=leaves,
-        buffers=buffers,
-        order=order,
-        schedule=list(order),
-        data_names={},
-        arrays=arrays,
-    )
-
-
-def merged_phases(scenarios: Sequence[Scenario]) -> list[Phase]:
-    """Every run's timeline as one: t = 0 values, then each change at its instant.
-
-    Later changes become steps of one phase (phases only name spans of a run; each run's
-    metrics use its own). At one instant, a run's changes keep their order.
-    """
-    first: list[Change] = []
-    later: dict[Fraction, list[Change]] = {}
-    for i, sc in enumerate(scenarios):
-        pre = prefix_of(i) + "."
-        timeline = sc.timeline
-        first += [_renamed(c, pre) for c in timeline.initial]
-        for point in timeline.points():
-            later.setdefault(point.at, []).extend(_renamed(c, pre) for c in point.changes)
-    steps = [Step(at, changes) for at, changes in sorted(later.items())]
-    return [Phase(Fraction(0), first, within=steps)]
-
-
-def _renamed(change: Change, pre: str) -> Change:
-    return Change(pre + change.leaf, change.param, change.value, change.written)
-
-
 class MultiRun(Simulation):
     """Runs of one scenario's world, stepped together (see the module's docstring).
 
     ``scenarios`` must share duration, log rate and world structure (``runs/batched.py``
     checks that before it puts them in one batch). ``ungrouped`` names templates whose
     ``step_many`` needs all members in one shared service (the robots' physics world, when
-    each run steps its own): they step one by one here. ``columns`` takes over the runs'
-    physics steps (``physics/columns.py``).
+    each run steps its own), or says so of an initialized component: they step one by one.
+    ``columns`` takes over the runs' physics steps (``physics/columns.py``).
     """
 
     def __init__(
         self,
         scenarios: Sequence[Scenario],
-        ungrouped: Collection[type] = (),
+        ungrouped: Collection[type] | Callable[[Any], bool] = (),
         columns: Any = None,
     ) -> None:
         self.scenarios = list(scenarios)
         #: the batch's column physics (``physics/columns.py``), which takes over every
         #: run's physics step; None: each run's world steps its own Space
         self.column_physics = columns
-        self._ungrouped = tuple(ungrouped)
+        self._ungrouped = ungrouped if callable(ungrouped) else tuple(ungrouped)
         base = self.scenarios[0]
-        self.runs: list[RunView] = []
-        world = merged_world([sc.world for sc in self.scenarios])
+        self.runs: list[RunView] = [RunView(self, sc) for sc in self.scenarios]
         super().__init__(
-            world,
+            base.world,
             seed=base.seed,
             duration=base.duration,
-            phases=merged_phases(self.scenarios),
             log_rate=base.log_rate,
             grouping=batch.Grouping(self._batch_key, min_group=1),
             context=MultiRun._run_context,
+            runs=self.scenarios,
         )
-        self.runs = [RunView(self, sc) for sc in self.scenarios]
-        quality = [
-            prefix_of(i) + "." + sc.quality.signal if sc.quality else None
+        #: each run's quality signal: its position in the store (None: the run has none)
+        store = self.store
+        self._q_at = [
+            store.at(sc.quality.signal, i) if sc.quality else None
             for i, sc in enumerate(self.scenarios)
         ]
-        self._q_index = [i for i, q in enumerate(quality) if q is not None]
-        names = [q for q in quality if q is not None]
-        self._q_get: Callable[[dict[str, float]], Any] | None = (
-            None
-            if not names
-            else operator.itemgetter(*names)
-            if len(names) > 1
-            else (lambda v: (v[names[0]],))
-        )
+        self._q_index = [i for i, at in enumerate(self._q_at) if at is not None]
+        where = np.array([at for at in self._q_at if at is not None], dtype=np.intp)
+        first = int(where[0]) if len(where) else 0
+        if len(where) and (where == first + np.arange(len(where))).all():
+            self._q_where: slice | np.ndarray = slice(first, first + len(where))
+        else:
+            self._q_where = where
         self._q_t = array("d")
-        self._q_rows: list[tuple[float, ...]] = []
-        if self._q_get is not None:
+        self._q_rows: list[np.ndarray] = []
+        if self._q_index:
             self.add_log_listener(self._sample)
 
-    def _sample(self, t_s: float, values: dict[str, float]) -> None:
-        assert self._q_get is not None
-        self._q_rows.append(self._q_get(values))
+    def _sample(self, t_s: float, values: Any) -> None:
+        """One quality sample of every run: a copy of the signal's column (one C call)."""
+        self._q_rows.append(self.store.col[self._q_where].copy())
         self._q_t.append(t_s)
 
-    def _run_context(self, path: str) -> Context:
-        head, _, local = path.partition(".")
-        return RunContext(self, path, self.runs[int(head[1:])], local)
+    def _run_context(self, path: str, run: int) -> Context:
+        return RunContext(self, path, run)
 
-    def _batch_key(self, task: _Task, freq: Fraction) -> tuple[Any, ...] | None:
+    def _batch_key(self, task: Task, freq: Fraction) -> tuple[Any, ...] | None:
         cls = type(task.comp)
-        if not hasattr(cls, "step_many") or cls.has_arrays() or issubclass(cls, self._ungrouped):
+        if not hasattr(cls, "step_many") or cls.has_arrays():
+            return None
+        alone = self._ungrouped
+        if alone(task.comp) if callable(alone) else issubclass(cls, alone):
             return None
         delay = task.delay
         if delay is not None and delay.draw is not None:
             return None
         latency = None if delay is None else delay.fixed
-        local = task.path.partition(".")[2]
         inputs = tuple(sorted(p for p, _ in task.inputs))
-        return (local, cls, freq, task.phase, latency, inputs)
+        return (task.path, cls, freq, task.phase, latency, inputs)
 
-    def run_of(self, component: str) -> int | None:
-        """The run a component path (or a fault's ``who``) belongs to, if any."""
-        head, dot, _ = component.partition(".")
-        if dot and head[:1] == "R" and head[1:].isdigit():
-            k = int(head[1:])
-            return k if k < len(self.runs) else None
-        return None
+    @staticmethod
+    def run_of(fault: BaseException) -> int | None:
+        """The run a fault belongs to (``tasks.in_run``), if any one run's."""
+        run = getattr(fault, "run", None)
+        return run if isinstance(run, int) else None
 
     def outcomes(self) -> list[BatchShare]:
         """Each run's samples, events and changes so far."""

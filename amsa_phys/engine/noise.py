@@ -162,10 +162,35 @@ def gauss_markov(sigma: float, tau: float, dt: float) -> tuple[float, float]:
     return 1.0, sigma * math.sqrt(dt)
 
 
+#: :func:`gauss_markov_many`'s recent answers: a group's sensors ask it every step with the
+#: same parameter arrays and period, and its libm calls cost a batched sweep ~5 % (profiled)
+_GM_CACHE: dict[tuple[bytes, bytes, float], tuple[np.ndarray, np.ndarray]] = {}
+_GM_CACHE_SIZE = 64
+
+
 def gauss_markov_many(
     sigma: np.ndarray, tau: np.ndarray, dt: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`gauss_markov` for arrays of parameters (one per copy)."""
+    """:func:`gauss_markov` for arrays of parameters (one per copy). The answer is
+    remembered for the same values (read-only arrays: a caller cannot edit a shared one)."""
+    sigma = np.asarray(sigma, dtype=np.float64)
+    tau = np.asarray(tau, dtype=np.float64)
+    key = (sigma.tobytes(), tau.tobytes(), dt)
+    hit = _GM_CACHE.get(key)
+    if hit is not None and hit[0].shape == np.broadcast_shapes(sigma.shape, tau.shape):
+        return hit
+    phi, q = _gauss_markov_many(sigma, tau, dt)
+    phi.flags.writeable = False
+    q.flags.writeable = False
+    if len(_GM_CACHE) >= _GM_CACHE_SIZE:
+        _GM_CACHE.clear()
+    _GM_CACHE[key] = (phi, q)
+    return phi, q
+
+
+def _gauss_markov_many(
+    sigma: np.ndarray, tau: np.ndarray, dt: float
+) -> tuple[np.ndarray, np.ndarray]:
     safe = np.where(tau > 0, tau, 1.0)
     # libm's exp/expm1, as gauss_markov's math calls: numpy's round otherwise (engine/libm.py)
     phi = np.where(tau > 0, libm.exp(-dt / safe), 1.0)

@@ -30,8 +30,6 @@ from collections.abc import Callable, Sequence
 from fractions import Fraction
 from typing import Any
 
-import numpy as np
-
 from ..errors import RunFault
 from ..model.adaptrules import RULE_COLUMN, Rule
 from ..model.scenario import Change, Phase, Scenario, traced_columns
@@ -40,13 +38,14 @@ from ..model.timeline import Timeline
 from ..model.world import WorldSpec
 from . import batch, interrupt, schedule
 from .adapt import AdaptRules
+from .build import build_components, make_task, plan_groups
 from .clock import TickGrid
 from .context import Context, Event, Hook, RunResult
 from .delivery import Deliveries
 from .instants import InstantSource, TimelineSource
 from .log import RunLog
-from .store import BufferStore
-from .tasks import COMPONENT_ERRORS, Steppers, Task
+from .store import BufferStore, ReadAPI
+from .tasks import COMPONENT_ERRORS, Steppers, Task, in_run
 from .timing import DelayLine, run_phases
 
 #: Wraps a component as it is built: ``wrap(path, component)`` returns what the engine runs
@@ -58,8 +57,11 @@ _Task = Task
 __all__ = ["COMPONENT_ERRORS", "Context", "Event", "RunResult", "Simulation", "Task", "Wrap"]
 
 
-class Simulation:
+class Simulation(ReadAPI):
     """One run of a scenario (or of a bare world, for tests).
+
+    Read from outside with :meth:`read`, :meth:`read_many`, :meth:`column` and
+    :meth:`write` (``store.ReadAPI``).
 
     ``wrap`` is the construction hook: each component, once built, is passed through
     ``wrap(path, component)`` and the engine runs what it returns, so a caller that stands
@@ -85,25 +87,40 @@ class Simulation:
         adapt: Sequence[Rule] = (),
         wrap: Wrap | None = None,
         grouping: bool | batch.Grouping = True,
-        context: Callable[[Simulation, str], Context] = Context,
+        context: Callable[[Simulation, str, int], Context] = Context,
+        runs: Sequence[Scenario] = (),
     ) -> None:
         self.world = world
         self.seed = seed
         self.duration = Fraction(duration)
-        #: the run's timeline (``model/timeline.py``): the only reader of the phases here
-        self.timeline = Timeline.of(phases, self.duration)
+        #: ``runs``: a batch of runs of ``world``'s structure (``multirun.py``) stepped
+        #: together, each with its own parameters, timeline and seed; the store then holds
+        #: one row per run in every column. Alone: the batch of one (``world``, ``phases``)
+        self.worlds = [sc.world for sc in runs] or [world]
+        self.seeds = [sc.seed for sc in runs] or [seed]
+        #: each run's timeline (``model/timeline.py``): the only reader of the phases here
+        self.timelines = [Timeline.of(sc.phases, self.duration) for sc in runs] or [
+            Timeline.of(phases, self.duration)
+        ]
+        self.timeline = self.timelines[0]
         self.phases = list(self.timeline.phases)
         self.log_rate = Fraction(log_rate)
         self.shared: dict[str, Any] = {}
         self.events: list[Event] = []
-        #: every buffer's value (``store.py``); read from outside with :meth:`read`
-        self.store = BufferStore({n: b.initial for n, b in world.buffers.items()}, world.arrays)
-        self.values: dict[str, float] = self.store.values
+        #: every buffer's value, one float64 array (``store.py``); read with :meth:`read`
+        self.store = BufferStore.of_worlds(self.worlds, [RULE_COLUMN] if adapt else [])
+        #: the same values by name (a view: tests and listeners speak names)
+        self.values = self.store.values
         #: the buffers of a trace row, in order (all of them unless ``trace_columns:`` chose)
         self.columns = list(world.buffers) if columns is None else list(columns)
-        self.log = RunLog(self.columns, trace, quality_signal)
+        self.log = RunLog(
+            self.columns, trace, quality_signal, self.store.at, self.values, self.store.col
+        )
         self._hooks: list[tuple[Fraction, Hook, str]] = []
-        self.components: dict[str, Template] = {}
+        #: each run's components by path (one dict for a single run)
+        self.members: list[dict[str, Template]] = [{} for _ in self.timelines]
+        #: the (first) run's components by path
+        self.components: dict[str, Template] = self.members[0]
         self._wrap = wrap
         #: how like copies step as arrays (``batch.py``); False: leaf by leaf, a reference
         self.grouping = grouping if isinstance(grouping, batch.Grouping) else batch.Grouping()
@@ -125,11 +142,9 @@ class Simulation:
         self._sources: list[InstantSource] = []
         self._next_instant_tick: float = math.inf  # deliveries' or sources', the earliest
         self._next_source_tick: float = math.inf  # the instant sources' alone
-        self._steppers = Steppers(self.values, self._send, self._who)
+        self._steppers = Steppers(self.store.data, self._send, self._who, self.store.col)
         #: ``adapt:`` rules (``engine/adapt.py``), asked at every instant with components
         self._adapt = AdaptRules(adapt, self._param_value) if adapt else None
-        if adapt:
-            self.values[RULE_COLUMN] = 0.0
         self._build()
 
     @classmethod
@@ -148,43 +163,27 @@ class Simulation:
             **kw,
         )
 
-    # -- reading from outside ------------------------------------------------------------------
-    def read(self, buffer: str) -> float:
-        """The current value of Data ``buffer`` (``Component.port``); safe from any thread,
-        and never waits (``store.py`` says why)."""
-        return self.store.read(buffer)
-
-    def read_many(self, buffers: Sequence[str]) -> np.ndarray:
-        """The current values of ``buffers`` as one float64 array, read together."""
-        return self.store.read_many(buffers)
-
-    def write(self, buffer: str, value: float) -> None:
-        """Set Data ``buffer`` from outside the loop (another thread); visible from the next
-        instant, never in the middle of one."""
-        self.store.write(buffer, value)
-
     # -- construction -------------------------------------------------------------------
     def _build(self) -> None:
-        params = {path: dict(leaf.params) for path, leaf in self.world.leaves.items()}
-        for change in self.timeline.initial:  # phase 0 values are in force at initialize
-            params[change.leaf][change.param] = change.value
-        for path in self.world.order:
-            leaf = self.world.leaves[path]
-            comp = leaf.template(path, params[path])
-            self.components[path] = comp if self._wrap is None else self._wrap(path, comp)
+        for members, timeline, world in zip(self.members, self.timelines, self.worlds, strict=True):
+            members.update(build_components(world, timeline, self._wrap))
 
     def initialize(self) -> None:
-        """The paper's initialize(): cascades to every Leaf (in execution order)."""
+        """The paper's initialize(): cascades to every Leaf (in execution order; in a batch
+        every run's copy of a Leaf, then the next Leaf's)."""
         if self._initialized:
             return
         self._initialized = True
-        for path, comp in self.components.items():
-            try:
-                comp.initialize(self._new_context(self, path))
-            except RunFault:
-                raise
-            except COMPONENT_ERRORS as exc:  # a component's own bug or bad configuration
-                raise RunFault(self._who(path), 0, f"initialize failed: {exc!r}") from exc
+        for path in self.world.order:
+            for run, members in enumerate(self.members):
+                try:
+                    members[path].initialize(self._new_context(self, path, run))
+                except RunFault as exc:
+                    in_run(exc, run)
+                    raise
+                except COMPONENT_ERRORS as exc:  # a component's own bug or configuration
+                    fault = RunFault(self._who(path), 0, f"initialize failed: {exc!r}")
+                    raise in_run(fault, run) from exc
         self._compile()
 
     def add_hook(self, rate_hz: Fraction, fn: Hook, name: str) -> None:
@@ -219,17 +218,23 @@ class Simulation:
         return now
 
     def _compile(self) -> None:
-        leaves = self.world.leaves
-        periods = [1 / leaves[p].freq for p in self.world.order]
+        order = self.world.order
+        periods = sorted({1 / w.leaves[p].freq for w in self.worlds for p in order})
         periods += [1 / r for r, _, _ in self._hooks] + [1 / self.log_rate]
-        instants = [p.at for p in self.timeline.points()] + [self.duration]
-        #: each Leaf's timer phase (0 unless the world gives or draws one): on the grid
-        self.timer_phases = run_phases(self.world, self.seed)
-        instants += [ph for ph in self.timer_phases.values() if ph]
-        self.grid = TickGrid.for_run(periods, instants)
-        g = self.grid
+        instants = [p.at for t in self.timelines for p in t.points()] + [self.duration]
+        #: each Leaf's timer phase in each run (0 unless the world gives or draws one)
+        phases = [run_phases(w, seed) for w, seed in zip(self.worlds, self.seeds, strict=True)]
+        self.timer_phases = phases[0]
+        instants += [ph for run in phases for ph in run.values() if ph]
+        self.grid = g = TickGrid.for_run(periods, instants)
         self._tick_num, self._tick_den = g.tick.numerator, g.tick.denominator
-        self._tasks = [self._task(path, g) for path in self.world.order]
+        self._tasks = [
+            make_task(w, path, members[path], g, ph[path], seed, self.store, run)
+            for path in order
+            for run, (w, members, ph, seed) in enumerate(
+                zip(self.worlds, self.members, phases, self.seeds, strict=True)
+            )
+        ]
         self._log_period = g.ticks(1 / self.log_rate)
         hooks = [(g.ticks(1 / r), fn) for r, fn, _ in self._hooks]
         try:
@@ -242,57 +247,19 @@ class Simulation:
                 f"{float(g.time(exc.cycle)):g} s ({exc.count} events); use "
                 "commensurate frequencies",
             ) from None
-        self._plan_groups(cycle)
+        worlds = self.worlds
+        self._groups_of = plan_groups(
+            cycle,
+            self._tasks,
+            lambda t: worlds[t.run].leaves[t.path].freq,
+            self.grouping,
+            self._steppers,
+        )
         self._table = schedule.runs(cycle)
         self._end = g.ticks(self.duration)
-        self._sources.insert(0, TimelineSource(self.timeline, g))
+        self._sources[:0] = [TimelineSource(t, g, r) for r, t in enumerate(self.timelines)]
         self._next_source_tick = min(s.next_tick() for s in self._sources)
         self._next_instant_tick = min(self._next_source_tick, self.deliveries.next_due())
-
-    def _task(self, path: str, g: TickGrid) -> Task:
-        """``path``'s Leaf as the schedule runs it, its ports resolved to buffer names."""
-        leaf = self.world.leaves[path]
-        arrays = self.world.arrays
-        task = Task(
-            path,
-            self.components[path],
-            g.ticks(1 / leaf.freq),
-            list(leaf.inputs.items()),
-            {p.name: f"{path}.{p.name}" for p in leaf.template.outputs},
-        )
-        for port in leaf.template.inputs:
-            if port.array and port.name in leaf.inputs:
-                task.arrays_in[port.name] = arrays[leaf.inputs[port.name]]
-        for port in leaf.template.outputs:
-            if port.array:
-                task.arrays_out[port.name] = arrays[f"{path}.{port.name}"]
-        task.phase = g.ticks(self.timer_phases[path])
-        if leaf.timing.delayed:
-            task.delay = DelayLine(leaf, g.tick, self.seed)
-        return task
-
-    def _plan_groups(self, cycle: list[schedule.Instant]) -> None:
-        """Like components of repeated Composites step as arrays where that changes no read:
-        each instant's tasks become ``(step, task or group)`` pairs."""
-        leaves = self.world.leaves
-        g = self.grouping
-        keys = {t.path: g.key(t, leaves[t.path].freq) for t in self._tasks}
-        planned = batch.plan([i.tasks for i in cycle], keys, g.min_group, g.enabled)
-        self._groups_of: dict[str, list[batch.Group]] = {}
-        steppers = self._steppers
-        for inst, seq in zip(cycle, planned, strict=True):
-            inst.tasks = [
-                (steppers.step_group, item)
-                if isinstance(item, batch.Group)
-                else (steppers.for_task(item), item)
-                for item in seq
-            ]
-            for item in seq:
-                if isinstance(item, batch.Group):
-                    for path in item.paths:
-                        groups = self._groups_of.setdefault(path, [])
-                        if item not in groups:
-                            groups.append(item)
 
     # -- running --------------------------------------------------------------------------
     def run(self) -> RunResult:
@@ -332,7 +299,7 @@ class Simulation:
         table = self._table
         end = self._end
         cursor = self._cursor
-        record, values = self.log.record, self.values
+        record, values = self.log.record, self.store.data
         num, den = self._tick_num, self._tick_den
         try:
             while cursor <= until:
@@ -379,8 +346,13 @@ class Simulation:
                             self._apply_adapt()
                         if tasks:
                             now = self.now
-                            for run, task in tasks:
-                                run(task, now)
+                            try:
+                                for run, task in tasks:
+                                    run(task, now)
+                            except RunFault as exc:
+                                if isinstance(task, Task):  # a group's fault names its run
+                                    in_run(exc, task.run)
+                                raise
                         if log:
                             # float(tick * n) without building a Fraction: int / int is
                             # correctly rounded, the same float ``float(Fraction)`` gives
@@ -400,7 +372,7 @@ class Simulation:
         ``tick``: deliveries of delayed outputs, then each instant source's changes (the
         timeline's first; ``instants.py``). Afterwards ``_next_instant_tick`` is the next
         tick at which any of them is due, so the hot loop makes one comparison for all."""
-        nxt = self.deliveries.deliver(tick, self.values)
+        nxt = self.deliveries.deliver(tick, self.store.data, self.store.col)
         if self._next_source_tick <= tick:
             for source in self._sources:
                 if source.next_tick() <= tick:
@@ -408,15 +380,19 @@ class Simulation:
                         if phase is not None:
                             self.phase_index = phase
                         self._now_override = self.grid.time(at)
+                        run = getattr(source, "run", 0)
                         try:
                             for change in changes:
-                                self.apply_change(change)
+                                if run:
+                                    self._change(change, run)
+                                else:  # the single run's (a subclass may judge it first)
+                                    self.apply_change(change)
                         finally:
                             self._now_override = None
             self._next_source_tick = min(s.next_tick() for s in self._sources)
         self._next_instant_tick = min(nxt, self._next_source_tick)
 
-    def _send(self, line: DelayLine, writes: list[tuple[str, float]]) -> None:
+    def _send(self, line: DelayLine, writes: list[tuple[int, float]]) -> None:
         """Put a delayed Leaf's publication in flight: visible from ``line.due(now)``."""
         due = line.due(self._tick)
         self.deliveries.push(due, writes)
@@ -426,7 +402,7 @@ class Simulation:
     def in_flight(self, buffer: str) -> int:
         """How many publications of ``buffer`` are sent but not yet visible (the ROS
         simulator tells a node which message its reader sees by this)."""
-        return self.deliveries.in_flight(buffer)
+        return self.deliveries.in_flight(self.store.at(buffer))
 
     def add_log_listener(self, fn: Callable[[float, dict[str, float]], None]) -> None:
         """Call ``fn(t_s, values)`` at every logged instant, after the trace row.
@@ -444,20 +420,26 @@ class Simulation:
 
     def apply_change(self, change: Change) -> None:
         """Set a parameter now (timeline or live); the component is told after."""
-        comp = self.components[change.leaf]
+        self._change(change, 0)
+
+    def _change(self, change: Change, run: int) -> None:
+        """:meth:`apply_change` in run ``run`` of a batch."""
+        comp = self.members[run][change.leaf]
         setattr(comp.p, change.param, change.value)
-        for group in getattr(self, "_groups_of", {}).get(change.leaf, ()):
+        for group in getattr(self, "_groups_of", {}).get((run, change.leaf), ()):
             group.params.invalidate()
         self.change_log.append((self.now, change))
         try:
             comp.on_param_change(change.param, change.value)
-        except RunFault:
+        except RunFault as exc:
+            in_run(exc, run)
             raise
         except COMPONENT_ERRORS as exc:
             why = f"on_param_change raised {exc!r}" if isinstance(exc, SystemExit) else exc
-            raise RunFault(
+            fault = RunFault(
                 self._who(change.leaf), self.now, f"rejected {change.param}={change.value!r}: {why}"
-            ) from None  # a rejection is a message, not a crash (--debug still finds it)
+            )
+            raise in_run(fault, run) from None  # a message, not a crash (--debug finds it)
 
     def next_instant(self) -> Fraction:
         """Time of the next instant at which something runs (where a live change lands)."""

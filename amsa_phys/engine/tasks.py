@@ -24,7 +24,6 @@ from array import array
 from collections.abc import Callable, Mapping, MutableMapping
 from dataclasses import dataclass, field
 from fractions import Fraction
-from itertools import compress
 from typing import Any
 
 import numpy as np
@@ -63,7 +62,30 @@ class Task:
     phase: int = 0
     delay: DelayLine | None = None
     #: a delayed Leaf's own last outputs, which it reads back at once (as its node does)
-    own: dict[str, float] = field(default_factory=dict)
+    own: dict[Any, float] = field(default_factory=dict)
+    #: the same inputs, outputs and array ports by their position in the buffer store
+    #: (:meth:`bind`); until bound, by name (a test's dict of values)
+    reads: list[tuple[str, Any]] = field(default_factory=list)
+    writes: dict[str, Any] = field(default_factory=dict)
+    reads_arrays: dict[str, list[Any]] = field(default_factory=dict)
+    writes_arrays: dict[str, list[Any]] = field(default_factory=dict)
+    #: the run of a batch this task belongs to (``engine/multirun.py``); 0 alone
+    run: int = 0
+
+    def __post_init__(self) -> None:
+        self.reads = list(self.inputs)
+        self.writes = dict(self.targets)
+
+    def bind(self, at: Callable[[str], int]) -> None:
+        """Resolve every buffer name to its position in the store (``at(name)``): the
+        steppers index the store's array, never a dict by name."""
+        arrays = self.arrays_in  # an array port's name is no buffer: its elements are
+        self.reads = [(port, -1 if port in arrays else at(buf)) for port, buf in self.inputs]
+        self.writes = {
+            port: -1 if port in self.arrays_out else at(buf) for port, buf in self.targets.items()
+        }
+        self.reads_arrays = {p: [at(n) for n in ns] for p, ns in self.arrays_in.items()}
+        self.writes_arrays = {p: [at(n) for n in ns] for p, ns in self.arrays_out.items()}
 
 
 def checked_writes(
@@ -73,13 +95,14 @@ def checked_writes(
     now: Fraction,
     who: Callable[[str], str],
 ) -> None:
-    """Put ``task``'s scalar outputs ``out`` into ``into`` by buffer name, each a finite float.
+    """Put ``task``'s scalar outputs ``out`` into ``into`` at their buffers' positions
+    (:meth:`Task.bind`), each a finite float.
 
     The one judge of published scalars: anything refused raises the RunFault that names the
     first bad output (:func:`bad_output`). Outputs before a refused one may already be in
     ``into``; the fault ends the run, so nothing reads them.
     """
-    targets = task.targets
+    targets = task.writes
     try:
         for key, value in out.items():
             number = float(value)
@@ -90,7 +113,15 @@ def checked_writes(
         raise bad_output(who(task.path), now, targets, out) from None
 
 
-def bad_output(who: str, now: Fraction, targets: Mapping[str, str], out: Any) -> RunFault:
+def in_run(fault: RunFault, run: int | None) -> RunFault:
+    """``fault`` marked as run ``run``'s, unless already marked: a batch (``multirun.py``)
+    makes that run alone, which says what went wrong; unmarked, no one run is to blame."""
+    if getattr(fault, "run", None) is None:
+        fault.run = run  # type: ignore[attr-defined]
+    return fault
+
+
+def bad_output(who: str, now: Fraction, targets: Mapping[str, Any], out: Any) -> RunFault:
     """The fault for the first output :func:`checked_writes` refused (a slow path)."""
     if not isinstance(out, Mapping):
         return RunFault(
@@ -123,16 +154,22 @@ class Steppers:
     """The ways a task steps, over one run's buffers (see the module docstring).
 
     ``send(line, writes)`` puts a delayed publication in flight (the delivery heap);
-    ``who(path)`` names a component in a fault.
+    ``who(path)`` names a component in a fault; ``values`` and ``col`` are the buffer
+    store's two views of its one array (``store.py``).
     """
 
     def __init__(
         self,
-        values: dict[str, float],
-        send: Callable[[DelayLine, list[tuple[str, float]]], None],
+        values: MutableMapping[Any, float] | array,
+        send: Callable[[DelayLine, list[tuple[Any, float]]], None],
         who: Callable[[str], str],
+        col: np.ndarray | None = None,
     ) -> None:
+        #: what the scalar paths index: the store's ``array('d')`` by position (a test's
+        #: dict by name works alike)
         self.values = values
+        #: the same memory as a numpy array: what groups read and write (``store.py``)
+        self.col = col
         self.send = send
         self.who = who
 
@@ -153,7 +190,7 @@ class Steppers:
     def step(self, task: Task, now: Fraction) -> None:
         """Run one component: read its inputs, call ``do_step``, publish its outputs."""
         values = self.values
-        inp = {port: values[buf] for port, buf in task.inputs}
+        inp = {port: values[at] for port, at in task.reads}
         try:
             out = task.comp.do_step(now, inp)
         except RunFault:
@@ -161,7 +198,7 @@ class Steppers:
         except COMPONENT_ERRORS as exc:  # inlined :meth:`_call`: the hot path
             raise RunFault(self.who(task.path), now, f"do_step raised {exc!r}") from exc
         if out:  # checked_writes(task, out, values, now, self.who), inlined (module doc)
-            targets = task.targets
+            targets = task.writes
             try:
                 for key, value in out.items():
                     number = float(value)
@@ -176,7 +213,7 @@ class Steppers:
         line instead of the buffers (it reads its own outputs back at once)."""
         values = self.values
         own = task.own
-        inp = {port: own.get(buf, values[buf]) for port, buf in task.inputs}
+        inp = {port: own.get(at, values[at]) for port, at in task.reads}
         try:
             out = task.comp.do_step(now, inp)
         except RunFault:
@@ -185,7 +222,7 @@ class Steppers:
             raise RunFault(self.who(task.path), now, f"do_step raised {exc!r}") from exc
         if not out:
             return
-        writes: dict[str, float] = {}
+        writes: dict[Any, float] = {}
         checked_writes(task, out, writes, now, self.who)
         own.update(writes)
         assert task.delay is not None
@@ -199,35 +236,36 @@ class Steppers:
         (or not at all, if the key is missing). Kept apart so the scalar path stays lean.
         """
         values = self.values
-        arrays_in = task.arrays_in
+        arrays_in = task.reads_arrays
         inp: dict[str, Any] = {}
-        for port, buf in task.inputs:
+        for port, at in task.reads:
             names = arrays_in.get(port)
-            inp[port] = values[buf] if names is None else np.array([values[n] for n in names])
+            inp[port] = values[at] if names is None else np.array([values[n] for n in names])
         out = self._call(task, now, inp)
         if not out:
             return
-        writes: list[tuple[str, float]] = []
+        writes: list[tuple[Any, float]] = []
         scalars: dict[str, Any] = {}
         try:
             items = list(out.items())
         except AttributeError:
-            raise bad_output(self.who(task.path), now, task.targets, out) from None
+            raise bad_output(self.who(task.path), now, task.writes, out) from None
         for key, value in items:
-            names = task.arrays_out.get(key)
+            names = task.writes_arrays.get(key)
             if names is None:
                 scalars[key] = value
                 continue
             writes.extend(
                 zip(names, self._checked_array(task, now, key, value, len(names)), strict=True)
             )
-        checked: dict[str, float] = {}
+        checked: dict[Any, float] = {}
         checked_writes(task, scalars, checked, now, self.who)
         writes.extend(checked.items())
         if task.delay is not None:
             self.send(task.delay, writes)
         else:
-            values.update(writes)
+            for at, value in writes:
+                values[at] = value
 
     def _checked_array(self, task: Task, now: Fraction, key: str, value: Any, n: int) -> list:
         """An array output as ``n`` finite floats, or the fault that says what is wrong."""
@@ -248,10 +286,14 @@ class Steppers:
         return arr.tolist()
 
     def step_group(self, group: batch.Group, now: Fraction) -> None:
-        """Run a group of like components in one call (``engine/batch.py``)."""
-        values = self.values
-        # array('d', tuple) then a view: a third cheaper than np.array on a tuple of floats
-        inp = {port: np.frombuffer(array("d", get(values))) for port, get in group.inputs}
+        """Run a group of like components in one call (``engine/batch.py``).
+
+        Each input port is the members' column gathered in one numpy call (a copy: a
+        template may keep or edit its inputs), each output written back into the store's
+        array in place, in one call too (only the published rows, under a mask).
+        """
+        col = self.col
+        inp = {port: col[at].copy() if type(at) is slice else col[at] for port, at in group.inputs}
         who = self.who
         try:
             out, published = group.template.step_many(
@@ -274,10 +316,10 @@ class Steppers:
                 f"None or a boolean mask of {n} rows, got ({short_repr(out)}, "
                 f"{short_repr(published)})",
             )
-        mask = None if published is None else published.tolist()
+        outputs = group.outputs
         for port, arr in out.items():
-            bufs = group.outputs.get(port)
-            if bufs is None:
+            at = outputs.get(port)
+            if at is None:
                 raise RunFault(
                     who(group.paths[0]), now, f"published unknown output {short_repr(port)}"
                 )
@@ -293,9 +335,18 @@ class Steppers:
                     ) from None
             k = batch.first_bad(arr, published)
             if k is not None:
-                raise RunFault(who(group.paths[k]), now, f"output {port} is {arr[k]}")
-            pairs = zip(bufs, arr.tolist(), strict=True)
+                fault = RunFault(who(group.paths[k]), now, f"output {port} is {arr[k]}")
+                raise in_run(fault, group.tasks[k].run)
             if group.delay is not None:  # the copies' common latency (no jitter: batch.py)
-                self.send(group.delay, list(pairs if mask is None else compress(pairs, mask)))
+                # whole columns in flight (a copy: the template may reuse its array)
+                if published is None:
+                    self.send(group.delay, [(at, arr.copy())])
+                else:
+                    where = np.asarray(group.targets[port], dtype=np.intp)[published]
+                    self.send(group.delay, [(where, arr[published])])
+            elif published is None:
+                col[at] = arr
+            elif type(at) is slice:
+                np.copyto(col[at], arr, where=published)
             else:
-                values.update(pairs if mask is None else compress(pairs, mask))
+                col[at[published]] = arr[published]

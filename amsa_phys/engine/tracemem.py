@@ -26,11 +26,19 @@ class TraceMemory:
         self._flat = array("d")
         self._closed = False
 
-    def write(self, t_s: float, values: Sequence[float]) -> None:
-        """Append one row (the engine's trace callback)."""
+    def write(self, t_s: float, values: Sequence[float] | np.ndarray) -> None:
+        """Append one row (the engine's trace callback): floats, or a float64 array, which
+        the engine gives this writer (:attr:`packed_rows`) — its bytes are appended as they
+        are, three times cheaper than boxing each value as a float and unboxing it here."""
         flat = self._flat
         flat.append(t_s)
-        flat.extend(values)
+        if type(values) is np.ndarray:
+            flat.frombytes(values.tobytes())
+        else:
+            flat.extend(values)
+
+    #: tells the engine's log (``log.py``) to hand :meth:`write` rows as float64 arrays
+    write.packed_rows = True  # type: ignore[attr-defined]
 
     def close(self) -> None:
         """No more rows: the arrays handed out from now on are views, not copies."""

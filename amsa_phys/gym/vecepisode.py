@@ -25,14 +25,14 @@ from typing import Any
 
 import numpy as np
 
-from ..engine.multirun import MultiRun, prefix_of
+from ..engine.multirun import MultiRun
 from ..model.scenario import Scenario
 from ..model.template import Template
 from .episode import JOIN_TIMEOUT_S, _Stop
 
 _STOP = object()
 
-ExchangeMany = Callable[[Fraction, Mapping[str, np.ndarray], list[int]], Mapping[str, Any]]
+ExchangeMany = Callable[[Fraction, Mapping[str, np.ndarray], Sequence[Any]], Mapping[str, Any]]
 
 
 def stand_in_many(original: type[Template], exchange: ExchangeMany) -> type[Template]:
@@ -56,10 +56,15 @@ def stand_in_many(original: type[Template], exchange: ExchangeMany) -> type[Temp
         def step_many(
             cls, comps: Sequence[Any], t: Fraction, inputs: Mapping[str, Any], p: Any, state: Any
         ) -> tuple[Mapping[str, Any], Any]:
-            runs = [int(c.path.partition(".")[0][1:]) for c in comps]
-            return exchange(t, inputs, runs)
+            return exchange(t, inputs, comps)
 
     return Agents
+
+
+def _holds_physics(comp: Any) -> bool:
+    """Whether ``comp`` holds its run's physics world (a robot: its ``step_many`` would
+    command every run's rovers through the first one's world)."""
+    return getattr(comp, "physics", None) is not None
 
 
 class VecEpisode:
@@ -78,10 +83,12 @@ class VecEpisode:
         agent = dataclasses.replace(leaf, template=stand_in_many(leaf.template, self._exchange))
         world = dataclasses.replace(world, leaves={**world.leaves, path: agent})
         scenarios = [dataclasses.replace(scenario, world=world, seed=int(s)) for s in seeds]
-        # every other component steps one by one, as in a single run: the runs' robots live
-        # in separate Spaces, and each run's arithmetic is then exactly the single env's
-        others = {lf.template for p, lf in world.leaves.items() if p != path}
-        self.sim = MultiRun(scenarios, ungrouped=tuple(others))
+        # the runs' robots live in separate Spaces (contacts are each run's own): a component
+        # that holds its run's physics world steps one by one; the others step as groups
+        # over the store's columns, with each run's own streams and arithmetic
+        self.sim = MultiRun(scenarios, ungrouped=_holds_physics)
+        #: each run's agent (by identity) -> its run
+        self._run_of = {id(m[path]): r for r, m in enumerate(self.sim.members)}
         self.n = len(scenarios)
         self.path = path
         self.observed = list(observed)
@@ -108,8 +115,9 @@ class VecEpisode:
         self._to_agent.put(("done", None, None))
 
     def _exchange(
-        self, t: Fraction, inputs: Mapping[str, Any], runs: list[int]
+        self, t: Fraction, inputs: Mapping[str, Any], comps: Sequence[Any]
     ) -> tuple[Mapping[str, Any], Any]:
+        runs = [self._run_of[id(c)] for c in comps]
         order = np.argsort(runs)  # the group's member order -> run order
         back = np.empty_like(order)
         back[order] = np.arange(len(order))
@@ -144,19 +152,12 @@ class VecEpisode:
 
     def final_inputs(self) -> np.ndarray:
         """What every run's component reads at the end (the last observation)."""
-        leaves = self.sim.world.leaves
-        return np.array(
-            [
-                self.sim.read_many(
-                    [leaves[f"{prefix_of(i)}.{self.path}"].inputs[p] for p in self.observed]
-                )
-                for i in range(self.n)
-            ]
-        )
+        inputs = self.sim.world.leaves[self.path].inputs
+        return np.column_stack([self.sim.column(inputs[p]) for p in self.observed])
 
     def signals(self, signal: str) -> np.ndarray:
-        """The quality signal of every run now."""
-        return self.sim.read_many([f"{prefix_of(i)}.{signal}" for i in range(self.n)])
+        """The quality signal of every run now (its column in the store)."""
+        return self.sim.column(signal)
 
     def collisions(self) -> np.ndarray:
         """Collisions so far, per run."""

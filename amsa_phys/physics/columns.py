@@ -44,6 +44,7 @@ from typing import Any
 import numpy as np
 import pymunk
 
+from ..engine.tasks import in_run
 from ..errors import RunFault
 from .fleet import Fleet
 from .force_model import make_force_model
@@ -214,7 +215,8 @@ class ColumnPhysics:
         self.steps += 1
         if bad is not None:
             rover = self.rovers[bad[0]]
-            raise RunFault(rover.name, self.sim.now + 1 / self.worlds[0].rate, bad[1])
+            fault = RunFault(rover.name, self.sim.now + 1 / self.worlds[0].rate, bad[1])
+            raise in_run(fault, int(self._run[bad[0]]))  # the batch makes that run alone
 
     def _contacts(self, dt: float) -> None:
         """Mark the runs whose shapes are within reach of each other before this step."""

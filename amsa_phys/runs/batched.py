@@ -180,7 +180,7 @@ def run_batch(jobs: Sequence[Job], stats: dict[str, int] | None = None) -> list[
         try:
             sim.run()
         except RunFault as exc:
-            k = sim.run_of(exc.component)
+            k = sim.run_of(exc)
             if k is None:  # not any one run's: each alone says what it is
                 rows.update((job.index, run_job(job)) for job, _ in todo)
                 break

@@ -112,3 +112,23 @@ def test_bad_arguments() -> None:
         vec.reset(seed=[1])
     with pytest.raises(gymnasium.error.ResetNeeded):
         vec.step(np.zeros((2, 2)))
+
+
+def test_the_runs_sensors_and_controllers_step_as_columns_and_the_robots_alone() -> None:
+    """The vector env rides the batch's columns: every component but those holding their
+    run's physics world (the robots, each run's own Space) steps as one group of all runs,
+    its ports slices of the store's array."""
+    vec = FollowVecEnv(3, SCENARIO2, duration=2)
+    vec.reset(seed=5)
+    episode = vec._episode
+    assert episode is not None
+    sim = episode.sim
+    grouped = {g.paths[0]: g for gs in sim._groups_of.values() for g in gs}
+    world = sim.world.leaves
+    robots = {p for p, comp in sim.components.items() if getattr(comp, "physics", None)}
+    assert robots  # the leader and the follower
+    assert set(grouped) == set(world) - robots
+    for group in grouped.values():
+        assert len(group.tasks) == 3
+        assert all(isinstance(at, slice) for _, at in group.inputs)
+    vec.close()

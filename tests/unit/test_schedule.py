@@ -104,3 +104,41 @@ def test_deliveries_arrive_by_due_tick_then_send_order() -> None:
     heap.deliver(9, values)
     assert values["A.x"] == 1.0
     assert not heap
+
+
+def test_a_groups_publication_arrives_as_whole_columns_in_send_order() -> None:
+    from array import array
+
+    import numpy as np
+
+    data = array("d", [0.0] * 8)  # the store's two views of one memory (engine/store.py)
+    col = np.frombuffer(data)
+    heap = Deliveries()
+    heap.push(2, [(slice(0, 8, 2), np.array([1.0, 2.0, 3.0, 4.0]))])  # a group's column
+    heap.push(2, [(4, 9.0)])  # a scalar publication due at the same tick, sent later: wins
+    heap.push(3, [(np.array([1, 7]), np.array([5.0, 6.0]))])  # the published rows only
+    assert heap.in_flight(4) == 2
+    assert heap.in_flight(7) == 1
+    assert heap.in_flight(3) == 0
+    heap.deliver(2, data, col)
+    assert data.tolist() == [1.0, 0.0, 2.0, 0.0, 9.0, 0.0, 4.0, 0.0]
+    heap.deliver(3, data, col)
+    assert (data[1], data[7]) == (5.0, 6.0)
+    assert not heap
+
+
+def test_gauss_markov_factors_are_remembered_read_only_and_equal_the_scalar_ones() -> None:
+    import numpy as np
+
+    from amsa_phys.engine import noise
+
+    sigma = np.array([0.1, 0.2, 0.1])
+    tau = np.array([10.0, 0.0, 10.0])
+    phi, q = noise.gauss_markov_many(sigma, tau, 0.25)
+    for k in range(3):
+        assert (phi[k], q[k]) == noise.gauss_markov(sigma[k], tau[k], 0.25)  # to the bit
+    again = noise.gauss_markov_many(sigma.copy(), tau.copy(), 0.25)
+    assert again[0] is phi  # the same values: the answer remembered
+    assert not phi.flags.writeable  # so no caller can edit what others share
+    other = noise.gauss_markov_many(sigma, tau, 0.5)
+    assert other[0][0] != phi[0]  # another period, another answer

@@ -179,3 +179,118 @@ def test_grouping_is_an_argument_and_gives_the_same_values(tmp_path: Path) -> No
     assert np.allclose(grouped.read_many(names), single.read_many(names), rtol=1e-12)
     assert grouped.read("Car3.D.y") == pytest.approx(1 / (11 * 1.4))
     assert not hasattr(batch, "ENABLED")  # grouping is an argument, no module switch
+
+
+# -- the column store: one float64 array, positions, columns, views (issue 29) ---------------
+def test_a_batch_store_is_one_array_with_a_column_per_buffer_and_a_row_per_run(
+    tmp_path: Path,
+) -> None:
+    w = _world(tmp_path, SCAN)
+    store = BufferStore({n: b.initial for n, b in w.buffers.items()}, w.arrays, runs=3)
+    names = store.names
+    for run in range(3):
+        for b, name in enumerate(names):
+            assert store.at(name, run) == b * 3 + run  # a column's runs are consecutive
+    store.write("S.vals[2]", 7.5, run=1)
+    assert list(store.column("S.vals[2]")) == [0.0, 7.5, 0.0]  # that run only
+    assert store.read("S.vals[2]", 1) == 7.5
+    assert store.row(1)[store.index["S.vals[2]"]] == 7.5
+    assert store.row(0)[store.index["S.vals[2]"]] == 0.0
+    # the scalar view and the numpy view are one memory: no copy between them
+    store.data[store.at("Sum.total", 2)] = 3.25
+    assert store.col[store.at("Sum.total", 2)] == 3.25
+    store.col[store.at("Sum.total", 0)] = -1.5
+    assert store.data[store.at("Sum.total", 0)] == -1.5
+    assert type(store.data[0]) is float  # the scalar path hands components Python floats
+    assert store.table.shape == (len(names), 3)
+    assert store.table.base is not None  # a view of the one array, not a copy
+    with pytest.raises(IndexError):
+        store.at("Sum.total", 3)
+    with pytest.raises(KeyError):
+        store.at("Sum.nope")
+
+
+def test_the_named_view_reads_and_writes_the_array_and_invents_no_buffer(tmp_path: Path) -> None:
+    w = _world(tmp_path, SCAN)
+    store = BufferStore({n: b.initial for n, b in w.buffers.items()}, w.arrays)
+    store.values["Sum.total"] = 4
+    assert store.data[store.at("Sum.total")] == 4.0
+    assert type(store.values["Sum.total"]) is float
+    assert list(store.values) == store.names
+    assert len(store.values) == len(store)
+    assert "Sum.total" in store.values
+    assert "Sum.nope" not in store.values
+    with pytest.raises(KeyError):
+        store.values["Sum.nope"] = 1.0
+    with pytest.raises(KeyError):
+        store.values["Sum.nope"]
+
+
+def test_a_group_port_is_a_slice_when_evenly_spaced_and_an_index_otherwise() -> None:
+    from amsa_phys.engine.batch import columns
+
+    assert columns([4, 5, 6, 7]) == slice(4, 8, 1)  # one Leaf across a batch's runs
+    assert columns([3, 10, 17]) == slice(3, 24, 7)  # copies of a Composite, one run
+    assert columns([9]) == slice(9, 10, 1)
+    irregular = columns([2, 10, 17])  # the first copy reads the leader's buffer
+    assert isinstance(irregular, np.ndarray)
+    assert list(irregular) == [2, 10, 17]
+    backwards = columns([5, 4, 3])
+    assert isinstance(backwards, np.ndarray)
+    data = np.arange(30.0)
+    for at in ([4, 5, 6, 7], [3, 10, 17], [2, 10, 17], [5, 4, 3]):
+        assert list(data[columns(at)]) == [data[i] for i in at]
+
+
+def test_groups_write_their_columns_in_place_and_give_the_leaf_by_leaf_values(
+    tmp_path: Path,
+) -> None:
+    w = _world(tmp_path, COPIES)
+    grouped = Simulation(w, duration=Fraction(1))
+    single = Simulation(w, duration=Fraction(1), grouping=False)
+    for sim in (grouped, single):
+        sim.run()
+    (group,) = {g for gs in grouped._groups_of.values() for g in gs}
+    assert isinstance(group.outputs["y"], slice)  # the copies' outputs: one strided slice
+    assert np.array_equal(grouped.store.col, single.store.col)  # every buffer, to the bit
+
+
+BATCH_SCENARIO = """
+world: w.yaml
+duration: 1
+seed: {seed}
+set: {{Car2.D.k: {k}}}
+timeline:
+  - {{at: 0.5, set: {{A.gain: {gain}}}}}
+"""
+
+
+def _scenario(tmp_path: Path, seed: int, k: float, gain: float) -> Any:
+    from amsa_phys.model.scenario import load_scenario
+
+    (tmp_path / "w.yaml").write_text(COPIES.replace("count: 40", "count: 2"))
+    path = tmp_path / f"s{seed}.yaml"
+    path.write_text(BATCH_SCENARIO.format(seed=seed, k=k, gain=gain))
+    return load_scenario(path)
+
+
+def test_a_batch_of_runs_gives_each_run_its_single_runs_values(tmp_path: Path) -> None:
+    """Runs on an integer axis: each run its own parameters and timeline, its own row in
+    every column, the values of the run made alone; no buffer is renamed."""
+    from amsa_phys.engine.multirun import MultiRun
+
+    scenarios = [_scenario(tmp_path, s, k, g) for s, k, g in ((1, 1.0, 2.0), (2, 2.5, -1.0))]
+    scenarios.append(scenarios[0])
+    batch = MultiRun(scenarios)
+    batch.run()
+    assert batch.store.runs == 3
+    assert set(batch.store.names) == set(scenarios[0].world.buffers)  # names as alone
+    for run, sc in enumerate(scenarios):
+        alone = Simulation.from_scenario(sc)
+        alone.run()
+        assert np.array_equal(batch.store.row(run), alone.store.row()), run
+    # the Dividers of every run stepped as one group, their port one slice of the array
+    groups = {g for gs in batch._groups_of.values() for g in gs}
+    assert groups
+    assert all(isinstance(g.inputs[0][1], slice) for g in groups)
+    assert list(batch.column("A.count")) == [22.0, -11.0, 22.0]  # 11 steps, gain from 0.5 s

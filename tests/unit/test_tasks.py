@@ -39,6 +39,7 @@ def _task(comp: Comp, *, delayed: bool = False, arrays: bool = False) -> Task:
         task.delay = object()  # type: ignore[assignment]  # only handed to ``send``
     if arrays:
         task.arrays_out["w"] = ["C.w[0]", "C.w[1]"]
+    task.bind(lambda name: name)  # positions are the names: the values here are a dict
     return task
 
 
