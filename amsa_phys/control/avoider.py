@@ -40,6 +40,8 @@ class ReactiveAvoider(Template):
     computed from them and the number of ranges received.
     """
 
+    batchable = True  # each run's copy steps alone in a batch (no step_many needed)
+
     kind = Kind.CONTROLLER
     inputs = (
         Port("ranges", 0.0, "lidar ranges, beam by beam", "m", array=True),

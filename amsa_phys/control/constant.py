@@ -13,6 +13,8 @@ from ..model.template import Kind, Port, Template
 class ConstantPower(Template):
     """Publishes fixed left/right powers (change them with the timeline)."""
 
+    batchable = True  # each run's copy steps alone in a batch (no step_many needed)
+
     kind = Kind.CONTROLLER
     uses_random = False
     outputs = (

@@ -44,6 +44,8 @@ class DistanceMonitor(Template):
 class GoalMonitor(Template):
     """Distance from a rover's true position to a goal point: the quality signal of a mission."""
 
+    batchable = True  # each run's copy steps alone in a batch (no step_many needed)
+
     kind = Kind.OBSERVER
     inputs = (Port("posX", 0.0, "true x", "m"), Port("posY", 0.0, "true y", "m"))
     outputs = (Port("distanceToGoal", 0.0, "true distance to the goal", "m"),)

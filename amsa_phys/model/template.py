@@ -132,11 +132,12 @@ class Template:
     uses_random: ClassVar[bool] = True
     #: Capabilities a batch of runs relies on (``runs/batched.py``), declared here rather
     #: than inferred from names. ``batchable``: runs of one batch may hold this template
-    #: (None: yes if it is built in or defines ``step_many``). ``shares_physics``: copies in
-    #: different runs can share the batch's one physics world (False for what changes the
-    #: ground itself, a terrain zone). ``batch_params_at_start``: a batch sets this
-    #: template's parameters at t = 0 only (a rover's, held in the batch's columns), so a
-    #: timeline that changes them mid-run runs alone.
+    #: (None: yes if it defines ``step_many``; the built-in templates declare it).
+    #: ``shares_physics``: copies in different runs can share the batch's one physics world
+    #: (False for what changes the ground itself, a terrain zone).
+    #: ``batch_params_at_start``: a batch sets this template's parameters at t = 0 only (a
+    #: rover's, held in the batch's columns), so a timeline that changes them mid-run runs
+    #: alone.
     batchable: ClassVar[bool | None] = None
     shares_physics: ClassVar[bool] = True
     batch_params_at_start: ClassVar[bool] = False

@@ -45,6 +45,8 @@ class Lidar(Template):
     mixed pixels at edges.
     """
 
+    batchable = True  # each run's copy steps alone in a batch (no step_many needed)
+
     kind = Kind.SENSOR
     inputs = (
         Port("posX", 0.0, "x of the mount", "m"),

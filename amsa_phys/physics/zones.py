@@ -28,6 +28,8 @@ class FrictionZone(Template):
     ``{at: 60, set: {Mud.friction: 0.3}}``). Overlapping zones: the last declared wins.
     """
 
+    batchable = True  # each run's copy steps alone in a batch (no step_many needed)
+
     template_name = "frictionZone"
     #: a zone changes the ground itself: the batch's column physics has one ground
     shares_physics = False
@@ -100,6 +102,8 @@ class GradeZone(Template):
     (``tests/fidelity/test_slopes.py``). The world stays a plane: a slope changes forces,
     not the height or the drawing.
     """
+
+    batchable = True  # each run's copy steps alone in a batch (no step_many needed)
 
     template_name = "gradeZone"
     #: a zone changes the ground itself: the batch's column physics has one ground

@@ -78,10 +78,13 @@ def unbatchable(scenario: Scenario) -> str | None:
 
 
 def _batchable(template: type) -> bool:
+    """What the template declares; undeclared, only a template with ``step_many`` (a user's
+    template without it may keep state a batch cannot see: it runs alone). Never inferred
+    from where the template lives: built-in ones declare it like any other."""
     declared = getattr(template, "batchable", None)
     if declared is not None:
         return bool(declared)
-    return template.__module__.startswith("amsa_phys.") or hasattr(template, "step_many")
+    return hasattr(template, "step_many")
 
 
 def _shares_physics(template: Any) -> bool:

@@ -41,6 +41,8 @@ class IMU(Template):
     (``lostData`` %) publishes nothing.
     """
 
+    batchable = True  # each run's copy steps alone in a batch (no step_many needed)
+
     kind = Kind.SENSOR
     inputs = (
         Port("speed", 0.0, "true forward speed", "m/s"),

@@ -30,6 +30,8 @@ class WheelOdometry(Template):
     publishes nothing, but the integration goes on (encoder counts are cumulative).
     """
 
+    batchable = True  # each run's copy steps alone in a batch (no step_many needed)
+
     kind = Kind.SENSOR
     inputs = (
         Port("wheelSpeedL", 0.0, "left wheel rim speed (encoder)", "m/s"),

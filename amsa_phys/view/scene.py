@@ -128,8 +128,9 @@ def describe_phase(sim: Simulation, planned: Sequence[Fraction] | None = None) -
     replaces that value in the line and says when it landed (``Kv=0.35 live at 130.2 s``),
     and so does a timeline step that starts no phase (``new_phase: false``) once applied
     (``Kv=0.15 at 20.0 s``): the HUD never shows a value the run is not using. ``planned``:
-    the file's phase starts and duration when ``--duration`` shortened the run (``Scenario.planned_bounds``):
-    the count is then the file's, and the line says where this run stops.
+    the file's phase starts and duration when ``--duration`` shortened the run
+    (``Scenario.planned_bounds``): the count is then the file's, and the line says where
+    this run stops.
     """
     phase = sim.phases[sim.phase_index]
     live: dict[tuple[str, str], tuple[Any, Any, str]] = {}

@@ -79,3 +79,18 @@ def test_the_robots_say_when_they_are_random() -> None:
         False,
     ]
     assert not ControlledRobot.is_random({})
+
+
+def test_batchable_is_never_inferred_from_the_module_a_template_lives_in(tmp_path: Path) -> None:
+    """A template in a module named like the package's own, declaring nothing and without
+    step_many, runs alone like any user template; every built-in template declares itself."""
+    import importlib
+
+    from amsa_phys.model.template import BUILTINS
+
+    posing = type("Posing", (toys.Relay,), {"template_name": "posing", "__module__": "amsa_phys.x"})
+    assert "without step_many" in str(unbatchable(_scenario(tmp_path, posing)))
+    for name, ref in BUILTINS.items():
+        module, _, cls = ref.partition(":")
+        template = getattr(importlib.import_module(module), cls)
+        assert template.batchable is not None or hasattr(template, "step_many"), name

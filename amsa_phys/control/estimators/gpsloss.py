@@ -26,6 +26,8 @@ class GPSLossMonitor(Template):
     of samples are in, it publishes 0 (no evidence of loss).
     """
 
+    batchable = True  # each run's copy steps alone in a batch (no step_many needed)
+
     kind = Kind.OBSERVER
     uses_random = False
     #: the windows are sized once, at initialize

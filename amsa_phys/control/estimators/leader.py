@@ -35,6 +35,8 @@ class LeaderMonitor(Template):
     straight for a while). Until ``window`` seconds have passed, both outputs are 0.
     """
 
+    batchable = True  # each run's copy steps alone in a batch (no step_many needed)
+
     kind = Kind.OBSERVER
     uses_random = False
     #: the windows are sized once, at initialize

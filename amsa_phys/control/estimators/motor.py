@@ -33,6 +33,8 @@ class MotorMonitor(Template):
     samples are in.
     """
 
+    batchable = True  # each run's copy steps alone in a batch (no step_many needed)
+
     kind = Kind.OBSERVER
     uses_random = False
     #: the windows are sized once, at initialize
