@@ -9,6 +9,7 @@ their id).
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import shutil
 import signal
@@ -147,3 +148,12 @@ def build_workspace(ws: Path, scenario: Path, pkg: str) -> Path:
         f'exec roslaunch {pkg} "$@"\n'
     )
     return ws
+
+
+def metrics_without_wall(run_dir: Path) -> dict:
+    """A run's ``metrics.json`` without the only fields a wall clock sets, to compare a ROS
+    run with the in-process one."""
+    data = json.loads((run_dir / "metrics.json").read_text())
+    for key in ("wall_time_s", "real_time_factor"):
+        data.pop(key)
+    return data

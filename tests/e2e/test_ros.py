@@ -60,11 +60,7 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
-def _metrics(path: Path) -> dict:
-    data = json.loads((path / "metrics.json").read_text())
-    for key in ("wall_time_s", "real_time_factor"):  # the only fields a wall clock sets
-        data.pop(key)
-    return data
+_metrics = ros_launch.metrics_without_wall
 
 
 def _bag_topics(bag: Path) -> dict[str, list[float]]:

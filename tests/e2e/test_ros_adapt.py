@@ -27,11 +27,7 @@ pytestmark = pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missin
 launcher = ros_launch.launcher  # the fixture
 
 
-def _metrics(path: Path) -> dict:
-    data = json.loads((path / "metrics.json").read_text())
-    for key in ("wall_time_s", "real_time_factor"):  # the only fields a wall clock sets
-        data.pop(key)
-    return data
+_metrics = ros_launch.metrics_without_wall
 
 
 def test_lockstep_fires_the_rules_where_amsa_phys_run_does(

@@ -21,7 +21,6 @@ machine: each is an executable of its own compiled against roscpp's headers.)
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
 from pathlib import Path
 
@@ -56,11 +55,7 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
-def _metrics(path: Path) -> dict:
-    data = json.loads((path / "metrics.json").read_text())
-    for key in ("wall_time_s", "real_time_factor"):  # the only fields a wall clock sets
-        data.pop(key)
-    return data
+_metrics = ros_launch.metrics_without_wall
 
 
 def test_the_fixture_runs_every_cpp_template_as_a_cpp_node(workspace: Path) -> None:
