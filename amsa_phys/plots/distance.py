@@ -259,6 +259,10 @@ def cut_note(metrics: dict[str, Any]) -> str:
         return ""
     status = str(metrics.get("status") or "completed")
     if status == "completed" and ran >= planned:
+        # a whole run of a scenario that --duration shortened: its last phase is cut
+        overall = metrics.get("overall")
+        if isinstance(overall, dict) and overall.get("partial"):
+            return f" — shortened to {ran:g} s by --duration (its last phase cut)"
         return ""
     why = {"interrupted": "interrupted (Ctrl-C)"}.get(status, status)
     why = why.split(" at t=")[0]  # "closed in the window at t=42.5 s": the time is said once

@@ -147,7 +147,10 @@ def test_the_doc_table_is_the_palette() -> None:
 def test_a_run_closed_in_the_window_says_where_in_its_plot_titles(tmp_path: Path) -> None:
     out = run(tmp_path)
     metrics = json.loads((out / "metrics.json").read_text())
-    assert cut_note(metrics) == ""
+    # --duration 30 of a 500 s scenario: said too, as shortened (tryout: it said nothing)
+    assert cut_note(metrics) == " — shortened to 30 s by --duration (its last phase cut)"
+    whole = {**metrics, "overall": {**metrics["overall"], "partial": False}}
+    assert cut_note(whole) == ""
     metrics.update(simulated=12.5, duration=30.0, status="closed in the window at t=12.5 s")
     fig = distance_figure(out / "trace.csv", metrics)
     try:
