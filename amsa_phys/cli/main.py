@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 import sysconfig
 import threading
@@ -104,10 +105,26 @@ class _Version(argparse.Action):
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with usage errors as one line (exit 2), pointing at ``--help``."""
+    """argparse with usage errors as one line (exit 2), pointing at ``--help``.
+
+    No abbreviated options: ``--hea`` taken for ``--headless`` hides a typo, and an option
+    added later would change what an old abbreviation means in users' scripts.
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
-        """Print ``error: <prog>: <message>`` and exit 2."""
+        """Print ``error: <prog>: <message>`` and exit 2 (a mistyped command gets a
+        "did you mean", as every other name does)."""
+        bad = re.match(r"argument COMMAND: invalid choice: '([^']*)'", message)
+        if bad is not None:
+            from ..model.suggest import did_you_mean
+
+            hint = did_you_mean(bad.group(1), list(COMMANDS))
+            if hint:
+                message = f"unknown command {bad.group(1)!r}{hint}"
         self.exit(2, one_line(f"error: {self.prog}: {message} (see {self.prog} --help)") + "\n")
 
 
