@@ -68,12 +68,25 @@ def plot_tracks(bag: Path, png: Path) -> dict[str, np.ndarray]:
     if signal:
         s = np.array(signal)
         right.plot(s[:, 0], s[:, 1], lw=1, label=SIGNAL)
-        top = float(s[:, 1].max())
-        for t, what in phases:
+        lo, hi = float(s[:, 1].min()), float(s[:, 1].max())
+        right.set_ylim(lo - 0.05 * (hi - lo), hi + 0.35 * (hi - lo))  # room above for labels
+        for i, (t, what) in enumerate(phases):
             right.axvline(t, color="grey", lw=0.8, ls="--")
-            right.text(t, top, f" {what}", fontsize=7, va="top", rotation=90, clip_on=True)
-        right.legend(fontsize=7)
-    right.set(xlabel="simulated time (s)", ylabel="m", title="a Data buffer and /amsa/events")
+            # horizontal, above the curve, stepped down so neighbours never overlap
+            y = hi + (0.3 - 0.09 * (i % 3)) * (hi - lo)
+            label = what.split(": ", 1)[-1].replace("MyFollowerController.", "")
+            right.text(
+                t,
+                y,
+                f" {label}",
+                fontsize=7,
+                va="top",
+                clip_on=True,
+                bbox={"boxstyle": "square,pad=0.1", "fc": "white", "ec": "none"},
+            )
+        # the topic goes in the title: a legend box would cover the curve's troughs
+    right.set(xlabel="simulated time (s)", ylabel="m")
+    right.set_title(f"{SIGNAL} and /amsa/events", fontsize=9)
     right.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(png, dpi=110)
