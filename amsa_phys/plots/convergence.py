@@ -9,6 +9,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from matplotlib.colors import BoundaryNorm
 
 from .save import save_png
 
@@ -32,16 +33,22 @@ def plot_convergence(
     without a value (a fault: the worst there is) is marked on the axis's edge.
     """
     fig, ax = plt.subplots(figsize=(8, 4.5), dpi=100)
-    runs = list(range(1, len(values) + 1))
+    runs = list(range(len(values)))  # numbered from 0, as runs.csv's `run` and the headline
     finite = [v for v in values if v is not None and math.isfinite(v)]
     xs = [r for r, v in zip(runs, values, strict=True) if v is not None and math.isfinite(v)]
     gens = [
         g for g, v in zip(generations, values, strict=True) if v is not None and math.isfinite(v)
     ]
     if finite:
-        dots = ax.scatter(xs, finite, c=gens, cmap="viridis", s=14, zorder=2, label="run")
-        if max(generations, default=0) > 0:
-            fig.colorbar(dots, ax=ax, label="generation")
+        last = max(generations, default=0)
+        # generations are whole numbers: one colour each, a tick on each (not a 0.0-1.0 ramp)
+        norm = BoundaryNorm([g - 0.5 for g in range(last + 2)], plt.get_cmap("viridis").N)
+        dots = ax.scatter(
+            xs, finite, c=gens, cmap="viridis", norm=norm, s=14, zorder=2, label="run"
+        )
+        if last > 0:
+            bar = fig.colorbar(dots, ax=ax, label="generation")
+            bar.set_ticks(list(range(0, last + 1, max(1, (last + 1) // 10))))
     worst: list[float] = []
     current = math.nan
     for v in values:
@@ -61,7 +68,7 @@ def plot_convergence(
         ax.axhline(threshold, color="black", ls="--", lw=1, label=f"bound {threshold:g}")
     if reference is not None:
         ax.axhline(reference[0], color="tab:blue", ls=":", lw=1.5, label=reference[1])
-    ax.set_xlabel("runs")
+    ax.set_xlabel("run (as numbered in runs.csv)")
     ax.set_ylabel(label)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
