@@ -132,20 +132,20 @@ class FreeRobot(Robot):
     ) -> tuple[Mapping[str, Any], None]:
         """``do_step`` for many copies at once (a batched sweep's leaders): each copy's
         behaviour as alone, the powers and poses as arrays (``ControlledRobot.step_many``)."""
-        straight = p.behavior == 1  # behaviour 1 is the cruise power on both wheels
+        behavior = p.behavior
+        straight = behavior == 1  # behaviour 1 is the cruise power on both wheels
         if straight.all():
             left = right = p.cruisePower
         else:
-            powers = np.array(
-                [
-                    (cp, cp) if s else c._behaviour(t)
-                    for c, s, cp in zip(
-                        comps, straight.tolist(), p.cruisePower.tolist(), strict=True
-                    )
-                ],
-                dtype=np.float64,
-            )
-            left, right = powers[:, 0], powers[:, 1]
+            left = np.array(p.cruisePower, dtype=np.float64)
+            right = left.copy()
+            random = behavior == 4
+            for i in np.flatnonzero(~straight & ~random).tolist():  # circles, waypoints, ...
+                left[i], right[i] = comps[i]._behaviour(t)
+            if random.any():
+                rows = np.flatnonzero(random)
+                sl, sr = cls._random_many(comps, t, p, rows, state)
+                left[rows], right[rows] = sl, sr
         return ControlledRobot.step_many(
             comps,  # type: ignore[arg-type]
             t,
@@ -153,6 +153,68 @@ class FreeRobot(Robot):
             p,
             state,
         )
+
+    @classmethod
+    def _random_many(
+        cls,
+        every: Sequence[FreeRobot],
+        t: Fraction,
+        p: Any,
+        rows: np.ndarray,
+        state: dict[str, Any],
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Behaviour 4 for the copies ``every[rows]``: :meth:`_behaviour`'s floats, bit for
+        bit, as arrays.
+
+        Why: steering each copy in Python was ~26 % of a scenario2 batch. A copy draws a new
+        heading and speed only every ``changePeriod`` s (scalar, from its own generator, as
+        alone); between draws the steering law is arithmetic over the copies. ``math.cos``
+        stays scalar: numpy may compute ``cos`` with its own SIMD code, which can differ from
+        libm's (what a single run uses) in the last bit; subtraction, product, ``%`` (the
+        same fmod-based rule as Python's) and comparisons are IEEE-exact in both.
+        """
+        mine = state.get("random")
+        if mine is None or mine["rows"] != rows.tobytes():  # first step, or behaviours changed
+            comps = [every[i] for i in rows.tolist()]
+            physics = comps[0].physics
+            mine = state["random"] = {
+                "rows": rows.tobytes(),
+                "comps": comps,
+                "index": physics.index_of([c.rover for c in comps]),
+                "heading": np.array([c.target_heading for c in comps], dtype=np.float64),
+                "factor": np.array([c.speed_factor for c in comps], dtype=np.float64),
+                "soonest": min(c.next_change for c in comps),
+            }
+        comps = mine["comps"]
+        if t >= mine["soonest"]:  # some copies draw: each as alone, from its own generator
+            heading, factor = mine["heading"], mine["factor"]
+            for k, c in enumerate(comps):
+                if t >= c.next_change:
+                    c._change(t)
+                    heading[k] = c.target_heading
+                    factor[k] = c.speed_factor
+            mine["soonest"] = min(c.next_change for c in comps)
+        angle = comps[0].physics.kinematics_array(mine["index"])[:, 2]
+        power = np.asarray(p.cruisePower)[rows] * mine["factor"]
+        err = (mine["heading"] - angle + math.pi) % (2 * math.pi) - math.pi  # wrap_angle
+        diff = np.asarray(p.steerGain)[rows] * err
+        cos = np.fromiter(map(math.cos, err.tolist()), dtype=np.float64, count=len(comps))
+        forward = power * np.where(cos > 0.0, cos, 0.0)  # max(0.0, cos): NaN gives 0.0
+        return forward - diff, forward + diff
+
+    def _change(self, t: Fraction) -> None:
+        """Behaviours 3 and 4 at a change time: the next change, the new speed (and heading)."""
+        p = self.p
+        b = p.behavior
+        self.next_change = t + Fraction(str(p.changePeriod))
+        if b == 3:
+            cycle = (1.0, 0.5, 1.5, 1.0)
+            self.speed_factor = cycle[int(t / Fraction(str(p.changePeriod))) % 4]
+        elif b == 4:
+            self.target_heading = self.rover.kinematics()[2] + self.rng.uniform(
+                -p.randomTurn, p.randomTurn
+            )
+            self.speed_factor = float(self.rng.uniform(0.5, 1.2))
 
     def _behaviour(self, t: Fraction) -> tuple[float, float]:
         p = self.p
@@ -165,15 +227,7 @@ class FreeRobot(Robot):
         if b == 1:
             return cruise, cruise
         if t >= self.next_change:
-            self.next_change = t + Fraction(str(p.changePeriod))
-            if b == 3:
-                cycle = (1.0, 0.5, 1.5, 1.0)
-                self.speed_factor = cycle[int(t / Fraction(str(p.changePeriod))) % 4]
-            elif b == 4:
-                self.target_heading = self.rover.kinematics()[2] + self.rng.uniform(
-                    -p.randomTurn, p.randomTurn
-                )
-                self.speed_factor = float(self.rng.uniform(0.5, 1.2))
+            self._change(t)
         if b == 3:
             return cruise * self.speed_factor, cruise * self.speed_factor
         if b == 5:

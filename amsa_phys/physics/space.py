@@ -35,7 +35,7 @@ from . import fleet
 from .bodyio import BodyIO
 from .force_model import ForceModel, make_force_model
 from .forces import ground_list
-from .rover import DiffDriveRover
+from .rover import DiffDriveRover, PendingPowers
 from .terrain import Terrain
 from .wheel import WheelModel
 
@@ -74,6 +74,9 @@ class PhysicsWorld:
         self.space.collision_slop = CONTACT_SLOP_M
         self.space.collision_bias = CONTACT_BIAS
         self.rovers: list[DiffDriveRover] = []
+        #: commands of :meth:`set_powers` not yet written onto the rovers (``rover.py``)
+        self._pending = PendingPowers(self.rovers)
+        self._band: np.ndarray | None = None  # each rover's deadband (``set_powers``)
         self._owner: dict[int, str] = {}
         self.collisions = 0
         self._touching: dict[tuple[str, str], int] = {}
@@ -148,6 +151,8 @@ class PhysicsWorld:
         )
         self._owner[id(rover.shape)] = name
         self.rovers.append(rover)
+        rover.attach_pending(self._pending, len(self.rovers) - 1)
+        self._band = None
         self._model = None  # the batch layout changed
         return rover
 
@@ -158,6 +163,7 @@ class PhysicsWorld:
         """Rebuild a rover's wheel model after a parameter change (motor wear, ...)."""
         rover.wheel = self._wheel_model(p)
         rover.update_drive()  # the deadband may have changed
+        self._band = None
         if self._model is not None:
             self._model.refresh()
             self._where = [None] * len(self.rovers)  # grip and resistance changed too
@@ -269,23 +275,22 @@ class PhysicsWorld:
 
         The grouped controlled robots of a platoon (``step_many``) command 200 rovers at
         4 Hz; one by one that is ~0.8 µs a rover. Saturation is the motor driver's (±100 %,
-        NaN to -100 as :func:`rover._saturate`); the rovers' ``power_l``/``power_r`` (which the
-        per-rover force model and the renderer read) and the batch model's arrays both follow.
+        NaN to -100 as :func:`rover._saturate`) and the deadband each driver's, as numpy over
+        the group (the same floats: the comparisons are the scalar code's). The force model's
+        drive array gets them now; the rovers' ``power_l`` ... ``drive_r`` (read by the
+        renderer and the pure force model) through :class:`rover.PendingPowers` when read.
         """
         if self.group is not None:  # a batch's columns: no window reads power_l there
             self.group.set_powers(rovers, index, left, right)
             return
         left = np.where(np.isnan(left), -100.0, np.clip(left, -100.0, 100.0))
         right = np.where(np.isnan(right), -100.0, np.clip(right, -100.0, 100.0))
-        drive_l, drive_r = [], []
-        for rover, lp, rp in zip(rovers, left.tolist(), right.tolist(), strict=True):
-            band = rover.wheel.deadband_pct  # as rover.update_drive
-            rover.power_l = lp
-            rover.power_r = rp
-            rover.drive_l = dl = lp if not -band < lp < band else 0.0
-            rover.drive_r = dr = rp if not -band < rp < band else 0.0
-            drive_l.append(dl)
-            drive_r.append(dr)
+        if self._band is None:
+            self._band = np.array([r.wheel.deadband_pct for r in self.rovers], dtype=np.float64)
+        band = self._band[index]
+        drive_l = np.where((-band < left) & (left < band), 0.0, left)
+        drive_r = np.where((-band < right) & (right < band), 0.0, right)
+        self._pending.put(index, left, right, drive_l, drive_r)
         drives = self._model.drives if self._model is not None else None
         if drives is not None:
             drives[0, index] = drive_l

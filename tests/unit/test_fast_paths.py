@@ -203,13 +203,27 @@ def test_commanding_many_rovers_equals_one_by_one(tmp_path: Path, cars: int) -> 
     left = rng.uniform(-150, 150, cars)
     right = rng.uniform(-150, 150, cars)
     left[0], right[1] = np.nan, 100.0
+    # inside, at and just outside the driver's 2 % deadband, and -0.0
+    left[2], right[2], left[3], right[3], left[4] = 1.5, -2.0, 2.0000001, -1.9999, -0.0
     many, one = (s.shared["physics"] for s in sims)
     chosen = many.rovers[1:]  # the cars, not the leader
     many.set_powers(chosen, many.index_of(chosen), left, right)
     for rover, lp, rp in zip(one.rovers[1:], left.tolist(), right.tolist(), strict=True):
         rover.set_power(lp, rp)
+    # a single command after the group's wins (the leader's is set this way every step)
+    many.rovers[2].set_power(33.0, -7.5)
+    one.rovers[2].set_power(33.0, -7.5)
+
+    def bits(r: object) -> list[bytes]:
+        return [
+            np.float64(getattr(r, k)).tobytes()
+            for k in ("power_l", "power_r", "drive_l", "drive_r")
+        ]
+
     for a, b in zip(many.rovers, one.rovers, strict=True):
-        assert (a.power_l, a.power_r) == (b.power_l, b.power_r)
+        assert bits(a) == bits(b)
+    assert one.rovers[3].drive_l == 0.0  # the band bites
+    assert one.rovers[3].drive_r == -2.0
     for sim in sims:
         sim.run()
     finals = [[list(r.kinematics()) for r in s.shared["physics"].rovers] for s in sims]
