@@ -4,7 +4,15 @@ Out (both sides): a stream's message is built by ``stdmsgs.build`` — the very 
 the MCAP bag, so covariances come from the sensor's noise model the same way — once every
 field of it has a new value since the last message (a Leaf publishes all of its outputs
 at a step, each on its topic; a GPS that lost its fix publishes nothing, so no NavSatFix
-either). Stamped with ``rospy.Time.now()``: simulated time (``/clock``). The tf tree is REP 105's
+either). Stamped with the simulated time at which its values were produced, as in the bag.
+In lockstep the values come from the simulator, on :data:`VALUES`: one message per Leaf
+step, its instant and the values of the buffers this node reads (the very floats of the
+data topics). One connection carries both, so no race between a ``/clock`` connection and a
+data connection can stamp a message with another instant, and ``/clock`` (published only
+where a node steps: 4 Hz in scenario1) does not stamp a 10 Hz Leader's pose 0.25 s late
+with repeated stamps. In free mode each node steps on its own timer and the simulator does
+not know when a value was produced: the data topics, stamped with ``rospy.Time.now()``
+(``/clock``). The tf tree is REP 105's
 per robot, as in the bag: ``map`` -> ``<robot>/odom`` (identity, latched on ``/tf_static``)
 -> ``<robot>/base_link`` (the true pose, on ``/tf``).
 
@@ -21,7 +29,8 @@ from __future__ import annotations
 import math
 import threading
 import time
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
+from fractions import Fraction
 from typing import Any
 
 from ...errors import AmsaError
@@ -29,6 +38,7 @@ from ...stdmsgs import DEFAULT_ORIGIN, Context, Source, build, geodetic_to_enu, 
 from ...stdmsgs.build import static_transform, transform
 from .. import names
 from ..boundary import NODE, SIM_PARAM, plan
+from ..graph import RosGraph
 from . import rosio
 from .config import load_config
 
@@ -37,6 +47,10 @@ NO_FIX = -1
 
 #: ``/clock`` period with ``sim:=false`` (wall seconds): finer than any Leaf's period
 CLOCK_PERIOD = 0.005
+
+#: lockstep: the simulator's ``NUM DEN BUFFER VALUE ...`` per Leaf step (std_msgs/String):
+#: the step's instant (a fraction of seconds) and the values it wrote that this node reads
+VALUES = "/amsa/boundary/values"
 
 
 def ros1_classes() -> dict[str, Any]:
@@ -84,17 +98,23 @@ class Outbound:
         self.fresh: set[str] = set()
         self.wanted = set(buffers_of(src))
 
-    def got(self, buffer: str) -> None:
-        """A field's buffer has a new value (the node's lock is held)."""
+    def got(self, buffer: str, at: Fraction | None = None) -> None:
+        """A field's buffer has a new value, produced at ``at`` (simulated seconds; None:
+        now, by ``/clock``); the node's lock is held."""
         self.fresh.add(buffer)
         if self.fresh >= self.wanted:
             self.fresh.clear()
-            self.publish()
+            self.publish(at)
 
-    def publish(self) -> None:
+    def publish(self, at: Fraction | None = None) -> None:
         rospy = self.node.rospy
-        now = rospy.Time.now()
-        ctx = Context((now.secs, now.nsecs), now.to_sec(), self.period, self.node.origin)
+        if at is None:
+            now = rospy.Time.now()
+            stamp, t_s = (now.secs, now.nsecs), now.to_sec()
+        else:  # as the bag stamps it (``bag/recorder.py``)
+            ns = rosio.to_ns(at)
+            stamp, t_s = (ns // 10**9, ns % 10**9), float(at)
+        ctx = Context(stamp, t_s, self.period, self.node.origin)
         values = self.node.values
         msg = build(self.src, values, self.params, ctx)
         self.pub.publish(fill(rospy, self.cls(), msg))
@@ -111,6 +131,7 @@ class BoundaryNode:
         self.rospy = rospy
         cfg = load_config(rospy)
         self.graph = cfg.graph
+        self.lockstep = cfg.mode == "lockstep"
         self.sim = bool(rospy.get_param(SIM_PARAM, True))
         self.plan = plan(self.graph)
         self.classes = ros1_classes()
@@ -152,13 +173,19 @@ class BoundaryNode:
                 self.subs.append(rospy.Subscriber(src.topic, cls, self._on_std, callback_args=src))
 
     def listen(self) -> None:
-        """Subscribe to the data topics the outbound streams read.
+        """Subscribe to the data topics the outbound streams read (lockstep: to :data:`VALUES`).
 
-        With the simulator, only once ``/clock`` runs: every node waits at start until each
-        of its publishers has exactly the subscribers the graph counts, and a subscriber of
-        ours counted in a consumer's place would let a producer publish before that
+        With the simulator in free mode, only once ``/clock`` runs: every node waits at
+        start until each of its publishers has exactly the subscribers the graph counts, and
+        a subscriber of ours counted in a consumer's place would let a producer publish before that
         consumer is connected (its lockstep step would then wait forever for a lost message).
         """
+        if self.sim and self.lockstep:  # the values with their instants, from the simulator
+            String = rosio.msgs()[1]  # (no count of subscribers waits for this one: at once)
+            self.subs.append(
+                self.rospy.Subscriber(VALUES, String, self._on_values, tcp_nodelay=True)
+            )
+            return
         if self.sim:
             Clock = rosio.msgs()[2]
             self.rospy.wait_for_message(names.CLOCK, Clock)
@@ -174,6 +201,16 @@ class BoundaryNode:
             self.values[buffer] = msg.data
             for o in self.readers[buffer]:
                 o.got(buffer)
+
+    def _on_values(self, msg: Any) -> None:
+        """Lockstep: a Leaf step's values that this node reads, at the step's instant."""
+        at, values = parse_values(msg.data)
+        with self.lock:
+            for buffer, value in values:
+                if buffer in self.readers:
+                    self.values[buffer] = value
+                    for o in self.readers[buffer]:
+                        o.got(buffer, at)
 
     def _on_std(self, msg: Any, src: Source) -> None:
         """A driver's message on a sensor stream: its fields on their data topics."""
@@ -197,6 +234,23 @@ class BoundaryNode:
             ns = int((time.monotonic() - wall0) * speed * 1e9)
             pub.publish(Clock(self.rospy.Time(ns // 10**9, ns % 10**9)))
             time.sleep(CLOCK_PERIOD)  # the clock's own tick: pacing is this node's job
+
+
+def format_values(t: Fraction, values: Iterable[tuple[str, float]]) -> str:
+    """A :data:`VALUES` message: ``t`` exactly, each float as ``repr`` (it reads back the same)."""
+    return " ".join([str(t.numerator), str(t.denominator), *(f"{b} {v!r}" for b, v in values)])
+
+
+def parse_values(text: str) -> tuple[Fraction, list[tuple[str, float]]]:
+    """A :data:`VALUES` message: the instant and the values."""
+    num, den, *rest = text.split(" ")
+    values = [(rest[i], float(rest[i + 1])) for i in range(0, len(rest), 2)]
+    return Fraction(int(num), int(den)), values
+
+
+def readable(graph: RosGraph) -> set[str]:
+    """Every buffer the boundary publishes from with the simulator (what :data:`VALUES` carries)."""
+    return {b for src in plan(graph).sources for b in buffers_of(src)}
 
 
 def buffers_of(src: Source) -> list[str]:

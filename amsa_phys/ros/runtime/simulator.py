@@ -35,6 +35,7 @@ from ...runs.single import run_scenario
 from .. import names
 from ..graph import RosGraph
 from . import readiness, records, rosio
+from .boundary import VALUES, format_values, readable
 from .config import NodeConfig, load_config
 from .rossim import RosSimulation
 from .waves import DueAt, wave
@@ -83,6 +84,12 @@ class Link:
         self.wall0: float | None = None
         self.speed = 1.0
         self.clock_pub = rosio.make_publisher(rospy, names.CLOCK, Clock, latch=True)
+        #: lockstep: the buffers the boundary node reads, each Leaf step's values of them
+        #: published with the step's instant (``boundary.py``: its messages' stamps)
+        self.boundary_reads = readable(self.graph) if self.lockstep else set()
+        self.values_pub = (
+            rosio.make_publisher(rospy, VALUES, String) if self.boundary_reads else None
+        )
         self.data_pubs = {
             b: self.gate.publisher(names.topic(b), Float64, self.graph.subscribers(b))
             for p in self.graph.local
@@ -311,7 +318,16 @@ class Link:
                 f"{self.received[b][0]} messages on {names.topic(b)}, {self.published[b]} "
                 "answered steps (a step asked twice, or another publisher on the topic)",
             )
+        self.tell_boundary(t, [(b, self.received[b][1]) for b in got])
         return {b.rpartition(".")[2]: self.received[b][1] for b in got}
+
+    def tell_boundary(self, t: Fraction, values: list[tuple[str, float]]) -> None:
+        """Lockstep: the values of a Leaf's step at ``t`` that the boundary node reads."""
+        if self.values_pub is None:
+            return
+        told = [(b, v) for b, v in values if b in self.boundary_reads]
+        if told and self.values_pub.get_num_connections():
+            self.values_pub.publish(self.String(format_values(t, told)))
 
     def reload(self, path: str, name: str, t: Fraction) -> None:
         """A remote Leaf re-reads one parameter now (a timeline change at its instant)."""
@@ -322,14 +338,15 @@ class Link:
             raise ValueError(head[2] if len(head) > 2 else "refused")
 
     # -- local Leaves --------------------------------------------------------------------------
-    def publisher_of(self, path: str) -> Callable[[Mapping[str, Any]], None]:
-        """What publishes the outputs of a Leaf stepped here on their topics."""
+    def publisher_of(self, path: str) -> Callable[[Fraction, Mapping[str, Any]], None]:
+        """What publishes the outputs of a Leaf stepped here, at ``t``, on their topics."""
         ports = [(b.rpartition(".")[2], b) for b in self.graph.outputs(path)]
         pubs = self.data_pubs
         Float64 = self.Float64
         published = self.published
 
-        def publish(out: Mapping[str, Any]) -> None:
+        def publish(t: Fraction, out: Mapping[str, Any]) -> None:
+            sent = []
             for port, b in ports:
                 if port in out:
                     try:
@@ -338,6 +355,8 @@ class Link:
                         continue  # the engine reports it
                     pubs[b].publish(Float64(number))
                     published[b] += 1
+                    sent.append((b, number))
+            self.tell_boundary(t, sent)
 
         return publish
 

@@ -50,7 +50,9 @@ class PublishingLeaf:
     work as in ``amsa-phys run``.
     """
 
-    def __init__(self, comp: Template, publish: Callable[[Mapping[str, Any]], None]) -> None:
+    def __init__(
+        self, comp: Template, publish: Callable[[Fraction, Mapping[str, Any]], None]
+    ) -> None:
         self._comp = comp
         self._publish = publish
 
@@ -61,7 +63,7 @@ class PublishingLeaf:
         """The component's step, then its outputs on their topics."""
         out = self._comp.do_step(t, inp)
         if out:
-            self._publish(out)
+            self._publish(t, out)
         return out
 
 
