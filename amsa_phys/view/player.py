@@ -16,6 +16,7 @@ import numpy as np
 
 from .camera import Camera
 from .draw import INK, LOST, MUTED, Renderer
+from .mouse import pan_zoom
 from .pg import font, pygame
 from .plotpane import SignalPicker, draw_side_panes, picker_key
 from .replay import Event, ReplayScene
@@ -143,32 +144,35 @@ class Player:
 
     # -- input -----------------------------------------------------------------------------------
     def handle(self, event: pygame.event.Event) -> None:
-        """React to one pygame event."""
+        """React to one pygame event: the time slider first, then the map's mouse."""
+        if self._slider_event(event):
+            return
+        handled, self._drag = pan_zoom(event, self.camera, self._drag)
+        if handled:
+            return
         if event.type == pygame.QUIT:
             self.running = False
         elif event.type == pygame.KEYDOWN:
             self._key(event)
-        elif event.type == pygame.MOUSEWHEEL:
-            self.camera.zoom(1.15**event.y, pygame.mouse.get_pos())
-        elif event.type == pygame.MOUSEBUTTONDOWN and event.button == 1:
-            if self.slider.inflate(0, 12).collidepoint(event.pos):
-                self._seeking = True
-                self._seek_x(event.pos[0])
-            else:
-                self._drag = event.pos
-        elif event.type == pygame.MOUSEBUTTONUP and event.button == 1:
-            self._seeking = False
-            self._drag = None
-        elif event.type == pygame.MOUSEMOTION:
-            if self._seeking:
-                self._seek_x(event.pos[0])
-            elif self._drag is not None:
-                self.camera.pan(event.pos[0] - self._drag[0], event.pos[1] - self._drag[1])
-                self._drag = event.pos
         elif event.type == pygame.VIDEORESIZE:
             size = (max(320, event.w), max(240, event.h))
             self.screen = pygame.display.set_mode(size, pygame.RESIZABLE)
             self._layout(size)
+
+    def _slider_event(self, event: pygame.event.Event) -> bool:
+        """A press on the slider starts seeking, motion while seeking seeks; True if taken.
+        A release ends seeking and is passed on (it also ends a map drag)."""
+        if event.type == pygame.MOUSEBUTTONDOWN and event.button == 1:
+            if self.slider.inflate(0, 12).collidepoint(event.pos):
+                self._seeking = True
+                self._seek_x(event.pos[0])
+                return True
+        elif event.type == pygame.MOUSEMOTION and self._seeking:
+            self._seek_x(event.pos[0])
+            return True
+        elif event.type == pygame.MOUSEBUTTONUP and event.button == 1:
+            self._seeking = False
+        return False
 
     def _seek_x(self, x: int) -> None:
         """Seek to the time under pixel column ``x`` of the slider."""

@@ -23,6 +23,7 @@ from ..model.scenario import Quality
 from .camera import Camera
 from .draw import INK, LOST, MUTED, Renderer
 from .drive import advance
+from .mouse import pan_zoom
 from .panel import ParamPanel
 from .pg import pygame
 from .plotpane import LiveSeries, SignalPicker, draw_side_panes, picker_key
@@ -177,19 +178,13 @@ class Window:
     # -- input ---------------------------------------------------------------------------
     def handle(self, event: pygame.event.Event) -> None:
         """React to one pygame event."""
+        handled, self._drag = pan_zoom(event, self.camera, self._drag)
+        if handled:
+            return
         if event.type == pygame.QUIT:
             self.running = False
         elif event.type == pygame.KEYDOWN:
             self._key(event)
-        elif event.type == pygame.MOUSEWHEEL:
-            self.camera.zoom(1.15**event.y, pygame.mouse.get_pos())
-        elif event.type == pygame.MOUSEBUTTONDOWN and event.button == 1:
-            self._drag = event.pos
-        elif event.type == pygame.MOUSEBUTTONUP and event.button == 1:
-            self._drag = None
-        elif event.type == pygame.MOUSEMOTION and self._drag is not None:
-            self.camera.pan(event.pos[0] - self._drag[0], event.pos[1] - self._drag[1])
-            self._drag = event.pos
         elif event.type == pygame.VIDEORESIZE:
             self._resize((event.w, event.h))
 
