@@ -44,7 +44,8 @@ def _kind(pid: int) -> str | None:
     text = b" ".join(argv).decode(errors="replace")
     if "amsa_simulator" in text:
         return KINDS[0]
-    if any(a.endswith(b"_cpp") for a in argv[:1]):
+    # the C++ Leaves: the container (every one in one process) or a nodelet standalone each
+    if any(a.endswith((b"_cpp", b"/amsa_leaves", b"/nodelet")) for a in argv[:1]):
         return KINDS[2]
     if "roslaunch" in text or "rosmaster" in text or "rosout" in text:
         return KINDS[3]

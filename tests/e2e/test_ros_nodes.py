@@ -63,10 +63,12 @@ def test_the_fixture_runs_every_cpp_template_as_a_cpp_node(workspace: Path) -> N
     bodies = cpp_bodies()
     ran = {leaf.template.name() for leaf in world.leaves.values() if has_cpp(leaf, bodies)}
     assert ran == set(bodies)
-    binaries = workspace / "devel" / "lib" / PKG
-    for path, leaf in world.leaves.items():
-        if has_cpp(leaf, bodies):
-            assert (binaries / f"{names.script(path)}_cpp").is_file(), path
+    # one nodelet class per template, compiled once into the package's library, and the
+    # container that loads every C++ Leaf of the package into one process
+    assert (workspace / "devel" / "lib" / f"lib{PKG}_leaves.so").is_file()
+    assert (workspace / "devel" / "lib" / PKG / names.CONTAINER).is_file()
+    sources = sorted(p.stem for p in (workspace / "src" / PKG / "src" / "leaves").iterdir())
+    assert sources == sorted(bodies)
 
 
 @pytest.mark.parametrize("cpp", ["true", "false"])

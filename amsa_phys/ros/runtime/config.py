@@ -23,13 +23,14 @@ class NodeConfig:
 
 
 def load_config(rospy: Any) -> NodeConfig:
-    """Read ``/amsa/{scenario,mode,local,bag,timeout}`` and load the scenario."""
+    """Read ``/amsa/{scenario,mode,local,bag,timeout,container}`` and load the scenario."""
     try:
         path = rospy.get_param("/amsa/scenario")
         mode = rospy.get_param("/amsa/mode", "lockstep")
         local = rospy.get_param("/amsa/local", [])
         bag = bool(rospy.get_param("/amsa/bag", False))
         timeout = float(rospy.get_param("/amsa/timeout", 60.0))
+        shared = rospy.get_param("/amsa/container", [])  # the C++ Leaves in one process
     except KeyError as exc:
         raise ConfigError(
             "is not on the parameter server (start the nodes with roslaunch)", key=str(exc)
@@ -37,4 +38,4 @@ def load_config(rospy: Any) -> NodeConfig:
     if mode not in MODES:
         raise ConfigError(f"expected lockstep or free, got {mode!r}", key="/amsa/mode")
     scenario = load_scenario(path)
-    return NodeConfig(scenario, RosGraph.of(scenario.world, local, bag), mode, timeout)
+    return NodeConfig(scenario, RosGraph.of(scenario.world, local, bag, shared), mode, timeout)
