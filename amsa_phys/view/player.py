@@ -20,6 +20,7 @@ from .mouse import pan_zoom
 from .pg import font, pygame
 from .plotpane import SignalPicker, draw_side_panes, picker_key
 from .replay import Event, ReplayScene
+from .scene import Frame
 
 SPEEDS = (1 / 16, 1 / 8, 1 / 4, 1 / 2, 1, 2, 4, 8, 16, 32, 64)
 MAX_REAL_DT = 0.1
@@ -42,7 +43,7 @@ HELP = [
     "              enter picks / drops, g closes)",
     "c             camera: fit, then follow each rover",
     "z x, wheel    zoom in / out",
-    "h or F1       this help",
+    "h or F1       this help (any other key closes it)",
     "q or esc      quit",
 ]
 
@@ -188,6 +189,10 @@ class Player:
         shift = bool(event.mod & pygame.KMOD_SHIFT)
         if self.picker.visible and self._picker_key(key, event.unicode):
             return
+        if self.show_help and key not in (pygame.K_h, pygame.K_F1):
+            self.show_help = False  # any key puts the help away (and does its job) ...
+            if key == pygame.K_ESCAPE:
+                return  # ... but Esc only that: it never quits from the help
         if key in (pygame.K_q, pygame.K_ESCAPE):
             self.running = False
         elif key == pygame.K_SPACE:
@@ -242,7 +247,7 @@ class Player:
 
     # -- drawing ---------------------------------------------------------------------------------
     def status(self) -> list[str]:
-        """Top-right lines: play state, speed, camera, last notice."""
+        """Top-right lines: play state, speed, camera (the last notice goes in the HUD)."""
         state = "playing" if self.playing else "PAUSED"
         if self.row >= self.scene.rows - 1:
             state = "end of the run"
@@ -253,19 +258,31 @@ class Player:
         status = str(self.scene.metrics.get("status") or "")
         if status and status != "completed":
             lines.append(f"run {status}")
-        if self.notice:
-            lines.append(self.notice)
         return lines
 
     def draw(self) -> None:
-        """The current row, the slider, and the open panes."""
+        """The current row, the slider, and the open panes (drawn again when what covers
+        the map moved, so the picture and the camera agree: ``Window.draw``)."""
         frame = self.scene.frame(self.row)
+        cam = self.camera
+        points = [(r.x, r.y, r.name) for r in frame.rovers]
+        cam.update(points, 0.05 if self.playing else 1e9)
+        for _ in range(2):
+            room = (cam.top, cam.right)
+            self._paint(frame)
+            if (cam.top, cam.right) == room:
+                break
+            cam.update(points, 0.05 if self.playing else 1e9)
+        pygame.display.flip()
+
+    def _paint(self, frame: Frame) -> None:
+        """Draw ``frame``, the slider and the panes; set the camera's covers from them."""
         view = self.screen.subsurface(self.view_rect)
         cam = self.camera
-        cam.update([(r.x, r.y, r.name) for r in frame.rovers], 0.05 if self.playing else 1e9)
-        self.renderer.draw(view, frame, cam, self.status())
+        self.renderer.draw(view, frame, cam, self.status(), self.notice)
+        cam.top = max(box.bottom for box in self.renderer.boxes.values()) + 6  # under the HUD
         self._slider()
-        draw_side_panes(
+        right = draw_side_panes(
             self.screen,
             self.renderer,
             self.picker,
@@ -274,7 +291,8 @@ class Player:
             HELP,
             self.view_rect,
         )
-        pygame.display.flip()
+        # beside the help or the signal list
+        cam.right = self.view_rect.right - right.left if right is not None else 0
 
     def scene_series(self, name: str, span_s: float) -> tuple[np.ndarray, np.ndarray]:
         """The pane's samples of ``name`` up to the row shown (the replay's whole history)."""

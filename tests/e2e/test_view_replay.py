@@ -325,18 +325,18 @@ def test_view_in_a_real_x_window_scrubs_to_an_event_and_draws_the_traced_pose(
 def _drawn_at(
     scene: object, row: int, size: tuple[int, int]
 ) -> list[tuple[tuple[int, int], tuple[int, int, int]]]:
-    """Where the paused player draws each rover's centre at ``row``, and in which colour:
-    the camera in fit mode settles at once while paused."""
-    from amsa_phys.view.camera import Camera
-
-    frame = scene.frame(row)  # type: ignore[attr-defined]
-    camera = Camera((size[0], size[1] - SLIDER_H))
-    points = [(r.x, r.y, r.name) for r in frame.rovers]
-    camera.update(points, 1e9)
-    camera.update(points, 1e9)
+    """Where the paused player draws each rover's centre after End then b (at ``row``), and
+    in which colour: the same player, headless, given the same keys (the camera frames the
+    rovers under its HUD, which then holds the jump's notice; in fit mode it settles at once
+    while paused)."""
+    player = Player(scene, title="model", size=size)  # type: ignore[arg-type]
+    player.step(player.scene.rows)
+    player.jump(-1)
+    assert player.row == row
+    player.frame(0.0)
     out = []
-    for r in frame.rovers:
-        x, y = camera.to_screen(r.x, r.y)
+    for r in player.scene.frame(row).rovers:
+        x, y = player.camera.to_screen(r.x, r.y)
         out.append(((round(x), round(y)), rover_colour(r.index)))
     return out
 
