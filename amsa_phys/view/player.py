@@ -2,9 +2,10 @@
 
 Same renderer, camera and HUD as the live window, fed by a
 :class:`~amsa_phys.view.replay.ReplayScene`; a slider along the bottom shows where the
-cursor is in the run, with a tick for every phase start and change (grey), collision and
-lost fix (red). Click or drag on it to seek. The cursor always sits on a logged instant,
-so every picture is exactly the trace's row.
+cursor is in the run, with a mark for every event in the palette's language
+(``marks.draw_slider_mark``: grey for the timeline, red for alerts). Click or drag on it to
+seek. The cursor always sits on a logged instant, so every picture is exactly the trace's
+row.
 
 ``frame(real_dt)`` runs one iteration (events, advance, draw) so that tests drive the player
 with injected events and an exact clock under SDL's dummy driver, as they do the window.
@@ -15,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 
 from .camera import Camera
-from .draw import INK, LOST, MUTED, Renderer
+from .draw import INK, MUTED, Renderer
+from .marks import SLIDER_ORDER, draw_slider_mark, slider_kind
 from .mouse import pan_zoom
 from .pg import font, pygame
 from .plotpane import SignalPicker, draw_side_panes, picker_key
@@ -28,7 +30,6 @@ FPS = 60
 #: seconds a shift+arrow moves the cursor
 BIG_STEP_S = 5.0
 SLIDER_H = 34
-PHASE_TICK = (102, 102, 102)
 
 HELP = [
     "space         play / pause",
@@ -313,12 +314,9 @@ class Player:
         done = bar.copy()
         done.width = self.slider_x(self.t) - bar.x
         pygame.draw.rect(screen, (190, 200, 215), done)
-        for e in self.scene.events:
-            x = self.slider_x(e.t)
-            if e.kind in ("phase", "change"):
-                pygame.draw.line(screen, PHASE_TICK, (x, bar.top - 4), (x, bar.bottom + 4), 2)
-            else:
-                pygame.draw.line(screen, LOST, (x, bar.top), (x, bar.bottom), 1)
+        rank = {kind: i for i, kind in enumerate(SLIDER_ORDER)}
+        for e in sorted(self.scene.events, key=lambda e: rank[slider_kind(e.kind)]):
+            draw_slider_mark(screen, e.kind, self.slider_x(e.t), bar)
         x = self.slider_x(self.t)
         pygame.draw.rect(screen, INK, (x - 3, bar.top - 6, 6, bar.height + 12))
         label = font(max(9, self.renderer.text_px - 3)).render(
