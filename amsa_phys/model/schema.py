@@ -46,6 +46,7 @@ def duration_problem(duration: Fraction) -> str | None:
         )
     return None
 
+
 #: A Data name: a NAME, or ``Composite.NAME`` for a Data declared inside a Composite.
 DATA_NAME = r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$"
 _num = {"type": "number"}
