@@ -177,8 +177,9 @@ def _phase_notes(ax: Axes, phases: list[dict[str, Any]]) -> list[str]:
 
 def _inner_changes(ax: Axes, phases: list[dict[str, Any]]) -> list[float]:
     """Mark changes made inside a phase (live in the window, ``new_phase: false``): a dashed
-    line and what was set, upright along the bottom so it never meets the phase notes; one
-    legend entry for them all. Returns their times (the legend is kept off them)."""
+    line in the timeline's grey (``palette.PHASE``; phase starts are dotted) and what was
+    set, upright along the bottom so it never meets the phase notes; one legend entry for
+    them all. Returns their times (the legend is kept off them)."""
     times = []
     for phase in phases:
         for change in phase.get("changes", []):
@@ -186,7 +187,7 @@ def _inner_changes(ax: Axes, phases: list[dict[str, Any]]) -> list[float]:
             times.append(float(at))
             ax.axvline(
                 at,
-                color="tab:purple",
+                color=hex_colour(PHASE),
                 lw=0.8,
                 ls="--",
                 alpha=0.8,
@@ -204,7 +205,7 @@ def _inner_changes(ax: Axes, phases: list[dict[str, Any]]) -> list[float]:
                 ha="right",
                 va="bottom",
                 fontsize=NOTE_PT - 0.5,
-                color="tab:purple",
+                color=hex_colour(PHASE),
                 zorder=6,  # over the legend, should they ever meet
             )
     return times
