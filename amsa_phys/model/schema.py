@@ -15,7 +15,7 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 from .adaptrules import SCHEMA as ADAPT
-from .params import short_repr, yaml_type
+from .params import number_text_hint, short_repr, yaml_type
 from .rates import MAX_RATE_HZ, MIN_PHYSICS_RATE_HZ, MIN_RATE_HZ
 from .suggest import did_you_mean
 from .yamlio import KeyPath, YamlDoc
@@ -382,7 +382,8 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
         words = " or ".join(_TYPE_WORDS.get(w, w) for w in wants)
         if not path:  # the whole file: say what it is, never echo what it holds
             return path, f"expected {words}, got {yaml_type(inst)}: not a world or scenario file"
-        return path, f"expected {words}, got {yaml_type(inst)} {short_repr(inst)}"
+        hint = number_text_hint(inst) if {"number", "integer"} & set(wants) else ""
+        return path, f"expected {words}, got {yaml_type(inst)} {short_repr(inst)}{hint}"
     if kind in ("minimum", "maximum") and err.schema.get("description") == "rate":
         lo, hi = err.schema["minimum"], err.schema["maximum"]
         if inst <= 0:
@@ -405,7 +406,7 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
             return path, f"must be > 0, got {inst}"
         return path, (
             'expected a positive number of seconds or an exact fraction such as "7/3", '
-            f"got {yaml_type(inst)} {short_repr(inst)}"
+            f"got {yaml_type(inst)} {short_repr(inst)}{number_text_hint(inst)}"
         )
     if kind == "anyOf" and isinstance(inst, dict):
         return path, "needs 'below' or 'above'"

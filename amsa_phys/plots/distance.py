@@ -297,10 +297,13 @@ def distance_figure(
         s = data[:, header.index(signal)]
         ref = float(quality["reference"])
         tol = float(quality["tolerance"])
+        # a tolerance near the float limit (the schema takes any finite one) is drawn to
+        # PLOTTABLE: the axis's top, its edge with headroom, would overflow to inf
+        band = min(tol, PLOTTABLE)
         ax.fill_between(
             [t[0], t[-1]],
-            ref - tol,
-            ref + tol,
+            ref - band,
+            ref + band,
             color=hex_colour(REFERENCE),
             alpha=0.15,
             label=f"tolerance ±{tol:g} m",
@@ -309,7 +312,7 @@ def distance_figure(
         ax.axhline(ref, color=ref_colour, lw=1.2, ls="--", label=f"reference {ref:g} m")
         # palette.SIGNAL, near-black: blue and orange are the rovers' colours everywhere
         ax.plot(t, s, color=hex_colour(SIGNAL), lw=1.2, label=signal)
-        top = max(float(np.nanmax(s)) if np.isfinite(s).any() else 0.0, ref + tol)
+        top = max(float(np.nanmax(s)) if np.isfinite(s).any() else 0.0, ref + band)
         lines = _phase_notes(ax, metrics.get("phases", []))
         changes = _inner_changes(ax, metrics.get("phases", []))
         _collisions(ax, metrics.get("events", []), t, s)
