@@ -34,9 +34,6 @@ from ..engine.runner import Simulation
 from ..model.scenario import Scenario
 from ..model.template import Template
 
-#: How long the vector env's ``close`` waits for its worker thread to leave (``vecepisode.py``)
-JOIN_TIMEOUT_S = 10.0
-
 
 class _Stop(BaseException):
     """Ends the run from inside the stand-in's step (not an Exception: the engine must not
@@ -83,6 +80,7 @@ class Episode:
         trace: Callable[[float, list[float]], None] | None = None,
     ) -> None:
         world = scenario.world
+        self.path = path
         leaf = world.leaves[path]
         agent = dataclasses.replace(leaf, template=stand_in(leaf.template, self._exchange))
         world = dataclasses.replace(world, leaves={**world.leaves, path: agent})

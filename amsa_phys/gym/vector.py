@@ -71,7 +71,9 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         drawn = [s if s is not None else int(self.np_random.integers(0, 2**31 - 1)) for s in seeds]
         self.close_extras()
         single = self.single
-        self._episode = VecEpisode(single._scenario, single.path, drawn, single.observed)
+        self._episode = VecEpisode(
+            single._scenario, single.path, drawn, single.observed, single.acted
+        )
         self._seen = np.zeros(self.num_envs, dtype=np.int64)
         self._autoreset = False
         info = self._info()
@@ -95,7 +97,7 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
             raise ValueError(f"expected actions of shape ({n}, {len(acted)}), got {a.shape}")
         scale = self.single.action_scale
         episode = self._episode
-        episode.step({name: a[:, j] * scale for j, name in enumerate(acted)})
+        episode.step(a * scale)
         collisions = episode.collisions()
         new = collisions - self._seen
         self._seen = collisions
@@ -109,9 +111,8 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
     def _observations(self) -> np.ndarray:
         episode = self._episode
         assert episode is not None
-        raw = episode.final_inputs() if episode.done else episode.inputs
         observer = self.single.observer
-        return np.stack([observer(row) for row in raw])
+        return np.stack([observer(row) for row in episode.observed_rows()])
 
     def _info(self) -> dict[str, Any]:
         episode = self._episode

@@ -114,21 +114,24 @@ def test_bad_arguments() -> None:
         vec.step(np.zeros((2, 2)))
 
 
-def test_the_runs_sensors_and_controllers_step_as_columns_and_the_robots_alone() -> None:
-    """The vector env rides the batch's columns: every component but those holding their
-    run's physics world (the robots, each run's own Space) steps as one group of all runs,
-    its ports slices of the store's array."""
+def test_every_component_steps_as_columns_and_the_rovers_are_columns() -> None:
+    """The vector env rides the batch's columns: every component, the robots included,
+    steps as one group of all runs, its ports slices of the store's array, and the rovers
+    of all runs are the column physics' rows (no run's Space is stepped)."""
     vec = FollowVecEnv(3, SCENARIO2, duration=2)
     vec.reset(seed=5)
     episode = vec._episode
     assert episode is not None
     sim = episode.sim
     grouped = {g.paths[0]: g for gs in sim._groups_of.values() for g in gs}
-    world = sim.world.leaves
-    robots = {p for p, comp in sim.components.items() if getattr(comp, "physics", None)}
-    assert robots  # the leader and the follower
-    assert set(grouped) == set(world) - robots
+    assert set(grouped) == set(sim.world.leaves)
     for group in grouped.values():
         assert len(group.tasks) == 3
         assert all(isinstance(at, slice) for _, at in group.inputs)
+    for _ in range(8):
+        vec.step(np.zeros((3, 2)))
+    columns = episode.columns
+    assert columns.steps == 200  # 2 s at 100 Hz, for all runs at once
+    assert len(columns.rovers) == 6
+    assert all(w.space.current_time_step == 0 for w in columns.worlds)  # never stepped
     vec.close()

@@ -1,0 +1,70 @@
+"""A run of the vector env continued alone: its single episode, replayed to where it is.
+
+When a run of the batch comes within reach of a contact (``gym/veccolumns.py``), the
+columns can no longer make it (contacts are each pymunk Space's own, and depend on the
+Space's whole history: ``physics/columns.py``). The run is then made exactly as the single
+env makes it: a :class:`~amsa_phys.gym.episode.Episode` of its scenario (its seed, its own
+Space from t = 0) is stepped with the outputs the agent gave that run so far — recorded by
+the vector env — up to the agent's current instant, and carries on from there, one step
+per vector step. Up to the instant it was found within reach the run's rows in the batch
+were its single run's, so the agent acted on exactly what this replay shows it, and the
+replay arrives where the single env with the same seed and actions would be: contacts,
+collisions and all, bit for bit.
+
+The price is the replay, once per run and episode (~50 µs per past step on 2 shared
+cores), and a single env's speed for the rest of that run's episode.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..model.scenario import Scenario
+from .episode import Episode
+
+
+class Solo:
+    """Run ``row`` of a vector episode, made alone from t = 0 (see the module docstring)."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        path: str,
+        observed: Sequence[str],
+        acted: Sequence[str],
+        past: Sequence[np.ndarray],
+    ) -> None:
+        """``past``: the outputs given to this run at each agent instant so far, in
+        ``acted`` order (one row per step)."""
+        self.observed = list(observed)
+        self.acted = list(acted)
+        self.episode = Episode(scenario, path)
+        for row in past:
+            self.step(row)
+
+    def step(self, row: np.ndarray) -> None:
+        """Publish ``row`` (the agent's outputs, ``acted`` order); run to the next instant."""
+        self.episode.step(dict(zip(self.acted, row.tolist(), strict=True)))
+
+    def inputs(self) -> list[float]:
+        """What the component reads now (``observed`` order): at its instant, or at the end."""
+        episode = self.episode
+        if episode.done:
+            leaf = episode.sim.world.leaves[episode.path]
+            return episode.sim.read_many([leaf.inputs[p] for p in self.observed]).tolist()  # type: ignore[no-any-return]
+        inputs = episode.inputs
+        return [inputs[p] for p in self.observed]
+
+    def signal(self, name: str) -> float:
+        """The quality signal now."""
+        return float(self.episode.sim.read(name))
+
+    def collisions(self) -> int:
+        """Collisions of this run so far."""
+        return sum(1 for e in self.episode.sim.events if e.kind == "collision")
+
+    def close(self) -> None:
+        """Stop the episode (safe to call twice)."""
+        self.episode.close()
