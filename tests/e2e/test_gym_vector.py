@@ -135,3 +135,124 @@ def test_every_component_steps_as_columns_and_the_rovers_are_columns() -> None:
     assert len(columns.rovers) == 6
     assert all(w.space.current_time_step == 0 for w in columns.worlds)  # never stepped
     vec.close()
+
+
+def _single_episode(seed: int, actions: np.ndarray, **kw: object) -> list[tuple]:
+    """The single env's (obs, reward, truncated, info) with ``seed`` and ``actions``."""
+    single = FollowEnv(**kw)  # type: ignore[arg-type]
+    obs, info = single.reset(seed=seed)
+    seen = [(obs, 0.0, False, info)]
+    for a in actions:
+        obs, reward, _, truncated, info = single.step(a)
+        seen.append((obs, reward, truncated, info))
+    single.close()
+    return seen
+
+
+def test_runs_that_come_within_reach_continue_alone_exactly_as_the_single_env() -> None:
+    """Contacts are not the columns': a run whose rovers come within reach is made alone
+    (its single episode replayed with the agent's past outputs). Every run, the ones that
+    ram their leader included, is the single env's episode bit for bit, for a whole
+    episode of the packaged scenario (random leader, GPS loss): observation, reward, end,
+    signal and collisions."""
+    n, steps = 4, 160  # 40 s
+    rng = np.random.default_rng(7)
+    actions = rng.uniform(-1, 1, size=(steps, n, 2))
+    actions[:, 0] = 1.0  # full power from the start: rams the leader
+    actions[60:, 3] = 1.0  # full power from 15 s on: rams it later
+    seeds = [21, 22, 23, 24]
+    vec = FollowVecEnv(n, duration=40)
+    obs, _ = vec.reset(seed=seeds)
+    seen = [(obs, np.zeros(n), np.zeros(n, dtype=bool), None)]
+    for a in actions:
+        obs, reward, terminated, truncated, info = vec.step(a)
+        assert not terminated.any()
+        seen.append((obs, reward, truncated, info))
+    episode = vec._episode
+    assert episode is not None
+    assert {0, 3} <= set(episode.solo)  # the rammers went alone
+    assert 2 not in episode.solo  # a random walk stays far behind its leader
+    for i, seed in enumerate(seeds):
+        single = _single_episode(seed, actions[:, i], duration=40)
+        for k, (s_obs, s_rew, s_trunc, s_info) in enumerate(single):
+            v_obs, v_rew, v_trunc, v_info = seen[k]
+            np.testing.assert_array_equal(v_obs[i], s_obs)  # bit for bit
+            assert v_rew[i] == s_rew
+            assert v_trunc[i] == s_trunc
+            if v_info is not None:
+                assert v_info["signal"][i] == s_info["signal"]
+                assert v_info["collisions"][i] == s_info["collisions"]
+                assert v_info["t"][i] == s_info["t"]
+    assert seen[-1][3]["collisions"][0] >= 1  # the rammer did collide
+    vec.close()
+
+
+def test_a_seed_gives_the_same_episode_whatever_the_batch_and_its_order() -> None:
+    """Determinism: a run depends on its seed only, not on the number of envs, its place
+    in the batch, or which runs went alone beside it."""
+    actions = {5: 0.2, 6: 1.0, 7: -0.3}  # seed -> constant action (seed 6 rams its leader)
+
+    def run(seeds: list[int]) -> dict[int, list[np.ndarray]]:
+        vec = FollowVecEnv(len(seeds), SCENARIO2, duration=30)
+        obs, _ = vec.reset(seed=seeds)
+        rows = {s: [obs[i]] for i, s in enumerate(seeds)}
+        a = np.array([[actions[s]] * 2 for s in seeds])
+        for _ in range(120):
+            obs, reward, _, _, _ = vec.step(a)
+            for i, s in enumerate(seeds):
+                rows[s] += [obs[i], reward[i : i + 1]]
+        vec.close()
+        return rows
+
+    three = run([5, 6, 7])
+    two = run([7, 6])
+    one = run([5])
+    for seed, rows in (*two.items(), *one.items()):
+        assert all(np.array_equal(a, b) for a, b in zip(rows, three[seed], strict=True))
+
+
+def test_a_run_within_reach_stops_moving_in_the_columns() -> None:
+    """Once a run is found within reach its rows in the columns are no longer used; they
+    are frozen, so a follower passing through its leader there (no contacts in columns)
+    can never fly off and fault the whole batch (``gym/veccolumns.py``)."""
+    vec = FollowVecEnv(2, SCENARIO1, duration=60)
+    vec.reset(seed=[1, 2])
+    episode = vec._episode
+    assert episode is not None
+    full = np.array([[1.0, 1.0], [0.2, 0.2]])
+    for _ in range(200):  # the follower reaches its leader in ~25 s
+        vec.step(full)
+        if episode.solo:
+            break
+    columns = episode.columns
+    frozen = columns._io.state[:2].copy()  # run 0's two rovers
+    moving = columns._io.state[2:].copy()
+    for _ in range(8):
+        vec.step(full)
+    np.testing.assert_array_equal(columns._io.state[:2], frozen)
+    assert not np.array_equal(columns._io.state[2:], moving)  # run 1 goes on in the columns
+    assert set(episode.solo) == {0}
+    vec.close()
+
+
+def test_stepping_from_another_thread_is_refused() -> None:
+    import threading
+
+    vec = FollowVecEnv(2, SCENARIO1, duration=5)
+    vec.reset(seed=3)
+    caught: list[BaseException] = []
+
+    def other() -> None:
+        try:
+            vec.step(np.zeros((2, 2)))
+        except BaseException as exc:
+            caught.append(exc)
+
+    worker = threading.Thread(target=other)
+    worker.start()
+    worker.join()
+    assert isinstance(caught[0], RuntimeError)
+    assert str(caught[0]).startswith("step() must be called from the thread that called reset()")
+    _, _, _, _, info = vec.step(np.zeros((2, 2)))  # the refused step did not happen
+    assert info["t"].tolist() == [0.25, 0.25]
+    vec.close()
