@@ -256,3 +256,29 @@ def test_stepping_from_another_thread_is_refused() -> None:
     _, _, _, _, info = vec.step(np.zeros((2, 2)))  # the refused step did not happen
     assert info["t"].tolist() == [0.25, 0.25]
     vec.close()
+
+
+def test_gymnasiums_vector_wrappers_and_the_checkers_rules() -> None:
+    """What ``env_checker`` asks of a single env, asked of the vector env (Gymnasium 1.x has
+    no vector checker): observations in the batched space as float64 arrays of their own
+    (not reused by the next step), the reset seeds deterministic, Gymnasium's own vector
+    wrappers run on it (episode statistics at the autoreset)."""
+    from gymnasium.wrappers.vector import RecordEpisodeStatistics
+
+    vec = RecordEpisodeStatistics(FollowVecEnv(3, SCENARIO2, duration=2))
+    obs, _ = vec.reset(seed=4)
+    again, _ = FollowVecEnv(3, SCENARIO2, duration=2).reset(seed=4)
+    np.testing.assert_array_equal(obs, again)
+    kept = obs.copy()
+    for k in range(10):
+        new, reward, terminated, truncated, info = vec.step(vec.action_space.sample())
+        assert vec.observation_space.contains(new)
+        assert new.dtype == np.float64
+        assert reward.dtype == np.float64
+        assert terminated.dtype == truncated.dtype == np.bool_
+        np.testing.assert_array_equal(obs, kept)  # the previous observation is untouched
+        obs, kept = new, new.copy()
+        if k == 7:
+            assert truncated.all()
+            assert info["episode"]["l"].tolist() == [8, 8, 8]  # the wrapper saw the end
+    vec.close()
