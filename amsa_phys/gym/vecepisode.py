@@ -64,6 +64,20 @@ def stand_in_many(original: type[Template], exchange: ExchangeMany) -> type[Temp
     return Agents
 
 
+def _why_not_columns(scenario: Scenario) -> str | None:
+    """Why the runs of ``scenario`` cannot be columns: what a batched sweep cannot hold
+    (terrain zones, lidars, rovers changed during the run, ...: ``runs/batched.py``)."""
+    from ..runs.batched import unbatchable  # the sweep's rules; imports the pool lazily
+
+    return unbatchable(scenario)
+
+
+def _holds_physics(comp: Any) -> bool:
+    """Whether ``comp`` holds its run's physics world (a robot: its ``step_many`` would
+    command every run's rovers through the first one's world)."""
+    return getattr(comp, "physics", None) is not None
+
+
 class VecEpisode:
     """``len(seeds)`` runs of ``scenario`` with the agent in place of the Leaf ``path``.
 
@@ -87,10 +101,15 @@ class VecEpisode:
         world = dataclasses.replace(world, leaves={**world.leaves, path: agent})
         #: each run's scenario, with the component itself (what a run made alone replaces)
         self.scenarios = [dataclasses.replace(scenario, seed=int(s)) for s in seeds]
-        self.columns = EpisodeColumns()
-        self.sim = MultiRun(
-            [dataclasses.replace(sc, world=world) for sc in self.scenarios], columns=self.columns
-        )
+        runs = [dataclasses.replace(sc, world=world) for sc in self.scenarios]
+        #: why the runs cannot be columns (None: they are), ``runs/batched.py``'s reasons
+        self.why_not_columns = _why_not_columns(runs[0])
+        #: the runs' column physics, or None: each run steps its own Space
+        self.columns = EpisodeColumns() if self.why_not_columns is None else None
+        if self.columns is not None:
+            self.sim = MultiRun(runs, columns=self.columns)
+        else:  # a robot's group step would command every run's rovers through one Space
+            self.sim = MultiRun(runs, ungrouped=_holds_physics)
         self.n = len(self.scenarios)
         self.path = path
         self.observed = list(observed)
@@ -187,6 +206,8 @@ class VecEpisode:
 
     def _hand_off(self) -> None:
         """Continue alone every run newly found within reach (``gym/solo.py``)."""
+        if self.columns is None:
+            return  # each run's own Space makes its contacts
         new = self.columns.touched.difference(self.solo)
         for run in sorted(new):
             past = [a[run] for a in self.past]

@@ -40,6 +40,13 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
                 key="render_mode" if kwargs.get("render_mode") is not None else "record_trace",
             )
         self.single = FollowEnv(scenario, **kwargs)  # validates every argument, once
+        if self.single._scenario.adapt:
+            raise ConfigError(
+                "the vector env cannot run adapt: rules (each run would switch its "
+                "parameters at its own instants); use FollowEnv, or gymnasium.make_vec(..., "
+                'vectorization_mode="sync")',
+                key="scenario",
+            )
         self.num_envs = num_envs
         self.single_observation_space = self.single.observation_space
         self.single_action_space = self.single.action_space

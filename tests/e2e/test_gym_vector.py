@@ -282,3 +282,52 @@ def test_gymnasiums_vector_wrappers_and_the_checkers_rules() -> None:
             assert truncated.all()
             assert info["episode"]["l"].tolist() == [8, 8, 8]  # the wrapper saw the end
     vec.close()
+
+
+def test_a_world_columns_cannot_hold_runs_each_space_and_still_equals_the_single_env(
+    tmp_path: Path,
+) -> None:
+    """A terrain zone (a mud strip the rovers cross) is what a batched sweep cannot hold
+    (its columns have one ground). The vector env then steps each run's own Space (the
+    other components still grouped), and each run is still the single env's episode."""
+    import yaml
+
+    world = yaml.safe_load((ROOT / "worlds" / "mde_challenge.yaml").read_text())
+    world["components"]["Mud"] = {
+        "template": "frictionZone",
+        "freq": 1,
+        "params": {
+            "friction": 0.3,
+            "rollingResistance": 0.05,
+            "polygon": [[2, -10], [30, -10], [30, 10], [2, 10]],
+        },
+    }
+    (tmp_path / "world.yaml").write_text(yaml.safe_dump(world))
+    scenario = {
+        "world": str(tmp_path / "world.yaml"),
+        "duration": 6,
+        "quality": {
+            "signal": "MyDistanceMonitor.distanceFollowerToLeader",
+            "reference": 15,
+            "tolerance": 1.5,
+        },
+    }
+    vec = FollowVecEnv(2, scenario)
+    vec.reset(seed=[3, 4])
+    episode = vec._episode
+    assert episode is not None
+    assert episode.columns is None
+    assert "terrain zone" in str(episode.why_not_columns)
+    actions = np.random.default_rng(2).uniform(0, 1, size=(24, 2, 2))
+    seen = [vec.step(a) for a in actions]
+    vec.close()
+    for i, seed in enumerate([3, 4]):
+        single = _single_episode(seed, actions[:, i], scenario=scenario)
+        for (obs, reward, *_), (s_obs, s_rew, *_) in zip(seen, single[1:], strict=True):
+            np.testing.assert_array_equal(obs[i], s_obs)
+            assert reward[i] == s_rew
+
+
+def test_adapt_rules_are_refused_with_the_way_out() -> None:
+    with pytest.raises(ap.ConfigError, match=r"adapt: rules.*FollowEnv"):
+        FollowVecEnv(2, str(ROOT / "scenarios" / "adaptive.yaml"))
