@@ -137,7 +137,9 @@ class Episode:
         except BaseException:  # the run's fault (or Ctrl-C inside it) ends the episode
             self.done = True
             raise
-        self._answer(message)
+        if message is _ENDED:  # ``_answer`` inlined: once per env-step
+            self.done = True
+            self.t = self.end
 
     def close(self) -> None:
         """Stop the run (it leaves at the instant it is paused at); safe to call twice.
