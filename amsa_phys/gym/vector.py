@@ -118,8 +118,7 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
     def _observations(self) -> np.ndarray:
         episode = self._episode
         assert episode is not None
-        observer = self.single.observer
-        return np.stack([observer(row) for row in episode.observed_rows()])
+        return self.single.observer.of_rows(episode.observed_rows())
 
     def _info(self) -> dict[str, Any]:
         episode = self._episode
