@@ -26,7 +26,9 @@ from .episode import Episode
 
 
 class Solo:
-    """Run ``row`` of a vector episode, made alone from t = 0 (see the module docstring)."""
+    """Run ``row`` of a vector episode, made alone from t = 0 (see the module docstring),
+    behind the interface of a :class:`~amsa_phys.gym.vecepisode.VecEpisode` of one run
+    (rows in, rows out), so the vector env treats both alike."""
 
     def __init__(
         self,
@@ -34,36 +36,34 @@ class Solo:
         path: str,
         observed: Sequence[str],
         acted: Sequence[str],
-        past: Sequence[np.ndarray],
     ) -> None:
-        """``past``: the outputs given to this run at each agent instant so far, in
-        ``acted`` order (one row per step)."""
         self.observed = list(observed)
         self.acted = list(acted)
         self.episode = Episode(scenario, path)
-        for row in past:
-            self.step(row)
 
-    def step(self, row: np.ndarray) -> None:
-        """Publish ``row`` (the agent's outputs, ``acted`` order); run to the next instant."""
-        self.episode.step(dict(zip(self.acted, row.tolist(), strict=True)))
+    def step(self, outputs: np.ndarray) -> None:
+        """Publish ``outputs[0]`` (the agent's outputs, ``acted`` order); run to the next
+        instant."""
+        self.episode.step(dict(zip(self.acted, outputs[0].tolist(), strict=True)))
 
-    def inputs(self) -> list[float]:
-        """What the component reads now (``observed`` order): at its instant, or at the end."""
+    def observed_rows(self) -> np.ndarray:
+        """What the component reads now (``observed`` order), at its instant or at the end,
+        as one row."""
         episode = self.episode
         if episode.done:
             leaf = episode.sim.world.leaves[episode.path]
-            return episode.sim.read_many([leaf.inputs[p] for p in self.observed]).tolist()  # type: ignore[no-any-return]
+            values = episode.sim.read_many([leaf.inputs[p] for p in self.observed])
+            return values.reshape(1, -1)  # type: ignore[no-any-return]
         inputs = episode.inputs
-        return [inputs[p] for p in self.observed]
+        return np.array([[inputs[p] for p in self.observed]], dtype=np.float64)
 
-    def signal(self, name: str) -> float:
-        """The quality signal now."""
-        return float(self.episode.sim.read(name))
+    def signals(self, name: str) -> np.ndarray:
+        """The quality signal now, as one row."""
+        return np.array([self.episode.sim.read(name)], dtype=np.float64)
 
-    def collisions(self) -> int:
-        """Collisions of this run so far."""
-        return sum(1 for e in self.episode.sim.events if e.kind == "collision")
+    def collisions(self) -> np.ndarray:
+        """Collisions of this run so far, as one row."""
+        return np.array([sum(1 for e in self.episode.sim.events if e.kind == "collision")])
 
     def close(self) -> None:
         """Stop the episode (safe to call twice)."""

@@ -331,3 +331,35 @@ def test_a_world_columns_cannot_hold_runs_each_space_and_still_equals_the_single
 def test_adapt_rules_are_refused_with_the_way_out() -> None:
     with pytest.raises(ap.ConfigError, match=r"adapt: rules.*FollowEnv"):
         FollowVecEnv(2, str(ROOT / "scenarios" / "adaptive.yaml"))
+
+
+def test_many_runs_within_reach_at_once_go_alone_together_and_equal_the_single_env() -> None:
+    """Five runs driving at full power behind a straight leader reach it at the same
+    instant: they go alone as one batch of per-run Spaces (``CHUNK``), replayed together,
+    and still equal their single envs, collisions (counted by their Spaces) included."""
+    n, steps = 6, 120  # 30 s
+    actions = np.ones((steps, n, 2))
+    actions[0, :, 0] = np.linspace(0.9, 1.0, n)  # one first step each: their own episodes
+    actions[:, 5] = 0.0
+    seeds = list(range(30, 36))
+    vec = FollowVecEnv(n, SCENARIO1, duration=30)
+    vec.reset(seed=seeds)
+    seen = [vec.step(a) for a in actions]
+    episode = vec._episode
+    assert episode is not None
+    assert episode.solo == {0, 1, 2, 3, 4}
+    (runs, member), *rest = episode.alone
+    assert not rest
+    assert runs.tolist() == [0, 1, 2, 3, 4]
+    assert member.columns is None  # per-run Spaces  # type: ignore[union-attr]
+    assert (seen[-1][4]["collisions"][:5] >= 1).all()
+    vec.close()
+    for i in (0, 4, 5):
+        single = _single_episode(seeds[i], actions[:, i], scenario=SCENARIO1, duration=30)
+        for (obs, reward, _, truncated, info), (s_obs, s_rew, s_trunc, s_info) in zip(
+            seen, single[1:], strict=True
+        ):
+            np.testing.assert_array_equal(obs[i], s_obs)
+            assert reward[i] == s_rew
+            assert truncated[i] == s_trunc
+            assert info["collisions"][i] == s_info["collisions"]
