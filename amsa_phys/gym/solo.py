@@ -11,8 +11,10 @@ were its single run's, so the agent acted on exactly what this replay shows it, 
 replay arrives where the single env with the same seed and actions would be: contacts,
 collisions and all, bit for bit.
 
-The price is the replay, once per run and episode (~50 µs per past step on 2 shared
-cores), and a single env's speed for the rest of that run's episode.
+The price is the replay, once per run and episode (~60 µs per past step on 2 shared
+cores), and a single env's speed for the rest of that run's episode. Several runs going
+alone at one instant are replayed together instead, as a batch of per-run Spaces
+(``vecepisode.py``); this class is the one-run case, behind the same interface.
 """
 
 from __future__ import annotations

@@ -11,9 +11,15 @@ with every run's inputs as one array (a greenlet, as the single env's ``gym/epis
 
 Contacts are the one thing columns do not make. A run whose shapes come within reach of
 each other is frozen in the columns (``gym/veccolumns.py``) and, at the agent's next
-instant, continues alone: its single episode replayed with the agent's past outputs to
-that instant (``gym/solo.py``). So every run is the episode the single env gives with the
-same seed and actions, contacts included; the tests compare them step for step.
+instant, continues alone: its own episode replayed from t = 0 with the agent's past outputs
+to that instant (``gym/solo.py``) — a single episode, or, when several runs go alone at the
+same instant, a batch of them with per-run Spaces (this class with ``columns=False``, at
+most :data:`CHUNK` runs). So every run is the episode the single env gives with the same
+seed and actions, contacts included; the tests compare them step for step.
+
+Worlds whose runs a batched sweep cannot hold as columns (terrain zones, lidars, rovers
+changed during the run: ``runs/batched.py``) run as that batch of per-run Spaces from the
+start: every other component still steps as one group of all runs.
 """
 
 from __future__ import annotations

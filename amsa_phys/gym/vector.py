@@ -1,12 +1,15 @@
-"""``amsa_phys/FollowVec-v0``: N agents in N runs of one scenario, in one process.
+"""``amsa_phys/Follow-v0``'s vector entry point: N agents in N runs of one scenario, in one process.
 
-A ``gymnasium.vector.VectorEnv`` over one batched simulation (``gym/vecepisode.py``): every
-sub-environment is the episode :class:`~amsa_phys.gym.follow.FollowEnv` gives with the same
-seed (same observation, reward, end), but the N runs are stepped together — one thread
-handoff per vector step. Gymnasium 1.x's ``NEXT_STEP`` autoreset: all sub-environments
-reach the scenario's duration at the same step (one duration for all); the ``step`` after
-that starts new episodes (seeds drawn from the env's generator) and returns their first
-observations with reward 0 and ``terminated = truncated = False``, ignoring the action.
+A ``gymnasium.vector.VectorEnv`` over one batched simulation on columns
+(``gym/vecepisode.py``): every sub-environment is the episode
+:class:`~amsa_phys.gym.follow.FollowEnv` gives with the same seed and actions (same
+observation, reward, end, contacts included), but the N runs are stepped together — their
+components as groups, their rovers as columns, one stack switch per vector step. Gymnasium
+1.x's ``NEXT_STEP`` autoreset: all sub-environments reach the scenario's duration at the same
+step (one duration for all); the ``step`` after that starts new episodes (seeds drawn from
+the env's generator) and returns their first observations with reward 0 and
+``terminated = truncated = False``, ignoring the action. Like the single env, it belongs to
+the thread that calls ``reset``.
 """
 
 from __future__ import annotations
