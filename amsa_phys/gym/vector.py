@@ -101,6 +101,8 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
             obs, info = self._start([None] * n)
             zeros = np.zeros(n, dtype=bool)
             return obs, np.zeros(n), zeros, zeros.copy(), info
+        if self._episode.done:  # a fault in a run ended the batch (step raised it)
+            raise gymnasium.error.ResetNeeded("call reset() before step(): a run faulted")
         a = np.asarray(actions, dtype=np.float64).reshape(n, -1)
         acted = self.single.acted
         if a.shape != (n, len(acted)):

@@ -363,3 +363,40 @@ def test_many_runs_within_reach_at_once_go_alone_together_and_equal_the_single_e
             assert reward[i] == s_rew
             assert truncated[i] == s_trunc
             assert info["collisions"][i] == s_info["collisions"]
+
+
+def test_a_fault_is_raised_by_step_then_reset_is_needed() -> None:
+    """A run's fault (a non-finite action, refused by the engine as the single env's)
+    is raised by the step that meets it; the batch then needs a reset, like the single env."""
+    from amsa_phys.errors import RunFault
+
+    vec = FollowVecEnv(2, SCENARIO1, duration=5)
+    vec.reset(seed=1)
+    vec.step(np.zeros((2, 2)))
+    with pytest.raises(RunFault, match="agent"):
+        vec.step(np.array([[0.0, 0.0], [np.nan, 0.0]]))
+    with pytest.raises(gymnasium.error.ResetNeeded):
+        vec.step(np.zeros((2, 2)))
+    _, info = vec.reset(seed=1)
+    assert info["t"].tolist() == [0.0, 0.0]
+    vec.close()
+
+
+def test_after_the_autoreset_every_run_is_back_in_the_columns() -> None:
+    """The runs that went alone in one episode start the next one in the columns, and
+    that episode is again the single env's."""
+    vec = FollowVecEnv(2, SCENARIO1, duration=30)
+    vec.reset(seed=[8, 9])
+    ram = np.array([[1.0, 1.0], [0.0, 0.0]])
+    for _ in range(120):
+        vec.step(ram)
+    assert vec._episode is not None
+    assert vec._episode.solo == {0}
+    _, _, _, _, info = vec.step(ram)  # the autoreset
+    seeds = info["seed"].tolist()
+    assert vec._episode.solo == set()
+    seen = [vec.step(ram)[0] for _ in range(8)]
+    vec.close()
+    single = _single_episode(seeds[0], ram[:1].repeat(8, axis=0), scenario=SCENARIO1, duration=30)
+    for obs, (s_obs, *_) in zip(seen, single[1:], strict=True):
+        np.testing.assert_array_equal(obs[0], s_obs)
