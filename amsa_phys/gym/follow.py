@@ -137,6 +137,13 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
             )
         leaf = world.leaves[self.path]
         ports = [p for p in leaf.template.inputs if p.name in leaf.inputs]
+        arrays = [p.name for p in ports if p.array]
+        if arrays:  # an observation is a flat vector of the inputs' numbers, one each
+            raise ConfigError(
+                f"{self.path} reads the array input {arrays[0]!r} (a lidar's ranges): the "
+                "agent observes one number per input; replace a component that reads numbers",
+                key="controller",
+            )
         self.observed = [p.name for p in ports]
         if not self.observed:
             raise ConfigError(
