@@ -144,7 +144,7 @@ class VecEpisode:
         self.past: list[np.ndarray] = []
         self._rows = np.zeros((self.n, len(self.observed)))
         self._order: tuple[int, np.ndarray | None, np.ndarray | None] | None = None
-        self._outputs: dict[str, np.ndarray] = {}
+        self._batch_rows = self._rows  # the inputs at the agent's instant (``_exchange``)
         self._agent = greenlet.getcurrent()
         self._run = greenlet.greenlet(self._main, parent=self._agent)
         self._answer(self._run.switch())
