@@ -220,6 +220,40 @@ def gym_env(reps: int) -> None:
             vec.close()
         ok = statistics.median(vec_rates) >= 50000
         report(f"vector env, {n} envs: env-steps/s", med(vec_rates), ">= 50000", ok)
+    # whole episodes of the packaged scenario (random leader, GPS loss, 120 s): a random
+    # policy (an RL run's start), and every run driving at full power into its leader (each
+    # run then goes alone at the contact: the vector env's worst case)
+    for n, policy in ((1000, "random actions"), (100, "full power, every run rams its leader")):
+        vec_rates, alone = [], []
+        for i in range(reps):
+            rates_i, alone_i = _vec_episode(FollowVecEnv, n, policy.startswith("random"), i)
+            vec_rates.append(rates_i)
+            alone.append(alone_i)
+        print(
+            f"info  vector env, {n} envs, {policy}, whole episodes: {med(vec_rates)} "
+            f"env-steps/s; runs gone alone {med(alone)}",
+            flush=True,
+        )
+
+
+def _vec_episode(make: Any, n: int, random: bool, seed: int) -> tuple[float, float]:
+    """(env-steps a second, runs made alone) over one whole episode of the packaged scenario."""
+    import numpy as np
+
+    vec = make(n)
+    vec.reset(seed=seed)
+    rng = np.random.default_rng(seed)
+    steps, done = 0, False
+    t0 = time.process_time()
+    while not done:
+        actions = rng.uniform(-1, 1, (n, 2)) if random else np.ones((n, 2))
+        *_, truncated, _ = vec.step(actions)
+        steps += 1
+        done = bool(truncated.all())
+    rate = n * steps / (time.process_time() - t0)
+    alone = len(getattr(vec._episode, "solo", ()))  # 0 before the columns (issue 29)
+    vec.close()
+    return rate, float(alone)
 
 
 def _gym_floor(env: Any) -> float:

@@ -137,6 +137,13 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
             )
         leaf = world.leaves[self.path]
         ports = [p for p in leaf.template.inputs if p.name in leaf.inputs]
+        arrays = [p.name for p in ports if p.array]
+        if arrays:  # an observation is a flat vector of the inputs' numbers, one each
+            raise ConfigError(
+                f"{self.path} reads the array input {arrays[0]!r} (a lidar's ranges): the "
+                "agent observes one number per input; replace a component that reads numbers",
+                key="controller",
+            )
         self.observed = [p.name for p in ports]
         if not self.observed:
             raise ConfigError(
@@ -166,6 +173,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         self._frames: Any = None
         self._collisions = 0
         self._seen_events = 0
+        self._data: Any = None  # the episode's store (``step`` reads the signal there)
+        self._signal_at = 0
 
     # -- Gymnasium API ---------------------------------------------------------------------
     def reset(
@@ -191,6 +200,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         self._memory = TraceMemory(list(scenario.world.buffers)) if self.record_trace else None
         trace = self._memory.write if self._memory is not None else None
         self._episode = Episode(scenario, self.path, trace)
+        store = self._episode.sim.store
+        self._data, self._signal_at = store.data, store.at(self._signal)
         self._collisions = 0
         self._seen_events = 0
         if self.render_mode == "rgb_array":
@@ -218,14 +229,20 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         episode = self._episode
         if episode is None or episode.done:
             raise gymnasium.error.ResetNeeded("call reset() before step(): the episode has ended")
-        if type(action) is np.ndarray and action.dtype == np.float64 and action.ndim == 1:
-            a = action
+        if (
+            type(action) is np.ndarray
+            and action.dtype == np.float64
+            and action.shape == self._action_shape
+        ):
+            values = action.tolist()
         else:
             a = np.asarray(action, dtype=np.float64).reshape(-1)
-        if a.shape != self._action_shape:
-            raise ValueError(f"expected an action of shape ({len(self.acted)},), got {a.shape}")
+            if a.shape != self._action_shape:
+                raise ValueError(f"expected an action of shape ({len(self.acted)},), got {a.shape}")
+            values = a.tolist()
         scale = self.action_scale
-        episode.step({name: v * scale for name, v in zip(self.acted, a.tolist(), strict=True)})
+        # the shape was checked: strict=False skips zip's own length check (it costs a third)
+        episode.step({name: v * scale for name, v in zip(self.acted, values, strict=False)})
         if self._frames is not None:
             self._frames.sample()
             if self.render_mode == "human":
@@ -237,15 +254,20 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
             new = sum(1 for e in events[self._seen_events :] if e.kind == "collision")
             self._seen_events = len(events)
             self._collisions += new
-        signal = sim.read(self._signal)
+        signal = self._data[self._signal_at]  # sim.read(signal), its position looked up once
         reward = -abs(signal - self._reference) / self._tolerance
         reward -= self.collision_penalty * new
         reward += 0.0  # -0.0 (no error at all) reads as 0.0
         done = episode.done
         if done and self._memory is not None:
             self._memory.close()
-        info = {"t": float(episode.t), "signal": float(signal), "collisions": self._collisions}
-        return self._observation(), float(reward), False, done, info
+        t = episode.t  # float(t), without Fraction.__float__'s two property calls
+        info = {"t": t.numerator / t.denominator, "signal": signal, "collisions": self._collisions}
+        if done:
+            return self._observation(), reward, False, done, info
+        inputs = episode.inputs  # ``_observation`` inlined: the usual step
+        obs = self.observer.of_values([inputs[p] for p in self.observed])
+        return obs, reward, False, done, info
 
     def render(self) -> np.ndarray | None:  # type: ignore[override]
         """The current picture (``render_mode="rgb_array"``), ``(height, width, 3)`` uint8."""

@@ -92,6 +92,41 @@ class Observer:
             return raw
         return self.of_values(raw.tolist())
 
+    def of_rows(self, rows: np.ndarray) -> np.ndarray:
+        """:meth:`__call__` of every row of ``rows`` (``(n, len(raw_names))``): the vector
+        env's observations, as arrays instead of ``n`` Python calls (a third of a vector
+        step at 1,000 envs). The same floats as row by row: the arithmetic is elementwise
+        IEEE (each operation rounded once, as in Python), ``%`` is Python's (numpy's
+        ``remainder`` takes the divisor's sign the same way), and the transcendental
+        functions are ``math``'s, mapped (numpy's SIMD ones may differ in the last bit,
+        ``engine/libm.py``); a NaN clips to -1 as in :meth:`of_values`."""
+        rows = np.asarray(rows, dtype=np.float64)
+        if self.mode == "absolute":
+            return rows.copy()
+        cols: list[np.ndarray] = []
+        if self.own is not None:
+            ox, oy, oh = self.own
+            heading = rows[:, oh].tolist()
+            c = np.fromiter(map(math.cos, heading), np.float64, len(heading))
+            s = np.fromiter(map(math.sin, heading), np.float64, len(heading))
+            x0, y0, scale = rows[:, ox], rows[:, oy], self.range_m
+            for ix, iy in self.relative:
+                dx, dy = rows[:, ix] - x0, rows[:, iy] - y0
+                cols += [(c * dx + s * dy) / scale, (-s * dx + c * dy) / scale]
+        for i, unit in self.rest:
+            v = rows[:, i]
+            if unit == "m":
+                cols.append(v / self.range_m)
+            elif unit == "m/s":
+                cols.append(v / self.speed_mps)
+            elif unit == "rad":
+                cols.append(((v + math.pi) % (2 * math.pi) - math.pi) / math.pi)
+            else:
+                cols.append(np.fromiter(map(math.tanh, v.tolist()), np.float64, len(v)))
+        out = np.column_stack(cols) if cols else np.zeros((len(rows), 0))
+        # the scalar clip: v inside [-1, 1] kept, above 1 -> 1, below -1 or NaN -> -1
+        return np.where(out > 1.0, 1.0, np.where(out >= -1.0, out, -1.0))
+
     def of_values(self, values: list[float]) -> np.ndarray:
         """:meth:`__call__` of the raw inputs as a list of floats (port order): the env's
         per-step path, which has them as floats already (a handful of them: plain Python

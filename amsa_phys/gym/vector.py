@@ -1,12 +1,15 @@
-"""``amsa_phys/FollowVec-v0``: N agents in N runs of one scenario, in one process.
+"""``amsa_phys/Follow-v0``'s vector entry point: N agents in N runs of one scenario, in one process.
 
-A ``gymnasium.vector.VectorEnv`` over one batched simulation (``gym/vecepisode.py``): every
-sub-environment is the episode :class:`~amsa_phys.gym.follow.FollowEnv` gives with the same
-seed (same observation, reward, end), but the N runs are stepped together — one thread
-handoff per vector step. Gymnasium 1.x's ``NEXT_STEP`` autoreset: all sub-environments
-reach the scenario's duration at the same step (one duration for all); the ``step`` after
-that starts new episodes (seeds drawn from the env's generator) and returns their first
-observations with reward 0 and ``terminated = truncated = False``, ignoring the action.
+A ``gymnasium.vector.VectorEnv`` over one batched simulation on columns
+(``gym/vecepisode.py``): every sub-environment is the episode
+:class:`~amsa_phys.gym.follow.FollowEnv` gives with the same seed and actions (same
+observation, reward, end, contacts included), but the N runs are stepped together — their
+components as groups, their rovers as columns, one stack switch per vector step. Gymnasium
+1.x's ``NEXT_STEP`` autoreset: all sub-environments reach the scenario's duration at the same
+step (one duration for all); the ``step`` after that starts new episodes (seeds drawn from
+the env's generator) and returns their first observations with reward 0 and
+``terminated = truncated = False``, ignoring the action. Like the single env, it belongs to
+the thread that calls ``reset``.
 """
 
 from __future__ import annotations
@@ -40,6 +43,13 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
                 key="render_mode" if kwargs.get("render_mode") is not None else "record_trace",
             )
         self.single = FollowEnv(scenario, **kwargs)  # validates every argument, once
+        if self.single._scenario.adapt:
+            raise ConfigError(
+                "the vector env cannot run adapt: rules (each run would switch its "
+                "parameters at its own instants); use FollowEnv, or gymnasium.make_vec(..., "
+                'vectorization_mode="sync")',
+                key="scenario",
+            )
         self.num_envs = num_envs
         self.single_observation_space = self.single.observation_space
         self.single_action_space = self.single.action_space
@@ -71,7 +81,9 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         drawn = [s if s is not None else int(self.np_random.integers(0, 2**31 - 1)) for s in seeds]
         self.close_extras()
         single = self.single
-        self._episode = VecEpisode(single._scenario, single.path, drawn, single.observed)
+        self._episode = VecEpisode(
+            single._scenario, single.path, drawn, single.observed, single.acted
+        )
         self._seen = np.zeros(self.num_envs, dtype=np.int64)
         self._autoreset = False
         info = self._info()
@@ -89,13 +101,15 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
             obs, info = self._start([None] * n)
             zeros = np.zeros(n, dtype=bool)
             return obs, np.zeros(n), zeros, zeros.copy(), info
+        if self._episode.done:  # a fault in a run ended the batch (step raised it)
+            raise gymnasium.error.ResetNeeded("call reset() before step(): a run faulted")
         a = np.asarray(actions, dtype=np.float64).reshape(n, -1)
         acted = self.single.acted
         if a.shape != (n, len(acted)):
             raise ValueError(f"expected actions of shape ({n}, {len(acted)}), got {a.shape}")
         scale = self.single.action_scale
         episode = self._episode
-        episode.step({name: a[:, j] * scale for j, name in enumerate(acted)})
+        episode.step(a * scale)
         collisions = episode.collisions()
         new = collisions - self._seen
         self._seen = collisions
@@ -109,9 +123,7 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
     def _observations(self) -> np.ndarray:
         episode = self._episode
         assert episode is not None
-        raw = episode.final_inputs() if episode.done else episode.inputs
-        observer = self.single.observer
-        return np.stack([observer(row) for row in raw])
+        return self.single.observer.of_rows(episode.observed_rows())
 
     def _info(self) -> dict[str, Any]:
         episode = self._episode

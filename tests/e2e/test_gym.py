@@ -237,3 +237,10 @@ def test_gymnasium_finds_the_env_without_an_explicit_import() -> None:
         [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT
     )
     assert out.stdout.strip() == "(3,) 0.0"
+
+
+def test_a_component_reading_an_array_is_refused_in_one_line() -> None:
+    """The obstacle course's avoider reads the lidar's ranges (an array port): the env
+    used to fail at the first observation with numpy's "truth value of an array"."""
+    with pytest.raises(ap.ConfigError, match="array input 'ranges'"):
+        FollowEnv(str(ROOT / "scenarios" / "obstacle_course.yaml"))

@@ -104,3 +104,23 @@ def test_an_env_left_open_at_exit_says_nothing() -> None:
         [sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False
     )
     assert (done.returncode, done.stderr) == (0, "")
+
+
+def test_a_reset_in_another_thread_moves_the_env_there() -> None:
+    """The episode belongs to the thread that reset it: another thread may take the env
+    over by calling reset() (the paused episode is dropped), and steps there as usual; the
+    first thread's step is then refused with the clear error, not greenlet's."""
+    env = FollowEnv(SCENARIO1, duration=20)
+    reference = observations(FollowEnv(SCENARIO1, duration=20), 6, 3)
+    env.reset(seed=1)
+    env.step(HALF)
+    seen: list[np.ndarray] = []
+    worker = threading.Thread(target=lambda: seen.extend(observations(env, 6, 3)))
+    worker.start()
+    worker.join()
+    assert all(np.array_equal(a, b) for a, b in zip(seen, reference, strict=True))
+    with pytest.raises(RuntimeError, match="the thread that called reset"):
+        env.step(HALF)
+    env.reset(seed=6)  # and back: a reset here takes it again
+    assert np.array_equal(env.step(HALF)[0], reference[1])
+    env.close()
