@@ -56,6 +56,16 @@ def cpp_double(value: float) -> str:
     return text if any(c in text for c in ".en") else text + ".0"
 
 
+def _first(initial: float | tuple[float, ...]) -> float:
+    """A Data's initial value; an array port's elements all start at its port's initial."""
+    return initial[0] if isinstance(initial, tuple) else initial
+
+
+def _size(graph: RosGraph, data: str) -> str:
+    """``, N`` for an array port (``Topic.size``/``OutputPort.size``), nothing for a number."""
+    return f", {graph.size(data)}" if graph.is_array(data) else ""
+
+
 def hz(freq: Fraction) -> str:
     """A frequency as people read it (``4``, ``0.5``)."""
     return f"{float(freq):g}"
@@ -68,8 +78,8 @@ def cpp_node(graph: RosGraph, path: str, pkg: str, source: str, bodies: dict[str
     buffers = graph.input_buffers(path)
     outputs = graph.outputs(path)
     topics = [
-        f"{{{cpp_string(names.topic(b))}, {cpp_double(world.buffers[b].initial)}, "
-        f"{str(world.leaves[world.buffers[b].producer].timing.delayed).lower()}}}"
+        f"{{{cpp_string(names.topic(b))}, {cpp_double(_first(graph.initial(b)))}, "
+        f"{str(world.leaves[graph.producer(b)].timing.delayed).lower()}{_size(graph, b)}}}"
         for b in buffers
     ]
     inputs = []
@@ -79,7 +89,7 @@ def cpp_node(graph: RosGraph, path: str, pkg: str, source: str, bodies: dict[str
         inputs.append(f"{{{cpp_string(port)}, {index}}}")
     outs = [
         f"{{{cpp_string(b.rpartition('.')[2])}, {cpp_string(names.topic(b))}, "
-        f"{cpp_double(world.buffers[b].initial)}, {graph.subscribers(b)}}}"
+        f"{cpp_double(_first(graph.initial(b)))}, {graph.subscribers(b)}{_size(graph, b)}}}"
         for b in outputs
     ]
     params = []

@@ -2,7 +2,10 @@
 //
 // The C++ route of the AMSA paper: a Leaf's doStep() in C++ behind the same topics,
 // parameters and protocol as the Python nodes (see amsa_phys/ros/runtime/leaf.py):
-//  - inputs: std_msgs/Float64 topics /Producer/output; outputs: /Leaf/output;
+//  - inputs: std_msgs/Float64 topics /Producer/output; outputs: /Leaf/output; an array port
+//    (a lidar's ranges) is one std_msgs/Float64MultiArray topic of the port's fixed length
+//    (one dimension labelled with the port, data_offset 0), checked on receipt: a message
+//    of another length fails the step that reads it, naming the topic;
 //  - parameters /Leaf/param, checked against the template's [min, max] whenever they change;
 //  - lockstep: "step SEQ NUM DEN C1..Cn" on /amsa/step/Leaf: step at t = NUM/DEN once each
 //    input topic has carried Ci messages, reading message number Ci of each (a delayed
@@ -15,6 +18,7 @@
 
 #include <ros/ros.h>
 #include <std_msgs/Float64.h>
+#include <std_msgs/Float64MultiArray.h>
 #include <std_msgs/String.h>
 
 #include <chrono>
@@ -44,6 +48,7 @@ struct Topic {
   std::string name;
   double initial;
   bool delayed;  // its producer has latency or jitter: readers may be told an older message
+  int size = 0;  // 0: one number (std_msgs/Float64); N: an array port, Float64MultiArray of N
 };
 
 struct OutputPort {
@@ -51,6 +56,7 @@ struct OutputPort {
   std::string topic;
   double initial;
   int subscribers;  // without the bag recorder
+  int size = 0;  // 0: one number; N: an array port of N numbers (Float64MultiArray)
 };
 
 struct ParamSpec {
@@ -102,10 +108,15 @@ class LeafNode {
       if (topics_[i].delayed) history_[i][0] = topics_[i].initial;
     }
     for (const OutputPort& o : outputs_) own_.push_back(o.initial);
+    initArrays();
 
     ros::AsyncSpinner spinner(2);
     spinner.start();
     for (std::size_t i = 0; i < topics_.size(); ++i) {
+      if (topics_[i].size > 0) {
+        subs_.push_back(subscribeArray(nh, i));
+        continue;
+      }
       subs_.push_back(nh.subscribe<std_msgs::Float64>(
           topics_[i].name, 1000,
           [this, i](const std_msgs::Float64::ConstPtr& m) { onData(i, m->data); },
@@ -113,7 +124,10 @@ class LeafNode {
     }
     auto wake = [this](const ros::SingleSubscriberPublisher&) { notify(); };
     for (const OutputPort& o : outputs_) {
-      pubs_.push_back(nh.advertise<std_msgs::Float64>(o.topic, 1000, wake, ros::SubscriberStatusCallback()));
+      if (o.size > 0)
+        pubs_.push_back(nh.advertise<std_msgs::Float64MultiArray>(o.topic, 1000, wake, ros::SubscriberStatusCallback()));
+      else
+        pubs_.push_back(nh.advertise<std_msgs::Float64>(o.topic, 1000, wake, ros::SubscriberStatusCallback()));
       // sim:=false (the controller side alone): no simulator to wait for, start at once
       want_.push_back(sim ? o.subscribers + (bag ? 1 : 0) : 0);
     }
@@ -146,6 +160,10 @@ class LeafNode {
   virtual void doStep(double t, const std::vector<double>& in, std::vector<double>& out,
                       std::vector<bool>& published) = 0;
   double p(const std::string& name) const { return values_.at(name); }
+  // An array input port's numbers (``port``: its index in the template's input ports; in[]
+  // holds 0 there), and an array output port's, which doStep fills to the port's length.
+  const std::vector<double>& array(std::size_t port) const { return arrays_in_.at(port); }
+  std::vector<double>& arrayOut(std::size_t port) { return arrays_out_.at(port); }
   std::map<std::string, double> values_;
 
  private:
@@ -232,6 +250,55 @@ class LeafNode {
     cond_.notify_all();
   }
 
+  // -- array ports: std_msgs/Float64MultiArray topics (a second kind of input and output) --
+  void initArrays() {
+    latest_arr_.assign(topics_.size(), std::vector<double>());
+    history_arr_.assign(topics_.size(), std::map<std::int64_t, std::vector<double>>());
+    bad_.assign(topics_.size(), std::string());
+    for (std::size_t i = 0; i < topics_.size(); ++i) {
+      if (topics_[i].size <= 0) continue;
+      latest_arr_[i].assign(static_cast<std::size_t>(topics_[i].size), topics_[i].initial);
+      if (topics_[i].delayed) history_arr_[i][0] = latest_arr_[i];
+    }
+    own_arr_.assign(outputs_.size(), std::vector<double>());
+    for (std::size_t k = 0; k < outputs_.size(); ++k)
+      if (outputs_[k].size > 0)
+        own_arr_[k].assign(static_cast<std::size_t>(outputs_[k].size), outputs_[k].initial);
+    arrays_in_.assign(inputs_.size(), std::vector<double>());
+    arrays_out_.assign(outputs_.size(), std::vector<double>());
+  }
+
+  ros::Subscriber subscribeArray(ros::NodeHandle& nh, std::size_t i) {
+    return nh.subscribe<std_msgs::Float64MultiArray>(
+        topics_[i].name, 1000,
+        [this, i](const std_msgs::Float64MultiArray::ConstPtr& m) { onArray(i, *m); },
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  }
+
+  // An array message: its doubles from data_offset on, of exactly the declared length (a
+  // message of another length is kept as empty: the step that reads it fails, naming it).
+  void onArray(std::size_t i, const std_msgs::Float64MultiArray& m) {
+    const std::size_t offset = m.layout.data_offset;
+    std::vector<double> value;
+    if (offset <= m.data.size()) value.assign(m.data.begin() + offset, m.data.end());
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (value.size() != static_cast<std::size_t>(topics_[i].size)) {
+      bad_[i] = topics_[i].name + " carried " + std::to_string(value.size()) +
+                " values, the port declares " + std::to_string(topics_[i].size) +
+                " (std_msgs/Float64MultiArray of fixed length)";
+      if (!lockstep_) {  // free: the message is dropped, the last value stays
+        ROS_ERROR("%s: %s", path_.c_str(), bad_[i].c_str());
+        return;
+      }
+      value.clear();
+    }
+    count_[i] += 1;
+    latest_arr_[i] = value;
+    if (topics_[i].delayed) history_arr_[i][count_[i]] = value;
+    if (!pending_.empty()) tryPending();
+    cond_.notify_all();
+  }
+
   void onStep(const std::string& text) {
     std::lock_guard<std::mutex> lock(mutex_);
     pending_ = text;
@@ -269,33 +336,75 @@ class LeafNode {
         return;
       }
     std::vector<double> seen = latest_;
+    std::vector<std::vector<double>> seen_arr = latest_arr_;
     for (std::size_t i = 0; i < want.size() && i < count_.size(); ++i) {
       if (!topics_[i].delayed) continue;
+      if (topics_[i].size > 0) {
+        std::map<std::int64_t, std::vector<double>>& kept = history_arr_[i];
+        seen_arr[i] = kept.at(want[i]);
+        kept.erase(kept.begin(), kept.lower_bound(want[i]));
+        continue;
+      }
       std::map<std::int64_t, double>& kept = history_[i];
       seen[i] = kept.at(want[i]);  // message number want[i] is what the Leaf sees now
       kept.erase(kept.begin(), kept.lower_bound(want[i]));
     }
-    const std::string result = step(static_cast<double>(num) / static_cast<double>(den), seen);
+    for (std::size_t i = 0; i < topics_.size(); ++i)
+      if (topics_[i].size > 0 && seen_arr[i].empty()) {
+        reply("fault " + seq + " " + bad_[i]);
+        return;
+      }
+    const std::string result =
+        step(static_cast<double>(num) / static_cast<double>(den), seen, seen_arr);
     if (!result.empty() && result[0] == '!') reply("error " + seq + " " + result.substr(1));
     else reply("done " + seq + result);
   }
 
   // doStep with the inputs ``seen`` (by topic); publishes; " I J .." (the outputs
   // published), or "!message" if doStep threw.
-  std::string step(double t, const std::vector<double>& seen) {
+  std::string step(double t, const std::vector<double>& seen,
+                   const std::vector<std::vector<double>>& seen_arr) {
     std::vector<double> in;
-    for (const InputPort& ip : inputs_)
+    for (std::size_t j = 0; j < inputs_.size(); ++j) {
+      const InputPort& ip = inputs_[j];
+      const bool array = ip.topic >= 0 ? topics_[ip.topic].size > 0
+                                       : outputs_[-(ip.topic + 1)].size > 0;
+      if (array) {
+        arrays_in_[j] = ip.topic >= 0 ? seen_arr[ip.topic] : own_arr_[-(ip.topic + 1)];
+        in.push_back(0.0);
+        continue;
+      }
       in.push_back(ip.topic >= 0 ? seen[ip.topic] : own_[-(ip.topic + 1)]);
+    }
     std::vector<double> out(outputs_.size(), 0.0);
     std::vector<bool> published(outputs_.size(), false);
+    for (std::vector<double>& a : arrays_out_) a.clear();
     try {
       doStep(t, in, out, published);
     } catch (const std::exception& exc) {
       return std::string("!C++ exception: ") + exc.what();
     }
+    for (std::size_t k = 0; k < outputs_.size(); ++k)
+      if (published[k] && outputs_[k].size > 0 &&
+          arrays_out_[k].size() != static_cast<std::size_t>(outputs_[k].size))
+        return "!output " + outputs_[k].port + " has " + std::to_string(arrays_out_[k].size()) +
+               " values, the port declares " + std::to_string(outputs_[k].size);
     std::string indexes;
     for (std::size_t k = 0; k < outputs_.size(); ++k) {
       if (!published[k]) continue;
+      if (outputs_[k].size > 0) {
+        std_msgs::Float64MultiArray m;
+        m.layout.dim.resize(1);
+        m.layout.dim[0].label = outputs_[k].port;
+        m.layout.dim[0].size = static_cast<std::uint32_t>(outputs_[k].size);
+        m.layout.dim[0].stride = static_cast<std::uint32_t>(outputs_[k].size);
+        m.layout.data_offset = 0;
+        m.data = arrays_out_[k];
+        pubs_[k].publish(m);
+        own_arr_[k] = arrays_out_[k];
+        indexes += " " + std::to_string(k);
+        continue;
+      }
       std_msgs::Float64 m;
       m.data = out[k];
       pubs_[k].publish(m);
@@ -345,7 +454,7 @@ class LeafNode {
         std::lock_guard<std::mutex> lock(mutex_);
         const double t = static_cast<double>(phase_num) / static_cast<double>(phase_den) +
                          static_cast<double>(k * freq_den_) / static_cast<double>(freq_num_);
-        std::string error = step(t, latest_);
+        std::string error = step(t, latest_, latest_arr_);
         if (!error.empty() && error[0] == '!') ROS_ERROR("%s", error.c_str() + 1);
       }
       k += 1;
@@ -366,6 +475,12 @@ class LeafNode {
   std::vector<std::int64_t> count_;
   std::vector<double> latest_, own_;
   std::vector<std::map<std::int64_t, double>> history_;  // delayed topics' kept messages
+  // array ports: the latest message of each array topic (empty: one of the wrong length),
+  // a delayed one's kept messages, the last length error, own array outputs, and the
+  // arrays doStep reads and writes (by input / output port)
+  std::vector<std::vector<double>> latest_arr_, own_arr_, arrays_in_, arrays_out_;
+  std::vector<std::map<std::int64_t, std::vector<double>>> history_arr_;
+  std::vector<std::string> bad_;
   std::map<std::string, std::string> last_error_;
   std::string pending_;
   bool lockstep_ = true;
