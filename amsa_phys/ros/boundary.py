@@ -65,6 +65,9 @@ def controller_side(graph: RosGraph, inbound: list[Source]) -> list[str]:
     """
     sensors = {s.leaf for s in inbound}
     available = {b for s in inbound for b in _buffers(s)}
+    # an array port read in whole (a LaserScan's ranges) is its topic's Data
+    arrays = graph.world.arrays
+    available.update(a for a, elements in arrays.items() if set(elements) <= available)
     side: list[str] = []
     changed = True
     while changed:

@@ -41,6 +41,7 @@ from .. import names
 from ..boundary import SIM_PARAM
 from ..graph import NodeContext
 from . import rosio
+from .arrays import array_msg, pack, unpack
 from .config import load_config
 
 
@@ -84,7 +85,7 @@ class LeafNode:
         self.history: dict[str, dict[int, Any]] = {b: {0: self.value[b]} for b in self.delayed}
         self.own: dict[str, Any] = {b: graph.initial(b) for b in self.outputs}
         self.graph = graph
-        Array = rosio.array_msg() if any(map(graph.is_array, self.buffers + self.outputs)) else None
+        Array = array_msg() if any(map(graph.is_array, self.buffers + self.outputs)) else None
         self.Array = Array
         kind = {b: Array if graph.is_array(b) else Float64 for b in self.buffers + self.outputs}
         self.pending: list[str] | None = None
@@ -116,7 +117,7 @@ class LeafNode:
         value: Any = msg.data
         if self.graph.is_array(buffer):
             try:
-                value = rosio.unpack(msg, self.graph.size(buffer), names.topic(buffer))
+                value = unpack(msg, self.graph.size(buffer), names.topic(buffer))
             except ValueError as exc:
                 if self.cfg.mode != "lockstep":  # free: the old value stays, said once a message
                     self.rospy.logerr(f"{self.path}: {exc}; keeping the last scan")
@@ -214,7 +215,7 @@ class LeafNode:
         for index, number in values:
             b = self.outputs[index]
             if self.graph.is_array(b):
-                self.pubs[index].publish(rosio.pack(self.Array, b.rpartition(".")[2], number))
+                self.pubs[index].publish(pack(self.Array, b.rpartition(".")[2], number))
             else:
                 self.pubs[index].publish(self.Float64(number))
             self.own[b] = number

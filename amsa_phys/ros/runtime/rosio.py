@@ -50,39 +50,6 @@ def msgs() -> tuple[Any, Any, Any]:
     return Float64, String, Clock
 
 
-def array_msg() -> Any:
-    """``std_msgs/Float64MultiArray``: the message of an array port's topic."""
-    from std_msgs.msg import Float64MultiArray
-
-    return Float64MultiArray
-
-
-def pack(cls: Any, label: str, values: Any) -> Any:
-    """An array port's value as its topic carries it: one dimension, labelled with the port's
-    name, ``size`` = ``stride`` = the length, ``data_offset`` 0, the doubles in beam order."""
-    from std_msgs.msg import MultiArrayDimension
-
-    data = [float(v) for v in values]
-    msg = cls()
-    msg.layout.dim = [MultiArrayDimension(label, len(data), len(data))]
-    msg.layout.data_offset = 0
-    msg.data = data
-    return msg
-
-
-def unpack(msg: Any, size: int, topic: str) -> tuple[float, ...]:
-    """An array topic's doubles, checked against the port's declared length (else
-    ``ValueError`` naming the topic: the length is fixed by the world, as the trace's
-    columns are)."""
-    data = tuple(msg.data)[msg.layout.data_offset :]
-    if len(data) != size:
-        raise ValueError(
-            f"{topic} carried {len(data)} values, the port declares {size} "
-            "(std_msgs/Float64MultiArray of fixed length)"
-        )
-    return data
-
-
 def to_ns(t: Fraction) -> int:
     """Nanoseconds of a simulated instant, rounded down (the same everywhere: exact compare)."""
     return t.numerator * 1_000_000_000 // t.denominator

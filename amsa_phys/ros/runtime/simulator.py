@@ -35,6 +35,7 @@ from ...runs.single import run_scenario
 from .. import names
 from ..graph import RosGraph
 from . import readiness, records, rosio
+from .arrays import array_msg, elements, pack, unpack
 from .boundary import VALUES, format_values, readable
 from .config import NodeConfig, load_config
 from .rossim import RosSimulation
@@ -71,7 +72,7 @@ class Link:
         self.sim: Simulation | None = None
         self.published = dict.fromkeys(self.graph.data(), 0)
         #: array ports (a lidar's ranges): one std_msgs/Float64MultiArray topic each
-        self.Array = rosio.array_msg() if world.arrays else None
+        self.Array = array_msg() if world.arrays else None
         #: a remote array output of the wrong length (buffer -> the message saying so)
         self.bad: dict[str, str] = {}
         self.received: dict[str, list[Any]] = {}
@@ -134,7 +135,7 @@ class Link:
         value = msg.data
         if self.graph.is_array(buffer):
             try:
-                value = rosio.unpack(msg, self.graph.size(buffer), names.topic(buffer))
+                value = unpack(msg, self.graph.size(buffer), names.topic(buffer))
             except ValueError as exc:
                 if not self.lockstep:  # free: the message is dropped, the last value stays
                     self.rospy.logerr(f"{names.SIMULATOR}: {exc}")
@@ -213,13 +214,9 @@ class Link:
             return
         with self.cond:
             fresh, self.fresh = self.fresh, {}
-        arrays = self.graph.world.arrays
-        for buffer, value in fresh.items():
-            if buffer in arrays:  # an array port: each element's buffer
-                for element, v in zip(arrays[buffer], value, strict=True):
-                    sim.write(element, v)
-            else:
-                sim.write(buffer, value)
+        for data, value in fresh.items():
+            for buffer, v in elements(self.graph.world.arrays, data, value):
+                sim.write(buffer, v)
 
     # -- waiting ----------------------------------------------------------------------------
     def _wait(self, ready: Callable[[], bool], who: str, t: Fraction, what: str) -> None:
@@ -357,9 +354,7 @@ class Link:
         if self.values_pub is None:
             return
         arrays = self.graph.world.arrays
-        flat: list[tuple[str, float]] = []
-        for b, v in values:
-            flat.extend(zip(arrays[b], v, strict=True) if b in arrays else [(b, v)])
+        flat = [e for b, v in values for e in elements(arrays, b, v)]
         told = [(b, v) for b, v in flat if b in self.boundary_reads]
         if told and self.values_pub.get_num_connections():
             self.values_pub.publish(self.String(format_values(t, told)))
@@ -390,7 +385,7 @@ class Link:
                             number: Any = tuple(float(v) for v in out[port])
                             if len(number) != len(arrays[b]):
                                 continue  # the engine reports it
-                            pubs[b].publish(rosio.pack(self.Array, port, number))
+                            pubs[b].publish(pack(self.Array, port, number))
                         else:
                             number = float(out[port])
                             pubs[b].publish(Float64(number))
