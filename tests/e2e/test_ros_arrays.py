@@ -5,9 +5,10 @@ and launched in lockstep for its first 12 s: the lidar's 31 ranges travel from t
 (where the Lidar casts its rays into the pymunk world) to the ReactiveAvoider's node as one
 ``std_msgs/Float64MultiArray`` topic, ``/Scanner/ranges``. The trace and metrics must equal
 ``amsa-phys run --duration 12`` byte for byte with the C++ ReactiveAvoider (the default) and
-with its Python twin (``cpp:=false``). Mutation-checked: the C++ body's forward power with
-``cruisePower * (slow * cos θ)`` grouped otherwise, or a beam's corridor test with ``<=``,
-fails the C++ case. Skipped, with the reason, where ROS, catkin, unshare or root is missing.
+with its Python twin (``cpp:=false``). Mutation-checked: the C++ body's beam directions
+computed as ``k * delta / div + lo`` instead of numpy's ``k * step + lo`` (last-bit
+differences) fails the C++ case (``tests/unit/test_cpp_avoider.py`` compares the body with
+the template bit for bit on random scans, where rarer differences show). Skipped, with the reason, where ROS, catkin, unshare or root is missing.
 """
 
 from __future__ import annotations
