@@ -85,7 +85,9 @@ def controller_side(graph: RosGraph, inbound: list[Source]) -> list[str]:
 def plan(graph: RosGraph) -> Plan:
     """The boundary of ``graph``'s world."""
     sources = find_sources(graph.world)
-    inbound = [s for s in sources if s.role.name in SENSOR_ROLES and s.leaf in graph.remote]
+    # a sensor stream is read in whether its Leaf is a node or steps in the simulator (a
+    # Lidar casts its rays there): with sim:=false the robot's driver takes its place
+    inbound = [s for s in sources if s.role.name in SENSOR_ROLES]
     controller = controller_side(graph, inbound)
     sim_only = [p for p in graph.remote if p not in controller]
     return Plan(sources, inbound, controller, sim_only)
