@@ -76,15 +76,24 @@ class RosGraph:
     world: WorldSpec
     local: frozenset[str]
     bag: bool = False
+    #: the signals the adapt node reads when it runs the rules beside the simulator
+    #: (``rules:=node``): it is one more subscriber of each
+    adapt_signals: frozenset[str] = frozenset()
 
     @classmethod
-    def of(cls, world: WorldSpec, local: Iterable[str], bag: bool = False) -> RosGraph:
+    def of(
+        cls,
+        world: WorldSpec,
+        local: Iterable[str],
+        bag: bool = False,
+        adapt_signals: Iterable[str] = (),
+    ) -> RosGraph:
         """The graph with ``local`` Leaves in the simulator (checked against the world)."""
         local = frozenset(local)
         unknown = sorted(local - set(world.leaves))
         if unknown:
             raise ConfigError(f"unknown Leaf {unknown[0]!r} in /amsa/local")
-        return cls(world, local, bag)
+        return cls(world, local, bag, frozenset(adapt_signals))
 
     @property
     def remote(self) -> list[str]:
@@ -116,6 +125,7 @@ class RosGraph:
         n = sum(1 for p in self.remote if p != producer and buffer in self.input_buffers(p))
         if producer not in self.local:
             n += 1  # the simulator: the trace, and the Leaves it steps
+        n += 1 if buffer in self.adapt_signals else 0  # the adapt node (rules:=node)
         return n + (1 if self.bag else 0)
 
     def data_topics(self) -> list[str]:

@@ -34,7 +34,7 @@ from ...runs.rundir import default_run_dir, prepare_run_dir
 from ...runs.single import run_scenario
 from .. import names
 from ..graph import RosGraph
-from . import readiness, records, rosio
+from . import adaptlink, readiness, records, rosio
 from .arrays import array_msg, elements, pack, unpack
 from .boundary import VALUES, format_values, readable
 from .config import NodeConfig, load_config
@@ -445,6 +445,7 @@ def main() -> None:
         out_dir = Path(out) if out else default_run_dir(scenario.name, root)
         prepare_run_dir(out_dir, bool(rospy.get_param("~force", False)), flag="out:=")
         link = Link(rospy, cfg)
+        adaptlink.attach(link)  # rules:=node: the adapt node runs the rules
         link.speed = float(rospy.get_param("~speed", 1.0))
         link.waves = bool(rospy.get_param("~waves", True))
         if not link.speed > 0 or math.isinf(link.speed):
