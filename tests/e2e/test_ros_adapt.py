@@ -6,7 +6,9 @@ two rules fire (t = 40.1 s and 57.1 s in-process): the run equals ``amsa-phys ru
 70`` byte for byte (trace.csv, with the rule column, and metrics.json with its adapt events),
 with the rules fired inside the simulator (``rules:=sim``, the default) and by the
 ``amsa_adapt`` node, the one a robot runs with ``sim:=false`` (``rules:=node``: the
-simulator asks it at every instant; ``ros/runtime/adaptlink.py``).
+simulator asks it at every instant; ``ros/runtime/adaptlink.py``). Mutation-checked: the
+adapt node judging each signal's previous message instead of the one the simulator names
+fires a rule one step late and the ``rules:=node`` case fails.
 Skipped, with the reason, where ROS is missing.
 """
 
