@@ -1,15 +1,17 @@
 """The platoon's launch in memory (issue 26 item 5: under 1 GB), by kind of process.
 
 Exports ``worlds/platoon.yaml`` (10 cars: each a GPS, a GPS on the car ahead, a compass, a
-distance monitor, a controller and a drive), builds it with catkin and launches it in
-lockstep twice in one sitting: with the C++ nodes (the default) and with ``cpp:=false``
-(every Leaf a Python node, as before the C++ nodes). While each runs, the resident memory
-of every process the launch started is sampled from ``/proc`` every 0.2 s, summed: RSS
-(the issue's measure) and PSS (which shares a library's pages out among the processes that
-map them instead of counting them in each). At the RSS peak the sum is split into: the
-simulator node (Python: pymunk, numpy and the engine), the other Python nodes (scenario,
-boundary, Leaves), the C++ Leaf nodes, and ROS itself (roslaunch, rosmaster, rosout).
-It also says whether the two traces are byte-identical.
+distance monitor, a controller and a drive), builds it with catkin (timed) and launches it
+in lockstep three times in one sitting: with every C++ Leaf in one process (the container,
+the default), with each C++ Leaf in a process of its own (``cpp_container:=false``, as
+before the container) and with ``cpp:=false`` (every Leaf a Python node). While each runs,
+the resident memory of every process the launch started is sampled from ``/proc`` every
+0.2 s, summed: RSS (the issue's measure) and PSS (which shares a library's pages out among
+the processes that map them instead of counting them in each). At the RSS peak the sum is
+split into: the simulator node (Python: pymunk, numpy and the engine), the other Python
+nodes (scenario, boundary, Leaves), the C++ Leaves (the container, or a nodelet process
+each), and ROS itself (roslaunch, rosmaster, rosout). It also says whether the three traces
+are byte-identical.
 
 Needs ROS 1 (roslaunch, catkin_make), ``unshare -n`` and root, as tests/e2e/test_ros.py.
 Run: ``python benchmarks/bench_ros_memory.py [--duration 20]``.
@@ -32,6 +34,8 @@ from pathlib import Path
 
 from bench_ros import PLATOON, _env, _ours, build
 
+#: the C++ Leaves in one process (the default), one process each, and the Python twins
+CONFIGS = ("cpp_container:=true", "cpp_container:=false", "cpp:=false")
 KINDS = ("simulator", "python nodes", "C++ nodes", "ROS (roslaunch, master, rosout)")
 
 
@@ -44,7 +48,8 @@ def _kind(pid: int) -> str | None:
     text = b" ".join(argv).decode(errors="replace")
     if "amsa_simulator" in text:
         return KINDS[0]
-    if any(a.endswith(b"_cpp") for a in argv[:1]):
+    # the C++ Leaves: the container (every one in one process) or a nodelet standalone each
+    if any(a.endswith((b"_cpp", b"/amsa_leaves", b"/nodelet")) for a in argv[:1]):
         return KINDS[2]
     if "roslaunch" in text or "rosmaster" in text or "rosout" in text:
         return KINDS[3]
@@ -133,19 +138,18 @@ def main_bench() -> None:
             build(PLATOON, ws, "--duration", args.duration)
             print(f"platoon: export and catkin_make             {time.perf_counter() - t0:.0f} s")
         traces = []
-        for cpp in ("true", "false"):
-            out = ws / f"out_{cpp}"
-            rss, pss, split, wall = measure(
-                ws, f"out:={out}", "plots:=false", "force:=true", f"cpp:={cpp}"
-            )
+        for how in CONFIGS:
+            out = ws / f"out_{how.replace(':=', '_')}"
+            rss, pss, split, wall = measure(ws, f"out:={out}", "plots:=false", "force:=true", how)
             traces.append((out / "trace.csv").read_bytes())
-            print(f"platoon {args.duration} s lockstep, cpp:={cpp}: peak memory (summed)")
+            print(f"platoon {args.duration} s lockstep, {how}: peak memory (summed)")
             print(f"  RSS {rss / 1024:6.0f} MiB, PSS {pss / 1024:6.0f} MiB; at the RSS peak:")
             for kind in KINDS:
                 r, q, n = split.get(kind, (0, 0, 0))
                 print(f"  {kind:34s} RSS {r / 1024:5.0f} MiB, PSS {q / 1024:5.0f} MiB, {n:2d} proc")
             print(f"  launch to done                     {wall:6.1f} s")
-        print(f"platoon: traces byte-identical (C++ vs Python)  {traces[0] == traces[1]}")
+        same = all(t == traces[0] for t in traces)
+        print(f"platoon: traces byte-identical ({', '.join(CONFIGS)})  {same}")
 
 
 if __name__ == "__main__":

@@ -34,7 +34,18 @@ from ..model.world import WorldSpec
 from ..runs.resolve import resolved_scenario
 from ..runs.rundir import unique_names
 from . import boundary, names
-from .cppnode import check_cpp_ports, cmake_targets, cpp_bodies, cpp_node, has_cpp, hz
+from .cppnode import (
+    check_cpp_ports,
+    cmake_targets,
+    cpp_bodies,
+    cpp_leaf,
+    cpp_templates,
+    has_cpp,
+    hz,
+    leaves_yaml,
+    manifest_export,
+    plugins_xml,
+)
 from .graph import RosGraph, classify
 from .launchxml import launch_xml
 from .quote import Code, check_name, cmake_arg, fill, py_string, yaml_comment, yaml_dump
@@ -174,9 +185,14 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
             "leaf",
             Code(py_string(path)),
         )
-    for path in cpp:
-        files[f"src/{names.script(path)}.cpp"] = cpp_node(graph, path, pkg, source, bodies)
+    for tname, paths in cpp_templates(graph, cpp).items():
+        files[f"src/leaves/{tname}.cpp"] = cpp_leaf(graph, tname, paths, pkg, source, bodies)
     if cpp:
+        files[f"src/{names.CONTAINER}.cpp"] = (FILES / "amsa_leaves.cpp").read_text()
+        files["nodelet_plugins.xml"] = plugins_xml(graph, pkg, cpp)
+        files[f"config/{names.CONTAINER}.yaml"] = leaves_yaml(
+            graph, pkg, cpp, boundary.plan(graph).controller
+        )
         files[f"include/{pkg}/amsa_leaf_node.h"] = (FILES / "amsa_leaf_node.h").read_text()
         files[f"include/{pkg}/amsa_pymath.h"] = (FILES / "amsa_pymath.h").read_text()
         for header in ("amsa_noise.h", "amsa_rng.h", "amsa_ziggurat.h", "amsa_window.h"):
@@ -196,6 +212,7 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         version=__version__,
         source=source,
         description=str(world.data.get("description") or f"The {pkg} system."),
+        export=manifest_export(cpp),
     )
     files["CMakeLists.txt"] = _fill(
         "CMakeLists.txt.in",
@@ -203,7 +220,7 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         version=__version__,
         source=source,
         python_nodes=Code("\n".join(f"  {cmake_arg(f)}" for f in python_nodes)),
-        cpp_targets=cmake_targets(cpp),
+        cpp_targets=cmake_targets(graph, pkg, cpp),
     )
     files["README.md"] = readme(graph, pkg, source, launches, mode, cpp)
     for rel, text in files.items():

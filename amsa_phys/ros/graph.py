@@ -76,6 +76,8 @@ class RosGraph:
     world: WorldSpec
     local: frozenset[str]
     bag: bool = False
+    #: the Leaves hosted together in one process (the C++ container, ``/amsa/container``)
+    shared: frozenset[str] = frozenset()
     #: the signals the adapt node reads when it runs the rules beside the simulator
     #: (``rules:=node``): it is one more subscriber of each
     adapt_signals: frozenset[str] = frozenset()
@@ -86,14 +88,18 @@ class RosGraph:
         world: WorldSpec,
         local: Iterable[str],
         bag: bool = False,
+        shared: Iterable[str] = (),
         adapt_signals: Iterable[str] = (),
     ) -> RosGraph:
-        """The graph with ``local`` Leaves in the simulator (checked against the world)."""
+        """The graph with ``local`` Leaves in the simulator and ``shared`` ones in the C++
+        container (checked against the world)."""
         local = frozenset(local)
-        unknown = sorted(local - set(world.leaves))
-        if unknown:
-            raise ConfigError(f"unknown Leaf {unknown[0]!r} in /amsa/local")
-        return cls(world, local, bag, frozenset(adapt_signals))
+        shared = frozenset(shared)
+        for what, leaves in (("/amsa/local", local), ("/amsa/container", shared)):
+            unknown = sorted(leaves - set(world.leaves))
+            if unknown:
+                raise ConfigError(f"unknown Leaf {unknown[0]!r} in {what}")
+        return cls(world, local, bag, shared, frozenset(adapt_signals))
 
     @property
     def remote(self) -> list[str]:
@@ -120,9 +126,16 @@ class RosGraph:
         return [f"{path}.{p.name}" for p in self.leaf(path).template.outputs]
 
     def subscribers(self, buffer: str) -> int:
-        """How many subscribers the topic of ``buffer`` has once everything is connected."""
+        """How many subscribers the topic of ``buffer`` has once everything is connected.
+
+        ROS 1 counts processes, not subscriptions: the Leaves of the C++ container
+        (:attr:`shared`) that read a topic are one subscriber of it (roscpp subscribes a
+        process once per topic), as the master registers them (one node).
+        """
         producer = buffer.rpartition(".")[0]
-        n = sum(1 for p in self.remote if p != producer and buffer in self.input_buffers(p))
+        readers = [p for p in self.remote if p != producer and buffer in self.input_buffers(p)]
+        n = sum(1 for p in readers if p not in self.shared)
+        n += 1 if any(p in self.shared for p in readers) else 0
         if producer not in self.local:
             n += 1  # the simulator: the trace, and the Leaves it steps
         n += 1 if buffer in self.adapt_signals else 0  # the adapt node (rules:=node)

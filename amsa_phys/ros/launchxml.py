@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from .. import __version__
 from . import boundary, names
-from .cppnode import hz
+from .cppnode import hz, plugin
 from .graph import RosGraph
 from .quote import Code, fill, yaml_scalar
 
@@ -42,7 +42,7 @@ _HEAD = """\
     <param name="timeout" type="double" value="$(arg timeout)"/>
     <param name="seed" type="str" value="@@{seed:xml_attr}"/>
     <rosparam param="local">@@{local:xml_text}</rosparam>
-  </group>
+@@{container:code}  </group>
   <rosparam command="load" file="$(find @@{pkg:xml_attr})/config/@@{fname:xml_attr}_params.yaml"/>
 
   <!-- the physics (@@{local_names:xml_comment}) and /clock; writes the run directory -->
@@ -64,6 +64,22 @@ _HEAD = """\
     <param name="speed" type="double" value="$(arg speed)"/>
   </node>
 """
+
+
+def _container(cpp: list[str]) -> Code:
+    """``/amsa/container``: the Leaves in the C++ container when it runs (cpp and
+    cpp_container), else none; every node counts its subscribers (processes) by it."""
+    if not cpp:
+        return Code("")
+    on = "$(eval arg('cpp') and arg('cpp_container'))"
+    leaves = Code("[" + ", ".join(yaml_scalar(p) for p in cpp) + "]")
+    return fill(
+        '    <rosparam if="@@{on:code}" param="container">@@{leaves:xml_text}</rosparam>\n'
+        '    <rosparam unless="@@{on:code}" param="container">[]</rosparam>\n',
+        on=Code(on),
+        leaves=leaves,
+    )
+
 
 _LEAF = "  <!-- @@{path:xml_comment}: @@{tname:xml_comment}, @@{hz:xml_comment} Hz -->"
 _COMMON = 'pkg="@@{pkg:xml_attr}" name="@@{base:xml_attr}"@@{ns:code} required="true"'
@@ -103,6 +119,11 @@ def launch_xml(
             '  <arg name="cpp" default="true" doc="run the Leaves with a C++ body as their'
             ' roscpp node (false: their Python twin)"/>'
         )
+        lines.append(
+            '  <arg name="cpp_container" default="true" doc="with cpp: every C++ Leaf in one'
+            " process (amsa_leaves, a nodelet manager); false: one process per Leaf (nodelet"
+            ' standalone)"/>'
+        )
     lines.append(
         fill(
             _HEAD,
@@ -114,6 +135,7 @@ def launch_xml(
             scenario=names.SCENARIO,
             boundary=boundary.NODE,
             seed=str(seed),
+            container=_container(cpp),
         )
     )
     if adapt:
@@ -131,6 +153,20 @@ def launch_xml(
                 pkg=pkg,
             )
         )
+    if cpp:
+        lines.append(
+            fill(
+                "  <!-- the C++ Leaves: their wiring, and their container (every C++ Leaf in"
+                " one process) -->\n"
+                '  <rosparam if="$(arg cpp)" command="load"'
+                ' file="$(find @@{pkg:xml_attr})/config/@@{container:xml_attr}.yaml"/>\n'
+                "  <node if=\"$(eval arg('cpp') and arg('cpp_container'))\""
+                ' pkg="@@{pkg:xml_attr}" type="@@{container:xml_attr}"'
+                ' name="@@{container:xml_attr}" required="true" output="screen"/>',
+                pkg=pkg,
+                container=names.CONTAINER,
+            )
+        )
     side = boundary.plan(graph).controller
     for path in graph.remote:
         leaf = graph.leaf(path)
@@ -143,9 +179,20 @@ def launch_xml(
         # sim:=false runs the controller side only (boundary.py); the rest is the simulator's
         sim = "True" if path in side else "arg('sim')"
         if path in cpp:
-            cpp_on = Code(f"if=\"$(eval {sim} and arg('cpp'))\" ")
+            # cpp_container:=false: the Leaf's nodelet alone in a process of its own
+            alone = Code(f"if=\"$(eval {sim} and arg('cpp') and not arg('cpp_container'))\" ")
             cpp_off = Code(f"if=\"$(eval {sim} and not arg('cpp'))\" ")
-            lines.append(fill(node, when=cpp_on, c=common, t=f"{script}_cpp"))
+            lines.append(
+                fill(
+                    '  <node @@{when:code}pkg="nodelet" type="nodelet"'
+                    ' args="standalone @@{plugin:xml_attr}" name="@@{base:xml_attr}"@@{ns:code}'
+                    ' required="true"/>',
+                    when=alone,
+                    plugin=plugin(pkg, leaf.template.name()),
+                    base=base,
+                    ns=ns,
+                )
+            )
             lines.append(fill(node, when=cpp_off, c=common, t=f"{script}.py"))
         else:
             when = Code("" if path in side else 'if="$(arg sim)" ')

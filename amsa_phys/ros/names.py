@@ -21,6 +21,9 @@ SCENARIO = "amsa_scenario"
 #: Names a top-level component may not take (the framework's nodes and namespaces).
 RESERVED = {"amsa", SIMULATOR, SCENARIO, "clock", "rosout", "rosout_agg", "amsa_bag"}
 RESERVED.update({"amsa_boundary", "amsa_adapt"})  # the boundary and adapt nodes
+#: The process that hosts every C++ Leaf (a nodelet manager: ros/files/amsa_leaves.cpp).
+CONTAINER = "amsa_leaves"
+RESERVED.add(CONTAINER)
 
 CLOCK = "/clock"
 READY = "/amsa/ready"

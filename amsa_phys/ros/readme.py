@@ -112,6 +112,16 @@ node exists, or amsa-phys's `ros/runtime/leaf.py`) and the announcement.
 """
 
 
+_CPP_ARGS = (
+    ", `cpp` (`false`: the C++ Leaves' Python twins), `cpp_container` (`true`, the default:"
+    " every C++ Leaf in one process, `amsa_leaves`, a nodelet manager; `false`: each in a"
+    " process of its own, `nodelet standalone PKG/TEMPLATE`). The C++ Leaves are nodelets, one"
+    " class per template (`nodelet_plugins.xml`): `nodelet load PKG/TEMPLATE MANAGER` loads"
+    " one into a manager of your own, with its parameters and its wiring"
+    " (`config/amsa_leaves.yaml`) in its private namespace"
+)
+
+
 def readme(
     graph: RosGraph,
     pkg: str,
@@ -127,7 +137,7 @@ def readme(
     for path, leaf in world.leaves.items():
         where = md_code(names.SIMULATOR if path in graph.local else names.ns(path))
         if path in cpp:
-            where += " (C++, or Python with `cpp:=false`)"
+            where += " (C++ in `amsa_leaves`, or Python with `cpp:=false`)"
         params = ", ".join(md_code(p.name) for p in leaf.template.params) or "-"
         topics = ", ".join(md_code(names.topic(b)) for b in graph.outputs(path))
         cells = [md_code(path), md_code(leaf.template.name()), hz(leaf.freq), where, topics, params]
@@ -141,7 +151,7 @@ def readme(
         launch=launches[0],
         launches=Code(", ".join(md_code(x) for x in launches)),
         mode=mode,
-        cpp_arg=Code(", `cpp`" if cpp else ""),
+        cpp_arg=Code(_CPP_ARGS if cpp else ""),
         local=Code(", ".join(md_code(p) for p in local) or "none"),
         rows=Code("\n".join(rows)),
     )

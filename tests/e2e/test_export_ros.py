@@ -48,7 +48,14 @@ def test_package_has_a_node_per_leaf_a_topic_per_data_a_parameter_per_parameter(
     assert manifest.findtext("name") == "mdeChallenge"  # named after the root component
     launch = ET.parse(pkg / "launch" / "ros_short.launch").getroot()
     nodes = {n.get("name"): n for n in launch.iter("node")}
-    assert set(nodes) == {"amsa_simulator", "amsa_scenario", *REMOTE, "amsa_bag", "amsa_boundary"}
+    assert set(nodes) == {
+        "amsa_simulator",
+        "amsa_scenario",
+        *REMOTE,
+        "amsa_bag",
+        "amsa_boundary",
+        "amsa_leaves",  # the C++ Leaves' container
+    }
     # the boundary's standard messages are for onlookers: without them the run still runs
     optional = {"amsa_bag", "amsa_boundary"}
     assert all(n.get("required") == "true" for k, n in nodes.items() if k not in optional)
@@ -62,10 +69,40 @@ def test_package_has_a_node_per_leaf_a_topic_per_data_a_parameter_per_parameter(
     args = {a.get("name"): a.get("default") for a in launch.iter("arg")}
     assert args["mode"] == "free"  # --mode sets the launch files' default
     assert {"out", "bag", "speed", "duration", "cpp", "force", "plots", "sim"} <= set(args)
-    # the C++ route for the template with a C++ body, its Python twin otherwise
-    types = [n.get("type") for n in launch.iter("node") if n.get("name") == "MyNormalizePower"]
-    assert types == ["MyNormalizePower_cpp", "MyNormalizePower.py"]
-    assert "add_executable(MyNormalizePower_cpp" in (pkg / "CMakeLists.txt").read_text()
+    # the C++ route for the templates with a C++ body: one nodelet class per template in one
+    # library, every C++ Leaf in the container by default, alone in a process of its own
+    # with cpp_container:=false (nodelet standalone), its Python twin with cpp:=false
+    leaf = [n for n in launch.iter("node") if n.get("name") == "MyNormalizePower"]
+    assert [(n.get("pkg"), n.get("type"), n.get("args")) for n in leaf] == [
+        ("nodelet", "nodelet", "standalone mdeChallenge/NormalizePower"),
+        ("mdeChallenge", "MyNormalizePower.py", None),
+    ]
+    assert "not arg('cpp_container')" in leaf[0].get("if")
+    assert "arg('cpp_container')" in nodes["amsa_leaves"].get("if")
+    cmake = (pkg / "CMakeLists.txt").read_text()
+    assert "add_library(mdeChallenge_leaves src/leaves/GPS.cpp src/leaves/Compass.cpp" in cmake
+    assert "add_executable(amsa_leaves src/amsa_leaves.cpp)" in cmake
+    plugins = ET.parse(pkg / "nodelet_plugins.xml").getroot()
+    assert [c.get("name") for c in plugins.iter("class")] == [
+        f"mdeChallenge/{t}"
+        for t in ("GPS", "Compass", "DistanceMonitor", "FollowerController", "NormalizePower")
+    ]
+    assert manifest.find("export/nodelet").get("plugin") == "${prefix}/nodelet_plugins.xml"
+    wired = yaml.safe_load((pkg / "config" / "amsa_leaves.yaml").read_text())
+    assert [leaf["name"] for leaf in wired["amsa_leaves"]["leaves"]] == [
+        "/LeaderGPS",
+        "/FollowerGPS",
+        "/FollowerCompass",
+        "/MyDistanceMonitor",
+        "/MyFollowerController",
+        "/MyNormalizePower",
+    ]
+    # the controller's outputs: the actuator and the simulator read LeftPower (2 processes
+    # apart, 2 in the container: the container and the simulator); leaderSpeed only the trace
+    assert (
+        "output LeftPower /MyFollowerController/LeftPower 0x0.0p+0 2 2\n"
+        in (wired["MyFollowerController"]["amsa_wiring"])
+    )
     # one topic per Data: the bag records every trace column's topic
     bag = next(n for n in launch.iter("node") if n.get("name") == "amsa_bag")
     scenario = load_scenario(SCENARIO)
@@ -169,8 +206,8 @@ def test_an_array_port_is_one_multiarray_topic_with_a_legal_name(tmp_path: Path)
     launch = (out / "launch" / "obstacle_course.launch").read_text()
     assert " /Scanner/ranges " in launch
     assert "[" not in launch.partition('type="record"')[2]
-    cpp = (out / "src" / "Pilot.cpp").read_text()
-    assert '{"/Scanner/ranges", 0.0, false, 31}' in cpp
+    wiring = (out / "config" / "amsa_leaves.yaml").read_text()
+    assert "topic /Scanner/ranges 0x0.0p+0 0 31" in wiring
     assert "ranges <- /Scanner/ranges [31]" in (out / "nodes" / "Pilot.py").read_text()
 
 

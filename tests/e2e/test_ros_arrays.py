@@ -13,8 +13,8 @@ the template bit for bit on random scans, where rarer differences show).
 With ``sim:=false`` a robot of the test's own publishes a 360-beam ``sensor_msgs/LaserScan``
 (plus GPS fixes and a compass): the boundary fits it to the lidar's 31 beams and the pilot
 steers the robot round a post to its goal (mutation-checked: with the fitted scan
-mirrored, beam i from beam 30 - i, the robot stalls in front of the post, 8 m short). Skipped, with the reason, where
-ROS, catkin, unshare or root is missing.
+mirrored, beam i from beam 30 - i, the robot stalls in front of the post, 8 m short).
+Skipped, with the reason, where ROS, catkin, unshare or root is missing.
 """
 
 from __future__ import annotations
@@ -54,11 +54,12 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
-def test_the_avoider_is_a_cpp_node_reading_one_array_topic(workspace: Path) -> None:
+def test_the_avoider_is_a_cpp_leaf_reading_one_array_topic(workspace: Path) -> None:
     src = workspace / "src" / PKG
-    assert (workspace / "devel" / "lib" / PKG / "Pilot_cpp").is_file()
-    node = (src / "src" / "Pilot.cpp").read_text()
-    assert '{"/Scanner/ranges", 0.0, false, 31}' in node  # an array topic of 31 values
+    assert (src / "src" / "leaves" / "ReactiveAvoider.cpp").is_file()
+    assert (workspace / "devel" / "lib" / f"lib{PKG}_leaves.so").is_file()
+    wiring = (src / "config" / "amsa_leaves.yaml").read_text()
+    assert "topic /Scanner/ranges 0x0.0p+0 0 31" in wiring  # an array topic of 31 values
     assert "/Scanner/ranges [31]" in (src / "nodes" / "Pilot.py").read_text()
 
 

@@ -65,19 +65,32 @@ def test_the_fixture_runs_every_cpp_template_as_a_cpp_node(workspace: Path) -> N
     # the ReactiveAvoider needs a lidar in a world with obstacles: test_ros_arrays.py runs it
     # (the obstacle course, C++ and Python, byte-identical)
     assert ran | {"ReactiveAvoider"} == set(bodies)
-    binaries = workspace / "devel" / "lib" / PKG
-    for path, leaf in world.leaves.items():
-        if has_cpp(leaf, bodies):
-            assert (binaries / f"{names.script(path)}_cpp").is_file(), path
+    # one nodelet class per template, compiled once into the package's library, and the
+    # container that loads every C++ Leaf of the package into one process
+    assert (workspace / "devel" / "lib" / f"lib{PKG}_leaves.so").is_file()
+    assert (workspace / "devel" / "lib" / PKG / names.CONTAINER).is_file()
+    sources = sorted(p.stem for p in (workspace / "src" / PKG / "src" / "leaves").iterdir())
+    assert sources == sorted(ran)
 
 
-@pytest.mark.parametrize("cpp", ["true", "false"])
+@pytest.mark.parametrize(
+    "args",
+    [
+        (),  # the default: every C++ Leaf in one process (amsa_leaves)
+        ("cpp_container:=false",),  # each C++ Leaf in a process of its own
+        ("cpp:=false",),  # the Python twins
+    ],
+    ids=["container", "standalone", "python"],
+)
 def test_lockstep_reproduces_the_run_with_cpp_nodes_and_without(
-    workspace: Path, reference: Path, launcher: Callable[..., Launch], cpp: str
+    workspace: Path, reference: Path, launcher: Callable[..., Launch], args: tuple[str, ...]
 ) -> None:
-    out = workspace / f"lockstep_cpp_{cpp}"
-    launch = launcher(workspace, "ros_nodes.launch", f"out:={out}", "plots:=false", f"cpp:={cpp}")
+    out = workspace / ("lockstep_" + ("_".join(args).replace(":=", "_") or "container"))
+    launch = launcher(workspace, "ros_nodes.launch", f"out:={out}", "plots:=false", *args)
     text = launch.finish()
     assert "completed" in text, text[-3000:]
+    if not args:  # one process hosts every C++ Leaf
+        assert text.count("process[amsa_leaves") == 1, text[-3000:]
+        assert "(nodelet/nodelet)" not in text, text[-3000:]
     assert (out / "trace.csv").read_bytes() == (reference / "trace.csv").read_bytes()
     assert _metrics(out) == _metrics(reference)

@@ -12,6 +12,7 @@ import re
 from pathlib import Path
 
 import pytest
+import yaml
 
 from amsa_phys.cli.main import main
 from amsa_phys.model.scenario import load_scenario
@@ -41,9 +42,13 @@ def package(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_inputs_follow_the_templates_order_not_the_worlds(package: Path) -> None:
     # CartGoal lists {posY: Cart.posY, posX: Cart.posX}: subscribed in that order (topic 0 is
     # /Cart/posY), but the body's in[0] must be posX, i.e. topic 1
-    source = (package / "src" / "CartGoal.cpp").read_text()
-    assert re.search(r'\{"/Cart/posY", [^}]*\},\s*\{"/Cart/posX"', source)
-    assert re.search(r'\{\{"posX", 1\},\s*\{"posY", 0\}\}', source)
+    wired = yaml.safe_load((package / "config" / "amsa_leaves.yaml").read_text())
+    lines = wired["CartGoal"]["amsa_wiring"].splitlines()
+    assert [line.split()[1] for line in lines if line.startswith("topic ")] == [
+        "/Cart/posY",
+        "/Cart/posX",
+    ]
+    assert [line for line in lines if line.startswith("input ")] == ["input posX 1", "input posY 0"]
 
 
 def test_the_launch_file_sets_the_scenarios_seed(package: Path) -> None:

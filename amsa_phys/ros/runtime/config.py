@@ -26,13 +26,14 @@ class NodeConfig:
 
 
 def load_config(rospy: Any) -> NodeConfig:
-    """Read ``/amsa/{scenario,mode,local,bag,timeout,rules}`` and load the scenario."""
+    """Read ``/amsa/{scenario,mode,local,bag,timeout,container,rules}``; load the scenario."""
     try:
         path = rospy.get_param("/amsa/scenario")
         mode = rospy.get_param("/amsa/mode", "lockstep")
         local = rospy.get_param("/amsa/local", [])
         bag = bool(rospy.get_param("/amsa/bag", False))
         timeout = float(rospy.get_param("/amsa/timeout", 60.0))
+        shared = rospy.get_param("/amsa/container", [])  # the C++ Leaves in one process
     except KeyError as exc:
         raise ConfigError(
             "is not on the parameter server (start the nodes with roslaunch)", key=str(exc)
@@ -46,5 +47,5 @@ def load_config(rospy: Any) -> NodeConfig:
     sim = bool(rospy.get_param("/amsa/sim", True))
     node = rules == "node" and bool(scenario.adapt) and sim and mode == "lockstep"
     signals = sorted({c.signal for r in scenario.adapt for c in r.when}) if node else []
-    graph = RosGraph.of(scenario.world, local, bag, signals)
+    graph = RosGraph.of(scenario.world, local, bag, shared, signals)
     return NodeConfig(scenario, graph, mode, timeout, node)

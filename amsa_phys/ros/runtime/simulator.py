@@ -164,8 +164,10 @@ class Link:
             self.cond.notify_all()
 
     def _on_ready(self, msg: Any) -> None:
+        # one name per node; a process hosting several Leaves (the C++ container) latches
+        # one message naming every Leaf ready so far, separated by spaces
         with self.cond:
-            self.ready.add(msg.data)
+            self.ready.update(msg.data.split())
             self.cond.notify_all()
 
     # -- start ------------------------------------------------------------------------------
