@@ -274,5 +274,9 @@ def test_a_scenario_with_adapt_rules_exports_them(
     ]
     launch = ET.parse(pkg / "launch" / "adaptive.launch").getroot()
     node = next(n for n in launch.iter("node") if n.get("name") == "amsa_adapt")
-    assert node.get("unless") == "$(arg sim)"
+    # sim:=false, or rules:=node in lockstep (the simulator asks it: test_ros_adapt.py)
+    want = "$(eval not arg('sim') or (arg('rules') == 'node' and arg('mode') == 'lockstep'))"
+    assert node.get("if") == want
+    rules = next(a for a in launch.iter("arg") if a.get("name") == "rules")
+    assert rules.get("default") == "sim"
     py_compile.compile(str(pkg / "nodes" / "amsa_adapt.py"), doraise=True)

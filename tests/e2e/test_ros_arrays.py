@@ -24,9 +24,11 @@ import math
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import pytest
 import ros_launch
 from ros_launch import Launch, build_workspace, ros_missing
+from rosbags.highlevel import AnyReader
 
 from amsa_phys.cli.main import main
 
@@ -68,11 +70,23 @@ def test_lockstep_reproduces_the_obstacle_course_with_cpp_and_python_avoider(
     workspace: Path, reference: Path, launcher: Callable[..., Launch], cpp: str
 ) -> None:
     out = workspace / f"lockstep_cpp_{cpp}"
-    args = [f"out:={out}", "plots:=false", f"cpp:={cpp}", f"duration:={DURATION}"]
+    bag = workspace / f"data_{cpp}.bag"
+    args = [f"out:={out}", "plots:=false", f"cpp:={cpp}", f"duration:={DURATION}", f"bag:={bag}"]
     text = launcher(workspace, "obstacle_course.launch", *args).finish()
     assert "partial" in text or "completed" in text, text[-3000:]
     assert (out / "trace.csv").read_bytes() == (reference / "trace.csv").read_bytes()
     assert ros_launch.metrics_without_wall(out) == ros_launch.metrics_without_wall(reference)
+    # bag:= records the array topic: every scan, whole, as the trace has it
+    trace = np.genfromtxt(reference / "trace.csv", delimiter=",", names=True)
+    rows = {tuple(trace[f"Scannerranges{i}"][k] for i in range(31)) for k in range(len(trace))}
+    with AnyReader([bag]) as reader:
+        conns = [c for c in reader.connections if c.topic == "/Scanner/ranges"]
+        assert [c.msgtype for c in conns] == ["std_msgs/msg/Float64MultiArray"]
+        scans = [reader.deserialize(raw, conns[0].msgtype) for _, _, raw in reader.messages(conns)]
+    assert len(scans) > 10 * int(DURATION)  # a scan every 0.1 s
+    dim = scans[0].layout.dim
+    assert [(d.label, d.size, d.stride) for d in dim] == [("ranges", 31, 31)]
+    assert {tuple(s.data.tolist()) for s in scans} == rows - {(0.0,) * 31}
 
 
 #: A robot of the test's own (plain rospy, no amsa-phys code) in an open field: a post of
