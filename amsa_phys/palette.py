@@ -51,7 +51,9 @@ INK: RGB = (32, 32, 36)
 SIGNAL: RGB = (38, 38, 38)
 #: the reference value and the tolerance band
 REFERENCE: RGB = (44, 160, 44)
-#: phase starts and live changes (vertical lines in plots, ticks on the replay's slider)
+#: the timeline: phase starts and changes inside a phase (a timeline entry with
+#: ``new_phase: false``, a live change made in the window, an ``adapt:`` switch) -- lines
+#: in the plots, lines and ticks on the replay's slider; grey, never red (red is an alert)
 PHASE: RGB = (102, 102, 102)
 #: the true-distance line between rovers in the window: dashed, in the error colour
 #: (green / amber / red); amber is kept clear of the leader's orange (hue and lightness)
@@ -79,7 +81,15 @@ GPS_FIX = Mark("GPS fix", "+", (127, 127, 127), "a fix as published (measured po
 START = Mark("start", "o", (0, 0, 0), "where a rover's path starts")
 END = Mark("end", "s", (0, 0, 0), "where a rover's path ends (or the run was cut)")
 
-MARKS: tuple[Mark, ...] = (LOST_FIX, COLLISION, GPS_FIX, START, END)
+#: where an ``adapt:`` rule switched parameters: a grey ▼ (a change, made by a rule: not an
+#: alert, so never red)
+ADAPT_SWITCH = Mark(
+    "adapt switch", "v", PHASE, "an adapt: rule switched parameters (the values it set beside it)"
+)
+#: anything else a component recorded (``record_event``): a small dark dot
+OTHER_EVENT = Mark("other event", ".", INK, "an event a component recorded (its kind and detail)")
+
+MARKS: tuple[Mark, ...] = (LOST_FIX, COLLISION, GPS_FIX, START, END, ADAPT_SWITCH, OTHER_EVENT)
 
 
 def rover_colour(index: int) -> RGB:

@@ -14,6 +14,7 @@ from ..falsify.objective import Objective, build_objective
 from ..falsify.outputs import describe_value, headline, write_results, write_worst
 from ..falsify.search import Progress, Settings, search
 from ..falsify.space import build_space
+from ..model.configure import duration_option
 from ..model.scenario import load_scenario
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.suite import input_files
@@ -73,8 +74,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("must be at least 1", key="--jobs")
     if args.executor == "dask" and not args.scheduler:
         raise ConfigError("the Dask executor needs --scheduler ADDR", key="--executor")
-    if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
-        raise ConfigError("must be a positive number of seconds", key="--duration")
+    if args.duration is not None:
+        duration_option(args.duration)
     space = build_space(scenario, args.ranges, args.grid)
     end = args.duration if args.duration is not None else float(scenario.duration)
     n_phases = sum(1 for p in scenario.phases if p.at < end)

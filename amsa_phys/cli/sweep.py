@@ -14,6 +14,7 @@ from typing import Any
 from ..atomic import write_atomic
 from ..engine import interrupt
 from ..errors import ConfigError, Interrupted, one_line
+from ..model.configure import duration_option
 from ..model.scenario import load_scenario
 from ..model.wording import plural
 from ..model.yamlio import load_yaml
@@ -84,6 +85,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
 def build_plan(args: argparse.Namespace) -> SweepPlan:
     """Merge the scenario's ``sweep:`` section with the command line (which wins)."""
     scenario = load_scenario(args.scenario)
+    if args.duration is not None:  # refused once, before a job is built (not in every row)
+        duration_option(args.duration)
     doc = load_yaml(args.scenario)
     section = scenario.data.get("sweep", {})
     axes: list[Axis] = []

@@ -12,9 +12,13 @@ headless run, every frame in the window and in a recording, which is well under 
 wall-clock second for any world this project ships. A second signal raises at once: the user
 insists (a component stuck in an endless loop never returns from ``advance``).
 
-Only the main thread can own signal handlers, and a handler somebody else installed (a sweep
-worker ignores SIGINT; a host application has its own) is left alone: :class:`deferred` is
-then a no-op and nothing is ever requested.
+Only the main thread can own signal handlers, and a SIGINT handler somebody else installed (a
+sweep worker ignores SIGINT; a host application has its own; a shell script's ``cmd &`` starts
+its job with SIGINT ignored) is left alone. The deferral itself holds whoever owns SIGINT: the
+CLI's SIGTERM handler (:func:`sigterm_as_ctrl_c`) only ever requests a stop while a run
+defers. It used to depend on SIGINT too, so ``amsa-phys run ... > log &`` from a script
+(SIGINT ignored) was stopped by ``kill`` wherever it was, mid-second and even mid-instant,
+while the same run in a terminal stopped on a whole second.
 
 Sweeps and ``amsa-phys test -j`` defer interrupts in the main process too: Ctrl-C raised inside
 ``concurrent.futures`` (holding one of its locks) could hang the pool's shutdown. Their
@@ -74,14 +78,14 @@ def check() -> None:
 
 @contextmanager
 def deferred() -> Iterator[None]:
-    """While active, SIGINT (if Python's default handler has it) only requests a stop."""
+    """While active, SIGINT (if Python's default handler has it) and the CLI's SIGTERM
+    (:func:`sigterm_as_ctrl_c`, whoever owns SIGINT) only request a stop."""
     global _installed, _requested
-    if threading.current_thread() is not threading.main_thread() or signal.getsignal(
-        signal.SIGINT
-    ) not in (signal.default_int_handler, request):
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGINT, request)
+    take_sigint = signal.getsignal(signal.SIGINT) in (signal.default_int_handler, request)
+    previous = signal.signal(signal.SIGINT, request) if take_sigint else None
     if not _installed:
         _requested = False
     _installed += 1
@@ -89,7 +93,8 @@ def deferred() -> Iterator[None]:
         yield
     finally:
         _installed -= 1
-        signal.signal(signal.SIGINT, previous)
+        if take_sigint:
+            signal.signal(signal.SIGINT, previous)
         if not _installed:
             _requested = False
 

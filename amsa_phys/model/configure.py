@@ -27,7 +27,7 @@ from .scenariobuild import (
     trace_problem,
 )
 from .scenariospec import Scenario, shortened
-from .schema import MAX_SEED
+from .schema import MAX_SEED, duration_problem
 from .yamlio import YamlDoc
 
 
@@ -46,7 +46,7 @@ def configure_scenario(
     if seed is not None:
         scenario = with_seed(scenario, seed)
     if duration is not None:
-        scenario = shortened(scenario, positive_fraction(duration, "--duration"))
+        scenario = shortened(scenario, duration_option(duration))
     if log_rate is not None:
         scenario = with_log_rate(scenario, log_rate)
     if trace_columns is not None:
@@ -144,6 +144,16 @@ def _refuse_conflict(given: dict[str, tuple[str, Any]], key: str, text: str, val
             f"set twice, {first[0].strip()!r} and {text.strip()!r}: give one value",
             key=f"--set {key}",
         )
+
+
+def duration_option(value: float | Fraction, option: str = "--duration") -> Fraction:
+    """``--duration`` (run, sweep, falsify, ``ap.run``'s ``duration=``), exactly: a positive
+    finite number up to ``schema.MAX_DURATION_S``, the limit a file's ``duration:`` has."""
+    duration = value if isinstance(value, Fraction) else positive_fraction(value, option)
+    why = duration_problem(duration)
+    if why is not None:
+        raise ConfigError(why, key=option)
+    return duration
 
 
 def positive_fraction(value: float, option: str) -> Fraction:

@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import math
+import re
 import reprlib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -108,7 +109,7 @@ MAX_INT = 2**63 - 1
 def _number(value: Any, integer: bool) -> Any:
     if isinstance(value, bool) or not isinstance(value, int | float):
         want = "an integer" if integer else "a number"
-        raise ValueError(f"expected {want}, got {_show(value)}")
+        raise ValueError(f"expected {want}, got {_show(value)}{number_text_hint(value)}")
     if isinstance(value, float) and not math.isfinite(value):
         raise ValueError(f"expected a finite number, got {value}")
     if integer:
@@ -165,3 +166,28 @@ def short_repr(value: Any) -> str:
 def _show(value: Any) -> str:
     """Describe a wrong value briefly: its YAML type and its (cut) repr."""
     return f"{yaml_type(value)} {short_repr(value)}"
+
+
+#: A number in exponent notation that YAML 1.1 reads as text (mantissa, exponent).
+_EXPONENT = re.compile(r"([-+]?(?:\d[\d_]*)?(?:\.[\d_]*)?)[eE]([-+]?\d+)")
+
+
+def number_text_hint(value: Any) -> str:
+    """`` (YAML reads 1e-3 as text: write 1.0e-3)`` for such a string, else ``""``.
+
+    PyYAML follows YAML 1.1, whose floats need a dot and a signed exponent: ``1e-3``,
+    ``1e12`` and ``1.0e12`` are strings there, though YAML 1.2, JSON and Python read them
+    as numbers. "expected a number, got string '1e-3'" alone leaves the reader puzzled;
+    the hint gives the spelling that is read as a number.
+    """
+    if not isinstance(value, str):
+        return ""
+    match = _EXPONENT.fullmatch(value)
+    if match is None or not any(c.isdigit() for c in match.group(1)):
+        return ""
+    mantissa, exponent = match.groups()
+    if "." not in mantissa:
+        mantissa += ".0"
+    if exponent[0] not in "+-":
+        exponent = "+" + exponent
+    return f" (YAML reads {value} as text: write {mantissa}e{exponent})"

@@ -85,6 +85,9 @@ def _duration(doc: YamlDoc, data: dict[str, Any]) -> Fraction:
     duration = Fraction(str(data["duration"]))
     if duration <= 0:
         raise doc.error(("duration",), f"must be > 0, got {data['duration']}")
+    why = schema.duration_problem(duration)
+    if why is not None:
+        raise doc.error(("duration",), why)
     return duration
 
 

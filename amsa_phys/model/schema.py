@@ -11,10 +11,11 @@ from __future__ import annotations
 import importlib
 import math
 import sys
+from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 from .adaptrules import SCHEMA as ADAPT
-from .params import short_repr, yaml_type
+from .params import number_text_hint, short_repr, yaml_type
 from .rates import MAX_RATE_HZ, MIN_PHYSICS_RATE_HZ, MIN_RATE_HZ
 from .suggest import did_you_mean
 from .yamlio import KeyPath, YamlDoc
@@ -25,6 +26,27 @@ if TYPE_CHECKING:  # imported only to word an error: ~50-100 ms of imports off t
 NAME = r"^[A-Za-z_][A-Za-z0-9_]*$"
 #: The largest seed: numpy's seed tree takes any non-negative integer, files stay int64.
 MAX_SEED = 2**63 - 1
+#: The longest run, in seconds of simulated time: 10^6 s (11.6 days, 2,000 times the paper's
+#: 500 s scenarios). Hostile input must be bounded in time: ``duration: 1e308`` (or
+#: ``--duration 1e308``) was legal and ran until it was stopped. The MDE world runs ~500x
+#: real time, so the longest run of it takes about half an hour. The file's ``duration:``
+#: and every ``--duration`` (run, sweep, falsify, ``ap.run``) are held to it.
+MAX_DURATION_S = 1_000_000
+
+
+def duration_problem(duration: Fraction) -> str | None:
+    """Why ``duration`` (seconds, exact) cannot be a run's length (None if it can)."""
+    if duration <= 0:
+        return f"must be > 0, got {float(duration):g}"
+    if duration > MAX_DURATION_S:
+        return (
+            f"must be at most {MAX_DURATION_S:,} s of simulated time "
+            f"({MAX_DURATION_S / 86_400:.1f} days, the limit on a run's length), "
+            f"got {float(duration):g}"
+        )
+    return None
+
+
 #: A Data name: a NAME, or ``Composite.NAME`` for a Data declared inside a Composite.
 DATA_NAME = r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$"
 _num = {"type": "number"}
@@ -360,7 +382,8 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
         words = " or ".join(_TYPE_WORDS.get(w, w) for w in wants)
         if not path:  # the whole file: say what it is, never echo what it holds
             return path, f"expected {words}, got {yaml_type(inst)}: not a world or scenario file"
-        return path, f"expected {words}, got {yaml_type(inst)} {short_repr(inst)}"
+        hint = number_text_hint(inst) if {"number", "integer"} & set(wants) else ""
+        return path, f"expected {words}, got {yaml_type(inst)} {short_repr(inst)}{hint}"
     if kind in ("minimum", "maximum") and err.schema.get("description") == "rate":
         lo, hi = err.schema["minimum"], err.schema["maximum"]
         if inst <= 0:
@@ -383,7 +406,7 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
             return path, f"must be > 0, got {inst}"
         return path, (
             'expected a positive number of seconds or an exact fraction such as "7/3", '
-            f"got {yaml_type(inst)} {short_repr(inst)}"
+            f"got {yaml_type(inst)} {short_repr(inst)}{number_text_hint(inst)}"
         )
     if kind == "anyOf" and isinstance(inst, dict):
         return path, "needs 'below' or 'above'"

@@ -218,28 +218,48 @@ class ColumnPhysics:
             fault = RunFault(rover.name, self.sim.now + 1 / self.worlds[0].rate, bad[1])
             raise in_run(fault, int(self._run[bad[0]]))  # the batch makes that run alone
 
+    def within_reach_at_start(self) -> set[int]:
+        """The runs whose first step would mark them touched: within reach at t = 0.
+
+        Call after the batch is initialised (every run's world adopted) and before it steps.
+        The first step's watch sees exactly this state, so each of these runs would be
+        computed in the columns only to be thrown away and made alone: the batch makes them
+        alone at once instead (``runs/batched.py``; the paper's Fig. 5 starts the follower
+        1 m behind the leader, and every run of its sweeps was computed twice).
+        """
+        if not any(w.rovers for w in self.worlds):
+            return set()  # nothing the columns step: nothing to touch
+        self._model or self._start()
+        return self._near(self._io.state, self.dt)
+
     def _contacts(self, dt: float) -> None:
         """Mark the runs whose shapes are within reach of each other before this step."""
-        before = self._io.before
-        x, y = before[:, 0], before[:, 1]
-        speed = np.hypot(before[:, 3], before[:, 4])
+        self.touched.update(self._near(self._io.before, dt))
+
+    def _near(self, state: np.ndarray, dt: float) -> set[int]:
+        """Runs (of ``state``, the columns' rows) whose shapes are within reach of each other
+        or of a static shape, or too fast for the columns, in a step of ``dt``."""
+        out: set[int] = set()
+        x, y = state[:, 0], state[:, 1]
+        speed = np.hypot(state[:, 3], state[:, 4])
         reach = self._radius + REACH_M + 2.0 * dt * speed
         fast = speed > 0.99 * self._sub
         if fast.any():
-            self.touched.update(self._run[fast].tolist())
+            out.update(self._run[fast].tolist())
         if len(self._pa):
             pa, pb = self._pa, self._pb
             gap = np.hypot(x[pa] - x[pb], y[pa] - y[pb])
             near = gap < reach[pa] + reach[pb]
             if near.any():
-                self.touched.update(self._run[pa[near]].tolist())
+                out.update(self._run[pa[near]].tolist())
         if len(self._boxes):
             b = self._boxes
             dx = np.maximum(np.maximum(b[None, :, 0] - x[:, None], 0.0), x[:, None] - b[None, :, 2])
             dy = np.maximum(np.maximum(b[None, :, 1] - y[:, None], 0.0), y[:, None] - b[None, :, 3])
             near = (np.hypot(dx, dy) < reach[:, None]).any(axis=1)
             if near.any():
-                self.touched.update(self._run[near].tolist())
+                out.update(self._run[near].tolist())
+        return out
 
 
 def _body_state(body: pymunk.Body) -> list[float]:

@@ -12,7 +12,10 @@ from typing import Any
 import numpy as np
 from matplotlib.axes import Axes
 
-COLOR = "tab:red"
+from ..palette import ADAPT_SWITCH, hex_colour
+
+#: ``palette.ADAPT_SWITCH``: the timeline's grey (a switch is a change, not an alert: red is)
+COLOR = hex_colour(ADAPT_SWITCH.colour)
 
 
 def switch_text(detail: str) -> str:
@@ -37,7 +40,7 @@ def adapt_switches(
     ax.plot(
         at,
         y,
-        "v",
+        ADAPT_SWITCH.marker,
         color=color,
         ms=7,
         zorder=5,

@@ -33,7 +33,7 @@ def plot_convergence(
     without a value (a fault: the worst there is) is marked on the axis's edge.
     """
     fig, ax = plt.subplots(figsize=(8, 4.5), dpi=100)
-    runs = list(range(len(values)))  # numbered from 0, as runs.csv's `run` and the headline
+    runs = list(range(len(values)))  # numbered from 0, as results.csv's `run` and the headline
     finite = [v for v in values if v is not None and math.isfinite(v)]
     xs = [r for r, v in zip(runs, values, strict=True) if v is not None and math.isfinite(v)]
     gens = [
@@ -68,7 +68,7 @@ def plot_convergence(
         ax.axhline(threshold, color="black", ls="--", lw=1, label=f"bound {threshold:g}")
     if reference is not None:
         ax.axhline(reference[0], color="tab:blue", ls=":", lw=1.5, label=reference[1])
-    ax.set_xlabel("run (as numbered in runs.csv)")
+    ax.set_xlabel("run (as numbered in results.csv)")
     ax.set_ylabel(label)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)

@@ -177,8 +177,9 @@ def _phase_notes(ax: Axes, phases: list[dict[str, Any]]) -> list[str]:
 
 def _inner_changes(ax: Axes, phases: list[dict[str, Any]]) -> list[float]:
     """Mark changes made inside a phase (live in the window, ``new_phase: false``): a dashed
-    line and what was set, upright along the bottom so it never meets the phase notes; one
-    legend entry for them all. Returns their times (the legend is kept off them)."""
+    line in the timeline's grey (``palette.PHASE``; phase starts are dotted) and what was
+    set, upright along the bottom so it never meets the phase notes; one legend entry for
+    them all. Returns their times (the legend is kept off them)."""
     times = []
     for phase in phases:
         for change in phase.get("changes", []):
@@ -186,7 +187,7 @@ def _inner_changes(ax: Axes, phases: list[dict[str, Any]]) -> list[float]:
             times.append(float(at))
             ax.axvline(
                 at,
-                color="tab:purple",
+                color=hex_colour(PHASE),
                 lw=0.8,
                 ls="--",
                 alpha=0.8,
@@ -204,7 +205,7 @@ def _inner_changes(ax: Axes, phases: list[dict[str, Any]]) -> list[float]:
                 ha="right",
                 va="bottom",
                 fontsize=NOTE_PT - 0.5,
-                color="tab:purple",
+                color=hex_colour(PHASE),
                 zorder=6,  # over the legend, should they ever meet
             )
     return times
@@ -296,10 +297,13 @@ def distance_figure(
         s = data[:, header.index(signal)]
         ref = float(quality["reference"])
         tol = float(quality["tolerance"])
+        # a tolerance near the float limit (the schema takes any finite one) is drawn to
+        # PLOTTABLE: the axis's top, its edge with headroom, would overflow to inf
+        band = min(tol, PLOTTABLE)
         ax.fill_between(
             [t[0], t[-1]],
-            ref - tol,
-            ref + tol,
+            ref - band,
+            ref + band,
             color=hex_colour(REFERENCE),
             alpha=0.15,
             label=f"tolerance ±{tol:g} m",
@@ -308,7 +312,7 @@ def distance_figure(
         ax.axhline(ref, color=ref_colour, lw=1.2, ls="--", label=f"reference {ref:g} m")
         # palette.SIGNAL, near-black: blue and orange are the rovers' colours everywhere
         ax.plot(t, s, color=hex_colour(SIGNAL), lw=1.2, label=signal)
-        top = max(float(np.nanmax(s)) if np.isfinite(s).any() else 0.0, ref + tol)
+        top = max(float(np.nanmax(s)) if np.isfinite(s).any() else 0.0, ref + band)
         lines = _phase_notes(ax, metrics.get("phases", []))
         changes = _inner_changes(ax, metrics.get("phases", []))
         _collisions(ax, metrics.get("events", []), t, s)

@@ -7,7 +7,7 @@ follower blue). The static world — walls, obstacles — is drawn by one functi
 static layer is a few more lines there. Terrain (friction zones) comes from the run's own
 ``scenario.yaml`` (``plots/zones.py``) and goes through the same view.
 
-A long, nearly straight run (scenario 1: a 420 m straight line) drawn to scale is a
+A long, nearly straight run (scenario 1: a 124 m straight line) drawn to scale is a
 hairline in a square of empty metres. When every true path stays within 5 % of its length
 of one straight line, and the world has no obstacles or walls (an arena is drawn to scale,
 it is what the paths are read against), the plot turns into a *lateral-offset view*:

@@ -9,12 +9,14 @@ from __future__ import annotations
 import csv
 import io
 import math
+import re
 from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
 from ..model.metrics import METRICS
 from ..model.params import short_repr
+from ..model.suggest import did_you_mean
 
 #: Metric columns written for the overall block and each phase.
 METRIC_KEYS = METRICS
@@ -25,16 +27,30 @@ def metric_names(n_phases: int) -> list[str]:
     return [*METRIC_KEYS, *(f"phase{i}.{k}" for i in range(n_phases) for k in METRIC_KEYS)]
 
 
+#: ``phase<i>.<metric>``: a phase's column, whose metric part may be right and its phase absent
+_PHASE_METRIC = re.compile(r"phase\d+\.(.+)")
+
+
 def unknown_metric(metric: str, n_phases: int) -> str | None:
-    """Why ``metric`` names no column of a sweep with ``n_phases`` phases (None if it does)."""
+    """Why ``metric`` names no column of a sweep with ``n_phases`` phases (None if it does).
+
+    A misspelt name gets the nearest column (``max_after`` -> ``max_after_approach``); a
+    known metric of a phase the runs do not reach gets none (``phase1.rms_error`` is not a
+    typo of ``phase0.rms_error``): the list of phases that follows says which exist.
+    """
     if metric in metric_names(n_phases):
         return None
+    of_phase = _PHASE_METRIC.fullmatch(metric)
+    if of_phase and of_phase.group(1) in METRIC_KEYS:
+        hint = ""
+    else:
+        hint = did_you_mean(metric, metric_names(n_phases))
     phases = (
         f"; or phase<i>.<metric> for i in 0..{n_phases - 1}"
         if n_phases > 1
         else "; or phase0.<metric>" * n_phases
     )
-    return f"unknown metric {metric!r}; known: {', '.join(METRIC_KEYS)}{phases}"
+    return f"unknown metric {metric!r}{hint}; known: {', '.join(METRIC_KEYS)}{phases}"
 
 
 def read_results(path: Path) -> tuple[list[dict[str, Any]], list[str]]:

@@ -30,28 +30,51 @@ class Camera:
         self.mode = "fit"
         self.target: str | None = None  # rover followed in ``follow`` mode
         self._placed = False
-        #: pixels at the left covered by a panel: fit mode frames the rovers beside it
+        #: pixels covered at the left (the parameter panel), at the right (the help, the
+        #: signal list) and at the top (the HUD and status boxes): fit mode frames the rovers
+        #: in the room they leave, so nothing the window draws over the map hides a rover
         self.left = 0
+        self.right = 0
+        self.top = 0
 
     # -- transforms ------------------------------------------------------------------------
     def to_screen(self, x: float, y: float) -> tuple[float, float]:
         """Pixel coordinates of the world point (x, y)."""
         return (
             self.mid_x + (x - self.cx) * self.scale,
-            self.height / 2 - (y - self.cy) * self.scale,
+            self.mid_y - (y - self.cy) * self.scale,
         )
 
     def to_world(self, px: float, py: float) -> tuple[float, float]:
         """World point under the pixel (px, py)."""
         return (
             self.cx + (px - self.mid_x) / self.scale,
-            self.cy - (py - self.height / 2) / self.scale,
+            self.cy - (py - self.mid_y) / self.scale,
         )
+
+    def room(self) -> tuple[float, float, float, float]:
+        """The pixels (x0, y0, x1, y1) the map is framed in: what the panels and the HUD
+        leave. A cover that would leave less than a quarter of the window is ignored (in a
+        320x240 window the help covers nearly all of it: it is an overlay there)."""
+        x0, x1 = self.left, self.width - self.right
+        if x1 - x0 < self.width // 4:
+            x1 = self.width
+            if x1 - x0 < self.width // 4:
+                x0 = 0
+        y0 = self.top if self.height - self.top >= self.height // 4 else 0
+        return x0, y0, x1, self.height
 
     @property
     def mid_x(self) -> float:
-        """Pixel column the camera centres on: the middle of the room beside the panel."""
-        return self.left + (self.width - self.left) / 2
+        """Pixel column the camera centres on: the middle of the room beside the panels."""
+        x0, _, x1, _ = self.room()
+        return (x0 + x1) / 2
+
+    @property
+    def mid_y(self) -> float:
+        """Pixel row the camera centres on: the middle of the room under the HUD."""
+        _, y0, _, y1 = self.room()
+        return (y0 + y1) / 2
 
     # -- following the action --------------------------------------------------------------
     def update(self, points: Sequence[tuple[float, float, str]], dt_sim: float) -> None:
@@ -67,8 +90,8 @@ class Camera:
         ys = [p[1] for p in points]
         span_x = max(max(xs) - min(xs), MIN_SPAN_M)
         span_y = max(max(ys) - min(ys), MIN_SPAN_M * self.height / self.width)
-        room = max(self.width - self.left, self.width // 3)
-        scale = min(room / span_x, self.height / span_y) / (1 + 2 * MARGIN)
+        x0, y0, x1, y1 = self.room()
+        scale = min((x1 - x0) / span_x, (y1 - y0) / span_y) / (1 + 2 * MARGIN)
         tx, ty = (max(xs) + min(xs)) / 2, (max(ys) + min(ys)) / 2
         if not self._placed:
             self.cx, self.cy, self.scale = tx, ty, scale
@@ -82,7 +105,7 @@ class Camera:
         # never let a rover leave the picture while gliding
         for x, y, _ in points:
             px, py = self.to_screen(x, y)
-            if not (self.left <= px <= self.width and 0 <= py <= self.height):
+            if not (x0 <= px <= x1 and y0 <= py <= y1):
                 self.cx, self.cy, self.scale = tx, ty, scale
                 break
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from collections.abc import Sequence
 
 import numpy as np
@@ -79,6 +80,10 @@ class Renderer:
         self.small = font(max(8, self.text_px - 3))
         #: the text boxes of the last frame drawn (``hud``, ``status``), in pixels
         self.boxes: dict[str, pygame.Rect] = {}
+        #: the lines of those boxes as drawn (wrapped), for tests
+        self.texts: dict[str, list[str]] = {}
+        #: the lines of the last :meth:`panel` as drawn (wrapped)
+        self.last_text: list[str] = []
         #: the rovers' name boxes of the last frame, in the frame's rover order
         self.labels: list[pygame.Rect] = []
         #: the distance labels of the last frame (names are placed clear of them)
@@ -90,8 +95,10 @@ class Renderer:
         frame: Frame,
         camera: Camera,
         status: Sequence[str] = (),
+        notice: str = "",
     ) -> None:
-        """Draw ``frame`` as seen by ``camera``; ``status`` lines go top-right."""
+        """Draw ``frame`` as seen by ``camera``; ``status`` lines go top-right, a ``notice``
+        (what the last key did: a live change, the camera's mode) under the HUD's lines."""
         surface.fill(BACKGROUND)
         self._grid(surface, camera)
         for zone in frame.zones:
@@ -124,7 +131,7 @@ class Renderer:
         for r in frame.rovers:
             self._rover(surface, camera, r, colours[r.name])
         self._labels(surface, camera, frame.rovers)
-        self._hud(surface, frame, camera, status)
+        self._hud(surface, frame, camera, status, notice)
 
     # -- world layer -------------------------------------------------------------------------
     def _grid(self, surface: pygame.Surface, camera: Camera) -> None:
@@ -279,7 +286,12 @@ class Renderer:
 
     # -- HUD ---------------------------------------------------------------------------------
     def _hud(
-        self, surface: pygame.Surface, frame: Frame, camera: Camera, status: Sequence[str]
+        self,
+        surface: pygame.Surface,
+        frame: Frame,
+        camera: Camera,
+        status: Sequence[str],
+        notice: str = "",
     ) -> None:
         m, q = frame.metrics, frame.quality
         lines = [f"t {frame.t:8.2f} s / {frame.duration:g} s", frame.phase_text]
@@ -300,23 +312,38 @@ class Renderer:
         else:
             lines.append(f"collisions {m.collisions}")
             colours.append(INK)
+        if notice:  # in the HUD's room, not the status box's: the status stays narrow
+            lines.append(notice)
+            colours.append(MUTED)
         w = self.size[0]
         gap = self.MARGIN
         full = w - 2 * gap
         status_w = self.text_width(status) if status else 0
-        hud_w = self.text_width(lines)
         beside = full - status_w - gap  # room left of the status box
-        if not status or hud_w <= beside or beside >= 0.55 * full:
+        # the status beside the HUD, or under it: whichever ends higher (the map keeps the
+        # most room); side by side when the HUD fits there whole
+        status_h = self.text_height(status, full) if status else 0
+        side = self.text_height(lines, beside) if beside > 40 else None
+        under = self.text_height(lines, full) + gap // 2 + status_h
+        if not status or (side is not None and max(side, status_h) <= under):
             hud = self.panel(surface, lines, colours, (gap, gap), align_right=False, width=beside)
             top = gap
         else:  # too narrow for both on one row: the status goes under the HUD
             hud = self.panel(surface, lines, colours, (gap, gap), align_right=False, width=full)
             top = hud.bottom + gap // 2
         self.boxes = {"hud": hud}
+        self.texts = {"hud": self.last_text}
         if status:
             self.boxes["status"] = self.panel(
                 surface, list(status), [INK] * len(status), (gap, top), align_right=True
             )
+            self.texts["status"] = self.last_text
+
+    def text_height(self, lines: Sequence[str], width: int) -> int:
+        """Height of a panel holding ``lines`` wrapped to ``width`` (padding included)."""
+        room = max(40, width - 12)
+        count = sum(len(_wrap(t, self.font, room)) for t in lines)
+        return count * self.font.get_height() + 12
 
     def text_width(self, lines: Sequence[str]) -> int:
         """Width of a panel holding ``lines`` unwrapped, padding included."""
@@ -339,11 +366,13 @@ class Renderer:
         """
         pad = 6
         room = max(40, (width if width is not None else self.size[0] - 2 * at[0]) - 2 * pad)
-        rendered = [
-            self.font.render(part, True, c)
+        parts = [
+            (part, c)
             for t, c in zip(lines, colours, strict=True)
             for part in _wrap(t, self.font, room)
         ]
+        self.last_text = [part for part, _ in parts]
+        rendered = [self.font.render(part, True, c) for part, c in parts]
         box_w = max(r.get_width() for r in rendered) + 2 * pad
         box_h = sum(r.get_height() for r in rendered) + 2 * pad
         x = self.size[0] - box_w - at[0] if align_right else at[0]
@@ -357,10 +386,37 @@ class Renderer:
         return pygame.Rect(x, at[1], box_w, box_h)
 
 
+#: Where a HUD line may break first: after an item of a list (``Kv=0.2 live at 9.4 s, ``),
+#: after a label (``from 0 s: ``, ``| ``) or between the HUD's fields (two spaces).
+_BREAKS = re.compile(r"(?<=, )|(?<=: )|(?<=\| )|(?<=  )")
+
+
 def _wrap(text: str, fnt: pygame.font.Font, room: int) -> list[str]:
-    """``text`` split at spaces into lines at most ``room`` pixels wide (words cut if need be)."""
+    """``text`` split into lines at most ``room`` pixels wide: between items first, so that
+    ``Kv=0.2 live at 9.4 s`` never loses its ``s``, then at spaces, then inside a word."""
     if fnt.size(text)[0] <= room:
         return [text]
+    out: list[str] = []
+    line = ""
+    for item in _BREAKS.split(text):
+        if fnt.size(line + item.rstrip())[0] <= room:
+            line += item
+            continue
+        if line:
+            out.append(line.rstrip())
+            line = ""
+        if fnt.size(item.rstrip())[0] <= room:
+            line = item
+        else:  # an item wider than the room on its own: at its spaces
+            parts = _wrap_words(item.rstrip(), fnt, room)
+            out += parts[:-1]
+            line = parts[-1] + " "
+    out.append(line.rstrip())
+    return out
+
+
+def _wrap_words(text: str, fnt: pygame.font.Font, room: int) -> list[str]:
+    """``text`` split at spaces into lines at most ``room`` pixels wide (words cut if need be)."""
     out: list[str] = []
     line = ""
     for word in text.split(" "):
@@ -384,7 +440,7 @@ def _screen(camera: Camera, points: Sequence[tuple[float, float]]) -> list[list[
     arr = np.asarray(points, dtype=float)
     out = np.empty_like(arr)
     out[:, 0] = camera.mid_x + (arr[:, 0] - camera.cx) * camera.scale
-    out[:, 1] = camera.height / 2 - (arr[:, 1] - camera.cy) * camera.scale
+    out[:, 1] = camera.mid_y - (arr[:, 1] - camera.cy) * camera.scale
     np.clip(out, -1e5, 1e5, out=out)  # SDL draws garbage for coordinates near int limits
     return out.tolist()
 

@@ -2,9 +2,10 @@
 
 Same renderer, camera and HUD as the live window, fed by a
 :class:`~amsa_phys.view.replay.ReplayScene`; a slider along the bottom shows where the
-cursor is in the run, with a tick for every phase start and change (grey), collision and
-lost fix (red). Click or drag on it to seek. The cursor always sits on a logged instant,
-so every picture is exactly the trace's row.
+cursor is in the run, with a mark for every event in the palette's language
+(``marks.draw_slider_mark``: grey for the timeline, red for alerts). Click or drag on it to
+seek. The cursor always sits on a logged instant, so every picture is exactly the trace's
+row.
 
 ``frame(real_dt)`` runs one iteration (events, advance, draw) so that tests drive the player
 with injected events and an exact clock under SDL's dummy driver, as they do the window.
@@ -15,11 +16,13 @@ from __future__ import annotations
 import numpy as np
 
 from .camera import Camera
-from .draw import INK, LOST, MUTED, Renderer
+from .draw import INK, MUTED, Renderer
+from .marks import SLIDER_ORDER, draw_slider_mark, slider_kind
 from .mouse import pan_zoom
 from .pg import font, pygame
 from .plotpane import SignalPicker, draw_side_panes, picker_key
 from .replay import Event, ReplayScene
+from .scene import Frame
 
 SPEEDS = (1 / 16, 1 / 8, 1 / 4, 1 / 2, 1, 2, 4, 8, 16, 32, 64)
 MAX_REAL_DT = 0.1
@@ -27,7 +30,6 @@ FPS = 60
 #: seconds a shift+arrow moves the cursor
 BIG_STEP_S = 5.0
 SLIDER_H = 34
-PHASE_TICK = (102, 102, 102)
 
 HELP = [
     "space         play / pause",
@@ -42,7 +44,7 @@ HELP = [
     "              enter picks / drops, g closes)",
     "c             camera: fit, then follow each rover",
     "z x, wheel    zoom in / out",
-    "h or F1       this help",
+    "h or F1       this help (any other key closes it)",
     "q or esc      quit",
 ]
 
@@ -188,6 +190,10 @@ class Player:
         shift = bool(event.mod & pygame.KMOD_SHIFT)
         if self.picker.visible and self._picker_key(key, event.unicode):
             return
+        if self.show_help and key not in (pygame.K_h, pygame.K_F1):
+            self.show_help = False  # any key puts the help away (and does its job) ...
+            if key == pygame.K_ESCAPE:
+                return  # ... but Esc only that: it never quits from the help
         if key in (pygame.K_q, pygame.K_ESCAPE):
             self.running = False
         elif key == pygame.K_SPACE:
@@ -242,7 +248,7 @@ class Player:
 
     # -- drawing ---------------------------------------------------------------------------------
     def status(self) -> list[str]:
-        """Top-right lines: play state, speed, camera, last notice."""
+        """Top-right lines: play state, speed, camera (the last notice goes in the HUD)."""
         state = "playing" if self.playing else "PAUSED"
         if self.row >= self.scene.rows - 1:
             state = "end of the run"
@@ -253,19 +259,31 @@ class Player:
         status = str(self.scene.metrics.get("status") or "")
         if status and status != "completed":
             lines.append(f"run {status}")
-        if self.notice:
-            lines.append(self.notice)
         return lines
 
     def draw(self) -> None:
-        """The current row, the slider, and the open panes."""
+        """The current row, the slider, and the open panes (drawn again when what covers
+        the map moved, so the picture and the camera agree: ``Window.draw``)."""
         frame = self.scene.frame(self.row)
+        cam = self.camera
+        points = [(r.x, r.y, r.name) for r in frame.rovers]
+        cam.update(points, 0.05 if self.playing else 1e9)
+        for _ in range(2):
+            room = (cam.top, cam.right)
+            self._paint(frame)
+            if (cam.top, cam.right) == room:
+                break
+            cam.update(points, 0.05 if self.playing else 1e9)
+        pygame.display.flip()
+
+    def _paint(self, frame: Frame) -> None:
+        """Draw ``frame``, the slider and the panes; set the camera's covers from them."""
         view = self.screen.subsurface(self.view_rect)
         cam = self.camera
-        cam.update([(r.x, r.y, r.name) for r in frame.rovers], 0.05 if self.playing else 1e9)
-        self.renderer.draw(view, frame, cam, self.status())
+        self.renderer.draw(view, frame, cam, self.status(), self.notice)
+        cam.top = max(box.bottom for box in self.renderer.boxes.values()) + 6  # under the HUD
         self._slider()
-        draw_side_panes(
+        right = draw_side_panes(
             self.screen,
             self.renderer,
             self.picker,
@@ -274,7 +292,8 @@ class Player:
             HELP,
             self.view_rect,
         )
-        pygame.display.flip()
+        # beside the help or the signal list
+        cam.right = self.view_rect.right - right.left if right is not None else 0
 
     def scene_series(self, name: str, span_s: float) -> tuple[np.ndarray, np.ndarray]:
         """The pane's samples of ``name`` up to the row shown (the replay's whole history)."""
@@ -295,12 +314,9 @@ class Player:
         done = bar.copy()
         done.width = self.slider_x(self.t) - bar.x
         pygame.draw.rect(screen, (190, 200, 215), done)
-        for e in self.scene.events:
-            x = self.slider_x(e.t)
-            if e.kind in ("phase", "change"):
-                pygame.draw.line(screen, PHASE_TICK, (x, bar.top - 4), (x, bar.bottom + 4), 2)
-            else:
-                pygame.draw.line(screen, LOST, (x, bar.top), (x, bar.bottom), 1)
+        rank = {kind: i for i, kind in enumerate(SLIDER_ORDER)}
+        for e in sorted(self.scene.events, key=lambda e: rank[slider_kind(e.kind)]):
+            draw_slider_mark(screen, e.kind, self.slider_x(e.t), bar)
         x = self.slider_x(self.t)
         pygame.draw.rect(screen, INK, (x - 3, bar.top - 6, 6, bar.height + 12))
         label = font(max(9, self.renderer.text_px - 3)).render(

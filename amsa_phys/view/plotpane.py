@@ -224,8 +224,12 @@ def draw_side_panes(
     show_help: bool,
     help_lines: list[str],
     area: pygame.Rect,
-) -> None:
-    """The plot pane (bottom right), the signal list and the help (right), under the HUD."""
+) -> pygame.Rect | None:
+    """The plot pane (bottom right), the signal list and the help (right), under the HUD.
+
+    Returns the box of the list or help drawn at the right (None if neither is open): the
+    camera frames the rovers beside it, so the key list never hides the leader.
+    """
     top = max(box.bottom for box in renderer.boxes.values()) + 6 if renderer.boxes else 10
     if picker.picked:
         w = max(240, area.width * 2 // 5)
@@ -238,6 +242,9 @@ def draw_side_panes(
         if picker.message:
             lines.append(picker.message)
             colours.append(INK)
-        renderer.panel(screen, lines, colours, (10, top), align_right=True)
-    elif show_help:
-        renderer.panel(screen, help_lines, [INK] * len(help_lines), (10, top), align_right=True)
+        return renderer.panel(screen, lines, colours, (10, top), align_right=True)
+    if show_help:
+        return renderer.panel(
+            screen, help_lines, [INK] * len(help_lines), (10, top), align_right=True
+        )
+    return None

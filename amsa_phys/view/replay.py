@@ -129,8 +129,11 @@ class ReplayScene:
                 out.append(Event(float(p["start"]), "phase", f"phase {i}: {sets}"))
             for c in p.get("changes") or []:
                 sets = ", ".join(f"{k}={v}" for k, v in (c.get("set") or {}).items())
-                out.append(Event(float(c["at"]), "change", f"change: {sets}"))
+                how = "live change" if c.get("label") == "live" else "change"
+                out.append(Event(float(c["at"]), "change", f"{how}: {sets}"))
         for e in self.metrics.get("events") or []:
+            if e.get("kind") == "live change":
+                continue  # the phase's change above: one mark and one stop for it, not two
             out.append(
                 Event(float(e["t"]), str(e.get("kind")), f"{e.get('kind')} {e.get('detail', '')}")
             )

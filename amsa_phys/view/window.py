@@ -28,7 +28,7 @@ from .panel import ParamPanel
 from .pg import pygame
 from .plotpane import LiveSeries, SignalPicker, draw_side_panes, picker_key
 from .recorder import Recorder
-from .scene import Scene
+from .scene import Frame, Scene
 
 SPEEDS = (1 / 16, 1 / 8, 1 / 4, 1 / 2, 1, 2, 4, 8, 16, 32, 64, 128, 256)
 MAX_REAL_DT = 0.1  # seconds of wall clock a single frame may cover
@@ -47,7 +47,7 @@ HELP = [  # every key _key and _panel_key handle
     "  0-9 . - e   type a value; enter applies, esc drops",
     "g             plot signals (list: type to filter,",
     "              enter picks / drops, g closes)",
-    "h or F1       this help",
+    "h or F1       this help (any other key closes it)",
     "q or esc      quit (the outputs are written;",
     "              esc first closes the panel)",
 ]
@@ -197,6 +197,10 @@ class Window:
         if self.picker.visible and picker_key(self.picker, key, event.unicode):
             return
         quit_asked, self._quit_asked = self._quit_asked, False
+        if self.show_help and key not in (pygame.K_h, pygame.K_F1):
+            self.show_help = False  # any key puts the help away (and does its job) ...
+            if key == pygame.K_ESCAPE:
+                return  # ... but Esc only that: it never quits from the help
         if key in (pygame.K_q, pygame.K_ESCAPE):
             self.quit(confirmed=quit_asked)
         elif key == pygame.K_SPACE:
@@ -294,7 +298,8 @@ class Window:
 
     # -- drawing -------------------------------------------------------------------------
     def status(self) -> list[str]:
-        """Top-right lines: run state, speed, camera, recording."""
+        """Top-right lines: run state, speed, camera, recording (the notice goes in the HUD,
+        which has the room: a long one here squeezed the HUD into wrapping at 1280x720)."""
         if self.finished:
             state = "finished (q to close)"
         elif self.paused:
@@ -304,18 +309,34 @@ class Window:
         lines = [f"{state}  x{self.speed:g}", f"camera {self.camera.label()}  h: help"]
         if self.recorder is not None:
             lines.append(f"recording {self.recorder.options.path.name}")
-        if self.notice:
-            lines.append(self.notice)
         return lines
 
     def draw(self) -> None:
-        """Render the current state to the window."""
+        """Render the current state to the window.
+
+        What covers the map (the HUD and status at the top, the parameter panel at the left,
+        the help or signal list at the right) is known once drawn; the camera frames the
+        rovers in the room they leave. When that room changed (a panel opened, the HUD grew)
+        the frame is drawn again with it, so the picture and the camera always agree.
+        """
         frame = self.scene.frame()
         cam = self.camera
-        cam.update([(r.x, r.y, r.name) for r in frame.rovers], 0.0 if self.paused else 0.05)
-        self.renderer.draw(self.screen, frame, cam, self.status())
+        points = [(r.x, r.y, r.name) for r in frame.rovers]
+        cam.update(points, 0.0 if self.paused else 0.05)
+        for _ in range(2):
+            room = (cam.left, cam.top, cam.right)
+            self._paint(frame)
+            if (cam.left, cam.top, cam.right) == room:
+                break
+            cam.update(points, 0.0)  # no glide: only keeps every rover in the new room
+        pygame.display.flip()
+
+    def _paint(self, frame: Frame) -> None:
+        """Draw ``frame`` and the open panels; set the camera's covers from where they went."""
+        self.renderer.draw(self.screen, frame, self.camera, self.status(), self.notice)
         h = self.screen.get_height()
         below = max(box.bottom for box in self.renderer.boxes.values()) + 6
+        self.camera.top = below  # the rovers are framed under the HUD and status
         top = max(h // 3, below)  # under the HUD and status, however they were laid out
         line_px = self.renderer.font.get_linesize()
 
@@ -331,15 +352,17 @@ class Window:
                 colours.append(LOST if self.panel.refused else INK)
             at = (10, fitting(len(lines)))
             box = self.renderer.panel(self.screen, lines, colours, at, align_right=False)
-            # the next frames frame the rovers beside the panel, not under it
-            self.camera.left = box.right
+            self.camera.left = box.right  # the rovers are framed beside the panel
         else:
             self.camera.left = 0
+        right = None
         if self.show_help:
             at = (10, fitting(len(HELP)))
-            self.renderer.panel(self.screen, HELP, [INK] * len(HELP), at, align_right=True)
+            right = self.renderer.panel(self.screen, HELP, [INK] * len(HELP), at, align_right=True)
         area = self.screen.get_rect()
-        draw_side_panes(
+        listed = draw_side_panes(
             self.screen, self.renderer, self.picker, self.series.series, False, [], area
         )
-        pygame.display.flip()
+        right = listed or right
+        # the help and the signal list sit at the right: the rovers are framed beside them
+        self.camera.right = area.right - right.left if right is not None else 0

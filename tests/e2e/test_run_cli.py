@@ -199,6 +199,54 @@ def test_sigint_finalises_outputs_and_exits_130(tmp_path: Path) -> None:
     assert 0 < metrics["simulated"] < 100000
 
 
+def _ignore_sigint() -> None:
+    """What a shell script's ``cmd &`` does to its background job."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@pytest.mark.parametrize("sigint", ["default", "ignored"])
+@pytest.mark.parametrize("stdout", ["terminal", "file"])
+def test_sigterm_stops_on_a_whole_second_however_the_run_was_started(
+    tmp_path: Path, stdout: str, sigint: str
+) -> None:
+    """``kill`` gives the same on a terminal and in ``amsa-phys run ... > log &`` from a
+    script (stdout a file, SIGINT ignored): one line naming the instant and the directory,
+    exit 130, metrics.json ``interrupted`` at a whole second, the trace up to that instant.
+    With SIGINT ignored the SIGTERM used to land wherever the run was: mid-second."""
+    import pty
+    import re
+    import signal
+
+    from longrun import start_long_run
+
+    out = tmp_path / "int"
+    if stdout == "terminal":
+        main_fd, sink = pty.openpty()
+    else:
+        sink = os.open(tmp_path / "stdout.txt", os.O_WRONLY | os.O_CREAT)
+    pre = _ignore_sigint if sigint == "ignored" else None
+    try:
+        proc = start_long_run(out, stdout=sink, stderr=subprocess.PIPE, preexec_fn=pre)
+    finally:
+        os.close(sink)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    if stdout == "terminal":
+        os.close(main_fd)
+    assert proc.returncode == 130
+    match = re.fullmatch(r"error: interrupted at t=(\d+)\.00 s; outputs so far are in (.*)\n", err)
+    assert match, err
+    assert match[2] == str(out)
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["status"] == "interrupted"
+    assert metrics["simulated"] == int(match[1])  # between two simulated seconds, never in one
+    last = (out / "trace.csv").read_text().rstrip("\n").rsplit("\n", 1)[-1]
+    assert float(last.split(",", 1)[0]) == metrics["simulated"]
+    assert sorted(p.name for p in out.iterdir() if p.name.endswith(".tmp")) == []
+
+
 def test_plot_redraws_both_figures(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = run(tmp_path, "a")
     (out / "distance.png").unlink()

@@ -325,18 +325,18 @@ def test_view_in_a_real_x_window_scrubs_to_an_event_and_draws_the_traced_pose(
 def _drawn_at(
     scene: object, row: int, size: tuple[int, int]
 ) -> list[tuple[tuple[int, int], tuple[int, int, int]]]:
-    """Where the paused player draws each rover's centre at ``row``, and in which colour:
-    the camera in fit mode settles at once while paused."""
-    from amsa_phys.view.camera import Camera
-
-    frame = scene.frame(row)  # type: ignore[attr-defined]
-    camera = Camera((size[0], size[1] - SLIDER_H))
-    points = [(r.x, r.y, r.name) for r in frame.rovers]
-    camera.update(points, 1e9)
-    camera.update(points, 1e9)
+    """Where the paused player draws each rover's centre after End then b (at ``row``), and
+    in which colour: the same player, headless, given the same keys (the camera frames the
+    rovers under its HUD, which then holds the jump's notice; in fit mode it settles at once
+    while paused)."""
+    player = Player(scene, title="model", size=size)  # type: ignore[arg-type]
+    player.step(player.scene.rows)
+    player.jump(-1)
+    assert player.row == row
+    player.frame(0.0)
     out = []
-    for r in frame.rovers:
-        x, y = camera.to_screen(r.x, r.y)
+    for r in player.scene.frame(row).rovers:
+        x, y = player.camera.to_screen(r.x, r.y)
         out.append(((round(x), round(y)), rover_colour(r.index)))
     return out
 
@@ -493,3 +493,70 @@ def test_hud_shows_the_value_in_force_after_a_change_inside_a_phase(tmp_path: Pa
     assert early.endswith(": Kv=0.35")
     assert "Kv=0.15 at 20.0 s" in late
     assert "Kv=0.35" not in late
+
+
+def test_the_slider_marks_speak_the_palettes_language(tmp_path: Path) -> None:
+    """A live change was a grey line with a red core on the slider (two events: the phase's
+    change and the run's ``live change`` event, the second drawn as an alert). Now each
+    change is one event and one grey mark, phase starts grey lines, and red is only for
+    alerts (here lost fixes): no red where the timeline changed."""
+    from amsa_phys.palette import ALERT, PHASE
+    from amsa_phys.view.window import Window
+
+    world = ROOT / "worlds" / "mde_challenge.yaml"
+    path = tmp_path / "s.yaml"
+    path.write_text(
+        f"world: {world}\nduration: 12\nseed: 1\n"
+        "quality: {signal: MyDistanceMonitor.distanceFollowerToLeader, reference: 15}\n"
+        "set: {LeaderGPS.lostDataGPS: 30}\n"
+        "timeline:\n  - {at: 6, set: {MyFollowerController.Kv: 0.15}}\n"
+        "  - {at: 9, set: {MyFollowerController.Kv: 0.1}, new_phase: false}\n"
+    )
+
+    def live_change_at_two_seconds(sim, scenario, rec):  # type: ignore[no-untyped-def]
+        w = Window(sim, scenario.quality, size=(320, 240))
+        while sim.now < 2:
+            w.frame(0.1)
+        press(pygame.K_p)
+        w.frame(0.0)
+        while w.panel.row.key != "MyFollowerController.Kv":
+            press(pygame.K_DOWN)
+            w.frame(0.0)
+        for ch in "0.2":
+            press(pygame.K_PERIOD if ch == "." else ord(ch), text=ch)
+        press(pygame.K_RETURN)
+        w.frame(0.0)
+        while not w.finished:
+            w.frame(0.5)
+
+    out = tmp_path / "session"
+    out.mkdir()
+    run_scenario(load_scenario(path), out, window=live_change_at_two_seconds, plot=False)
+    scene = load_run(out)
+    timeline = [e for e in scene.events if e.kind not in ("lost fix",)]
+    assert [(e.kind, e.text.split(":")[0]) for e in timeline] == [
+        ("change", "live change"),
+        ("phase", "phase 1"),
+        ("change", "change"),
+    ]
+    assert any(e.kind == "lost fix" for e in scene.events)
+    p = Player(scene, title="test", size=(800, 480))
+    p.seek(float(scene.t[-1]))  # the cursor out of the way, at the end
+    p.frame(0.0)
+    bar = p.slider
+
+    def colours(x: int, rows: range) -> set[tuple[int, int, int]]:
+        return {tuple(p.screen.get_at((c, y)))[:3] for c in (x - 1, x, x + 1) for y in rows}
+
+    upper = range(bar.top - 4, bar.centery - 1)  # where no lost fix or collision reaches
+    for e in timeline:
+        seen = colours(p.slider_x(e.t), upper)
+        assert PHASE in seen, e
+        assert ALERT not in seen, e  # the timeline is never drawn as an alert
+    # a phase start crosses the bar; a change inside a phase stops at its middle
+    lower = range(bar.centery + 2, bar.bottom + 3)
+    phase_x = p.slider_x(timeline[1].t)
+    assert PHASE in colours(phase_x, lower)
+    assert PHASE not in colours(p.slider_x(timeline[2].t), lower)
+    lost = next(e for e in scene.events if e.kind == "lost fix")
+    assert ALERT in colours(p.slider_x(lost.t), range(bar.top, bar.bottom))

@@ -145,3 +145,88 @@ def test_the_snapshot_and_video_hud_count_phases_like_the_window(
         "phase 0 (of 0–1) from 0 s: behavior=1, lostDataGPS=0, motorCoef=100, Kv=0.35"
         " (run stops at 100 s of 500)"
     ]
+
+
+def live_change_at(size: tuple[int, int]) -> Window:
+    """scenario1 for 9.4 s at x1, then Kv = 0.2 applied in the panel (``live at 9.4 s``),
+    the panel closed again."""
+    scenario = load_scenario(ROOT / "scenarios" / "scenario1.yaml")
+    sim = Simulation.from_scenario(scenario)
+    sim.initialize()
+    w = Window(sim, scenario.quality, size=size)
+    for _ in range(94):
+        w.frame(0.1)
+    open_panel_on(w, "MyFollowerController.Kv")
+    for ch in "0.2":
+        press(pygame.K_PERIOD if ch == "." else ord(ch), ch)
+    press(pygame.K_RETURN)
+    w.frame(0.1)
+    press(pygame.K_p)
+    for _ in range(5):
+        w.frame(0.1)
+    return w
+
+
+def covered(w: Window) -> list[tuple[str, str]]:
+    """(rover, box) for every rover whose centre is under a box drawn over the map."""
+    boxes = dict(w.renderer.boxes)
+    out = []
+    for r in w.scene.rovers():
+        at = w.camera.to_screen(r.x, r.y)
+        out += [(r.name, name) for name, box in boxes.items() if box.collidepoint(at)]
+    return out
+
+
+@pytest.mark.parametrize("size", [(1280, 720), (320, 240)], ids=["1280x720", "smallest"])
+def test_the_hud_keeps_a_live_change_on_one_line(size: tuple[int, int]) -> None:
+    """``Kv=0.2 live at 9.4 s`` lost its ``s`` to a second line at 1280x720 (the status box
+    held the long notice and squeezed the HUD). At 1280x720 the whole phase line fits on
+    one line; in the smallest window (320x240, what a resize allows) it wraps between items,
+    never inside one; the boxes stay inside the window, apart, and off the rovers."""
+    w = live_change_at(size)
+    phase = w.scene.frame().phase_text
+    assert phase.endswith("Kv=0.2 live at 9.4 s")
+    hud = w.renderer.texts["hud"]
+    if size == (1280, 720):
+        assert phase in hud
+    else:
+        assert any(line.endswith("Kv=0.2 live at 9.4 s") for line in hud), hud
+    assert any("live: MyFollowerController.Kv = 0.2" in line for line in hud)  # the notice
+    screen = w.screen.get_rect()
+    assert all(screen.contains(box) for box in w.renderer.boxes.values())
+    assert not w.renderer.boxes["hud"].colliderect(w.renderer.boxes["status"])
+    assert covered(w) == []
+
+
+@pytest.mark.parametrize("size", [(1280, 720), (800, 450)], ids=str)
+def test_the_help_does_not_hide_the_rovers_and_any_key_puts_it_away(
+    size: tuple[int, int],
+) -> None:
+    """The key list covered the leader: the camera now frames the rovers beside it (and
+    under the HUD). Esc closes it without quitting; any other key closes it and acts."""
+    scenario = load_scenario(ROOT / "scenarios" / "scenario1.yaml", duration=30)
+    sim = Simulation.from_scenario(scenario)
+    sim.initialize()
+    w = Window(sim, scenario.quality, size=size)
+    for _ in range(60):
+        w.frame(0.1)
+    press(pygame.K_h)
+    w.frame(0.1)  # the frame the help opens in already frames the rovers beside it
+    assert w.show_help
+    helpbox = pygame.Rect(size[0] - w.camera.right, 0, w.camera.right, size[1])
+    assert w.camera.right > size[0] // 4
+    for r in w.scene.rovers():
+        x, y = w.camera.to_screen(r.x, r.y)
+        assert 0 < x < helpbox.left, r.name
+        assert 0 < y < size[1], r.name
+    assert covered(w) == []
+    press(pygame.K_ESCAPE)
+    w.frame(0.1)
+    assert not w.show_help
+    assert w.running  # Esc put the help away, it did not quit
+    assert w.camera.right == 0
+    press(pygame.K_h)
+    press(pygame.K_SPACE)  # any other key: the help goes and the key does its job
+    w.frame(0.1)
+    assert not w.show_help
+    assert w.paused

@@ -1,9 +1,11 @@
-"""Every size estimate survives any duration the schema accepts (issue 33, 12).
+"""Absurd durations: refused in one line, and no size estimate overflows (issue 33, 12).
 
-The schema takes any positive finite duration, up to ~1.8e308 s. ``--duration 1e308`` made
-the trace-size note overflow (``OverflowError: cannot convert float infinity to integer``,
-a traceback and exit 1) before the run began. A duration that large is legal — the run
-simply goes on until it is stopped or faults — so the estimate, not the duration, was wrong.
+``--duration 1e308`` made the trace-size note overflow (``OverflowError: cannot convert float
+infinity to integer``, a traceback and exit 1) before the run began; once that was fixed the
+run went on "forever" (until stopped or faulting). Hostile input must be bounded in time: a
+run is at most ``schema.MAX_DURATION_S`` (10^6 s) long, in a file and on every command line,
+refused before anything is built. The estimates still take any float (the API's memory check
+and the note share them), so they are tested up to the float range.
 """
 
 from __future__ import annotations
@@ -22,9 +24,9 @@ from amsa_phys.model.tracecols import estimate_trace_bytes, size_text
 ROOT = Path(__file__).resolve().parent.parent.parent
 SHORT = ROOT / "tests" / "fixtures" / "mde_short.yaml"
 ENV = {**os.environ, "PYTHONPATH": str(ROOT / "tests")}
-NOTE = (
-    "amsa-phys: note: trace.csv will be over 1e+299 GB (1 columns at 20 Hz for 1e+308 s); "
-    "--trace-columns or --log-rate make it smaller\n"
+LIMIT = (
+    "must be at most 1,000,000 s of simulated time (11.6 days, the limit on a run's length), "
+    "got 1e+308"
 )
 
 
@@ -43,11 +45,11 @@ def test_estimate_is_the_rows_times_the_row() -> None:
     assert size_text(2.5e17) == "about 2.5e+08 GB"
 
 
-def test_the_note_is_one_line_at_1e308(capsys: pytest.CaptureFixture[str]) -> None:
-    warn_if_trace_is_large(load_scenario(SHORT, duration=1e308))
+def test_the_note_is_one_line_at_the_longest_run(capsys: pytest.CaptureFixture[str]) -> None:
+    warn_if_trace_is_large(load_scenario(SHORT, duration=1e6, log_rate=10_000))
     assert capsys.readouterr().err == (
-        "amsa-phys: note: trace.csv will be over 1e+299 GB (25 columns at 20 Hz for 1e+308 s); "
-        "--trace-columns or --log-rate make it smaller\n"
+        "amsa-phys: note: trace.csv will be about 4680.0 GB (25 columns at 10000 Hz for "
+        "1e+06 s); --trace-columns or --log-rate make it smaller\n"
     )
 
 
@@ -60,39 +62,55 @@ def _toy(tmp_path: Path, duration: str) -> Path:
     return path
 
 
+def _cli(argv: list[str]) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "amsa_phys", *argv],
+        capture_output=True,
+        text=True,
+        env=ENV,
+        check=False,
+    )
+
+
 @pytest.mark.parametrize(
-    ("file_duration", "option"),
-    [("5", ["--duration", "1e308"]), ("1.0e+308", [])],
-    ids=["option", "file"],
+    ("file_duration", "option", "message"),
+    [
+        ("5", ["--duration", "1e308"], f"--duration: {LIMIT}"),
+        ("1.0e+308", [], f"{{path}}:4: duration: {LIMIT}"),
+        ("1000000", ["--duration", "1000000.5"], f"--duration: {LIMIT[:-6]}1e+06"),
+    ],
+    ids=["option", "file", "just-over"],
 )
-def test_cli_run_of_1e308_seconds_has_no_traceback(
-    tmp_path: Path, file_duration: str, option: list[str]
+def test_cli_run_longer_than_the_limit_is_refused_in_one_line(
+    tmp_path: Path, file_duration: str, option: list[str], message: str
 ) -> None:
+    """exit 2, one line naming the option (or the file's line and key), nothing written."""
     scen = _toy(tmp_path, file_duration)
-    argv = ["run", str(scen), "--headless", "-q", "--out", str(tmp_path / "o"), *option]
-    proc = subprocess.run(
-        [sys.executable, "-m", "amsa_phys", *argv],
-        capture_output=True,
-        text=True,
-        env=ENV,
-        check=False,
-    )
-    assert proc.stderr == NOTE + "error: run fault at t=1.000 s in B (Bad): output u is nan\n"
+    out = tmp_path / "o"
+    proc = _cli(["run", str(scen), "--headless", "-q", "--out", str(out), *option])
+    assert proc.stderr == "error: " + message.format(path=scen) + "\n"
+    assert proc.returncode == 2
+    assert not out.exists()
+
+
+def test_the_longest_run_is_accepted(tmp_path: Path) -> None:
+    """The limit itself runs (here until the toy faults at t = 1 s): exit 3, not 2."""
+    scen = _toy(tmp_path, "5")
+    argv = ["run", str(scen), "--headless", "-q", "--out", str(tmp_path / "o")]
+    proc = _cli([*argv, "--duration", "1000000"])
+    assert proc.stderr == "error: run fault at t=1.000 s in B (Bad): output u is nan\n"
     assert proc.returncode == 3
-    assert (tmp_path / "o" / "metrics.json").is_file()
 
 
-@pytest.mark.parametrize("executor", ["local", "batch"])
-def test_sweep_of_1e308_seconds_has_no_traceback(tmp_path: Path, executor: str) -> None:
-    argv = ["sweep", str(_toy(tmp_path, "5")), "--grid", "B.boom=false", "--duration", "1e308"]
-    argv += ["--out", str(tmp_path / "sw"), "-j", "1", "--executor", executor]
-    proc = subprocess.run(
-        [sys.executable, "-m", "amsa_phys", *argv],
-        capture_output=True,
-        text=True,
-        env=ENV,
-        check=False,
+@pytest.mark.parametrize("command", ["sweep", "falsify"])
+def test_sweep_and_falsify_refuse_it_before_any_run(tmp_path: Path, command: str) -> None:
+    axis = (
+        ["--grid", "B.boom=false"]
+        if command == "sweep"
+        else ["--range", "B.boom=0:1", "--budget", "2"]
     )
-    assert "Traceback" not in proc.stderr
-    assert "run 0: run fault at t=1.000 s in B (Bad): output u is nan" in proc.stderr
-    assert (tmp_path / "sw" / "results.csv").is_file()
+    argv = [command, str(_toy(tmp_path, "5")), *axis, "--duration", "1e308"]
+    proc = _cli([*argv, "--out", str(tmp_path / "sw")])
+    assert proc.stderr == f"error: --duration: {LIMIT}\n"
+    assert proc.returncode == 2
+    assert not (tmp_path / "sw").exists()

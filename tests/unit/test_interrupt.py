@@ -41,6 +41,22 @@ def test_a_handler_somebody_else_installed_is_left_alone() -> None:
         signal.signal(signal.SIGINT, previous)
 
 
+def test_sigterm_is_deferred_even_when_sigint_is_ignored() -> None:
+    """``amsa-phys run ... &`` from a script starts with SIGINT ignored: the CLI's SIGTERM
+    still only requests a stop while a run defers (it used to raise wherever the run was)."""
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        with interrupt.sigterm_as_ctrl_c(), interrupt.deferred():
+            assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN  # still left alone
+            os.kill(os.getpid(), signal.SIGTERM)
+            assert interrupt.requested()
+            with pytest.raises(KeyboardInterrupt):  # a second one: at once
+                os.kill(os.getpid(), signal.SIGTERM)
+        assert not interrupt.requested()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def test_outside_the_main_thread_nothing_is_installed() -> None:
     seen: list[Any] = []
 

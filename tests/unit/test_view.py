@@ -173,3 +173,24 @@ def test_drawing_helpers() -> None:
     assert error_colour(0.5, 1.0) == error_colour(-1.0, 1.0)  # inside the band: same green
     assert error_colour(5.0, 1.0) == error_colour(2.5, 1.0) == (214, 39, 40)  # never orange
     assert error_colour(1.1, 1.0) == error_colour(2.0, 1.0) == (250, 200, 40)  # amber, not olive
+
+
+def test_hud_lines_wrap_between_items_never_inside_one() -> None:
+    """At any width a HUD line breaks after an item (``, ``), a label (``: ``) or between
+    fields, so ``Kv=0.2 live at 9.4 s`` is never cut from its ``s`` while it fits at all
+    (word wrapping cut it at 1280x720)."""
+    from amsa_phys.view.draw import _wrap
+    from amsa_phys.view.pg import font
+
+    fnt = font(15)
+    text = (
+        "phase 0 (of 0–3) from 0 s: behavior=1, lostDataGPS=0, motorCoef=100, Kv=0.2 live at 9.4 s"
+    )
+    item = "Kv=0.2 live at 9.4 s"
+    widest = fnt.size(text)[0]
+    for room in range(fnt.size(item)[0], widest + 2):
+        lines = _wrap(text, fnt, room)
+        assert any(line.endswith(item) for line in lines), (room, lines)
+        assert all(fnt.size(line)[0] <= room for line in lines), (room, lines)
+        assert " ".join(lines) == text  # nothing lost or doubled at the breaks
+    assert _wrap(text, fnt, widest) == [text]
