@@ -18,6 +18,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from .. import names
+
 
 def array_msg() -> Any:
     """``std_msgs/Float64MultiArray``: the message of an array port's topic."""
@@ -50,6 +52,17 @@ def unpack(msg: Any, size: int, topic: str) -> tuple[float, ...]:
             "(std_msgs/Float64MultiArray of fixed length)"
         )
     return data
+
+
+def read(graph: Any, data: str, msg: Any) -> tuple[Any, str]:
+    """A Data topic's message as its value (an array port's: a tuple, checked), and ``""``;
+    or ``(None, why)`` for an array of the wrong length (``graph``: a ``RosGraph``)."""
+    if not graph.is_array(data):
+        return msg.data, ""
+    try:
+        return unpack(msg, graph.size(data), names.topic(data)), ""
+    except ValueError as exc:
+        return None, str(exc)
 
 
 def elements(arrays: Mapping[str, list[str]], data: str, value: Any) -> list[tuple[str, Any]]:

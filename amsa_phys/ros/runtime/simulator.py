@@ -35,7 +35,7 @@ from ...runs.single import run_scenario
 from .. import names
 from ..graph import RosGraph
 from . import adaptlink, readiness, records, rosio
-from .arrays import array_msg, elements, pack, unpack
+from .arrays import array_msg, elements, pack, read
 from .boundary import VALUES, format_values, readable
 from .config import NodeConfig, load_config
 from .rossim import RosSimulation
@@ -132,22 +132,17 @@ class Link:
 
     # -- callbacks (rospy's threads) ---------------------------------------------------------
     def _on_data(self, msg: Any, buffer: str) -> None:
-        value = msg.data
-        if self.graph.is_array(buffer):
-            try:
-                value = unpack(msg, self.graph.size(buffer), names.topic(buffer))
-            except ValueError as exc:
-                if not self.lockstep:  # free: the message is dropped, the last value stays
-                    self.rospy.logerr(f"{names.SIMULATOR}: {exc}")
-                    return
-                with self.cond:
-                    self.bad.setdefault(buffer, str(exc))
-                    self.received[buffer][0] += 1
-                    self.cond.notify_all()
-                return
+        value, bad = read(self.graph, buffer, msg)
+        if bad and not self.lockstep:  # free: the message is dropped, the last value stays
+            self.rospy.logerr(f"{names.SIMULATOR}: {bad}")
+            return
         with self.cond:
             r = self.received[buffer]
             r[0] += 1
+            if bad:  # the step that published it fails, naming the topic
+                self.bad.setdefault(buffer, bad)
+                self.cond.notify_all()
+                return
             r[1] = value
             if not self.lockstep:
                 self.fresh[buffer] = value  # free mode: the latest value is the value
