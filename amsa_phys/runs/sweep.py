@@ -58,10 +58,15 @@ MAX_RUNS = 1_000_000
 
 @dataclass(frozen=True)
 class Axis:
-    """One dimension of the grid: a parameter (or ``context``) and its values."""
+    """One dimension of the grid: a parameter (or ``context``) and its values.
+
+    ``option`` is the command-line option that gave it (``--grid``, ``--range``), which its
+    errors name: a bad ``--range`` value is reported as the ``--range`` the user typed.
+    """
 
     key: str
     values: tuple[Any, ...]
+    option: str = field(default="--grid", compare=False)
 
 
 @dataclass(frozen=True)
@@ -200,7 +205,7 @@ def parse_range(text: str) -> Axis:
     if n > MAX_RUNS:
         raise ConfigError(f"{n:,} values: at most {MAX_RUNS:,}", key=f"--range {key.strip()}")
     values = np.linspace(start, stop, n) if n > 1 else np.array([start])
-    return Axis(key.strip(), tuple(float(round(v, 12)) for v in values))
+    return Axis(key.strip(), tuple(float(round(v, 12)) for v in values), option="--range")
 
 
 def check_size(axes: list[Axis], seeds: int) -> None:
@@ -220,16 +225,16 @@ def check_axes(axes: list[Axis], scenario: Scenario) -> None:
     seen = set()
     for axis in axes:
         if axis.key in seen:
-            raise ConfigError(f"{axis.key} appears twice", key="--grid")
+            raise ConfigError(f"{axis.key} appears twice", key=axis.option)
         seen.add(axis.key)
         for value in axis.values:
             if axis.key.startswith(PHYSICS_PREFIX):
-                physics_setting(axis.key, value, option=f"--grid {axis.key}")
+                physics_setting(axis.key, value, option=f"{axis.option} {axis.key}")
                 continue
             try:
                 resolve_change(axis.key, value, scenario.world)
             except ValueError as exc:
-                raise ConfigError(str(exc), key=f"--grid {axis.key}") from None
+                raise ConfigError(str(exc), key=f"{axis.option} {axis.key}") from None
 
 
 def apply_setting(scenario: Scenario, key: str, value: Any) -> Scenario:
