@@ -65,6 +65,9 @@ def controller_side(graph: RosGraph, inbound: list[Source]) -> list[str]:
     """
     sensors = {s.leaf for s in inbound}
     available = {b for s in inbound for b in _buffers(s)}
+    # an array port read in whole (a LaserScan's ranges) is its topic's Data
+    arrays = graph.world.arrays
+    available.update(a for a, elements in arrays.items() if set(elements) <= available)
     side: list[str] = []
     changed = True
     while changed:
@@ -82,7 +85,9 @@ def controller_side(graph: RosGraph, inbound: list[Source]) -> list[str]:
 def plan(graph: RosGraph) -> Plan:
     """The boundary of ``graph``'s world."""
     sources = find_sources(graph.world)
-    inbound = [s for s in sources if s.role.name in SENSOR_ROLES and s.leaf in graph.remote]
+    # a sensor stream is read in whether its Leaf is a node or steps in the simulator (a
+    # Lidar casts its rays there): with sim:=false the robot's driver takes its place
+    inbound = [s for s in sources if s.role.name in SENSOR_ROLES]
     controller = controller_side(graph, inbound)
     sim_only = [p for p in graph.remote if p not in controller]
     return Plan(sources, inbound, controller, sim_only)

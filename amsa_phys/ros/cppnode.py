@@ -59,6 +59,16 @@ def cpp_double(value: float) -> str:
     return text if any(c in text for c in ".en") else text + ".0"
 
 
+def _first(initial: float | tuple[float, ...]) -> float:
+    """A Data's initial value; an array port's elements all start at its port's initial."""
+    return initial[0] if isinstance(initial, tuple) else initial
+
+
+def _size(graph: RosGraph, data: str) -> str:
+    """`` N`` for an array port's topic (its length), nothing for a number."""
+    return f" {graph.size(data)}" if graph.is_array(data) else ""
+
+
 def hz(freq: Fraction) -> str:
     """A frequency as people read it (``4``, ``0.5``)."""
     return f"{float(freq):g}"
@@ -138,9 +148,10 @@ def wiring(graph: RosGraph, path: str, cpp: list[str]) -> str:
     outputs = graph.outputs(path)
     freq = Fraction(leaf.freq)
     lines = [f"path {path}", f"freq {freq.numerator} {freq.denominator}"]
-    for b in buffers:
-        delayed = int(world.leaves[world.buffers[b].producer].timing.delayed)
-        lines.append(f"topic {names.topic(b)} {float(world.buffers[b].initial).hex()} {delayed}")
+    for b in buffers:  # an array port's topic: its length last (a Float64MultiArray)
+        delayed = int(world.leaves[graph.producer(b)].timing.delayed)
+        initial = float(_first(graph.initial(b))).hex()
+        lines.append(f"topic {names.topic(b)} {initial} {delayed}{_size(graph, b)}")
     for port in [p.name for p in leaf.template.inputs]:  # the body's order, not the YAML's
         buffer = leaf.inputs[port]
         index = buffers.index(buffer) if buffer in buffers else -(1 + outputs.index(buffer))
@@ -150,10 +161,10 @@ def wiring(graph: RosGraph, path: str, cpp: list[str]) -> str:
     alone = replace(graph, shared=frozenset())
     together = replace(graph, shared=frozenset(cpp))
     for b in outputs:
-        initial = float(world.buffers[b].initial).hex()
+        initial = float(_first(graph.initial(b))).hex()
         lines.append(
             f"output {b.rpartition('.')[2]} {names.topic(b)} {initial} "
-            f"{alone.subscribers(b)} {together.subscribers(b)}"
+            f"{alone.subscribers(b)} {together.subscribers(b)}{_size(graph, b)}"
         )
     return "\n".join(lines) + "\n"
 

@@ -3,9 +3,11 @@
 The package is named after the root component (the world's ``name``) and holds, as in the
 paper's code generator: one node per Leaf (a Python script running the project's own
 template class; a C++ (roscpp) twin for templates with a C++ body, e.g. NormalizePower), a
-``std_msgs/Float64`` topic per Data, a ROS parameter per Parameter, a scenario node, a launch
-file per scenario, ``package.xml``, ``CMakeLists.txt`` and a README. The physical Leaves
-(those that share the pymunk world) step inside the simulator node, which also publishes
+``std_msgs/Float64`` topic per Data (an array port, a lidar's ranges: one
+``std_msgs/Float64MultiArray`` topic of the port's fixed length), a ROS parameter per
+Parameter, a scenario node, a launch file per scenario, ``package.xml``, ``CMakeLists.txt``
+and a README. The physical Leaves (those that share the pymunk world) step inside the
+simulator node, which also publishes
 ``/clock`` and writes the run directory. Files are written into a directory the caller
 stages and renames (``runs.rundir.staged_dir``): nothing is half-written.
 
@@ -106,18 +108,14 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
             file=sources[0],
         )
     names.check_world(world)
-    for port, elements in world.arrays.items():  # one buffer per element, named port[i]
-        raise ConfigError(
-            f"{port} is an array port ({len(elements)} values): export ros publishes one "
-            "std_msgs/Float64 topic per Data and cannot carry arrays (a lidar's ranges); "
-            "export a world without array ports",
-            file=sources[0],
-        )
+    arrays = {e for elements in world.arrays.values() for e in elements}
     for buffer in world.buffers.values():
+        if buffer.name in arrays:  # an array port's element: the port's topic carries it
+            continue
         if not isinstance(buffer.initial, float | int) or isinstance(buffer.initial, bool):
             raise ConfigError(
-                f"Data {buffer.name} is not a number (array ports cannot be exported: "
-                "one std_msgs/Float64 topic per Data)",
+                f"Data {buffer.name} is not a number (a topic carries a std_msgs/Float64, or an "
+                "array port's std_msgs/Float64MultiArray)",
                 file=sources[0],
             )
     local = classify(world, scenarios[0].seed)
@@ -244,18 +242,22 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
 def _leaf_doc(graph: RosGraph, path: str) -> str:
     leaf = graph.leaf(path)
     lines = [f"Runs {leaf.template_ref} ({leaf.template.describe()})"]
-    lines.append("Subscribes (std_msgs/Float64):")
+    lines.append("Subscribes (std_msgs/Float64; [N]: Float64MultiArray of N values):")
     for port, buffer in leaf.inputs.items():
-        lines.append(f"  {port} <- {names.topic(buffer)}")
-    lines.append("Publishes (std_msgs/Float64):")
+        lines.append(f"  {port} <- {names.topic(buffer)}{_size(graph, buffer)}")
+    lines.append("Publishes:")
     for b in graph.outputs(path):
-        lines.append(f"  {names.topic(b)}")
+        lines.append(f"  {names.topic(b)}{_size(graph, b)}")
     if leaf.template.params:
         lines.append("Parameters (checked against the template's range on every change):")
         for p in leaf.template.params:
             rng = f" {p.range_text()}" if p.range_text() else ""
             lines.append(f"  {names.param(path, p.name)}: {p.type}{rng}")
     return "\n".join(lines)
+
+
+def _size(graph: RosGraph, data: str) -> str:
+    return f" [{graph.size(data)}]" if graph.is_array(data) else ""
 
 
 def _simulator_doc(graph: RosGraph) -> str:

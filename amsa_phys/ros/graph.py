@@ -78,6 +78,9 @@ class RosGraph:
     bag: bool = False
     #: the Leaves hosted together in one process (the C++ container, ``/amsa/container``)
     shared: frozenset[str] = frozenset()
+    #: the signals the adapt node reads when it runs the rules beside the simulator
+    #: (``rules:=node``): it is one more subscriber of each
+    adapt_signals: frozenset[str] = frozenset()
 
     @classmethod
     def of(
@@ -86,6 +89,7 @@ class RosGraph:
         local: Iterable[str],
         bag: bool = False,
         shared: Iterable[str] = (),
+        adapt_signals: Iterable[str] = (),
     ) -> RosGraph:
         """The graph with ``local`` Leaves in the simulator and ``shared`` ones in the C++
         container (checked against the world)."""
@@ -95,7 +99,7 @@ class RosGraph:
             unknown = sorted(leaves - set(world.leaves))
             if unknown:
                 raise ConfigError(f"unknown Leaf {unknown[0]!r} in {what}")
-        return cls(world, local, bag, shared)
+        return cls(world, local, bag, shared, frozenset(adapt_signals))
 
     @property
     def remote(self) -> list[str]:
@@ -134,8 +138,42 @@ class RosGraph:
         n += 1 if any(p in self.shared for p in readers) else 0
         if producer not in self.local:
             n += 1  # the simulator: the trace, and the Leaves it steps
+        n += 1 if buffer in self.adapt_signals else 0  # the adapt node (rules:=node)
         return n + (1 if self.bag else 0)
 
     def data_topics(self) -> list[str]:
-        """Every Data topic, in trace-column order."""
-        return [names.topic(b) for b in self.world.buffers]
+        """Every Data topic, in trace-column order (an array port's once, at its first element)."""
+        return [names.topic(b) for b in self.data()]
+
+    # -- array ports (a lidar's ranges): one topic per port, std_msgs/Float64MultiArray -------
+    def data(self) -> list[str]:
+        """Every Data as the package has topics: scalar buffers, and each array port by its
+        name (``Scanner.ranges``, not its elements), in trace-column order."""
+        element = {e: name for name, elements in self.world.arrays.items() for e in elements}
+        out: list[str] = []
+        for b in self.world.buffers:
+            name = element.get(b, b)
+            if name == b or b == self.world.arrays[name][0]:
+                out.append(name)
+        return out
+
+    def is_array(self, data: str) -> bool:
+        """Whether ``data`` (a buffer or port name, as :meth:`outputs` gives) is an array port."""
+        return data in self.world.arrays
+
+    def size(self, data: str) -> int:
+        """How many numbers a Data's topic carries (1: a scalar, std_msgs/Float64)."""
+        return len(self.world.arrays[data]) if data in self.world.arrays else 1
+
+    def initial(self, data: str) -> float | tuple[float, ...]:
+        """The value a Data holds before its producer first publishes (an array: a tuple)."""
+        buffers = self.world.buffers
+        if data in self.world.arrays:
+            return tuple(float(buffers[e].initial) for e in self.world.arrays[data])
+        return float(buffers[data].initial)
+
+    def producer(self, data: str) -> str:
+        """The Leaf that publishes ``data``."""
+        if data in self.world.arrays:
+            return data.rpartition(".")[0]
+        return self.world.buffers[data].producer

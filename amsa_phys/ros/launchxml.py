@@ -141,8 +141,14 @@ def launch_xml(
     if adapt:
         lines.append(
             fill(
-                "  <!-- adapt: rules (sim:=false; with the simulator they fire inside it) -->\n"
-                '  <node unless="$(arg sim)" pkg="@@{pkg:xml_attr}" type="amsa_adapt.py"'
+                '  <arg name="rules" default="sim" doc="lockstep: sim fires the adapt: rules'
+                " inside the simulator; node asks the amsa_adapt node (the one sim:=false"
+                ' runs), for comparison"/>\n'
+                '  <param name="/amsa/rules" value="$(arg rules)"/>\n'
+                "  <!-- adapt: rules (sim:=false, or rules:=node in lockstep; else they fire"
+                " inside the simulator) -->\n"
+                "  <node if=\"$(eval not arg('sim') or (arg('rules') == 'node' and"
+                ' arg(\'mode\') == \'lockstep\'))" pkg="@@{pkg:xml_attr}" type="amsa_adapt.py"'
                 ' name="amsa_adapt" required="true" output="screen"/>',
                 pkg=pkg,
             )

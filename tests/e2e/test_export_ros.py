@@ -196,20 +196,19 @@ def test_bad_output_directory_or_world_is_one_line_and_changes_nothing(
     assert "runs another world" in err
 
 
-def test_a_world_with_an_array_port_is_refused_in_one_line(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    """The obstacle course's lidar publishes 31 ranges as one array port: a Float64 topic
-    per Data cannot carry it, and a topic named ``/Scanner/ranges[0]`` is not a legal ROS
-    name, so the export stops before writing anything."""
+def test_an_array_port_is_one_multiarray_topic_with_a_legal_name(tmp_path: Path) -> None:
+    """The obstacle course's lidar publishes 31 ranges as one array port: one
+    ``std_msgs/Float64MultiArray`` topic ``/Scanner/ranges`` (no ``/Scanner/ranges[0]``, which
+    is not a legal ROS name), read by the avoider's node and recorded by ``bag:=``."""
     out = tmp_path / "oc"
     course = ROOT / "scenarios" / "obstacle_course.yaml"
-    code, _, err = cli(capsys, "export", "ros", str(course), "-o", str(out))
-    assert code == 2
-    assert err.count("\n") == 1
-    assert "Scanner.ranges is an array port (31 values)" in err
-    assert not out.exists()
-    assert list(tmp_path.iterdir()) == []
+    assert main(["export", "ros", str(course), "-o", str(out)]) == 0
+    launch = (out / "launch" / "obstacle_course.launch").read_text()
+    assert " /Scanner/ranges " in launch
+    assert "[" not in launch.partition('type="record"')[2]
+    wiring = (out / "config" / "amsa_leaves.yaml").read_text()
+    assert "topic /Scanner/ranges 0x0.0p+0 0 31" in wiring
+    assert "ranges <- /Scanner/ranges [31]" in (out / "nodes" / "Pilot.py").read_text()
 
 
 def test_no_path_of_the_exporting_machine_in_any_generated_file(tmp_path: Path) -> None:
@@ -275,5 +274,9 @@ def test_a_scenario_with_adapt_rules_exports_them(
     ]
     launch = ET.parse(pkg / "launch" / "adaptive.launch").getroot()
     node = next(n for n in launch.iter("node") if n.get("name") == "amsa_adapt")
-    assert node.get("unless") == "$(arg sim)"
+    # sim:=false, or rules:=node in lockstep (the simulator asks it: test_ros_adapt.py)
+    want = "$(eval not arg('sim') or (arg('rules') == 'node' and arg('mode') == 'lockstep'))"
+    assert node.get("if") == want
+    rules = next(a for a in launch.iter("arg") if a.get("name") == "rules")
+    assert rules.get("default") == "sim"
     py_compile.compile(str(pkg / "nodes" / "amsa_adapt.py"), doraise=True)

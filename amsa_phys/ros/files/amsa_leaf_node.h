@@ -7,7 +7,10 @@
 // ~amsa_wiring (below). The package's amsa_leaves executable is a nodelet manager that loads
 // every C++ Leaf into one process; `nodelet standalone PKG/TEMPLATE` runs one Leaf alone, and
 // `nodelet load PKG/TEMPLATE MANAGER` loads it into a manager of your own.
-//  - inputs: std_msgs/Float64 topics /Producer/output; outputs: /Leaf/output;
+//  - inputs: std_msgs/Float64 topics /Producer/output; outputs: /Leaf/output; an array port
+//    (a lidar's ranges) is one std_msgs/Float64MultiArray topic of the port's fixed length
+//    (one dimension labelled with the port, data_offset 0), checked on receipt: a message
+//    of another length fails the step that reads it, naming the topic;
 //  - parameters ~param (the nodelet's private namespace, /Leaf/param in the launch files),
 //    checked against the template's [min, max] whenever they change;
 //  - lockstep: "step SEQ NUM DEN C1..Cn" on /amsa/step/Leaf: step at t = NUM/DEN once each
@@ -22,16 +25,18 @@
 //
 // The interface of a template's C++ body (files/cpp/TEMPLATE.inc, pasted into the class):
 // override doStep() (and checkParams() for rules between parameters); read parameters with
-// p("name") (values_ holds them); kPath is the Leaf's path (its random stream's key) and
+// p("name") (values_ holds them); an array input port's numbers with array(PORT) (in[] holds
+// 0 there), an array output's written into arrayOut(PORT); kPath is the Leaf's path (its random stream's key) and
 // seed() the scenario's seed (/amsa/seed). Unchanged from the one-executable-per-Leaf nodes,
 // where kPath and seed() were file-level names of each executable.
 //
 // ~amsa_wiring, one item per line (numbers as C hex floats, which read back exactly):
 //   path LEAF.PATH          freq NUM DEN
-//   topic NAME INITIAL DELAYED(0|1)            (each subscribed input topic, in order)
+//   topic NAME INITIAL DELAYED(0|1) [SIZE]     (each subscribed input topic, in order; SIZE
+//                           for an array port's topic: a Float64MultiArray of SIZE values)
 //   input PORT INDEX        (the template's input ports in order: a topic's index, or
 //                            -(1 + k) for the Leaf's own output k)
-//   output PORT TOPIC INITIAL SUBSCRIBERS SHARED  (the template's output ports in order;
+//   output PORT TOPIC INITIAL SUBSCRIBERS SHARED [SIZE]  (the template's output ports in order;
 //                           the processes subscribed, without the bag recorder: every Leaf
 //                           a process of its own, and the C++ Leaves in one; ROS 1 counts a
 //                           process once per topic however many of its Leaves read it)
@@ -40,6 +45,7 @@
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
 #include <std_msgs/Float64.h>
+#include <std_msgs/Float64MultiArray.h>
 #include <std_msgs/String.h>
 
 #include <atomic>
@@ -74,6 +80,7 @@ struct Topic {
   std::string name;
   double initial;
   bool delayed;  // its producer has latency or jitter: readers may be told an older message
+  int size = 0;  // 0: one number (std_msgs/Float64); N: an array port, Float64MultiArray of N
 };
 
 struct OutputPort {
@@ -82,6 +89,7 @@ struct OutputPort {
   double initial;
   int subscribers;         // processes subscribed, every Leaf a process of its own
   int subscribers_shared;  // the same with the C++ Leaves in one process (the container)
+  int size = 0;            // 0: one number; N: an array port of N numbers (Float64MultiArray)
 };
 
 struct ParamSpec {
@@ -130,6 +138,7 @@ inline bool parse_wiring(const std::string& text, Wiring* w, std::string* error)
       int delayed = 0;
       ok = static_cast<bool>(in >> t.name >> initial >> delayed) && read_double(initial, &t.initial);
       t.delayed = delayed != 0;
+      if (ok && !(in >> t.size)) t.size = 0;  // optional: an array port's length
       w->topics.push_back(t);
     } else if (what == "input") {
       InputPort ip;
@@ -141,6 +150,7 @@ inline bool parse_wiring(const std::string& text, Wiring* w, std::string* error)
       ok = static_cast<bool>(in >> o.port >> o.topic >> initial >> o.subscribers >>
                              o.subscribers_shared) &&
            read_double(initial, &o.initial);
+      if (ok && !(in >> o.size)) o.size = 0;  // optional: an array port's length
       w->outputs.push_back(o);
     } else {
       ok = false;
@@ -239,9 +249,14 @@ class LeafNode : public nodelet::Nodelet {
       if (topics_[i].delayed) history_[i][0] = topics_[i].initial;
     }
     for (const OutputPort& o : outputs_) own_.push_back(o.initial);
+    initArrays();
 
     // the nodelet's callbacks (one queue per nodelet: in order, one at a time)
     for (std::size_t i = 0; i < topics_.size(); ++i) {
+      if (topics_[i].size > 0) {
+        subs_.push_back(subscribeArray(nh, i));
+        continue;
+      }
       subs_.push_back(nh.subscribe<std_msgs::Float64>(
           topics_[i].name, 1000,
           [this, i](const std_msgs::Float64::ConstPtr& m) { onData(i, m->data); },
@@ -249,7 +264,10 @@ class LeafNode : public nodelet::Nodelet {
     }
     auto wake = [this](const ros::SingleSubscriberPublisher&) { notify(); };
     for (const OutputPort& o : outputs_) {
-      pubs_.push_back(nh.advertise<std_msgs::Float64>(o.topic, 1000, wake, ros::SubscriberStatusCallback()));
+      if (o.size > 0)
+        pubs_.push_back(nh.advertise<std_msgs::Float64MultiArray>(o.topic, 1000, wake, ros::SubscriberStatusCallback()));
+      else
+        pubs_.push_back(nh.advertise<std_msgs::Float64>(o.topic, 1000, wake, ros::SubscriberStatusCallback()));
       // sim:=false (the controller side alone): no simulator to wait for, start at once
       const int subscribers = shared ? o.subscribers_shared : o.subscribers;
       want_.push_back(sim ? subscribers + (bag ? 1 : 0) : 0);
@@ -275,6 +293,10 @@ class LeafNode : public nodelet::Nodelet {
   virtual void doStep(double t, const std::vector<double>& in, std::vector<double>& out,
                       std::vector<bool>& published) = 0;
   double p(const std::string& name) const { return values_.at(name); }
+  // An array input port's numbers (``port``: its index in the template's input ports; in[]
+  // holds 0 there), and an array output port's, which doStep fills to the port's length.
+  const std::vector<double>& array(std::size_t port) const { return arrays_in_.at(port); }
+  std::vector<double>& arrayOut(std::size_t port) { return arrays_out_.at(port); }
   // The scenario's seed (/amsa/seed, from the launch file): the root of every random stream.
   std::string seed() const {
     std::string value;
@@ -382,6 +404,55 @@ class LeafNode : public nodelet::Nodelet {
     cond_.notify_all();
   }
 
+  // -- array ports: std_msgs/Float64MultiArray topics (a second kind of input and output) --
+  void initArrays() {
+    latest_arr_.assign(topics_.size(), std::vector<double>());
+    history_arr_.assign(topics_.size(), std::map<std::int64_t, std::vector<double>>());
+    bad_.assign(topics_.size(), std::string());
+    for (std::size_t i = 0; i < topics_.size(); ++i) {
+      if (topics_[i].size <= 0) continue;
+      latest_arr_[i].assign(static_cast<std::size_t>(topics_[i].size), topics_[i].initial);
+      if (topics_[i].delayed) history_arr_[i][0] = latest_arr_[i];
+    }
+    own_arr_.assign(outputs_.size(), std::vector<double>());
+    for (std::size_t k = 0; k < outputs_.size(); ++k)
+      if (outputs_[k].size > 0)
+        own_arr_[k].assign(static_cast<std::size_t>(outputs_[k].size), outputs_[k].initial);
+    arrays_in_.assign(inputs_.size(), std::vector<double>());
+    arrays_out_.assign(outputs_.size(), std::vector<double>());
+  }
+
+  ros::Subscriber subscribeArray(ros::NodeHandle& nh, std::size_t i) {
+    return nh.subscribe<std_msgs::Float64MultiArray>(
+        topics_[i].name, 1000,
+        [this, i](const std_msgs::Float64MultiArray::ConstPtr& m) { onArray(i, *m); },
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  }
+
+  // An array message: its doubles from data_offset on, of exactly the declared length (a
+  // message of another length is kept as empty: the step that reads it fails, naming it).
+  void onArray(std::size_t i, const std_msgs::Float64MultiArray& m) {
+    const std::size_t offset = m.layout.data_offset;
+    std::vector<double> value;
+    if (offset <= m.data.size()) value.assign(m.data.begin() + offset, m.data.end());
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (value.size() != static_cast<std::size_t>(topics_[i].size)) {
+      bad_[i] = topics_[i].name + " carried " + std::to_string(value.size()) +
+                " values, the port declares " + std::to_string(topics_[i].size) +
+                " (std_msgs/Float64MultiArray of fixed length)";
+      if (!lockstep_) {  // free: the message is dropped, the last value stays
+        NODELET_ERROR("%s", bad_[i].c_str());
+        return;
+      }
+      value.clear();
+    }
+    count_[i] += 1;
+    latest_arr_[i] = value;
+    if (topics_[i].delayed) history_arr_[i][count_[i]] = value;
+    if (!pending_.empty()) tryPending();
+    cond_.notify_all();
+  }
+
   void onStep(const std::string& text) {
     std::lock_guard<std::mutex> lock(mutex_);
     pending_ = text;
@@ -419,33 +490,75 @@ class LeafNode : public nodelet::Nodelet {
         return;
       }
     std::vector<double> seen = latest_;
+    std::vector<std::vector<double>> seen_arr = latest_arr_;
     for (std::size_t i = 0; i < want.size() && i < count_.size(); ++i) {
       if (!topics_[i].delayed) continue;
+      if (topics_[i].size > 0) {
+        std::map<std::int64_t, std::vector<double>>& kept = history_arr_[i];
+        seen_arr[i] = kept.at(want[i]);
+        kept.erase(kept.begin(), kept.lower_bound(want[i]));
+        continue;
+      }
       std::map<std::int64_t, double>& kept = history_[i];
       seen[i] = kept.at(want[i]);  // message number want[i] is what the Leaf sees now
       kept.erase(kept.begin(), kept.lower_bound(want[i]));
     }
-    const std::string result = step(static_cast<double>(num) / static_cast<double>(den), seen);
+    for (std::size_t i = 0; i < topics_.size(); ++i)
+      if (topics_[i].size > 0 && seen_arr[i].empty()) {
+        reply("fault " + seq + " " + bad_[i]);
+        return;
+      }
+    const std::string result =
+        step(static_cast<double>(num) / static_cast<double>(den), seen, seen_arr);
     if (!result.empty() && result[0] == '!') reply("error " + seq + " " + result.substr(1));
     else reply("done " + seq + result);
   }
 
   // doStep with the inputs ``seen`` (by topic); publishes; " I J .." (the outputs
   // published), or "!message" if doStep threw.
-  std::string step(double t, const std::vector<double>& seen) {
+  std::string step(double t, const std::vector<double>& seen,
+                   const std::vector<std::vector<double>>& seen_arr) {
     std::vector<double> in;
-    for (const InputPort& ip : inputs_)
+    for (std::size_t j = 0; j < inputs_.size(); ++j) {
+      const InputPort& ip = inputs_[j];
+      const bool array = ip.topic >= 0 ? topics_[ip.topic].size > 0
+                                       : outputs_[-(ip.topic + 1)].size > 0;
+      if (array) {
+        arrays_in_[j] = ip.topic >= 0 ? seen_arr[ip.topic] : own_arr_[-(ip.topic + 1)];
+        in.push_back(0.0);
+        continue;
+      }
       in.push_back(ip.topic >= 0 ? seen[ip.topic] : own_[-(ip.topic + 1)]);
+    }
     std::vector<double> out(outputs_.size(), 0.0);
     std::vector<bool> published(outputs_.size(), false);
+    for (std::vector<double>& a : arrays_out_) a.clear();
     try {
       doStep(t, in, out, published);
     } catch (const std::exception& exc) {
       return std::string("!C++ exception: ") + exc.what();
     }
+    for (std::size_t k = 0; k < outputs_.size(); ++k)
+      if (published[k] && outputs_[k].size > 0 &&
+          arrays_out_[k].size() != static_cast<std::size_t>(outputs_[k].size))
+        return "!output " + outputs_[k].port + " has " + std::to_string(arrays_out_[k].size()) +
+               " values, the port declares " + std::to_string(outputs_[k].size);
     std::string indexes;
     for (std::size_t k = 0; k < outputs_.size(); ++k) {
       if (!published[k]) continue;
+      if (outputs_[k].size > 0) {
+        std_msgs::Float64MultiArray m;
+        m.layout.dim.resize(1);
+        m.layout.dim[0].label = outputs_[k].port;
+        m.layout.dim[0].size = static_cast<std::uint32_t>(outputs_[k].size);
+        m.layout.dim[0].stride = static_cast<std::uint32_t>(outputs_[k].size);
+        m.layout.data_offset = 0;
+        m.data = arrays_out_[k];
+        pubs_[k].publish(m);
+        own_arr_[k] = arrays_out_[k];
+        indexes += " " + std::to_string(k);
+        continue;
+      }
       std_msgs::Float64 m;
       m.data = out[k];
       pubs_[k].publish(m);
@@ -503,7 +616,7 @@ class LeafNode : public nodelet::Nodelet {
         std::lock_guard<std::mutex> lock(mutex_);
         const double t = static_cast<double>(phase_num) / static_cast<double>(phase_den) +
                          static_cast<double>(k * freq_den_) / static_cast<double>(freq_num_);
-        std::string error = step(t, latest_);
+        std::string error = step(t, latest_, latest_arr_);
         if (!error.empty() && error[0] == '!') NODELET_ERROR("%s", error.c_str() + 1);
       }
       k += 1;
@@ -526,6 +639,12 @@ class LeafNode : public nodelet::Nodelet {
   std::vector<std::int64_t> count_;
   std::vector<double> latest_, own_;
   std::vector<std::map<std::int64_t, double>> history_;  // delayed topics' kept messages
+  // array ports: the latest message of each array topic (empty: one of the wrong length),
+  // a delayed one's kept messages, the last length error, own array outputs, and the
+  // arrays doStep reads and writes (by input / output port)
+  std::vector<std::vector<double>> latest_arr_, own_arr_, arrays_in_, arrays_out_;
+  std::vector<std::map<std::int64_t, std::vector<double>>> history_arr_;
+  std::vector<std::string> bad_;
   std::map<std::string, std::string> last_error_;
   std::string pending_;
   bool lockstep_ = true;

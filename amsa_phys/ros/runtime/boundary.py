@@ -40,6 +40,7 @@ from .. import names
 from ..boundary import NODE, SIM_PARAM, plan
 from ..graph import RosGraph
 from . import rosio
+from .arrays import ScanShape, array_msg, fit_scan, pack, unpack
 from .config import load_config
 
 #: NavSatStatus.STATUS_NO_FIX: a fix the receiver says it does not have
@@ -139,6 +140,10 @@ class BoundaryNode:
 
         self.TransformStamped = TransformStamped
         self.Float64 = rosio.msgs()[0]
+        world = self.graph.world
+        self.Array = array_msg() if world.arrays else None
+        #: an array port's element buffer -> the port (its topic carries them all)
+        self.element = {e: a for a, elements in world.arrays.items() for e in elements}
         self.origin = DEFAULT_ORIGIN
         self.lock = threading.Lock()
         world = self.graph.world
@@ -165,10 +170,19 @@ class BoundaryNode:
         self.readers = readers
         self.subs: list[Any] = []
         self.data_pubs: dict[str, Any] = {}
+        #: sim:=false: each lidar Leaf's declared scan, to which a robot's scan is fitted
+        self.scans: dict[str, ScanShape] = {}
         if not self.sim:
             for src in self.plan.inbound:
+                if src.role.name == "LaserScan":
+                    p = rosio.read_params(rospy, self.graph.leaf(src.leaf))
+                    self.scans[src.leaf] = ScanShape.of(p)
+            for src in self.plan.inbound:
                 for b in buffers_of(src):
-                    self.data_pubs[b] = rosio.make_publisher(rospy, names.topic(b), self.Float64)
+                    d = self.element.get(b, b)
+                    if d not in self.data_pubs:
+                        cls = self.Array if d in world.arrays else self.Float64
+                        self.data_pubs[d] = rosio.make_publisher(rospy, names.topic(d), cls)
                 cls = self.classes[src.role.msg]
                 self.subs.append(rospy.Subscriber(src.topic, cls, self._on_std, callback_args=src))
 
@@ -189,18 +203,36 @@ class BoundaryNode:
         if self.sim:
             Clock = rosio.msgs()[2]
             self.rospy.wait_for_message(names.CLOCK, Clock)
+        topics = {self.element.get(b, b) for b in self.readers}  # an array: its port's topic
         self.subs += [
             self.rospy.Subscriber(
-                names.topic(b), self.Float64, self._on_data, callback_args=b, tcp_nodelay=True
+                names.topic(d),
+                self.Array if self.graph.is_array(d) else self.Float64,
+                self._on_data,
+                callback_args=d,
+                tcp_nodelay=True,
             )
-            for b in self.readers
+            for d in self.graph.data()
+            if d in topics
         ]
 
-    def _on_data(self, msg: Any, buffer: str) -> None:
+    def _on_data(self, msg: Any, data: str) -> None:
+        arrays = self.graph.world.arrays
+        if data in arrays:  # an array port: its elements' buffers, which the streams read
+            try:
+                value = unpack(msg, len(arrays[data]), names.topic(data))
+            except ValueError as exc:
+                self.rospy.logerr(f"{NODE}: {exc}")
+                return
+            pairs = list(zip(arrays[data], value, strict=True))
+        else:
+            pairs = [(data, msg.data)]
         with self.lock:
-            self.values[buffer] = msg.data
-            for o in self.readers[buffer]:
-                o.got(buffer)
+            for buffer, v in pairs:
+                self.values[buffer] = v
+            for buffer, _ in pairs:
+                for o in self.readers.get(buffer, ()):
+                    o.got(buffer)
 
     def _on_values(self, msg: Any) -> None:
         """Lockstep: a Leaf step's values that this node reads, at the step's instant."""
@@ -214,14 +246,15 @@ class BoundaryNode:
 
     def _on_std(self, msg: Any, src: Source) -> None:
         """A driver's message on a sensor stream: its fields on their data topics."""
-        fields = read_fields(src, msg, self.origin)
+        fields = read_fields(src, msg, self.origin, self.scans.get(src.leaf))
         if fields is None:
             return
         for name, value in fields.items():
             buf = src.buffers[name]
-            if isinstance(buf, tuple):
-                for b, v in zip(buf, value, strict=False):
-                    self.data_pubs[b].publish(self.Float64(v))
+            if isinstance(buf, tuple):  # an array port: one message on its port's topic
+                port = self.element[buf[0]]
+                label = port.rpartition(".")[2]
+                self.data_pubs[port].publish(pack(self.Array, label, value))
             else:
                 self.data_pubs[buf].publish(self.Float64(value))
 
@@ -261,8 +294,11 @@ def buffers_of(src: Source) -> list[str]:
     return out
 
 
-def read_fields(src: Source, msg: Any, origin: tuple[float, float]) -> dict[str, Any] | None:
-    """A standard message's fields as the stream's Leaf outputs them (None: drop it)."""
+def read_fields(
+    src: Source, msg: Any, origin: tuple[float, float], scan: ScanShape | None = None
+) -> dict[str, Any] | None:
+    """A standard message's fields as the stream's Leaf outputs them (None: drop it;
+    ``scan``: a lidar Leaf's declared scan, to which a LaserScan is fitted)."""
     role = src.role.name
     if role == "NavSatFix":
         if msg.status.status <= NO_FIX:
@@ -278,6 +314,8 @@ def read_fields(src: Source, msg: Any, origin: tuple[float, float]) -> dict[str,
         pose = msg.pose.pose
         return {"x": pose.position.x, "y": pose.position.y, "yaw": quaternion_yaw(pose.orientation)}
     if role == "LaserScan":
+        if scan is not None:
+            return {"ranges": fit_scan(msg, scan)}
         far = msg.range_max
         return {"ranges": [far if math.isinf(r) or r > far else r for r in msg.ranges]}
     return None

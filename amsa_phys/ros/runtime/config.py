@@ -20,10 +20,13 @@ class NodeConfig:
     graph: RosGraph
     mode: str
     timeout: float
+    #: lockstep with the simulator: the adapt node runs the ``adapt:`` rules, asked by the
+    #: simulator at each instant (``rules:=node``), rather than the simulator itself
+    rules_node: bool = False
 
 
 def load_config(rospy: Any) -> NodeConfig:
-    """Read ``/amsa/{scenario,mode,local,bag,timeout,container}`` and load the scenario."""
+    """Read ``/amsa/{scenario,mode,local,bag,timeout,container,rules}``; load the scenario."""
     try:
         path = rospy.get_param("/amsa/scenario")
         mode = rospy.get_param("/amsa/mode", "lockstep")
@@ -38,4 +41,11 @@ def load_config(rospy: Any) -> NodeConfig:
     if mode not in MODES:
         raise ConfigError(f"expected lockstep or free, got {mode!r}", key="/amsa/mode")
     scenario = load_scenario(path)
-    return NodeConfig(scenario, RosGraph.of(scenario.world, local, bag, shared), mode, timeout)
+    rules = str(rospy.get_param("/amsa/rules", "sim"))
+    if rules not in ("sim", "node"):
+        raise ConfigError(f"expected sim or node, got {rules!r}", key="/amsa/rules")
+    sim = bool(rospy.get_param("/amsa/sim", True))
+    node = rules == "node" and bool(scenario.adapt) and sim and mode == "lockstep"
+    signals = sorted({c.signal for r in scenario.adapt for c in r.when}) if node else []
+    graph = RosGraph.of(scenario.world, local, bag, shared, signals)
+    return NodeConfig(scenario, graph, mode, timeout, node)

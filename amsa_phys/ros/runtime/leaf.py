@@ -1,8 +1,9 @@
 """A Leaf as a ROS node: the project's own template class behind topics and parameters.
 
-Inputs are ``std_msgs/Float64`` topics ``/Producer/output``; outputs are published on
-``/Leaf/output``; parameters are read from ``/Leaf/param`` and judged by the template (type,
-[min, max], rules between parameters) whenever they change.
+Inputs are ``std_msgs/Float64`` topics ``/Producer/output`` (an array port's:
+``std_msgs/Float64MultiArray`` of the port's fixed length, ``rosio.pack``); outputs are
+published on ``/Leaf/output``; parameters are read from ``/Leaf/param`` and judged by the
+template (type, [min, max], rules between parameters) whenever they change.
 
 **lockstep** (reproduces ``amsa-phys run``): the simulator sends ``step SEQ NUM DEN C1..Cn``
 on ``/amsa/step/Leaf`` — the instant as an exact fraction and, for each input topic, how many
@@ -28,8 +29,11 @@ from __future__ import annotations
 
 import math
 import threading
+from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
+
+import numpy as np
 
 from ...engine.timing import leaf_phase
 from ...errors import AmsaError, ConfigError
@@ -37,7 +41,16 @@ from .. import names
 from ..boundary import SIM_PARAM
 from ..graph import NodeContext
 from . import rosio
+from .arrays import array_msg, pack, unpack
 from .config import load_config
+
+
+@dataclass(frozen=True)
+class BadMessage:
+    """An array message of the wrong length, kept in its place: a step that would read it
+    fails naming the topic (its count still advances, so the others stay in step)."""
+
+    text: str
 
 
 class LeafNode:
@@ -63,18 +76,22 @@ class LeafNode:
         self.buffers = graph.input_buffers(path)
         self.outputs = graph.outputs(path)
         self.count = {b: 0 for b in self.buffers}
-        self.value = {b: float(world.buffers[b].initial) for b in self.buffers}
+        self.value: dict[str, Any] = {b: graph.initial(b) for b in self.buffers}
         #: messages of delayed producers by number (0: the initial value), kept until the
         #: simulator says a later one is due; other producers' readers need only the latest
         self.delayed = {
             b for b in self.buffers if world.leaves[b.rpartition(".")[0]].timing.delayed
         }
-        self.history: dict[str, dict[int, float]] = {b: {0: self.value[b]} for b in self.delayed}
-        self.own = {b: float(world.buffers[b].initial) for b in self.outputs}
+        self.history: dict[str, dict[int, Any]] = {b: {0: self.value[b]} for b in self.delayed}
+        self.own: dict[str, Any] = {b: graph.initial(b) for b in self.outputs}
+        self.graph = graph
+        Array = array_msg() if any(map(graph.is_array, self.buffers + self.outputs)) else None
+        self.Array = Array
+        kind = {b: Array if graph.is_array(b) else Float64 for b in self.buffers + self.outputs}
         self.pending: list[str] | None = None
         self.subs = [
             rospy.Subscriber(
-                names.topic(b), Float64, self._on_data, callback_args=b, tcp_nodelay=True
+                names.topic(b), kind[b], self._on_data, callback_args=b, tcp_nodelay=True
             )
             for b in self.buffers
         ]
@@ -83,7 +100,7 @@ class LeafNode:
         # free mode needs no handshake, so the node starts at once
         sim = bool(rospy.get_param(SIM_PARAM, True))
         self.pubs = [
-            self.gate.publisher(names.topic(b), Float64, graph.subscribers(b) if sim else 0)
+            self.gate.publisher(names.topic(b), kind[b], graph.subscribers(b) if sim else 0)
             for b in self.outputs
         ]
         if cfg.mode == "lockstep":
@@ -97,11 +114,20 @@ class LeafNode:
 
     # -- lockstep ---------------------------------------------------------------------------
     def _on_data(self, msg: Any, buffer: str) -> None:
+        value: Any = msg.data
+        if self.graph.is_array(buffer):
+            try:
+                value = unpack(msg, self.graph.size(buffer), names.topic(buffer))
+            except ValueError as exc:
+                if self.cfg.mode != "lockstep":  # free: the old value stays, said once a message
+                    self.rospy.logerr(f"{self.path}: {exc}; keeping the last scan")
+                    return
+                value = BadMessage(str(exc))
         with self.lock:
             self.count[buffer] += 1
-            self.value[buffer] = msg.data
+            self.value[buffer] = value
             if buffer in self.history:
-                self.history[buffer][self.count[buffer]] = msg.data
+                self.history[buffer][self.count[buffer]] = value
             if self.pending is not None:
                 self._try()
 
@@ -138,6 +164,10 @@ class LeafNode:
                 seen[b] = kept[c]
                 for old in [k for k in kept if k < c]:
                     del kept[old]
+        bad = [v.text for v in seen.values() if isinstance(v, BadMessage)]
+        if bad:
+            self._reply(seq, ("fault", bad[0]))
+            return
         self._reply(seq, self._step(Fraction(int(req[2]), int(req[3])), seen))
 
     def _reply(self, seq: str, result: tuple[str, str]) -> None:
@@ -148,9 +178,13 @@ class LeafNode:
         self.done.publish(self.String("\n".join(lines)))
 
     # -- stepping (both modes) --------------------------------------------------------------
-    def _inputs(self, seen: dict[str, float] | None = None) -> dict[str, float]:
+    def _inputs(self, seen: dict[str, Any] | None = None) -> dict[str, Any]:
         value = self.value if seen is None else seen
-        return {port: (self.own[b] if b in self.own else value[b]) for port, b in self.ports}
+        inp = {port: (self.own[b] if b in self.own else value[b]) for port, b in self.ports}
+        for port, b in self.ports:  # an array port: a float array, as the engine gives it
+            if self.graph.is_array(b):
+                inp[port] = np.array(inp[port], dtype=float)
+        return inp
 
     def _step(self, t: Fraction, seen: dict[str, float] | None = None) -> tuple[str, str]:
         """``do_step`` at ``t`` on ``seen`` (default: the latest messages); publish the
@@ -159,19 +193,32 @@ class LeafNode:
             out = self.comp.do_step(t, self._inputs(seen))
         except Exception as exc:  # the engine reports it as "do_step raised ..."
             return "error", repr(exc)
-        values: list[tuple[int, float]] = []
+        values: list[tuple[int, Any]] = []
         ports = [b.rpartition(".")[2] for b in self.outputs]
         for key, value in (out or {}).items():
             if key not in ports:
                 return "fault", f"published unknown output {key!r}"
+            b = self.outputs[ports.index(key)]
             try:
-                number = float(value)
+                if self.graph.is_array(b):
+                    number: Any = tuple(float(v) for v in value)
+                    if len(number) != self.graph.size(b):
+                        return "fault", (
+                            f"output {key} has {len(number)} values, the port declares "
+                            f"{self.graph.size(b)}"
+                        )
+                else:
+                    number = float(value)
             except (TypeError, ValueError):
                 return "fault", f"output {key} is not a number: {value!r}"
             values.append((ports.index(key), number))
         for index, number in values:
-            self.pubs[index].publish(self.Float64(number))
-            self.own[self.outputs[index]] = number
+            b = self.outputs[index]
+            if self.graph.is_array(b):
+                self.pubs[index].publish(pack(self.Array, b.rpartition(".")[2], number))
+            else:
+                self.pubs[index].publish(self.Float64(number))
+            self.own[b] = number
         return "done", " ".join(str(i) for i, _ in values)
 
     def _reload(self, name: str, cached: bool = False) -> tuple[str, str]:

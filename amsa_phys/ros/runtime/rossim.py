@@ -13,9 +13,10 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 from ...engine.runner import Simulation
+from ...model.adaptrules import RULE_COLUMN
 from ...model.scenario import Change, Scenario, traced_columns
 from .. import names
-from . import rosio
+from . import adaptlink, rosio
 from .standins import stand_ins
 
 if TYPE_CHECKING:  # the simulator node imports this module
@@ -83,6 +84,23 @@ class RosSimulation(Simulation):
                 return
         value = self.link.phase_value(self.phase_index, self.now, change)
         super().apply_change(Change(change.leaf, change.param, value))
+
+    def _apply_adapt(self) -> None:
+        """``rules:=node``: the adapt node says which rule fires now; applied as the engine
+        applies its own firing (``adaptlink.py``). Otherwise the engine's own rules."""
+        if not self.link.cfg.rules_node:
+            super()._apply_adapt()
+            return
+        fired = adaptlink.due(self.link, self, self.now)
+        if fired is None:
+            return
+        number, detail = fired
+        assert self._adapt is not None
+        rule = next(r for r in self._adapt.rules if r.number == number)
+        for change in rule.changes:
+            self.apply_change(change)
+        self.values[RULE_COLUMN] = float(number)
+        self.record_event("adapt", detail)
 
     def _live_params(self) -> None:
         """Free mode: a ``rosparam set`` lands at the next instant, recorded.

@@ -34,7 +34,8 @@ from ...runs.rundir import default_run_dir, prepare_run_dir
 from ...runs.single import run_scenario
 from .. import names
 from ..graph import RosGraph
-from . import readiness, records, rosio
+from . import adaptlink, readiness, records, rosio
+from .arrays import array_msg, elements, pack, read
 from .boundary import VALUES, format_values, readable
 from .config import NodeConfig, load_config
 from .rossim import RosSimulation
@@ -67,9 +68,13 @@ class Link:
         world = self.graph.world
         #: free mode: the outputs nodes published since the loop last took them (buffer ->
         #: latest value); the loop's own thread writes them into the engine (:meth:`take`)
-        self.fresh: dict[str, float] = {}
+        self.fresh: dict[str, Any] = {}
         self.sim: Simulation | None = None
-        self.published = dict.fromkeys(world.buffers, 0)
+        self.published = dict.fromkeys(self.graph.data(), 0)
+        #: array ports (a lidar's ranges): one std_msgs/Float64MultiArray topic each
+        self.Array = array_msg() if world.arrays else None
+        #: a remote array output of the wrong length (buffer -> the message saying so)
+        self.bad: dict[str, str] = {}
         self.received: dict[str, list[Any]] = {}
         self.replies: dict[str, list[str] | None] = {}
         self.ready: set[str] = set()
@@ -91,7 +96,7 @@ class Link:
             rosio.make_publisher(rospy, VALUES, String) if self.boundary_reads else None
         )
         self.data_pubs = {
-            b: self.gate.publisher(names.topic(b), Float64, self.graph.subscribers(b))
+            b: self.gate.publisher(names.topic(b), self._kind(b), self.graph.subscribers(b))
             for p in self.graph.local
             for b in self.graph.outputs(p)
         }
@@ -100,9 +105,9 @@ class Link:
         self.data_subs: dict[str, Any] = {}
         for path in self.graph.remote:
             for b in self.graph.outputs(path):
-                self.received[b] = [0, float(world.buffers[b].initial)]
+                self.received[b] = [0, self.graph.initial(b)]
                 self.data_subs[b] = rospy.Subscriber(
-                    names.topic(b), Float64, self._on_data, callback_args=b, tcp_nodelay=True
+                    names.topic(b), self._kind(b), self._on_data, callback_args=b, tcp_nodelay=True
                 )
                 self.subs.append(self.data_subs[b])
             if self.lockstep:
@@ -121,14 +126,26 @@ class Link:
         self.subs.append(rospy.Subscriber(names.READY, String, self._on_ready, tcp_nodelay=True))
         self.expected_ready = {*self.graph.remote, names.SCENARIO}
 
+    def _kind(self, data: str) -> Any:
+        """The message class of a Data's topic."""
+        return self.Array if self.graph.is_array(data) else self.Float64
+
     # -- callbacks (rospy's threads) ---------------------------------------------------------
     def _on_data(self, msg: Any, buffer: str) -> None:
+        value, bad = read(self.graph, buffer, msg)
+        if bad and not self.lockstep:  # free: the message is dropped, the last value stays
+            self.rospy.logerr(f"{names.SIMULATOR}: {bad}")
+            return
         with self.cond:
             r = self.received[buffer]
             r[0] += 1
-            r[1] = msg.data
+            if bad:  # the step that published it fails, naming the topic
+                self.bad.setdefault(buffer, bad)
+                self.cond.notify_all()
+                return
+            r[1] = value
             if not self.lockstep:
-                self.fresh[buffer] = msg.data  # free mode: the latest value is the value
+                self.fresh[buffer] = value  # free mode: the latest value is the value
             self.cond.notify_all()
 
     def _on_done(self, msg: Any, path: str) -> None:
@@ -194,8 +211,9 @@ class Link:
             return
         with self.cond:
             fresh, self.fresh = self.fresh, {}
-        for buffer, value in fresh.items():
-            sim.write(buffer, value)
+        for data, value in fresh.items():
+            for buffer, v in elements(self.graph.world.arrays, data, value):
+                sim.write(buffer, v)
 
     # -- waiting ----------------------------------------------------------------------------
     def _wait(self, ready: Callable[[], bool], who: str, t: Fraction, what: str) -> None:
@@ -259,8 +277,9 @@ class Link:
         """How many messages of each input a remote Leaf sees now: every message so far, less
         a delayed producer's still in flight."""
         sim = self.sim
-        return " ".join(
-            str(self.published[b] - (sim.in_flight(b) if sim is not None else 0))
+        arrays = self.graph.world.arrays
+        return " ".join(  # an array's elements travel together: its first one's count
+            str(self.published[b] - (sim.in_flight(arrays.get(b, [b])[0]) if sim else 0))
             for b in self.graph.input_buffers(path)
         )
 
@@ -311,6 +330,9 @@ class Link:
             t,
             "its outputs",
         )
+        bad = [b for b in got if b in self.bad]
+        if bad:
+            raise RunFault(who, t, self.bad[bad[0]])
         extra = [b for b in got if self.received[b][0] != self.published[b]]
         if extra:  # a node that stepped more often than asked: what it sees is no longer known
             b = extra[0]
@@ -323,11 +345,14 @@ class Link:
         self.tell_boundary(t, [(b, self.received[b][1]) for b in got])
         return {b.rpartition(".")[2]: self.received[b][1] for b in got}
 
-    def tell_boundary(self, t: Fraction, values: list[tuple[str, float]]) -> None:
-        """Lockstep: the values of a Leaf's step at ``t`` that the boundary node reads."""
+    def tell_boundary(self, t: Fraction, values: list[tuple[str, Any]]) -> None:
+        """Lockstep: the values of a Leaf's step at ``t`` that the boundary node reads (an
+        array port's as its elements' buffers, which the standard messages read)."""
         if self.values_pub is None:
             return
-        told = [(b, v) for b, v in values if b in self.boundary_reads]
+        arrays = self.graph.world.arrays
+        flat = [e for b, v in values for e in elements(arrays, b, v)]
+        told = [(b, v) for b, v in flat if b in self.boundary_reads]
         if told and self.values_pub.get_num_connections():
             self.values_pub.publish(self.String(format_values(t, told)))
 
@@ -346,16 +371,23 @@ class Link:
         pubs = self.data_pubs
         Float64 = self.Float64
         published = self.published
+        arrays = self.graph.world.arrays
 
         def publish(t: Fraction, out: Mapping[str, Any]) -> None:
-            sent = []
+            sent: list[tuple[str, Any]] = []
             for port, b in ports:
                 if port in out:
                     try:
-                        number = float(out[port])
+                        if b in arrays:
+                            number: Any = tuple(float(v) for v in out[port])
+                            if len(number) != len(arrays[b]):
+                                continue  # the engine reports it
+                            pubs[b].publish(pack(self.Array, port, number))
+                        else:
+                            number = float(out[port])
+                            pubs[b].publish(Float64(number))
                     except (TypeError, ValueError):
                         continue  # the engine reports it
-                    pubs[b].publish(Float64(number))
                     published[b] += 1
                     sent.append((b, number))
             self.tell_boundary(t, sent)
@@ -410,6 +442,7 @@ def main() -> None:
         out_dir = Path(out) if out else default_run_dir(scenario.name, root)
         prepare_run_dir(out_dir, bool(rospy.get_param("~force", False)), flag="out:=")
         link = Link(rospy, cfg)
+        adaptlink.attach(link)  # rules:=node: the adapt node runs the rules
         link.speed = float(rospy.get_param("~speed", 1.0))
         link.waves = bool(rospy.get_param("~waves", True))
         if not link.speed > 0 or math.isinf(link.speed):
