@@ -26,7 +26,7 @@ import numpy as np
 from .bodyio import STATE, BodyIO, locked_step, substeps
 from .fewrovers import FewRovers
 from .fleet import _GROUND_ROWS, Fleet
-from .forces import Folded, fold
+from .forces import Folded, fold, per_kind
 from .rover import DiffDriveRover
 from .step_path import describe, extension
 from .wheel import SLIP_SPEED_MIN, step_constants
@@ -118,6 +118,11 @@ def plan_row(rover: DiffDriveRover, dt: float) -> list[float]:
     s = step_constants(rover.wheel, dt, rover.mass, rover.moment, rover.half_track)
     f["big_bc"] = s.big_bc
     return [f[name] for name in PLAN_FIELDS]
+
+
+def plan_rows(rovers: Sequence[DiffDriveRover], dt: float) -> list[list[float]]:
+    """:func:`plan_row` of every rover, folded once per kind of rover (``forces.per_kind``)."""
+    return per_kind(rovers, lambda r: plan_row(r, dt))
 
 
 def _locked_step(space: Any, step: Any) -> int:
@@ -313,8 +318,8 @@ class CompiledFleet(Fleet):
     def refresh(self) -> None:
         """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
         super().refresh()
-        for k, r in enumerate(self.rovers):
-            self._plan_buf[k] = plan_row(r, self.dt)
+        if self.rovers:
+            self._plan_buf[...] = plan_rows(self.rovers, self.dt)
 
     def advance(self) -> tuple[int, str] | None:
         """One physics step in C; a safety violation or None."""
@@ -356,9 +361,9 @@ class ColumnForces(Fleet):
     def refresh(self) -> None:
         """Re-read every rover's constants into the C plan (folded as FewRovers folds them)."""
         super().refresh()
-        self._plan = np.array(
-            [plan_row(r, self.dt) for r in self.rovers], dtype=np.float64
-        ).reshape(len(self.rovers), len(PLAN_FIELDS))
+        self._plan = np.array(plan_rows(self.rovers, self.dt), dtype=np.float64).reshape(
+            len(self.rovers), len(PLAN_FIELDS)
+        )
 
     def apply(self, state: np.ndarray) -> None:
         """Every rover's force and torque for this step (into the io's forces), rims advanced."""
