@@ -361,9 +361,13 @@ class ColumnForces(Fleet):
     def refresh(self) -> None:
         """Re-read every rover's constants into the C plan (folded as FewRovers folds them)."""
         super().refresh()
-        self._plan = np.array(plan_rows(self.rovers, self.dt), dtype=np.float64).reshape(
+        plan = np.array(plan_rows(self.rovers, self.dt), dtype=np.float64).reshape(
             len(self.rovers), len(PLAN_FIELDS)
         )
+        if getattr(self, "_plan", None) is None:
+            self._plan = plan
+        else:  # in place: a :meth:`columns` step holds this array
+            self._plan[...] = plan
 
     def apply(self, state: np.ndarray) -> None:
         """Every rover's force and torque for this step (into the io's forces), rims advanced."""
@@ -374,3 +378,25 @@ class ColumnForces(Fleet):
         )
         if self._span is None:
             self._out[self.rows] = out
+
+    def columns(self, state: np.ndarray, forces: np.ndarray, inverse: tuple, screen: dict) -> Any:
+        """The whole column step in C (``_step.Columns``) over these arrays: contact screening
+        on the state before the step, this model's forces, Chipmunk's integration of a body
+        without contacts and the safety check, as ``columns.ColumnPhysics`` does them in
+        numpy, in one call. ``inverse`` is (1/m, 1/I) per rover; ``screen`` the screening's
+        arrays (``ColumnPhysics._start``); ``state`` and ``forces`` the io's, which the step
+        updates in place (this model's ``state`` becomes ``state``)."""
+        self.state = state
+        return _step.Columns(  # type: ignore[union-attr]
+            self._plan,
+            self.drives,
+            self.rims,
+            self.ground,
+            state,
+            forces,
+            *inverse,
+            self.dt,
+            self.max_speed**2,
+            self.extent,
+            **screen,
+        )
