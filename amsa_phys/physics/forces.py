@@ -41,6 +41,7 @@ import dataclasses
 import math
 from array import array
 from collections.abc import Callable, Sequence
+from operator import attrgetter
 from typing import Any, NamedTuple, TypeVar
 
 from .rover import DiffDriveRover
@@ -123,7 +124,8 @@ def fold(rover: DiffDriveRover, dt: float) -> Folded:
 
 
 _T = TypeVar("_T")
-_FIELDS: dict[type, tuple[str, ...]] = {}
+#: per wheel class: a getter of all its dataclass fields as one tuple (one C call)
+_FIELDS: dict[type, Callable[[Any], tuple[Any, ...]]] = {}
 
 
 def fold_key(rover: DiffDriveRover) -> tuple[type, bytes]:
@@ -131,14 +133,15 @@ def fold_key(rover: DiffDriveRover) -> tuple[type, bytes]:
     with equal keys fold to the same constants (``-0.0`` and ``0.0``, or two NaNs, differ)."""
     w = rover.wheel
     kind = type(w)
-    names = _FIELDS.get(kind)
-    if names is None:
+    fields = _FIELDS.get(kind)
+    if fields is None:
         if not dataclasses.is_dataclass(w):  # no known fields: this rover shares nothing
             return kind, id(rover).to_bytes(8, "little") + b"id"
-        names = _FIELDS[kind] = tuple(f.name for f in dataclasses.fields(w))
-    values = [getattr(w, name) for name in names]
-    values += (rover.mass, rover.moment, rover.half_track)
-    return kind, array("d", values).tobytes()
+        names = [f.name for f in dataclasses.fields(w)]
+        fields = _FIELDS[kind] = attrgetter(names[0], names[0], *names[1:])  # always a tuple
+    values = array("d", fields(w))
+    values.extend((rover.mass, rover.moment, rover.half_track))
+    return kind, values.tobytes()
 
 
 def per_kind(rovers: Sequence[DiffDriveRover], make: Callable[[DiffDriveRover], _T]) -> list[_T]:
