@@ -52,6 +52,8 @@ def check_layout(ext: Any) -> tuple[str, ...]:
         problems.append(f"SLIP_SPEED_MIN {ext.SLIP_SPEED_MIN} != wheel.py's {SLIP_SPEED_MIN}")
     if list(ext.GROUND_ROWS) != _GROUND_ROWS or len(_GROUND_ROWS) != ext.GROUND_TERMS:
         problems.append(f"ground rows {ext.GROUND_ROWS} != fleet._GROUND_ROWS {_GROUND_ROWS}")
+    if not hasattr(ext, "Columns"):  # older builds: no batch step, Stepper takes 7 functions
+        problems.append("no Columns (the batch's step)")
     if problems:
         raise ImportError(
             "amsa_phys.physics._step was built from another version of _step.c ("
