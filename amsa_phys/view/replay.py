@@ -118,7 +118,9 @@ class ReplayScene:
         if q is None or q.signal not in self.col:
             return None
         s = self.data[:, self.col[q.signal]]
-        return np.maximum.accumulate(s), np.minimum.accumulate(s), np.cumsum((s - q.reference) ** 2)
+        with np.errstate(over="ignore", invalid="ignore"):  # a huge legal reference: inf
+            sq = np.cumsum((s - q.reference) ** 2)
+        return np.maximum.accumulate(s), np.minimum.accumulate(s), sq
 
     def _events(self) -> list[Event]:
         """Every instant worth jumping to, in time order."""

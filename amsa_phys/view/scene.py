@@ -320,7 +320,10 @@ class Scene:
             m.value = v
             m.max = max(m.max, v)
             m.min = min(m.min, v)
-            m.sum_sq += (v - self.quality.reference) ** 2
+            # a product, not ``** 2``: a huge legal reference overflows to inf (as the
+            # metrics' rms does) instead of raising OverflowError mid-run
+            error = v - self.quality.reference
+            m.sum_sq += error * error
             m.count += 1
 
     def frame(self, t: float | None = None) -> Frame:

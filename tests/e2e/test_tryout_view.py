@@ -1,0 +1,56 @@
+"""What a new user's tryout found in the window, the replay and the CLI (polish2's list):
+each test here failed on the code before its fix."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from amsa_phys.cli.main import main
+from amsa_phys.cli.view import load_run
+from amsa_phys.engine.runner import Simulation
+from amsa_phys.model.scenario import load_scenario
+from amsa_phys.view.pg import pygame
+from amsa_phys.view.player import Player
+from amsa_phys.view.window import Window
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+WORLD = (ROOT / "worlds" / "mde_challenge.yaml").as_posix()
+
+
+def press(key: int, text: str = "", mod: int = 0) -> None:
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=key, mod=mod, unicode=text))
+
+
+def scenario(tmp_path: Path, quality: str, extra: str = "", duration: float = 6) -> Path:
+    path = tmp_path / "s.yaml"
+    path.write_text(
+        f"world: {WORLD}\nduration: {duration}\nseed: 1\nquality: {quality}\n"
+        "set: {Leader.behavior: 1, MyFollowerController.Kv: 0.35}\n" + extra
+    )
+    return path
+
+
+def test_a_huge_legal_reference_draws_instead_of_crashing(tmp_path: Path) -> None:
+    """``reference: 1.0e+308`` is legal: ``(v - reference) ** 2`` raised OverflowError in the
+    scene's live metrics (snapshot, video, window) and the HUD printed a 309-digit error."""
+    huge = (
+        "{signal: MyDistanceMonitor.distanceFollowerToLeader, reference: 1.0e+308, tolerance: 1.5}"
+    )
+    scen = scenario(tmp_path, huge)
+    out, png = tmp_path / "run", tmp_path / "snap.png"
+    argv = ["run", str(scen), "--headless", "-q", "--no-plot", "--out", str(out)]
+    assert main([*argv, "--snapshot", str(png)]) == 0
+    assert png.stat().st_size > 0
+    sim = Simulation.from_scenario(load_scenario(scen))
+    sim.initialize()
+    w = Window(sim, load_scenario(scen).quality, size=(800, 450))
+    sim.advance(sim.grid.ticks(2))
+    w.frame(0.0)
+    hud = "\n".join(w.renderer.texts["hud"])
+    assert "ref 1e+308" in hud
+    assert "error -1e+308 m" in hud
+    assert "rms error overflow m" in hud  # metrics.json writes it null, listed as nonfinite
+    assert max(len(line) for line in hud.splitlines()) < 120
+    p = Player(load_run(out), title="test", size=(640, 360))
+    p.frame(0.0)
+    assert "error -1e+308 m" in "\n".join(p.renderer.texts["hud"])
