@@ -19,6 +19,7 @@ from matplotlib.figure import Figure
 from ..errors import ConfigError
 from ..model.params import short_repr
 from ..palette import COLLISION, PHASE, REFERENCE, SIGNAL, hex_colour
+from ..valuetext import value_text
 from .adaptmarks import adapt_switches
 from .save import save_png
 
@@ -153,7 +154,7 @@ def _phase_notes(ax: Axes, phases: list[dict[str, Any]]) -> list[str]:
         start = phase["start"]
         if start > 0:
             ax.axvline(start, color=hex_colour(PHASE), lw=0.8, ls=":")
-        lines = [f"{k.split('.')[-1]}={v}" for k, v in phase["set"].items()]
+        lines = [f"{k.split('.')[-1]}={value_text(v)}" for k, v in phase["set"].items()]
         if len(lines) > MAX_NOTE_LINES:
             lines = [*lines[: MAX_NOTE_LINES - 1], f"+{len(lines) - MAX_NOTE_LINES + 1} more"]
         if phase.get("label"):
@@ -193,7 +194,9 @@ def _inner_changes(ax: Axes, phases: list[dict[str, Any]]) -> list[float]:
                 alpha=0.8,
                 label="change inside a phase" if len(times) == 1 else None,
             )
-            what = ", ".join(f"{k.split('.')[-1]}={v}" for k, v in change["set"].items())
+            what = ", ".join(
+                f"{k.split('.')[-1]}={value_text(v)}" for k, v in change["set"].items()
+            )
             label = change.get("label")
             ax.annotate(
                 f"{label}: {what}" if label else what,

@@ -23,6 +23,7 @@ from ..model.scenario import Quality
 from ..model.world import WorldSpec
 from ..palette import rover_names, rover_ranks
 from ..tracemarks import gps_links, lossy_in_run, lost_fix_rows
+from ..valuetext import value_text
 from .scene import (
     GPS_POINTS,
     LOST_POINTS,
@@ -306,12 +307,13 @@ class ReplayScene:
                 for k, v in (c.get("set") or {}).items():
                     inside[k] = (float(c["at"]), v, how)
         sets = [
-            f"{k.rpartition('.')[2]}={v}"
+            f"{k.rpartition('.')[2]}={value_text(v)}"
             for k, v in (p.get("set") or {}).items()
             if k not in inside
         ]
         sets += [
-            f"{k.rpartition('.')[2]}={v} {how} {at:.1f} s" for k, (at, v, how) in inside.items()
+            f"{k.rpartition('.')[2]}={value_text(v)} {how} {at:.1f} s"
+            for k, (at, v, how) in inside.items()
         ]
         return phase_line(index, len(self.phases), p.get("label", ""), float(p["start"]), sets)
 

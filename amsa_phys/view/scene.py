@@ -19,6 +19,7 @@ from ..engine.runner import Simulation
 from ..model.geometry import Obstacle, static_obstacles
 from ..model.scenario import Quality
 from ..palette import rover_names
+from ..valuetext import value_text
 
 #: Trail and GPS history kept per rover: bounded, so a long run draws in constant time.
 TRAIL_POINTS = 1500
@@ -146,8 +147,10 @@ def describe_phase(sim: Simulation, planned: Sequence[Fraction] | None = None) -
     latest: dict[tuple[str, str], Any] = {}
     for c in phase.changes:  # the last assignment of a key wins, in its first place
         latest[(c.leaf, c.param)] = c.value
-    parts = [f"{p}={_short(v)}" for (leaf, p), v in latest.items() if (leaf, p) not in live]
-    parts += [f"{p}={_short(v)} {how} {float(at):.1f} s" for (_, p), (at, v, how) in live.items()]
+    parts = [f"{p}={value_text(v)}" for (leaf, p), v in latest.items() if (leaf, p) not in live]
+    parts += [
+        f"{p}={value_text(v)} {how} {float(at):.1f} s" for (_, p), (at, v, how) in live.items()
+    ]
     count = len(planned) - 1 if planned else len(sim.phases)
     text = phase_line(sim.phase_index, count, phase.label, float(phase.at), parts)
     if planned and sim.duration < planned[-1]:
@@ -178,14 +181,6 @@ def adapt_text(sim: Simulation) -> str:
             )
             return f" | adapt at {event.t:.1f} s: {rule}: {short}"
     return ""
-
-
-def _short(value: Any) -> str:
-    if isinstance(value, float):
-        return f"{value:g}"
-    if isinstance(value, tuple):
-        return f"[{len(value)} points]"
-    return str(value)
 
 
 class Scene:

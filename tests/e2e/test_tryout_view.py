@@ -5,12 +5,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from amsa_phys.cli.main import main
 from amsa_phys.cli.view import load_run
 from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.view.pg import pygame
 from amsa_phys.view.player import Player
+from amsa_phys.view.scene import describe_phase
 from amsa_phys.view.window import Window
 
 ROOT = Path(__file__).resolve().parent.parent.parent
@@ -54,3 +57,30 @@ def test_a_huge_legal_reference_draws_instead_of_crashing(tmp_path: Path) -> Non
     p = Player(load_run(out), title="test", size=(640, 360))
     p.frame(0.0)
     assert "error -1e+308 m" in "\n".join(p.renderer.texts["hud"])
+
+
+QUALITY = "{signal: MyDistanceMonitor.distanceFollowerToLeader, reference: 15, tolerance: 1.5}"
+
+
+def test_a_parameter_value_is_spelt_alike_in_the_table_the_hud_and_the_replay(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``cruisePower=9.0`` in the run's table and the replay's HUD, ``9`` in the live HUD,
+    and ``:g`` rounded 0.1234567 to 0.123457 there: one spelling, every digit, no ``.0``."""
+    extra = (
+        "timeline:\n"
+        "  - {at: 3, set: {Leader.cruisePower: 9.0, MyFollowerController.Kv: 0.1234567}}\n"
+    )
+    scen = scenario(tmp_path, QUALITY, extra)
+    out = tmp_path / "run"
+    assert main(["run", str(scen), "--headless", "--no-plot", "--out", str(out)]) == 0
+    table = capsys.readouterr().out
+    assert "Leader.cruisePower=9, MyFollowerController.Kv=0.1234567" in table
+    sim = Simulation.from_scenario(load_scenario(scen))
+    sim.initialize()
+    sim.advance(sim.grid.ticks(4))
+    live = describe_phase(sim)
+    assert live.endswith("from 3 s: cruisePower=9, Kv=0.1234567")
+    p = Player(load_run(out), title="test", size=(640, 360))
+    replay = p.scene.frame(len(p.scene.t) - 1).phase_text
+    assert replay == live
