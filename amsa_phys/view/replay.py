@@ -69,7 +69,9 @@ class ReplayScene:
             if q
             else None
         )
-        self.duration = float(metrics.get("duration") or self.t[-1])
+        # the run's end, which the slider says too: a run closed early in the window keeps
+        # the file's duration in metrics.json ("/ 200 s" in the HUD beside "/ 63.4 s")
+        self.duration = float(self.t[-1])
         self.phases: list[dict[str, Any]] = list(metrics.get("phases") or [])
         shown = rover_names(columns)
         self.ranks = rover_ranks(rover_names(list(world.buffers)), shown)

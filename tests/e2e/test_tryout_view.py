@@ -84,3 +84,44 @@ def test_a_parameter_value_is_spelt_alike_in_the_table_the_hud_and_the_replay(
     p = Player(load_run(out), title="test", size=(640, 360))
     replay = p.scene.frame(len(p.scene.t) - 1).phase_text
     assert replay == live
+
+
+def test_the_replay_hud_forgets_a_jumps_notice_and_ends_where_the_run_did(tmp_path: Path) -> None:
+    """PgDn then End left ``125.00 s: phase 1: ...`` in the HUD at the run's end; a run closed
+    early in the window said ``/ 200 s`` in the HUD and ``/ 4 s`` on the slider."""
+    short = ROOT / "tests" / "fixtures" / "mde_short.yaml"
+    out = tmp_path / "run"
+    assert main(["run", str(short), "--headless", "-q", "--no-plot", "--duration", "130",
+                 "--out", str(out)]) == 0  # fmt: skip
+    p = Player(load_run(out), title="test", size=(800, 480))
+    press(pygame.K_PAGEDOWN)
+    p.frame(0.0)
+    assert "125.00 s: phase 1" in "\n".join(p.renderer.texts["hud"])
+    press(pygame.K_END)
+    p.frame(0.0)
+    assert p.t == 130.0
+    hud = "\n".join(p.renderer.texts["hud"])
+    assert "125.00 s" not in hud
+    assert hud.startswith("t   130.00 s / 130 s\nphase 1 (of 0–1) from 125 s: Kv=0.15")
+
+    def close_at_four_seconds(sim: Simulation, scen: object, rec: object) -> None:
+        w = Window(sim, load_scenario(short).quality, size=(320, 240))
+        while sim.now < 4:
+            w.frame(0.1)
+        press(pygame.K_ESCAPE)
+        w.frame(0.1)
+
+    from amsa_phys.runs.single import run_scenario
+
+    early = tmp_path / "early"
+    early.mkdir()
+    run_scenario(
+        load_scenario(short, duration=200), early, window=close_at_four_seconds, plot=False
+    )
+    p = Player(load_run(early), title="test", size=(800, 480))
+    press(pygame.K_END)
+    p.frame(0.0)
+    end = p.scene.t[-1]
+    assert 4 <= end < 5
+    assert p.renderer.texts["hud"][0] == f"t {end:8.2f} s / {end:g} s"
+    assert p.scene.duration == end  # the slider's label says the same end
