@@ -120,7 +120,11 @@ class Frame:
     collisions: list[tuple[float, float]] = field(default_factory=list)
 
 
-def describe_phase(sim: Simulation, planned: Sequence[Fraction] | None = None) -> str:
+def describe_phase(
+    sim: Simulation,
+    planned: Sequence[Fraction] | None = None,
+    replaced: Sequence[str] = (),
+) -> str:
     """``phase 2 (of 0–3) from 125 s: Kv=0.15`` — what the HUD prints about the current phase.
 
     A parameter set twice at a phase's start (the scenario's ``set:`` and a ``--set``
@@ -131,7 +135,9 @@ def describe_phase(sim: Simulation, planned: Sequence[Fraction] | None = None) -
     (``Kv=0.15 at 20.0 s``): the HUD never shows a value the run is not using. ``planned``:
     the file's phase starts and duration when ``--duration`` shortened the run
     (``Scenario.planned_bounds``): the count is then the file's, and the line says where
-    this run stops.
+    this run stops. ``replaced``: components an agent stands in for (the Gymnasium env):
+    their parameters are set but act on nothing, so they are not listed as if they did
+    (the env's status box says ``agent: MyFollowerController``).
     """
     phase = sim.phases[sim.phase_index]
     live: dict[tuple[str, str], tuple[Any, Any, str]] = {}
@@ -140,13 +146,15 @@ def describe_phase(sim: Simulation, planned: Sequence[Fraction] | None = None) -
     for point in sim.timeline.points():
         if phase.at < point.at <= sim.now and not point.starts_phase:
             for c in point.changes:
-                live[(c.leaf, c.param)] = (point.at, c.value, "at")
+                if c.leaf not in replaced:
+                    live[(c.leaf, c.param)] = (point.at, c.value, "at")
     for at, c in sim.live_changes:
-        if at >= phase.at:
+        if at >= phase.at and c.leaf not in replaced:
             live[(c.leaf, c.param)] = (at, c.value, "live at")
     latest: dict[tuple[str, str], Any] = {}
     for c in phase.changes:  # the last assignment of a key wins, in its first place
-        latest[(c.leaf, c.param)] = c.value
+        if c.leaf not in replaced:
+            latest[(c.leaf, c.param)] = c.value
     parts = [f"{p}={value_text(v)}" for (leaf, p), v in latest.items() if (leaf, p) not in live]
     parts += [
         f"{p}={value_text(v)} {how} {float(at):.1f} s" for (_, p), (at, v, how) in live.items()
@@ -198,8 +206,11 @@ class Scene:
         sim: Simulation,
         quality: Quality | None = None,
         planned: Sequence[Fraction] | None = None,
+        replaced: Sequence[str] = (),
     ) -> None:
         self.sim = sim
+        #: components an agent stands in for: their parameters are not shown as acting
+        self.replaced = tuple(replaced)
         self.quality = quality
         #: the file's phase bounds when ``--duration`` shortened the run (the HUD counts them)
         self.planned = planned
@@ -345,7 +356,7 @@ class Scene:
             quality=self.quality,
             phase_index=sim.phase_index,
             phase_count=len(sim.phases),
-            phase_text=describe_phase(sim, self.planned),
+            phase_text=describe_phase(sim, self.planned, self.replaced),
             duration=float(sim.duration),
             scans=self.scans(),
             zones=self.zones(),

@@ -125,3 +125,23 @@ def test_the_replay_hud_forgets_a_jumps_notice_and_ends_where_the_run_did(tmp_pa
     assert 4 <= end < 5
     assert p.renderer.texts["hud"][0] == f"t {end:8.2f} s / {end:g} s"
     assert p.scene.duration == end  # the slider's label says the same end
+
+
+def test_the_gym_frame_does_not_show_the_replaced_controllers_parameters() -> None:
+    """The agent replaced MyFollowerController: its ``Kv=0.35`` acts on nothing, and the
+    ``rgb_array`` HUD showed it as if it did."""
+    gym = pytest.importorskip("amsa_phys.gym", reason="the gym extra is not installed")
+    env = gym.FollowEnv(
+        str(ROOT / "scenarios" / "scenario1.yaml"),
+        duration=10,
+        render_mode="rgb_array",
+        render_size=(640, 360),
+    )
+    env.reset(seed=1)
+    env.step(env.action_space.sample())
+    assert env.render() is not None
+    hud = env._frames.renderer.texts["hud"]
+    status = env._frames.renderer.texts["status"]
+    assert hud[1] == "phase 0 from 0 s: behavior=1, lostDataGPS=0, motorCoef=100"
+    assert "agent: MyFollowerController" in status
+    env.close()
