@@ -227,6 +227,11 @@ class Scene:
         #: where collisions happened (the midpoint of the rovers named), as the plots mark them
         self.collisions: deque[tuple[float, float]] = deque(maxlen=LOST_POINTS)
         self._events_seen = 0
+        #: the logged instant a picture is due at (``expect``) and the rovers as they stood
+        #: there: the physics step that ends an instant moves the bodies on, so a picture
+        #: drawn after the instant would show them one step later than its HUD's sample
+        self._due: float | None = None
+        self._held: tuple[float, list[RoverPose]] | None = None
         # rovers in declaration order: the i-th has the i-th colour, as in the plots
         self._rank = {name: i for i, name in enumerate(rover_names(list(sim.world.buffers)))}
         self.pair_lines = self._between_rovers()
@@ -289,8 +294,15 @@ class Scene:
         out.sort(key=lambda r: self._rank.get(r.name, len(self._rank)))
         return out
 
+    def expect(self, t: float) -> None:
+        """A picture will be drawn at ``t``: if a logged instant falls there, keep the rovers
+        as they stand at its log (after its components, before its physics step)."""
+        self._due = t
+
     def _sample(self, t_s: float, values: dict[str, float]) -> None:
         """One logged instant: extend trails, note new and lost GPS fixes, update metrics."""
+        if t_s == self._due:
+            self._held = (t_s, self.rovers())
         physics = self._physics()
         where: dict[str, tuple[float, float]] = {}
         for r in physics.rovers if physics is not None else ():
@@ -339,7 +351,10 @@ class Scene:
         simulation's current instant. A trail ends at the rover's current position.
         """
         sim = self.sim
-        rovers = self.rovers()
+        when = float(sim.now) if t is None else t
+        held = self._held
+        # at a logged instant, the rovers where its components and log saw them
+        rovers = held[1] if held is not None and held[0] == when else self.rovers()
         trails = {k: list(v) for k, v in self.trails.items()}
         for r in rovers:
             trails.setdefault(r.name, []).append((r.x, r.y))
@@ -347,7 +362,7 @@ class Scene:
         physics = self._physics()
         m.collisions = physics.collisions if physics is not None else 0
         return Frame(
-            t=float(sim.now) if t is None else t,
+            t=when,
             rovers=rovers,
             trails=trails,
             gps=self.gps,

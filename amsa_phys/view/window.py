@@ -159,7 +159,7 @@ class Window:
             tick = int(target / self.sim.grid.tick)
             if tick >= self.sim.grid.ticks(self.sim.now):
                 before = self.sim.now
-                advance(self.sim, min(tick, self._end), self.sinks)
+                self._advance(min(tick, self._end))
                 self._owed -= float(self.sim.now - before)
         if self.notice.endswith(QUEUED_NOTICE) and not self.sim.pending_live:
             self._quit_asked = False  # the queued change has landed: the warning is stale
@@ -173,7 +173,13 @@ class Window:
         if self.finished:
             return
         tick = self.sim.grid.ticks(self.sim.next_instant())
-        advance(self.sim, min(tick, self._end), self.sinks)
+        self._advance(min(tick, self._end))
+
+    def _advance(self, tick: int) -> None:
+        """Run every instant up to ``tick``; the picture drawn then shows the rovers where
+        that instant's log saw them (not one physics step on)."""
+        self.scene.expect(float(self.sim.grid.time(tick)))
+        advance(self.sim, tick, self.sinks)
 
     # -- input ---------------------------------------------------------------------------
     def handle(self, event: pygame.event.Event) -> None:

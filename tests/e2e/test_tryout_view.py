@@ -145,3 +145,57 @@ def test_the_gym_frame_does_not_show_the_replaced_controllers_parameters() -> No
     assert hud[1] == "phase 0 from 0 s: behavior=1, lostDataGPS=0, motorCoef=100"
     assert "agent: MyFollowerController" in status
     env.close()
+
+
+def logged(sim: Simulation) -> dict[float, dict[str, float]]:
+    """Every logged row of ``sim`` by time, as trace.csv will have it."""
+    rows: dict[float, dict[str, float]] = {}
+    sim.add_log_listener(lambda t, values: rows.__setitem__(t, dict(values)))
+    return rows
+
+
+def test_a_picture_at_a_logged_instant_shows_that_instants_sample(tmp_path: Path) -> None:
+    """A video frame (and the snapshot, and the window) at t was drawn before the components
+    due at t ran: its HUD showed the sample before t (21.42 m at 130.00 s where trace.csv
+    has 21.14 m). Now the HUD's measured value and the drawn rovers are trace.csv's row at t;
+    the trace itself is unchanged (the golden and byte-identity tests hold it)."""
+    from fractions import Fraction
+
+    from amsa_phys.view.drive import advance
+    from amsa_phys.view.recorder import Snapshot, SnapshotOptions
+
+    class Seen(Snapshot):
+        """The snapshot, noting what it drew (the HUD's value then: the metrics live on)."""
+
+        def write(self, t: Fraction | None = None) -> Path:
+            frame = self.scene.frame(None if t is None else float(t))
+            self.seen = (frame, frame.metrics.value)
+            return super().write(t)
+
+    short = ROOT / "tests" / "fixtures" / "mde_short.yaml"
+    scen = load_scenario(short, duration=12)
+    signal = scen.quality.signal
+    for at in (Fraction(10), Fraction(21, 2)):  # the monitor runs at 4 Hz: 10 s and 10.5 s
+        sim = Simulation.from_scenario(scen)
+        sim.initialize()
+        rows = logged(sim)
+        snap = Seen(sim, SnapshotOptions(tmp_path / "s.png", (320, 240), at), scen.quality)
+        advance(sim, sim.grid.ticks(at) + 100, [snap])  # on past the picture
+        row = rows[float(at)]
+        frame, value = snap.seen
+        assert value == row[signal]
+        assert rows[float(at) - 0.05][signal] != row[signal]  # the sample before differs
+        for r in frame.rovers:
+            assert (r.x, r.y) == (row[f"{r.name}.posX"], row[f"{r.name}.posY"])
+    # the live window: the picture after an instant is that instant's row too
+    sim = Simulation.from_scenario(scen)
+    sim.initialize()
+    rows = logged(sim)
+    w = Window(sim, scen.quality, size=(320, 240))
+    while sim.now < 10:
+        w.frame(0.1)
+    frame = w.scene.frame()
+    row = rows[frame.t]
+    assert w.scene.metrics.value == row[signal]
+    for r in frame.rovers:
+        assert (r.x, r.y) == (row[f"{r.name}.posX"], row[f"{r.name}.posY"])
