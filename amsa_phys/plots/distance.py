@@ -295,7 +295,7 @@ def distance_figure(
     FigureCanvasAgg(fig)  # the canvas pyplot would give it (callers draw and measure on it)
     ax = fig.subplots()
     changes: list[float] = []
-    if signal in header and data.size and abs(float(quality["reference"])) < PLOTTABLE:
+    if signal in header and data.size:
         t = data[:, 0]
         s = data[:, header.index(signal)]
         ref = float(quality["reference"])
@@ -303,19 +303,30 @@ def distance_figure(
         # a tolerance near the float limit (the schema takes any finite one) is drawn to
         # PLOTTABLE: the axis's top, its edge with headroom, would overflow to inf
         band = min(tol, PLOTTABLE)
-        ax.fill_between(
-            [t[0], t[-1]],
-            ref - band,
-            ref + band,
-            color=hex_colour(REFERENCE),
-            alpha=0.15,
-            label=f"tolerance ±{tol:g} m",
-        )
         ref_colour = hex_colour(REFERENCE)
-        ax.axhline(ref, color=ref_colour, lw=1.2, ls="--", label=f"reference {ref:g} m")
+        top = float(np.nanmax(s)) if np.isfinite(s).any() else 0.0
+        if abs(ref) < PLOTTABLE:
+            ax.fill_between(
+                [t[0], t[-1]],
+                ref - band,
+                ref + band,
+                color=ref_colour,
+                alpha=0.15,
+                label=f"tolerance ±{tol:g} m",
+            )
+            ax.axhline(ref, color=ref_colour, lw=1.2, ls="--", label=f"reference {ref:g} m")
+            top = max(top, ref + band)
+        else:  # a legal reference near the float limit: the signal still has its plot
+            ax.plot(
+                [],
+                [],
+                color=ref_colour,
+                lw=1.2,
+                ls="--",
+                label=f"reference {ref:g} m (off the scale)",
+            )
         # palette.SIGNAL, near-black: blue and orange are the rovers' colours everywhere
         ax.plot(t, s, color=hex_colour(SIGNAL), lw=1.2, label=signal)
-        top = max(float(np.nanmax(s)) if np.isfinite(s).any() else 0.0, ref + band)
         lines = _phase_notes(ax, metrics.get("phases", []))
         changes = _inner_changes(ax, metrics.get("phases", []))
         _collisions(ax, metrics.get("events", []), t, s)

@@ -3,6 +3,7 @@ each test here failed on the code before its fix."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -57,6 +58,15 @@ def test_a_huge_legal_reference_draws_instead_of_crashing(tmp_path: Path) -> Non
     p = Player(load_run(out), title="test", size=(640, 360))
     p.frame(0.0)
     assert "error -1e+308 m" in "\n".join(p.renderer.texts["hud"])
+    # distance.png still plots the signal (it said "no quality signal")
+    from amsa_phys.plots.distance import distance_figure
+
+    metrics = json.loads((out / "metrics.json").read_text())
+    labels = distance_figure(out / "trace.csv", metrics).axes[0].get_legend_handles_labels()[1]
+    assert labels == [
+        "reference 1e+308 m (off the scale)",
+        "MyDistanceMonitor.distanceFollowerToLeader",
+    ]
 
 
 QUALITY = "{signal: MyDistanceMonitor.distanceFollowerToLeader, reference: 15, tolerance: 1.5}"
