@@ -20,6 +20,7 @@ from fractions import Fraction
 from ..engine import interrupt
 from ..engine.runner import Simulation
 from ..model.scenario import Quality
+from ..valuetext import value_text
 from .camera import Camera
 from .draw import INK, LOST, MUTED, Renderer
 from .drive import advance
@@ -276,7 +277,7 @@ class Window:
         """
         pending = self.sim.pending_live
         if pending and not confirmed and not self.finished:
-            changes = ", ".join(f"{c.key}={c.value}" for c in pending)
+            changes = ", ".join(f"{c.key}={value_text(c.value)}" for c in pending)
             self.notice = f"{changes}{QUEUED_NOTICE}"
             self._quit_asked = True
             return
@@ -292,7 +293,9 @@ class Window:
         change = self.panel.commit()
         if change is not None:
             at = self.sim.apply_live(change)
-            self.panel.message = f"{change.key} = {change.value} at t = {float(at):.2f} s"
+            self.panel.message = (
+                f"{change.key} = {value_text(change.value)} at t = {float(at):.2f} s"
+            )
             self.notice = f"live: {self.panel.message}"
 
     def _resize(self, size: tuple[int, int]) -> None:

@@ -94,6 +94,15 @@ def test_a_parameter_value_is_spelt_alike_in_the_table_the_hud_and_the_replay(
     p = Player(load_run(out), title="test", size=(640, 360))
     replay = p.scene.frame(len(p.scene.t) - 1).phase_text
     assert replay == live
+    # the window's panel spells it so too (it rounded to 6 digits: 0.123457)
+    w = Window(sim, load_scenario(scen).quality, size=(640, 360))
+    press(pygame.K_p)
+    w.frame(0.0)
+    while w.panel.row.key != "MyFollowerController.Kv":
+        press(pygame.K_DOWN)
+        w.frame(0.0)
+    (selected,) = [line for line in w.panel.lines() if line.startswith(">")]
+    assert selected.startswith("> MyFollowerController.Kv = 0.1234567 ")
 
 
 def test_the_replay_hud_forgets_a_jumps_notice_and_ends_where_the_run_did(tmp_path: Path) -> None:
