@@ -96,8 +96,9 @@ Physical Leaves (@@{local:code}) share one pymunk world, so they step inside
 
 _FRAMEWORK = """
 Framework topics: `/clock`, `/amsa/step/LEAF` and `/amsa/done/LEAF` (lockstep requests and
-answers, `std_msgs/String`), `/amsa/phase` (the scenario node's announcements),
-`/amsa/ready` (start-up handshake: ROS 1 drops what is published before a subscriber
+answers, `std_msgs/String`; for the C++ Leaves in `amsa_leaves`, one message a wave on
+`/amsa/step/amsa_leaves` and `/amsa/done/amsa_leaves`), `/amsa/phase` (the scenario node's
+announcements), `/amsa/ready` (start-up handshake: ROS 1 drops what is published before a subscriber
 connects, so the run starts once every publisher has all its subscribers).
 
 ## Your own node

@@ -180,6 +180,51 @@ class ReadyBoard {
   std::set<std::string> ready_;
 };
 
+class LeafNode;
+
+// Lockstep in the container: the simulator asks the container's Leaves of a wave in one
+// message on /amsa/step/amsa_leaves, a line each: "/LEAF step SEQ NUM DEN C1..Cn" (or
+// "/LEAF param SEQ NAME"), in the engine's order; a count "N+" is N plus what the input's
+// producer, a Leaf asked earlier in the same message, publishes on it in this step (its
+// reader is stepped once the producer has answered). Once every Leaf of the message has
+// answered, one message on /amsa/done/amsa_leaves holds the answers, "/LEAF ANSWER" a line.
+class Dispatcher {
+ public:
+  static Dispatcher& get() {
+    static Dispatcher dispatcher;
+    return dispatcher;
+  }
+  void add(LeafNode* leaf);
+  bool connected() const { return done_ && done_.getNumSubscribers() > 0; }
+  void answer(const std::string& leaf, const std::string& text);
+
+ private:
+  struct Item {
+    LeafNode* leaf = nullptr;
+    std::string head;                     // "step SEQ NUM DEN" or "param SEQ NAME"
+    std::vector<std::string> counts;      // step: C1..Cn, "N+" for a chained input
+    std::vector<int> producer;            // for each count: the item it waits for, or -1
+    std::vector<std::size_t> out_index;   // ... and the producer's output index
+    bool sent = false, done = false;
+    std::string answer;
+  };
+  struct Batch {
+    std::vector<Item> items;
+    std::size_t left = 0;
+  };
+
+  void onBatch(const std::string& text);
+  // The items whose producers have answered, as requests to send (mutex_ held).
+  void ready(Batch& batch, std::vector<std::pair<LeafNode*, std::string>>* send);
+
+  std::mutex mutex_;
+  std::map<std::string, LeafNode*> leaves_;
+  std::map<std::string, std::pair<std::string, std::size_t>> producers_;  // topic -> (leaf, k)
+  std::deque<Batch> open_;
+  ros::Subscriber sub_;
+  ros::Publisher done_;
+};
+
 class LeafNode : public nodelet::Nodelet {
  public:
   LeafNode(std::vector<std::string> in_ports, std::vector<std::string> out_ports,
@@ -191,6 +236,26 @@ class LeafNode : public nodelet::Nodelet {
     notify();
     if (worker_.joinable()) worker_.join();
   }
+
+  // A request ("step SEQ NUM DEN C1..Cn" or "param SEQ NAME"): kept until its inputs are in.
+  void submit(const std::string& text) {
+    std::string answer;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      pending_ = text;
+      answer = tryPending();
+    }
+    if (!answer.empty()) reply(answer);
+  }
+
+  // The nodelet's name, /LEAF (getName() is protected in nodelet::Nodelet).
+  const std::string& nodeName() const { return getName(); }
+  // The topic of input ``i`` (the container resolves counts by its producer).
+  const std::string& topicName(std::size_t i) const { return topics_.at(i).name; }
+  std::size_t topicCount() const { return topics_.size(); }
+  // The topic of output ``k``.
+  const std::string& outputTopic(std::size_t k) const { return outputs_.at(k).topic; }
+  std::size_t outputCount() const { return outputs_.size(); }
 
   void onInit() override {
     ros::NodeHandle& nh = getNodeHandle();
@@ -255,11 +320,14 @@ class LeafNode : public nodelet::Nodelet {
       want_.push_back(sim ? subscribers + (bag ? 1 : 0) : 0);
     }
     lockstep_ = mode == "lockstep";
-    if (lockstep_) {
+    shared_ = lockstep_ && shared;  // asked through the container's one topic (Dispatcher)
+    if (shared_) {
+      Dispatcher::get().add(this);
+    } else if (lockstep_) {
       done_ = nh.advertise<std_msgs::String>("/amsa/done" + getName(), 1000, wake, ros::SubscriberStatusCallback());
       step_sub_ = nh.subscribe<std_msgs::String>(
           "/amsa/step" + getName(), 1000,
-          [this](const std_msgs::String::ConstPtr& m) { onStep(m->data); },
+          [this](const std_msgs::String::ConstPtr& m) { submit(m->data); },
           ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
     }
     // onInit must return (the manager loads the next Leaf): start-up and free mode's loop
@@ -325,7 +393,8 @@ class LeafNode : public nodelet::Nodelet {
       bool all = true;
       for (std::size_t i = 0; i < pubs_.size(); ++i)
         if (static_cast<int>(pubs_[i].getNumSubscribers()) < want_[i]) all = false;
-      if (lockstep_ && done_.getNumSubscribers() < 1) all = false;
+      if (lockstep_ && !shared_ && done_.getNumSubscribers() < 1) all = false;
+      if (shared_ && !Dispatcher::get().connected()) all = false;
       if (all) return true;
       if (std::chrono::steady_clock::now() >= deadline) return false;
       cond_.wait_for(lock, std::chrono::milliseconds(500));
@@ -374,22 +443,22 @@ class LeafNode : public nodelet::Nodelet {
   }
 
   void onData(std::size_t i, double value) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    count_[i] += 1;
-    latest_[i] = value;
-    if (topics_[i].delayed) history_[i][count_[i]] = value;
-    if (!pending_.empty()) tryPending();
-    cond_.notify_all();
+    std::string answer;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      count_[i] += 1;
+      latest_[i] = value;
+      if (topics_[i].delayed) history_[i][count_[i]] = value;
+      if (!pending_.empty()) answer = tryPending();
+      cond_.notify_all();
+    }
+    if (!answer.empty()) reply(answer);  // outside the lock: the container may go on with
+                                         // a Leaf waiting for this one (Dispatcher)
   }
 
-  void onStep(const std::string& text) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    pending_ = text;
-    tryPending();
-  }
-
-  // Run the pending request once its inputs are in (mutex_ held).
-  void tryPending() {
+  // Run the pending request once its inputs are in (mutex_ held); the answer, or "" if it
+  // is still waiting for an input.
+  std::string tryPending() {
     std::istringstream in(pending_);
     std::string verb, seq;
     in >> verb >> seq;
@@ -399,11 +468,10 @@ class LeafNode : public nodelet::Nodelet {
       pending_.clear();
       for (const ParamSpec& spec : params_) {
         if (spec.name != name) continue;
-        if (reload(spec, false, &error)) reply("done " + seq); else reply("error " + seq + " " + error);
-        return;
+        if (reload(spec, false, &error)) return "done " + seq;
+        return "error " + seq + " " + error;
       }
-      reply("error " + seq + " no parameter " + name);
-      return;
+      return "error " + seq + " no parameter " + name;
     }
     std::int64_t num = 0, den = 1;
     in >> num >> den;
@@ -411,13 +479,10 @@ class LeafNode : public nodelet::Nodelet {
     std::int64_t c = 0;
     while (in >> c) want.push_back(c);
     for (std::size_t i = 0; i < want.size() && i < count_.size(); ++i)
-      if (count_[i] < want[i]) return;  // an input message is still on its way
+      if (count_[i] < want[i]) return "";  // an input message is still on its way
     pending_.clear();
     for (std::size_t i = 0; i < want.size() && i < count_.size(); ++i)
-      if (count_[i] != want[i] && !topics_[i].delayed) {
-        reply("fault " + seq + " inputs out of step");
-        return;
-      }
+      if (count_[i] != want[i] && !topics_[i].delayed) return "fault " + seq + " inputs out of step";
     std::vector<double> seen = latest_;
     for (std::size_t i = 0; i < want.size() && i < count_.size(); ++i) {
       if (!topics_[i].delayed) continue;
@@ -426,8 +491,8 @@ class LeafNode : public nodelet::Nodelet {
       kept.erase(kept.begin(), kept.lower_bound(want[i]));
     }
     const std::string result = step(static_cast<double>(num) / static_cast<double>(den), seen);
-    if (!result.empty() && result[0] == '!') reply("error " + seq + " " + result.substr(1));
-    else reply("done " + seq + result);
+    if (!result.empty() && result[0] == '!') return "error " + seq + " " + result.substr(1);
+    return "done " + seq + result;
   }
 
   // doStep with the inputs ``seen`` (by topic); publishes; " I J .." (the outputs
@@ -456,6 +521,10 @@ class LeafNode : public nodelet::Nodelet {
   }
 
   void reply(const std::string& text) {
+    if (shared_) {
+      Dispatcher::get().answer(getName(), text);
+      return;
+    }
     std_msgs::String m;
     m.data = text;
     done_.publish(m);
@@ -529,10 +598,145 @@ class LeafNode : public nodelet::Nodelet {
   std::map<std::string, std::string> last_error_;
   std::string pending_;
   bool lockstep_ = true;
+  bool shared_ = false;  // lockstep in the container: requests come through the Dispatcher
   std::atomic<bool> stop_{false};
   std::mutex mutex_;
   std::condition_variable cond_;
   std::thread worker_;  // start-up, then free mode's loop
 };
+
+inline void Dispatcher::add(LeafNode* leaf) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  leaves_[leaf->nodeName()] = leaf;
+  for (std::size_t k = 0; k < leaf->outputCount(); ++k)
+    producers_[leaf->outputTopic(k)] = std::make_pair(leaf->nodeName(), k);
+  if (!sub_) {
+    ros::NodeHandle nh;
+    done_ = nh.advertise<std_msgs::String>("/amsa/done/amsa_leaves", 1000);
+    sub_ = nh.subscribe<std_msgs::String>(
+        "/amsa/step/amsa_leaves", 1000,
+        [this](const std_msgs::String::ConstPtr& m) { onBatch(m->data); }, ros::VoidConstPtr(),
+        ros::TransportHints().tcpNoDelay());
+  }
+}
+
+inline void Dispatcher::onBatch(const std::string& text) {
+  std::vector<std::pair<LeafNode*, std::string>> send;
+  std::string refused;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Batch batch;
+    std::istringstream lines(text);
+    std::string line;
+    std::map<std::string, int> index;  // leaf -> its item in this batch
+    while (std::getline(lines, line)) {
+      std::istringstream in(line);
+      std::string name, verb, seq;
+      in >> name >> verb >> seq;
+      auto found = leaves_.find(name);
+      if (found == leaves_.end()) {
+        refused += name + " error " + seq + " no Leaf " + name + " in this container\n";
+        continue;
+      }
+      Item item;
+      item.leaf = found->second;
+      item.head = verb + " " + seq;
+      std::string word;
+      if (verb == "step") {
+        std::string num, den;
+        in >> num >> den;
+        item.head += " " + num + " " + den;
+        while (in >> word) {
+          const std::size_t i = item.counts.size();
+          int from = -1;
+          std::size_t k = 0;
+          if (!word.empty() && word.back() == '+') {
+            word.pop_back();
+            auto p = i < item.leaf->topicCount() ? producers_.find(item.leaf->topicName(i))
+                                                 : producers_.end();
+            if (p != producers_.end() && index.count(p->second.first)) {
+              from = index[p->second.first];
+              k = p->second.second;
+            }
+          }
+          item.counts.push_back(word);
+          item.producer.push_back(from);
+          item.out_index.push_back(k);
+        }
+      } else {
+        while (in >> word) item.head += " " + word;
+      }
+      index[name] = static_cast<int>(batch.items.size());
+      batch.items.push_back(item);
+    }
+    batch.left = batch.items.size();
+    if (batch.left > 0) {
+      open_.push_back(batch);
+      ready(open_.back(), &send);
+    }
+  }
+  if (!refused.empty()) {
+    std_msgs::String m;
+    m.data = refused.substr(0, refused.size() - 1);
+    done_.publish(m);
+  }
+  for (auto& s : send) s.first->submit(s.second);
+}
+
+inline void Dispatcher::ready(Batch& batch, std::vector<std::pair<LeafNode*, std::string>>* send) {
+  for (Item& item : batch.items) {
+    if (item.sent) continue;
+    bool waiting = false;
+    std::string request = item.head;
+    for (std::size_t i = 0; i < item.counts.size(); ++i) {
+      std::string count = item.counts[i];
+      if (item.producer[i] >= 0) {
+        const Item& from = batch.items[item.producer[i]];
+        if (!from.done) { waiting = true; break; }
+        // "done SEQ I J ..": the outputs it published in this step
+        std::istringstream in(from.answer);
+        std::string kind, seq, k;
+        in >> kind >> seq;
+        long long n = std::stoll(count);
+        while (in >> k)
+          if (kind == "done" && k == std::to_string(item.out_index[i])) n += 1;
+        count = std::to_string(n);
+      }
+      request += " " + count;
+    }
+    if (waiting) continue;
+    item.sent = true;
+    send->emplace_back(item.leaf, request);
+  }
+}
+
+inline void Dispatcher::answer(const std::string& leaf, const std::string& text) {
+  std::vector<std::pair<LeafNode*, std::string>> send;
+  std::string all;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto b = open_.begin(); b != open_.end(); ++b) {
+      Item* mine = nullptr;
+      for (Item& item : b->items)
+        if (item.sent && !item.done && item.leaf->nodeName() == leaf) mine = &item;
+      if (mine == nullptr) continue;
+      mine->done = true;
+      mine->answer = text;
+      b->left -= 1;
+      ready(*b, &send);
+      if (b->left == 0) {
+        for (const Item& item : b->items) all += item.leaf->nodeName() + " " + item.answer + "\n";
+        open_.erase(b);
+      }
+      break;
+    }
+  }
+  if (!all.empty()) {
+    std_msgs::String m;
+    m.data = all.substr(0, all.size() - 1);
+    done_.publish(m);
+  }
+  for (auto& s : send) s.first->submit(s.second);
+}
 
 }  // namespace amsa

@@ -38,7 +38,7 @@ from . import readiness, records, rosio
 from .boundary import VALUES, format_values, readable
 from .config import NodeConfig, load_config
 from .rossim import RosSimulation
-from .waves import DueAt, wave
+from .waves import DueAt, chained, wave
 
 
 class RemoteError(Exception):
@@ -98,6 +98,18 @@ class Link:
         self.step_pubs = {}
         self.subs = []
         self.data_subs: dict[str, Any] = {}
+        #: lockstep: the Leaves of the C++ container are asked together, one message a wave
+        #: on the container's step topic, and answer in one (``batch``: the requests so far)
+        self.shared = self.graph.shared if self.lockstep else frozenset()
+        self.batch: list[str] = []
+        self.node_paths = {names.ns(p): p for p in self.shared}
+        if self.shared:
+            self.batch_pub = self.gate.publisher(names.step_topic(names.CONTAINER), String, 1)
+            self.subs.append(
+                rospy.Subscriber(
+                    names.done_topic(names.CONTAINER), String, self._on_batch, tcp_nodelay=True
+                )
+            )
         for path in self.graph.remote:
             for b in self.graph.outputs(path):
                 self.received[b] = [0, float(world.buffers[b].initial)]
@@ -107,6 +119,7 @@ class Link:
                 self.subs.append(self.data_subs[b])
             if self.lockstep:
                 self.replies[path] = None
+            if self.lockstep and path not in self.shared:
                 self.step_pubs[path] = self.gate.publisher(names.step_topic(path), String, 1)
                 self.subs.append(
                     rospy.Subscriber(
@@ -134,6 +147,17 @@ class Link:
     def _on_done(self, msg: Any, path: str) -> None:
         with self.cond:
             self.replies[path] = msg.data.split("\n")
+            self.cond.notify_all()
+
+    def _on_batch(self, msg: Any) -> None:
+        """The container's answer for a wave: ``LEAF ANSWER`` a line, each Leaf's answer as
+        its own node would have sent it."""
+        with self.cond:
+            for line in msg.data.split("\n"):
+                node, _, answer = line.partition(" ")
+                path = self.node_paths.get(node)
+                if path is not None:
+                    self.replies[path] = [answer]
             self.cond.notify_all()
 
     def _on_phase(self, msg: Any) -> None:
@@ -221,13 +245,23 @@ class Link:
 
     # -- lockstep requests -------------------------------------------------------------------
     def _ask(self, path: str, verb: str, args: str, t: Fraction) -> None:
-        """Send ``VERB SEQ ARGS`` to a node; :meth:`_answer` waits for its answer."""
+        """Send ``VERB SEQ ARGS`` to a node (a Leaf of the container: into the batch that
+        :meth:`_send` sends); :meth:`_answer` waits for its answer."""
         self.seq += 1
         seq = str(self.seq)
         with self.cond:
             self.replies[path] = None
         self.asked[path] = (t, seq)
-        self.step_pubs[path].publish(self.String(f"{verb} {seq} {args}"))
+        if path in self.shared:
+            self.batch.append(f"{names.ns(path)} {verb} {seq} {args}")
+        else:
+            self.step_pubs[path].publish(self.String(f"{verb} {seq} {args}"))
+
+    def _send(self) -> None:
+        """The container's requests asked so far, in one message."""
+        if self.batch:
+            self.batch_pub.publish(self.String("\n".join(self.batch)))
+            self.batch = []
 
     def _answer(self, path: str, t: Fraction, what: str) -> list[str]:
         """Wait for a node's answer to what it was asked; ``[kind, seq, text]``.
@@ -253,14 +287,17 @@ class Link:
     def _request(self, path: str, verb: str, args: str, t: Fraction, what: str) -> list[str]:
         """Ask a node and wait for its answer."""
         self._ask(path, verb, args, t)
+        self._send()
         return self._answer(path, t, what)
 
-    def _counts(self, path: str) -> str:
+    def _counts(self, path: str, plus: set[str]) -> str:
         """How many messages of each input a remote Leaf sees now: every message so far, less
-        a delayed producer's still in flight."""
+        a delayed producer's still in flight; ``N+`` for an input in ``plus``, whose writer,
+        asked in the same wave, adds what it publishes (``waves.chained``)."""
         sim = self.sim
         return " ".join(
             str(self.published[b] - (sim.in_flight(b) if sim is not None else 0))
+            + ("+" if b in plus else "")
             for b in self.graph.input_buffers(path)
         )
 
@@ -288,12 +325,25 @@ class Link:
         """
         if not self.lockstep:
             return {}
-        self.publish_clock(t)
+        if self.graph.bag or self.last_clock < 0:
+            # lockstep: no node steps by /clock (each request carries its instant), the
+            # scenario node gets it at each phase's instant (phase_value); a bag's recorder
+            # stamps messages by it, so it ticks at every step only when bag:= records
+            self.publish_clock(t)
         asked = self.asked.get(path)
         if asked is None or asked[0] != t:
-            for p in self._wave(path, t):
-                if p == path or p not in self.asked:  # once an instant: asked is a step
-                    self._ask(p, "step", f"{t.numerator} {t.denominator} {self._counts(p)}", t)
+            now = self._wave(path, t)
+            batch: list[str] = []
+            for p in now:
+                if p != path and p in self.asked:  # once an instant: asked is a step
+                    continue
+                plus = chained(self.graph, now, p)
+                if any(b.rpartition(".")[0] not in batch for b in plus):
+                    continue  # its writer was asked in an earlier message: ask it later
+                batch.append(p)
+                counts = self._counts(p, plus)
+                self._ask(p, "step", f"{t.numerator} {t.denominator} {counts}", t)
+            self._send()
         head = self._answer(path, t, "a step")
         kind, text = head[0], head[2] if len(head) > 2 else ""
         who = f"{path} ({self.graph.leaf(path).template.name()})"
