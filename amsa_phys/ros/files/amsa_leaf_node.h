@@ -187,7 +187,9 @@ class LeafNode;
 // "/LEAF param SEQ NAME"), in the engine's order; a count "N+" is N plus what the input's
 // producer, a Leaf asked earlier in the same message, publishes on it in this step (its
 // reader is stepped once the producer has answered). Once every Leaf of the message has
-// answered, one message on /amsa/done/amsa_leaves holds the answers, "/LEAF ANSWER" a line.
+// answered, one message on /amsa/done/amsa_leaves holds the answers, "/LEAF ANSWER" a line;
+// a step's answer is "done SEQ I J .. | VI VJ ..": the outputs published and their values
+// (C hex floats), which the simulator records instead of subscribing to those topics.
 class Dispatcher {
  public:
   static Dispatcher& get() {
@@ -316,7 +318,10 @@ class LeafNode : public nodelet::Nodelet {
     for (const OutputPort& o : outputs_) {
       pubs_.push_back(nh.advertise<std_msgs::Float64>(o.topic, 1000, wake, ros::SubscriberStatusCallback()));
       // sim:=false (the controller side alone): no simulator to wait for, start at once
-      const int subscribers = shared ? o.subscribers_shared : o.subscribers;
+      // in lockstep the simulator takes a container Leaf's values from its answer and does
+      // not subscribe to its outputs (the counts include it as one subscriber)
+      const int subscribers =
+          shared ? o.subscribers_shared - (mode == "lockstep" ? 1 : 0) : o.subscribers;
       want_.push_back(sim ? subscribers + (bag ? 1 : 0) : 0);
     }
     lockstep_ = mode == "lockstep";
@@ -508,7 +513,7 @@ class LeafNode : public nodelet::Nodelet {
     } catch (const std::exception& exc) {
       return std::string("!C++ exception: ") + exc.what();
     }
-    std::string indexes;
+    std::string indexes, values;
     for (std::size_t k = 0; k < outputs_.size(); ++k) {
       if (!published[k]) continue;
       std_msgs::Float64 m;
@@ -516,8 +521,13 @@ class LeafNode : public nodelet::Nodelet {
       pubs_[k].publish(m);
       own_[k] = out[k];
       indexes += " " + std::to_string(k);
+      char hex[64];
+      std::snprintf(hex, sizeof hex, " %a", out[k]);  // C99 hex float: the exact double
+      values += hex;
     }
-    return indexes;
+    // in the container the answer carries the values too: the simulator takes them from it
+    // instead of subscribing to every output (one message an instant instead of one each)
+    return shared_ ? indexes + " |" + values : indexes;
   }
 
   void reply(const std::string& text) {
@@ -698,7 +708,7 @@ inline void Dispatcher::ready(Batch& batch, std::vector<std::pair<LeafNode*, std
         std::string kind, seq, k;
         in >> kind >> seq;
         long long n = std::stoll(count);
-        while (in >> k)
+        while (in >> k && k != "|")  // "done SEQ I J .. | VALUES"
           if (kind == "done" && k == std::to_string(item.out_index[i])) n += 1;
         count = std::to_string(n);
       }

@@ -113,6 +113,8 @@ class Link:
         for path in self.graph.remote:
             for b in self.graph.outputs(path):
                 self.received[b] = [0, float(world.buffers[b].initial)]
+                if path in self.shared:
+                    continue  # lockstep: the container's answers carry the values
                 self.data_subs[b] = rospy.Subscriber(
                     names.topic(b), Float64, self._on_data, callback_args=b, tcp_nodelay=True
                 )
@@ -352,6 +354,14 @@ class Link:
         if kind == "fault":
             raise RunFault(who, t, text)
         outputs = self.graph.outputs(path)
+        if path in self.shared:  # "I J .. | VI VJ ..": the outputs published, their values
+            indexes, _, values = text.partition("|")
+            got = [outputs[int(i)] for i in indexes.split()]
+            for b, v in zip(got, values.split(), strict=True):
+                self.published[b] += 1
+                self.received[b] = [self.published[b], float.fromhex(v)]
+            self.tell_boundary(t, [(b, self.received[b][1]) for b in got])
+            return {b.rpartition(".")[2]: self.received[b][1] for b in got}
         got = [outputs[int(i)] for i in text.split()]
         for b in got:
             self.published[b] += 1
