@@ -154,6 +154,54 @@ def launch(ws: Path, launch_file: str, *args: str) -> tuple[float, float, int, s
     return wall, float(m.group(1)), peak[0], text
 
 
+#: The floor of lockstep: a rover driven by two C++ Leaves of the container (a constant power
+#: and an actuator chained on it) at scenario1's 4 Hz, so one wait an instant as scenario1
+#: has at best, and next to nothing else: what a lockstep instant costs on this machine
+#: beyond the in-process loop (a request, the container's steps and the answer, through
+#: rospy and roscpp over loopback TCP)
+FLOOR_WORLD = """\
+name: rosFloor
+physics: {rate: 100, ground: {friction: 0.8, rolling_resistance: 0.0017}, obstacles: []}
+components:
+  Cart:
+    template: controlledRobot
+    freq: 4
+    inputs: {powerL: Act.normalizedPowerL, powerR: Act.normalizedPowerR}
+  Act:
+    template: NormalizePower
+    freq: 4
+    inputs: {powerL: Drive.LeftPower, powerR: Drive.RightPower}
+  Drive:
+    template: ConstantPower
+    freq: 4
+    params: {left: 9.0, right: 7.0}
+"""
+
+
+def floor(root: Path, duration: str, repeat: int) -> None:
+    """Lockstep's floor on this machine (:data:`FLOOR_WORLD`), against its in-process loop."""
+    (root / "floor_world.yaml").write_text(FLOOR_WORLD)
+    scenario = root / "floor.yaml"
+    scenario.write_text(f"name: floor\nworld: floor_world.yaml\nduration: {duration}\nseed: 1\n")
+    ws = root / "ws_floor"
+    build(scenario, ws)
+    for _ in range(repeat):
+        ref = root / "floor_ref"
+        with contextlib.redirect_stdout(io.StringIO()):
+            argv = ["run", str(scenario), "--headless", "-q", "--no-plot", "--out", str(ref)]
+            assert main([*argv, "--force"]) == 0
+        loop = json.loads((ref / "metrics.json").read_text())["wall_time_s"]
+        _, run, _, _ = launch(
+            ws, "floor.launch", f"out:={ws / 'out'}", "plots:=false", "force:=true"
+        )
+        instants = 4 * float(duration)
+        print(
+            f"floor (one wait an instant, 4 Hz) {duration} s: in-process loop {loop:.3f} s, "
+            f"lockstep {run:.3f} s: {(run - loop) / instants * 1e6:.0f} us an instant beyond "
+            f"the loop; scenario1's floor {instants:.0f} instants x that"
+        )
+
+
 def main_bench() -> None:
     """Measure and print."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -200,6 +248,7 @@ def main_bench() -> None:
                     f"CPU of the launch {LAST_CPU_S:.1f} s, peak memory {rss / 1024:.0f} MiB, "
                     f"trace byte-identical {same}"
                 )
+        floor(root, args.duration, args.repeat)
         ws = root / "ws2"
         build(PLATOON, ws, "--duration", args.platoon_duration)
         wall, run, rss, _ = launch(ws, "platoon.launch", f"out:={ws / 'out'}", "plots:=false")

@@ -41,7 +41,8 @@ Launch files: @@{launches:code}. Arguments: `mode` (`lockstep` or `free`, defaul
 @@{mode:md_code}), `out` (run directory, default `runs/NAME-STAMP` in the current directory;
 an existing one is replaced only with `force:=true` and only if amsa-phys made it), `bag`
 (record every Data topic), `speed` (free mode), `duration` (simulated seconds, default the
-scenario's), `plots`, `timeout`@@{cpp_arg:code}.
+scenario's), `plots`, `timeout`, `boundary` (the standard messages: by default in free mode
+and with `sim:=false`, in lockstep with `boundary:=true`)@@{cpp_arg:code}.
 The run ends by itself (the simulator is a required node); Ctrl-C stops every node and
 writes the outputs so far.
 
