@@ -37,6 +37,7 @@ from ..graph import RosGraph
 from . import readiness, records, rosio
 from .boundary import VALUES, format_values, readable
 from .config import NodeConfig, load_config
+from .container import Container, stepped
 from .rossim import RosSimulation
 from .waves import DueAt, chained, wave
 
@@ -98,18 +99,9 @@ class Link:
         self.step_pubs = {}
         self.subs = []
         self.data_subs: dict[str, Any] = {}
-        #: lockstep: the Leaves of the C++ container are asked together, one message a wave
-        #: on the container's step topic, and answer in one (``batch``: the requests so far)
+        #: lockstep: the Leaves of the C++ container, asked a wave at a time (container.py)
         self.shared = self.graph.shared if self.lockstep else frozenset()
-        self.batch: list[str] = []
-        self.node_paths = {names.ns(p): p for p in self.shared}
-        if self.shared:
-            self.batch_pub = self.gate.publisher(names.step_topic(names.CONTAINER), String, 1)
-            self.subs.append(
-                rospy.Subscriber(
-                    names.done_topic(names.CONTAINER), String, self._on_batch, tcp_nodelay=True
-                )
-            )
+        self.container = Container(rospy, self.gate, String, self.shared, self._on_answers)
         for path in self.graph.remote:
             for b in self.graph.outputs(path):
                 self.received[b] = [0, float(world.buffers[b].initial)]
@@ -151,15 +143,11 @@ class Link:
             self.replies[path] = msg.data.split("\n")
             self.cond.notify_all()
 
-    def _on_batch(self, msg: Any) -> None:
-        """The container's answer for a wave: ``LEAF ANSWER`` a line, each Leaf's answer as
-        its own node would have sent it."""
+    def _on_answers(self, answers: list[tuple[str, str]]) -> None:
+        """The container's answers for a wave, each as the Leaf's own node would send it."""
         with self.cond:
-            for line in msg.data.split("\n"):
-                node, _, answer = line.partition(" ")
-                path = self.node_paths.get(node)
-                if path is not None:
-                    self.replies[path] = [answer]
+            for path, answer in answers:
+                self.replies[path] = [answer]
             self.cond.notify_all()
 
     def _on_phase(self, msg: Any) -> None:
@@ -247,23 +235,17 @@ class Link:
 
     # -- lockstep requests -------------------------------------------------------------------
     def _ask(self, path: str, verb: str, args: str, t: Fraction) -> None:
-        """Send ``VERB SEQ ARGS`` to a node (a Leaf of the container: into the batch that
-        :meth:`_send` sends); :meth:`_answer` waits for its answer."""
+        """Send ``VERB SEQ ARGS`` to a node (a Leaf of the container: with the others of the
+        wave, ``container.send``); :meth:`_answer` waits for its answer."""
         self.seq += 1
         seq = str(self.seq)
         with self.cond:
             self.replies[path] = None
         self.asked[path] = (t, seq)
         if path in self.shared:
-            self.batch.append(f"{names.ns(path)} {verb} {seq} {args}")
+            self.container.add(path, f"{verb} {seq} {args}")
         else:
             self.step_pubs[path].publish(self.String(f"{verb} {seq} {args}"))
-
-    def _send(self) -> None:
-        """The container's requests asked so far, in one message."""
-        if self.batch:
-            self.batch_pub.publish(self.String("\n".join(self.batch)))
-            self.batch = []
 
     def _answer(self, path: str, t: Fraction, what: str) -> list[str]:
         """Wait for a node's answer to what it was asked; ``[kind, seq, text]``.
@@ -289,7 +271,7 @@ class Link:
     def _request(self, path: str, verb: str, args: str, t: Fraction, what: str) -> list[str]:
         """Ask a node and wait for its answer."""
         self._ask(path, verb, args, t)
-        self._send()
+        self.container.send()
         return self._answer(path, t, what)
 
     def _counts(self, path: str, plus: set[str]) -> str:
@@ -345,7 +327,7 @@ class Link:
                 batch.append(p)
                 counts = self._counts(p, plus)
                 self._ask(p, "step", f"{t.numerator} {t.denominator} {counts}", t)
-            self._send()
+            self.container.send()
         head = self._answer(path, t, "a step")
         kind, text = head[0], head[2] if len(head) > 2 else ""
         who = f"{path} ({self.graph.leaf(path).template.name()})"
@@ -354,14 +336,13 @@ class Link:
         if kind == "fault":
             raise RunFault(who, t, text)
         outputs = self.graph.outputs(path)
-        if path in self.shared:  # "I J .. | VI VJ ..": the outputs published, their values
-            indexes, _, values = text.partition("|")
-            got = [outputs[int(i)] for i in indexes.split()]
-            for b, v in zip(got, values.split(), strict=True):
+        if path in self.shared:  # the values come with the answer
+            values = stepped(text, outputs)
+            for b, v in values:
                 self.published[b] += 1
-                self.received[b] = [self.published[b], float.fromhex(v)]
-            self.tell_boundary(t, [(b, self.received[b][1]) for b in got])
-            return {b.rpartition(".")[2]: self.received[b][1] for b in got}
+                self.received[b] = [self.published[b], v]
+            self.tell_boundary(t, values)
+            return {b.rpartition(".")[2]: v for b, v in values}
         got = [outputs[int(i)] for i in text.split()]
         for b in got:
             self.published[b] += 1
