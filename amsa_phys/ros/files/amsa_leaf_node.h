@@ -26,15 +26,7 @@
 // seed() the scenario's seed (/amsa/seed). Unchanged from the one-executable-per-Leaf nodes,
 // where kPath and seed() were file-level names of each executable.
 //
-// ~amsa_wiring, one item per line (numbers as C hex floats, which read back exactly):
-//   path LEAF.PATH          freq NUM DEN
-//   topic NAME INITIAL DELAYED(0|1)            (each subscribed input topic, in order)
-//   input PORT INDEX        (the template's input ports in order: a topic's index, or
-//                            -(1 + k) for the Leaf's own output k)
-//   output PORT TOPIC INITIAL SUBSCRIBERS SHARED  (the template's output ports in order;
-//                           the processes subscribed, without the bag recorder: every Leaf
-//                           a process of its own, and the C++ Leaves in one; ROS 1 counts a
-//                           process once per topic however many of its Leaves read it)
+// ~amsa_wiring: the Leaf's path, rate, topics and ports (format in amsa_wiring.h).
 #pragma once
 
 #include <nodelet/nodelet.h>
@@ -61,173 +53,13 @@
 #include <utility>
 #include <vector>
 
-#include "amsa_pymath.h"  // Python's hypot and float % for the C++ bodies
+#include "amsa_container.h"  // lockstep in the container: Dispatcher, ReadyBoard
+#include "amsa_wiring.h"     // the ports, parameters and ~amsa_wiring
+#include "amsa_pymath.h"     // Python's hypot and float % for the C++ bodies
 
 namespace amsa {
 
-struct InputPort {
-  std::string port;
-  int topic;  // index into the subscribed topics, or -(1 + output index) for an own output
-};
-
-struct Topic {
-  std::string name;
-  double initial;
-  bool delayed;  // its producer has latency or jitter: readers may be told an older message
-};
-
-struct OutputPort {
-  std::string port;
-  std::string topic;
-  double initial;
-  int subscribers;         // processes subscribed, every Leaf a process of its own
-  int subscribers_shared;  // the same with the C++ Leaves in one process (the container)
-};
-
-struct ParamSpec {
-  std::string name;
-  char type;  // 'd' double, 'i' integer, 'b' boolean
-  bool has_min, has_max;
-  double min, max;
-};
-
-inline std::string fmt_g(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
-// A Leaf's wiring (~amsa_wiring, format above), parsed; false with a message if malformed.
-struct Wiring {
-  std::string path;
-  std::int64_t freq_num = 0, freq_den = 1;
-  std::vector<Topic> topics;
-  std::vector<InputPort> inputs;
-  std::vector<OutputPort> outputs;
-};
-
-inline bool read_double(const std::string& text, double* value) {
-  char* end = nullptr;
-  *value = std::strtod(text.c_str(), &end);  // C hex floats: exact
-  return end != nullptr && *end == '\0' && !text.empty();
-}
-
-inline bool parse_wiring(const std::string& text, Wiring* w, std::string* error) {
-  std::istringstream lines(text);
-  std::string line;
-  while (std::getline(lines, line)) {
-    std::istringstream in(line);
-    std::string what;
-    if (!(in >> what)) continue;
-    bool ok = true;
-    if (what == "path") {
-      ok = static_cast<bool>(in >> w->path);
-    } else if (what == "freq") {
-      ok = static_cast<bool>(in >> w->freq_num >> w->freq_den) && w->freq_num > 0 && w->freq_den > 0;
-    } else if (what == "topic") {
-      Topic t;
-      std::string initial;
-      int delayed = 0;
-      ok = static_cast<bool>(in >> t.name >> initial >> delayed) && read_double(initial, &t.initial);
-      t.delayed = delayed != 0;
-      w->topics.push_back(t);
-    } else if (what == "input") {
-      InputPort ip;
-      ok = static_cast<bool>(in >> ip.port >> ip.topic);
-      w->inputs.push_back(ip);
-    } else if (what == "output") {
-      OutputPort o;
-      std::string initial;
-      ok = static_cast<bool>(in >> o.port >> o.topic >> initial >> o.subscribers >>
-                             o.subscribers_shared) &&
-           read_double(initial, &o.initial);
-      w->outputs.push_back(o);
-    } else {
-      ok = false;
-    }
-    if (!ok) {
-      *error = "~amsa_wiring: cannot read the line \"" + line + "\"";
-      return false;
-    }
-  }
-  if (w->path.empty()) {
-    *error = "~amsa_wiring: no path line";
-    return false;
-  }
-  return true;
-}
-
-// /amsa/ready of this process: one latched publisher (ROS 1 keeps one latched message per
-// topic and process), whose message lists every Leaf of the process that is ready so far.
-class ReadyBoard {
- public:
-  static void announce(const std::string& path) {
-    static ReadyBoard board;
-    std::lock_guard<std::mutex> lock(board.mutex_);
-    if (!board.pub_) {
-      ros::NodeHandle nh;
-      board.pub_ = nh.advertise<std_msgs::String>("/amsa/ready", 1, true);
-    }
-    board.ready_.insert(path);
-    std_msgs::String m;
-    for (const std::string& p : board.ready_) m.data += (m.data.empty() ? "" : " ") + p;
-    board.pub_.publish(m);
-  }
-
- private:
-  std::mutex mutex_;
-  ros::Publisher pub_;
-  std::set<std::string> ready_;
-};
-
-class LeafNode;
-
-// Lockstep in the container: the simulator asks the container's Leaves of a wave in one
-// message on /amsa/step/amsa_leaves, a line each: "/LEAF step SEQ NUM DEN C1..Cn" (or
-// "/LEAF param SEQ NAME"), in the engine's order; a count "N+" is N plus what the input's
-// producer, a Leaf asked earlier in the same message, publishes on it in this step (its
-// reader is stepped once the producer has answered). Once every Leaf of the message has
-// answered, one message on /amsa/done/amsa_leaves holds the answers, "/LEAF ANSWER" a line;
-// a step's answer is "done SEQ I J .. | VI VJ ..": the outputs published and their values
-// (C hex floats), which the simulator records instead of subscribing to those topics.
-class Dispatcher {
- public:
-  static Dispatcher& get() {
-    static Dispatcher dispatcher;
-    return dispatcher;
-  }
-  void add(LeafNode* leaf);
-  bool connected() const { return done_ && done_.getNumSubscribers() > 0; }
-  void answer(const std::string& leaf, const std::string& text);
-
- private:
-  struct Item {
-    LeafNode* leaf = nullptr;
-    std::string head;                     // "step SEQ NUM DEN" or "param SEQ NAME"
-    std::vector<std::string> counts;      // step: C1..Cn, "N+" for a chained input
-    std::vector<int> producer;            // for each count: the item it waits for, or -1
-    std::vector<std::size_t> out_index;   // ... and the producer's output index
-    bool sent = false, done = false;
-    std::string answer;
-  };
-  struct Batch {
-    std::vector<Item> items;
-    std::size_t left = 0;
-  };
-
-  void onBatch(const std::string& text);
-  // The items whose producers have answered, as requests to send (mutex_ held).
-  void ready(Batch& batch, std::vector<std::pair<LeafNode*, std::string>>* send);
-
-  std::mutex mutex_;
-  std::map<std::string, LeafNode*> leaves_;
-  std::map<std::string, std::pair<std::string, std::size_t>> producers_;  // topic -> (leaf, k)
-  std::deque<Batch> open_;
-  ros::Subscriber sub_;
-  ros::Publisher done_;
-};
-
-class LeafNode : public nodelet::Nodelet {
+class LeafNode : public nodelet::Nodelet, public Steppable {
  public:
   LeafNode(std::vector<std::string> in_ports, std::vector<std::string> out_ports,
            std::vector<ParamSpec> params)
@@ -240,7 +72,7 @@ class LeafNode : public nodelet::Nodelet {
   }
 
   // A request ("step SEQ NUM DEN C1..Cn" or "param SEQ NAME"): kept until its inputs are in.
-  void submit(const std::string& text) {
+  void submit(const std::string& text) override {
     std::string answer;
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -251,13 +83,13 @@ class LeafNode : public nodelet::Nodelet {
   }
 
   // The nodelet's name, /LEAF (getName() is protected in nodelet::Nodelet).
-  const std::string& nodeName() const { return getName(); }
+  const std::string& nodeName() const override { return getName(); }
   // The topic of input ``i`` (the container resolves counts by its producer).
-  const std::string& topicName(std::size_t i) const { return topics_.at(i).name; }
-  std::size_t topicCount() const { return topics_.size(); }
+  const std::string& topicName(std::size_t i) const override { return topics_.at(i).name; }
+  std::size_t topicCount() const override { return topics_.size(); }
   // The topic of output ``k``.
-  const std::string& outputTopic(std::size_t k) const { return outputs_.at(k).topic; }
-  std::size_t outputCount() const { return outputs_.size(); }
+  const std::string& outputTopic(std::size_t k) const override { return outputs_.at(k).topic; }
+  std::size_t outputCount() const override { return outputs_.size(); }
 
   void onInit() override {
     ros::NodeHandle& nh = getNodeHandle();
@@ -614,139 +446,5 @@ class LeafNode : public nodelet::Nodelet {
   std::condition_variable cond_;
   std::thread worker_;  // start-up, then free mode's loop
 };
-
-inline void Dispatcher::add(LeafNode* leaf) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  leaves_[leaf->nodeName()] = leaf;
-  for (std::size_t k = 0; k < leaf->outputCount(); ++k)
-    producers_[leaf->outputTopic(k)] = std::make_pair(leaf->nodeName(), k);
-  if (!sub_) {
-    ros::NodeHandle nh;
-    done_ = nh.advertise<std_msgs::String>("/amsa/done/amsa_leaves", 1000);
-    sub_ = nh.subscribe<std_msgs::String>(
-        "/amsa/step/amsa_leaves", 1000,
-        [this](const std_msgs::String::ConstPtr& m) { onBatch(m->data); }, ros::VoidConstPtr(),
-        ros::TransportHints().tcpNoDelay());
-  }
-}
-
-inline void Dispatcher::onBatch(const std::string& text) {
-  std::vector<std::pair<LeafNode*, std::string>> send;
-  std::string refused;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    Batch batch;
-    std::istringstream lines(text);
-    std::string line;
-    std::map<std::string, int> index;  // leaf -> its item in this batch
-    while (std::getline(lines, line)) {
-      std::istringstream in(line);
-      std::string name, verb, seq;
-      in >> name >> verb >> seq;
-      auto found = leaves_.find(name);
-      if (found == leaves_.end()) {
-        refused += name + " error " + seq + " no Leaf " + name + " in this container\n";
-        continue;
-      }
-      Item item;
-      item.leaf = found->second;
-      item.head = verb + " " + seq;
-      std::string word;
-      if (verb == "step") {
-        std::string num, den;
-        in >> num >> den;
-        item.head += " " + num + " " + den;
-        while (in >> word) {
-          const std::size_t i = item.counts.size();
-          int from = -1;
-          std::size_t k = 0;
-          if (!word.empty() && word.back() == '+') {
-            word.pop_back();
-            auto p = i < item.leaf->topicCount() ? producers_.find(item.leaf->topicName(i))
-                                                 : producers_.end();
-            if (p != producers_.end() && index.count(p->second.first)) {
-              from = index[p->second.first];
-              k = p->second.second;
-            }
-          }
-          item.counts.push_back(word);
-          item.producer.push_back(from);
-          item.out_index.push_back(k);
-        }
-      } else {
-        while (in >> word) item.head += " " + word;
-      }
-      index[name] = static_cast<int>(batch.items.size());
-      batch.items.push_back(item);
-    }
-    batch.left = batch.items.size();
-    if (batch.left > 0) {
-      open_.push_back(batch);
-      ready(open_.back(), &send);
-    }
-  }
-  if (!refused.empty()) {
-    std_msgs::String m;
-    m.data = refused.substr(0, refused.size() - 1);
-    done_.publish(m);
-  }
-  for (auto& s : send) s.first->submit(s.second);
-}
-
-inline void Dispatcher::ready(Batch& batch, std::vector<std::pair<LeafNode*, std::string>>* send) {
-  for (Item& item : batch.items) {
-    if (item.sent) continue;
-    bool waiting = false;
-    std::string request = item.head;
-    for (std::size_t i = 0; i < item.counts.size(); ++i) {
-      std::string count = item.counts[i];
-      if (item.producer[i] >= 0) {
-        const Item& from = batch.items[item.producer[i]];
-        if (!from.done) { waiting = true; break; }
-        // "done SEQ I J ..": the outputs it published in this step
-        std::istringstream in(from.answer);
-        std::string kind, seq, k;
-        in >> kind >> seq;
-        long long n = std::stoll(count);
-        while (in >> k && k != "|")  // "done SEQ I J .. | VALUES"
-          if (kind == "done" && k == std::to_string(item.out_index[i])) n += 1;
-        count = std::to_string(n);
-      }
-      request += " " + count;
-    }
-    if (waiting) continue;
-    item.sent = true;
-    send->emplace_back(item.leaf, request);
-  }
-}
-
-inline void Dispatcher::answer(const std::string& leaf, const std::string& text) {
-  std::vector<std::pair<LeafNode*, std::string>> send;
-  std::string all;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (auto b = open_.begin(); b != open_.end(); ++b) {
-      Item* mine = nullptr;
-      for (Item& item : b->items)
-        if (item.sent && !item.done && item.leaf->nodeName() == leaf) mine = &item;
-      if (mine == nullptr) continue;
-      mine->done = true;
-      mine->answer = text;
-      b->left -= 1;
-      ready(*b, &send);
-      if (b->left == 0) {
-        for (const Item& item : b->items) all += item.leaf->nodeName() + " " + item.answer + "\n";
-        open_.erase(b);
-      }
-      break;
-    }
-  }
-  if (!all.empty()) {
-    std_msgs::String m;
-    m.data = all.substr(0, all.size() - 1);
-    done_.publish(m);
-  }
-  for (auto& s : send) s.first->submit(s.second);
-}
 
 }  // namespace amsa
