@@ -301,6 +301,7 @@ class Simulation(ReadAPI):
         cursor = self._cursor
         record, values = self.log.record, self.store.data
         num, den = self._tick_num, self._tick_den
+        adapt = self._adapt  # fixed at construction
         try:
             while cursor <= until:
                 base = (cursor // cycle) * cycle
@@ -342,10 +343,12 @@ class Simulation(ReadAPI):
                         self._tick = tick
                         if self._pending_live:
                             self._apply_live()
-                        if tasks and self._adapt is not None:
-                            self._apply_adapt()
                         if tasks:
-                            now = self.now
+                            if adapt is not None:
+                                self._apply_adapt()
+                            # the ``now`` property's Fraction, built here without its checks
+                            now = Fraction(tick * num, den)
+                            self._now_cache = (tick, now)
                             try:
                                 for run, task in tasks:
                                     run(task, now)

@@ -18,7 +18,8 @@ The extension is optional (``setup.py``): :func:`status` says which path runs an
 from __future__ import annotations
 
 import array
-from collections.abc import Sequence
+import functools
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -234,6 +235,12 @@ class CompiledFewRovers(FewRovers):
     def rim_speeds(self, k: int) -> tuple[float, float]:
         """Rover ``k``'s left and right rim speeds (m/s) after the last step."""
         return self._stepper.rim_speeds(k)  # type: ignore[no-any-return]
+
+    def readers(self, k: int) -> tuple[Callable[[], list[float]], Callable[[], Any]]:
+        """:meth:`kinematics` and :meth:`rim_speeds` of rover ``k`` as calls straight into
+        the C step (``PhysicsWorld`` attaches them to the rover: no Python frame between)."""
+        stepper = self._stepper
+        return functools.partial(stepper.kinematics, k), functools.partial(stepper.rim_speeds, k)
 
     def advance(self) -> tuple[int, str] | None:
         """One physics step in C; a safety violation or None.
