@@ -117,6 +117,9 @@ class Simulation(ReadAPI):
             self.columns, trace, quality_signal, self.store.at, self.values, self.store.col
         )
         self._hooks: list[tuple[Fraction, Hook, str]] = []
+        #: hooks that take a run of their instants in one call (:meth:`batch_hook`)
+        self._many: dict[Hook, Callable[[int, Callable[[int], None]], int]] = {}
+        self._run_first = self._run_spacing = 0  # the run of instants ``many`` is taking
         #: each run's components by path (one dict for a single run)
         self.members: list[dict[str, Template]] = [{} for _ in self.timelines]
         #: the (first) run's components by path
@@ -191,6 +194,15 @@ class Simulation(ReadAPI):
         if self._initialized and hasattr(self, "_table"):
             raise RuntimeError("hooks must be added during initialize")
         self._hooks.append((Fraction(rate_hz), fn, name))
+
+    def batch_hook(self, fn: Hook, many: Callable[[int, Callable[[int], None]], int]) -> None:
+        """Let the hook ``fn`` (added with :meth:`add_hook`) take a run of its instants in
+        one call where nothing else is due between them: ``many(count, seek)`` takes up to
+        ``count`` of them, as ``count`` calls of ``fn`` at those instants would, and returns
+        how many it took (the loop calls ``fn`` for the rest); before it raises, it calls
+        ``seek(k)`` to move the clock to the ``k``-th instant (0: the first), where its
+        fault happened. The physics step batches its steps so (``physics/space.py``)."""
+        self._many[fn] = many
 
     def add_instant_source(self, source: InstantSource) -> None:
         """Apply ``source``'s changes at their exact instants (``instants.py``), after the
@@ -302,6 +314,7 @@ class Simulation(ReadAPI):
         record, values = self.log.record, self.store.data
         num, den = self._tick_num, self._tick_den
         adapt = self._adapt  # fixed at construction
+        many_of, seek = self._many, self._seek
         try:
             while cursor <= until:
                 base = (cursor // cycle) * cycle
@@ -322,7 +335,16 @@ class Simulation(ReadAPI):
                         # nothing else can happen in between, so no checks per instant
                         if len(hooks) == 1:  # the usual case: the physics step alone
                             hook = hooks[0]
-                            for tick in range(first, last + 1, spacing):
+                            start = first
+                            many = many_of.get(hook) if many_of else None
+                            if many is not None:
+                                self._tick = self._run_first = first
+                                self._run_spacing = spacing
+                                done = many((last - first) // spacing + 1, seek)
+                                if done:
+                                    start = first + done * spacing
+                                    self._tick = start - spacing
+                            for tick in range(start, last + 1, spacing):
                                 self._tick = tick
                                 hook()
                         else:
@@ -369,6 +391,10 @@ class Simulation(ReadAPI):
             # after a fault inside a run of physics-only instants ``cursor`` is still the
             # run's start; the instant that failed is ``_tick``, as on the general path
             self._cursor = max(cursor, self._tick)
+
+    def _seek(self, k: int) -> None:
+        """The clock at the ``k``-th instant of the run a batched hook is taking."""
+        self._tick = self._run_first + k * self._run_spacing
 
     def _apply_instant(self, tick: int) -> None:
         """THE point where instant-level changes are applied, before the components due at

@@ -194,6 +194,8 @@ class CompiledFewRovers(FewRovers):
             self.extent,
             self.sub_speed,
         )
+        #: whether :meth:`advance_many` can batch steps (an extension built before it cannot)
+        self.batches = hasattr(self._stepper, "advance_many")
 
     # rims and state are buffers the C step holds: assigning either copies into it (as the
     # pure class's users assign lists), so the step never runs on a stale buffer
@@ -263,6 +265,24 @@ class CompiledFewRovers(FewRovers):
         if bad < 0:
             return None
         return self.first_violation(self.state, self.max_speed, self.extent)
+
+    def advance_many(self, count: int) -> tuple[int, tuple[int, str] | None]:
+        """Up to ``count`` physics steps in one C call, each as :meth:`advance` takes it:
+        (steps taken, the safety violation after the last of them or None). The caller
+        checks :attr:`batches` and locks the space; a collision callback finds its step in
+        :meth:`batch_index` and may end the batch there (:meth:`stop_batch`)."""
+        done, bad = self._stepper.advance_many(count)
+        if bad < 0:
+            return done, None
+        return done, self.first_violation(self.state, self.max_speed, self.extent)
+
+    def batch_index(self) -> int:
+        """The step :meth:`advance_many` is taking (0: its first)."""
+        return self._stepper.batch_i  # type: ignore[no-any-return]
+
+    def stop_batch(self) -> None:
+        """End :meth:`advance_many` after the step under way."""
+        self._stepper.stop_batch()
 
 
 class CompiledFleet(Fleet):
