@@ -354,7 +354,8 @@ class Simulation(ReadAPI):
                                     hook()
                         cursor = last + 1
                         continue
-                    for tick in range(first, last + 1, spacing):
+                    # one instant (the usual entry) or a run the checks above refused
+                    for tick in (first,) if last_off == off else range(first, last + 1, spacing):
                         if tick < cursor:
                             continue
                         if tick > until:
