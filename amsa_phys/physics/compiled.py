@@ -194,8 +194,13 @@ class CompiledFewRovers(FewRovers):
             self.extent,
             self.sub_speed,
         )
-        #: whether :meth:`advance_many` can batch steps (an extension built before it cannot)
-        self.batches = hasattr(self._stepper, "advance_many")
+        #: ``advance_many(count)``: up to ``count`` steps in one C call, each as
+        #: :meth:`advance` takes it: (steps taken, the first bad rover's index after the
+        #: last of them, or -1). The C call itself, which ``PhysicsWorld.step_many`` makes
+        #: with no layer between; the caller locks the space, and a collision callback finds
+        #: its step in :meth:`batch_index` and may end the batch there (:meth:`stop_batch`).
+        #: None with an extension built before it.
+        self.advance_many = getattr(self._stepper, "advance_many", None)
 
     # rims and state are buffers the C step holds: assigning either copies into it (as the
     # pure class's users assign lists), so the step never runs on a stale buffer
@@ -265,16 +270,6 @@ class CompiledFewRovers(FewRovers):
         if bad < 0:
             return None
         return self.first_violation(self.state, self.max_speed, self.extent)
-
-    def advance_many(self, count: int) -> tuple[int, tuple[int, str] | None]:
-        """Up to ``count`` physics steps in one C call, each as :meth:`advance` takes it:
-        (steps taken, the safety violation after the last of them or None). The caller
-        checks :attr:`batches` and locks the space; a collision callback finds its step in
-        :meth:`batch_index` and may end the batch there (:meth:`stop_batch`)."""
-        done, bad = self._stepper.advance_many(count)
-        if bad < 0:
-            return done, None
-        return done, self.first_violation(self.state, self.max_speed, self.extent)
 
     def batch_index(self) -> int:
         """The step :meth:`advance_many` is taking (0: its first)."""

@@ -251,21 +251,17 @@ class PhysicsWorld:
         Why: at 100 Hz the step's two Python layers and the engine's loop around them were
         ~0.3 us of each ~1.1 us step (issue 29).
         """
-        model = self._model or self._start()
+        model: Any = self._model or self._start()
         space = self.space
-        if (
-            not getattr(model, "batches", False)
-            or self.terrain.zones
-            or self.terrain.grades
-            or space._bodies_to_check
-        ):
+        advance = getattr(model, "advance_many", None)
+        if advance is None or self.terrain.zones or self.terrain.grades or space._bodies_to_check:
             return 0
         space._locked = True
         self._seek = seek
         try:
-            done, bad = model.advance_many(count)  # type: ignore[attr-defined]
+            done, bad = advance(count)
         except BaseException:
-            seek(model.batch_index())  # type: ignore[attr-defined]
+            seek(model.batch_index())
             raise
         finally:
             self._seek = None
@@ -275,9 +271,13 @@ class PhysicsWorld:
         if space._removed_shapes:
             space._removed_shapes.clear()
         self._steps += done
-        if bad is not None:
-            seek(done - 1)
-            raise RunFault(self.rovers[bad[0]].name, self.sim.now + 1 / self.rate, bad[1])
+        if bad >= 0:  # as model.advance() reports it
+            violation = model.first_violation(model.state, model.max_speed, model.extent)
+            if violation is not None:
+                seek(done - 1)
+                raise RunFault(
+                    self.rovers[violation[0]].name, self.sim.now + 1 / self.rate, violation[1]
+                )
         return done  # type: ignore[no-any-return]
 
     def _start(self) -> ForceModel:
