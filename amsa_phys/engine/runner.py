@@ -268,6 +268,7 @@ class Simulation(ReadAPI):
             self._steppers,
         )
         self._table = schedule.runs(cycle)
+        self._plan = self._with_merges(self._table)
         self._end = g.ticks(self.duration)
         self._sources[:0] = [TimelineSource(t, g, r) for r, t in enumerate(self.timelines)]
         self._next_source_tick = min(s.next_tick() for s in self._sources)
@@ -308,7 +309,7 @@ class Simulation(ReadAPI):
         self.initialize()
         until = min(until_tick, self._end)
         cycle = self._cycle
-        table = self._table
+        table = self._plan
         end = self._end
         cursor = self._cursor
         record, values = self.log.record, self.store.data
@@ -318,7 +319,7 @@ class Simulation(ReadAPI):
         try:
             while cursor <= until:
                 base = (cursor // cycle) * cycle
-                for off, tasks, log, hooks, last_off, spacing in table:
+                for off, tasks, log, hooks, last_off, spacing, merge in table:
                     first = base + off
                     last = base + last_off
                     if last < cursor:
@@ -384,6 +385,26 @@ class Simulation(ReadAPI):
                             # correctly rounded, the same float ``float(Fraction)`` gives
                             record((tick * num) / den, values)
                         if tick < end:
+                            if merge is not None and tick == first:
+                                # this instant's hook and the run of it alone that follows
+                                # in one batch, when nothing else can happen in that run
+                                run_last = base + merge[0]
+                                if (
+                                    run_last <= until
+                                    and run_last < end
+                                    and run_last < self._next_instant_tick
+                                    and not self._pending_live
+                                ):
+                                    step = merge[1]
+                                    self._run_first, self._run_spacing = tick, step
+                                    done = merge[2]((run_last - tick) // step + 1, seek)
+                                    hook = hooks[0]
+                                    for rest in range(tick + done * step, run_last + 1, step):
+                                        self._tick = rest
+                                        hook()
+                                    self._tick = run_last
+                                    cursor = run_last + 1
+                                    continue
                             for hook in hooks:
                                 hook()
                         cursor = tick + 1
@@ -392,6 +413,23 @@ class Simulation(ReadAPI):
             # after a fault inside a run of physics-only instants ``cursor`` is still the
             # run's start; the instant that failed is ``_tick``, as on the general path
             self._cursor = max(cursor, self._tick)
+
+    def _with_merges(self, table: list[schedule.Entry]) -> list[tuple[Any, ...]]:
+        """The table's entries, each with what its hook may take in the same batch: for an
+        instant whose single hook batches (:meth:`batch_hook`) and is followed at once by a
+        run of that hook alone, ``(last, spacing, many)`` of that run (its instants then go
+        with this instant's hook in one ``many`` call); None otherwise."""
+        plan: list[tuple[Any, ...]] = []
+        for i, (off, tasks, log, hooks, last_off, spacing) in enumerate(table):
+            merge = None
+            after = table[i + 1] if i + 1 < len(table) else None
+            if last_off == off and len(hooks) == 1 and hooks[0] in self._many and after:
+                n_off, n_tasks, n_log, n_hooks, n_last, n_spacing = after
+                alone = not n_tasks and not n_log and n_hooks == hooks
+                if alone and (n_last == n_off or n_spacing == n_off - off):  # evenly spaced
+                    merge = (n_last, n_off - off, self._many[hooks[0]])
+            plan.append((off, tasks, log, hooks, last_off, spacing, merge))
+        return plan
 
     def _seek(self, k: int) -> None:
         """The clock at the ``k``-th instant of the run a batched hook is taking."""

@@ -10,13 +10,14 @@ inside a batch and must find its own step's time), and a safety fault's time and
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 
 import pytest
 
 from amsa_phys.engine.runner import Simulation
 from amsa_phys.errors import RunFault
-from amsa_phys.model.scenario import Scenario, load_scenario
+from amsa_phys.model.scenario import Change, Scenario, load_scenario
 from amsa_phys.physics import compiled
 from amsa_phys.physics.space import PhysicsWorld
 
@@ -27,10 +28,12 @@ pytestmark = pytest.mark.skipif(not compiled.active(), reason="the batched step 
 
 def _ramming(duration: float = 40) -> Scenario:
     """Scenario1 with the follower driving into a leader that wanders: contacts that begin
-    and end inside runs of physics-only instants (at 14.97 s, 21.21 s, ...)."""
+    and end inside runs of physics-only instants (at 35.77 s, 38.05 s, ...), and the
+    controller's delayed outputs arriving inside them too (0.48 s: 48 ticks after a 4 Hz
+    instant), where a batch must stop."""
     sets = [
         "MyFollowerController.distanceRef=0",
-        "MyFollowerController.latency=0",
+        "MyFollowerController.latency=0.48",  # its outputs land between log instants
         "Leader.behavior=4",
     ]
     return load_scenario(SCENARIO1, sets, duration=duration)
@@ -48,7 +51,7 @@ def _run(scenario: Scenario, batched: bool, monkeypatch: pytest.MonkeyPatch) -> 
     with monkeypatch.context() as m:
         m.setattr(PhysicsWorld, "_on_separate", recording)
         if not batched:
-            m.setattr(PhysicsWorld, "step_many", lambda self, count, seek: 0)
+            m.setattr(Simulation, "batch_hook", lambda self, fn, many: None)
         rows: list[tuple[float, ...]] = []
         sim = Simulation.from_scenario(scenario, trace=lambda t, r: rows.append((t, *r)))
         fault = None
@@ -108,3 +111,61 @@ def test_a_fault_inside_a_batch_names_its_step(monkeypatch: pytest.MonkeyPatch) 
     assert "exceeds physics.max_speed" in batched["fault"]
     assert round(batched["now"] * 20) != batched["now"] * 20, "not inside a batch"
     assert batched == alone
+
+
+def test_advancing_in_pieces_stops_where_asked(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``advance(until)`` ending inside a run of physics-only instants (the ROS simulator,
+    the window): a batch never steps past ``until``, and the physics state read there is
+    the step-by-step run's."""
+    ticks = [1, 3, 5, 6, 9, 12, 24, 25, 27, 44, 45, 47, 48, 50, 51, 77, 98, 130, 149, 400]
+
+    def pieces(batched: bool) -> list:
+        with monkeypatch.context() as m:
+            if not batched:
+                m.setattr(Simulation, "batch_hook", lambda self, fn, many: None)
+            sim = Simulation.from_scenario(load_scenario(SCENARIO1, duration=5))
+            sim.initialize()
+            seen = []
+            for tick in ticks:
+                sim.advance(tick)
+                state = list(sim.shared["physics"]._model.state)
+                seen.append((tick, sim.now, sim._cursor, state))
+            return seen
+
+    assert pieces(True) == pieces(False)
+
+
+class _Wear:
+    """An instant source (``engine/instants.py``) that weakens the follower's motors at
+    ticks between log instants: the physics must take the change at its own step."""
+
+    def __init__(self, ticks: list[int]) -> None:
+        self._ticks = ticks
+
+    def next_tick(self) -> float:
+        return self._ticks[0] if self._ticks else math.inf
+
+    def due(self, tick: int) -> list:
+        out = []
+        while self._ticks and self._ticks[0] <= tick:
+            at = self._ticks.pop(0)
+            out.append((at, None, [Change("Follower", "stallForce", 8.5 - at / 100)]))
+        return out
+
+
+def test_changes_between_log_instants_land_at_their_step(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A parameter change due inside a run of physics-only instants stops the batch there:
+    the same trace as step by step."""
+
+    def trace(batched: bool) -> list:
+        with monkeypatch.context() as m:
+            if not batched:
+                m.setattr(Simulation, "batch_hook", lambda self, fn, many: None)
+            rows: list = []
+            scenario = load_scenario(SCENARIO1, duration=10)
+            sim = Simulation.from_scenario(scenario, trace=lambda t, r: rows.append((t, *r)))
+            sim.add_instant_source(_Wear([102, 213, 347, 411, 598]))
+            sim.run()
+            return rows
+
+    assert trace(True) == trace(False)
