@@ -43,6 +43,7 @@ from .clock import TickGrid
 from .context import Context, Event, Hook, RunResult
 from .delivery import Deliveries
 from .instants import InstantSource, TimelineSource
+from .livechanges import LiveChanges
 from .log import RunLog
 from .store import BufferStore, ReadAPI
 from .tasks import COMPONENT_ERRORS, Steppers, Task, in_run
@@ -57,7 +58,7 @@ _Task = Task
 __all__ = ["COMPONENT_ERRORS", "Context", "Event", "RunResult", "Simulation", "Task", "Wrap"]
 
 
-class Simulation(ReadAPI):
+class Simulation(ReadAPI, LiveChanges):
     """One run of a scenario (or of a bare world, for tests).
 
     Read from outside with :meth:`read`, :meth:`read_many`, :meth:`column` and
@@ -268,7 +269,7 @@ class Simulation(ReadAPI):
             self._steppers,
         )
         self._table = schedule.runs(cycle)
-        self._plan = self._with_merges(self._table)
+        self._plan = schedule.merges(self._table, self._many)
         self._end = g.ticks(self.duration)
         self._sources[:0] = [TimelineSource(t, g, r) for r, t in enumerate(self.timelines)]
         self._next_source_tick = min(s.next_tick() for s in self._sources)
@@ -414,23 +415,6 @@ class Simulation(ReadAPI):
             # run's start; the instant that failed is ``_tick``, as on the general path
             self._cursor = max(cursor, self._tick)
 
-    def _with_merges(self, table: list[schedule.Entry]) -> list[tuple[Any, ...]]:
-        """The table's entries, each with what its hook may take in the same batch: for an
-        instant whose single hook batches (:meth:`batch_hook`) and is followed at once by a
-        run of that hook alone, ``(last, spacing, many)`` of that run (its instants then go
-        with this instant's hook in one ``many`` call); None otherwise."""
-        plan: list[tuple[Any, ...]] = []
-        for i, (off, tasks, log, hooks, last_off, spacing) in enumerate(table):
-            merge = None
-            after = table[i + 1] if i + 1 < len(table) else None
-            if last_off == off and len(hooks) == 1 and hooks[0] in self._many and after:
-                n_off, n_tasks, n_log, n_hooks, n_last, n_spacing = after
-                alone = not n_tasks and not n_log and n_hooks == hooks
-                if alone and (n_last == n_off or n_spacing == n_off - off):  # evenly spaced
-                    merge = (n_last, n_off - off, self._many[hooks[0]])
-            plan.append((off, tasks, log, hooks, last_off, spacing, merge))
-        return plan
-
     def _seek(self, k: int) -> None:
         """The clock at the ``k``-th instant of the run a batched hook is taking."""
         self._tick = self._run_first + k * self._run_spacing
@@ -480,76 +464,6 @@ class Simulation(ReadAPI):
         frame rate or speed-up (at x256 a frame spans seconds of simulated time).
         """
         self.log.listeners.append(fn)
-
-    @property
-    def pending_live(self) -> list[Change]:
-        """Live changes queued for the next instant, not yet applied."""
-        return list(self._pending_live)
-
-    def apply_change(self, change: Change) -> None:
-        """Set a parameter now (timeline or live); the component is told after."""
-        self._change(change, 0)
-
-    def _change(self, change: Change, run: int) -> None:
-        """:meth:`apply_change` in run ``run`` of a batch."""
-        comp = self.members[run][change.leaf]
-        setattr(comp.p, change.param, change.value)
-        for group in getattr(self, "_groups_of", {}).get((run, change.leaf), ()):
-            group.params.invalidate()
-        self.change_log.append((self.now, change))
-        try:
-            comp.on_param_change(change.param, change.value)
-        except RunFault as exc:
-            in_run(exc, run)
-            raise
-        except COMPONENT_ERRORS as exc:
-            why = f"on_param_change raised {exc!r}" if isinstance(exc, SystemExit) else exc
-            fault = RunFault(
-                self._who(change.leaf), self.now, f"rejected {change.param}={change.value!r}: {why}"
-            )
-            raise in_run(fault, run) from None  # a message, not a crash (--debug finds it)
-
-    def next_instant(self) -> Fraction:
-        """Time of the next instant at which something runs (where a live change lands)."""
-        self.initialize()
-        return self.grid.time(schedule.next_tick(self._table, self._cycle, self._cursor))
-
-    def apply_live(self, change: Change) -> Fraction:
-        """Queue a change made by hand (the window); it lands at :meth:`next_instant`.
-
-        It is applied after the timeline changes due at that instant and before the
-        components, exactly where a timeline entry at that time would be, so writing it into
-        the resolved scenario's timeline replays the session. Returns the instant.
-        """
-        at = self.next_instant()
-        self._pending_live.append(change)
-        return at
-
-    def _apply_live(self) -> None:
-        pending, self._pending_live = self._pending_live, []
-        for change in pending:
-            self.apply_change(change)
-            self.live_changes.append((self.now, change))
-            self.record_event("live change", f"{change.key}={change.value}")
-
-    def _apply_adapt(self) -> None:
-        """Apply the ``adapt:`` rule due now, like a timeline change at this instant."""
-        assert self._adapt is not None
-        firing = self._adapt.due(self.now, self.values)
-        if firing is None:
-            return
-        for change in firing.rule.changes:
-            self.apply_change(change)
-        self.values[RULE_COLUMN] = float(firing.rule.number)
-        self.record_event("adapt", firing.detail())
-
-    def _param_value(self, leaf: str, param: str) -> Any:
-        """The value of ``leaf.param`` in force now."""
-        return getattr(self.components[leaf].p, param)
-
-    def record_event(self, kind: str, detail: str) -> None:
-        """See :meth:`Context.record_event`."""
-        self.events.append(Event(float(self.now), kind, detail))
 
     def result(self) -> RunResult:
         """Samples and events so far."""
