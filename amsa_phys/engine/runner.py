@@ -43,6 +43,7 @@ from .clock import TickGrid
 from .context import Context, Event, Hook, RunResult
 from .delivery import Deliveries
 from .instants import InstantSource, TimelineSource
+from .livechanges import LiveChanges
 from .log import RunLog
 from .store import BufferStore, ReadAPI
 from .tasks import COMPONENT_ERRORS, Steppers, Task, in_run
@@ -57,7 +58,7 @@ _Task = Task
 __all__ = ["COMPONENT_ERRORS", "Context", "Event", "RunResult", "Simulation", "Task", "Wrap"]
 
 
-class Simulation(ReadAPI):
+class Simulation(ReadAPI, LiveChanges):
     """One run of a scenario (or of a bare world, for tests).
 
     Read from outside with :meth:`read`, :meth:`read_many`, :meth:`column` and
@@ -117,6 +118,9 @@ class Simulation(ReadAPI):
             self.columns, trace, quality_signal, self.store.at, self.values, self.store.col
         )
         self._hooks: list[tuple[Fraction, Hook, str]] = []
+        #: hooks that take a run of their instants in one call (:meth:`batch_hook`)
+        self._many: dict[Hook, Callable[[int, Callable[[int], None]], int]] = {}
+        self._run_first = self._run_spacing = 0  # the run of instants ``many`` is taking
         #: each run's components by path (one dict for a single run)
         self.members: list[dict[str, Template]] = [{} for _ in self.timelines]
         #: the (first) run's components by path
@@ -192,6 +196,15 @@ class Simulation(ReadAPI):
             raise RuntimeError("hooks must be added during initialize")
         self._hooks.append((Fraction(rate_hz), fn, name))
 
+    def batch_hook(self, fn: Hook, many: Callable[[int, Callable[[int], None]], int]) -> None:
+        """Let the hook ``fn`` (added with :meth:`add_hook`) take a run of its instants in
+        one call where nothing else is due between them: ``many(count, seek)`` takes up to
+        ``count`` of them, as ``count`` calls of ``fn`` at those instants would, and returns
+        how many it took (the loop calls ``fn`` for the rest); before it raises, it calls
+        ``seek(k)`` to move the clock to the ``k``-th instant (0: the first), where its
+        fault happened. The physics step batches its steps so (``physics/space.py``)."""
+        self._many[fn] = many
+
     def add_instant_source(self, source: InstantSource) -> None:
         """Apply ``source``'s changes at their exact instants (``instants.py``), after the
         timeline's at the same instant and before live changes and the components: the
@@ -256,6 +269,7 @@ class Simulation(ReadAPI):
             self._steppers,
         )
         self._table = schedule.runs(cycle)
+        self._plan = schedule.merges(self._table, self._many)
         self._end = g.ticks(self.duration)
         self._sources[:0] = [TimelineSource(t, g, r) for r, t in enumerate(self.timelines)]
         self._next_source_tick = min(s.next_tick() for s in self._sources)
@@ -296,15 +310,17 @@ class Simulation(ReadAPI):
         self.initialize()
         until = min(until_tick, self._end)
         cycle = self._cycle
-        table = self._table
+        table = self._plan
         end = self._end
         cursor = self._cursor
         record, values = self.log.record, self.store.data
         num, den = self._tick_num, self._tick_den
+        adapt = self._adapt  # fixed at construction
+        many_of, seek = self._many, self._seek
         try:
             while cursor <= until:
                 base = (cursor // cycle) * cycle
-                for off, tasks, log, hooks, last_off, spacing in table:
+                for off, tasks, log, hooks, last_off, spacing, merge in table:
                     first = base + off
                     last = base + last_off
                     if last < cursor:
@@ -321,7 +337,16 @@ class Simulation(ReadAPI):
                         # nothing else can happen in between, so no checks per instant
                         if len(hooks) == 1:  # the usual case: the physics step alone
                             hook = hooks[0]
-                            for tick in range(first, last + 1, spacing):
+                            start = first
+                            many = many_of.get(hook) if many_of else None
+                            if many is not None:
+                                self._tick = self._run_first = first
+                                self._run_spacing = spacing
+                                done = many((last - first) // spacing + 1, seek)
+                                if done:
+                                    start = first + done * spacing
+                                    self._tick = start - spacing
+                            for tick in range(start, last + 1, spacing):
                                 self._tick = tick
                                 hook()
                         else:
@@ -331,7 +356,8 @@ class Simulation(ReadAPI):
                                     hook()
                         cursor = last + 1
                         continue
-                    for tick in range(first, last + 1, spacing):
+                    # one instant (the usual entry) or a run the checks above refused
+                    for tick in (first,) if last_off == off else range(first, last + 1, spacing):
                         if tick < cursor:
                             continue
                         if tick > until:
@@ -342,10 +368,12 @@ class Simulation(ReadAPI):
                         self._tick = tick
                         if self._pending_live:
                             self._apply_live()
-                        if tasks and self._adapt is not None:
-                            self._apply_adapt()
                         if tasks:
-                            now = self.now
+                            if adapt is not None:
+                                self._apply_adapt()
+                            # the ``now`` property's Fraction, built here without its checks
+                            now = Fraction(tick * num, den)
+                            self._now_cache = (tick, now)
                             try:
                                 for run, task in tasks:
                                     run(task, now)
@@ -358,6 +386,26 @@ class Simulation(ReadAPI):
                             # correctly rounded, the same float ``float(Fraction)`` gives
                             record((tick * num) / den, values)
                         if tick < end:
+                            if merge is not None and tick == first:
+                                # this instant's hook and the run of it alone that follows
+                                # in one batch, when nothing else can happen in that run
+                                run_last = base + merge[0]
+                                if (
+                                    run_last <= until
+                                    and run_last < end
+                                    and run_last < self._next_instant_tick
+                                    and not self._pending_live
+                                ):
+                                    step = merge[1]
+                                    self._run_first, self._run_spacing = tick, step
+                                    done = merge[2]((run_last - tick) // step + 1, seek)
+                                    hook = hooks[0]
+                                    for rest in range(tick + done * step, run_last + 1, step):
+                                        self._tick = rest
+                                        hook()
+                                    self._tick = run_last
+                                    cursor = run_last + 1
+                                    continue
                             for hook in hooks:
                                 hook()
                         cursor = tick + 1
@@ -366,6 +414,10 @@ class Simulation(ReadAPI):
             # after a fault inside a run of physics-only instants ``cursor`` is still the
             # run's start; the instant that failed is ``_tick``, as on the general path
             self._cursor = max(cursor, self._tick)
+
+    def _seek(self, k: int) -> None:
+        """The clock at the ``k``-th instant of the run a batched hook is taking."""
+        self._tick = self._run_first + k * self._run_spacing
 
     def _apply_instant(self, tick: int) -> None:
         """THE point where instant-level changes are applied, before the components due at
@@ -412,76 +464,6 @@ class Simulation(ReadAPI):
         frame rate or speed-up (at x256 a frame spans seconds of simulated time).
         """
         self.log.listeners.append(fn)
-
-    @property
-    def pending_live(self) -> list[Change]:
-        """Live changes queued for the next instant, not yet applied."""
-        return list(self._pending_live)
-
-    def apply_change(self, change: Change) -> None:
-        """Set a parameter now (timeline or live); the component is told after."""
-        self._change(change, 0)
-
-    def _change(self, change: Change, run: int) -> None:
-        """:meth:`apply_change` in run ``run`` of a batch."""
-        comp = self.members[run][change.leaf]
-        setattr(comp.p, change.param, change.value)
-        for group in getattr(self, "_groups_of", {}).get((run, change.leaf), ()):
-            group.params.invalidate()
-        self.change_log.append((self.now, change))
-        try:
-            comp.on_param_change(change.param, change.value)
-        except RunFault as exc:
-            in_run(exc, run)
-            raise
-        except COMPONENT_ERRORS as exc:
-            why = f"on_param_change raised {exc!r}" if isinstance(exc, SystemExit) else exc
-            fault = RunFault(
-                self._who(change.leaf), self.now, f"rejected {change.param}={change.value!r}: {why}"
-            )
-            raise in_run(fault, run) from None  # a message, not a crash (--debug finds it)
-
-    def next_instant(self) -> Fraction:
-        """Time of the next instant at which something runs (where a live change lands)."""
-        self.initialize()
-        return self.grid.time(schedule.next_tick(self._table, self._cycle, self._cursor))
-
-    def apply_live(self, change: Change) -> Fraction:
-        """Queue a change made by hand (the window); it lands at :meth:`next_instant`.
-
-        It is applied after the timeline changes due at that instant and before the
-        components, exactly where a timeline entry at that time would be, so writing it into
-        the resolved scenario's timeline replays the session. Returns the instant.
-        """
-        at = self.next_instant()
-        self._pending_live.append(change)
-        return at
-
-    def _apply_live(self) -> None:
-        pending, self._pending_live = self._pending_live, []
-        for change in pending:
-            self.apply_change(change)
-            self.live_changes.append((self.now, change))
-            self.record_event("live change", f"{change.key}={change.value}")
-
-    def _apply_adapt(self) -> None:
-        """Apply the ``adapt:`` rule due now, like a timeline change at this instant."""
-        assert self._adapt is not None
-        firing = self._adapt.due(self.now, self.values)
-        if firing is None:
-            return
-        for change in firing.rule.changes:
-            self.apply_change(change)
-        self.values[RULE_COLUMN] = float(firing.rule.number)
-        self.record_event("adapt", firing.detail())
-
-    def _param_value(self, leaf: str, param: str) -> Any:
-        """The value of ``leaf.param`` in force now."""
-        return getattr(self.components[leaf].p, param)
-
-    def record_event(self, kind: str, detail: str) -> None:
-        """See :meth:`Context.record_event`."""
-        self.events.append(Event(float(self.now), kind, detail))
 
     def result(self) -> RunResult:
         """Samples and events so far."""

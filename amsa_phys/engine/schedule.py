@@ -11,7 +11,7 @@ the run: unit-testable on plain integers (``tests/unit/test_schedule.py``).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -104,3 +104,24 @@ def next_tick(table: Sequence[Entry], cycle: int, cursor: int) -> int:
             if tick >= cursor:
                 return tick
     return base + cycle + table[0][0]
+
+
+def merges(table: Sequence[Entry], many: Mapping[Hook, Any]) -> list[tuple[Any, ...]]:
+    """The table's entries, each with what its hook may take in the same batch.
+
+    For an instant whose single hook batches (``many``: ``Simulation.batch_hook``) and is
+    followed at once by a run of that hook alone (evenly spaced), ``(last, spacing, batch)``
+    of that run: the loop hands the instant's hook and the run to ``batch`` in one call
+    when nothing else is due in it. None otherwise.
+    """
+    plan: list[tuple[Any, ...]] = []
+    for i, (off, tasks, log, hooks, last_off, spacing) in enumerate(table):
+        merge = None
+        after = table[i + 1] if i + 1 < len(table) else None
+        if last_off == off and len(hooks) == 1 and hooks[0] in many and after:
+            n_off, n_tasks, n_log, n_hooks, n_last, n_spacing = after
+            alone = not n_tasks and not n_log and n_hooks == hooks
+            if alone and (n_last == n_off or n_spacing == n_off - off):  # evenly spaced
+                merge = (n_last, n_off - off, many[hooks[0]])
+        plan.append((off, tasks, log, hooks, last_off, spacing, merge))
+    return plan

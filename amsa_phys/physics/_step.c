@@ -16,6 +16,7 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <structmember.h>
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
@@ -86,6 +87,8 @@ typedef struct {
      * rover_forces takes them instead of computing them again when its state's angle is
      * the cached one bit for bit (~5 % of the step). NULL: always computed. */
     double *rot;
+    Py_ssize_t batch_i; /* advance_many: the step under way (0: the first) */
+    int stop;           /* advance_many: end after the step under way */
 } Stepper;
 
 /* ---- wheel.py's rare branches --------------------------------------------------------- */
@@ -571,6 +574,40 @@ static PyObject *Stepper_advance(Stepper *st, PyObject *Py_UNUSED(ignored))
     return PyLong_FromSsize_t(read_check(st));
 }
 
+/* Up to ``count`` whole steps in one call, each as Stepper_advance takes it: (steps run,
+ * the first bad rover's index after the last of them or -1). ``batch_i`` is the step under
+ * way (a collision callback reads it to know its step's time, and may end the batch after
+ * that step with stop_batch). The caller locks the space. */
+static PyObject *Stepper_advance_many(Stepper *st, PyObject *arg)
+{
+    Py_ssize_t count = PyLong_AsSsize_t(arg);
+    if (count == -1 && PyErr_Occurred())
+        return NULL;
+    Py_ssize_t done = 0;
+    st->stop = 0;
+    while (done < count && !st->stop) {
+        st->batch_i = done;
+        apply_all(st);
+        int n = substeps(st->top2, st->sub_speed);
+        double h = st->dt / (double)n;
+        for (int i = 0; i < n && !PyErr_Occurred(); i++)
+            st->space_step(st->space, h);
+        if (PyErr_Occurred())
+            return NULL;
+        done++;
+        Py_ssize_t bad = read_check(st);
+        if (bad >= 0)
+            return Py_BuildValue("(nn)", done, bad);
+    }
+    return Py_BuildValue("(nn)", done, (Py_ssize_t)-1);
+}
+
+static PyObject *Stepper_stop_batch(Stepper *st, PyObject *Py_UNUSED(ignored))
+{
+    st->stop = 1;
+    Py_RETURN_NONE;
+}
+
 static PyObject *Stepper_apply(Stepper *st, PyObject *Py_UNUSED(ignored))
 {
     apply_all(st);
@@ -765,6 +802,11 @@ static PyMethodDef Stepper_methods[] = {
     {"advance", (PyCFunction)Stepper_advance, METH_NOARGS,
      "Forces, body writes, cpSpaceStep, body reads and the safety check: the first bad "
      "rover's index, or -1. The caller locks the space as pymunk would."},
+    {"advance_many", (PyCFunction)Stepper_advance_many, METH_O,
+     "Up to n steps, each as advance: (steps run, the first bad rover's index after the "
+     "last, or -1). The caller locks the space as pymunk would."},
+    {"stop_batch", (PyCFunction)Stepper_stop_batch, METH_NOARGS,
+     "End advance_many after the step under way."},
     {"apply", (PyCFunction)Stepper_apply, METH_NOARGS,
      "Forces and body writes only (the caller steps the space itself)."},
     {"read_check", (PyCFunction)Stepper_read_check, METH_NOARGS,
@@ -776,6 +818,12 @@ static PyMethodDef Stepper_methods[] = {
     {NULL, NULL, 0, NULL},
 };
 
+static PyMemberDef Stepper_members[] = {
+    {"batch_i", T_PYSSIZET, offsetof(Stepper, batch_i), READONLY,
+     "advance_many: the step under way (0: the first)."},
+    {NULL, 0, 0, 0, NULL},
+};
+
 static PyTypeObject StepperType = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "amsa_phys.physics._step.Stepper",
     .tp_basicsize = sizeof(Stepper),
@@ -785,6 +833,7 @@ static PyTypeObject StepperType = {
     .tp_init = (initproc)Stepper_init,
     .tp_dealloc = (destructor)Stepper_dealloc,
     .tp_methods = Stepper_methods,
+    .tp_members = Stepper_members,
 };
 
 /* ---- column_forces: the force model alone, over a batch's columns (physics/columns.py) ---

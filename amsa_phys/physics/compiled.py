@@ -18,7 +18,8 @@ The extension is optional (``setup.py``): :func:`status` says which path runs an
 from __future__ import annotations
 
 import array
-from collections.abc import Sequence
+import functools
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -203,8 +204,9 @@ class CompiledFewRovers(FewRovers):
         self._ground = array.array("d", [t for terms in grounds for t in terms])
         self.drives = np.zeros((2, n))
         super().__init__(io, rovers, dt, limits, grounds)  # sets rims and state (below)
+        slots = memoryview(self.drives)  # the same memory; an item write ~45 ns cheaper
         for k, r in enumerate(rovers):
-            r.attach_power_slot(self.drives, k)
+            r.attach_power_slot(slots, k)
         assert _step is not None
         self._stepper = _step.Stepper(
             _address(io.space._space),
@@ -223,6 +225,13 @@ class CompiledFewRovers(FewRovers):
             self.extent,
             self.sub_speed,
         )
+        #: ``advance_many(count)``: up to ``count`` steps in one C call, each as
+        #: :meth:`advance` takes it: (steps taken, the first bad rover's index after the
+        #: last of them, or -1). The C call itself, which ``PhysicsWorld.step_many`` makes
+        #: with no layer between; the caller locks the space, and a collision callback finds
+        #: its step in :meth:`batch_index` and may end the batch there (:meth:`stop_batch`).
+        #: None with an extension built before it.
+        self.advance_many = getattr(self._stepper, "advance_many", None)
 
     # rims and state are buffers the C step holds: assigning either copies into it (as the
     # pure class's users assign lists), so the step never runs on a stale buffer
@@ -265,6 +274,12 @@ class CompiledFewRovers(FewRovers):
         """Rover ``k``'s left and right rim speeds (m/s) after the last step."""
         return self._stepper.rim_speeds(k)  # type: ignore[no-any-return]
 
+    def readers(self, k: int) -> tuple[Callable[[], list[float]], Callable[[], Any]]:
+        """:meth:`kinematics` and :meth:`rim_speeds` of rover ``k`` as calls straight into
+        the C step (``PhysicsWorld`` attaches them to the rover: no Python frame between)."""
+        stepper = self._stepper
+        return functools.partial(stepper.kinematics, k), functools.partial(stepper.rim_speeds, k)
+
     def advance(self) -> tuple[int, str] | None:
         """One physics step in C; a safety violation or None.
 
@@ -286,6 +301,14 @@ class CompiledFewRovers(FewRovers):
         if bad < 0:
             return None
         return self.first_violation(self.state, self.max_speed, self.extent)
+
+    def batch_index(self) -> int:
+        """The step :meth:`advance_many` is taking (0: its first)."""
+        return self._stepper.batch_i  # type: ignore[no-any-return]
+
+    def stop_batch(self) -> None:
+        """End :meth:`advance_many` after the step under way."""
+        self._stepper.stop_batch()
 
 
 class CompiledFleet(Fleet):

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..model.template import Kind, Port, Template
-from .rover import DiffDriveRover, wrap_angle
+from .rover import DiffDriveRover
 from .roverparams import BODY_PARAMS, ROVER_PARAMS, WHEEL_PARAMS, check_geometry
 from .space import physics_of
 
@@ -40,6 +40,9 @@ POSE_OUTPUTS = (
         "m/s",
     ),
 )
+
+
+_PI, _TWO_PI, _cos, _sin = math.pi, 2 * math.pi, math.cos, math.sin
 
 
 class Robot(Template):
@@ -70,13 +73,14 @@ class Robot(Template):
             raise ValueError(f"{name} is fixed once the run has started")
 
     def _pose(self) -> dict[str, float]:
-        x, y, a, vx, vy, w = self.rover.kinematics()
-        left, right = self.rover.wheel_speeds()
+        rover = self.rover
+        x, y, a, vx, vy, w = rover.kinematics()
+        left, right = rover.wheel_speeds()
         return {
             "posX": x,
             "posY": y,
-            "heading": wrap_angle(a),
-            "speed": vx * math.cos(a) + vy * math.sin(a),
+            "heading": (a + _PI) % _TWO_PI - _PI,  # wrap_angle(a), inlined: every step
+            "speed": vx * _cos(a) + vy * _sin(a),
             "yawRate": w,
             "wheelSpeedL": left,
             "wheelSpeedR": right,
