@@ -79,8 +79,12 @@ On the target (a robot, another machine) install the exporting version there:
 it: `export AMSA_PHYS_PYTHON=/path/to/venv/bin/python` before `roslaunch`; each script then
 notes where `rospy` lives and re-executes itself with that Python, which appends ROS's
 Python packages after its own. Nothing in this package names a path of the machine that
-exported it: the workspace can be copied or moved (rebuild it there, or install it with
-`catkin_make install` and source `install/setup.bash`). User templates (`module:Class`)
+exported it, but a *built* workspace does: catkin writes absolute paths into `devel/` and
+`build/`, so a copied `devel/setup.bash` still points at the old place. To move the package
+to another directory or machine, copy the workspace's `src/` (or this package directory
+into another workspace's `src/`) and run `catkin_make` there; or build with `catkin_make
+install` and copy the `install/` tree, whose `setup.bash` finds its own place. User
+templates (`module:Class`)
 must be importable by that Python too (installed, or on `PYTHONPATH`). `package.xml`
 declares the dependency as the rosdep key `python3-amsa-phys-pip`; rosdep resolves it with
 a rule of your own (`python3-amsa-phys-pip: {ubuntu: {pip: {packages: [amsa-phys]}}}`) or
