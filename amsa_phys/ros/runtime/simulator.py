@@ -34,7 +34,7 @@ from ...runs.rundir import default_run_dir, prepare_run_dir
 from ...runs.single import run_scenario
 from .. import names
 from ..graph import RosGraph
-from . import adaptlink, readiness, records, rosio
+from . import adaptlink, ending, readiness, records, rosio
 from .arrays import array_msg, elements, pack, read
 from .boundary import VALUES, format_values, readable
 from .config import NodeConfig, load_config
@@ -469,6 +469,7 @@ def main() -> None:
         for check in checks:
             print(f"expect {check.describe()}", flush=True)
         code = 0 if all(c.passed for c in checks) else 1
+        print(ending.done_line(checks, out_dir), flush=True)
     except Interrupted as exc:
         print(f"error: {exc}", file=sys.stderr, flush=True)
         code = 130
@@ -479,6 +480,7 @@ def main() -> None:
         print(f"error: {exc}", file=sys.stderr, flush=True)
         code = exc.exit_code
     rospy.signal_shutdown("the run is over")
+    ending.end_launch(code)  # a passing run: roslaunch ends the launch, without alarm
     sys.exit(code)
 
 
