@@ -66,6 +66,25 @@ writes the outputs so far.
   in %) and `/clock` from the wall clock. With the simulator it publishes the same standard
   messages (and `/tf`) from the run, stamped with simulated time.
 
+### How a run ends
+
+The simulator's last line is `amsa_simulator: done: ...` with the expectations'
+verdict; after a passing run roslaunch then shuts down as on Ctrl-C. After a
+failed check or a fault, roslaunch prints in red `REQUIRED process [amsa_simulator-2] has
+died!` with the simulator's exit code (1: a check failed, 2: bad input, 3: a run fault): it
+means the simulator ended, and the launch with it; the lines above say why.
+
+`roslaunch` exits 0 whatever the checks said. For a CI, run the launch through this
+package's script, whose exit code is the run's verdict (0: every expectation passed, 1: one
+failed, 2: the run faulted or did not start, 130: interrupted):
+
+    rosrun @@{pkg:sh_word} run_lockstep @@{launch:sh_word} out:=/tmp/run; echo $?
+
+It adds `mode:=lockstep` unless a `mode:=` is given and `out:=runs/NAME-STAMP` (in the
+current directory) unless an `out:=` is, runs roslaunch, then judges the run directory's
+`scenario.yaml` expectations against its `metrics.json` and `trace.csv` as `amsa-phys run`
+does.
+
 ## Which Python
 
 The Python nodes import amsa-phys in the Python that runs them: catkin's relays start them
