@@ -138,6 +138,8 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
             source=source,
             module=Code(module),
             args=args,
+            # amsa-phys missing: the simulator alone says so (every node would, the same)
+            quiet=Code("False" if script == names.SIMULATOR else "True"),
         )
         executable.add(rel)
 
@@ -159,6 +161,7 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         source=source,
         module=Code("runcheck"),
         args=Code(py_string(pkg)),
+        quiet=Code("False"),
     )
     executable.add(f"nodes/{names.RUN_LOCKSTEP}")
     node(

@@ -15,6 +15,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -430,3 +431,46 @@ def test_run_lockstep_exits_with_the_runs_verdict(
     text = refused.finish()
     assert refused.proc.returncode == 2, text[-3000:]
     assert "run_lockstep: no run in" in text
+
+
+def test_a_simulator_that_cannot_start_is_the_one_error(
+    workspace: Path, launcher: Callable[..., Launch]
+) -> None:
+    """No AMSA_PHYS_PYTHON (amsa-phys not in ROS's python3): every Python node would say so;
+    the simulator alone does, and roslaunch stops the rest without a word of theirs."""
+    bare = workspace / "bare"
+    bare.mkdir(exist_ok=True)
+    script = (workspace / "launch.sh").read_text()
+    (bare / "launch.sh").write_text("unset AMSA_PHYS_PYTHON\n" + script)
+    text = launcher(bare, "ros_short.launch", "plots:=false").finish()
+    assert text.count("cannot import amsa_phys") == 1, text[-3000:]
+    assert "REQUIRED process [amsa_simulator-2] has died" in text, text[-3000:]
+    assert "gave up" not in text
+
+
+def test_a_leaf_without_simulator_says_what_it_waited_for(
+    workspace: Path, launcher: Callable[..., Launch]
+) -> None:
+    """A C++ Leaf whose readers never come (here: no simulator nor scenario node in the
+    launch file) names the topics short of subscribers, how long it waited, and points at
+    the simulator's own error; it used to say "not connected after 120 s" and no more."""
+    launch_dir = workspace / "src" / PKG / "launch"
+    original = (launch_dir / "ros_short.launch").read_text()
+    nosim = re.sub(r'  <node [^>]*type="amsa_simulator.py".*?</node>\n', "", original, flags=re.S)
+    nosim = re.sub(r'  <node [^>]*type="amsa_scenario.py"[^>]*/>\n', "", nosim)
+    assert "amsa_simulator.py" not in nosim
+    assert "amsa_scenario.py" not in nosim
+    (launch_dir / "ros_short_nosim.launch").write_text(nosim)
+    try:
+        text = launcher(workspace, "ros_short_nosim.launch", "timeout:=1").finish()
+    finally:
+        (launch_dir / "ros_short_nosim.launch").unlink()
+    # the first C++ Leaf to give up ends its process (a required node), and the launch
+    found = re.search(
+        r"error: (/\w+): gave up after (\d+\.\d) s waiting for the readers of (.*)", text
+    )
+    assert found is not None, text[-3000:]
+    leaf, waited, rest = found.groups()
+    assert float(waited) >= 2.0  # timeout:=1, twice that for the start
+    assert f"/amsa/done{leaf} (0 of 1 subscribers)" in rest
+    assert "; amsa_simulator reads each of them: if it did not start, its own error" in rest
