@@ -4,8 +4,9 @@
   loop, without roscore and process start-up) against the in-process run's loop
   (``metrics.json`` ``wall_time_s``), launch to done (the difference is start-up and exit),
   and the CPU seconds of every process of the launch (on a shared machine the run time
-  follows the load; the CPU does much less); with ``waves:=false`` (one node at a time, the
-  protocol before waves) and ``waves:=true`` alternated, in one sitting;
+  follows the load; the CPU does much less); with a process per C++ Leaf asked one at a time
+  (``waves:=false``) and in waves, and with every C++ Leaf in the container asked in one
+  message a wave (the default), alternated, in one sitting;
 * the platoon world's launch: the peak of the summed resident memory of every process the
   launch started (sampled from ``/proc`` every 0.2 s), and its run time.
 
@@ -38,6 +39,12 @@ from amsa_phys.cli.main import main
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIO1 = ROOT / "scenarios" / "scenario1.yaml"
 PLATOON = ROOT / "worlds" / "platoon.yaml"
+#: scenario1's lockstep protocols compared: (label, launch arguments)
+PROTOCOLS = (
+    ("a process per Leaf, one at a time", ("cpp_container:=false", "waves:=false")),
+    ("a process per Leaf, waves", ("cpp_container:=false",)),
+    ("container, one message a wave", ()),
+)
 #: CPU seconds of the last :func:`launch`'s processes
 LAST_CPU_S = 0.0
 
@@ -147,6 +154,54 @@ def launch(ws: Path, launch_file: str, *args: str) -> tuple[float, float, int, s
     return wall, float(m.group(1)), peak[0], text
 
 
+#: The floor of lockstep: a rover driven by two C++ Leaves of the container (a constant power
+#: and an actuator chained on it) at scenario1's 4 Hz, so one wait an instant as scenario1
+#: has at best, and next to nothing else: what a lockstep instant costs on this machine
+#: beyond the in-process loop (a request, the container's steps and the answer, through
+#: rospy and roscpp over loopback TCP)
+FLOOR_WORLD = """\
+name: rosFloor
+physics: {rate: 100, ground: {friction: 0.8, rolling_resistance: 0.0017}, obstacles: []}
+components:
+  Cart:
+    template: controlledRobot
+    freq: 4
+    inputs: {powerL: Act.normalizedPowerL, powerR: Act.normalizedPowerR}
+  Act:
+    template: NormalizePower
+    freq: 4
+    inputs: {powerL: Drive.LeftPower, powerR: Drive.RightPower}
+  Drive:
+    template: ConstantPower
+    freq: 4
+    params: {left: 9.0, right: 7.0}
+"""
+
+
+def floor(root: Path, duration: str, repeat: int) -> None:
+    """Lockstep's floor on this machine (:data:`FLOOR_WORLD`), against its in-process loop."""
+    (root / "floor_world.yaml").write_text(FLOOR_WORLD)
+    scenario = root / "floor.yaml"
+    scenario.write_text(f"name: floor\nworld: floor_world.yaml\nduration: {duration}\nseed: 1\n")
+    ws = root / "ws_floor"
+    build(scenario, ws)
+    for _ in range(repeat):
+        ref = root / "floor_ref"
+        with contextlib.redirect_stdout(io.StringIO()):
+            argv = ["run", str(scenario), "--headless", "-q", "--no-plot", "--out", str(ref)]
+            assert main([*argv, "--force"]) == 0
+        loop = json.loads((ref / "metrics.json").read_text())["wall_time_s"]
+        _, run, _, _ = launch(
+            ws, "floor.launch", f"out:={ws / 'out'}", "plots:=false", "force:=true"
+        )
+        instants = 4 * float(duration)
+        print(
+            f"floor (one wait an instant, 4 Hz) {duration} s: in-process loop {loop:.3f} s, "
+            f"lockstep {run:.3f} s: {(run - loop) / instants * 1e6:.0f} us an instant beyond "
+            f"the loop; scenario1's floor {instants:.0f} instants x that"
+        )
+
+
 def main_bench() -> None:
     """Measure and print."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -172,26 +227,28 @@ def main_bench() -> None:
         ref_cpu = time.process_time() - cpu0
         print(f"scenario1 {args.duration} s, in-process loop        {loop:.3f} s")
         print(f"scenario1 in-process: CPU of the whole run         {ref_cpu:.2f} s")
-        # waves:=false is the protocol before waves (one node at a time); alternated, best of
-        # --repeat, since the machine is shared
+        # the protocols, alternated, --repeat times each (the machine is shared): a process
+        # per C++ Leaf asked one at a time (waves:=false) and in waves, and the default, every
+        # C++ Leaf in the container, asked in one message a wave with chained readers
         for _ in range(args.repeat):
-            for waves in ("false", "true"):
+            for label, extra in PROTOCOLS:
                 wall, run, rss, _ = launch(
                     ws,
                     "scenario1.launch",
                     f"out:={ws / 'out'}",
                     "plots:=false",
                     f"duration:={args.duration}",
-                    f"waves:={waves}",
                     "force:=true",
+                    *extra,
                 )
                 same = (ws / "out" / "trace.csv").read_bytes() == (ref / "trace.csv").read_bytes()
                 print(
-                    f"scenario1 lockstep waves:={waves:5}: run {run:.3f} s ({run / loop:.1f}x), "
+                    f"scenario1 lockstep, {label:34}: run {run:.3f} s ({run / loop:.1f}x), "
                     f"launch to done {wall:.1f} s (start-up and exit {wall - run:.1f} s), "
                     f"CPU of the launch {LAST_CPU_S:.1f} s, peak memory {rss / 1024:.0f} MiB, "
                     f"trace byte-identical {same}"
                 )
+        floor(root, args.duration, args.repeat)
         ws = root / "ws2"
         build(PLATOON, ws, "--duration", args.platoon_duration)
         wall, run, rss, _ = launch(ws, "platoon.launch", f"out:={ws / 'out'}", "plots:=false")

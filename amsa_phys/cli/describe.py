@@ -12,6 +12,7 @@ from ..model.scenario import PHYSICS_PREFIX, Scenario, load_scenario
 from ..model.wording import plural
 from ..model.world import LeafSpec, WorldSpec
 from ..runs.expect import describe_bound, describe_what
+from ..valuetext import value_text
 from .loading import load_any
 
 
@@ -146,7 +147,7 @@ def _physics_lines(world: WorldSpec, physics_from: dict[str, Source]) -> list[st
 
 
 def _short(value: Any) -> str:
-    return f"{value:g}" if isinstance(value, float) else repr(value)
+    return value_text(value)  # as the run's table and the window print it
 
 
 def scenario_start(scenario: Scenario, in_file: int) -> dict[str, dict[str, tuple[Any, Source]]]:

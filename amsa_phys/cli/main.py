@@ -114,6 +114,39 @@ class _Parser(argparse.ArgumentParser):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
+        self._words: list[str] = []
+
+    def parse_known_args(self, args: Any = None, namespace: Any = None) -> Any:
+        """argparse's, remembering the words: an unknown option is reported by the top
+        parser, which needs them to find the command whose options to suggest."""
+        self._words = [str(w) for w in (sys.argv[1:] if args is None else args)]
+        return super().parse_known_args(args, namespace)
+
+    def _options(self) -> list[str]:
+        """Every option this command line could have meant: the top parser's and those of
+        the command given (``run``'s ``--headless``), in declaration order."""
+        parsers: list[argparse.ArgumentParser] = [self]
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                chosen = next((w for w in self._words if w in action.choices), None)
+                if chosen is not None:
+                    parsers.append(action.choices[chosen])
+        return [o for p in parsers for a in p._actions for o in a.option_strings]
+
+    def _option_hint(self, word: str) -> str:
+        """`` (did you mean --headless?)`` for a mistyped option: the only option it
+        begins (``--hea``, which Python 3.11's argparse does not suggest and an
+        abbreviation must not silently take), else the nearest by spelling."""
+        if not word.startswith("-"):
+            return ""
+        name = word.split("=", 1)[0]
+        options = self._options()
+        begun = [o for o in options if o.startswith("--") and o.startswith(name) and o != name]
+        if len(begun) == 1 and len(name) > 2:
+            return f" (did you mean {begun[0]}?)"
+        from ..model.suggest import did_you_mean
+
+        return did_you_mean(name, [o for o in options if o.startswith("--")])
 
     def error(self, message: str) -> NoReturn:
         """Print ``error: <prog>: <message>`` and exit 2 (a mistyped command gets a
@@ -125,6 +158,10 @@ class _Parser(argparse.ArgumentParser):
             hint = did_you_mean(bad.group(1), list(COMMANDS))
             if hint:
                 message = f"unknown command {bad.group(1)!r}{hint}"
+        extra = re.match(r"unrecognized arguments: (.*)", message)
+        if extra is not None:
+            words = extra.group(1).split(" ")
+            message = "unrecognized arguments: " + " ".join(w + self._option_hint(w) for w in words)
         self.exit(2, one_line(f"error: {self.prog}: {message} (see {self.prog} --help)") + "\n")
 
 

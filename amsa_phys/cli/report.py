@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from ..errors import one_line
+from ..valuetext import value_text
 
 
 def _fmt(value: Any, digits: int = 2) -> str:
@@ -62,9 +63,9 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
     blocks = [(str(i), p) for i, p in enumerate(metrics["phases"])]
     blocks.append(("all", {**metrics["overall"], "start": 0.0, "set": {}}))
     for name, b in blocks:
-        changes = ", ".join(f"{k}={v}" for k, v in b.get("set", {}).items())
+        changes = ", ".join(f"{k}={value_text(v)}" for k, v in b.get("set", {}).items())
         for c in b.get("changes", []):  # changes inside the phase (live, new_phase: false)
-            inner = ", ".join(f"{k}={v}" for k, v in c["set"].items())
+            inner = ", ".join(f"{k}={value_text(v)}" for k, v in c["set"].items())
             changes += f"{'; ' if changes else ''}at {c['at']:g} s: {inner}"
         rows.append(
             (

@@ -118,11 +118,21 @@ def _run(
         if written is not None:
             print(f"bag: {written}")
     checks = check_expectations(scenario.expect, outcome.metrics, out / "trace.csv")
+    # every verdict on stdout, in order (``run > log`` keeps them all, FAIL lines included);
+    # the failure itself is said once on stderr and by the exit code
     for check in checks:
+        print(one_line(f"expect {check.describe()}"))
+    failed = [c.what for c in checks if not c.passed]
+    if failed:
+        sys.stdout.flush()  # the verdicts before the error line on a shared terminal
         print(
-            one_line(f"expect {check.describe()}"), file=sys.stdout if check.passed else sys.stderr
+            one_line(
+                f"error: {len(failed)} {'check' if len(failed) == 1 else 'checks'} of "
+                f"{len(checks)} failed: {', '.join(failed)}"
+            ),
+            file=sys.stderr,
         )
-    return 0 if all(c.passed for c in checks) else 1
+    return 0 if not failed else 1
 
 
 def warn_if_trace_is_large(scenario: Scenario) -> None:

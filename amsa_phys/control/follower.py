@@ -189,8 +189,8 @@ class FollowerController(Template):
         same = has & (X[:, -1] == xl) & (Y[:, -1] == yl)
         upd = active & ~same
         if upd.any():
-            jump = libm.hypot(xl - X[:, -1], yl - Y[:, -1]) > 2 * p.maxSpeed * np.maximum(
-                ts - T[:, -1], 0.25
+            jump = libm.hypot_exceeds(
+                xl - X[:, -1], yl - Y[:, -1], 2 * p.maxSpeed * np.maximum(ts - T[:, -1], 0.25)
             )
             used[upd & has & jump] = False
             rows = np.flatnonzero(upd)

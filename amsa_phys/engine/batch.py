@@ -154,21 +154,26 @@ def plan(
     component reads at any instant are dropped everywhere, then the rest re-checked.
     """
     smallest = MIN_GROUP if min_group is None else min_group
-    banned: set[tuple[Any, ...]] = set()
+    # each distinct key as a small int: a key holds a Fraction, whose hash is Python code,
+    # and every instant looks up every task's key again (a 250-run batch: 2,000 tasks)
+    ids: dict[tuple[Any, ...], int] = {}
+    kid = {p: None if k is None else ids.setdefault(k, len(ids)) for p, k in keys.items()}
+    banned: set[int] = set()
     cache: dict[tuple[str, ...], Group] = {}
+    sources: dict[int, list[tuple[int, str]]] = {}
     while True:
         out: list[list[Any]] = []
-        bad: set[tuple[Any, ...]] = set()
+        bad: set[int] = set()
         for tasks in instants:
-            members: dict[tuple[Any, ...], list[Any]] = {}
+            members: dict[int, list[Any]] = {}
             if enabled:
                 for t in tasks:
-                    key = keys.get(ident(t))
+                    key = kid.get(ident(t))
                     if key is not None and key not in banned:
                         members.setdefault(key, []).append(t)
             groups = {k: v for k, v in members.items() if len(v) >= smallest}
             seq = _merged(tasks, groups, cache)
-            bad |= _breaks(tasks, seq, keys, groups)
+            bad |= _breaks(tasks, seq, kid, groups, sources)
             out.append(seq)
         if not bad:
             return out
@@ -176,11 +181,11 @@ def plan(
 
 
 def _merged(
-    tasks: Sequence[Any], groups: dict[tuple[Any, ...], list[Any]], cache: dict[Any, Group]
+    tasks: Sequence[Any], groups: dict[int, list[Any]], cache: dict[Any, Group]
 ) -> list[Any]:
     in_group = {id(t): k for k, ts in groups.items() for t in ts}
     seq: list[Any] = []
-    placed: set[tuple[Any, ...]] = set()
+    placed: set[int] = set()
     for t in tasks:
         key = in_group.get(id(t))
         if key is None:
@@ -197,21 +202,27 @@ def _merged(
 def _breaks(
     tasks: Sequence[Any],
     seq: Sequence[Any],
-    keys: dict[tuple[int, str], tuple[Any, ...] | None],
-    groups: dict[tuple[Any, ...], list[Any]],
-) -> set[tuple[Any, ...]]:
+    keys: dict[tuple[int, str], int | None],
+    groups: dict[int, list[Any]],
+    sources: dict[int, list[tuple[int, str]]],
+) -> set[int]:
     """Group keys whose merging would change a read at this instant (a reader reads the
-    writers of its own run)."""
+    writers of its own run). ``sources`` caches each task's writers (by ``id``) across
+    instants."""
+    if not groups:  # only a group's key can be bad
+        return set()
     pos = {ident(t): i for i, t in enumerate(tasks)}
     slot: dict[tuple[int, str], int] = {}
     for i, item in enumerate(seq):
         for t in item.tasks if isinstance(item, Group) else [item]:
             slot[ident(t)] = i
-    bad: set[tuple[Any, ...]] = set()
+    bad: set[int] = set()
     for r in tasks:
         me = ident(r)
-        for _, buf in r.inputs:
-            w = (r.run, buf.rpartition(".")[0])
+        writers = sources.get(id(r))
+        if writers is None:
+            writers = sources[id(r)] = [(r.run, buf.rpartition(".")[0]) for _, buf in r.inputs]
+        for w in writers:
             if w not in pos or w == me or tasks[pos[w]].delay is not None:
                 continue  # a delayed writer's outputs are never read in the same instant
             before = pos[w] < pos[me]
@@ -220,8 +231,8 @@ def _breaks(
                 continue
             for path in (w, me):
                 key = keys.get(path)
-                if key in groups:
-                    bad.add(key)  # type: ignore[arg-type]
+                if key is not None and key in groups:
+                    bad.add(key)
     return bad
 
 

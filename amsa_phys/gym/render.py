@@ -16,13 +16,22 @@ from ..view.pg import pygame
 from ..view.recorder import new_surface
 from ..view.scene import Scene
 
+#: the template name of the agent's stand-in (``episode.stand_in``)
+AGENT_TEMPLATE = "agent"
+
+
+def replaced_components(sim: Simulation) -> list[str]:
+    """The components the agent stands in for: their parameters (a replaced controller's
+    ``Kv=0.35``) act on nothing, so the HUD must not list them as if they did."""
+    return [p for p, leaf in sim.world.leaves.items() if leaf.template.name() == AGENT_TEMPLATE]
+
 
 class FrameSource:
     """Samples a simulation's history at every agent step and draws it on request."""
 
     def __init__(self, sim: Simulation, quality: Quality | None, size: tuple[int, int]) -> None:
         self.sim = sim
-        self.scene = Scene(sim, quality)
+        self.scene = Scene(sim, quality, replaced=replaced_components(sim))
         self.camera = Camera(size)
         self.renderer = Renderer(size)
         self.surface = new_surface(size)

@@ -19,6 +19,8 @@ runs' (``tests/fidelity/test_columns.py``, ``tests/e2e/test_gym_vector.py``).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ..physics.columns import ColumnPhysics
@@ -32,6 +34,14 @@ class EpisodeColumns(ColumnPhysics):
         #: how many runs were touched when :attr:`_frozen` was last rebuilt
         self._seen = 0
         self._frozen: np.ndarray | None = None  # rover rows of the touched runs
+
+    def _start(self) -> Any:
+        """The batch's set-up without the fused C step: that step screens for reach inside C
+        and never calls :meth:`_contacts`, where the freezing happens (and it checks the
+        frozen rows for faults before they could be put back). The forces stay C's."""
+        model = super()._start()
+        self._fused = None
+        return model
 
     def _contacts(self, dt: float) -> None:
         """Find the runs within reach before this step (the batch's rule), then put every

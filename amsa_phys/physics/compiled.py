@@ -26,7 +26,7 @@ import numpy as np
 from .bodyio import STATE, BodyIO, locked_step, substeps
 from .fewrovers import FewRovers
 from .fleet import _GROUND_ROWS, Fleet
-from .forces import Folded, fold
+from .forces import Folded, fold, per_kind
 from .rover import DiffDriveRover
 from .step_path import describe, extension
 from .wheel import SLIP_SPEED_MIN, step_constants
@@ -52,6 +52,8 @@ def check_layout(ext: Any) -> tuple[str, ...]:
         problems.append(f"SLIP_SPEED_MIN {ext.SLIP_SPEED_MIN} != wheel.py's {SLIP_SPEED_MIN}")
     if list(ext.GROUND_ROWS) != _GROUND_ROWS or len(_GROUND_ROWS) != ext.GROUND_TERMS:
         problems.append(f"ground rows {ext.GROUND_ROWS} != fleet._GROUND_ROWS {_GROUND_ROWS}")
+    if not hasattr(ext, "Columns"):  # older builds: no batch step, Stepper takes 7 functions
+        problems.append("no Columns (the batch's step)")
     if problems:
         raise ImportError(
             "amsa_phys.physics._step was built from another version of _step.c ("
@@ -73,6 +75,9 @@ _FUNCTIONS = (
     "cpBodySetTorque",
     "cpSpaceStep",
 )
+#: Read after each step when Chipmunk's rotation of a body is ``math.cos``/``math.sin`` of
+#: its angle (:func:`_rotation_is_libms`): the C step then skips computing them again.
+_ROTATION = "cpBodyGetRotation"
 
 
 def status() -> tuple[bool, str]:
@@ -92,18 +97,38 @@ _cached: tuple[int, ...] | bool | None = False
 
 
 def _functions() -> tuple[int, ...] | None:
-    """Addresses of :data:`_FUNCTIONS` in pymunk's own Chipmunk, or None if not reachable."""
+    """Addresses of :data:`_FUNCTIONS` in pymunk's own Chipmunk, or None if not reachable;
+    with :data:`_ROTATION`'s after them when :func:`_rotation_is_libms`."""
     global _cached
     if _cached is False:
         try:
             from pymunk._chipmunk import ffi, lib
 
-            _cached = tuple(
-                int(ffi.cast("uintptr_t", ffi.addressof(lib, name))) for name in _FUNCTIONS
-            )
+            names = _FUNCTIONS + ((_ROTATION,) if _rotation_is_libms() else ())
+            _cached = tuple(int(ffi.cast("uintptr_t", ffi.addressof(lib, n))) for n in names)
         except Exception:  # an older/newer pymunk layout: stay pure
             _cached = None
     return _cached  # type: ignore[return-value]
+
+
+def _rotation_is_libms(samples: int = 200) -> bool:
+    """Whether Chipmunk's rotation of a body equals ``math.cos`` and ``math.sin`` of its
+    angle (the functions the C step calls) on angles of every size and sign: true where
+    pymunk's Chipmunk calls the same libm (checked once a process, ~0.2 ms); elsewhere the C
+    step computes them itself."""
+    import math
+
+    import pymunk
+    from pymunk._chipmunk import lib
+
+    body = pymunk.Body(1.0, 1.0)
+    for i in range(samples):
+        angle = math.ldexp(math.sin(7.0 * i + 1.0), i % 40 - 20)  # |angle| 1e-6 .. 1e6
+        body.angle = angle
+        r = lib.cpBodyGetRotation(body._body)
+        if r.x != math.cos(angle) or r.y != math.sin(angle):
+            return False
+    return True
 
 
 def _address(handle: Any) -> int:
@@ -118,6 +143,11 @@ def plan_row(rover: DiffDriveRover, dt: float) -> list[float]:
     s = step_constants(rover.wheel, dt, rover.mass, rover.moment, rover.half_track)
     f["big_bc"] = s.big_bc
     return [f[name] for name in PLAN_FIELDS]
+
+
+def plan_rows(rovers: Sequence[DiffDriveRover], dt: float) -> list[list[float]]:
+    """:func:`plan_row` of every rover, folded once per kind of rover (``forces.per_kind``)."""
+    return per_kind(rovers, lambda r: plan_row(r, dt))
 
 
 def _locked_step(space: Any, step: Any) -> int:
@@ -313,8 +343,8 @@ class CompiledFleet(Fleet):
     def refresh(self) -> None:
         """Re-read every rover's constants (after a parameter change: motor wear, ...)."""
         super().refresh()
-        for k, r in enumerate(self.rovers):
-            self._plan_buf[k] = plan_row(r, self.dt)
+        if self.rovers:
+            self._plan_buf[...] = plan_rows(self.rovers, self.dt)
 
     def advance(self) -> tuple[int, str] | None:
         """One physics step in C; a safety violation or None."""
@@ -356,9 +386,13 @@ class ColumnForces(Fleet):
     def refresh(self) -> None:
         """Re-read every rover's constants into the C plan (folded as FewRovers folds them)."""
         super().refresh()
-        self._plan = np.array(
-            [plan_row(r, self.dt) for r in self.rovers], dtype=np.float64
-        ).reshape(len(self.rovers), len(PLAN_FIELDS))
+        plan = np.array(plan_rows(self.rovers, self.dt), dtype=np.float64).reshape(
+            len(self.rovers), len(PLAN_FIELDS)
+        )
+        if getattr(self, "_plan", None) is None:
+            self._plan = plan
+        else:  # in place: a :meth:`columns` step holds this array
+            self._plan[...] = plan
 
     def apply(self, state: np.ndarray) -> None:
         """Every rover's force and torque for this step (into the io's forces), rims advanced."""
@@ -369,3 +403,25 @@ class ColumnForces(Fleet):
         )
         if self._span is None:
             self._out[self.rows] = out
+
+    def columns(self, state: np.ndarray, forces: np.ndarray, inverse: tuple, screen: dict) -> Any:
+        """The whole column step in C (``_step.Columns``) over these arrays: contact screening
+        on the state before the step, this model's forces, Chipmunk's integration of a body
+        without contacts and the safety check, as ``columns.ColumnPhysics`` does them in
+        numpy, in one call. ``inverse`` is (1/m, 1/I) per rover; ``screen`` the screening's
+        arrays (``ColumnPhysics._start``); ``state`` and ``forces`` the io's, which the step
+        updates in place (this model's ``state`` becomes ``state``)."""
+        self.state = state
+        return _step.Columns(  # type: ignore[union-attr]
+            self._plan,
+            self.drives,
+            self.rims,
+            self.ground,
+            state,
+            forces,
+            *inverse,
+            self.dt,
+            self.max_speed**2,
+            self.extent,
+            **screen,
+        )

@@ -18,11 +18,12 @@ run large fleets or batched sweeps should have a compiler, which ``pip install``
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
 from .bodyio import BodyIO, substeps
-from .forces import fold, outside, rover_step, too_fast
+from .forces import fold, outside, per_kind, rover_step, too_fast
 from .rover import DiffDriveRover
 from .wheel import step_constants
 
@@ -58,8 +59,8 @@ class Fleet:
             r.attach_power_slot(self.drives, i)
         self.rims = np.zeros((2, n))
         self.ground = np.zeros((len(_GROUND_ROWS), n))
-        for k, terms in enumerate(grounds):
-            self.set_ground(k, terms)
+        if grounds:  # set_ground for every rover, in one assignment
+            self.ground[_GROUND_ROWS] = np.array(grounds, dtype=np.float64).T
         self._out = np.frombuffer(io.forces, dtype=np.float64).reshape(-1, 3)
         start = int(self.rows[0]) if n else 0
         consecutive = n > 0 and bool((self.rows == np.arange(start, start + n)).all())
@@ -73,12 +74,24 @@ class Fleet:
         """Re-read every rover's constants (after a parameter change: motor wear, ...).
 
         Folded exactly as ``FewRovers.refresh`` folds them: both call ``forces.rover_step``.
+        Lazily (:meth:`plans`): the compiled models subclassing this one never run the pure
+        pass, and keep constants of their own.
         """
-        self._plans = [
-            (*fold(r, self.dt), step_constants(r.wheel, self.dt, r.mass, r.moment, r.half_track))
-            for r in self.rovers
-        ]
+        self._plans: list[tuple[Any, ...]] | None = None  # folded when the pure pass needs them
         self.half_track = np.array([r.half_track for r in self.rovers], dtype=np.float64)
+
+    def plans(self) -> list[tuple[Any, ...]]:
+        """Every rover's constants for ``forces.rover_step`` (folded once per kind of rover)."""
+        if self._plans is None:
+            dt = self.dt
+            self._plans = per_kind(
+                self.rovers,
+                lambda r: (
+                    *fold(r, dt),
+                    step_constants(r.wheel, dt, r.mass, r.moment, r.half_track),
+                ),
+            )
+        return self._plans
 
     def set_ground(self, k: int, terms: list[float]) -> None:
         """Rover ``k``'s ground terms (``forces.ground_list``) from the next step on."""
@@ -131,7 +144,7 @@ class Fleet:
         results = [
             rover_step(plan, gnd, dt, row[2], row[3], row[4], row[5], ul, ur, dl, dr)
             for plan, gnd, row, ul, ur, dl, dr in zip(
-                self._plans, grounds, rows, rim_l, rim_r, drive_l, drive_r, strict=True
+                self.plans(), grounds, rows, rim_l, rim_r, drive_l, drive_r, strict=True
             )
         ]
         if results:

@@ -34,7 +34,7 @@ from ..errors import RunFault
 from . import fleet
 from .bodyio import BodyIO
 from .force_model import ForceModel, make_force_model
-from .forces import ground_list
+from .forces import ground_list, per_kind
 from .rover import DiffDriveRover, PendingPowers
 from .terrain import Terrain
 from .wheel import WheelModel
@@ -235,7 +235,8 @@ class PhysicsWorld:
         io = BodyIO(self.space, [r.body for r in self.rovers])
         limits = (self.max_speed, self.extent, resolvable_speed(self.rovers, self.space, self.dt))
         ground = self.terrain.ground(-1)
-        grounds = [ground_list(r, ground, ground) for r in self.rovers]
+        # each its own list (a few-rover model edits them in place), computed once per kind
+        grounds = [list(g) for g in per_kind(self.rovers, lambda r: ground_list(r, ground, ground))]
         model = make_force_model(io, self.rovers, self.dt, limits, grounds)
         self._model = model
         self._where = [(-1, -1, -1, -1)] * len(self.rovers)

@@ -19,6 +19,7 @@ from matplotlib.figure import Figure
 from ..errors import ConfigError
 from ..model.params import short_repr
 from ..palette import COLLISION, PHASE, REFERENCE, SIGNAL, hex_colour
+from ..valuetext import value_text
 from .adaptmarks import adapt_switches
 from .save import save_png
 
@@ -153,7 +154,7 @@ def _phase_notes(ax: Axes, phases: list[dict[str, Any]]) -> list[str]:
         start = phase["start"]
         if start > 0:
             ax.axvline(start, color=hex_colour(PHASE), lw=0.8, ls=":")
-        lines = [f"{k.split('.')[-1]}={v}" for k, v in phase["set"].items()]
+        lines = [f"{k.split('.')[-1]}={value_text(v)}" for k, v in phase["set"].items()]
         if len(lines) > MAX_NOTE_LINES:
             lines = [*lines[: MAX_NOTE_LINES - 1], f"+{len(lines) - MAX_NOTE_LINES + 1} more"]
         if phase.get("label"):
@@ -193,7 +194,9 @@ def _inner_changes(ax: Axes, phases: list[dict[str, Any]]) -> list[float]:
                 alpha=0.8,
                 label="change inside a phase" if len(times) == 1 else None,
             )
-            what = ", ".join(f"{k.split('.')[-1]}={v}" for k, v in change["set"].items())
+            what = ", ".join(
+                f"{k.split('.')[-1]}={value_text(v)}" for k, v in change["set"].items()
+            )
             label = change.get("label")
             ax.annotate(
                 f"{label}: {what}" if label else what,
@@ -292,7 +295,7 @@ def distance_figure(
     FigureCanvasAgg(fig)  # the canvas pyplot would give it (callers draw and measure on it)
     ax = fig.subplots()
     changes: list[float] = []
-    if signal in header and data.size and abs(float(quality["reference"])) < PLOTTABLE:
+    if signal in header and data.size:
         t = data[:, 0]
         s = data[:, header.index(signal)]
         ref = float(quality["reference"])
@@ -300,19 +303,30 @@ def distance_figure(
         # a tolerance near the float limit (the schema takes any finite one) is drawn to
         # PLOTTABLE: the axis's top, its edge with headroom, would overflow to inf
         band = min(tol, PLOTTABLE)
-        ax.fill_between(
-            [t[0], t[-1]],
-            ref - band,
-            ref + band,
-            color=hex_colour(REFERENCE),
-            alpha=0.15,
-            label=f"tolerance ±{tol:g} m",
-        )
         ref_colour = hex_colour(REFERENCE)
-        ax.axhline(ref, color=ref_colour, lw=1.2, ls="--", label=f"reference {ref:g} m")
+        top = float(np.nanmax(s)) if np.isfinite(s).any() else 0.0
+        if abs(ref) < PLOTTABLE:
+            ax.fill_between(
+                [t[0], t[-1]],
+                ref - band,
+                ref + band,
+                color=ref_colour,
+                alpha=0.15,
+                label=f"tolerance ±{tol:g} m",
+            )
+            ax.axhline(ref, color=ref_colour, lw=1.2, ls="--", label=f"reference {ref:g} m")
+            top = max(top, ref + band)
+        else:  # a legal reference near the float limit: the signal still has its plot
+            ax.plot(
+                [],
+                [],
+                color=ref_colour,
+                lw=1.2,
+                ls="--",
+                label=f"reference {ref:g} m (off the scale)",
+            )
         # palette.SIGNAL, near-black: blue and orange are the rovers' colours everywhere
         ax.plot(t, s, color=hex_colour(SIGNAL), lw=1.2, label=signal)
-        top = max(float(np.nanmax(s)) if np.isfinite(s).any() else 0.0, ref + band)
         lines = _phase_notes(ax, metrics.get("phases", []))
         changes = _inner_changes(ax, metrics.get("phases", []))
         _collisions(ax, metrics.get("events", []), t, s)

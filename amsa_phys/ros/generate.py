@@ -147,7 +147,7 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         names.SIMULATOR,
         f"{names.SIMULATOR}: the simulator node of {pkg}.",
         _simulator_doc(graph),
-        "simulator",
+        "simmain",
         Code(""),
     )
     # rosrun PKG run_lockstep SCENARIO.launch: roslaunch, then the run's verdict as exit code
@@ -211,7 +211,14 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         )
         files[f"include/{pkg}/amsa_leaf_node.h"] = (FILES / "amsa_leaf_node.h").read_text()
         files[f"include/{pkg}/amsa_pymath.h"] = (FILES / "amsa_pymath.h").read_text()
-        for header in ("amsa_noise.h", "amsa_rng.h", "amsa_ziggurat.h", "amsa_window.h"):
+        for header in (
+            "amsa_noise.h",
+            "amsa_rng.h",
+            "amsa_ziggurat.h",
+            "amsa_window.h",
+            "amsa_container.h",
+            "amsa_wiring.h",
+        ):
             files[f"include/{pkg}/{header}"] = (FILES / header).read_text()
     launches = []
     for scenario, fname in zip(scenarios, unique_names(s.name for s in scenarios), strict=True):

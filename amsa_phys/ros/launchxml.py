@@ -29,7 +29,10 @@ _ARGS = """\
   <arg name="waves" default="true" doc="lockstep: ask together the nodes of an instant whose\
  inputs are fixed (false: one at a time, for comparison)"/>
   <arg name="sim" default="true" doc="false: the controller side alone, in free mode, for a real\
- robot whose drivers publish the standard topics (see README.md)"/>"""
+ robot whose drivers publish the standard topics (see README.md)"/>
+  <arg name="boundary" default="$(eval arg('mode') != 'lockstep' or not arg('sim'))"\
+ doc="the robot boundary's standard messages (default: in free mode and with sim:=false; in\
+ lockstep only when asked, boundary:=true, since it costs the replica time)"/>"""
 
 _HEAD = """\
   <param name="/use_sim_time" value="true"/>
@@ -59,7 +62,8 @@ _HEAD = """\
  name="@@{scenario:xml_attr}" required="true" output="screen"/>
   <!-- the robot boundary: standard messages (sim:=false: from the robot's drivers in, and
        /clock from the wall clock) -->
-  <node pkg="@@{pkg:xml_attr}" type="@@{boundary:xml_attr}.py" name="@@{boundary:xml_attr}"\
+  <node if="$(arg boundary)" pkg="@@{pkg:xml_attr}" type="@@{boundary:xml_attr}.py"\
+ name="@@{boundary:xml_attr}"\
  output="screen">
     <param name="speed" type="double" value="$(arg speed)"/>
   </node>

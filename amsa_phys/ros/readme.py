@@ -43,7 +43,8 @@ Launch files: @@{launches:code}. Arguments: `mode` (`lockstep` or `free`, defaul
 @@{mode:md_code}), `out` (run directory, default `runs/NAME-STAMP` in the current directory;
 an existing one is replaced only with `force:=true` and only if amsa-phys made it), `bag`
 (record every Data topic), `speed` (free mode), `duration` (simulated seconds, default the
-scenario's), `plots`, `timeout`@@{cpp_arg:code}.
+scenario's), `plots`, `timeout`, `boundary` (the standard messages: by default in free mode
+and with `sim:=false`, in lockstep with `boundary:=true`)@@{cpp_arg:code}.
 The run ends by itself (the simulator is a required node); Ctrl-C stops every node and
 writes the outputs so far.
 
@@ -121,8 +122,9 @@ Physical Leaves (@@{local:code}) share one pymunk world, so they step inside
 
 _FRAMEWORK = """
 Framework topics: `/clock`, `/amsa/step/LEAF` and `/amsa/done/LEAF` (lockstep requests and
-answers, `std_msgs/String`), `/amsa/phase` (the scenario node's announcements),
-`/amsa/ready` (start-up handshake: ROS 1 drops what is published before a subscriber
+answers, `std_msgs/String`; for the C++ Leaves in `amsa_leaves`, one message a wave on
+`/amsa/step/amsa_leaves` and `/amsa/done/amsa_leaves`), `/amsa/phase` (the scenario node's
+announcements), `/amsa/ready` (start-up handshake: ROS 1 drops what is published before a subscriber
 connects, so the run starts once every publisher has all its subscribers).
 
 ## Your own node

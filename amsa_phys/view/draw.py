@@ -54,6 +54,19 @@ def error_colour(error: float, tolerance: float) -> tuple[int, int, int]:
     return BAD
 
 
+def hud_number(value: float, signed: bool = False) -> str:
+    """A metric as the HUD prints it: two decimals, but a huge (legal) value in
+    scientific notation and a non-finite one as a word.
+
+    ``reference: 1.0e+308`` is a legal scenario: its error printed with ``.2f`` is a
+    309-digit number that buried the HUD, and its rms error overflows to infinity
+    (``metrics.json`` writes it as null and lists it in ``nonfinite``)."""
+    if not math.isfinite(value):
+        return "overflow" if not math.isnan(value) else "nan"
+    sign = "+" if signed else ""
+    return f"{value:{sign}.2f}" if abs(value) < 1e9 else f"{value:{sign}.3g}"
+
+
 def nice_step(target_m: float) -> float:
     """The 1-2-5 series value nearest above ``target_m`` (grid spacing, scale bar)."""
     exp = math.floor(math.log10(target_m))
@@ -299,14 +312,14 @@ class Renderer:
         if q is not None and m.value is not None:
             err = m.value - q.reference
             lines.append(
-                f"measured {m.value:6.2f} m  ref {q.reference:g} ± {q.tolerance:g}  "
-                f"error {err:+.2f} m"
+                f"measured {hud_number(m.value):>6} m  ref {q.reference:g} ± {q.tolerance:g}  "
+                f"error {hud_number(err, signed=True)} m"
             )
             colours.append(darker(error_colour(err, q.tolerance)))  # readable on white
             rms = m.rms_error
             lines.append(
-                f"max {m.max:.2f} m  min {m.min:.2f} m  rms error "
-                f"{rms:.2f} m  collisions {m.collisions}"
+                f"max {hud_number(m.max)} m  min {hud_number(m.min)} m  rms error "
+                f"{hud_number(rms) if rms is not None else '-'} m  collisions {m.collisions}"
             )
             colours.append(INK)
         else:

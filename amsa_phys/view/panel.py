@@ -14,6 +14,7 @@ from typing import Any
 from ..engine.runner import Simulation
 from ..model.params import Param
 from ..model.scenario import Change
+from ..valuetext import value_text
 
 #: Steps per full range for the arrow keys (Shift: ten times finer).
 COARSE_STEPS = 20
@@ -192,6 +193,4 @@ class ParamPanel:
 
 
 def _fmt(value: Any) -> str:
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    return str(value)
+    return value_text(value)  # as the HUD, the replay and the run's table print it

@@ -67,6 +67,10 @@ class Player:
         self.running = True
         self.show_help = False
         self.notice = ""
+        #: the row an event's notice (``125.00 s: phase 1: ...``) is about: it is shown only
+        #: there, so a later seek (End, a click on the slider, playing on) never leaves it
+        #: describing an instant the picture no longer shows
+        self._notice_row: int | None = None
         self._owed = 0.0
         self._seeking = False
         self._drag: tuple[int, int] | None = None
@@ -112,9 +116,11 @@ class Player:
             found = next((e for e in reversed(events) if e.t < now - 1e-9), None)
         if found is None:
             self.notice = "no later event" if direction > 0 else "no earlier event"
+            self._notice_row = self.row
             return None
         self.seek(found.t)
         self.notice = f"{found.t:.2f} s: {found.text}"
+        self._notice_row = self.row
         return found
 
     # -- the loop ------------------------------------------------------------------------------
@@ -233,6 +239,7 @@ class Player:
             self.picker.visible = True
         elif key == pygame.K_c:
             self.notice = "camera: " + self.camera.cycle(self.scene.rover_names)
+            self._notice_row = None  # not about an instant: it stays
         elif key == pygame.K_z:
             self.camera.zoom(1.25)
         elif key == pygame.K_x:
@@ -261,6 +268,11 @@ class Player:
             lines.append(f"run {status}")
         return lines
 
+    def shown_notice(self) -> str:
+        """The HUD's last line: what the last key did, an event's only at its instant."""
+        stale = self._notice_row is not None and self._notice_row != self.row
+        return "" if stale else self.notice
+
     def draw(self) -> None:
         """The current row, the slider, and the open panes (drawn again when what covers
         the map moved, so the picture and the camera agree: ``Window.draw``)."""
@@ -280,7 +292,7 @@ class Player:
         """Draw ``frame``, the slider and the panes; set the camera's covers from them."""
         view = self.screen.subsurface(self.view_rect)
         cam = self.camera
-        self.renderer.draw(view, frame, cam, self.status(), self.notice)
+        self.renderer.draw(view, frame, cam, self.status(), self.shown_notice())
         cam.top = max(box.bottom for box in self.renderer.boxes.values()) + 6  # under the HUD
         self._slider()
         right = draw_side_panes(
@@ -320,6 +332,6 @@ class Player:
         x = self.slider_x(self.t)
         pygame.draw.rect(screen, INK, (x - 3, bar.top - 6, 6, bar.height + 12))
         label = font(max(9, self.renderer.text_px - 3)).render(
-            f"{self.t:.2f} s / {float(self.scene.t[-1]):g} s", True, MUTED
+            f"{self.t:.2f} s / {self.scene.duration:g} s", True, MUTED
         )
         screen.blit(label, (bar.right - label.get_width(), bar.top - label.get_height() - 6))

@@ -1,7 +1,7 @@
 """Headless video of a run: frames on the simulated clock, streamed to the encoder.
 
 Frame *k* shows the world at simulated time ``k * speedup / fps`` (after every instant
-before it has run), so video time equals simulated time (``--speedup 1``) whatever the wall
+at or before it has run), so video time equals simulated time (``--speedup 1``) whatever the wall
 clock does — a paused window records nothing, a fast machine records the same video as a
 slow one. A run of duration *D* gives ``ceil(D * fps / speedup)`` frames.
 """
@@ -68,6 +68,7 @@ class Recorder:
         self.surfaces = [new_surface(options.size) for _ in range(2)]
         self.encoder = VideoEncoder(options.path, options.size, options.fps, PIX_FMT)
         self._status = [f"x{float(options.speedup):g}  video {options.fps} fps"]
+        self.scene.expect(0.0)
 
     def next_time(self) -> Fraction | None:
         """Simulated time of the next frame, or None when every frame is out."""
@@ -85,6 +86,7 @@ class Recorder:
         self.renderer.draw(surface, frame, self.camera, self._status)
         self.encoder.submit(surface.get_view("0"))
         self.index += 1
+        self.scene.expect(float(self.period * self.index))
 
     def close(self) -> Path:
         """Finish the video (playable up to the last frame captured)."""
@@ -118,6 +120,7 @@ class Snapshot:
         self.options = options
         self.at = min(options.at if options.at is not None else sim.duration, sim.duration)
         self.scene = Scene(sim, quality, planned)  # the HUD counts the file's phases
+        self.scene.expect(float(self.at))
         self.written: Path | None = None
 
     def next_time(self) -> Fraction | None:

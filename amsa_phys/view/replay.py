@@ -23,6 +23,7 @@ from ..model.scenario import Quality
 from ..model.world import WorldSpec
 from ..palette import rover_names, rover_ranks
 from ..tracemarks import gps_links, lossy_in_run, lost_fix_rows
+from ..valuetext import value_text
 from .scene import (
     GPS_POINTS,
     LOST_POINTS,
@@ -68,7 +69,9 @@ class ReplayScene:
             if q
             else None
         )
-        self.duration = float(metrics.get("duration") or self.t[-1])
+        # the run's end, which the slider says too: a run closed early in the window keeps
+        # the file's duration in metrics.json ("/ 200 s" in the HUD beside "/ 63.4 s")
+        self.duration = float(self.t[-1])
         self.phases: list[dict[str, Any]] = list(metrics.get("phases") or [])
         shown = rover_names(columns)
         self.ranks = rover_ranks(rover_names(list(world.buffers)), shown)
@@ -118,7 +121,9 @@ class ReplayScene:
         if q is None or q.signal not in self.col:
             return None
         s = self.data[:, self.col[q.signal]]
-        return np.maximum.accumulate(s), np.minimum.accumulate(s), np.cumsum((s - q.reference) ** 2)
+        with np.errstate(over="ignore", invalid="ignore"):  # a huge legal reference: inf
+            sq = np.cumsum((s - q.reference) ** 2)
+        return np.maximum.accumulate(s), np.minimum.accumulate(s), sq
 
     def _events(self) -> list[Event]:
         """Every instant worth jumping to, in time order."""
@@ -304,12 +309,13 @@ class ReplayScene:
                 for k, v in (c.get("set") or {}).items():
                     inside[k] = (float(c["at"]), v, how)
         sets = [
-            f"{k.rpartition('.')[2]}={v}"
+            f"{k.rpartition('.')[2]}={value_text(v)}"
             for k, v in (p.get("set") or {}).items()
             if k not in inside
         ]
         sets += [
-            f"{k.rpartition('.')[2]}={v} {how} {at:.1f} s" for k, (at, v, how) in inside.items()
+            f"{k.rpartition('.')[2]}={value_text(v)} {how} {at:.1f} s"
+            for k, (at, v, how) in inside.items()
         ]
         return phase_line(index, len(self.phases), p.get("label", ""), float(p["start"]), sets)
 

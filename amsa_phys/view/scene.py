@@ -19,6 +19,7 @@ from ..engine.runner import Simulation
 from ..model.geometry import Obstacle, static_obstacles
 from ..model.scenario import Quality
 from ..palette import rover_names
+from ..valuetext import value_text
 
 #: Trail and GPS history kept per rover: bounded, so a long run draws in constant time.
 TRAIL_POINTS = 1500
@@ -119,7 +120,11 @@ class Frame:
     collisions: list[tuple[float, float]] = field(default_factory=list)
 
 
-def describe_phase(sim: Simulation, planned: Sequence[Fraction] | None = None) -> str:
+def describe_phase(
+    sim: Simulation,
+    planned: Sequence[Fraction] | None = None,
+    replaced: Sequence[str] = (),
+) -> str:
     """``phase 2 (of 0–3) from 125 s: Kv=0.15`` — what the HUD prints about the current phase.
 
     A parameter set twice at a phase's start (the scenario's ``set:`` and a ``--set``
@@ -130,7 +135,9 @@ def describe_phase(sim: Simulation, planned: Sequence[Fraction] | None = None) -
     (``Kv=0.15 at 20.0 s``): the HUD never shows a value the run is not using. ``planned``:
     the file's phase starts and duration when ``--duration`` shortened the run
     (``Scenario.planned_bounds``): the count is then the file's, and the line says where
-    this run stops.
+    this run stops. ``replaced``: components an agent stands in for (the Gymnasium env):
+    their parameters are set but act on nothing, so they are not listed as if they did
+    (the env's status box says ``agent: MyFollowerController``).
     """
     phase = sim.phases[sim.phase_index]
     live: dict[tuple[str, str], tuple[Any, Any, str]] = {}
@@ -139,15 +146,19 @@ def describe_phase(sim: Simulation, planned: Sequence[Fraction] | None = None) -
     for point in sim.timeline.points():
         if phase.at < point.at <= sim.now and not point.starts_phase:
             for c in point.changes:
-                live[(c.leaf, c.param)] = (point.at, c.value, "at")
+                if c.leaf not in replaced:
+                    live[(c.leaf, c.param)] = (point.at, c.value, "at")
     for at, c in sim.live_changes:
-        if at >= phase.at:
+        if at >= phase.at and c.leaf not in replaced:
             live[(c.leaf, c.param)] = (at, c.value, "live at")
     latest: dict[tuple[str, str], Any] = {}
     for c in phase.changes:  # the last assignment of a key wins, in its first place
-        latest[(c.leaf, c.param)] = c.value
-    parts = [f"{p}={_short(v)}" for (leaf, p), v in latest.items() if (leaf, p) not in live]
-    parts += [f"{p}={_short(v)} {how} {float(at):.1f} s" for (_, p), (at, v, how) in live.items()]
+        if c.leaf not in replaced:
+            latest[(c.leaf, c.param)] = c.value
+    parts = [f"{p}={value_text(v)}" for (leaf, p), v in latest.items() if (leaf, p) not in live]
+    parts += [
+        f"{p}={value_text(v)} {how} {float(at):.1f} s" for (_, p), (at, v, how) in live.items()
+    ]
     count = len(planned) - 1 if planned else len(sim.phases)
     text = phase_line(sim.phase_index, count, phase.label, float(phase.at), parts)
     if planned and sim.duration < planned[-1]:
@@ -180,14 +191,6 @@ def adapt_text(sim: Simulation) -> str:
     return ""
 
 
-def _short(value: Any) -> str:
-    if isinstance(value, float):
-        return f"{value:g}"
-    if isinstance(value, tuple):
-        return f"[{len(value)} points]"
-    return str(value)
-
-
 class Scene:
     """Builds :class:`Frame` s from one Simulation, remembering trails and GPS history.
 
@@ -203,8 +206,11 @@ class Scene:
         sim: Simulation,
         quality: Quality | None = None,
         planned: Sequence[Fraction] | None = None,
+        replaced: Sequence[str] = (),
     ) -> None:
         self.sim = sim
+        #: components an agent stands in for: their parameters are not shown as acting
+        self.replaced = tuple(replaced)
         self.quality = quality
         #: the file's phase bounds when ``--duration`` shortened the run (the HUD counts them)
         self.planned = planned
@@ -221,6 +227,11 @@ class Scene:
         #: where collisions happened (the midpoint of the rovers named), as the plots mark them
         self.collisions: deque[tuple[float, float]] = deque(maxlen=LOST_POINTS)
         self._events_seen = 0
+        #: the logged instant a picture is due at (``expect``) and the rovers as they stood
+        #: there: the physics step that ends an instant moves the bodies on, so a picture
+        #: drawn after the instant would show them one step later than its HUD's sample
+        self._due: float | None = None
+        self._held: tuple[float, list[RoverPose]] | None = None
         # rovers in declaration order: the i-th has the i-th colour, as in the plots
         self._rank = {name: i for i, name in enumerate(rover_names(list(sim.world.buffers)))}
         self.pair_lines = self._between_rovers()
@@ -283,8 +294,15 @@ class Scene:
         out.sort(key=lambda r: self._rank.get(r.name, len(self._rank)))
         return out
 
+    def expect(self, t: float) -> None:
+        """A picture will be drawn at ``t``: if a logged instant falls there, keep the rovers
+        as they stand at its log (after its components, before its physics step)."""
+        self._due = t
+
     def _sample(self, t_s: float, values: dict[str, float]) -> None:
         """One logged instant: extend trails, note new and lost GPS fixes, update metrics."""
+        if t_s == self._due:
+            self._held = (t_s, self.rovers())
         physics = self._physics()
         where: dict[str, tuple[float, float]] = {}
         for r in physics.rovers if physics is not None else ():
@@ -320,7 +338,10 @@ class Scene:
             m.value = v
             m.max = max(m.max, v)
             m.min = min(m.min, v)
-            m.sum_sq += (v - self.quality.reference) ** 2
+            # a product, not ``** 2``: a huge legal reference overflows to inf (as the
+            # metrics' rms does) instead of raising OverflowError mid-run
+            error = v - self.quality.reference
+            m.sum_sq += error * error
             m.count += 1
 
     def frame(self, t: float | None = None) -> Frame:
@@ -330,7 +351,10 @@ class Scene:
         simulation's current instant. A trail ends at the rover's current position.
         """
         sim = self.sim
-        rovers = self.rovers()
+        when = float(sim.now) if t is None else t
+        held = self._held
+        # at a logged instant, the rovers where its components and log saw them
+        rovers = held[1] if held is not None and held[0] == when else self.rovers()
         trails = {k: list(v) for k, v in self.trails.items()}
         for r in rovers:
             trails.setdefault(r.name, []).append((r.x, r.y))
@@ -338,7 +362,7 @@ class Scene:
         physics = self._physics()
         m.collisions = physics.collisions if physics is not None else 0
         return Frame(
-            t=float(sim.now) if t is None else t,
+            t=when,
             rovers=rovers,
             trails=trails,
             gps=self.gps,
@@ -347,7 +371,7 @@ class Scene:
             quality=self.quality,
             phase_index=sim.phase_index,
             phase_count=len(sim.phases),
-            phase_text=describe_phase(sim, self.planned),
+            phase_text=describe_phase(sim, self.planned, self.replaced),
             duration=float(sim.duration),
             scans=self.scans(),
             zones=self.zones(),

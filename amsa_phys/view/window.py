@@ -20,6 +20,7 @@ from fractions import Fraction
 from ..engine import interrupt
 from ..engine.runner import Simulation
 from ..model.scenario import Quality
+from ..valuetext import value_text
 from .camera import Camera
 from .draw import INK, LOST, MUTED, Renderer
 from .drive import advance
@@ -159,7 +160,7 @@ class Window:
             tick = int(target / self.sim.grid.tick)
             if tick >= self.sim.grid.ticks(self.sim.now):
                 before = self.sim.now
-                advance(self.sim, min(tick, self._end), self.sinks)
+                self._advance(min(tick, self._end))
                 self._owed -= float(self.sim.now - before)
         if self.notice.endswith(QUEUED_NOTICE) and not self.sim.pending_live:
             self._quit_asked = False  # the queued change has landed: the warning is stale
@@ -173,7 +174,13 @@ class Window:
         if self.finished:
             return
         tick = self.sim.grid.ticks(self.sim.next_instant())
-        advance(self.sim, min(tick, self._end), self.sinks)
+        self._advance(min(tick, self._end))
+
+    def _advance(self, tick: int) -> None:
+        """Run every instant up to ``tick``; the picture drawn then shows the rovers where
+        that instant's log saw them (not one physics step on)."""
+        self.scene.expect(float(self.sim.grid.time(tick)))
+        advance(self.sim, tick, self.sinks)
 
     # -- input ---------------------------------------------------------------------------
     def handle(self, event: pygame.event.Event) -> None:
@@ -270,7 +277,7 @@ class Window:
         """
         pending = self.sim.pending_live
         if pending and not confirmed and not self.finished:
-            changes = ", ".join(f"{c.key}={c.value}" for c in pending)
+            changes = ", ".join(f"{c.key}={value_text(c.value)}" for c in pending)
             self.notice = f"{changes}{QUEUED_NOTICE}"
             self._quit_asked = True
             return
@@ -286,7 +293,9 @@ class Window:
         change = self.panel.commit()
         if change is not None:
             at = self.sim.apply_live(change)
-            self.panel.message = f"{change.key} = {change.value} at t = {float(at):.2f} s"
+            self.panel.message = (
+                f"{change.key} = {value_text(change.value)} at t = {float(at):.2f} s"
+            )
             self.notice = f"live: {self.panel.message}"
 
     def _resize(self, size: tuple[int, int]) -> None:

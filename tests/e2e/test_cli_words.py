@@ -30,5 +30,17 @@ def test_an_abbreviated_option_is_refused_not_guessed(
     assert done.value.code == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
-    assert "unrecognized arguments: --hea" in err
+    assert "unrecognized arguments: --hea (did you mean --headless?)" in err
     assert not out.exists()
+
+
+def test_a_mistyped_option_names_the_nearest_option_of_its_command(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Python 3.11's argparse suggests nothing for an unknown option; the names of the
+    command given are searched, not just the top parser's."""
+    with pytest.raises(SystemExit) as done:
+        main(["run", str(SCENARIO), "--seeed", "3", "--outt=x"])
+    assert done.value.code == 2
+    err = capsys.readouterr().err
+    assert "--seeed (did you mean --seed?) 3 --outt=x (did you mean --out?)" in err

@@ -163,8 +163,12 @@ def test_many_streams_at_once_yield_what_each_yields_alone() -> None:
 
     alone = [[d() for _ in range(12)] for d in streams()]
     many = DrawnMany(streams(), block=5)
-    together = np.array([many() for _ in range(12)]).T
-    assert together.tolist() == alone
+    columns = [many() for _ in range(12)]  # kept: a refill must not overwrite them
+    assert np.array(columns).T.tolist() == alone
+    # uniform draws, and a callable that is no Generator method (filled by stacking)
+    for draw in (np.random.default_rng(8).random, lambda n: np.random.default_rng(8).random(n)):
+        many = DrawnMany([Drawn(draw, block=5)], block=5)
+        assert [float(many()[0]) for _ in range(3)] == np.random.default_rng(8).random(3).tolist()
     used = streams()
     used[1]()
     with pytest.raises(RuntimeError, match="drawn from before"):

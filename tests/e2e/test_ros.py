@@ -361,12 +361,21 @@ def test_free_mode_waits_for_a_user_node_by_its_topics(
     script.write_text(USER_MONITOR)
     script.chmod(0o755)
     original = (pkg / "launch" / "ros_short.launch").read_text()
+    # the Leaf's nodes (a C++ one alone with cpp_container:=false, its Python twin with
+    # cpp:=false) give way to the user's node, and the Leaf leaves the C++ container's list
     common = 'pkg="mdeChallenge" name="MyDistanceMonitor" required="true"'
-    when = "$(eval arg('sim') and {}arg('cpp'))"
-    cpp = f'  <node if="{when.format("")}" {common} type="MyDistanceMonitor_cpp"/>\n'
-    py = f'  <node if="{when.format("not ")}" {common} type="MyDistanceMonitor.py"/>'
-    assert cpp + py in original
-    launch_file.write_text(original.replace(cpp + py, f'  <node {common} type="user_monitor.py"/>'))
+    alone = (
+        "  <node if=\"$(eval arg('sim') and arg('cpp') and not arg('cpp_container'))\""
+        ' pkg="nodelet" type="nodelet" args="standalone mdeChallenge/DistanceMonitor"'
+        ' name="MyDistanceMonitor" required="true"/>\n'
+    )
+    py = f"  <node if=\"$(eval arg('sim') and not arg('cpp'))\" {common}"
+    py += ' type="MyDistanceMonitor.py"/>'
+    hosted = '"FollowerCompass", "MyDistanceMonitor", '
+    assert alone + py in original
+    assert hosted in original
+    user = original.replace(alone + py, f'  <node {common} type="user_monitor.py"/>')
+    launch_file.write_text(user.replace(hosted, '"FollowerCompass", '))
     out = workspace / "user-node"
     try:
         launch = launcher(

@@ -133,7 +133,9 @@ def test_lockstep_boundary_stamps_are_the_instants_of_their_values(
         f' args="-O {recorded} --tcpnodelay {" ".join(topics)}"/>\n</launch>',
     )
     (launch_dir / "stamps.launch").write_text(launch)
-    text = launcher(ws, "stamps.launch", f"out:={ws / 'lockstep'}", "plots:=false").finish()
+    # in lockstep the boundary runs when asked
+    args = (f"out:={ws / 'lockstep'}", "plots:=false", "boundary:=true")
+    text = launcher(ws, "stamps.launch", *args).finish()
     assert "completed" in text, text[-3000:]
     got = _read(recorded)
     assert set(got) == set(expected), (sorted(got), sorted(expected))

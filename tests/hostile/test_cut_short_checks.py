@@ -34,11 +34,13 @@ def test_issue_command_collides_and_exits_1(
         argv += ["--set", text]
     assert main(argv) == 1
     captured = capsys.readouterr()
-    # the failed check alone on stderr; the checks a cut run cannot judge stay skipped
-    assert captured.err == (
+    # every verdict on stdout, the failure said once on stderr; the checks a cut run
+    # cannot judge stay skipped
+    assert (
         "expect collisions = 1 (already broken when the run was cut short at t=60 s: "
         "a count only grows), below 1: FAIL\n"
-    )
+    ) in captured.out
+    assert captured.err == "error: 1 check of 4 failed: collisions\n"
     assert captured.out.count(": skipped (") == 3
 
 
@@ -138,4 +140,6 @@ def test_the_replay_judges_the_failed_check_too(
     capsys.readouterr()
     replay = ["run", str(tmp_path / "o" / "scenario.yaml"), "--headless", "--no-plot", "-q"]
     assert main([*replay, "--out", str(tmp_path / "r")]) == 1
-    assert capsys.readouterr().err == "expect collisions = 1, below 1: FAIL\n"
+    out, err = capsys.readouterr()
+    assert "expect collisions = 1, below 1: FAIL\n" in out  # with the other verdicts
+    assert err == "error: 1 check of 1 failed: collisions\n"

@@ -127,3 +127,6 @@ def test_the_c_layout_is_checked_at_import() -> None:
     for change in stale:
         with pytest.raises(ImportError, match="rebuild"):
             compiled.check_layout(types.SimpleNamespace(**{**good, **change}))
+    with pytest.raises(ImportError, match="no Columns"):  # a build from before the batch step
+        compiled.check_layout(types.SimpleNamespace(**good))
+    assert compiled.check_layout(types.SimpleNamespace(**good, Columns=ext.Columns))  # type: ignore[union-attr]

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.ros.graph import RosGraph, classify
-from amsa_phys.ros.runtime.waves import DueAt, wave
+from amsa_phys.ros.runtime.waves import DueAt, chained, wave
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 SENSORS = ["LeaderGPS", "FollowerGPS", "FollowerCompass", "MyDistanceMonitor"]
@@ -96,3 +96,69 @@ def test_due_at_follows_each_leaf_s_period_and_phase() -> None:
     assert due.at(30) == ["A", "C"]
     assert due.at(50) == ["A", "B"]
     assert due.at(55) == ["C"]
+
+
+# -- the C++ container: readers of a Leaf asked in the same message are chained -------------
+CONTAINER = [*SENSORS, "MyFollowerController", "MyNormalizePower"]
+
+
+def _shared(*overrides: str, shared: list[str] = CONTAINER) -> RosGraph:
+    world = load_scenario(ROOT / "scenarios" / "scenario1.yaml", list(overrides)).world
+    return RosGraph.of(world, classify(world), shared=shared)
+
+
+def test_scenario1_in_the_container_steps_in_one_wave_an_instant() -> None:
+    g = _shared()
+    due = list(g.world.order)
+    now = wave(g, due, "LeaderGPS")
+    assert now == [*SENSORS, "MyFollowerController", "MyNormalizePower"]
+    # the controller's inputs written at once by the sensors asked before it: counted as
+    # "N+", the messages before the instant plus what the sensor publishes now
+    assert chained(g, now, "MyFollowerController") == {
+        "LeaderGPS.gpsPosX",
+        "LeaderGPS.gpsPosY",
+        "FollowerGPS.gpsPosX",
+        "FollowerGPS.gpsPosY",
+        "FollowerCompass.compassHeading",
+        "MyDistanceMonitor.distanceFollowerToLeader",
+    }
+    assert chained(g, now, "MyNormalizePower") == set()  # through the controller's latency
+    assert all(chained(g, now, s) == set() for s in SENSORS)
+
+
+def test_a_writer_with_latency_is_not_chained() -> None:
+    # with jitter, what the controller sees of the FollowerGPS now was sent earlier: a count
+    # the simulator knows (published less in flight), not one to add the new fix to
+    g = _shared("FollowerGPS.jitter=0.1")
+    now = wave(g, list(g.world.order), "LeaderGPS")
+    assert "MyFollowerController" in now
+    assert "FollowerGPS.gpsPosX" not in chained(g, now, "MyFollowerController")
+
+
+def test_a_reader_outside_the_container_is_not_chained() -> None:
+    g = _shared(shared=SENSORS)  # the controller a node of its own (a Python twin)
+    due = list(g.world.order)
+    assert wave(g, due, "LeaderGPS") == [*SENSORS, "MyNormalizePower"]
+    assert chained(g, [*SENSORS, "MyFollowerController"], "MyFollowerController") == set()
+
+
+def test_a_reader_chains_only_on_writers_in_the_wave() -> None:
+    # FollowerCompass reads the Follower, stepped in the simulator after LeaderGPS: it is
+    # not in the wave, so the controller that reads it cannot be chained on it either
+    g = _shared()
+    due = ["LeaderGPS", "Follower", "FollowerCompass", "MyFollowerController"]
+    assert wave(g, due, "LeaderGPS") == ["LeaderGPS"]
+
+
+def test_the_platoon_in_the_container_still_steps_a_controller_before_its_sensors() -> None:
+    world = load_scenario(ROOT / "scenarios" / "platoon.yaml").world
+    local = classify(world)
+    g = RosGraph.of(world, local, shared=[p for p in world.leaves if p not in local])
+    due = list(world.order)
+    cars = [f"Car{k}" for k in range(1, 11)]
+    drives = {f"{c}.Drive" for c in cars}
+    assert wave(g, due, "Car1.Drive")[:10] == [f"{c}.Drive" for c in cars]
+    # the controller reads its sensors' older values: they must not publish before it steps
+    pilot = [p for p in wave(g, due, "Car1.Pilot") if p not in drives]
+    assert pilot[0] == "Car1.Pilot"
+    assert not {f"Car1.{s}" for s in ("Gps", "AheadGps", "Compass", "Gap")} & set(pilot)

@@ -26,20 +26,12 @@
 // The interface of a template's C++ body (files/cpp/TEMPLATE.inc, pasted into the class):
 // override doStep() (and checkParams() for rules between parameters); read parameters with
 // p("name") (values_ holds them); an array input port's numbers with array(PORT) (in[] holds
-// 0 there), an array output's written into arrayOut(PORT); kPath is the Leaf's path (its random stream's key) and
+// 0 there), an array output's written into arrayOut(PORT); kPath is the Leaf's path (its
+// random stream's key) and
 // seed() the scenario's seed (/amsa/seed). Unchanged from the one-executable-per-Leaf nodes,
 // where kPath and seed() were file-level names of each executable.
 //
-// ~amsa_wiring, one item per line (numbers as C hex floats, which read back exactly):
-//   path LEAF.PATH          freq NUM DEN
-//   topic NAME INITIAL DELAYED(0|1) [SIZE]     (each subscribed input topic, in order; SIZE
-//                           for an array port's topic: a Float64MultiArray of SIZE values)
-//   input PORT INDEX        (the template's input ports in order: a topic's index, or
-//                            -(1 + k) for the Leaf's own output k)
-//   output PORT TOPIC INITIAL SUBSCRIBERS SHARED [SIZE]  (the template's output ports in order;
-//                           the processes subscribed, without the bag recorder: every Leaf
-//                           a process of its own, and the C++ Leaves in one; ROS 1 counts a
-//                           process once per topic however many of its Leaves read it)
+// ~amsa_wiring: the Leaf's path, rate, topics and ports (format in amsa_wiring.h).
 #pragma once
 
 #include <nodelet/nodelet.h>
@@ -67,130 +59,13 @@
 #include <utility>
 #include <vector>
 
-#include "amsa_pymath.h"  // Python's hypot and float % for the C++ bodies
+#include "amsa_container.h"  // lockstep in the container: Dispatcher, ReadyBoard
+#include "amsa_wiring.h"     // the ports, parameters and ~amsa_wiring
+#include "amsa_pymath.h"     // Python's hypot and float % for the C++ bodies
 
 namespace amsa {
 
-struct InputPort {
-  std::string port;
-  int topic;  // index into the subscribed topics, or -(1 + output index) for an own output
-};
-
-struct Topic {
-  std::string name;
-  double initial;
-  bool delayed;  // its producer has latency or jitter: readers may be told an older message
-  int size = 0;  // 0: one number (std_msgs/Float64); N: an array port, Float64MultiArray of N
-};
-
-struct OutputPort {
-  std::string port;
-  std::string topic;
-  double initial;
-  int subscribers;         // processes subscribed, every Leaf a process of its own
-  int subscribers_shared;  // the same with the C++ Leaves in one process (the container)
-  int size = 0;            // 0: one number; N: an array port of N numbers (Float64MultiArray)
-};
-
-struct ParamSpec {
-  std::string name;
-  char type;  // 'd' double, 'i' integer, 'b' boolean
-  bool has_min, has_max;
-  double min, max;
-};
-
-inline std::string fmt_g(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
-// A Leaf's wiring (~amsa_wiring, format above), parsed; false with a message if malformed.
-struct Wiring {
-  std::string path;
-  std::int64_t freq_num = 0, freq_den = 1;
-  std::vector<Topic> topics;
-  std::vector<InputPort> inputs;
-  std::vector<OutputPort> outputs;
-};
-
-inline bool read_double(const std::string& text, double* value) {
-  char* end = nullptr;
-  *value = std::strtod(text.c_str(), &end);  // C hex floats: exact
-  return end != nullptr && *end == '\0' && !text.empty();
-}
-
-inline bool parse_wiring(const std::string& text, Wiring* w, std::string* error) {
-  std::istringstream lines(text);
-  std::string line;
-  while (std::getline(lines, line)) {
-    std::istringstream in(line);
-    std::string what;
-    if (!(in >> what)) continue;
-    bool ok = true;
-    if (what == "path") {
-      ok = static_cast<bool>(in >> w->path);
-    } else if (what == "freq") {
-      ok = static_cast<bool>(in >> w->freq_num >> w->freq_den) && w->freq_num > 0 && w->freq_den > 0;
-    } else if (what == "topic") {
-      Topic t;
-      std::string initial;
-      int delayed = 0;
-      ok = static_cast<bool>(in >> t.name >> initial >> delayed) && read_double(initial, &t.initial);
-      t.delayed = delayed != 0;
-      if (ok && !(in >> t.size)) t.size = 0;  // optional: an array port's length
-      w->topics.push_back(t);
-    } else if (what == "input") {
-      InputPort ip;
-      ok = static_cast<bool>(in >> ip.port >> ip.topic);
-      w->inputs.push_back(ip);
-    } else if (what == "output") {
-      OutputPort o;
-      std::string initial;
-      ok = static_cast<bool>(in >> o.port >> o.topic >> initial >> o.subscribers >>
-                             o.subscribers_shared) &&
-           read_double(initial, &o.initial);
-      if (ok && !(in >> o.size)) o.size = 0;  // optional: an array port's length
-      w->outputs.push_back(o);
-    } else {
-      ok = false;
-    }
-    if (!ok) {
-      *error = "~amsa_wiring: cannot read the line \"" + line + "\"";
-      return false;
-    }
-  }
-  if (w->path.empty()) {
-    *error = "~amsa_wiring: no path line";
-    return false;
-  }
-  return true;
-}
-
-// /amsa/ready of this process: one latched publisher (ROS 1 keeps one latched message per
-// topic and process), whose message lists every Leaf of the process that is ready so far.
-class ReadyBoard {
- public:
-  static void announce(const std::string& path) {
-    static ReadyBoard board;
-    std::lock_guard<std::mutex> lock(board.mutex_);
-    if (!board.pub_) {
-      ros::NodeHandle nh;
-      board.pub_ = nh.advertise<std_msgs::String>("/amsa/ready", 1, true);
-    }
-    board.ready_.insert(path);
-    std_msgs::String m;
-    for (const std::string& p : board.ready_) m.data += (m.data.empty() ? "" : " ") + p;
-    board.pub_.publish(m);
-  }
-
- private:
-  std::mutex mutex_;
-  ros::Publisher pub_;
-  std::set<std::string> ready_;
-};
-
-class LeafNode : public nodelet::Nodelet {
+class LeafNode : public nodelet::Nodelet, public Steppable {
  public:
   LeafNode(std::vector<std::string> in_ports, std::vector<std::string> out_ports,
            std::vector<ParamSpec> params)
@@ -201,6 +76,26 @@ class LeafNode : public nodelet::Nodelet {
     notify();
     if (worker_.joinable()) worker_.join();
   }
+
+  // A request ("step SEQ NUM DEN C1..Cn" or "param SEQ NAME"): kept until its inputs are in.
+  void submit(const std::string& text) override {
+    std::string answer;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      pending_ = text;
+      answer = tryPending();
+    }
+    if (!answer.empty()) reply(answer);
+  }
+
+  // The nodelet's name, /LEAF (getName() is protected in nodelet::Nodelet).
+  const std::string& nodeName() const override { return getName(); }
+  // The topic of input ``i`` (the container resolves counts by its producer).
+  const std::string& topicName(std::size_t i) const override { return topics_.at(i).name; }
+  std::size_t topicCount() const override { return topics_.size(); }
+  // The topic of output ``k``.
+  const std::string& outputTopic(std::size_t k) const override { return outputs_.at(k).topic; }
+  std::size_t outputCount() const override { return outputs_.size(); }
 
   void onInit() override {
     ros::NodeHandle& nh = getNodeHandle();
@@ -269,15 +164,21 @@ class LeafNode : public nodelet::Nodelet {
       else
         pubs_.push_back(nh.advertise<std_msgs::Float64>(o.topic, 1000, wake, ros::SubscriberStatusCallback()));
       // sim:=false (the controller side alone): no simulator to wait for, start at once
-      const int subscribers = shared ? o.subscribers_shared : o.subscribers;
+      // in lockstep the simulator takes a container Leaf's values from its answer and does
+      // not subscribe to its outputs (the counts include it as one subscriber)
+      const int subscribers =
+          shared ? o.subscribers_shared - (mode == "lockstep" ? 1 : 0) : o.subscribers;
       want_.push_back(sim ? subscribers + (bag ? 1 : 0) : 0);
     }
     lockstep_ = mode == "lockstep";
-    if (lockstep_) {
+    shared_ = lockstep_ && shared;  // asked through the container's one topic (Dispatcher)
+    if (shared_) {
+      Dispatcher::get().add(this);
+    } else if (lockstep_) {
       done_ = nh.advertise<std_msgs::String>("/amsa/done" + getName(), 1000, wake, ros::SubscriberStatusCallback());
       step_sub_ = nh.subscribe<std_msgs::String>(
           "/amsa/step" + getName(), 1000,
-          [this](const std_msgs::String::ConstPtr& m) { onStep(m->data); },
+          [this](const std_msgs::String::ConstPtr& m) { submit(m->data); },
           ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
     }
     // onInit must return (the manager loads the next Leaf): start-up and free mode's loop
@@ -356,8 +257,10 @@ class LeafNode : public nodelet::Nodelet {
       const int has = static_cast<int>(pubs_[i].getNumSubscribers());
       if (has < want_[i]) add(pubs_[i].getTopic(), has, want_[i]);
     }
-    if (lockstep_ && done_.getNumSubscribers() < 1)
+    if (lockstep_ && !shared_ && done_.getNumSubscribers() < 1)
       add(done_.getTopic(), static_cast<int>(done_.getNumSubscribers()), 1);
+    if (shared_ && !Dispatcher::get().connected())  // the container answers for its Leaves
+      add("/amsa/done/amsa_leaves", 0, 1);
     char secs[32];
     std::snprintf(secs, sizeof secs, "%.1f", waited);
     return std::string("gave up after ") + secs + " s waiting for the readers of " + topics +
@@ -372,7 +275,8 @@ class LeafNode : public nodelet::Nodelet {
       bool all = true;
       for (std::size_t i = 0; i < pubs_.size(); ++i)
         if (static_cast<int>(pubs_[i].getNumSubscribers()) < want_[i]) all = false;
-      if (lockstep_ && done_.getNumSubscribers() < 1) all = false;
+      if (lockstep_ && !shared_ && done_.getNumSubscribers() < 1) all = false;
+      if (shared_ && !Dispatcher::get().connected()) all = false;
       if (all) return true;
       if (std::chrono::steady_clock::now() >= deadline) return false;
       cond_.wait_for(lock, std::chrono::milliseconds(500));
@@ -421,12 +325,17 @@ class LeafNode : public nodelet::Nodelet {
   }
 
   void onData(std::size_t i, double value) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    count_[i] += 1;
-    latest_[i] = value;
-    if (topics_[i].delayed) history_[i][count_[i]] = value;
-    if (!pending_.empty()) tryPending();
-    cond_.notify_all();
+    std::string answer;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      count_[i] += 1;
+      latest_[i] = value;
+      if (topics_[i].delayed) history_[i][count_[i]] = value;
+      if (!pending_.empty()) answer = tryPending();
+      cond_.notify_all();
+    }
+    if (!answer.empty()) reply(answer);  // outside the lock: the container may go on with
+                                         // a Leaf waiting for this one (Dispatcher)
   }
 
   // -- array ports: std_msgs/Float64MultiArray topics (a second kind of input and output) --
@@ -460,32 +369,31 @@ class LeafNode : public nodelet::Nodelet {
     const std::size_t offset = m.layout.data_offset;
     std::vector<double> value;
     if (offset <= m.data.size()) value.assign(m.data.begin() + offset, m.data.end());
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (value.size() != static_cast<std::size_t>(topics_[i].size)) {
-      bad_[i] = topics_[i].name + " carried " + std::to_string(value.size()) +
-                " values, the port declares " + std::to_string(topics_[i].size) +
-                " (std_msgs/Float64MultiArray of fixed length)";
-      if (!lockstep_) {  // free: the message is dropped, the last value stays
-        NODELET_ERROR("%s", bad_[i].c_str());
-        return;
+    std::string answer;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (value.size() != static_cast<std::size_t>(topics_[i].size)) {
+        bad_[i] = topics_[i].name + " carried " + std::to_string(value.size()) +
+                  " values, the port declares " + std::to_string(topics_[i].size) +
+                  " (std_msgs/Float64MultiArray of fixed length)";
+        if (!lockstep_) {  // free: the message is dropped, the last value stays
+          NODELET_ERROR("%s", bad_[i].c_str());
+          return;
+        }
+        value.clear();
       }
-      value.clear();
+      count_[i] += 1;
+      latest_arr_[i] = value;
+      if (topics_[i].delayed) history_arr_[i][count_[i]] = value;
+      if (!pending_.empty()) answer = tryPending();
+      cond_.notify_all();
     }
-    count_[i] += 1;
-    latest_arr_[i] = value;
-    if (topics_[i].delayed) history_arr_[i][count_[i]] = value;
-    if (!pending_.empty()) tryPending();
-    cond_.notify_all();
+    if (!answer.empty()) reply(answer);  // outside the lock, as onData
   }
 
-  void onStep(const std::string& text) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    pending_ = text;
-    tryPending();
-  }
-
-  // Run the pending request once its inputs are in (mutex_ held).
-  void tryPending() {
+  // Run the pending request once its inputs are in (mutex_ held); the answer, or "" if it
+  // is still waiting for an input.
+  std::string tryPending() {
     std::istringstream in(pending_);
     std::string verb, seq;
     in >> verb >> seq;
@@ -495,11 +403,10 @@ class LeafNode : public nodelet::Nodelet {
       pending_.clear();
       for (const ParamSpec& spec : params_) {
         if (spec.name != name) continue;
-        if (reload(spec, false, &error)) reply("done " + seq); else reply("error " + seq + " " + error);
-        return;
+        if (reload(spec, false, &error)) return "done " + seq;
+        return "error " + seq + " " + error;
       }
-      reply("error " + seq + " no parameter " + name);
-      return;
+      return "error " + seq + " no parameter " + name;
     }
     std::int64_t num = 0, den = 1;
     in >> num >> den;
@@ -507,13 +414,10 @@ class LeafNode : public nodelet::Nodelet {
     std::int64_t c = 0;
     while (in >> c) want.push_back(c);
     for (std::size_t i = 0; i < want.size() && i < count_.size(); ++i)
-      if (count_[i] < want[i]) return;  // an input message is still on its way
+      if (count_[i] < want[i]) return "";  // an input message is still on its way
     pending_.clear();
     for (std::size_t i = 0; i < want.size() && i < count_.size(); ++i)
-      if (count_[i] != want[i] && !topics_[i].delayed) {
-        reply("fault " + seq + " inputs out of step");
-        return;
-      }
+      if (count_[i] != want[i] && !topics_[i].delayed) return "fault " + seq + " inputs out of step";
     std::vector<double> seen = latest_;
     std::vector<std::vector<double>> seen_arr = latest_arr_;
     for (std::size_t i = 0; i < want.size() && i < count_.size(); ++i) {
@@ -529,14 +433,11 @@ class LeafNode : public nodelet::Nodelet {
       kept.erase(kept.begin(), kept.lower_bound(want[i]));
     }
     for (std::size_t i = 0; i < topics_.size(); ++i)
-      if (topics_[i].size > 0 && seen_arr[i].empty()) {
-        reply("fault " + seq + " " + bad_[i]);
-        return;
-      }
+      if (topics_[i].size > 0 && seen_arr[i].empty()) return "fault " + seq + " " + bad_[i];
     const std::string result =
         step(static_cast<double>(num) / static_cast<double>(den), seen, seen_arr);
-    if (!result.empty() && result[0] == '!') reply("error " + seq + " " + result.substr(1));
-    else reply("done " + seq + result);
+    if (!result.empty() && result[0] == '!') return "error " + seq + " " + result.substr(1);
+    return "done " + seq + result;
   }
 
   // doStep with the inputs ``seen`` (by topic); publishes; " I J .." (the outputs
@@ -563,12 +464,16 @@ class LeafNode : public nodelet::Nodelet {
     } catch (const std::exception& exc) {
       return std::string("!C++ exception: ") + exc.what();
     }
-    for (std::size_t k = 0; k < outputs_.size(); ++k)
-      if (published[k] && outputs_[k].size > 0 &&
-          arrays_out_[k].size() != static_cast<std::size_t>(outputs_[k].size))
+    for (std::size_t k = 0; k < outputs_.size(); ++k) {
+      if (!published[k] || outputs_[k].size <= 0) continue;
+      if (arrays_out_[k].size() != static_cast<std::size_t>(outputs_[k].size))
         return "!output " + outputs_[k].port + " has " + std::to_string(arrays_out_[k].size()) +
                " values, the port declares " + std::to_string(outputs_[k].size);
-    std::string indexes;
+      // the container's answer carries scalar values only (no shipped C++ template has an
+      // array output): refuse rather than lose it
+      if (shared_) return "!array output " + outputs_[k].port + " in the C++ container: run it with cpp_container:=false";
+    }
+    std::string indexes, values;
     for (std::size_t k = 0; k < outputs_.size(); ++k) {
       if (!published[k]) continue;
       if (outputs_[k].size > 0) {
@@ -589,11 +494,20 @@ class LeafNode : public nodelet::Nodelet {
       pubs_[k].publish(m);
       own_[k] = out[k];
       indexes += " " + std::to_string(k);
+      char hex[64];
+      std::snprintf(hex, sizeof hex, " %a", out[k]);  // C99 hex float: the exact double
+      values += hex;
     }
-    return indexes;
+    // in the container the answer carries the values too: the simulator takes them from it
+    // instead of subscribing to every output (one message an instant instead of one each)
+    return shared_ ? indexes + " |" + values : indexes;
   }
 
   void reply(const std::string& text) {
+    if (shared_) {
+      Dispatcher::get().answer(getName(), text);
+      return;
+    }
     std_msgs::String m;
     m.data = text;
     done_.publish(m);
@@ -673,6 +587,7 @@ class LeafNode : public nodelet::Nodelet {
   std::map<std::string, std::string> last_error_;
   std::string pending_;
   bool lockstep_ = true;
+  bool shared_ = false;  // lockstep in the container: requests come through the Dispatcher
   std::atomic<bool> stop_{false};
   std::mutex mutex_;
   std::condition_variable cond_;

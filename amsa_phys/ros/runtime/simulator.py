@@ -15,31 +15,24 @@ exactly as ``amsa-phys run`` does, and exits, which ends the launch.
 
 from __future__ import annotations
 
-import math
-import os
-import sys
 import threading
 import time
 from collections.abc import Callable, Mapping
 from fractions import Fraction
-from pathlib import Path
 from typing import Any
 
 from ...engine import interrupt
 from ...engine.runner import Simulation
-from ...errors import AmsaError, Interrupted, RunFault
+from ...errors import RunFault
 from ...model.scenario import Change
-from ...runs.expect import check_expectations
-from ...runs.rundir import default_run_dir, prepare_run_dir
-from ...runs.single import run_scenario
 from .. import names
 from ..graph import RosGraph
-from . import adaptlink, ending, readiness, records, rosio
+from . import readiness, rosio
 from .arrays import array_msg, elements, pack, read
 from .boundary import VALUES, format_values, readable
-from .config import NodeConfig, load_config
-from .rossim import RosSimulation
-from .waves import DueAt, wave
+from .config import NodeConfig
+from .container import Container, stepped
+from .waves import DueAt, chained, wave
 
 
 class RemoteError(Exception):
@@ -103,15 +96,21 @@ class Link:
         self.step_pubs = {}
         self.subs = []
         self.data_subs: dict[str, Any] = {}
+        #: lockstep: the Leaves of the C++ container, asked a wave at a time (container.py)
+        self.shared = self.graph.shared if self.lockstep else frozenset()
+        self.container = Container(rospy, self.gate, String, self.shared, self._on_answers)
         for path in self.graph.remote:
             for b in self.graph.outputs(path):
                 self.received[b] = [0, self.graph.initial(b)]
+                if path in self.shared:
+                    continue  # lockstep: the container's answers carry the values
                 self.data_subs[b] = rospy.Subscriber(
                     names.topic(b), self._kind(b), self._on_data, callback_args=b, tcp_nodelay=True
                 )
                 self.subs.append(self.data_subs[b])
             if self.lockstep:
                 self.replies[path] = None
+            if self.lockstep and path not in self.shared:
                 self.step_pubs[path] = self.gate.publisher(names.step_topic(path), String, 1)
                 self.subs.append(
                     rospy.Subscriber(
@@ -151,6 +150,13 @@ class Link:
     def _on_done(self, msg: Any, path: str) -> None:
         with self.cond:
             self.replies[path] = msg.data.split("\n")
+            self.cond.notify_all()
+
+    def _on_answers(self, answers: list[tuple[str, str]]) -> None:
+        """The container's answers for a wave, each as the Leaf's own node would send it."""
+        with self.cond:
+            for path, answer in answers:
+                self.replies[path] = [answer]
             self.cond.notify_all()
 
     def _on_phase(self, msg: Any) -> None:
@@ -239,13 +245,17 @@ class Link:
 
     # -- lockstep requests -------------------------------------------------------------------
     def _ask(self, path: str, verb: str, args: str, t: Fraction) -> None:
-        """Send ``VERB SEQ ARGS`` to a node; :meth:`_answer` waits for its answer."""
+        """Send ``VERB SEQ ARGS`` to a node (a Leaf of the container: with the others of the
+        wave, ``container.send``); :meth:`_answer` waits for its answer."""
         self.seq += 1
         seq = str(self.seq)
         with self.cond:
             self.replies[path] = None
         self.asked[path] = (t, seq)
-        self.step_pubs[path].publish(self.String(f"{verb} {seq} {args}"))
+        if path in self.shared:
+            self.container.add(path, f"{verb} {seq} {args}")
+        else:
+            self.step_pubs[path].publish(self.String(f"{verb} {seq} {args}"))
 
     def _answer(self, path: str, t: Fraction, what: str) -> list[str]:
         """Wait for a node's answer to what it was asked; ``[kind, seq, text]``.
@@ -271,15 +281,18 @@ class Link:
     def _request(self, path: str, verb: str, args: str, t: Fraction, what: str) -> list[str]:
         """Ask a node and wait for its answer."""
         self._ask(path, verb, args, t)
+        self.container.send()
         return self._answer(path, t, what)
 
-    def _counts(self, path: str) -> str:
+    def _counts(self, path: str, plus: set[str]) -> str:
         """How many messages of each input a remote Leaf sees now: every message so far, less
-        a delayed producer's still in flight."""
+        a delayed producer's still in flight; ``N+`` for an input in ``plus``, whose writer,
+        asked in the same wave, adds what it publishes (``waves.chained``)."""
         sim = self.sim
         arrays = self.graph.world.arrays
         return " ".join(  # an array's elements travel together: its first one's count
             str(self.published[b] - (sim.in_flight(arrays.get(b, [b])[0]) if sim else 0))
+            + ("+" if b in plus else "")
             for b in self.graph.input_buffers(path)
         )
 
@@ -307,12 +320,25 @@ class Link:
         """
         if not self.lockstep:
             return {}
-        self.publish_clock(t)
+        if self.graph.bag or self.last_clock < 0:
+            # lockstep: no node steps by /clock (each request carries its instant), the
+            # scenario node gets it at each phase's instant (phase_value); a bag's recorder
+            # stamps messages by it, so it ticks at every step only when bag:= records
+            self.publish_clock(t)
         asked = self.asked.get(path)
         if asked is None or asked[0] != t:
-            for p in self._wave(path, t):
-                if p == path or p not in self.asked:  # once an instant: asked is a step
-                    self._ask(p, "step", f"{t.numerator} {t.denominator} {self._counts(p)}", t)
+            now = self._wave(path, t)
+            batch: list[str] = []
+            for p in now:
+                if p != path and p in self.asked:  # once an instant: asked is a step
+                    continue
+                plus = chained(self.graph, now, p)
+                if any(b.rpartition(".")[0] not in batch for b in plus):
+                    continue  # its writer was asked in an earlier message: ask it later
+                batch.append(p)
+                counts = self._counts(p, plus)
+                self._ask(p, "step", f"{t.numerator} {t.denominator} {counts}", t)
+            self.container.send()
         head = self._answer(path, t, "a step")
         kind, text = head[0], head[2] if len(head) > 2 else ""
         who = f"{path} ({self.graph.leaf(path).template.name()})"
@@ -321,6 +347,13 @@ class Link:
         if kind == "fault":
             raise RunFault(who, t, text)
         outputs = self.graph.outputs(path)
+        if path in self.shared:  # the values come with the answer
+            values = stepped(text, outputs)
+            for b, v in values:
+                self.published[b] += 1
+                self.received[b] = [self.published[b], v]
+            self.tell_boundary(t, values)
+            return {b.rpartition(".")[2]: v for b, v in values}
         got = [outputs[int(i)] for i in text.split()]
         for b in got:
             self.published[b] += 1
@@ -422,73 +455,3 @@ class Link:
         self._wait(lambda: self.phase_acked >= phase, names.SCENARIO, t, f"phase {phase}")
         leaf = self.graph.leaf(change.leaf)
         return rosio.read_param(self.rospy, change.leaf, leaf.template.param(change.param))
-
-
-def main() -> None:
-    """The simulator node's entry point."""
-    rospy = rosio.ros()
-    rospy.init_node(names.SIMULATOR, disable_signals=True)  # Ctrl-C is the engine's
-    code = 0
-    try:
-        cfg = load_config(rospy)
-        scenario, folded = records.fold_server_values(rospy, cfg.scenario)
-        for change in folded:
-            print(f"amsa_simulator: {change.key}={change.value} (parameter server)", flush=True)
-        duration = str(rospy.get_param("~duration", "") or "")
-        if duration:
-            scenario = records.cut(scenario, duration)
-        out = str(rospy.get_param("~out", "") or "")
-        root = Path(str(rospy.get_param("~runs", "") or os.environ.get("PWD", "."))) / "runs"
-        out_dir = Path(out) if out else default_run_dir(scenario.name, root)
-        prepare_run_dir(out_dir, bool(rospy.get_param("~force", False)), flag="out:=")
-        link = Link(rospy, cfg)
-        adaptlink.attach(link)  # rules:=node: the adapt node runs the rules
-        link.speed = float(rospy.get_param("~speed", 1.0))
-        link.waves = bool(rospy.get_param("~waves", True))
-        if not link.speed > 0 or math.isinf(link.speed):
-            raise AmsaError(f"speed:= must be a positive number, got {link.speed}")
-        ready_timeout = float(rospy.get_param("~ready_timeout", 120.0))
-        missing = link.wait_ready(ready_timeout)
-        if missing:
-            raise RunFault("ROS graph", 0, f"not connected after {ready_timeout:g} s: {missing}")
-        print(
-            f"amsa_simulator: {len(cfg.graph.remote)} nodes connected, running "
-            f"{scenario.name} ({cfg.mode})",
-            flush=True,
-        )
-        with interrupt.sigterm_as_ctrl_c():
-            outcome = run_scenario(
-                scenario,
-                out_dir,
-                plot=bool(rospy.get_param("~plots", True)),
-                progress=False,
-                simulation=lambda sc, trace: RosSimulation(sc, trace, link),
-            )
-        _summary(outcome.metrics, out_dir)
-        checks = check_expectations(scenario.expect, outcome.metrics, out_dir / "trace.csv")
-        for check in checks:
-            print(f"expect {check.describe()}", flush=True)
-        code = 0 if all(c.passed for c in checks) else 1
-        print(ending.done_line(checks, out_dir), flush=True)
-    except Interrupted as exc:
-        print(f"error: {exc}", file=sys.stderr, flush=True)
-        code = 130
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr, flush=True)
-        code = 130
-    except AmsaError as exc:
-        print(f"error: {exc}", file=sys.stderr, flush=True)
-        code = exc.exit_code
-    rospy.signal_shutdown("the run is over")
-    ending.end_launch(code)  # a passing run: roslaunch ends the launch, without alarm
-    sys.exit(code)
-
-
-def _summary(metrics: dict[str, Any], out_dir: Path) -> None:
-    overall = metrics["overall"]
-    parts = [f"{k}={v:.3f}" for k, v in overall.items() if isinstance(v, float)]
-    print(
-        f"amsa_simulator: {metrics['status']}, simulated {metrics['simulated']:g} s in "
-        f"{metrics['wall_time_s']:g} s; {' '.join([*parts, f'outputs in {out_dir}'])}",
-        flush=True,
-    )

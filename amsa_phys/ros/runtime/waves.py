@@ -23,6 +23,14 @@ longer in flight (``published - in_flight``), a number its step leaves unchanged
 message goes in flight, never visible at the same instant). In scenario1 the four sensors
 and the actuator (which reads the controller through its latency) form one wave, the
 controller (which reads the sensors) a second: two waits an instant instead of six.
+
+The Leaves of the C++ container (``graph.shared``: one process) go further: a container
+Leaf whose unfixed inputs are all written by container Leaves already in the wave joins it
+too, and its request counts those inputs as ``N+``: the messages before this instant plus
+what the writer publishes in this step, which the container adds once the writer has
+stepped (it steps the wave's Leaves in their order of dependence and answers for the whole
+wave in one message). In scenario1 every remote Leaf is in the container: one wave, one
+request and one answer an instant.
 """
 
 from __future__ import annotations
@@ -47,10 +55,11 @@ def wave(graph: RosGraph, due: Sequence[str], start: str) -> list[str]:
         inputs = graph.input_buffers(path)
         outputs = graph.outputs(path)
         delayed = graph.leaf(path).timing.delayed
+        waiting = [b for b in inputs if b in pending]
         if path in remote and (
             path == start
             or (
-                not any(b in pending for b in inputs)
+                (not waiting or _chained(graph, out, path, waiting))
                 # a node due before this one (asked now or later) reads what this one
                 # writes at once: it must step on the older message first (a loop the
                 # schedule cut), and a node holds its reader to the exact count
@@ -63,6 +72,32 @@ def wave(graph: RosGraph, due: Sequence[str], start: str) -> list[str]:
         if not delayed:
             pending.update(outputs)
     return out
+
+
+def _chained(graph: RosGraph, out: list[str], path: str, waiting: list[str]) -> bool:
+    """Whether a Leaf of the C++ container whose inputs are not fixed yet may still join:
+    every such input is written by a Leaf of the container already in the wave, which the
+    container steps first and whose messages of this step it counts in (:func:`chained`)."""
+    shared = graph.shared
+    return path in shared and all(
+        (p := b.rpartition(".")[0]) in shared and p in out for b in waiting
+    )
+
+
+def chained(graph: RosGraph, asked: list[str], path: str) -> set[str]:
+    """The inputs of ``path`` written at once by a Leaf asked before it in the same wave
+    (``asked``): both are in the C++ container, and the count the simulator sends for such
+    an input is the count before this instant's step, plus what that Leaf publishes now,
+    which only the container knows when it steps ``path`` (``N+`` in the request)."""
+    if path not in graph.shared:
+        return set()
+    before = set(asked[: asked.index(path)]) if path in asked else set(asked)
+    world = graph.world
+    return {
+        b
+        for b in graph.input_buffers(path)
+        if (p := b.rpartition(".")[0]) in before and not world.leaves[p].timing.delayed
+    }
 
 
 class DueAt:

@@ -1,0 +1,95 @@
+"""The simulator node's entry point: load the node's configuration, wait for the graph,
+run the scenario through ``runs.single.run_scenario`` on a :class:`RosSimulation` over a
+:class:`Link` (``simulator.py``), write the run directory and say how it went.
+
+Split from ``simulator.py`` (the Link, the protocol side) to keep each module to one job.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+from ...engine import interrupt
+from ...errors import AmsaError, Interrupted, RunFault
+from ...runs.expect import check_expectations
+from ...runs.rundir import default_run_dir, prepare_run_dir
+from ...runs.single import run_scenario
+from .. import names
+from . import adaptlink, ending, records, rosio
+from .config import load_config
+from .rossim import RosSimulation
+from .simulator import Link
+
+
+def main() -> None:
+    """The simulator node's entry point."""
+    rospy = rosio.ros()
+    rospy.init_node(names.SIMULATOR, disable_signals=True)  # Ctrl-C is the engine's
+    code = 0
+    try:
+        cfg = load_config(rospy)
+        scenario, folded = records.fold_server_values(rospy, cfg.scenario)
+        for change in folded:
+            print(f"amsa_simulator: {change.key}={change.value} (parameter server)", flush=True)
+        duration = str(rospy.get_param("~duration", "") or "")
+        if duration:
+            scenario = records.cut(scenario, duration)
+        out = str(rospy.get_param("~out", "") or "")
+        root = Path(str(rospy.get_param("~runs", "") or os.environ.get("PWD", "."))) / "runs"
+        out_dir = Path(out) if out else default_run_dir(scenario.name, root)
+        prepare_run_dir(out_dir, bool(rospy.get_param("~force", False)), flag="out:=")
+        link = Link(rospy, cfg)
+        adaptlink.attach(link)  # rules:=node: the adapt node runs the rules
+        link.speed = float(rospy.get_param("~speed", 1.0))
+        link.waves = bool(rospy.get_param("~waves", True))
+        if not link.speed > 0 or math.isinf(link.speed):
+            raise AmsaError(f"speed:= must be a positive number, got {link.speed}")
+        ready_timeout = float(rospy.get_param("~ready_timeout", 120.0))
+        missing = link.wait_ready(ready_timeout)
+        if missing:
+            raise RunFault("ROS graph", 0, f"not connected after {ready_timeout:g} s: {missing}")
+        print(
+            f"amsa_simulator: {len(cfg.graph.remote)} nodes connected, running "
+            f"{scenario.name} ({cfg.mode})",
+            flush=True,
+        )
+        with interrupt.sigterm_as_ctrl_c():
+            outcome = run_scenario(
+                scenario,
+                out_dir,
+                plot=bool(rospy.get_param("~plots", True)),
+                progress=False,
+                simulation=lambda sc, trace: RosSimulation(sc, trace, link),
+            )
+        _summary(outcome.metrics, out_dir)
+        checks = check_expectations(scenario.expect, outcome.metrics, out_dir / "trace.csv")
+        for check in checks:
+            print(f"expect {check.describe()}", flush=True)
+        code = 0 if all(c.passed for c in checks) else 1
+        print(ending.done_line(checks, out_dir), flush=True)
+    except Interrupted as exc:
+        print(f"error: {exc}", file=sys.stderr, flush=True)
+        code = 130
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr, flush=True)
+        code = 130
+    except AmsaError as exc:
+        print(f"error: {exc}", file=sys.stderr, flush=True)
+        code = exc.exit_code
+    rospy.signal_shutdown("the run is over")
+    ending.end_launch(code)  # a passing run: roslaunch ends the launch, without alarm
+    sys.exit(code)
+
+
+def _summary(metrics: dict[str, Any], out_dir: Path) -> None:
+    overall = metrics["overall"]
+    parts = [f"{k}={v:.3f}" for k, v in overall.items() if isinstance(v, float)]
+    print(
+        f"amsa_simulator: {metrics['status']}, simulated {metrics['simulated']:g} s in "
+        f"{metrics['wall_time_s']:g} s; {' '.join([*parts, f'outputs in {out_dir}'])}",
+        flush=True,
+    )
