@@ -479,7 +479,7 @@ def test_a_leaf_without_simulator_says_what_it_waited_for(
         r"error: (/\w+): gave up after (\d+\.\d) s waiting for the readers of (.*)", text
     )
     assert found is not None, text[-3000:]
-    leaf, waited, rest = found.groups()
+    _leaf, waited, rest = found.groups()
     assert float(waited) >= 2.0  # timeout:=1, twice that for the start
     assert "/amsa/done/amsa_leaves (0 of 1 subscribers)" in rest  # the container answers
     assert "; amsa_simulator reads each of them: if it did not start, its own error" in rest
