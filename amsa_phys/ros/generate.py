@@ -138,6 +138,8 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
             source=source,
             module=Code(module),
             args=args,
+            # amsa-phys missing: the simulator alone says so (every node would, the same)
+            quiet=Code("False" if script == names.SIMULATOR else "True"),
         )
         executable.add(rel)
 
@@ -148,6 +150,20 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         "simmain",
         Code(""),
     )
+    # rosrun PKG run_lockstep SCENARIO.launch: roslaunch, then the run's verdict as exit code
+    files[f"nodes/{names.RUN_LOCKSTEP}"] = _fill(
+        "node.py.in",
+        title=f"{names.RUN_LOCKSTEP}: launch a scenario of {pkg}, exit with its verdict.",
+        doc="rosrun PKG run_lockstep SCENARIO.launch [arg:=value ...]: runs roslaunch, then\n"
+        "judges the run directory's expectations as amsa-phys run does. Exit 0: every check\n"
+        "passed; 1: a check failed; 2: the run faulted or did not start; 130: interrupted.",
+        version=__version__,
+        source=source,
+        module=Code("runcheck"),
+        args=Code(py_string(pkg)),
+        quiet=Code("False"),
+    )
+    executable.add(f"nodes/{names.RUN_LOCKSTEP}")
     node(
         names.SCENARIO,
         f"{names.SCENARIO}: the scenario node of {pkg}.",

@@ -24,6 +24,8 @@ RESERVED.update({"amsa_boundary", "amsa_adapt"})  # the boundary and adapt nodes
 #: The process that hosts every C++ Leaf (a nodelet manager: ros/files/amsa_leaves.cpp).
 CONTAINER = "amsa_leaves"
 RESERVED.add(CONTAINER)
+#: The package's script that launches a scenario and exits with its verdict (``runcheck.py``).
+RUN_LOCKSTEP = "run_lockstep"
 
 CLOCK = "/clock"
 READY = "/amsa/ready"

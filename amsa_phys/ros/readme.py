@@ -67,6 +67,25 @@ writes the outputs so far.
   in %) and `/clock` from the wall clock. With the simulator it publishes the same standard
   messages (and `/tf`) from the run, stamped with simulated time.
 
+### How a run ends
+
+The simulator's last line is `amsa_simulator: done: ...` with the expectations'
+verdict; after a passing run roslaunch then shuts down as on Ctrl-C. After a
+failed check or a fault, roslaunch prints in red `REQUIRED process [amsa_simulator-2] has
+died!` with the simulator's exit code (1: a check failed, 2: bad input, 3: a run fault): it
+means the simulator ended, and the launch with it; the lines above say why.
+
+`roslaunch` exits 0 whatever the checks said. For a CI, run the launch through this
+package's script, whose exit code is the run's verdict (0: every expectation passed, 1: one
+failed, 2: the run faulted or did not start, 130: interrupted):
+
+    rosrun @@{pkg:sh_word} run_lockstep @@{launch:sh_word} out:=/tmp/run; echo $?
+
+It adds `mode:=lockstep` unless a `mode:=` is given and `out:=runs/NAME-STAMP` (in the
+current directory) unless an `out:=` is, runs roslaunch, then judges the run directory's
+`scenario.yaml` expectations against its `metrics.json` and `trace.csv` as `amsa-phys run`
+does.
+
 ## Which Python
 
 The Python nodes import amsa-phys in the Python that runs them: catkin's relays start them
@@ -80,8 +99,12 @@ On the target (a robot, another machine) install the exporting version there:
 it: `export AMSA_PHYS_PYTHON=/path/to/venv/bin/python` before `roslaunch`; each script then
 notes where `rospy` lives and re-executes itself with that Python, which appends ROS's
 Python packages after its own. Nothing in this package names a path of the machine that
-exported it: the workspace can be copied or moved (rebuild it there, or install it with
-`catkin_make install` and source `install/setup.bash`). User templates (`module:Class`)
+exported it, but a *built* workspace does: catkin writes absolute paths into `devel/` and
+`build/`, so a copied `devel/setup.bash` still points at the old place. To move the package
+to another directory or machine, copy the workspace's `src/` (or this package directory
+into another workspace's `src/`) and run `catkin_make` there; or build with `catkin_make
+install` and copy the `install/` tree, whose `setup.bash` finds its own place. User
+templates (`module:Class`)
 must be importable by that Python too (installed, or on `PYTHONPATH`). `package.xml`
 declares the dependency as the rosdep key `python3-amsa-phys-pip`; rosdep resolves it with
 a rule of your own (`python3-amsa-phys-pip: {ubuntu: {pip: {packages: [amsa-phys]}}}`) or

@@ -15,6 +15,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -96,6 +97,11 @@ def test_lockstep_reproduces_amsa_phys_run(
     text = launch.finish()
     print(f"lockstep launch to done: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
     assert "completed" in text, text[-3000:]
+    # a passing run ends as a clean shutdown: the simulator's last line says done, and
+    # roslaunch does not announce, in red, that a required process died
+    assert "amsa_simulator: done: 1 expectation passed" in text, text[-3000:]
+    assert "REQUIRED process" not in text, text[-3000:]
+    assert launch.proc.returncode == 0
     assert (out / "trace.csv").read_bytes() == (reference / "trace.csv").read_bytes()
     assert _metrics(out) == _metrics(reference)
     assert (out / "scenario.yaml").read_text() == (reference / "scenario.yaml").read_text()
@@ -389,3 +395,91 @@ def test_free_mode_waits_for_a_user_node_by_its_topics(
     free, ref = _metrics(out), _metrics(reference)
     for key, bound in FREE_BOUNDS.items():
         assert abs(free["overall"][key] - ref["overall"][key]) < bound, key
+
+
+def _edited_params(workspace: Path, old: str, new: str) -> tuple[Path, str]:
+    """The package's params file with ``old`` replaced by ``new``; (file, original text)."""
+    params = workspace / "src" / PKG / "config" / "ros_short_params.yaml"
+    original = params.read_text()
+    assert old in original
+    params.write_text(original.replace(old, new))
+    return params, original
+
+
+def test_run_lockstep_exits_with_the_runs_verdict(
+    workspace: Path, launcher: Callable[..., Launch]
+) -> None:
+    """roslaunch exits 0 whatever the run's checks say; ``rosrun PKG run_lockstep`` exits 0
+    when every expectation passes, 1 when one fails (here the leader cruises at 70 % in
+    phase 0, edited in the params file, and the follower falls 25 m behind), 2 when the run
+    does not even start (an out:= directory amsa-phys did not make)."""
+    checked = workspace / "checked"
+    checked.mkdir(exist_ok=True)
+    script = (workspace / "launch.sh").read_text()
+    assert f'exec roslaunch {PKG} "$@"' in script
+    (checked / "launch.sh").write_text(  # run from checked/, as a user from their shell
+        f"cd {checked}\n"
+        + script.replace(f'exec roslaunch {PKG} "$@"', f'exec rosrun {PKG} run_lockstep "$@"')
+    )
+    passing = launcher(checked, "ros_short.launch", "plots:=false")  # out: runs/ in its cwd
+    text = passing.finish()
+    assert passing.proc.returncode == 0, text[-3000:]
+    assert "run_lockstep: pass: 1 expectation passed" in text
+    assert len(list((checked / "runs").glob("ros_short-*/metrics.json"))) == 1
+    params, original = _edited_params(workspace, "  cruisePower: 7.0\n", "  cruisePower: 70.0\n")
+    try:
+        out = checked / "failing"
+        failing = launcher(checked, "ros_short", f"out:={out}", "plots:=false")
+        text = failing.finish()
+    finally:
+        params.write_text(original)
+    assert failing.proc.returncode == 1, text[-3000:]
+    assert "expect max_distance (phase 0) = 25.28, below 17: FAIL" in text
+    assert "run_lockstep: FAIL: 1 of 1 expectation failed" in text
+    refused = launcher(checked, "ros_short.launch", f"out:={workspace / 'src'}", "plots:=false")
+    text = refused.finish()
+    assert refused.proc.returncode == 2, text[-3000:]
+    assert "run_lockstep: no run in" in text
+
+
+def test_a_simulator_that_cannot_start_is_the_one_error(
+    workspace: Path, launcher: Callable[..., Launch]
+) -> None:
+    """No AMSA_PHYS_PYTHON (amsa-phys not in ROS's python3): every Python node would say so;
+    the simulator alone does, and roslaunch stops the rest without a word of theirs."""
+    bare = workspace / "bare"
+    bare.mkdir(exist_ok=True)
+    script = (workspace / "launch.sh").read_text()
+    (bare / "launch.sh").write_text("unset AMSA_PHYS_PYTHON\n" + script)
+    text = launcher(bare, "ros_short.launch", "plots:=false").finish()
+    assert text.count("cannot import amsa_phys") == 1, text[-3000:]
+    assert "REQUIRED process [amsa_simulator-2] has died" in text, text[-3000:]
+    assert "gave up" not in text
+
+
+def test_a_leaf_without_simulator_says_what_it_waited_for(
+    workspace: Path, launcher: Callable[..., Launch]
+) -> None:
+    """A C++ Leaf whose readers never come (here: no simulator nor scenario node in the
+    launch file) names the topics short of subscribers, how long it waited, and points at
+    the simulator's own error; it used to say "not connected after 120 s" and no more."""
+    launch_dir = workspace / "src" / PKG / "launch"
+    original = (launch_dir / "ros_short.launch").read_text()
+    nosim = re.sub(r'  <node [^>]*type="amsa_simulator.py".*?</node>\n', "", original, flags=re.S)
+    nosim = re.sub(r'  <node [^>]*type="amsa_scenario.py"[^>]*/>\n', "", nosim)
+    assert "amsa_simulator.py" not in nosim
+    assert "amsa_scenario.py" not in nosim
+    (launch_dir / "ros_short_nosim.launch").write_text(nosim)
+    try:
+        text = launcher(workspace, "ros_short_nosim.launch", "timeout:=1").finish()
+    finally:
+        (launch_dir / "ros_short_nosim.launch").unlink()
+    # the first C++ Leaf to give up ends its process (a required node), and the launch
+    found = re.search(
+        r"error: (/\w+): gave up after (\d+\.\d) s waiting for the readers of (.*)", text
+    )
+    assert found is not None, text[-3000:]
+    _leaf, waited, rest = found.groups()
+    assert float(waited) >= 2.0  # timeout:=1, twice that for the start
+    assert "/amsa/done/amsa_leaves (0 of 1 subscribers)" in rest  # the container answers
+    assert "; amsa_simulator reads each of them: if it did not start, its own error" in rest

@@ -233,12 +233,39 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
   }
 
   void work() {
+    const auto started = std::chrono::steady_clock::now();
     if (!waitConnected(2 * timeout_)) {
-      if (!stop_ && ros::ok()) fail("not connected after " + fmt_g(2 * timeout_) + " s");
+      // stopped (roslaunch ending the launch): nothing to report; else say what was missing
+      if (!stop_ && ros::ok() && !ros::isShuttingDown()) fail(notConnected(started));
       return;
     }
     ReadyBoard::announce(path_);
     if (!lockstep_) runFree();
+  }
+
+  // Which readers never came, after how long, and where the cause is: the simulator reads
+  // every output and the step answers, so if it did not start, its own error says why.
+  std::string notConnected(std::chrono::steady_clock::time_point started) const {
+    const double waited =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    std::string topics;
+    auto add = [&topics](const std::string& topic, int has, int want) {
+      topics += (topics.empty() ? "" : ", ") + topic + " (" + std::to_string(has) + " of " +
+                std::to_string(want) + " subscribers)";
+    };
+    for (std::size_t i = 0; i < pubs_.size(); ++i) {
+      const int has = static_cast<int>(pubs_[i].getNumSubscribers());
+      if (has < want_[i]) add(pubs_[i].getTopic(), has, want_[i]);
+    }
+    if (lockstep_ && !shared_ && done_.getNumSubscribers() < 1)
+      add(done_.getTopic(), static_cast<int>(done_.getNumSubscribers()), 1);
+    if (shared_ && !Dispatcher::get().connected())  // the container answers for its Leaves
+      add("/amsa/done/amsa_leaves", 0, 1);
+    char secs[32];
+    std::snprintf(secs, sizeof secs, "%.1f", waited);
+    return std::string("gave up after ") + secs + " s waiting for the readers of " + topics +
+           "; amsa_simulator reads each of them: if it did not start, its own error (above, "
+           "or in its log) says why";
   }
 
   bool waitConnected(double timeout) {

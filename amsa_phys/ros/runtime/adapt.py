@@ -22,13 +22,14 @@ event's text); the simulator applies the rule's changes then, as the engine does
 from __future__ import annotations
 
 import threading
+import time
 from fractions import Fraction
 from typing import Any
 
 from ...engine.adapt import AdaptRules
 from ...errors import AmsaError
 from .. import names
-from . import rosio
+from . import notready, rosio
 from .config import load_config
 
 #: The node's name (a Leaf cannot take it: ``names.RESERVED``).
@@ -134,11 +135,12 @@ def main() -> None:
     try:
         node = AdaptNode(rospy)
         if node.lockstep:
+            started = time.monotonic()
             missing = node.gate.wait(node.timeout * 2)
             if rospy.is_shutdown():
                 return
             if missing:
-                rosio.fail(rospy, f"{NODE}: not connected after {node.timeout * 2:g} s: {missing}")
+                rosio.fail(rospy, notready.message(NODE, node.gate, started))
             keep = rosio.announce_ready(rospy, NODE)
     except AmsaError as exc:
         rosio.fail(rospy, f"{NODE}: {exc}")

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
@@ -40,7 +41,7 @@ from ...errors import AmsaError, ConfigError
 from .. import names
 from ..boundary import SIM_PARAM
 from ..graph import NodeContext
-from . import rosio
+from . import notready, rosio
 from .arrays import array_msg, pack, unpack
 from .config import load_config
 
@@ -295,11 +296,12 @@ def main(path: str) -> None:
     rospy.init_node(path.rpartition(".")[2])
     try:
         node = LeafNode(rospy, path)
+        started = time.monotonic()
         missing = node.gate.wait(node.cfg.timeout * 2)
         if rospy.is_shutdown():
             return  # roslaunch is stopping (another node failed, or Ctrl-C)
         if missing:
-            rosio.fail(rospy, f"{path}: not connected after {node.cfg.timeout * 2:g} s: {missing}")
+            rosio.fail(rospy, notready.message(path, node.gate, started))
         keep = rosio.announce_ready(rospy, path)
     except AmsaError as exc:
         rosio.fail(rospy, f"{path}: {exc}")

@@ -9,11 +9,12 @@ where ``amsa-phys run`` applies it; in free mode the nodes pick it up at their n
 
 from __future__ import annotations
 
+import time
 from typing import Any
 
 from ...errors import AmsaError
 from .. import names
-from . import rosio
+from . import notready, rosio
 from .config import load_config
 
 
@@ -30,11 +31,12 @@ def main() -> None:
     clock = rosio.ClockFollower(rospy)
     gate = rosio.Gate(rospy)
     ack = gate.publisher(names.PHASE, String, 1, latch=True)
+    started = time.monotonic()
     missing = gate.wait(cfg.timeout * 2)
     if rospy.is_shutdown():
         return
     if missing:
-        rosio.fail(rospy, f"{names.SCENARIO}: not connected: {missing}")
+        rosio.fail(rospy, notready.message(names.SCENARIO, gate, started))
     keep: Any = rosio.announce_ready(rospy, names.SCENARIO)
     for k, phase in enumerate(cfg.scenario.phases[1:], start=1):
         if not clock.wait_until(rosio.to_ns(phase.at)):

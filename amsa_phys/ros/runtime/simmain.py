@@ -19,7 +19,7 @@ from ...runs.expect import check_expectations
 from ...runs.rundir import default_run_dir, prepare_run_dir
 from ...runs.single import run_scenario
 from .. import names
-from . import adaptlink, records, rosio
+from . import adaptlink, ending, records, rosio
 from .config import load_config
 from .rossim import RosSimulation
 from .simulator import Link
@@ -70,6 +70,7 @@ def main() -> None:
         for check in checks:
             print(f"expect {check.describe()}", flush=True)
         code = 0 if all(c.passed for c in checks) else 1
+        print(ending.done_line(checks, out_dir), flush=True)
     except Interrupted as exc:
         print(f"error: {exc}", file=sys.stderr, flush=True)
         code = 130
@@ -80,6 +81,7 @@ def main() -> None:
         print(f"error: {exc}", file=sys.stderr, flush=True)
         code = exc.exit_code
     rospy.signal_shutdown("the run is over")
+    ending.end_launch(code)  # a passing run: roslaunch ends the launch, without alarm
     sys.exit(code)
 
 
