@@ -52,6 +52,12 @@ CLOCK_PERIOD = 0.005
 #: lockstep: the simulator's ``NUM DEN BUFFER VALUE ...`` per Leaf step (std_msgs/String):
 #: the step's instant (a fraction of seconds) and the values it wrote that this node reads
 VALUES = "/amsa/boundary/values"
+#: Lockstep's end: the simulator sends :data:`FLUSH` on :data:`VALUES` after the run's last
+#: values and waits for the answer on :data:`FLUSHED` (latched) before it ends the launch, so
+#: the boundary has published every standard message of the run (a loaded machine's boundary
+#: may lag seconds behind the simulator; shutting the launch down at once lost the tail).
+FLUSH = "flush"
+FLUSHED = "/amsa/boundary/flushed"
 
 
 def ros1_classes() -> dict[str, Any]:
@@ -196,6 +202,8 @@ class BoundaryNode:
         """
         if self.sim and self.lockstep:  # the values with their instants, from the simulator
             String = rosio.msgs()[1]  # (no count of subscribers waits for this one: at once)
+            self.String = String
+            self.flushed = rosio.make_publisher(self.rospy, FLUSHED, String, latch=True)
             self.subs.append(
                 self.rospy.Subscriber(VALUES, String, self._on_values, tcp_nodelay=True)
             )
@@ -236,6 +244,9 @@ class BoundaryNode:
 
     def _on_values(self, msg: Any) -> None:
         """Lockstep: a Leaf step's values that this node reads, at the step's instant."""
+        if msg.data == FLUSH:  # the run's values are all handled (one publisher: in order)
+            self.flushed.publish(self.String(FLUSH))
+            return
         at, values = parse_values(msg.data)
         with self.lock:
             for buffer, value in values:

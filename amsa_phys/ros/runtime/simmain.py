@@ -65,6 +65,13 @@ def main() -> None:
                 progress=False,
                 simulation=lambda sc, trace: RosSimulation(sc, trace, link),
             )
+        if not link.drain_boundary(ready_timeout):
+            print(
+                f"amsa_simulator: the boundary node did not catch up in {ready_timeout:g} s; "
+                "its last standard messages may be missing",
+                file=sys.stderr,
+                flush=True,
+            )
         _summary(outcome.metrics, out_dir)
         checks = check_expectations(scenario.expect, outcome.metrics, out_dir / "trace.csv")
         for check in checks:

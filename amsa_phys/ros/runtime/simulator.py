@@ -29,7 +29,7 @@ from .. import names
 from ..graph import RosGraph
 from . import readiness, rosio
 from .arrays import array_msg, elements, pack, read
-from .boundary import VALUES, format_values, readable
+from .boundary import FLUSH, FLUSHED, VALUES, format_values, readable
 from .config import NodeConfig
 from .container import Container, stepped
 from .waves import DueAt, chained, wave
@@ -388,6 +388,19 @@ class Link:
         told = [(b, v) for b, v in flat if b in self.boundary_reads]
         if told and self.values_pub.get_num_connections():
             self.values_pub.publish(self.String(format_values(t, told)))
+
+    def drain_boundary(self, timeout: float) -> bool:
+        """Lockstep's end: wait until the boundary node has handled every values message
+        (:data:`FLUSH`; ``boundary.py``), at most ``timeout`` s; False if it did not say so."""
+        if self.values_pub is None or not self.values_pub.get_num_connections():
+            return True
+        flushed = threading.Event()
+        sub = self.rospy.Subscriber(FLUSHED, self.String, lambda _msg: flushed.set())
+        try:
+            self.values_pub.publish(self.String(FLUSH))
+            return flushed.wait(timeout)
+        finally:
+            sub.unregister()
 
     def reload(self, path: str, name: str, t: Fraction) -> None:
         """A remote Leaf re-reads one parameter now (a timeline change at its instant)."""
