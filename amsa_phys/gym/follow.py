@@ -279,8 +279,12 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         done = episode.done
         if done and self._memory is not None:
             self._memory.close()
-        t = episode.t  # float(t), without Fraction.__float__'s two property calls
-        info = {"t": t.numerator / t.denominator, "signal": signal, "collisions": self._collisions}
+        t = episode.t  # float(t), without Fraction.__float__'s calls (``episode._exchange``)
+        info = {
+            "t": t._numerator / t._denominator,
+            "signal": signal,
+            "collisions": self._collisions,
+        }
         if done:
             return self._observation(), reward, False, done, info
         inputs = episode.inputs  # ``_observation`` inlined: the usual step
