@@ -26,7 +26,6 @@ import dataclasses
 import sys
 from collections.abc import Callable, Mapping
 from fractions import Fraction
-from typing import Any
 
 import greenlet
 
@@ -59,9 +58,9 @@ def stand_in(original: type[Template], exchange: Exchange) -> type[Template]:
         params = original.params
         template_name = "agent"
 
-        def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
-            """The paper's doStep, answered by the agent."""
-            return exchange(t, inp)
+        #: the paper's doStep, answered by the agent: ``exchange`` itself, not a method
+        #: calling it (the engine calls ``do_step`` once per env-step: a frame less, issue 29)
+        do_step = staticmethod(exchange)
 
     return Agent
 
@@ -106,8 +105,9 @@ class Episode:
 
     def _exchange(self, t: Fraction, inp: Mapping[str, float]) -> Mapping[str, float]:
         # t >= end in integers: a Fraction comparison costs ~0.8 us, a tenth of the env's
-        # own share of a step (``follow.py``)
-        if t.numerator * self._end_den >= self._end_num * t.denominator:
+        # own share of a step (``follow.py``); ``_numerator``/``_denominator`` are the slots
+        # behind the properties (CPython's ``fractions``), read without two property calls
+        if t._numerator * self._end_den >= self._end_num * t._denominator:
             return {}  # the episode ended: publish nothing, keep the last action
         self.t = t
         self.inputs = inp  # type: ignore[assignment]

@@ -127,32 +127,36 @@ class Observer:
         # the scalar clip: v inside [-1, 1] kept, above 1 -> 1, below -1 or NaN -> -1
         return np.where(out > 1.0, 1.0, np.where(out >= -1.0, out, -1.0))
 
-    def of_values(self, values: list[float]) -> np.ndarray:
-        """:meth:`__call__` of the raw inputs as a list of floats (port order): the env's
-        per-step path, which has them as floats already (a handful of them: plain Python
-        beats numpy per element, and each unit's rule was chosen once, in ``__init__``)."""
+    def of_values(self, values: Sequence[float]) -> np.ndarray:
+        """:meth:`__call__` of the raw inputs as floats (a list or tuple, port order): the
+        env's per-step path, which has them as floats already (a handful of them: plain
+        Python beats numpy per element, and each unit's rule was chosen once, in
+        ``__init__``). Each element is clipped as it is made: ``v if -1 <= v <= 1`` else
+        1 or -1 is ``min(1, max(-1, v))`` (NaN too: -1) at a third the time, and a
+        comprehension over the finished list was a function call of its own (issue 29)."""
         if self.mode == "absolute":
             return np.array(values, dtype=np.float64)
         out: list[float] = []
+        append = out.append
         if self.own is not None:
             ox, oy, oh = self.own
             c, s = math.cos(values[oh]), math.sin(values[oh])
             x0, y0, scale = values[ox], values[oy], self.range_m
             for ix, iy in self.relative:
                 dx, dy = values[ix] - x0, values[iy] - y0
-                out += ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale)
+                v = (c * dx + s * dy) / scale
+                append(v if -1.0 <= v <= 1.0 else (1.0 if v > 1.0 else -1.0))
+                v = (-s * dx + c * dy) / scale
+                append(v if -1.0 <= v <= 1.0 else (1.0 if v > 1.0 else -1.0))
         for i, unit in self.rest:
             v = values[i]
             if unit == "m":
-                out.append(v / self.range_m)
+                v = v / self.range_m
             elif unit == "m/s":
-                out.append(v / self.speed_mps)
+                v = v / self.speed_mps
             elif unit == "rad":
-                out.append(((v + math.pi) % (2 * math.pi) - math.pi) / math.pi)
+                v = ((v + math.pi) % (2 * math.pi) - math.pi) / math.pi
             else:
-                out.append(math.tanh(v))
-        # min(1, max(-1, v)) spelled out: the same value (NaN too: -1), a third the time
-        return np.array(
-            [v if -1.0 <= v <= 1.0 else (1.0 if v > 1.0 else -1.0) for v in out],
-            dtype=np.float64,
-        )
+                v = math.tanh(v)
+            append(v if -1.0 <= v <= 1.0 else (1.0 if v > 1.0 else -1.0))
+        return np.array(out, dtype=np.float64)
