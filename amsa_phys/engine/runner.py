@@ -154,18 +154,21 @@ class Simulation(ReadAPI, LiveChanges):
     @classmethod
     def from_scenario(cls, scenario: Scenario, **kw: Any) -> Simulation:
         """A Simulation configured by a loaded scenario."""
-        q = scenario.quality.signal if scenario.quality else None
-        return cls(
-            scenario.world,
-            seed=scenario.seed,
-            duration=scenario.duration,
-            phases=scenario.phases,
-            log_rate=scenario.log_rate,
-            quality_signal=q,
-            columns=traced_columns(scenario),
-            adapt=scenario.adapt,
-            **kw,
-        )
+        return cls(scenario.world, **cls.scenario_kwargs(scenario), **kw)
+
+    @staticmethod
+    def scenario_kwargs(scenario: Scenario) -> dict[str, Any]:
+        """What a scenario says to the constructor besides its world: the one mapping from a
+        scenario to a Simulation (``from_scenario``; the ROS simulator's ``RosSimulation``)."""
+        return {
+            "seed": scenario.seed,
+            "duration": scenario.duration,
+            "phases": scenario.phases,
+            "log_rate": scenario.log_rate,
+            "quality_signal": scenario.quality.signal if scenario.quality else None,
+            "columns": traced_columns(scenario),
+            "adapt": scenario.adapt,
+        }
 
     # -- construction -------------------------------------------------------------------
     def _build(self) -> None:

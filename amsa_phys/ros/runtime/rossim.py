@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from ...engine.runner import Simulation
 from ...model.adaptrules import RULE_COLUMN
-from ...model.scenario import Change, Scenario, traced_columns
+from ...model.scenario import Change, Scenario
 from .. import names
 from . import adaptlink, rosio
 from .standins import stand_ins
@@ -27,19 +27,12 @@ class RosSimulation(Simulation):
     """The engine with remote Leaves, parameters from the server, ``/clock`` published."""
 
     def __init__(self, scenario: Scenario, trace: Any, link: Link) -> None:
-        q = scenario.quality.signal if scenario.quality else None
         super().__init__(
             scenario.world,
-            seed=scenario.seed,
-            duration=scenario.duration,
-            phases=scenario.phases,
-            log_rate=scenario.log_rate,
-            quality_signal=q,
-            trace=trace,
-            columns=traced_columns(scenario),
             # adapt: rules fire here, at the engine's exact instants (both modes); a change is
             # put on the parameter server before the Leaf is told (apply_change)
-            adapt=scenario.adapt,
+            **Simulation.scenario_kwargs(scenario),
+            trace=trace,
             # remote Leaves and publishing local ones stand in for the world's (standins.py)
             wrap=stand_ins(link, lambda: self.now),
             # every Leaf is called on its own: a node per Leaf, a topic per output
