@@ -85,6 +85,25 @@ def _container(cpp: list[str]) -> Code:
     )
 
 
+def _pipeline(adapt: bool) -> str:
+    """The ``pipeline`` argument and ``/amsa/pipeline``: lockstep asks the C++ container for
+    many instants at once, checking each answer against the in-process template
+    (``runtime/pipeline.py``), when every remote Leaf is in the container, no bag records the
+    topics and (with ``adapt:`` rules) the simulator fires the rules. Constant text."""
+    when = (
+        "arg('pipeline') and arg('mode') == 'lockstep' and arg('sim') and arg('cpp')"
+        " and arg('cpp_container') and arg('bag') == ''"
+        + (" and arg('rules') != 'node'" if adapt else "")
+    )
+    return (
+        '  <arg name="pipeline" default="true" doc="lockstep with every Leaf in the C++'
+        " container: ask it for many instants at once, each answer checked bit for bit"
+        " against the Leaf&apos;s in-process template (false: wait for every instant&apos;s"
+        ' answers, the nodes&apos; values driving the run)"/>\n'
+        f'  <param name="/amsa/pipeline" type="bool" value="$(eval {when})"/>'
+    )
+
+
 _LEAF = "  <!-- @@{path:xml_comment}: @@{tname:xml_comment}, @@{hz:xml_comment} Hz -->"
 _COMMON = 'pkg="@@{pkg:xml_attr}" name="@@{base:xml_attr}"@@{ns:code} required="true"'
 
@@ -157,6 +176,8 @@ def launch_xml(
                 pkg=pkg,
             )
         )
+    if cpp and set(cpp) == set(graph.remote):
+        lines.append(_pipeline(adapt))
     if cpp:
         lines.append(
             fill(

@@ -55,6 +55,9 @@ class Steppable {
   virtual std::size_t topicCount() const = 0;
   virtual const std::string& outputTopic(std::size_t k) const = 0;
   virtual std::size_t outputCount() const = 0;
+  // Pipelined lockstep: "call SEQ NUM DEN V1..Vn" (step now with these input values, by
+  // input port) or "set SEQ NAME VALUE" (take this parameter value), answered at once.
+  virtual std::string call(const std::string& request) = 0;
 };
 
 
@@ -92,6 +95,11 @@ class Dispatcher {
   };
 
   void onBatch(const std::string& text);
+  // Pipelined lockstep (/amsa/pipeline): the message is many instants of "call" and "set"
+  // lines, which carry their inputs' values; each is run at once, in order, on this thread,
+  // and one message answers them all (the simulator checks every value it gets back).
+  static bool pipelined(const std::string& text);
+  void onPipelined(const std::string& text);
   // The items whose producers have answered, as requests to send (mutex_ held).
   void ready(Batch& batch, std::vector<std::pair<Steppable*, std::string>>* send);
 
@@ -119,6 +127,7 @@ inline void Dispatcher::add(Steppable* leaf) {
 }
 
 inline void Dispatcher::onBatch(const std::string& text) {
+  if (pipelined(text)) return onPipelined(text);
   std::vector<std::pair<Steppable*, std::string>> send;
   std::string refused;
   {
@@ -179,6 +188,42 @@ inline void Dispatcher::onBatch(const std::string& text) {
     done_.publish(m);
   }
   for (auto& s : send) s.first->submit(s.second);
+}
+
+inline bool Dispatcher::pipelined(const std::string& text) {
+  std::istringstream in(text.substr(0, text.find('\n')));
+  std::string name, verb;
+  in >> name >> verb;
+  return verb == "call" || verb == "set";
+}
+
+inline void Dispatcher::onPipelined(const std::string& text) {
+  std::string all;
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    const std::size_t space = line.find(' ');
+    const std::string name = line.substr(0, space);
+    const std::string request = space == std::string::npos ? "" : line.substr(space + 1);
+    Steppable* leaf = nullptr;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      auto found = leaves_.find(name);
+      if (found != leaves_.end()) leaf = found->second;
+    }
+    if (leaf == nullptr) {
+      std::istringstream in(request);
+      std::string verb, seq;
+      in >> verb >> seq;
+      all += name + " error " + seq + " no Leaf " + name + " in this container\n";
+      continue;
+    }
+    all += name + " " + leaf->call(request) + "\n";
+  }
+  if (all.empty()) return;
+  std_msgs::String m;
+  m.data = all.substr(0, all.size() - 1);
+  done_.publish(m);
 }
 
 inline void Dispatcher::ready(Batch& batch, std::vector<std::pair<Steppable*, std::string>>* send) {

@@ -88,6 +88,58 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
     if (!answer.empty()) reply(answer);
   }
 
+  // Pipelined lockstep (the Dispatcher, amsa_container.h): "call SEQ NUM DEN V1..Vn" steps
+  // now on the input values given, by input port (C hex floats; an array port's as
+  // [V,V,..]); "set SEQ NAME VALUE" takes a parameter's value, judged as a server value is.
+  std::string call(const std::string& text) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::istringstream in(text);
+    std::string verb, seq;
+    in >> verb >> seq;
+    if (verb == "set") {
+      std::string name, word, error;
+      double v = 0;
+      in >> name >> word;
+      if (!read_double(word, &v)) return "error " + seq + " " + paramName(name) + ": not a number";
+      for (const ParamSpec& spec : params_) {
+        if (spec.name != name) continue;
+        if (!judge(spec, v, &error)) return "error " + seq + " " + error;
+        const double old = values_[spec.name];
+        values_[spec.name] = v;
+        if (!checkParams(&error)) {
+          values_[spec.name] = old;
+          return "error " + seq + " " + error;
+        }
+        return "done " + seq;
+      }
+      return "error " + seq + " no parameter " + name;
+    }
+    if (verb != "call") return "error " + seq + " unknown request " + verb;
+    std::int64_t num = 0, den = 1;
+    in >> num >> den;
+    std::vector<double> values;
+    for (std::size_t j = 0; j < inputs_.size(); ++j) {
+      std::string word;
+      double v = 0;
+      if (!(in >> word)) return "fault " + seq + " " + std::to_string(j) + " input values, the Leaf has " + std::to_string(inputs_.size());
+      if (!word.empty() && word[0] == '[') {  // an array port: [V,V,..]
+        std::vector<double>& arr = arrays_in_[j];
+        arr.clear();
+        std::istringstream items(word.substr(1, word.size() - 2));
+        std::string item;
+        while (std::getline(items, item, ','))
+          if (read_double(item, &v)) arr.push_back(v);
+        values.push_back(0.0);
+        continue;
+      }
+      if (!read_double(word, &v)) return "fault " + seq + " input " + inputs_[j].port + ": not a number";
+      values.push_back(v);
+    }
+    const std::string result = stepPorts(static_cast<double>(num) / static_cast<double>(den), values);
+    if (!result.empty() && result[0] == '!') return "error " + seq + " " + result.substr(1);
+    return "done " + seq + result;
+  }
+
   // The nodelet's name, /LEAF (getName() is protected in nodelet::Nodelet).
   const std::string& nodeName() const override { return getName(); }
   // The topic of input ``i`` (the container resolves counts by its producer).
@@ -121,6 +173,9 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
     ros::param::get("/amsa/sim", sim);
     ros::param::get("/amsa/bag", bag);
     ros::param::get("/amsa/timeout", timeout_);
+    // pipelined lockstep: the container's requests carry the inputs' values (call)
+    bool pipeline = false;
+    ros::param::get("/amsa/pipeline", pipeline);
     // /amsa/container: the Leaves sharing the container process (subscribers count so)
     bool shared = false;
     XmlRpc::XmlRpcValue container;
@@ -146,8 +201,10 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
     for (const OutputPort& o : outputs_) own_.push_back(o.initial);
     initArrays();
 
-    // the nodelet's callbacks (one queue per nodelet: in order, one at a time)
-    for (std::size_t i = 0; i < topics_.size(); ++i) {
+    // the nodelet's callbacks (one queue per nodelet: in order, one at a time); pipelined,
+    // the inputs come with each request instead, and no Leaf of the graph reads a topic
+    pipeline_ = mode == "lockstep" && shared && pipeline;
+    for (std::size_t i = 0; i < topics_.size() && !pipeline_; ++i) {
       if (topics_[i].size > 0) {
         subs_.push_back(subscribeArray(nh, i));
         continue;
@@ -168,7 +225,7 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
       // not subscribe to its outputs (the counts include it as one subscriber)
       const int subscribers =
           shared ? o.subscribers_shared - (mode == "lockstep" ? 1 : 0) : o.subscribers;
-      want_.push_back(sim ? subscribers + (bag ? 1 : 0) : 0);
+      want_.push_back(sim && !pipeline_ ? subscribers + (bag ? 1 : 0) : 0);
     }
     lockstep_ = mode == "lockstep";
     shared_ = lockstep_ && shared;  // asked through the container's one topic (Dispatcher)
@@ -303,11 +360,19 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
         break;
       default: *error = name + ": expected a number"; return false;
     }
+    if (!judge(spec, v, error)) return false;
+    *value = v;
+    return true;
+  }
+
+  // A number for parameter ``spec``, judged by its type and [min, max].
+  bool judge(const ParamSpec& spec, double v, std::string* error) const {
+    const std::string name = paramName(spec.name);
+    if (spec.type == 'b' && v != 0 && v != 1) { *error = name + ": expected a boolean, got " + fmt_g(v); return false; }
     if (spec.type == 'i' && v != std::floor(v)) { *error = name + ": expected an integer, got " + fmt_g(v); return false; }
     if (!std::isfinite(v)) { *error = name + ": expected a finite number"; return false; }
     if (spec.has_min && v < spec.min) { *error = name + ": " + fmt_g(v) + " is below the minimum " + fmt_g(spec.min); return false; }
     if (spec.has_max && v > spec.max) { *error = name + ": " + fmt_g(v) + " is above the maximum " + fmt_g(spec.max); return false; }
-    *value = v;
     return true;
   }
 
@@ -456,6 +521,13 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
       }
       in.push_back(ip.topic >= 0 ? seen[ip.topic] : own_[-(ip.topic + 1)]);
     }
+    return stepPorts(t, in);
+  }
+
+  // doStep on ``in`` (by input port; an array port's numbers in arrays_in_); publishes;
+  // " I J .." (the outputs published; in the container " I J .. | VI VJ .."), or
+  // "!message" if doStep threw.
+  std::string stepPorts(double t, const std::vector<double>& in) {
     std::vector<double> out(outputs_.size(), 0.0);
     std::vector<bool> published(outputs_.size(), false);
     for (std::vector<double>& a : arrays_out_) a.clear();
@@ -588,6 +660,7 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
   std::string pending_;
   bool lockstep_ = true;
   bool shared_ = false;  // lockstep in the container: requests come through the Dispatcher
+  bool pipeline_ = false;  // ... pipelined: each request carries its inputs (call)
   std::atomic<bool> stop_{false};
   std::mutex mutex_;
   std::condition_variable cond_;

@@ -23,10 +23,14 @@ class NodeConfig:
     #: lockstep with the simulator: the adapt node runs the ``adapt:`` rules, asked by the
     #: simulator at each instant (``rules:=node``), rather than the simulator itself
     rules_node: bool = False
+    #: lockstep with every remote Leaf in the C++ container: many instants a message, each
+    #: answer checked against the Leaf's in-process template (``pipeline.py``)
+    pipeline: bool = False
 
 
 def load_config(rospy: Any) -> NodeConfig:
-    """Read ``/amsa/{scenario,mode,local,bag,timeout,container,rules}``; load the scenario."""
+    """Read ``/amsa/{scenario,mode,local,bag,timeout,container,rules,pipeline}``; load the
+    scenario."""
     try:
         path = rospy.get_param("/amsa/scenario")
         mode = rospy.get_param("/amsa/mode", "lockstep")
@@ -48,4 +52,12 @@ def load_config(rospy: Any) -> NodeConfig:
     node = rules == "node" and bool(scenario.adapt) and sim and mode == "lockstep"
     signals = sorted({c.signal for r in scenario.adapt for c in r.when}) if node else []
     graph = RosGraph.of(scenario.world, local, bag, shared, signals)
-    return NodeConfig(scenario, graph, mode, timeout, node)
+    pipeline = (
+        bool(rospy.get_param("/amsa/pipeline", False))
+        and mode == "lockstep"
+        and sim
+        and not bag
+        and not node
+        and set(graph.remote) == set(graph.shared)
+    )
+    return NodeConfig(scenario, graph, mode, timeout, node, pipeline)

@@ -54,7 +54,7 @@ def main() -> None:
             raise RunFault("ROS graph", 0, f"not connected after {ready_timeout:g} s: {missing}")
         print(
             f"amsa_simulator: {len(cfg.graph.remote)} nodes connected, running "
-            f"{scenario.name} ({cfg.mode})",
+            f"{scenario.name} ({cfg.mode}{', pipelined' if cfg.pipeline else ''})",
             flush=True,
         )
         with interrupt.sigterm_as_ctrl_c():

@@ -32,6 +32,7 @@ from .arrays import array_msg, elements, pack, read
 from .boundary import FLUSH, FLUSHED, VALUES, format_values, readable
 from .config import NodeConfig
 from .container import Container, stepped
+from .pipeline import Pipeline
 from .waves import DueAt, chained, wave
 
 
@@ -88,8 +89,13 @@ class Link:
         self.values_pub = (
             rosio.make_publisher(rospy, VALUES, String) if self.boundary_reads else None
         )
+        #: pipelined lockstep (pipeline.py): the container's Leaves asked many instants at once
+        self.pipeline = Pipeline(self) if cfg.pipeline else None
+        quiet = self.pipeline is not None  # no node reads a data topic: inputs come inline
         self.data_pubs = {
-            b: self.gate.publisher(names.topic(b), self._kind(b), self.graph.subscribers(b))
+            b: self.gate.publisher(
+                names.topic(b), self._kind(b), 0 if quiet else self.graph.subscribers(b)
+            )
             for p in self.graph.local
             for b in self.graph.outputs(p)
         }
@@ -98,7 +104,8 @@ class Link:
         self.data_subs: dict[str, Any] = {}
         #: lockstep: the Leaves of the C++ container, asked a wave at a time (container.py)
         self.shared = self.graph.shared if self.lockstep else frozenset()
-        self.container = Container(rospy, self.gate, String, self.shared, self._on_answers)
+        answers = self.pipeline.on_answers if self.pipeline else self._on_answers
+        self.container = Container(rospy, self.gate, String, self.shared, answers)
         for path in self.graph.remote:
             for b in self.graph.outputs(path):
                 self.received[b] = [0, self.graph.initial(b)]
@@ -381,12 +388,12 @@ class Link:
     def tell_boundary(self, t: Fraction, values: list[tuple[str, Any]]) -> None:
         """Lockstep: the values of a Leaf's step at ``t`` that the boundary node reads (an
         array port's as its elements' buffers, which the standard messages read)."""
-        if self.values_pub is None:
+        if self.values_pub is None or not self.values_pub.get_num_connections():
             return
         arrays = self.graph.world.arrays
         flat = [e for b, v in values for e in elements(arrays, b, v)]
         told = [(b, v) for b, v in flat if b in self.boundary_reads]
-        if told and self.values_pub.get_num_connections():
+        if told:
             self.values_pub.publish(self.String(format_values(t, told)))
 
     def drain_boundary(self, timeout: float) -> bool:
@@ -418,11 +425,16 @@ class Link:
         Float64 = self.Float64
         published = self.published
         arrays = self.graph.world.arrays
+        # pipelined: no node of the graph reads the topics, so only a listener's are sent
+        quiet = self.pipeline is not None
 
         def publish(t: Fraction, out: Mapping[str, Any]) -> None:
             sent: list[tuple[str, Any]] = []
             for port, b in ports:
                 if port in out:
+                    if quiet and not pubs[b].impl.connections:  # get_num_connections()
+                        sent.append((b, out[port]))
+                        continue
                     try:
                         if b in arrays:
                             number: Any = tuple(float(v) for v in out[port])

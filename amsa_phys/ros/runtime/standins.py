@@ -5,7 +5,9 @@ The engine builds every component and passes each through ``Simulation(wrap=...)
 :class:`RemoteLeaf` (stepping it is asking its node to step); a Leaf that steps here (it
 shares the pymunk world) becomes a :class:`PublishingLeaf`, the component itself with its
 outputs published on their topics after each step. Nothing replaces entries of
-``Simulation.components`` or methods of a component after construction (issue 32).
+``Simulation.components`` or methods of a component after construction (issue 32). In
+pipelined lockstep a Leaf of the C++ container is a ``pipeline.CheckedLeaf``: its template
+steps here and its node is asked to do the same, the answers checked.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from ...model.template import Template
 from . import rosio
+from .pipeline import CheckedLeaf
 
 if TYPE_CHECKING:  # the link imports this module
     from .simulator import Link
@@ -76,11 +79,15 @@ def stand_ins(link: Link, now: Callable[[], Fraction]) -> Callable[[str, Templat
     graph = link.graph
 
     def wrap(path: str, comp: Template) -> Any:
-        if path in graph.remote:
+        pipelined = link.pipeline is not None and path in graph.shared
+        if path in graph.remote and not pipelined:
             return RemoteLeaf(path, comp.p, link, now)
-        if path in graph.local:
+        if path in graph.local or pipelined:
             for name, value in rosio.read_params(link.rospy, graph.leaf(path)).items():
                 setattr(comp.p, name, value)
+        if pipelined:  # stepped here too, its node asked to do the same (pipeline.py)
+            return CheckedLeaf(path, comp, link, now)
+        if path in graph.local:
             return PublishingLeaf(comp, link.publisher_of(path))
         return comp
 
