@@ -4,9 +4,11 @@
   loop, without roscore and process start-up) against the in-process run's loop
   (``metrics.json`` ``wall_time_s``), launch to done (the difference is start-up and exit),
   and the CPU seconds of every process of the launch (on a shared machine the run time
-  follows the load; the CPU does much less); with a process per C++ Leaf asked one at a time
-  (``waves:=false``) and in waves, and with every C++ Leaf in the container asked in one
-  message a wave (the default), alternated, in one sitting;
+  follows the load; the CPU does much less); with a process per C++ Leaf asked in waves,
+  with every C++ Leaf in the container asked in one message a wave and each instant's
+  answers awaited (``pipeline:=false``), and pipelined (the default: many instants a
+  message, each answer checked against the in-process template), alternated with the
+  in-process run, in one sitting;
 * the platoon world's launch: the peak of the summed resident memory of every process the
   launch started (sampled from ``/proc`` every 0.2 s), and its run time.
 
@@ -41,9 +43,9 @@ SCENARIO1 = ROOT / "scenarios" / "scenario1.yaml"
 PLATOON = ROOT / "worlds" / "platoon.yaml"
 #: scenario1's lockstep protocols compared: (label, launch arguments)
 PROTOCOLS = (
-    ("a process per Leaf, one at a time", ("cpp_container:=false", "waves:=false")),
     ("a process per Leaf, waves", ("cpp_container:=false",)),
-    ("container, one message a wave", ()),
+    ("container, one message a wave", ("pipeline:=false",)),
+    ("container, pipelined (default)", ()),
 )
 #: CPU seconds of the last :func:`launch`'s processes
 LAST_CPU_S = 0.0
@@ -227,11 +229,13 @@ def main_bench() -> None:
         ref_cpu = time.process_time() - cpu0
         print(f"scenario1 {args.duration} s, in-process loop        {loop:.3f} s")
         print(f"scenario1 in-process: CPU of the whole run         {ref_cpu:.2f} s")
-        # the protocols, alternated, --repeat times each (the machine is shared): a process
-        # per C++ Leaf asked one at a time (waves:=false) and in waves, and the default, every
-        # C++ Leaf in the container, asked in one message a wave with chained readers
+        # the protocols, alternated with the in-process loop, --repeat times each (the
+        # machine is shared): each ratio is against the loop measured just before it
         for _ in range(args.repeat):
             for label, extra in PROTOCOLS:
+                with contextlib.redirect_stdout(io.StringIO()):
+                    assert main([*argv, "--duration", args.duration, "--force"]) == 0
+                loop = json.loads((ref / "metrics.json").read_text())["wall_time_s"]
                 wall, run, rss, _ = launch(
                     ws,
                     "scenario1.launch",
@@ -243,7 +247,8 @@ def main_bench() -> None:
                 )
                 same = (ws / "out" / "trace.csv").read_bytes() == (ref / "trace.csv").read_bytes()
                 print(
-                    f"scenario1 lockstep, {label:34}: run {run:.3f} s ({run / loop:.1f}x), "
+                    f"scenario1 lockstep, {label:34}: run {run:.3f} s ({run / loop:.1f}x the "
+                    f"loop's {loop:.3f} s), "
                     f"launch to done {wall:.1f} s (start-up and exit {wall - run:.1f} s), "
                     f"CPU of the launch {LAST_CPU_S:.1f} s, peak memory {rss / 1024:.0f} MiB, "
                     f"trace byte-identical {same}"

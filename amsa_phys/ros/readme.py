@@ -146,7 +146,10 @@ _CPP_ARGS = (
     " process of its own, `nodelet standalone PKG/TEMPLATE`). The C++ Leaves are nodelets, one"
     " class per template (`nodelet_plugins.xml`): `nodelet load PKG/TEMPLATE MANAGER` loads"
     " one into a manager of your own, with its parameters and its wiring"
-    " (`config/amsa_leaves.yaml`) in its private namespace"
+    " (`config/amsa_leaves.yaml`) in its private namespace; `pipeline` (when every Leaf is"
+    " in the container, `true`, the default: lockstep asks the container for many instants"
+    " at once, each answer checked bit for bit against the Leaf's template in the simulator;"
+    " `false`: each instant's answers awaited and used, the nodes driving the run)"
 )
 
 

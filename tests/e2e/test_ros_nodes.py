@@ -21,6 +21,8 @@ machine: each is an executable of its own compiled against roscpp's headers.)
 
 from __future__ import annotations
 
+import json
+import re
 from collections.abc import Callable
 from pathlib import Path
 
@@ -76,11 +78,12 @@ def test_the_fixture_runs_every_cpp_template_as_a_cpp_node(workspace: Path) -> N
 @pytest.mark.parametrize(
     "args",
     [
-        (),  # the default: every C++ Leaf in one process (amsa_leaves)
+        (),  # the default: every C++ Leaf in one process (amsa_leaves), pipelined
+        ("pipeline:=false",),  # ... each instant's answers awaited, the nodes' values used
         ("cpp_container:=false",),  # each C++ Leaf in a process of its own
         ("cpp:=false",),  # the Python twins
     ],
-    ids=["container", "standalone", "python"],
+    ids=["container", "container_exact", "standalone", "python"],
 )
 def test_lockstep_reproduces_the_run_with_cpp_nodes_and_without(
     workspace: Path, reference: Path, launcher: Callable[..., Launch], args: tuple[str, ...]
@@ -89,8 +92,47 @@ def test_lockstep_reproduces_the_run_with_cpp_nodes_and_without(
     launch = launcher(workspace, "ros_nodes.launch", f"out:={out}", "plots:=false", *args)
     text = launch.finish()
     assert "completed" in text, text[-3000:]
-    if not args:  # one process hosts every C++ Leaf
+    if not args or args == ("pipeline:=false",):  # one process hosts every C++ Leaf
         assert text.count("process[amsa_leaves") == 1, text[-3000:]
         assert "(nodelet/nodelet)" not in text, text[-3000:]
+    # pipelined by default (every remote Leaf is in the container); else each instant awaited
+    assert ("(lockstep, pipelined)" in text) == (not args), text[-3000:]
     assert (out / "trace.csv").read_bytes() == (reference / "trace.csv").read_bytes()
     assert _metrics(out) == _metrics(reference)
+
+
+def test_a_node_unlike_its_template_stops_a_pipelined_run_and_drives_an_exact_one(
+    workspace: Path, reference: Path, launcher: Callable[..., Launch]
+) -> None:
+    """The launch file's ``/amsa/seed`` edited by hand: the C++ sensors draw other noise than
+    the model's. Pipelined lockstep ends at the first step where a node published another
+    value than its in-process template, naming both; the exact protocol (``pipeline:=false``)
+    follows the nodes, so its run completes and differs from ``amsa-phys run``."""
+    launch_dir = workspace / "src" / PKG / "launch"
+    original = (launch_dir / "ros_nodes.launch").read_text()
+    seed = re.search(r'<param name="seed" type="str" value="(\d+)"/>', original)
+    assert seed is not None, original[:2000]
+    reseeded = seed.group(0).replace(f'"{seed.group(1)}"', f'"{int(seed.group(1)) + 1}"')
+    (launch_dir / "ros_nodes_reseeded.launch").write_text(original.replace(seed.group(0), reseeded))
+    try:
+        out = workspace / "reseeded"
+        text = launcher(
+            workspace, "ros_nodes_reseeded.launch", f"out:={out}", "plots:=false"
+        ).finish()
+        assert "where its in-process template published" in text, text[-3000:]
+        status = json.loads((out / "metrics.json").read_text())["status"]
+        assert re.match(
+            r"fault: run fault at t=\S+ s in \w+ \((GPS|Compass|IMU|Odometry)\)", status
+        )
+        exact = workspace / "reseeded_exact"
+        text = launcher(
+            workspace,
+            "ros_nodes_reseeded.launch",
+            f"out:={exact}",
+            "plots:=false",
+            "pipeline:=false",
+        ).finish()
+        assert "completed" in text, text[-3000:]
+        assert (exact / "trace.csv").read_bytes() != (reference / "trace.csv").read_bytes()
+    finally:
+        (launch_dir / "ros_nodes_reseeded.launch").unlink()

@@ -566,9 +566,7 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
       pubs_[k].publish(m);
       own_[k] = out[k];
       indexes += " " + std::to_string(k);
-      char hex[64];
-      std::snprintf(hex, sizeof hex, " %a", out[k]);  // C99 hex float: the exact double
-      values += hex;
+      values += " " + pyhex(out[k]);  // the exact double, as Python's float.hex() writes it
     }
     // in the container the answer carries the values too: the simulator takes them from it
     // instead of subscribing to every output (one message an instant instead of one each)

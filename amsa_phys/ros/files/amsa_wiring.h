@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -48,6 +49,24 @@ struct ParamSpec {
   bool has_min, has_max;
   double min, max;
 };
+
+// A double exactly as Python's float.hex() writes it (strtod reads it back exactly): the
+// container's answers carry values so, and the simulator compares them as text.
+inline std::string pyhex(double v) {
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &v, sizeof bits);
+  const char* sign = (bits >> 63) ? "-" : "";
+  const int e = static_cast<int>((bits >> 52) & 0x7ff);
+  const unsigned long long m = bits & ((1ULL << 52) - 1);
+  if (e == 0x7ff) return m ? "nan" : std::string(sign) + "inf";
+  if (e == 0 && m == 0) return std::string(sign) + "0x0.0p+0";
+  char buf[48];
+  if (e == 0)
+    std::snprintf(buf, sizeof buf, "%s0x0.%013llxp-1022", sign, m);
+  else
+    std::snprintf(buf, sizeof buf, "%s0x1.%013llxp%+d", sign, m, e - 1023);
+  return buf;
+}
 
 inline std::string fmt_g(double v) {
   char buf[64];

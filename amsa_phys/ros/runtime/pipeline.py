@@ -64,18 +64,20 @@ class Pipeline:
         self.link = link
         graph = link.graph
         self.lines: list[str] = []
-        #: sequence number -> (Leaf, instant, what the node must answer: the outputs the twin
-        #: published as (buffer, hex) pairs, or None for a parameter value taken)
-        self.expected: dict[str, tuple[str, Fraction, list[tuple[str, str]] | None]] = {}
+        #: sequence number -> (Leaf, instant, the node's answer if it does what its twin did:
+        #: ``done SEQ I J .. | VI VJ ..`` with the values as ``float.hex`` writes them, which
+        #: is how the container writes them, or ``done SEQ`` for a parameter value taken)
+        self.expected: dict[str, tuple[str, Fraction, str]] = {}
         self.answers: deque[list[tuple[str, str]]] = deque()
         self.in_flight = 0
         self.outputs = {p: graph.outputs(p) for p in graph.shared}
         #: each Leaf's request head, input ports (the template's order) and output ports
+        #: (port, index)
         self.leaves = {
             p: (
                 f"{names.ns(p)} call ",
                 [i.name for i in graph.leaf(p).template.inputs],
-                [(b.rpartition(".")[2], b) for b in self.outputs[p]],
+                [(b.rpartition(".")[2], str(k)) for k, b in enumerate(self.outputs[p])],
             )
             for p in graph.shared
         }
@@ -90,8 +92,12 @@ class Pipeline:
         head, ports, outputs = self.leaves[path]
         values = " ".join([v.hex() if type(v) is float else _hex(v) for v in map(inp.get, ports)])
         self.lines.append(f"{head}{seq} {t.numerator} {t.denominator} {values}")
-        want = [(b, _hex(out[port])) for port, b in outputs if port in out] if out else []
-        self.expected[seq] = (path, t, want)
+        if out:
+            done = [(k, _hex(out[port])) for port, k in outputs if port in out]
+            want = "".join([" " + k for k, _ in done]) + " |" + "".join([" " + v for _, v in done])
+        else:
+            want = " |"
+        self.expected[seq] = (path, t, f"done {seq}{want}")
         if len(self.lines) >= BATCH:
             self.send()
 
@@ -101,7 +107,7 @@ class Pipeline:
         container reads the request)."""
         seq = self._seq()
         self.lines.append(f"{names.ns(path)} set {seq} {name} {float(value).hex()}")
-        self.expected[seq] = (path, t, None)
+        self.expected[seq] = (path, t, f"done {seq}")
 
     def send(self) -> None:
         """The queued requests in one message; then take the answers in, waiting for the
@@ -146,36 +152,35 @@ class Pipeline:
             self.waited += time.perf_counter() - t0
 
     def _check(self, path: str, answer: str) -> None:
-        """One node's answer against what its twin did: a fault if they differ."""
+        """One node's answer against what its twin did, as text: a fault if they differ."""
         kind, _, rest = answer.partition(" ")
         seq, _, text = rest.partition(" ")
-        if seq not in self.expected:
+        expected = self.expected.pop(seq, None)
+        if expected is None:
             raise RunFault(names.CONTAINER, 0, f"an answer to no request: {answer[:200]}")
-        leaf, t, want = self.expected.pop(seq)
+        leaf, t, want = expected
+        if answer == want:
+            return
         who = f"{leaf} ({self.link.graph.leaf(leaf).template.name()})"
         if kind == "fault":
             raise RunFault(who, t, text)
         if kind != "done":
-            did = "refused the parameter value" if want is None else "failed"
+            did = "failed" if "|" in want else "refused the parameter value"
             raise RunFault(who, t, f"its node {did} where its template did not: {text}")
-        if want is None:
-            return
-        got = [(b, v.hex()) for b, v in stepped(text, self.outputs[leaf])]
-        if got != want:
-            raise RunFault(who, t, diverged(leaf, got, want))
+        outputs = self.outputs[leaf]
+        got = stepped(text, outputs)
+        raise RunFault(who, t, diverged(leaf, got, stepped(want.split(" ", 2)[2], outputs)))
 
     def _seq(self) -> str:
         self.link.seq += 1
         return str(self.link.seq)
 
 
-def diverged(path: str, got: list[tuple[str, str]], want: list[tuple[str, str]]) -> str:
+def diverged(path: str, got: list[tuple[str, float]], want: list[tuple[str, float]]) -> str:
     """What a node published that its in-process template did not, in one line."""
 
-    def show(pairs: Sequence[tuple[str, str]]) -> str:
-        return ", ".join(f"{b.rpartition('.')[2]}={float.fromhex(v)!r}" for b, v in pairs) or (
-            "nothing"
-        )
+    def show(pairs: Sequence[tuple[str, float]]) -> str:
+        return ", ".join(f"{b.rpartition('.')[2]}={v!r}" for b, v in pairs) or "nothing"
 
     return (
         f"its node {names.ns(path)} published {show(got)} where its in-process template "
