@@ -234,6 +234,10 @@ def cmake_targets(graph: RosGraph, pkg: str, cpp: list[str]) -> Code:
         f"  target_link_libraries({lib} ${{roscpp_LIBRARIES}} ${{nodelet_LIBRARIES}})",
         f"  add_executable({names.CONTAINER} src/{names.CONTAINER}.cpp)",
         f"  target_link_libraries({names.CONTAINER} ${{roscpp_LIBRARIES}} ${{nodelet_LIBRARIES}})",
+        # amsa_leaves.cpp is the same in every package: it finds amsa_exit.h by this path
+        # (pkg is [A-Za-z][A-Za-z0-9_]*: cmake_arg leaves it unquoted, to append)
+        f"  target_include_directories({names.CONTAINER} PRIVATE"
+        f" ${{CMAKE_CURRENT_SOURCE_DIR}}/{cmake_arg(f'include/{pkg}')})",
         f"  install(TARGETS {lib} LIBRARY DESTINATION ${{CATKIN_PACKAGE_LIB_DESTINATION}})",
         f"  install(TARGETS {names.CONTAINER} RUNTIME DESTINATION"
         " ${CATKIN_PACKAGE_BIN_DESTINATION})",

@@ -218,6 +218,7 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
             "amsa_window.h",
             "amsa_container.h",
             "amsa_wiring.h",
+            "amsa_exit.h",
         ):
             files[f"include/{pkg}/{header}"] = (FILES / header).read_text()
     launches = []

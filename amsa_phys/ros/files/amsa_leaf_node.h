@@ -60,6 +60,7 @@
 #include <vector>
 
 #include "amsa_container.h"  // lockstep in the container: Dispatcher, ReadyBoard
+#include "amsa_exit.h"       // a failed Leaf's exit code for its process
 #include "amsa_wiring.h"     // the ports, parameters and ~amsa_wiring
 #include "amsa_pymath.h"     // Python's hypot and float % for the C++ bodies
 
@@ -281,6 +282,7 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
   void fail(const std::string& message) {
     std::fprintf(stderr, "error: %s: %s\n", getName().c_str(), message.c_str());
     NODELET_FATAL("%s", message.c_str());
+    setExitCode(2);  // bad configuration: the process exits 2, whoever hosts the Leaf
     ros::shutdown();
   }
 

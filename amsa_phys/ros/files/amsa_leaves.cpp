@@ -8,8 +8,12 @@
 // and a message between two Leaves of the process is handed over in memory (roscpp's
 // intra-process delivery) while still published on its topic for every other subscriber.
 // Being a manager, it also takes `nodelet load PKG/TEMPLATE /amsa_leaves` from others.
+// A Leaf that fails (at load, or later on its start-up thread: its readers never came)
+// shuts ROS down; the process then exits with the Leaf's code (2), not 0 (amsa_exit.h).
 #include <nodelet/loader.h>
 #include <ros/ros.h>
+
+#include "amsa_exit.h"  // include/PKG: a failed Leaf's exit code
 
 #include <cstdio>
 #include <set>
@@ -27,6 +31,7 @@ int fail(const std::string& message) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  amsa::hostReadsExitCode();  // before any thread: a failed Leaf leaves its code for below
   ros::init(argc, argv, "amsa_leaves");
   nodelet::Loader loader(true);
   XmlRpc::XmlRpcValue leaves;
@@ -60,5 +65,5 @@ int main(int argc, char** argv) {
     if (!ros::ok()) return 2;  // the Leaf said why (its parameters, its wiring)
   }
   ros::spin();
-  return 0;
+  return amsa::exitCode();  // 0, or 2 if a Leaf failed after its load (its start-up thread)
 }
