@@ -23,9 +23,6 @@ exact protocol (``pipeline:=false``) and free mode do.
 
 from __future__ import annotations
 
-import os
-import sys
-import time
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from fractions import Fraction
@@ -81,7 +78,6 @@ class Pipeline:
             )
             for p in graph.shared
         }
-        self.waited = 0.0  # seconds the engine waited for answers (AMSA_PIPELINE_STATS)
 
     # -- the engine's side ------------------------------------------------------------------
     def stepped(self, path: str, t: Fraction, inp: Mapping[str, Any], out: Any) -> None:
@@ -122,8 +118,6 @@ class Pipeline:
         """The run's end: every request sent, answered and checked."""
         self.send()
         self._take(lambda: not self.expected)
-        if os.environ.get("AMSA_PIPELINE_STATS"):
-            print(f"pipeline: waited {self.waited:.3f} s for answers", file=sys.stderr)
 
     # -- answers ----------------------------------------------------------------------------
     def on_answers(self, answers: list[tuple[str, str]]) -> None:
@@ -145,11 +139,9 @@ class Pipeline:
             if enough():
                 return
             oldest = min(self.expected.values(), key=lambda e: e[1])
-            t0 = time.perf_counter()
             self.link._wait(
                 lambda: bool(self.answers), names.CONTAINER, oldest[1], "pipelined answers"
             )
-            self.waited += time.perf_counter() - t0
 
     def _check(self, path: str, answer: str) -> None:
         """One node's answer against what its twin did, as text: a fault if they differ."""
