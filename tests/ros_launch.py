@@ -124,14 +124,17 @@ def launcher() -> Iterator[Callable[..., Launch]]:
         launch.proc.wait()
 
 
-def build_workspace(ws: Path, scenario: Path, pkg: str) -> Path:
+def build_workspace(ws: Path, scenario: Path, pkg: str, install: bool = False) -> Path:
     """``scenario`` exported as package ``pkg`` in ``ws/src``, built with catkin; ``ws``
-    gets ``launch.sh`` (``bash launch.sh NAME.launch ARGS``, run by :class:`Launch`)."""
+    gets ``launch.sh`` (``bash launch.sh NAME.launch ARGS``, run by :class:`Launch`), which
+    sources the devel space. ``install``: also ``catkin_make install`` (``ws/install``, the
+    space a workspace can be moved with)."""
     assert main(["export", "ros", str(scenario), "-o", str(ws / "src" / pkg)]) == 0
+    install_target = ["install"] if install else []
     t0 = time.perf_counter()
     build = subprocess.run(
         # Debian's python3 for catkin's own scripts (a venv's lacks catkin_pkg)
-        ["catkin_make", "-C", str(ws), "-DPYTHON_EXECUTABLE=/usr/bin/python3"],
+        ["catkin_make", *install_target, "-C", str(ws), "-DPYTHON_EXECUTABLE=/usr/bin/python3"],
         cwd=ws,
         capture_output=True,
         text=True,
@@ -148,6 +151,23 @@ def build_workspace(ws: Path, scenario: Path, pkg: str) -> Path:
         f'exec roslaunch {pkg} "$@"\n'
     )
     return ws
+
+
+@contextlib.contextmanager
+def package_edit(path: Path, text: str) -> Iterator[Path]:
+    """``path`` holds ``text`` inside the block; afterwards what it held before (or nothing,
+    if it did not exist), whether the block passed or failed. Tests edit a workspace shared
+    by the session (``ros_short_workspace`` in tests/e2e/conftest.py) this way, so that the
+    next test launches the package as it was built."""
+    before = path.read_text() if path.exists() else None
+    try:
+        path.write_text(text)
+        yield path
+    finally:
+        if before is None:
+            path.unlink(missing_ok=True)
+        else:
+            path.write_text(before)
 
 
 def metrics_without_wall(run_dir: Path) -> dict:
