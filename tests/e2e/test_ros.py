@@ -305,13 +305,14 @@ def test_a_moved_workspace_still_reproduces_the_run(
         f'exec roslaunch {PKG} "$@"\n'
     )
     out = moved / "run"
-    hidden = workspace.with_name(workspace.name + "-away")
-    workspace.rename(hidden)
+    made = workspace.resolve()  # the directory itself (workspace may be a link to it)
+    hidden = made.with_name(made.name + "-away")
+    made.rename(hidden)
     try:
         text = launcher(moved, "ros_short.launch", f"out:={out}", "plots:=false").finish()
-        assert not workspace.exists()
+        assert not made.exists()
     finally:
-        hidden.rename(workspace)
+        hidden.rename(made)
     assert "completed" in text, text[-3000:]
     assert (out / "trace.csv").read_bytes() == (reference / "trace.csv").read_bytes()
     assert _metrics(out) == _metrics(reference)
