@@ -48,6 +48,7 @@ def build_commands(
 class _Build:
     key: Key
     ws: Path
+    log: Path  # the commands' output, beside ws
     done: threading.Event = field(default_factory=threading.Event)
     urgent: bool = False  # a test waits for it: no lowered priority from now on
     error: str | None = None
@@ -58,11 +59,14 @@ class Prebuilder:
 
     def __init__(self, root: Path, wanted: list[Key]) -> None:
         self._lock = threading.Lock()
-        self._queue = [_Build(key, root / f"ws{i}") for i, key in enumerate(wanted)]
+        self._queue = [
+            _Build(key, root / f"ws{i}", root / f"ws{i}.log") for i, key in enumerate(wanted)
+        ]
         self._current: _Build | None = None
         self._finished: dict[Key, _Build] = {}
-        self._proc: subprocess.Popen[str] | None = None
+        self._proc: subprocess.Popen[bytes] | None = None
         self._stopped = False
+        self._halt = threading.Event()
         self._thread = threading.Thread(target=self._run, name="ros-prebuild", daemon=True)
 
     def start(self) -> None:
@@ -89,6 +93,9 @@ class Prebuilder:
                 with self._lock:
                     self._finished[build.key] = build
                 build.done.set()
+        # alive until the session ends, all builds done or not: a test that counts the
+        # process's threads around its work (test_gym_episode.py) must see the same number
+        self._halt.wait()
 
     def _execute(self, build: _Build, command: list[str], env: dict[str, str]) -> bool:
         """Run one command of ``build``; True when it failed (``build.error`` says how)."""
@@ -97,18 +104,20 @@ class Prebuilder:
                 build.error = "stopped before the end of the session's tests"
                 return True
             nice = [] if build.urgent else ["nice", "-n", "19"]
-            self._proc = subprocess.Popen(
-                [*nice, *command],
-                cwd=build.ws,
-                stdout=subprocess.PIPE,
-                stderr=subprocess.STDOUT,
-                text=True,
-                env=env,
-                start_new_session=True,  # its own process group: reniced or ended whole
-            )
-        output, _ = self._proc.communicate()
-        if self._proc.returncode != 0:
-            build.error = f"{' '.join(command)} failed ({self._proc.returncode}):\n{output[-3000:]}"
+            # output to a file, not a pipe: a process the tests fork meanwhile (a pool's
+            # worker) would inherit a pipe's open end and hold back its end of file
+            with build.log.open("a") as log:
+                self._proc = subprocess.Popen(
+                    [*nice, *command],
+                    cwd=build.ws,
+                    stdout=log,
+                    stderr=subprocess.STDOUT,
+                    env=env,
+                    start_new_session=True,  # its own process group: reniced or ended whole
+                )
+        if self._proc.wait() != 0:
+            output = build.log.read_text(errors="replace")[-3000:]
+            build.error = f"{' '.join(command)} failed ({self._proc.returncode}):\n{output}"
             return True
         return False
 
@@ -136,6 +145,7 @@ class Prebuilder:
         """End the build under way (its process group, by id) and drop the rest."""
         with self._lock:
             self._stopped = True
+            self._halt.set()
             self._queue.clear()
             if self._proc is not None and self._proc.poll() is None:
                 with contextlib.suppress(ProcessLookupError):
