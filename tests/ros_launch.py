@@ -22,8 +22,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
-
-from amsa_phys.cli.main import main
+import ros_prebuild
 
 LAUNCH_TIMEOUT = 120  # s of wall time before a launch is declared hung (and killed)
 
@@ -124,21 +123,31 @@ def launcher() -> Iterator[Callable[..., Launch]]:
         launch.proc.wait()
 
 
-def build_workspace(ws: Path, scenario: Path, pkg: str) -> Path:
+def build_workspace(ws: Path, scenario: Path, pkg: str, install: bool = False) -> Path:
     """``scenario`` exported as package ``pkg`` in ``ws/src``, built with catkin; ``ws``
-    gets ``launch.sh`` (``bash launch.sh NAME.launch ARGS``, run by :class:`Launch`)."""
-    assert main(["export", "ros", str(scenario), "-o", str(ws / "src" / pkg)]) == 0
+    gets ``launch.sh`` (``bash launch.sh NAME.launch ARGS``, run by :class:`Launch`), which
+    sources the devel space. ``install``: also ``catkin_make install`` (``ws/install``, the
+    space a workspace can be moved with). Where the session built the same in the background
+    (tests/ros_prebuild.py) and ``ws`` is new and empty, ``ws`` becomes a link to that build
+    (resolve it to reach the directory itself)."""
+    key = (scenario.resolve(), pkg, install)
+    fresh = not ws.exists() or (ws.is_dir() and not any(ws.iterdir()))
+    built = ros_prebuild.take(key) if fresh else None
     t0 = time.perf_counter()
-    build = subprocess.run(
-        # Debian's python3 for catkin's own scripts (a venv's lacks catkin_pkg)
-        ["catkin_make", "-C", str(ws), "-DPYTHON_EXECUTABLE=/usr/bin/python3"],
-        cwd=ws,
-        capture_output=True,
-        text=True,
-        env={**{k: v for k, v in os.environ.items() if k != "PYTHONPATH"}, "PWD": str(ws)},
-    )
-    assert build.returncode == 0, build.stdout[-3000:] + build.stderr[-3000:]
-    print(f"catkin_make: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
+    if built is not None:
+        assert built.error is None, built.error
+        if ws.exists():
+            ws.rmdir()
+        ws.parent.mkdir(parents=True, exist_ok=True)
+        ws.symlink_to(built.ws, target_is_directory=True)
+        waited = time.perf_counter() - t0
+        print(f"catkin_make: built in the background, waited {waited:.1f} s", file=sys.stderr)
+    else:
+        ws.mkdir(parents=True, exist_ok=True)
+        for command, env in ros_prebuild.build_commands(ws, *key):
+            done = subprocess.run(command, cwd=ws, capture_output=True, text=True, env=env)
+            assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+        print(f"catkin_make: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
     (ws / "launch.sh").write_text(
         "set -e\n"
         "ip link set lo up\n"  # the namespace's loopback: the only interface ROS sees
@@ -148,6 +157,23 @@ def build_workspace(ws: Path, scenario: Path, pkg: str) -> Path:
         f'exec roslaunch {pkg} "$@"\n'
     )
     return ws
+
+
+@contextlib.contextmanager
+def package_edit(path: Path, text: str) -> Iterator[Path]:
+    """``path`` holds ``text`` inside the block; afterwards what it held before (or nothing,
+    if it did not exist), whether the block passed or failed. Tests edit a workspace shared
+    by the session (``ros_short_workspace`` in tests/e2e/conftest.py) this way, so that the
+    next test launches the package as it was built."""
+    before = path.read_text() if path.exists() else None
+    try:
+        path.write_text(text)
+        yield path
+    finally:
+        if before is None:
+            path.unlink(missing_ok=True)
+        else:
+            path.write_text(before)
 
 
 def metrics_without_wall(run_dir: Path) -> dict:

@@ -1,6 +1,7 @@
 """``amsa-phys export ros`` for real: build with catkin, launch with roslaunch, compare.
 
-The package of a 30 s scenario1 (with timeline changes inside the run) is built once; then:
+The package of a 30 s scenario1 (with timeline changes inside the run) is built once for the
+session (``ros_short_workspace`` in conftest.py, shared with test_ros_boundary_stamps.py); then:
 lockstep reproduces ``amsa-phys run`` byte for byte (trace.csv, metrics.json but its wall
 time, scenario.yaml) and a bag of the Data topics holds the trace's values; free mode comes
 within stated bounds of the in-process metrics; Ctrl-C on roslaunch stops every process and
@@ -26,7 +27,7 @@ from pathlib import Path
 
 import pytest
 import ros_launch
-from ros_launch import Launch, build_workspace, ros_missing
+from ros_launch import Launch, package_edit, ros_missing
 
 from amsa_phys.cli.main import main
 from amsa_phys.model.scenario import load_scenario
@@ -48,9 +49,10 @@ launcher = ros_launch.launcher  # the fixture
 
 
 @pytest.fixture(scope="module")
-def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The exported package, built with catkin in a fresh workspace."""
-    return build_workspace(tmp_path_factory.mktemp("ws"), SCENARIO, PKG)
+def workspace(ros_short_workspace: Path) -> Path:
+    """The exported package, built (and installed) with catkin once for the session: a test
+    edits it only through ``package_edit`` and writes its outputs in its own ``tmp_path``."""
+    return ros_short_workspace
 
 
 @pytest.fixture(scope="module")
@@ -88,10 +90,10 @@ def _runs(values: list[float]) -> list[float]:
 
 
 def test_lockstep_reproduces_amsa_phys_run(
-    workspace: Path, reference: Path, launcher: Callable[..., Launch]
+    workspace: Path, reference: Path, launcher: Callable[..., Launch], tmp_path: Path
 ) -> None:
-    out = workspace / "lockstep"
-    bag = workspace / "lockstep.bag"
+    out = tmp_path / "lockstep"
+    bag = tmp_path / "lockstep.bag"
     t0 = time.perf_counter()
     launch = launcher(workspace, "ros_short.launch", f"out:={out}", "plots:=false", f"bag:={bag}")
     text = launch.finish()
@@ -128,9 +130,9 @@ def test_lockstep_reproduces_amsa_phys_run(
 
 
 def test_free_mode_metrics_within_bounds(
-    workspace: Path, reference: Path, launcher: Callable[..., Launch]
+    workspace: Path, reference: Path, launcher: Callable[..., Launch], tmp_path: Path
 ) -> None:
-    out = workspace / "free"
+    out = tmp_path / "free"
     t0 = time.perf_counter()
     launch = launcher(
         workspace, "ros_short.launch", f"out:={out}", "plots:=false", "mode:=free", "speed:=4"
@@ -174,9 +176,9 @@ def test_free_mode_metrics_within_bounds(
 
 
 def test_ctrl_c_stops_every_node_and_keeps_the_outputs(
-    workspace: Path, reference: Path, launcher: Callable[..., Launch]
+    workspace: Path, reference: Path, launcher: Callable[..., Launch], tmp_path: Path
 ) -> None:
-    out = workspace / "interrupted"
+    out = tmp_path / "interrupted"
     launch = launcher(
         workspace, "ros_short.launch", f"out:={out}", "plots:=false", "duration:=3600"
     )
@@ -222,12 +224,9 @@ def test_an_edited_params_file_is_what_runs_and_what_is_recorded(
         "MyFollowerController:\n  Kv: 0.1\n", "MyFollowerController:\n  Kv: 0.2\n"
     )
     assert edited != original
-    out = workspace / "edited"
-    params.write_text(edited)
-    try:
+    out = tmp_path / "edited"
+    with package_edit(params, edited):
         text = launcher(workspace, "ros_short.launch", f"out:={out}", "plots:=false").finish()
-    finally:
-        params.write_text(original)
     assert "completed" in text, text[-3000:]
     assert "MyFollowerController.Kv=0.2 (parameter server)" in text
     ref = tmp_path / "ref"
@@ -241,7 +240,7 @@ def test_duration_argument_cuts_the_run_as_run_duration_does(
 ) -> None:
     """``duration:=12.5`` stops inside phase 1: partial, its checks skipped, as ``run``
     (the ROS simulator had its own cut, which judged the cut phase as if complete)."""
-    out = workspace / "cut"
+    out = tmp_path / "cut"
     text = launcher(
         workspace, "ros_short.launch", f"out:={out}", "plots:=false", "duration:=12.5"
     ).finish()
@@ -255,11 +254,11 @@ def test_duration_argument_cuts_the_run_as_run_duration_does(
 
 
 def test_free_mode_live_edits_are_events_and_refused_ones_are_put_back(
-    workspace: Path, launcher: Callable[..., Launch]
+    workspace: Path, launcher: Callable[..., Launch], tmp_path: Path
 ) -> None:
     """A ``rosparam set`` of a node's parameter is an event of the run; a refused value does
     not stay on the parameter server. Waits for each effect, then stops with Ctrl-C."""
-    out = workspace / "live"
+    out = tmp_path / "live"
     launch = launcher(
         workspace,
         "ros_short.launch",
@@ -288,27 +287,16 @@ def test_free_mode_live_edits_are_events_and_refused_ones_are_put_back(
 
 
 def test_a_moved_workspace_still_reproduces_the_run(
-    tmp_path: Path, reference: Path, launcher: Callable[..., Launch]
+    workspace: Path, tmp_path: Path, reference: Path, launcher: Callable[..., Launch]
 ) -> None:
     """Issue 26: the package names no path of the machine that made it. Built and installed
-    (``catkin_make install``), the workspace is moved to another directory (the original
-    path is gone) and launched from there with the target's Python settings only: lockstep
-    still reproduces ``amsa-phys run`` byte for byte."""
-    ws = tmp_path / "made" / "ws"
-    assert main(["export", "ros", str(SCENARIO), "-o", str(ws / "src" / PKG)]) == 0
-    build = subprocess.run(
-        ["catkin_make", "install", "-C", str(ws), "-DPYTHON_EXECUTABLE=/usr/bin/python3"],
-        cwd=ws,
-        capture_output=True,
-        text=True,
-        env={**{k: v for k, v in os.environ.items() if k != "PYTHONPATH"}, "PWD": str(ws)},
-    )
-    assert build.returncode == 0, build.stdout[-3000:] + build.stderr[-3000:]
+    (``catkin_make install``: the session's workspace is), the workspace's sources and
+    install space are copied to another directory, the original workspace is gone (renamed
+    away for the launch, put back after it), and the copy is launched with the target's
+    Python settings only: lockstep still reproduces ``amsa-phys run`` byte for byte."""
     moved = tmp_path / "elsewhere" / "ws"
-    moved.parent.mkdir()
-    ws.rename(moved)
-    shutil.rmtree(moved / "build")  # only the installed package is used
-    shutil.rmtree(moved / "devel")
+    for space in ("src", "install"):  # only the installed package is used: no build, devel
+        shutil.copytree(workspace / space, moved / space, symlinks=True)
     (moved / "launch.sh").write_text(
         "set -e\nip link set lo up\n"
         f"export ROS_LOG_DIR={moved}/roshome/log ROS_MASTER_URI=http://localhost:11311\n"
@@ -317,9 +305,15 @@ def test_a_moved_workspace_still_reproduces_the_run(
         f'exec roslaunch {PKG} "$@"\n'
     )
     out = moved / "run"
-    text = launcher(moved, "ros_short.launch", f"out:={out}", "plots:=false").finish()
+    made = workspace.resolve()  # the directory itself (workspace may be a link to it)
+    hidden = made.with_name(made.name + "-away")
+    made.rename(hidden)
+    try:
+        text = launcher(moved, "ros_short.launch", f"out:={out}", "plots:=false").finish()
+        assert not made.exists()
+    finally:
+        hidden.rename(made)
     assert "completed" in text, text[-3000:]
-    assert not (tmp_path / "made" / "ws").exists()
     assert (out / "trace.csv").read_bytes() == (reference / "trace.csv").read_bytes()
     assert _metrics(out) == _metrics(reference)
 
@@ -350,7 +344,7 @@ while not rospy.is_shutdown():
 
 
 def test_free_mode_waits_for_a_user_node_by_its_topics(
-    workspace: Path, reference: Path, launcher: Callable[..., Launch]
+    workspace: Path, reference: Path, launcher: Callable[..., Launch], tmp_path: Path
 ) -> None:
     """Issue 26: a node that does not announce itself on /amsa/ready made a free-mode run
     abort after 120 s. Here a user's monitor node replaces the generated one; the run starts
@@ -358,8 +352,6 @@ def test_free_mode_waits_for_a_user_node_by_its_topics(
     pkg = workspace / "src" / PKG
     script = pkg / "user_monitor.py"
     launch_file = pkg / "launch" / "ros_short_user.launch"
-    script.write_text(USER_MONITOR)
-    script.chmod(0o755)
     original = (pkg / "launch" / "ros_short.launch").read_text()
     # the Leaf's nodes (a C++ one alone with cpp_container:=false, its Python twin with
     # cpp:=false) give way to the user's node, and the Leaf leaves the C++ container's list
@@ -375,9 +367,12 @@ def test_free_mode_waits_for_a_user_node_by_its_topics(
     assert alone + py in original
     assert hosted in original
     user = original.replace(alone + py, f'  <node {common} type="user_monitor.py"/>')
-    launch_file.write_text(user.replace(hosted, '"FollowerCompass", '))
-    out = workspace / "user-node"
-    try:
+    out = tmp_path / "user-node"
+    with (
+        package_edit(script, USER_MONITOR),
+        package_edit(launch_file, user.replace(hosted, '"FollowerCompass", ')),
+    ):
+        script.chmod(0o755)
         launch = launcher(
             workspace,
             "ros_short_user.launch",
@@ -387,9 +382,6 @@ def test_free_mode_waits_for_a_user_node_by_its_topics(
             "speed:=4",
         )
         text = launch.finish()
-    finally:
-        script.unlink()
-        launch_file.unlink()
     assert "running ros_short (free)" in text, text[-3000:]
     assert "completed" in text, text[-3000:]
     free, ref = _metrics(out), _metrics(reference)
@@ -397,24 +389,15 @@ def test_free_mode_waits_for_a_user_node_by_its_topics(
         assert abs(free["overall"][key] - ref["overall"][key]) < bound, key
 
 
-def _edited_params(workspace: Path, old: str, new: str) -> tuple[Path, str]:
-    """The package's params file with ``old`` replaced by ``new``; (file, original text)."""
-    params = workspace / "src" / PKG / "config" / "ros_short_params.yaml"
-    original = params.read_text()
-    assert old in original
-    params.write_text(original.replace(old, new))
-    return params, original
-
-
 def test_run_lockstep_exits_with_the_runs_verdict(
-    workspace: Path, launcher: Callable[..., Launch]
+    workspace: Path, launcher: Callable[..., Launch], tmp_path: Path
 ) -> None:
     """roslaunch exits 0 whatever the run's checks say; ``rosrun PKG run_lockstep`` exits 0
     when every expectation passes, 1 when one fails (here the leader cruises at 70 % in
     phase 0, edited in the params file, and the follower falls 25 m behind), 2 when the run
     does not even start (an out:= directory amsa-phys did not make)."""
-    checked = workspace / "checked"
-    checked.mkdir(exist_ok=True)
+    checked = tmp_path / "checked"
+    checked.mkdir()
     script = (workspace / "launch.sh").read_text()
     assert f'exec roslaunch {PKG} "$@"' in script
     (checked / "launch.sh").write_text(  # run from checked/, as a user from their shell
@@ -426,13 +409,13 @@ def test_run_lockstep_exits_with_the_runs_verdict(
     assert passing.proc.returncode == 0, text[-3000:]
     assert "run_lockstep: pass: 1 expectation passed" in text
     assert len(list((checked / "runs").glob("ros_short-*/metrics.json"))) == 1
-    params, original = _edited_params(workspace, "  cruisePower: 7.0\n", "  cruisePower: 70.0\n")
-    try:
+    params = workspace / "src" / PKG / "config" / "ros_short_params.yaml"
+    original = params.read_text()
+    assert "  cruisePower: 7.0\n" in original
+    with package_edit(params, original.replace("  cruisePower: 7.0\n", "  cruisePower: 70.0\n")):
         out = checked / "failing"
         failing = launcher(checked, "ros_short", f"out:={out}", "plots:=false")
         text = failing.finish()
-    finally:
-        params.write_text(original)
     assert failing.proc.returncode == 1, text[-3000:]
     assert "expect max_distance (phase 0) = 25.28, below 17: FAIL" in text
     assert "run_lockstep: FAIL: 1 of 1 expectation failed" in text
@@ -443,12 +426,12 @@ def test_run_lockstep_exits_with_the_runs_verdict(
 
 
 def test_a_simulator_that_cannot_start_is_the_one_error(
-    workspace: Path, launcher: Callable[..., Launch]
+    workspace: Path, launcher: Callable[..., Launch], tmp_path: Path
 ) -> None:
     """No AMSA_PHYS_PYTHON (amsa-phys not in ROS's python3): every Python node would say so;
     the simulator alone does, and roslaunch stops the rest without a word of theirs."""
-    bare = workspace / "bare"
-    bare.mkdir(exist_ok=True)
+    bare = tmp_path / "bare"
+    bare.mkdir()
     script = (workspace / "launch.sh").read_text()
     (bare / "launch.sh").write_text("unset AMSA_PHYS_PYTHON\n" + script)
     text = launcher(bare, "ros_short.launch", "plots:=false").finish()
@@ -469,11 +452,8 @@ def test_a_leaf_without_simulator_says_what_it_waited_for(
     nosim = re.sub(r'  <node [^>]*type="amsa_scenario.py"[^>]*/>\n', "", nosim)
     assert "amsa_simulator.py" not in nosim
     assert "amsa_scenario.py" not in nosim
-    (launch_dir / "ros_short_nosim.launch").write_text(nosim)
-    try:
+    with package_edit(launch_dir / "ros_short_nosim.launch", nosim):
         text = launcher(workspace, "ros_short_nosim.launch", "timeout:=1").finish()
-    finally:
-        (launch_dir / "ros_short_nosim.launch").unlink()
     # the first C++ Leaf to give up ends its process (a required node), and the launch
     found = re.search(
         r"error: (/\w+): gave up after (\d+\.\d) s waiting for the readers of (.*)", text

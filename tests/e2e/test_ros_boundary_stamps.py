@@ -10,8 +10,10 @@ in the in-process MCAP bag of the same scenario and seed (``amsa-phys run --bag`
 stamps are each Leaf's step time): the message with that stamp on that topic must hold the
 same values, and stamps strictly increase per topic (per robot frame on ``/tf``).
 Mutation-checked: the boundary stamping with ``rospy.Time.now()`` again (``/clock``) fails
-it. Both bags are read with ``rosbags``. Skipped, with the reason, where ROS, catkin,
-unshare or root is missing.
+it. Both bags are read with ``rosbags``. The package is the session's build of
+``ros_short.yaml`` (``ros_short_workspace`` in conftest.py, shared with test_ros.py): the
+test's launch file is removed after it, its outputs are in its own directory. Skipped, with
+the reason, where ROS, catkin, unshare or root is missing.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from typing import Any
 
 import pytest
 import ros_launch
-from ros_launch import Launch, build_workspace, ros_missing
+from ros_launch import Launch, package_edit, ros_missing
 from rosbags.highlevel import AnyReader
 
 import amsa_phys as ap
@@ -113,29 +115,30 @@ def _read(bag: Path) -> Keyed:
 
 
 def test_lockstep_boundary_stamps_are_the_instants_of_their_values(
-    tmp_path_factory: pytest.TempPathFactory, launcher: Callable[..., Launch]
+    ros_short_workspace: Path, tmp_path: Path, launcher: Callable[..., Launch]
 ) -> None:
-    ref = tmp_path_factory.mktemp("ref")
+    ref = tmp_path / "ref"
+    ref.mkdir()
     ap.run(SCENARIO, bag=ref / "run.mcap")
     expected = _read(ref / "run.mcap")
     topics = sorted({topic for topic, _ in expected} | {"/tf"})
-    ws = build_workspace(tmp_path_factory.mktemp("ws"), SCENARIO, PKG)
-    recorded = ws / "boundary.bag"
+    ws = ros_short_workspace
+    recorded = tmp_path / "boundary.bag"
     launch_dir = ws / "src" / PKG / "launch"
-    (ws / "wait_recorder.py").write_text(WAIT_RECORDER)
+    (tmp_path / "wait_recorder.py").write_text(WAIT_RECORDER)
     original = (launch_dir / "ros_short.launch").read_text()
     simulator = 'type="amsa_simulator.py" name="amsa_simulator"'
     assert original.count(simulator) == 1
-    prefix = f"/usr/bin/python3 {ws / 'wait_recorder.py'} {' '.join(topics)} --"
+    prefix = f"/usr/bin/python3 {tmp_path / 'wait_recorder.py'} {' '.join(topics)} --"
     launch = original.replace(simulator, f'{simulator} launch-prefix="{prefix}"').replace(
         "</launch>",
         '  <node pkg="rosbag" type="record" name="stamps_bag"'
         f' args="-O {recorded} --tcpnodelay {" ".join(topics)}"/>\n</launch>',
     )
-    (launch_dir / "stamps.launch").write_text(launch)
     # in lockstep the boundary runs when asked
-    args = (f"out:={ws / 'lockstep'}", "plots:=false", "boundary:=true")
-    text = launcher(ws, "stamps.launch", *args).finish()
+    args = (f"out:={tmp_path / 'lockstep'}", "plots:=false", "boundary:=true")
+    with package_edit(launch_dir / "stamps.launch", launch):
+        text = launcher(ws, "stamps.launch", *args).finish()
     assert "completed" in text, text[-3000:]
     got = _read(recorded)
     assert set(got) == set(expected), (sorted(got), sorted(expected))
