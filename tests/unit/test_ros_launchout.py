@@ -10,8 +10,10 @@ exception's ``...Error: `` nor a line that merely mentions an error. The e2e tes
 
 from __future__ import annotations
 
+import contextlib
 import os
 import pty
+import signal
 import subprocess
 import sys
 import textwrap
@@ -108,3 +110,42 @@ def test_the_launch_gets_a_terminal_where_the_user_has_one() -> None:
     assert err.decode().splitlines() == ["error: x", "isatty True"]
     assert shown.startswith("\x1b[1mstarted roslaunch server\x1b[0m\npartial line without")
     assert shown.rstrip().endswith("verdict 3 see the error above (x)")
+
+
+WAITS_FOR_CTRL_C = textwrap.dedent(
+    """
+    import signal, sys
+    def stop(*_):
+        print("stopped by SIGINT", flush=True)
+        sys.exit(0)
+    signal.signal(signal.SIGINT, stop)
+    print("ready", flush=True)
+    while True:
+        signal.pause()
+    """
+)
+
+
+def test_sigterm_to_the_script_stops_the_launch_as_ctrl_c() -> None:
+    """A CI's timeout that sends SIGTERM to ``run_lockstep`` alone: roslaunch gets the
+    SIGINT that stops a launch cleanly, its last words still pass through, and the script
+    goes on to its verdict (it used to leave roslaunch running, orphaned)."""
+    script = (
+        "import os, sys\n"
+        "from amsa_phys.ros.runtime.launchout import run\n"
+        f"code, seen = run([sys.executable, '-c', {WAITS_FOR_CTRL_C!r}], dict(os.environ))\n"
+        "print('verdict', code, flush=True)\n"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, start_new_session=True
+    )
+    try:
+        assert proc.stdout is not None
+        assert proc.stdout.readline() == "ready\n"
+        proc.send_signal(signal.SIGTERM)
+        out, _ = proc.communicate(timeout=60)
+    finally:  # the stand-in too, whatever happened
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert out == "stopped by SIGINT\nverdict 0\n"
+    assert proc.returncode == 0

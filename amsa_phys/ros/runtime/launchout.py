@@ -24,6 +24,7 @@ import fcntl
 import os
 import pty
 import re
+import signal
 import subprocess
 import sys
 import termios
@@ -152,7 +153,17 @@ def run(argv: list[str], env: dict[str, str]) -> tuple[int, Seen]:
     ]
     for reader in readers:
         reader.start()
-    code = proc.wait()
+    # SIGTERM to this script alone (a CI's timeout) would leave roslaunch writing into a
+    # closed pipe: it is passed on as the Ctrl-C that stops a launch cleanly, and the verdict
+    # follows (130 when the simulator says "interrupted")
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, lambda *_: proc.send_signal(signal.SIGINT))
+    try:
+        code = proc.wait()
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     for reader in readers:
         reader.join(DRAIN_S)
     return code, seen
