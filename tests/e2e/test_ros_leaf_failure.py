@@ -9,6 +9,12 @@ always did, so roslaunch reported "process has finished cleanly". And the launch
 at once (every Leaf process is ``required``), not when some timeout runs out:
 ``rosrun PKG run_lockstep`` then exits 2.
 
+The Python nodes stopped while they start (the simulator, the scenario node) say nothing, and
+``run_lockstep``'s last line names the Leaf's error. Mutation-checked: without the node
+script's start-up handler (``files/node.py.in``) the bad-parameter cases fail on the
+KeyboardInterrupt traceback; with ``run_lockstep`` not passing what it saw to ``judge``, on
+the last line.
+
 One build of ``tests/fixtures/ros_short.yaml`` serves every case. Mutation-checked: with
 ``amsa_leaves``' main returning 0 after ``ros::spin()`` the container's start-up-thread case
 fails (exit code 0); without ``amsa_exit.h``'s exit handler both ``nodelet standalone``
@@ -97,7 +103,19 @@ def test_a_bad_parameter_fails_the_leaf_process_and_run_lockstep(
     assert text.count(BAD_KV) == 1, text[-3000:]
     process = "amsa_leaves" if container == "true" else "MyFollowerController"
     assert _first_death(text) == (process, "2"), text[-3000:]
-    assert f"run_lockstep: no run in {out}" in text
+    # the Leaf's line is the one error: the Python nodes roslaunch stopped while they were
+    # starting end at once and quietly (no KeyboardInterrupt traceback, no node that only
+    # roslaunch's SIGTERM or SIGKILL ends), and run_lockstep's last line names the cause
+    assert "Traceback" not in text, text[-3000:]
+    assert "escalating to SIGTERM" not in text, text[-3000:]
+    # (the simulator, if it got as far as reading the parameters, says Kv is out of range
+    # too: the Leaf's line is still the first)
+    last = (
+        re.escape(f"run_lockstep: no run in {out} (metrics.json missing): the run did not start: ")
+        + r"see the (?:error above \(|\d errors above \(the first: )"
+    )
+    last += re.escape(f"{BAD_KV.removeprefix('error: ')})")
+    assert re.fullmatch(last, text.rstrip().splitlines()[-1]), text[-3000:]
     _no_crash(text)
 
 

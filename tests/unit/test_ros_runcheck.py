@@ -7,11 +7,15 @@ the e2e test (``tests/e2e/test_ros.py``) launches the script for real.
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
 from amsa_phys.cli.main import main
+from amsa_phys.ros.runtime.launchout import Seen
 from amsa_phys.ros.runtime.runcheck import judge, launch_args
 
 SCENARIO = Path(__file__).resolve().parent.parent / "fixtures" / "ros_short.yaml"
@@ -62,3 +66,55 @@ def test_launch_arguments_default_to_lockstep_and_an_absolute_out(
     assert args[-1] == f"out:={out}"
     args, out = launch_args("s1.launch", ["mode:=free", "out:=rel"])
     assert args == ["mode:=free", f"out:={tmp_path / 'rel'}"]  # the node runs in ROS_HOME
+
+
+def test_a_run_that_did_not_start_names_the_error_above(tmp_path: Path) -> None:
+    seen = Seen()
+    seen.note("error: /MyFollowerController: /MyFollowerController/Kv: -5 is below the minimum 0")
+    code, lines = judge(tmp_path, seen)
+    assert code == 2
+    assert lines == [
+        f"run_lockstep: no run in {tmp_path} (metrics.json missing): the run did not start: "
+        "see the error above (/MyFollowerController: /MyFollowerController/Kv: -5 is below "
+        "the minimum 0)"
+    ]
+
+
+FAKE_ROSLAUNCH = """#!{python}
+import sys
+print("... logging to /tmp/x", flush=True)
+print("error: /Leaf: {error}", file=sys.stderr, flush=True)
+print("REQUIRED process [amsa_leaves-4] has died!", flush=True)
+sys.exit({code})
+"""
+
+
+@pytest.mark.parametrize("code", [0, 1])
+def test_run_lockstep_last_line_is_the_cause(tmp_path: Path, code: int) -> None:
+    """The script itself, with a stand-in for roslaunch that fails the way a Leaf that
+    refuses its parameters makes it fail: exit 2, and the last line names the Leaf's error
+    (roslaunch's own exit code, if not 0, the line before)."""
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    fake = bin_dir / "roslaunch"
+    fake.write_text(
+        FAKE_ROSLAUNCH.format(python=sys.executable, error="Kv out of range", code=code)
+    )
+    fake.chmod(0o755)
+    out = tmp_path / "out"
+    script = "from amsa_phys.ros.runtime.runcheck import main; main('pkg')"
+    done = subprocess.run(
+        [sys.executable, "-c", script, "s1.launch", f"out:={out}"],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PATH": f"{bin_dir}{os.pathsep}{os.environ['PATH']}"},
+    )
+    assert done.returncode == 2, done.stderr
+    assert "... logging to /tmp/x" in done.stdout  # roslaunch's output passed through
+    lines = done.stderr.splitlines()
+    assert lines[0] == "error: /Leaf: Kv out of range"
+    assert lines[-1] == (
+        f"run_lockstep: no run in {out} (metrics.json missing): the run did not start: "
+        "see the error above (/Leaf: Kv out of range)"
+    )
+    assert (lines[-2] == "run_lockstep: roslaunch exited with 1") == (code == 1)

@@ -29,7 +29,7 @@ from typing import Any
 from ...engine.adapt import AdaptRules
 from ...errors import AmsaError
 from .. import names
-from . import notready, rosio
+from . import notready, rosio, startup
 from .config import load_config
 
 #: The node's name (a Leaf cannot take it: ``names.RESERVED``).
@@ -131,7 +131,7 @@ class AdaptNode:
 def main() -> None:
     """The adapt node's entry point."""
     rospy = rosio.ros()
-    rospy.init_node(NODE)
+    startup.init_node(rospy, NODE)
     try:
         node = AdaptNode(rospy)
         if node.lockstep:
@@ -145,6 +145,7 @@ def main() -> None:
     except AmsaError as exc:
         rosio.fail(rospy, f"{NODE}: {exc}")
         return
+    startup.started(rospy)
     rospy.spin()
     if node.lockstep:
         del keep

@@ -39,7 +39,7 @@ from ...stdmsgs.build import static_transform, transform
 from .. import names
 from ..boundary import NODE, SIM_PARAM, plan
 from ..graph import RosGraph
-from . import rosio
+from . import rosio, startup
 from .arrays import ScanShape, array_msg, fit_scan, pack, unpack
 from .config import load_config
 
@@ -335,7 +335,7 @@ def read_fields(
 def main() -> None:
     """The boundary node's entry point."""
     rospy = rosio.ros()
-    rospy.init_node(NODE)
+    startup.init_node(rospy, NODE)
     try:
         node = BoundaryNode(rospy)
         speed = float(rospy.get_param("~speed", 1.0))
@@ -344,6 +344,7 @@ def main() -> None:
     except AmsaError as exc:
         rosio.fail(rospy, f"{NODE}: {exc}")
         return
+    startup.started(rospy)
     if node.sim:
         try:
             node.listen()

@@ -41,7 +41,7 @@ from ...errors import AmsaError, ConfigError
 from .. import names
 from ..boundary import SIM_PARAM
 from ..graph import NodeContext
-from . import notready, rosio
+from . import notready, rosio, startup
 from .arrays import array_msg, pack, unpack
 from .config import load_config
 
@@ -293,7 +293,7 @@ def _same(a: Any, b: Any) -> bool:
 def main(path: str) -> None:
     """The node's entry point (the generated script calls it)."""
     rospy = rosio.ros()
-    rospy.init_node(path.rpartition(".")[2])
+    startup.init_node(rospy, path.rpartition(".")[2])
     try:
         node = LeafNode(rospy, path)
         started = time.monotonic()
@@ -306,6 +306,7 @@ def main(path: str) -> None:
     except AmsaError as exc:
         rosio.fail(rospy, f"{path}: {exc}")
         return
+    startup.started(rospy)
     if node.cfg.mode == "free":
         node.run_free()
     else:

@@ -8,8 +8,12 @@ arguments given (``mode:=lockstep`` unless ``mode:=`` is one of them, and ``out:
 ``runs/SCENARIO-STAMP`` in the current directory unless given), then judges the run directory
 the simulator wrote, exactly as ``amsa-phys run`` judges its own: the expectations of the
 run's ``scenario.yaml`` against its ``metrics.json`` and ``trace.csv``. Exit 0: every check
-passed; 1: a check failed; 2: the run faulted or wrote nothing (the simulator says why, above);
-130: interrupted.
+passed; 1: a check failed; 2: the run faulted or wrote nothing; 130: interrupted.
+
+roslaunch's output passes through this script (``launchout``), which notes its ``error: ``
+lines: when the run did not start, the last line names the first of them (the node that
+refused to start and why), as the cause the user would otherwise look for among
+roslaunch's screens.
 """
 
 from __future__ import annotations
@@ -18,7 +22,6 @@ import json
 import os
 import shutil
 import signal
-import subprocess
 import sys
 from pathlib import Path
 
@@ -28,15 +31,18 @@ from ...model.wording import plural
 from ...runs.expect import check_expectations
 from ...runs.rundir import default_run_dir
 from ..names import RUN_LOCKSTEP as SCRIPT
+from . import launchout
 
 USAGE = f"usage: rosrun PKG {SCRIPT} SCENARIO.launch [arg:=value ...]"
 
 
-def judge(out: Path) -> tuple[int, list[str]]:
-    """The exit code of the run in ``out`` and the lines that say why."""
+def judge(out: Path, seen: launchout.Seen | None = None) -> tuple[int, list[str]]:
+    """The exit code of the run in ``out`` and the lines that say why; ``seen``: what the
+    launch printed, to say why a run did not start."""
     metrics_file = out / "metrics.json"
     if not metrics_file.is_file():
-        return 2, [f"{SCRIPT}: no run in {out} (metrics.json missing): the run did not start"]
+        why = f": {seen.cause()}" if seen is not None else ""
+        return 2, [f"{SCRIPT}: no run in {out} (metrics.json missing): the run did not start{why}"]
     metrics = json.loads(metrics_file.read_text())
     status = str(metrics.get("status", ""))
     if status == "interrupted":
@@ -99,13 +105,13 @@ def main(pkg: str) -> None:
     before = _stamp(out / "metrics.json")  # a former run's (force:=true): not this run's
     # the nodes start afresh: this script's own re-execution (AMSA_PHYS_PYTHON) is not theirs
     env = {k: v for k, v in os.environ.items() if k != "AMSA_PHYS_REEXEC"}
-    done = subprocess.run([roslaunch, pkg, launch, *args], check=False, env=env)
+    returncode, seen = launchout.run([roslaunch, pkg, launch, *args], env)
     if before is not None and _stamp(out / "metrics.json") == before:
-        code, lines = 2, [f"{SCRIPT}: the run wrote no new metrics.json in {out}"]
+        code, lines = 2, [f"{SCRIPT}: the run wrote no new metrics.json in {out}: {seen.cause()}"]
     else:
-        code, lines = judge(out)
-    if code == 2 and done.returncode not in (0, None):
-        lines.append(f"{SCRIPT}: roslaunch exited with {done.returncode}")
+        code, lines = judge(out, seen)
+    if code == 2 and returncode != 0:  # before the verdict: the last line says why
+        lines.insert(-1, f"{SCRIPT}: roslaunch exited with {returncode}")
     for line in lines:
         print(line, file=sys.stdout if code == 0 else sys.stderr, flush=True)
     sys.exit(code)

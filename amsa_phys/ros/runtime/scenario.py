@@ -14,14 +14,14 @@ from typing import Any
 
 from ...errors import AmsaError
 from .. import names
-from . import notready, rosio
+from . import notready, rosio, startup
 from .config import load_config
 
 
 def main() -> None:
     """The scenario node's entry point."""
     rospy = rosio.ros()
-    rospy.init_node(names.SCENARIO)
+    startup.init_node(rospy, names.SCENARIO)
     _, String, _ = rosio.msgs()
     try:
         cfg = load_config(rospy)
@@ -38,6 +38,7 @@ def main() -> None:
     if missing:
         rosio.fail(rospy, notready.message(names.SCENARIO, gate, started))
     keep: Any = rosio.announce_ready(rospy, names.SCENARIO)
+    startup.started(rospy)
     for k, phase in enumerate(cfg.scenario.phases[1:], start=1):
         if not clock.wait_until(rosio.to_ns(phase.at)):
             return

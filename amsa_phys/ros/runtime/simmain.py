@@ -19,7 +19,7 @@ from ...runs.expect import check_expectations
 from ...runs.rundir import default_run_dir, prepare_run_dir
 from ...runs.single import run_scenario
 from .. import names
-from . import adaptlink, ending, records, rosio
+from . import adaptlink, ending, records, rosio, startup
 from .config import load_config
 from .rossim import RosSimulation
 from .simulator import Link
@@ -57,6 +57,7 @@ def main() -> None:
             f"{scenario.name} ({cfg.mode}{', pipelined' if cfg.pipeline else ''})",
             flush=True,
         )
+        startup.started()  # Ctrl-C and SIGTERM: the engine's, through the run
         with interrupt.sigterm_as_ctrl_c():
             outcome = run_scenario(
                 scenario,
