@@ -158,7 +158,8 @@ def launch(ws: Path, launch_file: str, *args: str) -> tuple[float, float, int, s
 
 #: The floor of lockstep: a rover driven by two C++ Leaves of the container (a constant power
 #: and an actuator chained on it) at scenario1's 4 Hz, so one wait an instant as scenario1
-#: has at best, and next to nothing else: what a lockstep instant costs on this machine
+#: has at best, and next to nothing else: what a lockstep instant that waits for its answers
+#: (``pipeline:=false``) costs on this machine
 #: beyond the in-process loop (a request, the container's steps and the answer, through
 #: rospy and roscpp over loopback TCP)
 FLOOR_WORLD = """\
@@ -194,7 +195,14 @@ def floor(root: Path, duration: str, repeat: int) -> None:
             assert main([*argv, "--force"]) == 0
         loop = json.loads((ref / "metrics.json").read_text())["wall_time_s"]
         _, run, _, _ = launch(
-            ws, "floor.launch", f"out:={ws / 'out'}", "plots:=false", "force:=true"
+            # the exact protocol: pipelined (the default here, every Leaf in the container)
+            # waits for no instant, so it would measure no round trip
+            ws,
+            "floor.launch",
+            f"out:={ws / 'out'}",
+            "plots:=false",
+            "force:=true",
+            "pipeline:=false",
         )
         instants = 4 * float(duration)
         print(
