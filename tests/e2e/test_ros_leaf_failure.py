@@ -30,10 +30,9 @@ from pathlib import Path
 
 import pytest
 import ros_launch
-from ros_launch import Launch, build_workspace, ros_missing
+from ros_launch import Launch, package_edit, ros_missing
 
 ROOT = Path(__file__).resolve().parent.parent.parent
-SCENARIO = ROOT / "tests" / "fixtures" / "ros_short.yaml"
 PKG = "mdeChallenge"
 BAD_KV = "error: /MyFollowerController: /MyFollowerController/Kv: -5 is below the minimum 0"
 
@@ -42,17 +41,23 @@ launcher = ros_launch.launcher  # the fixture
 
 
 @pytest.fixture(scope="module")
-def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The exported package, built with catkin in a fresh workspace; ``checked/launch.sh``
-    runs ``rosrun PKG run_lockstep`` instead of roslaunch (as a CI would)."""
-    ws = build_workspace(tmp_path_factory.mktemp("ws"), SCENARIO, PKG)
-    script = (ws / "launch.sh").read_text()
+def workspace(ros_short_workspace: Path) -> Path:
+    """The session's build of ros_short (tests/e2e/conftest.py), edited only through
+    ``package_edit``."""
+    return ros_short_workspace
+
+
+@pytest.fixture(scope="module")
+def checked(workspace: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A directory whose ``launch.sh`` runs ``rosrun PKG run_lockstep`` instead of roslaunch
+    (as a CI would) on the session's workspace."""
+    script = (workspace / "launch.sh").read_text()
     assert f'exec roslaunch {PKG} "$@"' in script
-    (ws / "checked").mkdir()
-    (ws / "checked" / "launch.sh").write_text(
+    checked = tmp_path_factory.mktemp("checked")
+    (checked / "launch.sh").write_text(
         script.replace(f'exec roslaunch {PKG} "$@"', f'exec rosrun {PKG} run_lockstep "$@"')
     )
-    return ws
+    return checked
 
 
 def _first_death(text: str) -> tuple[str, str]:
@@ -76,7 +81,11 @@ def _no_crash(text: str) -> None:
 
 @pytest.mark.parametrize("container", ["true", "false"])
 def test_a_bad_parameter_fails_the_leaf_process_and_run_lockstep(
-    workspace: Path, launcher: Callable[..., Launch], container: str
+    workspace: Path,
+    checked: Path,
+    launcher: Callable[..., Launch],
+    container: str,
+    tmp_path: Path,
 ) -> None:
     """Kv out of range in the params file: the C++ controller refuses it at load, its
     process (the container, or its own ``nodelet standalone``) exits 2, the launch ends,
@@ -85,11 +94,10 @@ def test_a_bad_parameter_fails_the_leaf_process_and_run_lockstep(
     params = workspace / "src" / PKG / "config" / "ros_short_params.yaml"
     original = params.read_text()
     assert original.count("  Kv: 0.1\n") == 1
-    params.write_text(original.replace("  Kv: 0.1\n", "  Kv: -5.0\n"))
-    try:
-        out = workspace / f"bad-{container}"
+    with package_edit(params, original.replace("  Kv: 0.1\n", "  Kv: -5.0\n")):
+        out = tmp_path / f"bad-{container}"
         launch = launcher(
-            workspace / "checked",
+            checked,
             "ros_short.launch",
             f"out:={out}",
             "plots:=false",
@@ -97,8 +105,6 @@ def test_a_bad_parameter_fails_the_leaf_process_and_run_lockstep(
             f"cpp_container:={container}",
         )
         text = launch.finish()
-    finally:
-        params.write_text(original)
     assert launch.proc.returncode == 2, text[-3000:]
     assert text.count(BAD_KV) == 1, text[-3000:]
     process = "amsa_leaves" if container == "true" else "MyFollowerController"
@@ -133,12 +139,9 @@ def test_a_leaf_failing_on_its_start_up_thread_fails_its_process(
     assert "amsa_simulator.py" not in nosim
     assert "amsa_scenario.py" not in nosim
     name = f"ros_short_nosim_{container}.launch"
-    (launch_dir / name).write_text(nosim)
-    try:
+    with package_edit(launch_dir / name, nosim):
         launch = launcher(workspace, name, "timeout:=0.5", f"cpp_container:={container}")
         text = launch.finish()
-    finally:
-        (launch_dir / name).unlink()
     assert launch.proc.returncode == 0  # roslaunch's own: 0 whatever its nodes did
     gave_up = re.findall(r"error: /(\w+): gave up after \d+\.\d s waiting for the readers of", text)
     assert gave_up, text[-3000:]

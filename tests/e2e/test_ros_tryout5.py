@@ -21,10 +21,9 @@ from pathlib import Path
 
 import pytest
 import ros_launch
-from ros_launch import Launch, build_workspace, ros_missing
+from ros_launch import Launch, package_edit, ros_missing
 
 ROOT = Path(__file__).resolve().parent.parent.parent
-SCENARIO = ROOT / "tests" / "fixtures" / "ros_short.yaml"
 PKG = "mdeChallenge"
 
 pytestmark = pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing()))
@@ -32,31 +31,34 @@ launcher = ros_launch.launcher  # the fixture
 
 
 @pytest.fixture(scope="module")
-def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The exported package, built once; ``checked/launch.sh`` runs ``rosrun PKG
-    run_lockstep`` instead of roslaunch, from ``checked/``."""
-    ws = build_workspace(tmp_path_factory.mktemp("ws"), SCENARIO, PKG)
-    checked = ws / "checked"
-    checked.mkdir()
-    script = (ws / "launch.sh").read_text()
+def workspace(ros_short_workspace: Path) -> Path:
+    """The session's build of ros_short (tests/e2e/conftest.py), edited only through
+    ``package_edit``."""
+    return ros_short_workspace
+
+
+@pytest.fixture(scope="module")
+def checked(workspace: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A directory whose ``launch.sh`` runs ``rosrun PKG run_lockstep`` instead of
+    roslaunch, from that directory, on the session's workspace."""
+    checked = tmp_path_factory.mktemp("checked")
+    script = (workspace / "launch.sh").read_text()
     assert f'exec roslaunch {PKG} "$@"' in script
     (checked / "launch.sh").write_text(
         f"cd {checked}\n"
         + script.replace(f'exec roslaunch {PKG} "$@"', f'exec rosrun {PKG} run_lockstep "$@"')
     )
-    return ws
+    return checked
 
 
 def test_ctrl_c_in_a_pipelined_run_is_130_with_the_outputs_kept(
-    workspace: Path, launcher: Callable[..., Launch]
+    checked: Path, launcher: Callable[..., Launch], tmp_path: Path
 ) -> None:
     """Ctrl-C (SIGINT to the process group, as a terminal sends it) once the scenario node
     has applied its first change: the run is pipelined, the script exits 130 and says so,
     the run directory says ``interrupted``, and no process of the launch is left."""
-    out = workspace / "interrupted"
-    launch = launcher(
-        workspace / "checked", "ros_short.launch", f"out:={out}", "plots:=false", "duration:=36000"
-    )
+    out = tmp_path / "interrupted"
+    launch = launcher(checked, "ros_short.launch", f"out:={out}", "plots:=false", "duration:=36000")
     lines = launch.lines
     assert launch.read_until("running ros_short (lockstep, pipelined)"), "".join(lines)[-3000:]
     assert launch.read_until("phase 1 at t=10 s"), "".join(lines)[-3000:]
@@ -69,7 +71,7 @@ def test_ctrl_c_in_a_pipelined_run_is_130_with_the_outputs_kept(
 
 
 def test_a_node_unlike_its_template_is_2_and_the_fault_names_the_way_out(
-    workspace: Path, launcher: Callable[..., Launch]
+    workspace: Path, checked: Path, launcher: Callable[..., Launch], tmp_path: Path
 ) -> None:
     """The launch file's ``/amsa/seed`` edited by hand: a C++ sensor draws other noise than
     the model's template, the pipelined run stops at that step and the script exits 2 with
@@ -79,13 +81,10 @@ def test_a_node_unlike_its_template_is_2_and_the_fault_names_the_way_out(
     seed = re.search(r'<param name="seed" type="str" value="(\d+)"/>', original)
     assert seed is not None, original[:2000]
     reseeded = seed.group(0).replace(f'"{seed.group(1)}"', f'"{int(seed.group(1)) + 1}"')
-    (launch_dir / "reseeded.launch").write_text(original.replace(seed.group(0), reseeded))
-    try:
-        out = workspace / "reseeded"
-        launch = launcher(workspace / "checked", "reseeded.launch", f"out:={out}", "plots:=false")
+    with package_edit(launch_dir / "reseeded.launch", original.replace(seed.group(0), reseeded)):
+        out = tmp_path / "reseeded"
+        launch = launcher(checked, "reseeded.launch", f"out:={out}", "plots:=false")
         text = launch.finish()
-    finally:
-        (launch_dir / "reseeded.launch").unlink()
     assert launch.proc.returncode == 2, text[-3000:]
     assert "running ros_short (lockstep, pipelined)" in text
     verdict = [ln for ln in text.splitlines() if ln.startswith("run_lockstep: ")]
