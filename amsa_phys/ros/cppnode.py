@@ -229,18 +229,22 @@ def cmake_targets(graph: RosGraph, pkg: str, cpp: list[str]) -> Code:
         return Code("  # no Leaf has a C++ body")
     lib = cmake_arg(library(pkg))
     sources = " ".join(cmake_arg(f"src/leaves/{t}.cpp") for t in cpp_templates(graph, cpp))
+    # the container's target is named after the package (CMake target names are global to
+    # a catkin workspace: two exported packages side by side would both define amsa_leaves);
+    # the executable is still devel/lib/PKG/amsa_leaves, what the launch files start
+    exe = cmake_arg(f"{pkg}_{names.CONTAINER}")
     lines = [
         f"  add_library({lib} {sources})",
         f"  target_link_libraries({lib} ${{roscpp_LIBRARIES}} ${{nodelet_LIBRARIES}})",
-        f"  add_executable({names.CONTAINER} src/{names.CONTAINER}.cpp)",
-        f"  target_link_libraries({names.CONTAINER} ${{roscpp_LIBRARIES}} ${{nodelet_LIBRARIES}})",
+        f"  add_executable({exe} src/{names.CONTAINER}.cpp)",
+        f"  set_target_properties({exe} PROPERTIES OUTPUT_NAME {names.CONTAINER})",
+        f"  target_link_libraries({exe} ${{roscpp_LIBRARIES}} ${{nodelet_LIBRARIES}})",
         # amsa_leaves.cpp is the same in every package: it finds amsa_exit.h by this path
         # (pkg is [A-Za-z][A-Za-z0-9_]*: cmake_arg leaves it unquoted, to append)
-        f"  target_include_directories({names.CONTAINER} PRIVATE"
+        f"  target_include_directories({exe} PRIVATE"
         f" ${{CMAKE_CURRENT_SOURCE_DIR}}/{cmake_arg(f'include/{pkg}')})",
         f"  install(TARGETS {lib} LIBRARY DESTINATION ${{CATKIN_PACKAGE_LIB_DESTINATION}})",
-        f"  install(TARGETS {names.CONTAINER} RUNTIME DESTINATION"
-        " ${CATKIN_PACKAGE_BIN_DESTINATION})",
+        f"  install(TARGETS {exe} RUNTIME DESTINATION ${{CATKIN_PACKAGE_BIN_DESTINATION}})",
         "  install(FILES nodelet_plugins.xml DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION})",
     ]
     return Code("\n".join(lines))

@@ -81,7 +81,13 @@ def test_package_has_a_node_per_leaf_a_topic_per_data_a_parameter_per_parameter(
     assert "arg('cpp_container')" in nodes["amsa_leaves"].get("if")
     cmake = (pkg / "CMakeLists.txt").read_text()
     assert "add_library(mdeChallenge_leaves src/leaves/GPS.cpp src/leaves/Compass.cpp" in cmake
-    assert "add_executable(amsa_leaves src/amsa_leaves.cpp)" in cmake
+    # the container's target is the package's own (two packages can share a workspace),
+    # its executable still amsa_leaves, which the launch file starts
+    assert "add_executable(mdeChallenge_amsa_leaves src/amsa_leaves.cpp)" in cmake
+    assert (
+        "set_target_properties(mdeChallenge_amsa_leaves PROPERTIES OUTPUT_NAME amsa_leaves)"
+        in cmake
+    )
     plugins = ET.parse(pkg / "nodelet_plugins.xml").getroot()
     assert [c.get("name") for c in plugins.iter("class")] == [
         f"mdeChallenge/{t}"

@@ -118,3 +118,29 @@ def test_run_lockstep_last_line_is_the_cause(tmp_path: Path, code: int) -> None:
         "see the error above (/Leaf: Kv out of range)"
     )
     assert (lines[-2] == "run_lockstep: roslaunch exited with 1") == (code == 1)
+
+
+def test_a_cut_run_says_how_many_checks_it_left_out(tmp_path: Path) -> None:
+    """``duration:=`` cuts a run short: the checks it could not judge are skipped, said in
+    the last line (the simulator's ``done:`` line says the same), not counted as passed."""
+    scenario1 = SCENARIO.parent.parent.parent / "scenarios" / "scenario1.yaml"
+    out = tmp_path / "cut"
+    argv = ["run", str(scenario1), "--headless", "--out", str(out), "-q", "--no-plot"]
+    main([*argv, "--duration", "100"])
+    code, lines = judge(out)
+    assert code == 0
+    assert lines[-1] == (
+        "run_lockstep: pass: 0 expectations passed, 4 skipped (not judged by this run: see "
+        f"scenario.yaml) ({out})"
+    )
+
+
+def test_the_simulators_done_line_counts_skipped_checks_apart(tmp_path: Path) -> None:
+    from amsa_phys.ros.runtime.ending import done_line
+    from amsa_phys.runs.expect import Check
+
+    checks = [Check(None, 1.0, True), Check(None, None, True, skipped=True, why="cut")]
+    assert done_line(checks, tmp_path) == (
+        f"amsa_simulator: done: 1 expectation passed, 1 skipped (not judged by this run); "
+        f"outputs in {tmp_path}"
+    )

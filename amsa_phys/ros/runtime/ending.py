@@ -28,12 +28,15 @@ WAIT_S = 60.0
 def done_line(checks: list[Any], out_dir: Path) -> str:
     """The simulator's last line: ``amsa_simulator: done: ...`` with the checks' verdict."""
     failed = [c for c in checks if not c.passed]
+    skipped = sum(1 for c in checks if c.passed and c.skipped)  # a cut run judges fewer
     if not checks:
         verdict = "no expectations to check"
     elif failed:
         verdict = f"{len(failed)} of {plural(len(checks), 'expectation')} FAILED"
     else:
-        verdict = f"{plural(len(checks), 'expectation')} passed"
+        verdict = f"{plural(len(checks) - skipped, 'expectation')} passed"
+    if skipped:
+        verdict += f", {skipped} skipped (not judged by this run)"
     return f"{names.SIMULATOR}: done: {verdict}; outputs in {out_dir}"
 
 

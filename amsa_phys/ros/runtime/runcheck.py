@@ -60,8 +60,23 @@ def judge(out: Path, seen: launchout.Seen | None = None) -> tuple[int, list[str]
     if failed:
         lines.append(f"{SCRIPT}: FAIL: {failed} of {total} failed ({out})")
         return 1, lines
-    lines.append(f"{SCRIPT}: pass: {total} passed ({out})")
+    lines.append(f"{SCRIPT}: pass: {total} passed{_left_out(out)} ({out})")
     return 0, lines
+
+
+def _left_out(out: Path) -> str:
+    """``, N skipped ...`` when the run was cut short (``duration:=``): its resolved
+    ``scenario.yaml`` leaves out the checks it could not judge, naming them in its head
+    comment (``runs/single.py``), which the simulator counted as skipped."""
+    try:
+        head = (out / "scenario.yaml").read_text().split("\n", 1)[0]
+    except OSError:
+        return ""
+    marker = "these checks were not judged and are left out: "
+    if marker not in head:
+        return ""
+    n = len(head.split(marker, 1)[1].split("; "))
+    return f", {n} skipped (not judged by this run: see scenario.yaml)"
 
 
 def launch_args(launch: str, args: list[str]) -> tuple[list[str], Path]:
