@@ -41,6 +41,7 @@ _HEAD = """\
     <param if="$(arg sim)" name="mode" value="$(arg mode)"/>
     <param unless="$(arg sim)" name="mode" value="free"/>
     <param name="sim" type="bool" value="$(arg sim)"/>
+    <param name="boundary" type="bool" value="$(arg boundary)"/>
     <param name="bag" type="bool" value="$(eval arg('bag') != '')"/>
     <param name="timeout" type="double" value="$(arg timeout)"/>
     <param name="seed" type="str" value="@@{seed:xml_attr}"/>

@@ -56,6 +56,9 @@ def test_package_has_a_node_per_leaf_a_topic_per_data_a_parameter_per_parameter(
         "amsa_boundary",
         "amsa_leaves",  # the C++ Leaves' container
     }
+    # the simulator is told whether the boundary runs: in lockstep it waits for it to listen
+    group = {p.get("name"): p.get("value") for p in launch.find("group").iter("param")}
+    assert group["boundary"] == "$(arg boundary)"
     # the boundary's standard messages are for onlookers: without them the run still runs
     optional = {"amsa_bag", "amsa_boundary"}
     assert all(n.get("required") == "true" for k, n in nodes.items() if k not in optional)

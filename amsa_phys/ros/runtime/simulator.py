@@ -86,8 +86,17 @@ class Link:
         #: lockstep: the buffers the boundary node reads, each Leaf step's values of them
         #: published with the step's instant (``boundary.py``: its messages' stamps)
         self.boundary_reads = readable(self.graph) if self.lockstep else set()
+        # boundary:=true (/amsa/boundary): the run starts once the boundary node listens, or
+        # a fast (pipelined) run could be over before its first standard message
+        told = self.boundary_reads and bool(rospy.get_param("/amsa/boundary", False))
         self.values_pub = (
-            rosio.make_publisher(rospy, VALUES, String) if self.boundary_reads else None
+            (
+                self.gate.publisher(VALUES, String, 1)
+                if told
+                else rosio.make_publisher(rospy, VALUES, String)
+            )
+            if self.boundary_reads
+            else None
         )
         #: pipelined lockstep (pipeline.py): the container's Leaves asked many instants at once
         self.pipeline = Pipeline(self) if cfg.pipeline else None
