@@ -90,10 +90,12 @@ def _pipeline(adapt: bool) -> str:
     """The ``pipeline`` argument and ``/amsa/pipeline``: lockstep asks the C++ container for
     many instants at once, checking each answer against the in-process template
     (``runtime/pipeline.py``), when every remote Leaf is in the container, no bag records the
-    topics and (with ``adapt:`` rules) the simulator fires the rules. Constant text."""
+    topics, the boundary node does not run (its Python publishers could not keep up with a
+    simulator that outruns them: their queues drop messages) and (with ``adapt:`` rules) the
+    simulator fires the rules. Constant text."""
     when = (
         "arg('pipeline') and arg('mode') == 'lockstep' and arg('sim') and arg('cpp')"
-        " and arg('cpp_container') and arg('bag') == ''"
+        " and arg('cpp_container') and arg('bag') == '' and not arg('boundary')"
         + (" and arg('rules') != 'node'" if adapt else "")
     )
     return (

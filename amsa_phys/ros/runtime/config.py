@@ -57,6 +57,7 @@ def load_config(rospy: Any) -> NodeConfig:
         and mode == "lockstep"
         and sim
         and not bag
+        and not bool(rospy.get_param("/amsa/boundary", False))
         and not node
         and set(graph.remote) == set(graph.shared)
     )
