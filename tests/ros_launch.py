@@ -176,6 +176,20 @@ def package_edit(path: Path, text: str) -> Iterator[Path]:
             path.write_text(before)
 
 
+def run_lockstep_dir(ws: Path, pkg: str, dest: Path) -> Path:
+    """``dest`` with a ``launch.sh`` that runs ``rosrun PKG run_lockstep`` on ``ws``'s build
+    instead of roslaunch (as a CI would), from ``dest`` (a relative ``out:=`` and the default
+    ``runs/`` land there, as from a user's shell)."""
+    script = (ws / "launch.sh").read_text()
+    assert f'exec roslaunch {pkg} "$@"' in script
+    dest.mkdir(parents=True, exist_ok=True)
+    (dest / "launch.sh").write_text(
+        f"cd {dest}\n"
+        + script.replace(f'exec roslaunch {pkg} "$@"', f'exec rosrun {pkg} run_lockstep "$@"')
+    )
+    return dest
+
+
 def metrics_without_wall(run_dir: Path) -> dict:
     """A run's ``metrics.json`` without the only fields a wall clock sets, to compare a ROS
     run with the in-process one."""

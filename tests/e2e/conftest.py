@@ -25,6 +25,15 @@ def ros_short_workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return build_workspace(tmp_path_factory.mktemp("ros_short_ws"), *ROS_SHORT)
 
 
+@pytest.fixture(scope="session")
+def ros_short_checked(ros_short_workspace: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A directory whose ``launch.sh`` runs ``rosrun mdeChallenge run_lockstep`` on
+    ``ros_short_workspace`` (tests/ros_launch.py ``run_lockstep_dir``)."""
+    from ros_launch import run_lockstep_dir
+
+    return run_lockstep_dir(ros_short_workspace, ROS_SHORT[1], tmp_path_factory.mktemp("checked"))
+
+
 def _skipped(item: pytest.Item) -> bool:
     """Marked to be skipped whatever happens (a skipif whose condition is already True)."""
     for mark in item.iter_markers():

@@ -396,14 +396,7 @@ def test_run_lockstep_exits_with_the_runs_verdict(
     when every expectation passes, 1 when one fails (here the leader cruises at 70 % in
     phase 0, edited in the params file, and the follower falls 25 m behind), 2 when the run
     does not even start (an out:= directory amsa-phys did not make)."""
-    checked = tmp_path / "checked"
-    checked.mkdir()
-    script = (workspace / "launch.sh").read_text()
-    assert f'exec roslaunch {PKG} "$@"' in script
-    (checked / "launch.sh").write_text(  # run from checked/, as a user from their shell
-        f"cd {checked}\n"
-        + script.replace(f'exec roslaunch {PKG} "$@"', f'exec rosrun {PKG} run_lockstep "$@"')
-    )
+    checked = ros_launch.run_lockstep_dir(workspace, PKG, tmp_path / "checked")
     passing = launcher(checked, "ros_short.launch", "plots:=false")  # out: runs/ in its cwd
     text = passing.finish()
     assert passing.proc.returncode == 0, text[-3000:]

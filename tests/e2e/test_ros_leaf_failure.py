@@ -48,16 +48,9 @@ def workspace(ros_short_workspace: Path) -> Path:
 
 
 @pytest.fixture(scope="module")
-def checked(workspace: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A directory whose ``launch.sh`` runs ``rosrun PKG run_lockstep`` instead of roslaunch
-    (as a CI would) on the session's workspace."""
-    script = (workspace / "launch.sh").read_text()
-    assert f'exec roslaunch {PKG} "$@"' in script
-    checked = tmp_path_factory.mktemp("checked")
-    (checked / "launch.sh").write_text(
-        script.replace(f'exec roslaunch {PKG} "$@"', f'exec rosrun {PKG} run_lockstep "$@"')
-    )
-    return checked
+def checked(ros_short_checked: Path) -> Path:
+    """Runs ``rosrun PKG run_lockstep`` on the session's build (tests/e2e/conftest.py)."""
+    return ros_short_checked
 
 
 def _first_death(text: str) -> tuple[str, str]:

@@ -38,17 +38,9 @@ def workspace(ros_short_workspace: Path) -> Path:
 
 
 @pytest.fixture(scope="module")
-def checked(workspace: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A directory whose ``launch.sh`` runs ``rosrun PKG run_lockstep`` instead of
-    roslaunch, from that directory, on the session's workspace."""
-    checked = tmp_path_factory.mktemp("checked")
-    script = (workspace / "launch.sh").read_text()
-    assert f'exec roslaunch {PKG} "$@"' in script
-    (checked / "launch.sh").write_text(
-        f"cd {checked}\n"
-        + script.replace(f'exec roslaunch {PKG} "$@"', f'exec rosrun {PKG} run_lockstep "$@"')
-    )
-    return checked
+def checked(ros_short_checked: Path) -> Path:
+    """Runs ``rosrun PKG run_lockstep`` on the session's build (tests/e2e/conftest.py)."""
+    return ros_short_checked
 
 
 def test_ctrl_c_in_a_pipelined_run_is_130_with_the_outputs_kept(
