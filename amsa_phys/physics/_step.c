@@ -309,6 +309,30 @@ static void slide(double u, double v, double f0, double res, double ivs, double 
     *up_out = up;
 }
 
+/* ---- wheel.patch_scrub: both patches' turn-slip moment, each capped at its own torque -- */
+static double patch_scrub(double w, double torque, double kl, double kr, double ksum, double tl,
+                          double tr, double ts, double dt_i)
+{
+    double base = w + torque * dt_i;
+    double scrub = -ksum * base / (1.0 + ksum * dt_i);
+    double wn = base / (1.0 + ksum * dt_i);
+    double ql = kl * wn, qr = kr * wn;
+    if (-tl <= ql && ql <= tl && -tr <= qr && qr <= tr)
+        return scrub;
+    double k2, t1, t2;
+    if (kl * tr >= kr * tl) {
+        t1 = tl, k2 = kr, t2 = tr;
+    } else {
+        t1 = tr, k2 = kl, t2 = tl;
+    }
+    double s1 = base > 0.0 ? -t1 : t1;
+    wn = (base + s1 * dt_i) / (1.0 + k2 * dt_i);
+    double s2 = -k2 * wn;
+    if (s2 > t2 || s2 < -t2)
+        return base > 0.0 ? -ts : ts;
+    return s1 + s2;
+}
+
 /* ---- forces.rover_step, one rover ------------------------------------------------------ */
 static inline int same_bits(double a, double b)
 {
@@ -413,15 +437,22 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
             fxl = pair[0], upl = pair[1], fxr = pair[2], upr = pair[3];
         }
     }
-    /* scrub */
+    /* scrub: each patch capped at its Coulomb torque (wheel.patch_scrub) */
     double isum = ivl + ivr;
     double torque = (fxr - fxl) * h;
+    double kphl = sphi * ivl;
+    double kphr = sphi * ivr;
     double kphi = sphi * isum;
-    double scrub = -kphi * (w + torque * dt_i) / (1.0 + kphi * dt_i);
-    if (scrub > ts)
-        scrub = ts;
-    else if (scrub < -ts)
-        scrub = -ts;
+    double base = w + torque * dt_i;
+    double den = 1.0 + kphi * dt_i;
+    double scrub = -kphi * base / den;
+    double wn = base / den;
+    double ysum = iyl + iyr; /* > 0 for any real ground (GRIP_FLOOR_N) */
+    double tl = ysum > 0.0 ? ts * iyr / ysum : 0.5 * ts;
+    double tr = ts - tl;
+    double ql = kphl * wn, qr = kphr * wn;
+    if (!(-tl <= ql && ql <= tl && -tr <= qr && qr <= tr))
+        scrub = patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i);
     torque += scrub;
     /* predicted heading change */
     double turn = w * dt + torque * turn_k;
@@ -482,12 +513,43 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     /* friction ellipse */
     int sat_l = t1 * t1 + t2 * t2 > 1.0;
     int sat_r = t3 * t3 + t4 * t4 > 1.0;
-    if (sat_l || sat_r) {
+    if (sat_l || sat_r) { /* forces.rover_step says why each part */
         double side0 = vy * co - vx * si;
+        double cancel = neg_m_dt * side / cos(0.5 * turn);
+        const double ky = p[P_KY];
         if (sat_l)
-            slide(ul, vl, f0l, rl, ivl, kx, p[P_KY], ixl, iyl, side0, fyl, &sc, &fxl, &fyl, &upl);
+            slide(ul, vl, f0l, rl, ivl, kx, ky, ixl, iyl, side0, cancel, &sc, &fxl, &fyl, &upl);
         if (sat_r)
-            slide(ur, vr, f0r, rr, ivr, kx, p[P_KY], ixr, iyr, side0, fyr, &sc, &fxr, &fyr, &upr);
+            slide(ur, vr, f0r, rr, ivr, kx, ky, ixr, iyr, side0, cancel, &sc, &fxr, &fyr, &upr);
+        if (!sat_r) {
+            double kg = ky_dt_m * ivr;
+            fyr = (cancel - fyl) * kg / (1.0 + kg);
+            t3 = fxr * ixr;
+            t4 = fyr * iyr;
+            if (t3 * t3 + t4 * t4 > 1.0) {
+                sat_r = 1;
+                slide(ur, vr, f0r, rr, ivr, kx, ky, ixr, iyr, side0, cancel, &sc, &fxr, &fyr,
+                      &upr);
+            }
+        } else if (!sat_l) {
+            double kg = ky_dt_m * ivl;
+            fyl = (cancel - fyr) * kg / (1.0 + kg);
+            t1 = fxl * ixl;
+            t2 = fyl * iyl;
+            if (t1 * t1 + t2 * t2 > 1.0) {
+                sat_l = 1;
+                slide(ul, vl, f0l, rl, ivl, kx, ky, ixl, iyl, side0, cancel, &sc, &fxl, &fyl,
+                      &upl);
+            }
+        }
+        if (sat_l && sat_r) {
+            double fsum = fyl + fyr;
+            if (fsum * cancel > 0.0 && fabs(fsum) > fabs(cancel)) {
+                double q = cancel / fsum;
+                fyl = fyl * q;
+                fyr = fyr * q;
+            }
+        }
         fx = fxl + fxr;
         torque = (fxr - fxl) * h + scrub;
         f_lat = fyl + fyr;

@@ -48,7 +48,8 @@ from .rover import DiffDriveRover
 from .wheel import (
     SLIP_SPEED_MIN,
     TORSION,
-    slide,
+    patch_scrub,
+    slide_pair,
     step_constants,
     wheel_pair,
 )
@@ -312,15 +313,22 @@ def rover_step(
             upl * ul > 0.0 and upr * ur > 0.0 and -fmax <= fml <= fmax and -fmax <= fmr <= fmax
         ):
             fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc)
-    # scrub: the patches' turn-slip moment, implicit in the yaw rate, capped
+    # scrub: the patches' turn-slip moment, implicit in the yaw rate, each patch capped at its
+    # Coulomb torque (wheel.patch_scrub; the caps in proportion to the patches' lateral grip)
     isum = ivl + ivr
     torque = (fxr - fxl) * h
+    kphl = sphi * ivl
+    kphr = sphi * ivr
     kphi = sphi * isum
-    scrub = -kphi * (w + torque * dt_i) / (1.0 + kphi * dt_i)
-    if scrub > ts:
-        scrub = ts
-    elif scrub < -ts:
-        scrub = -ts
+    base = w + torque * dt_i
+    den = 1.0 + kphi * dt_i
+    scrub = -kphi * base / den
+    wn = base / den
+    ysum = iyl + iyr  # > 0 for any real ground (GRIP_FLOOR_N)
+    tl = ts * iyr / ysum if ysum > 0.0 else 0.5 * ts
+    tr = ts - tl
+    if not (-tl <= kphl * wn <= tl and -tr <= kphr * wn <= tr):
+        scrub = patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i)
     torque += scrub
     # predicted heading change over this step (semi-implicit Euler, as pymunk does)
     turn = w * dt + torque * turn_k
@@ -390,11 +398,17 @@ def rover_step(
     sat_l = t1 * t1 + t2 * t2 > 1.0
     sat_r = t3 * t3 + t4 * t4 > 1.0
     if sat_l or sat_r:
-        side0 = vy * co - vx * si
-        if sat_l:
-            fxl, fyl, upl = slide(ul, vl, f0l, rl, ivl, (kx, ky, ixl, iyl), side0, fyl, sc)
-        if sat_r:
-            fxr, fyr, upr = slide(ur, vr, f0r, rr, ivr, (kx, ky, ixr, iyr), side0, fyr, sc)
+        # the lateral force that cancels the body's sideways velocity within the step
+        cancel = neg_m_dt * side / cos(0.5 * turn)
+        fxl, fyl, upl, fxr, fyr, upr = slide_pair(
+            (sat_l, sat_r),
+            (ul, vl, f0l, rl, ivl, ixl, iyl, fxl, fyl, upl),
+            (ur, vr, f0r, rr, ivr, ixr, iyr, fxr, fyr, upr),
+            (kx, ky, ky_dt_m),
+            vy * co - vx * si,
+            cancel,
+            sc,
+        )
         fx = fxl + fxr
         torque = (fxr - fxl) * h + scrub
         f_lat = fyl + fyr

@@ -50,10 +50,9 @@ def reference_forces(
     vl, vr = sl, sr
     # scrub
     torque = (fxr - fxl) * rover.half_track
-    kphi = TORSION * wm.patch_radius_m**2 * kx * (1 / vl + 1 / vr)
-    limit = wm.scrub_limit(mul) + wm.scrub_limit(mur)
-    scrub = -kphi * (w + torque * dt / body.moment) / (1 + kphi * dt / body.moment)
-    scrub = max(-limit, min(limit, scrub))
+    sphi = TORSION * wm.patch_radius_m**2 * kx
+    caps = (wm.scrub_limit(mul), wm.scrub_limit(mur))
+    scrub = _scrub(w, torque, (sphi / vl, sphi / vr), caps, dt / body.moment)
     torque += scrub
     # lateral grip at the end-of-step heading, applied along the mid-step normal
     turn = (w + torque / body.moment * dt) * dt
@@ -79,14 +78,31 @@ def reference_forces(
         side0 = vy * math.cos(a) - vx * math.sin(a)
         ky1 = wm.load_n / wm.slip_lat
         hub = (v_fwd - w * rover.half_track, v_fwd + w * rover.half_track)
-        if (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1:
-            fxl, fyl, upl = slide(
-                ul, hub[0], f0l, rl, 1 / sl, (kx, ky1, inv[0], inv[1]), side0, fyl, s
-            )
-        if (fxr * inv[2]) ** 2 + (fyr * inv[3]) ** 2 > 1:
-            fxr, fyr, upr = slide(
-                ur, hub[1], f0r, rr, 1 / sr, (kx, ky1, inv[2], inv[3]), side0, fyr, s
-            )
+        # no tyre, nor both together, pushes past the force that cancels the sideways
+        # velocity within the step
+        cancel = -rover.mass / dt * side / math.cos(0.5 * turn)
+        out = [(fxl, fyl, upl), (fxr, fyr, upr)]
+        slid = [
+            (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1,
+            (fxr * inv[2]) ** 2 + (fyr * inv[3]) ** 2 > 1,
+        ]
+        args = [(ul, hub[0], f0l, rl, 1 / sl), (ur, hub[1], f0r, rr, 1 / sr)]
+        for i in (0, 1):
+            if slid[i]:
+                tyre = (kx, ky1, inv[2 * i], inv[2 * i + 1])
+                out[i] = slide(*args[i], tyre, side0, cancel, s)
+        for i in (0, 1):  # a gripping tyre takes, implicitly, what the sliding one leaves
+            if slid[1 - i] and not slid[i]:
+                kg = ky1 / (sl, sr)[i] * dt / rover.mass
+                fy = (cancel - out[1 - i][1]) * kg / (1 + kg)
+                out[i] = (out[i][0], fy, out[i][2])
+                if (out[i][0] * inv[2 * i]) ** 2 + (fy * inv[2 * i + 1]) ** 2 > 1:
+                    slid[i] = True
+                    tyre = (kx, ky1, inv[2 * i], inv[2 * i + 1])
+                    out[i] = slide(*args[i], tyre, side0, cancel, s)
+        (fxl, fyl, upl), (fxr, fyr, upr) = out
+        if all(slid) and (fyl + fyr) * cancel > 0 and abs(fyl + fyr) > abs(cancel):
+            fyl, fyr = fyl * cancel / (fyl + fyr), fyr * cancel / (fyl + fyr)
         fx = fxl + fxr
         torque = (fxr - fxl) * rover.half_track + scrub
         f_lat = fyl + fyr
@@ -115,3 +131,24 @@ def load_factor(wm: WheelModel, force: float, grip: float) -> float:
         cap = abs(force)
     f = max(-cap, min(cap, force))
     return max(LOAD_FLOOR, min(wm.half_weight_n / wm.load_n, 1 - a * f))
+
+
+def _scrub(
+    w: float, torque: float, k: tuple[float, float], caps: tuple[float, float], dt_i: float
+) -> float:
+    """The patches' turn-slip moments, implicit in the yaw rate, each clamped to its own cap:
+    found plainly by bisection on the end-of-step yaw rate (the moment falls as it rises)."""
+
+    def excess(wn: float) -> float:
+        s = sum(max(-c, min(c, -ki * wn)) for ki, c in zip(k, caps, strict=True))
+        return wn - w - (torque + s) * dt_i
+
+    lo, hi = -1e6, 1e6
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if excess(mid) > 0:
+            hi = mid
+        else:
+            lo = mid
+    wn = 0.5 * (lo + hi)
+    return sum(max(-c, min(c, -ki * wn)) for ki, c in zip(k, caps, strict=True))

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 from rig import ON_AXLE, drive
 
-from amsa_phys.physics import forces
+from amsa_phys.physics import wheel
 from amsa_phys.physics.wheel import StepConstants, rim_and_tyre, slide
 
 #: A rover whose motors out-pull its tyres (600 N stall force a wheel, 40 N m current limit):
@@ -72,7 +72,7 @@ def old_slide(
 
 def mutate(monkeypatch: pytest.MonkeyPatch) -> None:
     """Run the pure Python model (the C step is held equal to it) with the old scheme."""
-    monkeypatch.setattr(forces, "slide", old_slide)
+    monkeypatch.setattr(wheel, "slide", old_slide)
     monkeypatch.setenv("AMSA_PHYS_PURE", "1")
 
 
@@ -223,7 +223,7 @@ def test_mutation_spin_up_check_fails_when_the_sliding_rim_is_not_solved(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # measured +254 %, +102 % and +57 % (and a peak slip of 0.6-34 cm/s, not 1.3-5.5 m/s)
-    monkeypatch.setattr(forces, "slide", rim_not_resolved)
+    monkeypatch.setattr(wheel, "slide", rim_not_resolved)
     monkeypatch.setenv("AMSA_PHYS_PURE", "1")
     runs = spin_up_errors(tmp_path)
     assert max(abs(err) for _, err in runs) > 0.03, runs
