@@ -37,13 +37,13 @@ typedef void (*space_step_fn)(void *, double);
 enum {
     P_KP, P_C, P_FMAX, P_MW, P_BB, P_BBE, P_E, P_E2, P_KX, P_H, P_TURN_K, P_DT_I, P_DT_M,
     P_SPHI, P_KY_DT_M, P_NEG_M_DT, P_BIG_BC, P_KY, P_MASS, P_XFER, P_KMAX, P_INV_G2,
-    P_C_EXP, PLAN_WIDTH
+    P_C_EXP, P_BRAKE, PLAN_WIDTH
 };
 
 static const char *const plan_fields[PLAN_WIDTH] = {
     "kp", "c", "f_max", "mw", "big_b", "big_be", "e", "e2", "kx", "half_track", "turn_k",
     "dt_i", "dt_m", "sphi", "ky_dt_m", "neg_m_dt", "big_bc", "ky", "mass", "xfer", "kmax",
-    "inv_g2", "c_exp",
+    "inv_g2", "c_exp", "brake",
 };
 
 #define SLIP_SPEED_MIN 0.1
@@ -356,9 +356,10 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     const double vmin = SLIP_SPEED_MIN, ivmin = 1.0 / SLIP_SPEED_MIN;
     const Py_ssize_t *go = st->ground_off;
     double ixl = g[go[0]], iyl = g[go[1]];
-    const double rl = g[go[2]];
+    double rl = g[go[2]];
     double ixr = g[go[3]], iyr = g[go[4]];
-    const double rr = g[go[5]], ts = g[go[6]];
+    double rr = g[go[5]];
+    const double ts = g[go[6]];
 
     double angle = state[2], vx = state[3], vy = state[4], w = state[5];
     const double gax = g[go[7]], gay = g[go[8]];
@@ -386,6 +387,13 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double kr = kx * ivr;
     double f0l = kp * st->drives[k] - p[P_C_EXP] * ul;
     double f0r = kp * st->drives[st->n + k] - p[P_C_EXP] * ur;
+    const double brake = p[P_BRAKE];
+    if (brake != 0.0) { /* the holding brake (forces.rover_step) */
+        if (st->drives[k] == 0.0)
+            rl = rl + brake;
+        if (st->drives[st->n + k] == 0.0)
+            rr = rr + brake;
+    }
     double fxl, fxr, upl, upr;
     double pu[2] = {ul, ur}, pv[2] = {vl, vr}, pf0[2] = {f0l, f0r}, pres[2] = {rl, rr};
     double pk[2] = {kl, kr}, pair[4];

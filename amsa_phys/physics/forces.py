@@ -90,6 +90,7 @@ class Folded(NamedTuple):
     kmax: float  # the drive wheels' largest relative load: the caster lifted
     inv_g2: float  # 1 / g^2: a slope's cos from its pull
     c_exp: float  # the back-EMF's explicit part (wheel.emf_implicitness)
+    brake: float  # the holding brake at the rim (N), while the driver applies no voltage
 
 
 def fold(rover: DiffDriveRover, dt: float) -> Folded:
@@ -121,6 +122,7 @@ def fold(rover: DiffDriveRover, dt: float) -> Folded:
         kmax=w.half_weight_n / w.load_n if w.load_n > 0.0 else 1.0,
         inv_g2=1.0 / (w.gravity * w.gravity) if w.gravity > 0.0 else 0.0,
         c_exp=s.c_exp,
+        brake=w.brake_force_n,
     )
 
 
@@ -238,6 +240,7 @@ def rover_step(
         kmax,
         inv_g2,
         c_exp,
+        brake,
         sc,
     ) = plan
     vmin = SLIP_SPEED_MIN
@@ -265,6 +268,11 @@ def rover_step(
     # the motor's force at rest less the back-EMF's explicit part (wheel.emf_implicitness)
     f0l = kp * drive_l - c_exp * ul
     f0r = kp * drive_r - c_exp * ur
+    if brake != 0.0:  # the holding brake: more Coulomb resistance at a rim the driver leaves
+        if drive_l == 0.0:
+            rl = rl + brake
+        if drive_r == 0.0:
+            rr = rr + brake
     rigid = False
     if ul == 0.0 and ur == 0.0:
         # a parked rover (wheel.held): the tyres hold the body against still rims; the

@@ -45,6 +45,9 @@ def reference_forces(
     f0l, f0r = wm.drive_force(rover.power_l), wm.drive_force(rover.power_r)
     f0l, f0r = f0l - s.c_exp * rims[0], f0r - s.c_exp * rims[1]  # wheel.emf_implicitness
     rl, rr = wm.resistance(crl), wm.resistance(crr)
+    # the holding brake: more Coulomb resistance at a rim the driver applies no voltage to
+    rl += wm.brake_force_n if wm.command(rover.power_l) == 0.0 else 0.0
+    rr += wm.brake_force_n if wm.command(rover.power_r) == 0.0 else 0.0
     ul, ur = rims
     fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kx / sl, kx / sr), s)
     vl, vr = sl, sr

@@ -149,6 +149,16 @@ ROVER_PARAMS: tuple[Param, ...] = (
     ),
     Param("rollingCoef", "float", "rolling resistance, times the ground's", 1.0, 0.0, 20.0),
     Param(
+        "brakeTorque",
+        "float",
+        "holding brake per driven wheel, engaged while the driver applies no voltage (the "
+        "command within the deadband): a parked rover holds on slopes it can climb",
+        0.0,
+        0.0,
+        1e5,
+        "N m",
+    ),
+    Param(
         "axleOffset",
         "float",
         "drive axle's position ahead of the centre of mass (negative: behind); with "
@@ -210,6 +220,7 @@ WHEEL_PARAMS = {
     "maxWheelTorque",
     "deadband",
     "jointFriction",
+    "brakeTorque",
     "slipComplianceLongitudinal",
     "slipComplianceLateral",
     "patchRadius",

@@ -470,6 +470,7 @@ def wheel_model(p: Any, gravity: float) -> WheelModel:
         max_force_n=p.maxWheelTorque / r,
         deadband_pct=p.deadband,
         joint_friction_n=p.jointFriction / r,
+        brake_force_n=p.brakeTorque / r,
         rim_mass_kg=p.wheelInertia / (r * r),
         load_n=p.mass * gravity * -x_c / (2 * span),
         slip_long=p.slipComplianceLongitudinal,

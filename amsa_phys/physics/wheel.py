@@ -105,6 +105,8 @@ class WheelModel:
     #: tyres of a rigid base, so it is carried at their rims); 0: ``load_n``
     half_weight_n: float = 0.0
     gravity: float = 9.81
+    #: the holding brake at the rim (N), engaged while the driver applies no voltage
+    brake_force_n: float = 0.0
 
     # -- driver ---------------------------------------------------------------------------
     def command(self, power_pct: float) -> float:
