@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..model.template import Kind, Port, Template
+from .power import POWER_NAMES, POWER_PARAMS, PowerSupply, power_on
 from .rover import DiffDriveRover
 from .roverparams import BODY_PARAMS, ROVER_PARAMS, WHEEL_PARAMS, check_geometry
 from .space import physics_of
@@ -97,11 +98,47 @@ class ControlledRobot(Robot):
         Port("powerR", 0.0, "right wheel power", "%"),
     )
     outputs = POSE_OUTPUTS
-    params = ROVER_PARAMS
+    params = ROVER_PARAMS + POWER_PARAMS
+    fixed_once_running = frozenset(BODY_PARAMS | POWER_NAMES)
+    #: the battery and windings (``power.py``), None with an ideal supply (the default)
+    supply: PowerSupply | None = None
+
+    def initialize(self, ctx: Any) -> None:
+        super().initialize(ctx)
+        if power_on(self.p):
+            self.supply = PowerSupply(self.p)
+            self._since: Fraction | None = None
+            self._applied = (0.0, 0.0)
+
+    def supplied(self, t: Fraction, left: float, right: float) -> tuple[float, float]:
+        """The commanded powers as the supply and the windings leave them (``power.py``):
+        first the step that ends is charged to the battery and the windings."""
+        supply = self.supply
+        assert supply is not None
+        if self._since is not None and t > self._since:
+            w = self.rover.wheel
+            rims = self.rover.wheel_speeds()
+            forces = (
+                w.motor_force(self._applied[0], rims[0]),
+                w.motor_force(self._applied[1], rims[1]),
+            )
+            duties = (
+                abs(w.command(self._applied[0])) / 100.0,
+                abs(w.command(self._applied[1])) / 100.0,
+            )
+            supply.update(forces, duties, w.stall_force_n, float(t - self._since))
+        self._since = t
+        sl, sr = left * supply.scale[0], right * supply.scale[1]
+        # the driver saturates at +-100 % (rover.set_power): so does the duty drawn
+        self._applied = (max(-100.0, min(100.0, sl)), max(-100.0, min(100.0, sr)))
+        return self._applied
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
         """The paper's doStep: apply the commanded powers, publish the pose."""
-        self.rover.set_power(inp["powerL"], inp["powerR"])
+        if self.supply is None:
+            self.rover.set_power(inp["powerL"], inp["powerR"])
+        else:
+            self.rover.set_power(*self.supplied(t, inp["powerL"], inp["powerR"]))
         return self._pose()
 
     @classmethod
@@ -115,6 +152,16 @@ class ControlledRobot(Robot):
     ) -> tuple[Mapping[str, Any], None]:
         """``do_step`` for many copies at once (``engine/batch.py``)."""
         physics = comps[0].physics
+        if "supplied" not in state:
+            state["supplied"] = any(c.supply is not None for c in comps)
+        if state["supplied"]:  # per rover, as do_step (power.py)
+            left, right = np.array(inp["powerL"], dtype=float), np.array(inp["powerR"], dtype=float)
+            left = np.broadcast_to(left, (len(comps),)).copy()
+            right = np.broadcast_to(right, (len(comps),)).copy()
+            for i, c in enumerate(comps):
+                if c.supply is not None:
+                    left[i], right[i] = c.supplied(t, float(left[i]), float(right[i]))
+            inp = {**inp, "powerL": left, "powerR": right}
         if "index" not in state:
             state["index"] = physics.index_of([c.rover for c in comps])
         if "rovers" not in state:

@@ -26,9 +26,9 @@ SCENARIO1 = Path(__file__).resolve().parents[2] / "scenarios" / "scenario1.yaml"
 pytestmark = pytest.mark.skipif(not compiled.active(), reason="the batched step is the C step's")
 
 
-def _ramming(duration: float = 40) -> Scenario:
+def _ramming(duration: float = 55) -> Scenario:
     """Scenario1 with the follower driving into a leader that wanders: contacts that begin
-    and end inside runs of physics-only instants (at 35.77 s, 38.05 s, ...), and the
+    and end inside runs of physics-only instants (at 35.73 s, 50.47 s, 52.02 s), and the
     controller's delayed outputs arriving inside them too (0.48 s: 48 ticks after a 4 Hz
     instant), where a batch must stop."""
     sets = [
