@@ -14,8 +14,8 @@ documented; the control period is far below every time constant here):
 
 * motor current ``I_i = I_stall F_i / F_stall``, ``F_i`` the motor's force at the ground
   (current-limited), ``I_stall`` its stall current at ``V_motor``;
-* battery current ``I_b = max(0, sum_i d_i I_i)`` (a PWM driver draws its duty ``d_i`` of the
-  motor current; no regeneration);
+* battery current ``I_b = max(0, I_load + sum_i d_i I_i)`` (a PWM driver draws its duty ``d_i``
+  of the motor current; no regeneration; ``I_load`` the rest of the rover);
 * charge ``q -= I_b dt / (3600 Q)`` (capacity Q in A h), open-circuit voltage linear in the
   charge between ``batteryEmptyVoltage`` and ``batteryFullVoltage``, terminal voltage
   ``V = OCV(q) - I_b R``;
@@ -46,6 +46,15 @@ POWER_PARAMS: tuple[Param, ...] = (
     Param("batteryCharge", "float", "battery charge at the start", 100.0, 0.0, 100.0, "%"),
     Param("batteryFullVoltage", "float", "open-circuit voltage when full", 25.2, 0.1, 1e4, "V"),
     Param("batteryEmptyVoltage", "float", "open-circuit voltage when empty", 19.8, 0.0, 1e4, "V"),
+    Param(
+        "batteryLoad",
+        "float",
+        "the rest of the rover's constant draw (computer, sensors)",
+        0.0,
+        0.0,
+        1e4,
+        "A",
+    ),
     Param("batteryResistance", "float", "battery internal resistance", 0.05, 0.0, 100.0, "ohm"),
     Param(
         "motorVoltage",
@@ -186,6 +195,7 @@ class PowerSupply:
         self.motor_v = g("motorVoltage")
         self.stall_current = g("stallCurrent")
         self.limit, self.top = g("motorTempLimit"), g("motorTempMax")
+        self.load = g("batteryLoad")
         self.scale = (self.supply_ratio(), self.supply_ratio())
 
     def supply_ratio(self) -> float:
@@ -199,7 +209,9 @@ class PowerSupply:
         the step that ends, ``stall`` the stall force; sets :attr:`scale`."""
         ratios = [f / stall if stall > 0.0 else 0.0 for f in forces]
         if self.battery is not None:
-            drawn = sum(d * r * self.stall_current for d, r in zip(duties, ratios, strict=True))
+            drawn = self.load + sum(
+                d * r * self.stall_current for d, r in zip(duties, ratios, strict=True)
+            )
             self.battery.draw(max(0.0, drawn), dt)
         v = self.supply_ratio()
         if self.windings is None:
