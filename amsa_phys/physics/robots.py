@@ -153,13 +153,14 @@ class ControlledRobot(Robot):
         """``do_step`` for many copies at once (``engine/batch.py``)."""
         physics = comps[0].physics
         if "supplied" not in state:
-            state["supplied"] = any(c.supply is not None for c in comps)
+            # (freeRobot's batch step comes here too: it has no supply)
+            state["supplied"] = any(getattr(c, "supply", None) is not None for c in comps)
         if state["supplied"]:  # per rover, as do_step (power.py)
             left, right = np.array(inp["powerL"], dtype=float), np.array(inp["powerR"], dtype=float)
             left = np.broadcast_to(left, (len(comps),)).copy()
             right = np.broadcast_to(right, (len(comps),)).copy()
             for i, c in enumerate(comps):
-                if c.supply is not None:
+                if getattr(c, "supply", None) is not None:
                     left[i], right[i] = c.supplied(t, float(left[i]), float(right[i]))
             inp = {**inp, "powerL": left, "powerR": right}
         if "index" not in state:
