@@ -529,6 +529,10 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
             slide(ul, vl, f0l, rl, ivl, kx, ky, ixl, iyl, side0, cancel, &sc, &fxl, &fyl, &upl);
         if (sat_r)
             slide(ur, vr, f0r, rr, ivr, kx, ky, ixr, iyr, side0, cancel, &sc, &fxr, &fyr, &upr);
+        if (sat_l && !sat_r)
+            rim_and_tyre(ur, vr + sc.e2 * fxl, f0r, rr, kx * ivr, &sc, &fxr, &upr);
+        else if (sat_r && !sat_l)
+            rim_and_tyre(ul, vl + sc.e2 * fxr, f0l, rl, kx * ivl, &sc, &fxl, &upl);
         if (!sat_r) {
             double kg = ky_dt_m * ivr;
             fyr = (cancel - fyl) * kg / (1.0 + kg);
@@ -559,7 +563,9 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
             }
         }
         fx = fxl + fxr;
-        torque = (fxr - fxl) * h + scrub;
+        torque = (fxr - fxl) * h;
+        scrub = patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i);
+        torque += scrub;
         f_lat = fyl + fyr;
     }
     double fwx = fx * cm - f_lat * sm;

@@ -418,7 +418,12 @@ def rover_step(
             sc,
         )
         fx = fxl + fxr
-        torque = (fxr - fxl) * h + scrub
+        # the scrub again, implicit with the torque the tyres now give: the gripping solve's
+        # forces are those that cancel each slip within the step (~1/dt), so its torque
+        # saturated the scrub whatever the yaw rate
+        torque = (fxr - fxl) * h
+        scrub = patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i)
+        torque += scrub
         f_lat = fyl + fyr
     fwx = fx * cm - f_lat * sm
     fwy = fx * sm + f_lat * cm

@@ -15,7 +15,15 @@ import math
 
 from .forces import GRIP_FLOOR_N, LOAD_FLOOR
 from .rover import DiffDriveRover
-from .wheel import TORSION, WheelModel, slide, slip_speed, step_constants, wheel_pair
+from .wheel import (
+    TORSION,
+    WheelModel,
+    rim_and_tyre,
+    slide,
+    slip_speed,
+    step_constants,
+    wheel_pair,
+)
 
 
 def reference_forces(
@@ -94,6 +102,11 @@ def reference_forces(
             if slid[i]:
                 tyre = (kx, ky1, inv[2 * i], inv[2 * i + 1])
                 out[i] = slide(*args[i], tyre, side0, cancel, s)
+        if slid[0] != slid[1]:  # the gripping wheel again, its hub moved by the sliding force
+            i = 0 if slid[1] else 1
+            u_i, hub_i, f0_i, r_i, iv_i = args[i]
+            fx_i, up_i = rim_and_tyre(u_i, hub_i + s.e2 * out[1 - i][0], f0_i, r_i, kx * iv_i, s)
+            out[i] = (fx_i, out[i][1], up_i)
         for i in (0, 1):  # a gripping tyre takes, implicitly, what the sliding one leaves
             if slid[1 - i] and not slid[i]:
                 kg = ky1 / (sl, sr)[i] * dt / rover.mass
@@ -107,7 +120,9 @@ def reference_forces(
         if all(slid) and (fyl + fyr) * cancel > 0 and abs(fyl + fyr) > abs(cancel):
             fyl, fyr = fyl * cancel / (fyl + fyr), fyr * cancel / (fyl + fyr)
         fx = fxl + fxr
-        torque = (fxr - fxl) * rover.half_track + scrub
+        # the scrub again, with the torque the tyres now give
+        torque = (fxr - fxl) * rover.half_track
+        torque += _scrub(w, torque, (sphi / vl, sphi / vr), caps, dt / body.moment)
         f_lat = fyl + fyr
     return (
         fx * math.cos(mid) - f_lat * math.sin(mid),

@@ -548,7 +548,9 @@ def slide_pair(
 ) -> tuple[float, float, float, float, float, float]:
     """Both wheels when at least one tyre slides: ``(F_xL, F_yL, u_L+, F_xR, F_yR, u_R+)``.
 
-    Each sliding tyre's force is the tyre law solved with its rim (:func:`slide`). The lateral
+    Each sliding tyre's force is the tyre law solved with its rim (:func:`slide`); a wheel
+    that still grips is solved again (:func:`rim_and_tyre`) with its hub moved by the sliding
+    one's force through the yaw, not by the gripping solve's for it. The lateral
     force a gripping tyre gave in the gripping solve was its share (by stiffness) of the force
     that brings the body's sideways velocity to its implicit end value with *both* tyres
     gripping; once the other slides, that share is wrong, and capping the sliding tyre at its
@@ -572,6 +574,12 @@ def slide_pair(
         fxl, fyl, upl = slide(ul, vl, f0l, rl, ivl, (kx, ky, ixl, iyl), side, cancel, s)
     if sat_r:
         fxr, fyr, upr = slide(ur, vr, f0r, rr, ivr, (kx, ky, ixr, iyr), side, cancel, s)
+    # a gripping wheel again, its hub moved by the sliding one's force (the joint solve had
+    # the other's gripping force, ~1/dt, which made this one's an O(1) error)
+    if sat_l and not sat_r:
+        fxr, upr = rim_and_tyre(ur, vr + s.e2 * fxl, f0r, rr, kx * ivr, s)
+    elif sat_r and not sat_l:
+        fxl, upl = rim_and_tyre(ul, vl + s.e2 * fxr, f0l, rl, kx * ivl, s)
     if not sat_r:  # the gripping tyre takes, implicitly, what the sliding one leaves
         kg = ky_dt_m * ivr
         fyr = (cancel - fyl) * kg / (1.0 + kg)
