@@ -75,10 +75,13 @@ def verdict(ok: bool) -> str:
 
 #: The sitting's rows when ``--save`` is given (``report`` adds each line to it).
 RECORDER: results.Recorder | None = None
+#: Standard output while ``--save`` records (the PASS/MISS lines other benchmarks print).
+TEE: results.Tee | None = None
 
 
 def report(name: str, measured: str, target: str, ok: bool) -> None:
-    print(f"{verdict(ok)}  {name:34s} {measured}   target {target}", flush=True)
+    with results.quiet(TEE):
+        print(f"{verdict(ok)}  {name:34s} {measured}   target {target}", flush=True)
     if RECORDER is not None:
         RECORDER.add(name, measured, target, ok)
 
@@ -446,9 +449,11 @@ def main() -> None:
         help="write the figures to benchmarks/results/perf.json and regenerate the docs' tables",
     )
     args = ap.parse_args()
-    global RECORDER
+    global RECORDER, TEE
     if args.save:
         RECORDER = results.Recorder(args.reps)
+        TEE = results.Tee(sys.stdout, RECORDER)
+        sys.stdout = TEE
     print(
         f"# {os.cpu_count()} cores, Python {sys.version.split()[0]}, "
         f"median of {args.reps} (min, max)",

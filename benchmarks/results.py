@@ -17,7 +17,9 @@ such a block. ``python -m benchmarks.results`` rewrites the blocks without measu
 
 from __future__ import annotations
 
+import contextlib
 import datetime
+import io
 import json
 import os
 import re
@@ -35,6 +37,8 @@ BLOCK = re.compile(r"(<!-- results: ([\w ,-]+?) -->\n)(.*?)(<!-- /results -->)",
 
 #: ``median (min A, max B)`` as ``perf.med`` prints it, then whatever the line adds.
 _MED = re.compile(r"^\s*(-?[\d.e+-]+) \(min (-?[\d.e+-]+), max (-?[\d.e+-]+)\)(.*)$", re.DOTALL)
+_MED_ANYWHERE = re.compile(r"(-?[\d.]+(?:e[+-]?\d+)?) \(min (-?[\d.e+-]+), max (-?[\d.e+-]+)\)")
+_AIM = re.compile(r"(?:target |\()([<>]=? ?[\d.,]+ ?[a-zA-Z]*)")
 _NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e[+-]?\d+)?")
 
 
@@ -113,7 +117,31 @@ class Recorder:
         self.load_before = os.getloadavg()[0]
 
     def add(self, figure: str, measured: str, aim: str, ok: bool) -> None:
+        """A line of ``perf.report``: name, measured text, aim and verdict apart."""
         value, spread, detail = parse_measured(measured)
+        self.add_row(figure, value, spread, detail, aim, ok)
+
+    def add_line(self, line: str) -> None:
+        """A PASS/MISS line printed by a benchmark of its own (``bench_engine``,
+        ``bench_batch``): kept whole as the figure, its median and aim read from it."""
+        ok, _, text = line.strip().partition(" ")
+        text = text.strip()
+        med = _MED_ANYWHERE.search(text)
+        value, spread = None, None  # the line itself, shown whole, says what it measured
+        if med:
+            value, spread = float(med[1]), [float(med[2]), float(med[3])]
+        aim = _AIM.search(text)
+        self.add_row(text, value, spread, "", aim[1] if aim else "", ok == "PASS")
+
+    def add_row(
+        self,
+        figure: str,
+        value: float | None,
+        spread: list[float] | None,
+        detail: str,
+        aim: str,
+        ok: bool,
+    ) -> None:
         self.rows.append(
             Row(
                 target=self.target,
@@ -137,6 +165,39 @@ class Recorder:
         rows = kept + [asdict(r) for r in self.rows]
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps({"rows": rows}, indent=1) + "\n")
+
+
+class Tee(io.TextIOBase):
+    """Standard output that also hands the PASS/MISS lines of benchmarks printing their own
+    to the recorder (lines that ``perf.report`` printed are recorded there, not here)."""
+
+    def __init__(self, out: Any, recorder: Recorder) -> None:
+        self.out, self.recorder, self.buffer_ = out, recorder, ""
+        self.quiet = False  #: set while ``perf.report`` prints a line it records itself
+
+    def write(self, text: str) -> int:
+        self.out.write(text)
+        self.buffer_ += text
+        *lines, self.buffer_ = self.buffer_.split("\n")
+        for line in lines:
+            if not self.quiet and line.startswith(("PASS", "MISS")):
+                self.recorder.add_line(line)
+        return len(text)
+
+    def flush(self) -> None:
+        self.out.flush()
+
+
+@contextlib.contextmanager
+def quiet(tee: Tee | None) -> Any:
+    """Within it the tee records nothing (the caller records the line itself)."""
+    if tee is not None:
+        tee.quiet = True
+    try:
+        yield
+    finally:
+        if tee is not None:
+            tee.quiet = False
 
 
 def load(path: Path = RESULTS) -> list[dict[str, Any]]:

@@ -235,3 +235,32 @@ def test_a_generated_block_is_skipped_and_checked() -> None:
         assert shown in fresh
     assert results.fill(fresh, rows) == fresh
     assert "Not measured yet" in results.fill(stale, [])
+
+
+def test_a_benchmarks_own_lines_are_recorded(tmp_path: Path) -> None:
+    """``perf.py --save`` keeps the PASS/MISS lines of benchmarks that print their own, with
+    the median, spread, aim, load and commit; a sitting replaces only its targets' rows."""
+    recorder = results.Recorder(reps=3)
+    recorder.start("engine")
+    tee = results.Tee(open(tmp_path / "out", "w"), recorder)  # noqa: SIM115
+    print(
+        "PASS  platoon 1,000 rovers: 44.0 (min 35.1, max 44.2)x real time (target >= 40x)", file=tee
+    )
+    print("info  not a figure", file=tee)
+    with results.quiet(tee):  # perf.report records its own lines
+        print("MISS  recorded elsewhere 1 (min 1, max 2)", file=tee)
+    (row,) = recorder.rows
+    assert (row.value, row.spread, row.target_text, row.verdict) == (
+        44.0,
+        [35.1, 44.2],
+        ">= 40x",
+        "PASS",
+    )
+    assert len(row.load) == 2
+    assert row.commit
+    path = tmp_path / "perf.json"
+    path.write_text(
+        '{"rows": [{"target": "gym", "figure": "kept"}, {"target": "engine", "figure": "old"}]}'
+    )
+    recorder.save(path)
+    assert [r["figure"] for r in results.load(path)] == ["kept", row.figure]
