@@ -68,7 +68,7 @@ def test_the_first_python_example_evaluates_its_checks(work: Path) -> None:
     namespace: dict[str, object] = {}
     printed = io.StringIO()
     with contextlib.redirect_stdout(printed):
-        exec(compile(code, "README.md", "exec"), namespace)  # noqa: S102 (our own README)
+        exec(compile(code, "README.md", "exec"), namespace)  # our own README's example
     run = namespace["run"]
     checks = run.checks  # type: ignore[attr-defined]
     assert checks, "the example's scenario has checks"

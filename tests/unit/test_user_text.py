@@ -47,7 +47,10 @@ ALWAYS = [
 #: 2.9 % rolling resistance and a 1 MiB chunk are not).
 CONTEXTUAL = [
     re.compile(rf"{_RANGE}\s*ms\b"),
-    re.compile(rf"{_RANGE}\s*s\b(?!/)"),
+    # seconds, but not a simulated duration ("300 s simulated", "30 s runs", "runs of 60 s")
+    re.compile(
+        rf"(?<!runs of )(?<![\d.,]){_RANGE}\s*s\b(?!/)(?!\s*(?:simulated|runs?\b|episodes?\b))"
+    ),
     re.compile(rf"{_RANGE}\s*(?:KiB|MiB|GiB|MB|GB)\b"),
     re.compile(rf"{_RANGE}\s*%"),
 ]
@@ -189,6 +192,7 @@ PHYSICS = [
     "motors that take ~10 s to change speed; the 7.5 s peak is 78 % of it.",
     "| optimizer | Fig. 5 box | CPU a search |\n| --- | --- | --- |\n| CMA | 5/5 (100.0 %) | x |",
     "A low-cost 2D scanner (31 beams, 2 % dropouts)",
+    "scenario1 (300 s simulated) as a real-time factor; 1,000 runs of 60 s, 30 s runs",
     "Kv = 0.35 peaks at 18–19 m after the start-up; from t = 100 s it settles.",
 ]
 
