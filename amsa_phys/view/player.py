@@ -40,10 +40,11 @@ HELP = [
     "pgdn pgup     next / previous phase start",
     "click, drag   the slider: seek",
     "] [ or + -    faster / slower",
-    "g             plot signals (list: type to filter,",
+    "g             plot signals (list: / filters,",
     "              enter picks / drops, g closes)",
     "c             camera: fit, then follow each rover",
-    "z x, wheel    zoom in / out",
+    "z x           zoom about the rover followed",
+    "wheel         zoom about the mouse",
     "h or F1       this help (any other key closes it)",
     "q or esc      quit",
 ]
@@ -240,10 +241,10 @@ class Player:
         elif key == pygame.K_c:
             self.notice = "camera: " + self.camera.cycle(self.scene.rover_names)
             self._notice_row = None  # not about an instant: it stays
-        elif key == pygame.K_z:
-            self.camera.zoom(1.25)
-        elif key == pygame.K_x:
-            self.camera.zoom(1 / 1.25)
+        elif key in (pygame.K_z, pygame.K_x):
+            factor = 1.25 if key == pygame.K_z else 1 / 1.25
+            self.notice = "camera: " + self.camera.key_zoom(factor, self.scene.rover_names)
+            self._notice_row = None  # not about an instant: it stays
         elif key in (pygame.K_UP, pygame.K_DOWN):
             self.camera.pan(0, 60 if key == pygame.K_UP else -60)
         elif key in (pygame.K_h, pygame.K_F1):
