@@ -282,9 +282,9 @@ class Player:
         points = [(r.x, r.y, r.name) for r in frame.rovers]
         cam.update(points, 0.05 if self.playing else 1e9)
         for _ in range(2):
-            room = (cam.top, cam.right)
+            room = (cam.top, cam.right, cam.left)
             self._paint(frame)
-            if (cam.top, cam.right) == room:
+            if (cam.top, cam.right, cam.left) == room:
                 break
             cam.update(points, 0.05 if self.playing else 1e9)
         pygame.display.flip()
@@ -296,7 +296,7 @@ class Player:
         self.renderer.draw(view, frame, cam, self.status(), self.shown_notice())
         cam.top = max(box.bottom for box in self.renderer.boxes.values()) + 6  # under the HUD
         self._slider()
-        right = draw_side_panes(
+        right, left = draw_side_panes(
             self.screen,
             self.renderer,
             self.picker,
@@ -307,6 +307,7 @@ class Player:
         )
         # beside the help or the signal list
         cam.right = self.view_rect.right - right.left if right is not None else 0
+        cam.left = left.right if left is not None else 0
 
     def scene_series(self, name: str, span_s: float) -> tuple[np.ndarray, np.ndarray]:
         """The pane's samples of ``name`` up to the row shown (the replay's whole history)."""

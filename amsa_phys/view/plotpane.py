@@ -243,11 +243,12 @@ def draw_side_panes(
     show_help: bool,
     help_lines: list[str],
     area: pygame.Rect,
-) -> pygame.Rect | None:
-    """The plot pane (bottom right), the signal list and the help (right), under the HUD.
+) -> tuple[pygame.Rect | None, pygame.Rect | None]:
+    """The plot pane (bottom right), the signal list and the help (right, or left when it
+    would reach the pane), under the HUD.
 
-    Returns the box of the list or help drawn at the right (None if neither is open): the
-    camera frames the rovers beside it, so the key list never hides the leader.
+    Returns the boxes drawn at the right and at the left (None where nothing is): the
+    camera frames the rovers beside them, so the key list never hides the leader.
     """
     top = max(box.bottom for box in renderer.boxes.values()) + 6 if renderer.boxes else 10
     pane = pane_rect(area, picker)
@@ -260,12 +261,21 @@ def draw_side_panes(
         if picker.message:
             lines.append(picker.message)
             colours.append(INK)
-        at = (beside_pane(screen, pane, top, len(lines), line_px), top)
-        return renderer.panel(screen, lines, colours, at, align_right=True)
+        margin, width = beside_pane(screen, pane, top, len(lines), line_px)
+        box = renderer.panel(screen, lines, colours, (margin, top), align_right=True, width=width)
+        return box, None
     if show_help:
-        at = (beside_pane(screen, pane, top, len(help_lines), line_px), top)
-        return renderer.panel(screen, help_lines, [INK] * len(help_lines), at, align_right=True)
-    return None
+        ink = [INK] * len(help_lines)
+        if reaches_pane(pane, top, len(help_lines), line_px):  # at the left, clear of it
+            return None, renderer.panel(screen, help_lines, ink, (10, top), align_right=False)
+        return renderer.panel(screen, help_lines, ink, (10, top), align_right=True), None
+    return None, None
+
+
+def reaches_pane(pane: pygame.Rect | None, top: int, n_lines: int, line_px: int) -> bool:
+    """Whether a box of ``n_lines`` drawn from ``top`` at the right would reach down to the
+    plot pane (the help drawn over the pane, or under it, hid both): it goes at the left."""
+    return pane is not None and top + n_lines * line_px + 12 >= pane.top
 
 
 def pane_rect(area: pygame.Rect, picker: SignalPicker) -> pygame.Rect | None:
@@ -279,10 +289,10 @@ def pane_rect(area: pygame.Rect, picker: SignalPicker) -> pygame.Rect | None:
 
 def beside_pane(
     screen: pygame.Surface, pane: pygame.Rect | None, top: int, n_lines: int, line_px: int
-) -> int:
-    """The right margin of a box of ``n_lines`` drawn at the right from ``top``: 10 px, or
-    left of the plot pane when it would reach down to it (the help or the list drawn over
-    the pane hid both)."""
+) -> tuple[int, int | None]:
+    """(right margin, width) of a box of ``n_lines`` drawn at the right from ``top``: 10 px
+    and the frame's width, or left of the plot pane, in the room left of it, when the box
+    would reach down to the pane (the help or the list drawn over the pane hid both)."""
     if pane is None or top + n_lines * line_px + 12 < pane.top:
-        return 10
-    return screen.get_width() - pane.left + 10
+        return 10, None
+    return screen.get_width() - pane.left + 10, pane.left - 20

@@ -30,10 +30,10 @@ from .pg import pygame
 from .plotpane import (
     LiveSeries,
     SignalPicker,
-    beside_pane,
     draw_side_panes,
     pane_rect,
     picker_key,
+    reaches_pane,
 )
 from .recorder import Recorder
 from .scene import Frame, Scene
@@ -374,15 +374,18 @@ class Window:
             self.camera.left = 0
         right = None
         area = self.screen.get_rect()
-        listed = draw_side_panes(
+        listed, _ = draw_side_panes(
             self.screen, self.renderer, self.picker, self.series.series, False, [], area
         )
-        if self.show_help and listed is None:  # after the pane, and beside it: never under
+        if self.show_help and listed is None:  # after the pane, never under it
             y = fitting(len(HELP))
-            x = beside_pane(self.screen, pane_rect(area, self.picker), y, len(HELP), line_px)
-            right = self.renderer.panel(
-                self.screen, HELP, [INK] * len(HELP), (x, y), align_right=True
-            )
+            ink = [INK] * len(HELP)
+            if reaches_pane(pane_rect(area, self.picker), y, len(HELP), line_px):
+                if not self.panel.visible:  # at the left, clear of the pane
+                    box = self.renderer.panel(self.screen, HELP, ink, (10, y), align_right=False)
+                    self.camera.left = box.right
+            else:
+                right = self.renderer.panel(self.screen, HELP, ink, (10, y), align_right=True)
         right = listed or right
         # the help and the signal list sit at the right: the rovers are framed beside them
         self.camera.right = area.right - right.left if right is not None else 0

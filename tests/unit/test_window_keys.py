@@ -19,7 +19,13 @@ from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.view.camera import Camera
 from amsa_phys.view.panel import ParamPanel
-from amsa_phys.view.plotpane import SignalPicker, beside_pane, pane_rect, picker_key
+from amsa_phys.view.plotpane import (
+    SignalPicker,
+    beside_pane,
+    pane_rect,
+    picker_key,
+    reaches_pane,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 ROVERS = [(0.0, 0.0, "Leader"), (-15.0, 0.0, "Follower")]
@@ -60,7 +66,7 @@ def test_c_is_the_cameras_key_with_the_signal_list_open() -> None:
     assert not picker_key(picker, pygame.K_z, "z")
 
 
-def test_the_help_goes_beside_the_plot_pane_not_under_it() -> None:
+def test_the_help_and_the_list_keep_clear_of_the_plot_pane() -> None:
     pygame.display.init()
     try:
         screen = pygame.Surface((1000, 700))
@@ -68,10 +74,15 @@ def test_the_help_goes_beside_the_plot_pane_not_under_it() -> None:
         picker.picked = ["a"]
         pane = pane_rect(screen.get_rect(), picker)
         assert pane is not None
-        margin = beside_pane(screen, pane, 40, 30, 18)  # 30 lines from y=40 reach the pane
+        margin, width = beside_pane(screen, pane, 40, 30, 18)  # 30 lines reach the pane
         assert screen.get_width() - margin <= pane.left  # its right edge left of the pane
-        assert beside_pane(screen, pane, 40, 3, 18) == 10  # short: at the right as before
-        assert beside_pane(screen, None, 40, 30, 18) == 10
+        assert width is not None
+        assert width <= pane.left - 10  # and it wraps within the room left of it
+        assert beside_pane(screen, pane, 40, 3, 18) == (10, None)  # short: as before
+        assert beside_pane(screen, None, 40, 30, 18) == (10, None)
+        assert reaches_pane(pane, 40, 30, 18)  # the help of 30 lines goes at the left
+        assert not reaches_pane(pane, 40, 3, 18)
+        assert not reaches_pane(None, 40, 30, 18)
     finally:
         pygame.display.quit()
 
