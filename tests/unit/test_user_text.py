@@ -280,3 +280,25 @@ def test_a_benchmarks_own_lines_are_recorded(tmp_path: Path) -> None:
     )
     recorder.save(path)
     assert [r["figure"] for r in results.load(path)] == ["kept", row.figure]
+
+
+def _perf_targets() -> set[str]:
+    """The names ``perf.py --only`` takes (read from its source: importing it loads every
+    benchmark)."""
+    import ast
+
+    tree = ast.parse((ROOT / "benchmarks" / "perf.py").read_text())
+    for node in ast.walk(tree):
+        if isinstance(node, ast.AnnAssign) and getattr(node.target, "id", "") == "TARGETS":
+            assert isinstance(node.value, ast.Dict)
+            return {k.value for k in node.value.keys if isinstance(k, ast.Constant)}
+    raise AssertionError("no TARGETS in benchmarks/perf.py")
+
+
+@pytest.mark.parametrize("page", PAGES, ids=_name)
+def test_every_block_names_a_target_perf_measures(page: Path) -> None:
+    targets = _perf_targets()
+    assert "gym" in targets
+    for m in results.BLOCK.finditer(page.read_text()):
+        unknown = set(m[2].replace(",", " ").split()) - targets
+        assert not unknown, f"{_name(page)}: no perf.py target {sorted(unknown)}"
