@@ -209,7 +209,7 @@ def run_batch(jobs: Sequence[Job], stats: dict[str, int] | None = None) -> list[
                     counts["contacts"] += 1
                     counts["at_start"] += 1
                 continue  # the rest as a batch of their own, built again without them
-            sim.run()
+            _run_whole(sim)
         except RunFault as exc:
             k = sim.run_of(exc)
             if k is None:  # not any one run's: each alone says what it is
@@ -230,6 +230,17 @@ def run_batch(jobs: Sequence[Job], stats: dict[str, int] | None = None) -> list[
             rows[job.index] = fill_metrics(job_row(job), metrics)
         break
     return [rows[job.index] for job in jobs]
+
+
+def _run_whole(sim: MultiRun) -> None:
+    """Run the batch to its end. A Ctrl-C noted meanwhile is raised by the engine once the
+    last instant has run: the batch is then whole, so its rows are kept and the caller
+    (``iter_batched``, between units) raises the Ctrl-C after them."""
+    try:
+        sim.run()
+    except KeyboardInterrupt:
+        if not sim.finished:
+            raise
 
 
 def run_unit(unit: Unit) -> list[dict[str, Any]]:

@@ -88,3 +88,24 @@ def test_no_summary_is_drawn_when_no_run_finished(
     assert main(argv) == 130
     assert (out / "results.csv").exists()
     assert not (out / "summary.png").exists()
+
+
+def test_a_batch_run_whole_keeps_its_rows_when_ctrl_c_came_meanwhile() -> None:
+    """In-process (``-j 1``) the engine raises a Ctrl-C noted during a batch once the batch's
+    last instant has run: the batch is whole, its rows are kept, and the Ctrl-C comes after."""
+    from amsa_phys.runs.batched import run_batch
+
+    plan = SweepPlan(
+        SCENARIO1,
+        [Axis("MyFollowerController.Kv", (0.1, 0.2))],
+        seeds=2,
+        base_seed=1,
+        duration=5,
+    )
+    with interrupt.deferred():
+        interrupt.request()  # as a Ctrl-C during the batch
+        rows = run_batch(plan.jobs())
+        assert [r["error"] for r in rows] == ["", "", "", ""]
+        assert all(isinstance(r["rms_error"], float) for r in rows)
+        with pytest.raises(KeyboardInterrupt):
+            interrupt.check()
