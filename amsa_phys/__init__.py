@@ -23,6 +23,7 @@ _LAZY = {
     "Run": ".api.result",
     "TraceSizeWarning": ".api.memory",
     "OverrideWarning": ".runs.overrides",
+    "ReferenceWarning": ".runs.references",
     "load": ".api.source",
     "validate": ".api.source",
     "AmsaError": ".errors",
@@ -45,6 +46,7 @@ __all__ = [  # noqa: RUF022  grouped as the README lists them
     "Run",
     "TraceSizeWarning",
     "OverrideWarning",
+    "ReferenceWarning",
     "load",
     "validate",
     "AmsaError",
@@ -71,6 +73,7 @@ if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eag
     from .model.template import Kind, Port, Template
     from .model.world import load_world
     from .runs.overrides import OverrideWarning
+    from .runs.references import ReferenceWarning
     from .runs.single import run_scenario
 
 

@@ -1,9 +1,11 @@
 """Every performance target of the project, measured in one go: value, baseline, PASS/MISS.
 
-Run: ``python benchmarks/perf.py [--reps 5] [--only NAME ...]``. Each figure is the median of
-``--reps`` repetitions (min and max shown); each baseline is measured in the same run, in the
-same process where the target says so, because these machines are noisy and only ratios
-compare. Targets (issue "Performance"):
+Run: ``python -m benchmarks.perf [--reps 5] [--only NAME ...] [--save]``. Each figure is the
+median of ``--reps`` repetitions (min and max shown); each baseline is measured in the same
+run, in the same process where the target says so, because these machines are noisy and only
+ratios compare. ``--save`` writes every PASS/MISS line to ``benchmarks/results/perf.json`` (with the
+load, date and commit) and regenerates the docs' tables from it (``benchmarks/results.py``).
+Targets:
 
 * headless run of scenario1 (300 s, 100 Hz physics, 8 components, trace at 20 Hz):
   >= 1000x real time in-process, and <= 1.2x the time of a bare loop stepping the same two
@@ -15,13 +17,13 @@ compare. Targets (issue "Performance"):
 * sweeps: speed-up from -j 1 to -j N >= 0.9 N;
 * memory: peak RSS of a 1-hour run and of a 1-hour recording within 1.5x of a 1-minute one;
 * plots never slow the run: a 200-rover, 30 s run with plots <= 1.3x the same run without;
-* start-up (issue 29): the whole ``run --headless`` process of scenario1 (300 s), CPU of the
+* start-up: the whole ``run --headless`` process of scenario1 (300 s), CPU of the
   process and its children, <= 15x ``python -c pass`` without plots and <= 40x with plots;
-* the Gymnasium env (issue 29): >= 20,000 steps/s (one env, constant action); the vector env
+* the Gymnasium env: >= 20,000 steps/s (one env, constant action); the vector env
   >= 50,000 env-steps/s with 1,000 envs;
 * batched sweeps (``bench_batch.py``): 1,000 runs of scenario1 <= 5 s on 2 cores and >= 10x
   the process pool; 10,000 runs <= 60 s with RSS <= 1.5x that of 1,000;
-* the engine (``bench_engine.py``, issues 29 and 32): batched sweep >= 5x the process pool
+* the engine (``bench_engine.py``): batched sweep >= 5x the process pool
   for scenario1 and scenario2 at 1,000 runs of 60 s, 1,000 scenario2 runs <= 5 s; the
   1,000-rover platoon >= 40x real time with the cost per rover-step flat from 200 to 1,000
   rovers; the API run of scenario1; the vector env >= 50,000 env-steps/s at 1,000 envs.
@@ -52,6 +54,7 @@ import bench_plots
 import bench_record
 import bench_run
 import bench_sweep
+import results
 import yaml
 
 from amsa_phys.engine.runner import Simulation
@@ -70,8 +73,17 @@ def verdict(ok: bool) -> str:
     return "PASS" if ok else "MISS"
 
 
+#: The sitting's rows when ``--save`` is given (``report`` adds each line to it).
+RECORDER: results.Recorder | None = None
+#: Standard output while ``--save`` records (the PASS/MISS lines other benchmarks print).
+TEE: results.Tee | None = None
+
+
 def report(name: str, measured: str, target: str, ok: bool) -> None:
-    print(f"{verdict(ok)}  {name:34s} {measured}   target {target}", flush=True)
+    with results.quiet(TEE):
+        print(f"{verdict(ok)}  {name:34s} {measured}   target {target}", flush=True)
+    if RECORDER is not None:
+        RECORDER.add(name, measured, target, ok)
 
 
 # -- headless run ----------------------------------------------------------------------------
@@ -131,7 +143,7 @@ def _child_cpu(argv: list[str]) -> float:
 def _compile_package() -> None:
     """Byte-compile the package, as installing a wheel does: an editable install in an
     environment with PYTHONDONTWRITEBYTECODE=1 otherwise compiles every module from source
-    in every measured process (+90 ms a run: the 19-22x measured before issue 29's work)."""
+    in every measured process (+90 ms a run)."""
     import compileall
 
     compileall.compile_dir(str(ROOT / "amsa_phys"), quiet=1)
@@ -251,7 +263,7 @@ def _vec_episode(make: Any, n: int, random: bool, seed: int) -> tuple[float, flo
         steps += 1
         done = bool(truncated.all())
     rate = n * steps / (time.process_time() - t0)
-    alone = len(getattr(vec._episode, "solo", ()))  # 0 before the columns (issue 29)
+    alone = len(getattr(vec._episode, "solo", ()))  # 0 before the column store
     vec.close()
     return rate, float(alone)
 
@@ -403,7 +415,7 @@ def plots(reps: int) -> None:
 
 
 def batched(reps: int) -> None:
-    """Batched sweeps (issue 18): 1,000 and 10,000 runs against the pool (bench_batch.py)."""
+    """Batched sweeps: 1,000 and 10,000 runs against the pool (bench_batch.py)."""
     bench_batch.targets()
 
 
@@ -415,12 +427,12 @@ TARGETS: dict[str, Callable[[int], None]] = {
     "sweeps": sweeps,
     "memory": memory,
     "plots": plots,
-    # issue 19: compiled step vs pure, process, --help, 1,000-rover platoon (bench_compiled.py)
+    # compiled step vs pure, process, --help, 1,000-rover platoon (bench_compiled.py)
     "compiled": lambda reps: bench_compiled.run_all(reps, report),
     "batched": batched,
-    "startup": startup,  # issue 29: whole process vs python -c pass
+    "startup": startup,  # whole process vs python -c pass
     "gym": gym_env,
-    # issues 29/32: the column store and the run axis (bench_engine.py): batched vs pool for
+    # the column store and the run axis (bench_engine.py): batched vs pool for
     # scenario1 and scenario2, the 1,000-rover platoon, the API run, the vector env
     "engine": lambda reps: [bench_engine.TARGETS[n](reps) for n in bench_engine.TARGETS],
 }
@@ -431,14 +443,29 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--only", nargs="*", choices=list(TARGETS), default=list(TARGETS))
+    ap.add_argument(
+        "--save",
+        action="store_true",
+        help="write the figures to benchmarks/results/perf.json and regenerate the docs' tables",
+    )
     args = ap.parse_args()
+    global RECORDER, TEE
+    if args.save:
+        RECORDER = results.Recorder(args.reps)
+        TEE = results.Tee(sys.stdout, RECORDER)
+        sys.stdout = TEE
     print(
         f"# {os.cpu_count()} cores, Python {sys.version.split()[0]}, "
         f"median of {args.reps} (min, max)",
         flush=True,
     )
     for name in args.only:
+        if RECORDER is not None:
+            RECORDER.start(name)
         TARGETS[name](args.reps if name != "memory" else max(1, min(args.reps, 3)))
+    if RECORDER is not None:
+        RECORDER.save()
+        results.write_pages()
 
 
 if __name__ == "__main__":

@@ -39,6 +39,7 @@ from ..model.scenario import (
 from ..model.world import build_world
 from ..model.yamlio import MAX_DEPTH, MAX_NODES, KeyPath, YamlDoc, dotted, load_yaml
 from ..runs.overrides import OverrideWarning, timeline_notes
+from ..runs.references import ReferenceWarning, reference_notes
 
 #: What errors in a scenario given as a mapping name instead of a file.
 MAPPING = "<mapping>"
@@ -128,6 +129,8 @@ def _load(
         raise TypeError(f"expected a scenario file path or a mapping, got {type(source).__name__}")
     for note in timeline_notes(scenario, overrides, "set="):  # as the CLI's warning: lines
         warnings.warn(note, OverrideWarning, stacklevel=caller_level())
+    for note in reference_notes(scenario):
+        warnings.warn(note, ReferenceWarning, stacklevel=caller_level())
     return scenario
 
 

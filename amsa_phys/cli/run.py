@@ -14,6 +14,7 @@ from ..model.tracecols import LARGE_TRACE_BYTES, estimate_trace_bytes, size_text
 from ..runs.expect import check_expectations
 from ..runs.overrides import timeline_notes
 from ..runs.plotjob import PlotJob
+from ..runs.references import reference_notes
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
 from ..runs.suite import input_files
@@ -83,6 +84,8 @@ def _run(
     if args.no_adapt:
         scenario = without_adapt(scenario)
     for note in timeline_notes(scenario, args.overrides, "--set"):  # as the sweep warns
+        print(one_line(f"warning: {note}"), file=sys.stderr)
+    for note in reference_notes(scenario):
         print(one_line(f"warning: {note}"), file=sys.stderr)
     if snapshot is not None and snapshot.at is not None and snapshot.at > scenario.duration:
         raise ConfigError(

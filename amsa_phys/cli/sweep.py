@@ -206,18 +206,9 @@ def run(args: argparse.Namespace) -> int:
     # process with -15 and no summary.png)
     with interrupt.sigterm_as_ctrl_c(), interrupt.deferred():
         write_results(rows, keys, out / "results.csv")
-        from ..plots.summary import plot_summary  # matplotlib: only once the rows are in
-
-        plot_summary(
-            rows,
-            keys,
-            plan.metric,
-            out / "summary.png",
-            one_line(
-                f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})"
-                + (f"; interrupted: {len(rows)} of {len(jobs)} runs" if interrupted else "")
-            ),
-        )
+        drawn = any(not r["error"] for r in rows)  # nothing to draw: no picture saying so
+        if drawn:
+            _summary(rows, keys, plan, out, name, interrupted, len(jobs))
         late = interrupt.requested()
     failed = [r for r in rows if r["error"]]
     print(
@@ -235,6 +226,30 @@ def run(args: argparse.Namespace) -> int:
             f"interrupted after the sweep's last run; its outputs are complete in {out}"
         )
     return 0
+
+
+def _summary(
+    rows: list[dict[str, Any]],
+    keys: list[str],
+    plan: Any,
+    out: Path,
+    name: str,
+    interrupted: bool,
+    planned: int,
+) -> None:
+    """``summary.png`` of the completed rows (only called when there is one)."""
+    from ..plots.summary import plot_summary  # matplotlib: only once the rows are in
+
+    plot_summary(
+        rows,
+        keys,
+        plan.metric,
+        out / "summary.png",
+        one_line(
+            f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})"
+            + (f"; interrupted: {len(rows)} of {planned} runs" if interrupted else "")
+        ),
+    )
 
 
 def rows_from(jobs: list[Job], args: argparse.Namespace) -> Iterator[dict[str, Any]]:

@@ -41,6 +41,7 @@ class FollowerController(Template):
 
     kind = Kind.CONTROLLER
     uses_random = False
+    setpoints = frozenset({"distanceRef"})
     inputs = (
         Port("xLeader", 0.0, "leader x (GPS)", "m"),
         Port("yLeader", 0.0, "leader y (GPS)", "m"),

@@ -44,6 +44,10 @@ class RunLog:
         # arrays instead of ~5 MiB of float objects in lists
         self._samples_t = array("d")
         self._samples_s = array("d")
+        #: True while the quality signal holds no measurement yet (its port's initial value
+        #: until a free-mode ROS node's first message): no sample is taken, so the metrics
+        #: never count a value nothing measured. The run's owner clears it.
+        self.quality_waits = False
         self.listeners: list[Listener] = []
         cols = [at(c) for c in self.columns]
         #: one row of the trace in column order, gathered in C
@@ -62,7 +66,7 @@ class RunLog:
         row, quality sample, listeners (given the values by name)."""
         if self._trace is not None:
             self._trace(t_s, self.row(values))  # type: ignore[arg-type]
-        if self._quality is not None:
+        if self._quality is not None and not self.quality_waits:
             self._samples_t.append(t_s)
             self._samples_s.append(values[self._quality])
         if self.listeners:

@@ -358,6 +358,14 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
         known = list(err.schema.get("properties", {}))
         extra = [k for k in inst if k not in known]
         key = extra[0] if extra else "?"
+        if not path and "world" in extra and "components" not in inst and "components" in known:
+            # a scenario where a world is wanted (``graph``, ``export amsa``, a world: naming a
+            # scenario): say which is which, as the reverse case does
+            named = inst["world"] if isinstance(inst["world"], str) else "its world"
+            return ("world",), (
+                "this is a scenario file (it names its world: here); a world file is expected "
+                f"— give the world it names ({short_repr(named)}) instead"
+            )
         hint = did_you_mean(str(key), known) or (
             f"; expected one of: {', '.join(known)}" if known else ""
         )

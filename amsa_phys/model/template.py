@@ -125,6 +125,10 @@ class Template:
     #: working beside the Gazebo/SDFormat ones. Files, ``--set`` and sweeps may use either;
     #: resolved scenarios write the canonical name.
     param_aliases: ClassVar[Mapping[str, str]] = {}
+    #: Parameters that are the setpoint of the quantity a scenario's quality signal judges
+    #: (a follower's ``distanceRef``): a run that moves one away from ``quality.reference``
+    #: is judged against a reference its controller no longer aims at, so it is warned.
+    setpoints: ClassVar[frozenset[str]] = frozenset()
     #: Whether a leaf of this template may draw random numbers that reach its outputs; a
     #: template whose randomness depends on its values overrides :meth:`is_random`. The
     #: default (True) is the safe answer for user templates: ``sweep`` warns that seeds

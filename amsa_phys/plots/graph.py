@@ -41,6 +41,8 @@ from .graphgeom import (
     _overlapping,
     _quadratic,
     _rounded,
+    _through,
+    detour,
 )
 from .graphmodel import (
     KIND_COLOURS,
@@ -109,6 +111,7 @@ ROVER_EDGE_W = 3.5
 ARC_RISE = 1.4  # how far a feedback arc rises above the boxes it joins
 LANE_STEP = 0.35  # between two feedback links routed around the boxes
 CORNER = 0.3  # radius of a routed link's corners
+DETOUR_GAP = 0.6  # how far into a column gap a link routed around a box turns
 MARGINS = (0.01, 0.01, 0.99, 0.92)  # fixed: labels are placed against the final transform
 #: where along an arrow a label is tried (0 = source end, 1 = target end): middle first
 ALONG = tuple(sorted((k / 40 for k in range(4, 37)), key=lambda t: (abs(t - 0.5), t)))
@@ -268,12 +271,13 @@ def _routes(
 ) -> dict[tuple[str, str], list[Point]]:
     """Every link as a polyline in data units, from its source box to its target box.
 
-    Forward links are straight, right side to left side; the links leaving (entering) one
-    box start (end) at points spread along its side in the order of the boxes they go to,
-    so a fan of links does not meet in one point. A link back (into a process: the loop's
-    feedback) arcs over the boxes from top to top where that arc crosses no other box;
-    otherwise it is routed around them: up from the source, along a lane above every box,
-    down beside the target and into its left side.
+    Forward links are straight, right side to left side, unless that line would cross a
+    third box: then they go around it along a free lane (``graphgeom.detour``). The links
+    leaving (entering) one box start (end) at points spread along its side in the order of
+    the boxes they go to, so a fan of links does not meet in one point. A link back (into a
+    process: the loop's feedback) arcs over the boxes from top to top where that arc
+    crosses no other box; otherwise it is routed around them: up from the source, along a
+    lane above every box, down beside the target and into its left side.
     """
     forward = [(a, b) for a, b in links if pos[b][0] > pos[a][0]]
     start: dict[tuple[str, str], float] = {}
@@ -290,7 +294,11 @@ def _routes(
     for a, b in links:
         (x0, y0), (x1, y1) = pos[a], pos[b]
         if (a, b) in start:
-            out[(a, b)] = [(x0 + BOX_W / 2, y0 + start[(a, b)]), (x1 - BOX_W / 2, y1 + end[(a, b)])]
+            line = [(x0 + BOX_W / 2, y0 + start[(a, b)]), (x1 - BOX_W / 2, y1 + end[(a, b)])]
+            others = [pos[n] for n in pos if n not in (a, b)]
+            if any(_through(line, c) for c in others):  # past a third box: around it
+                line = detour(line[0], line[1], others, DETOUR_GAP, CORNER) or line
+            out[(a, b)] = line
             continue
         p0, p2 = (x0, y0 + BOX_H / 2), (x1, y1 + BOX_H / 2)
         peak = max(p0[1], p2[1]) + ARC_RISE  # the curve's midpoint; the control is twice as high

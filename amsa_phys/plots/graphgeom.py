@@ -6,6 +6,8 @@ and ``Path`` as data only), which the layout calls to route links and place thei
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 from matplotlib.transforms import Bbox
 
@@ -154,3 +156,39 @@ def _overlapping(extent: Bbox, others: np.ndarray) -> int:
             & (others[:, 1] < extent.y1)
         )
     )
+
+
+def _through(line: list[Point], centre: Point, margin: float = 0.05) -> bool:
+    """Whether the polyline crosses the box centred at ``centre`` (grown by ``margin``)."""
+    x, y = centre
+    w, h = BOX_W / 2 + margin, BOX_H / 2 + margin
+    return _crosses(np.asarray(line), Bbox.from_extents(x - w, y - h, x + w, y + h))
+
+
+def detour(
+    p0: Point, p1: Point, others: list[Point], gap: float, corner: float
+) -> list[Point] | None:
+    """A forward link from ``p0`` (its source's right side) to ``p1`` (its target's left
+    side) that a straight line would draw through another box: out into the gap beside the
+    source, along a free horizontal lane (between two rows of boxes, or above or below them
+    all), into the gap beside the target, and in. Read as a straight line, a link through a
+    third box looks like that box's link. The lane nearest the straight line first; None
+    when every lane is blocked (``others``: the centres of the boxes to keep clear of)."""
+    if not others:
+        return None
+    ys = sorted({y for _, y in others} | {p0[1], p1[1]})
+    lanes = [(a + b) / 2 for a, b in itertools.pairwise(ys) if b - a > BOX_H + 0.2]
+    lanes += [ys[-1] + BOX_H, ys[0] - BOX_H]
+    middle = (p0[1] + p1[1]) / 2
+    for lane in sorted(lanes, key=lambda y: abs(y - middle)):
+        corners = [
+            p0,
+            (p0[0] + gap, p0[1]),
+            (p0[0] + gap, lane),
+            (p1[0] - gap, lane),
+            (p1[0] - gap, p1[1]),
+            p1,
+        ]
+        if not any(_through(corners, c) for c in others):
+            return _rounded(corners, corner)
+    return None

@@ -45,6 +45,14 @@ MAX_BATCH = 250
 #: fixed cost per call is shared by every run of a batch: 21 ms a run-minute at 63 runs
 #: a batch, 16 ms at 250, measured on scenario1).
 BATCHES_PER_WORKER = 2
+#: Most work in one automatic batch, in Leaf-seconds (runs x simulated seconds x Leaves):
+#: about a second of CPU, so a Ctrl-C, which cannot keep a batch's unfinished runs (they
+#: all end together), costs at most that much work a worker. 250 runs of scenario1 (8
+#: Leaves) at 60 s; 30 at 500 s.
+BATCH_WORK = 120_000
+#: On Ctrl-C the batches running get this long to finish (their rows kept) before their
+#: workers are killed: the sweep stops within it.
+FINISH_S = 1.0
 
 
 @dataclass(frozen=True)
@@ -121,6 +129,7 @@ def plan_units(
     keys: dict[tuple[tuple[str, Any], ...], str | None] = {}
     reasons: dict[str, int] = {}
     groups: dict[str, list[Job]] = {}
+    cost: dict[str, float] = {}  # batch key -> Leaf-seconds of one run
     alone: list[Job] = []
     for job in jobs:
         if job.point not in keys:
@@ -134,7 +143,9 @@ def plan_units(
                     reasons[why] = 0
                     keys[job.point] = None
                 else:
-                    keys[job.point] = batch_key(scenario)
+                    keys[job.point] = key = batch_key(scenario)
+                    leaf_s = float(scenario.duration) * max(1, len(scenario.world.leaves))
+                    cost[key] = max(cost.get(key, 0.0), leaf_s)
         key = keys[job.point]
         if job.keep_dir is not None or key is None:
             alone.append(job)
@@ -142,9 +153,11 @@ def plan_units(
             groups.setdefault(key, []).append(job)
     units = []
     n = size or auto_size(sum(len(g) for g in groups.values()), workers)
-    for members in groups.values():
-        for start in range(0, len(members), n):
-            units.append(Unit(tuple(members[start : start + n])))
+    for key, members in groups.items():
+        # automatic: also at most BATCH_WORK of work, so a Ctrl-C costs about a second
+        size_k = n if size else max(1, min(n, int(BATCH_WORK // cost.get(key, 1.0))))
+        for start in range(0, len(members), size_k):
+            units.append(Unit(tuple(members[start : start + size_k])))
     units += [Unit((job,), batched=False) for job in alone]
     notes = []
     kept = sum(1 for j in alone if j.keep_dir is not None)
@@ -196,7 +209,7 @@ def run_batch(jobs: Sequence[Job], stats: dict[str, int] | None = None) -> list[
                     counts["contacts"] += 1
                     counts["at_start"] += 1
                 continue  # the rest as a batch of their own, built again without them
-            sim.run()
+            _run_whole(sim)
         except RunFault as exc:
             k = sim.run_of(exc)
             if k is None:  # not any one run's: each alone says what it is
@@ -217,6 +230,17 @@ def run_batch(jobs: Sequence[Job], stats: dict[str, int] | None = None) -> list[
             rows[job.index] = fill_metrics(job_row(job), metrics)
         break
     return [rows[job.index] for job in jobs]
+
+
+def _run_whole(sim: MultiRun) -> None:
+    """Run the batch to its end. A Ctrl-C noted meanwhile is raised by the engine once the
+    last instant has run: the batch is then whole, so its rows are kept and the caller
+    (``iter_batched``, between units) raises the Ctrl-C after them."""
+    try:
+        sim.run()
+    except KeyboardInterrupt:
+        if not sim.finished:
+            raise
 
 
 def run_unit(unit: Unit) -> list[dict[str, Any]]:
@@ -250,7 +274,12 @@ def iter_batched(
         return []
 
     for _, rows in imap_resilient(
-        run_unit, units, min(workers, len(units)), note_lost, in_flight=2 * workers
+        run_unit,
+        units,
+        min(workers, len(units)),
+        note_lost,
+        in_flight=2 * workers,
+        finish_s=FINISH_S,
     ):
         yield from rows
     if lost:

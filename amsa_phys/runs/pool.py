@@ -52,6 +52,7 @@ def imap_resilient(
     lost: Callable[[T], R],
     *,
     in_flight: int,
+    finish_s: float = 0.0,
 ) -> Iterator[tuple[int, R]]:
     """``(index, fn(item))`` as jobs complete; ``(index, lost(item))`` for a job that kills
     its worker process twice.
@@ -62,13 +63,17 @@ def imap_resilient(
     propagates. Ctrl-C noted by :func:`interrupt.deferred` is raised between completions
     (checked every 0.2 s). Workers ignore SIGINT; on the way out the parent sets their stop
     flag (:func:`interrupt.follow`), so running jobs end at their next whole instant.
+
+    ``finish_s`` > 0 (short jobs whose partial work is worth nothing, a sweep's batches):
+    on Ctrl-C the running jobs get that long to finish, their results are yielded before
+    the Ctrl-C propagates, and the workers of the rest are killed at once.
     """
     stop = multiprocessing.get_context().Event()
     initializer = functools.partial(_worker_init, stop, os.getpid())
     todo = deque(enumerate(items))
     try:
         while todo:
-            suspects = yield from _pass(fn, todo, workers, in_flight, initializer, stop)
+            suspects = yield from _pass(fn, todo, workers, in_flight, initializer, stop, finish_s)
             for index, item in suspects:
                 yield index, _alone(fn, item, lost, initializer, stop)
     finally:
@@ -82,6 +87,7 @@ def _pass(
     in_flight: int,
     initializer: Callable[[], None],
     stop: Any,
+    finish_s: float = 0.0,
 ) -> Generator[tuple[int, R], None, list[tuple[int, T]]]:
     """Run jobs from ``todo`` until it is empty or the pool breaks; the jobs the break took."""
     with ProcessPoolExecutor(max_workers=workers, initializer=initializer) as pool:
@@ -103,13 +109,45 @@ def _pass(
                 yield from results
                 if broken:  # what the pool still held, finished or not, went with it
                     return sorted(running.values(), key=lambda job: job[0])
-        except BaseException:
-            stop.set()  # before the pool's shutdown waits for the jobs still running
+        except KeyboardInterrupt:
+            if finish_s <= 0:
+                _stop(pool, running, stop)
+                raise
+            finished = _finished_within(running, finish_s)
+            stop.set()
             for fut in running:
                 fut.cancel()
-            _stop_running(pool, list(running))
+            _kill_workers(pool)  # what is left is lost either way: at once, not after a grace
+            yield from finished
+            raise
+        except BaseException:
+            _stop(pool, running, stop)
             raise
     return []
+
+
+def _stop(pool: ProcessPoolExecutor, running: dict[Future[Any], Any], stop: Any) -> None:
+    """The stop flag, then no job not started, then the running ones stopped or killed."""
+    stop.set()  # before the pool's shutdown waits for the jobs still running
+    for fut in running:
+        fut.cancel()
+    _stop_running(pool, list(running))
+
+
+def _finished_within(
+    running: dict[Future[R], tuple[int, Any]], seconds: float
+) -> list[tuple[int, R]]:
+    """``(index, result)`` of the running jobs that finish within ``seconds`` (none if a
+    second Ctrl-C comes meanwhile: the user wants out now), in index order."""
+    try:
+        done, _ = wait(running, timeout=seconds)
+    except BaseException:  # a second Ctrl-C or SIGTERM, raised at once by interrupt.request
+        return []
+    out = []
+    for fut in sorted(done, key=lambda f: running[f][0]):
+        with contextlib.suppress(BaseException):  # a job that failed or was cancelled
+            out.append((running[fut][0], fut.result()))
+    return out
 
 
 def _stop_running(pool: ProcessPoolExecutor, running: list[Future[Any]]) -> None:

@@ -15,6 +15,7 @@ import functools
 import itertools
 import json
 import math
+import re
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -234,7 +235,23 @@ def check_axes(axes: list[Axis], scenario: Scenario) -> None:
             try:
                 resolve_change(axis.key, value, scenario.world)
             except ValueError as exc:
-                raise ConfigError(str(exc), key=f"{axis.option} {axis.key}") from None
+                hint = range_hint(axis, value)
+                raise ConfigError(f"{exc}{hint}", key=f"{axis.option} {axis.key}") from None
+
+
+#: ``0.1:0.3`` or ``0.1:0.3:5``: a range written where ``--grid`` wants a list.
+_NUM = r"\s*[-+]?[\d.]+(?:e[-+]?\d+)?\s*"
+_RANGE_LIKE = re.compile(rf"{_NUM}:{_NUM}(?::\s*\d+)?\s*")
+
+
+def range_hint(axis: Axis, value: Any) -> str:
+    """`` (a range start:stop:n is --range ...)`` when a ``--grid`` value looks like one: the
+    user meant the other option, and "expected a number" alone does not say so."""
+    if axis.option != "--grid" or not isinstance(value, str) or not _RANGE_LIKE.fullmatch(value):
+        return ""
+    parts = [x.strip() for x in value.split(":")]
+    spec = ":".join(parts) if len(parts) == 3 else f"{parts[0]}:{parts[1]}:5"
+    return f" (a range start:stop:n is given by --range: --range {axis.key}={spec})"
 
 
 def apply_setting(scenario: Scenario, key: str, value: Any) -> Scenario:

@@ -120,6 +120,19 @@ class Camera:
         if self.mode == "fit":
             self.mode = "free"
 
+    def key_zoom(self, factor: float, names: Sequence[str]) -> str:
+        """Zoom from the keyboard (``z``, ``x``): about the rover followed, so it stays in the
+        middle. From ``fit`` the camera starts following the first rover (the world's first,
+        the leader in the MDE worlds): zooming about the window's centre, as the wheel does
+        about the mouse, lost the rovers the fit was showing. Returns the HUD's label."""
+        if self.mode == "fit" and names:
+            self.mode, self.target = "follow", names[0]
+        if self.mode == "follow":
+            self.scale = min(max(self.scale * factor, 0.2), 2000.0)  # update() re-centres
+        else:
+            self.zoom(factor)
+        return self.label()
+
     def pan(self, dx_px: float, dy_px: float) -> None:
         """Move the view by a drag of (dx, dy) pixels."""
         self.cx -= dx_px / self.scale

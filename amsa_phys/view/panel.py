@@ -31,6 +31,12 @@ class Row:
     fixed: bool  # read only at initialize: shown, not editable once running
 
     @property
+    def editable(self) -> bool:
+        """A number, a flag or a choice: what arrows and typing can change. A list of points
+        (``Leader.waypoints``) or a text is shown, with its value, but set in the scenario."""
+        return self.param.type in EDITABLE_TYPES
+
+    @property
     def key(self) -> str:
         """``Leaf.param``."""
         return f"{self.leaf}.{self.param.name}"
@@ -45,7 +51,6 @@ class ParamPanel:
             Row(path, p, p.name in comp.fixed_once_running)
             for path, comp in sim.components.items()
             for p in comp.params
-            if p.type in EDITABLE_TYPES
         ]
         self.visible = False
         self.index = 0
@@ -87,8 +92,10 @@ class ParamPanel:
             row = self.rows[i]
             mark = ">" if i == self.index else " "
             lock = " (fixed)" if row.fixed else ""
-            span = row.param.range_text()
-            out.append(f"{mark} {row.key} = {self.shown(row)}  {span}{lock}")
+            if not row.editable:
+                lock = " (set it in the scenario)"
+            span = f"  {row.param.range_text()}" if row.editable else ""
+            out.append(f"{mark} {row.key} = {self.shown(row)}{span}{lock}")
         return out
 
     # -- navigation ----------------------------------------------------------------------
@@ -117,6 +124,9 @@ class ParamPanel:
     def step(self, direction: int, fine: bool = False) -> None:
         """Step the pending value by a share of the range (enum: next choice; bool: flip)."""
         p = self.row.param
+        if not self.row.editable:
+            self._not_here()
+            return
         base = self.pending if self.pending is not None else self.value()
         self.text = None
         if p.type == "bool":
@@ -143,7 +153,9 @@ class ParamPanel:
 
     def type_char(self, ch: str) -> None:
         """Typing a number replaces the pending value."""
-        if ch and (ch.isdigit() or ch in ".-+e"):
+        if not self.row.editable:
+            self._not_here()
+        elif ch and (ch.isdigit() or ch in ".-+e"):
             self.text = (self.text or "") + ch
             self.pending = None
 
@@ -164,6 +176,9 @@ class ParamPanel:
         if row.fixed:
             self.message = f"{row.key} is fixed once the run has started"
             self.cancel()
+            return None
+        if not row.editable:
+            self._not_here()
             return None
         raw: Any = self.pending
         if self.text is not None:
@@ -190,6 +205,16 @@ class ParamPanel:
         self.cancel()
         self.refused = False
         return Change(row.leaf, row.param.name, value)
+
+    def _not_here(self) -> None:
+        """Say why the selected row does not change here (a list of points, a text)."""
+        row = self.row
+        self.message = (
+            f"{row.key} is a {row.param.type} parameter: set it in the scenario "
+            f"(set: or timeline:), not here"
+        )
+        self.refused = True
+        self.cancel()
 
 
 def _fmt(value: Any) -> str:

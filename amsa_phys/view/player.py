@@ -40,10 +40,11 @@ HELP = [
     "pgdn pgup     next / previous phase start",
     "click, drag   the slider: seek",
     "] [ or + -    faster / slower",
-    "g             plot signals (list: type to filter,",
+    "g             plot signals (list: / filters,",
     "              enter picks / drops, g closes)",
     "c             camera: fit, then follow each rover",
-    "z x, wheel    zoom in / out",
+    "z x           zoom about the rover followed",
+    "wheel         zoom about the mouse",
     "h or F1       this help (any other key closes it)",
     "q or esc      quit",
 ]
@@ -240,10 +241,10 @@ class Player:
         elif key == pygame.K_c:
             self.notice = "camera: " + self.camera.cycle(self.scene.rover_names)
             self._notice_row = None  # not about an instant: it stays
-        elif key == pygame.K_z:
-            self.camera.zoom(1.25)
-        elif key == pygame.K_x:
-            self.camera.zoom(1 / 1.25)
+        elif key in (pygame.K_z, pygame.K_x):
+            factor = 1.25 if key == pygame.K_z else 1 / 1.25
+            self.notice = "camera: " + self.camera.key_zoom(factor, self.scene.rover_names)
+            self._notice_row = None  # not about an instant: it stays
         elif key in (pygame.K_UP, pygame.K_DOWN):
             self.camera.pan(0, 60 if key == pygame.K_UP else -60)
         elif key in (pygame.K_h, pygame.K_F1):
@@ -281,9 +282,9 @@ class Player:
         points = [(r.x, r.y, r.name) for r in frame.rovers]
         cam.update(points, 0.05 if self.playing else 1e9)
         for _ in range(2):
-            room = (cam.top, cam.right)
+            room = (cam.top, cam.right, cam.left)
             self._paint(frame)
-            if (cam.top, cam.right) == room:
+            if (cam.top, cam.right, cam.left) == room:
                 break
             cam.update(points, 0.05 if self.playing else 1e9)
         pygame.display.flip()
@@ -295,7 +296,7 @@ class Player:
         self.renderer.draw(view, frame, cam, self.status(), self.shown_notice())
         cam.top = max(box.bottom for box in self.renderer.boxes.values()) + 6  # under the HUD
         self._slider()
-        right = draw_side_panes(
+        right, left = draw_side_panes(
             self.screen,
             self.renderer,
             self.picker,
@@ -306,6 +307,7 @@ class Player:
         )
         # beside the help or the signal list
         cam.right = self.view_rect.right - right.left if right is not None else 0
+        cam.left = left.right if left is not None else 0
 
     def scene_series(self, name: str, span_s: float) -> tuple[np.ndarray, np.ndarray]:
         """The pane's samples of ``name`` up to the row shown (the replay's whole history)."""

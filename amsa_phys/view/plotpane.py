@@ -1,7 +1,7 @@
 """A live plot pane in the window: any traced signals the user picks, drawn with pygame.
 
-``g`` opens a list of every traced Data (up/down or type to filter, Enter adds or removes
-the selected signal, ``g``/Esc closes); the picked signals are drawn as lines over the last
+``g`` opens a list of every traced Data (up/down, or ``/`` and type to filter, Enter adds or
+removes the selected signal, ``g``/Esc closes); the picked signals are drawn as lines over the last
 :data:`SPAN_S` seconds, each in its own colour with its current value. Drawn with pygame
 lines rather than matplotlib: a matplotlib redraw costs tens of milliseconds, the window
 draws at 60 frames a second. The same pane serves the live run (samples gathered from the
@@ -42,6 +42,9 @@ class SignalPicker:
         self.columns = [c for c in columns if c != "t"]
         self.visible = False
         self.filter = ""
+        #: typing goes into the filter (after ``/``, as in less and vim): otherwise the
+        #: window's own keys (``c`` camera, ``z`` zoom, space) keep working with the list open
+        self.filtering = False
         self.index = 0
         self.picked: list[str] = []
         self.message = ""
@@ -88,7 +91,11 @@ class SignalPicker:
     def lines(self) -> list[str]:
         """The list as drawn: filter, then rows around the selection (* marks picked ones)."""
         matches = self.matches
-        head = f"signals (type to filter: {self.filter}_)  enter: pick / drop  g: close"
+        if self.filtering:
+            head = f"signals, filter: {self.filter}_  (enter: pick / drop, esc: end filter)"
+        else:
+            shown = f" [{self.filter}]" if self.filter else ""
+            head = f"signals{shown}  /: filter  enter: pick / drop  g: close"
         start = max(0, min(self.index - LIST_ROWS // 2, len(matches) - LIST_ROWS))
         rows = []
         for i in range(start, min(len(matches), start + LIST_ROWS)):
@@ -198,9 +205,23 @@ def _polyline(
 
 
 def picker_key(picker: SignalPicker, key: int, text: str) -> bool:
-    """The signal list's keys (the player and the live window share them)."""
+    """The signal list's keys (the player and the live window share them). Letters filter
+    only after ``/``; otherwise they are the window's (False)."""
+    if picker.filtering:
+        if key == pygame.K_ESCAPE:
+            picker.filtering = False
+            return True
+        if key == pygame.K_BACKSPACE and not picker.filter:
+            picker.filtering = False
+            return True
+        if text and text.isprintable() and not text.isspace():
+            picker.type_char(text)
+            return True
     if key in (pygame.K_g, pygame.K_ESCAPE):
         picker.visible = False
+        picker.filtering = False
+    elif text == "/":
+        picker.filtering = True
     elif key == pygame.K_UP:
         picker.move(-1)
     elif key == pygame.K_DOWN:
@@ -209,8 +230,6 @@ def picker_key(picker: SignalPicker, key: int, text: str) -> bool:
         picker.toggle()
     elif key == pygame.K_BACKSPACE:
         picker.backspace()
-    elif text and text.isprintable() and not text.isspace():
-        picker.type_char(text)
     else:
         return False
     return True
@@ -224,27 +243,56 @@ def draw_side_panes(
     show_help: bool,
     help_lines: list[str],
     area: pygame.Rect,
-) -> pygame.Rect | None:
-    """The plot pane (bottom right), the signal list and the help (right), under the HUD.
+) -> tuple[pygame.Rect | None, pygame.Rect | None]:
+    """The plot pane (bottom right), the signal list and the help (right, or left when it
+    would reach the pane), under the HUD.
 
-    Returns the box of the list or help drawn at the right (None if neither is open): the
-    camera frames the rovers beside it, so the key list never hides the leader.
+    Returns the boxes drawn at the right and at the left (None where nothing is): the
+    camera frames the rovers beside them, so the key list never hides the leader.
     """
     top = max(box.bottom for box in renderer.boxes.values()) + 6 if renderer.boxes else 10
-    if picker.picked:
-        w = max(240, area.width * 2 // 5)
-        h = max(120, area.height // 3)
-        rect = pygame.Rect(area.right - w - 10, area.bottom - h - 10, w, h)
-        draw_pane(screen, rect, picker.picked, series, renderer.text_px)
+    pane = pane_rect(area, picker)
+    if pane is not None:
+        draw_pane(screen, pane, picker.picked, series, renderer.text_px)
+    line_px = renderer.font.get_linesize()
     if picker.visible:
         lines = picker.lines()
         colours = [MUTED] + [INK] * (len(lines) - 1)
         if picker.message:
             lines.append(picker.message)
             colours.append(INK)
-        return renderer.panel(screen, lines, colours, (10, top), align_right=True)
+        margin, width = beside_pane(screen, pane, top, len(lines), line_px)
+        box = renderer.panel(screen, lines, colours, (margin, top), align_right=True, width=width)
+        return box, None
     if show_help:
-        return renderer.panel(
-            screen, help_lines, [INK] * len(help_lines), (10, top), align_right=True
-        )
-    return None
+        ink = [INK] * len(help_lines)
+        if reaches_pane(pane, top, len(help_lines), line_px):  # at the left, clear of it
+            return None, renderer.panel(screen, help_lines, ink, (10, top), align_right=False)
+        return renderer.panel(screen, help_lines, ink, (10, top), align_right=True), None
+    return None, None
+
+
+def reaches_pane(pane: pygame.Rect | None, top: int, n_lines: int, line_px: int) -> bool:
+    """Whether a box of ``n_lines`` drawn from ``top`` at the right would reach down to the
+    plot pane (the help drawn over the pane, or under it, hid both): it goes at the left."""
+    return pane is not None and top + n_lines * line_px + 12 >= pane.top
+
+
+def pane_rect(area: pygame.Rect, picker: SignalPicker) -> pygame.Rect | None:
+    """Where the plot pane goes (bottom right of ``area``), None when nothing is picked."""
+    if not picker.picked:
+        return None
+    w = max(240, area.width * 2 // 5)
+    h = max(120, area.height // 3)
+    return pygame.Rect(area.right - w - 10, area.bottom - h - 10, w, h)
+
+
+def beside_pane(
+    screen: pygame.Surface, pane: pygame.Rect | None, top: int, n_lines: int, line_px: int
+) -> tuple[int, int | None]:
+    """(right margin, width) of a box of ``n_lines`` drawn at the right from ``top``: 10 px
+    and the frame's width, or left of the plot pane, in the room left of it, when the box
+    would reach down to the pane (the help or the list drawn over the pane hid both)."""
+    if pane is None or top + n_lines * line_px + 12 < pane.top:
+        return 10, None
+    return screen.get_width() - pane.left + 10, pane.left - 20

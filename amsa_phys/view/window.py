@@ -27,7 +27,14 @@ from .drive import advance
 from .mouse import pan_zoom
 from .panel import ParamPanel
 from .pg import pygame
-from .plotpane import LiveSeries, SignalPicker, draw_side_panes, picker_key
+from .plotpane import (
+    LiveSeries,
+    SignalPicker,
+    draw_side_panes,
+    pane_rect,
+    picker_key,
+    reaches_pane,
+)
 from .recorder import Recorder
 from .scene import Frame, Scene
 
@@ -40,13 +47,14 @@ HELP = [  # every key _key and _panel_key handle
     "s or .        one instant (pauses)",
     "] [ or + -    faster / slower",
     "c             camera: fit, then follow each rover",
-    "z x, wheel    zoom in / out",
+    "z x           zoom about the rover followed",
+    "wheel         zoom about the mouse",
     "drag, arrows  pan",
     "p or tab      parameter panel (open / close)",
     "  up down     row; pgup pgdn: component",
     "  left right  step the value (shift: fine)",
     "  0-9 . - e   type a value; enter applies, esc drops",
-    "g             plot signals (list: type to filter,",
+    "g             plot signals (list: / filters,",
     "              enter picks / drops, g closes)",
     "h or F1       this help (any other key closes it)",
     "q or esc      quit (the outputs are written;",
@@ -218,10 +226,10 @@ class Window:
             self.speed_index = min(len(SPEEDS) - 1, self.speed_index + 1)
         elif key == pygame.K_LEFTBRACKET or key == pygame.K_MINUS:
             self.speed_index = max(0, self.speed_index - 1)
-        elif key == pygame.K_z:
-            self.camera.zoom(1.25)
-        elif key == pygame.K_x:
-            self.camera.zoom(1 / 1.25)
+        elif key in (pygame.K_z, pygame.K_x):
+            names = [r.name for r in self.scene.rovers()]
+            label = self.camera.key_zoom(1.25 if key == pygame.K_z else 1 / 1.25, names)
+            self.notice = f"camera: {label}"
         elif key == pygame.K_c:
             self.notice = "camera: " + self.camera.cycle([r.name for r in self.scene.rovers()])
         elif key in (pygame.K_LEFT, pygame.K_RIGHT, pygame.K_UP, pygame.K_DOWN):
@@ -365,13 +373,19 @@ class Window:
         else:
             self.camera.left = 0
         right = None
-        if self.show_help:
-            at = (10, fitting(len(HELP)))
-            right = self.renderer.panel(self.screen, HELP, [INK] * len(HELP), at, align_right=True)
         area = self.screen.get_rect()
-        listed = draw_side_panes(
+        listed, _ = draw_side_panes(
             self.screen, self.renderer, self.picker, self.series.series, False, [], area
         )
+        if self.show_help and listed is None:  # after the pane, never under it
+            y = fitting(len(HELP))
+            ink = [INK] * len(HELP)
+            if reaches_pane(pane_rect(area, self.picker), y, len(HELP), line_px):
+                if not self.panel.visible:  # at the left, clear of the pane
+                    box = self.renderer.panel(self.screen, HELP, ink, (10, y), align_right=False)
+                    self.camera.left = box.right
+            else:
+                right = self.renderer.panel(self.screen, HELP, ink, (10, y), align_right=True)
         right = listed or right
         # the help and the signal list sit at the right: the rovers are framed beside them
         self.camera.right = area.right - right.left if right is not None else 0

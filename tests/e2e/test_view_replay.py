@@ -133,6 +133,7 @@ def test_phase_keys_jump_to_phase_starts(tmp_path: Path) -> None:
 
 def test_plot_pane_draws_a_picked_signal(player: Player) -> None:
     press(pygame.K_g)
+    press(0, text="/")  # letters filter after /: without it they are the player's keys
     for ch in "distance":
         press(0, text=ch)
     press(pygame.K_RETURN)

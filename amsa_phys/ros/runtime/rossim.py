@@ -19,6 +19,17 @@ from .. import names
 from . import adaptlink, rosio
 from .standins import stand_ins
 
+
+def awaited_signal(scenario: Scenario, remote: list[str]) -> str | None:
+    """The quality signal if a node publishes it (its producer is a remote Leaf), else None:
+    in free mode such a buffer holds its port's initial value until the node's first
+    message, which the metrics must not count as a measurement."""
+    if scenario.quality is None:
+        return None
+    signal = scenario.quality.signal
+    return signal if signal.rpartition(".")[0] in remote else None
+
+
 if TYPE_CHECKING:  # the simulator node imports this module
     from .simulator import Link
 
@@ -52,6 +63,10 @@ class RosSimulation(Simulation):
             for p in graph.leaf(path).template.params
         }
         self.live: list[Change] = []  # live edits queued, not yet applied
+        #: free mode: the quality signal a node publishes, until its first message (its
+        #: port's initial value before that is no measurement: no quality sample is taken)
+        self.awaited = awaited_signal(scenario, graph.remote) if not link.lockstep else None
+        self.log.quality_waits = self.awaited is not None
         if not link.lockstep:
             rate = (
                 Fraction(str(scenario.world.physics["rate"])) if graph.local else scenario.log_rate
@@ -68,7 +83,15 @@ class RosSimulation(Simulation):
     def _pace(self) -> None:
         """Free mode: hold to the wall clock, then take what the nodes published meanwhile."""
         self.link.pace(self.now)
+        awaited = self.awaited
+        arrived = False
+        if awaited is not None:
+            with self.link.cond:  # only take() empties fresh: what is there now is taken now
+                arrived = awaited in self.link.fresh
         self.link.take()
+        if arrived:
+            self.log.quality_waits = False
+            self.awaited = None
 
     def apply_change(self, change: Change) -> None:
         """A timeline change, with the value the scenario node put on the parameter server."""
