@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 
 from ..errors import ConfigError
 from ..model.params import short_repr
+from ..model.schema import MAX_DURATION_S
 from ..palette import COLLISION, PHASE, REFERENCE, SIGNAL, hex_colour
 from ..valuetext import value_text
 from .adaptmarks import adapt_switches
@@ -87,9 +88,31 @@ def _read_trace(
         raise ConfigError(f"not a whole trace: {problem}", file=path, line=line)
     if cols is not None:
         header = [header[i] for i in cols]
+    why = time_problem(data[:, 0]) if len(data) else None
+    if why is not None:
+        raise ConfigError(why[1], file=path, line=why[0] + 2)
     data[~(np.abs(data) < PLOTTABLE)] = np.nan  # inf, nan and the unplottable
     data.flags.writeable = False  # shared between callers
     return header, data
+
+
+def time_problem(t: np.ndarray, first_row: int = 0) -> tuple[int, str] | None:
+    """The first row (counted from ``first_row``) whose time a run could not have written,
+    and why: not finite, outside ``0..MAX_DURATION_S``, or before the row above it (the
+    scrubber's binary search and every plot's x axis rely on ``t`` rising)."""
+    bad = ~np.isfinite(t)
+    if bad.any():
+        i = int(np.argmax(bad))
+        return first_row + i, f"t is not a finite time ({t[i]})"
+    out = (t < 0) | (t > MAX_DURATION_S)
+    if out.any():
+        i = int(np.argmax(out))
+        return first_row + i, f"t is outside 0..{MAX_DURATION_S:,} s ({t[i]:g})"
+    back = np.diff(t) < 0
+    if back.any():
+        i = int(np.argmax(back)) + 1
+        return first_row + i, f"t goes backwards ({t[i]:g} after {t[i - 1]:g})"
+    return None
 
 
 def _rows_as_wide_as(path: str, width: int) -> bool:
