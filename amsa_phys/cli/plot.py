@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 from fractions import Fraction
 from pathlib import Path
@@ -142,8 +141,8 @@ def _sweep_scenario(sweepdir: Path) -> str:
         return name
     for metrics in sorted((sweepdir / "runs").glob("*/metrics.json"))[:1]:
         try:
-            found = json.loads(metrics.read_text()).get("scenario")
-        except (OSError, ValueError, AttributeError):
+            found = read_metrics(metrics).get("scenario")  # judged, at most 64 MiB read
+        except (AmsaError, OSError):
             found = None
         if isinstance(found, str) and found:
             return found
