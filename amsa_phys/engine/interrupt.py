@@ -104,6 +104,8 @@ def stepping() -> Iterator[None]:
         yield
         return
     _stepping += 1
+    if _requested and _installed:  # asked between two steps: this one gets the grace too
+        _arm()
     try:
         yield
     finally:
