@@ -33,7 +33,8 @@ from collections.abc import Iterable, Mapping
 from fractions import Fraction
 from typing import Any
 
-from ...errors import AmsaError
+from ...errors import AmsaError, one_line
+from ...model.params import short_repr
 from ...stdmsgs import DEFAULT_ORIGIN, Context, Source, build, geodetic_to_enu, quaternion_yaw
 from ...stdmsgs.build import static_transform, transform
 from .. import names
@@ -247,7 +248,11 @@ class BoundaryNode:
         if msg.data == FLUSH:  # the run's values are all handled (one publisher: in order)
             self.flushed.publish(self.String(FLUSH))
             return
-        at, values = parse_values(msg.data)
+        try:
+            at, values = parse_values(msg.data)
+        except ValueError as exc:  # not the simulator's: said, dropped, the node goes on
+            self.rospy.logerr(one_line(f"{NODE}: {VALUES}: {exc}"))
+            return
         with self.lock:
             for buffer, value in values:
                 if buffer in self.readers:
@@ -286,10 +291,21 @@ def format_values(t: Fraction, values: Iterable[tuple[str, float]]) -> str:
 
 
 def parse_values(text: str) -> tuple[Fraction, list[tuple[str, float]]]:
-    """A :data:`VALUES` message: the instant and the values."""
-    num, den, *rest = text.split(" ")
-    values = [(rest[i], float(rest[i + 1])) for i in range(0, len(rest), 2)]
-    return Fraction(int(num), int(den)), values
+    """A :data:`VALUES` message: the instant and the values. Anything else on the topic
+    (another publisher's text, a torn message) is ``ValueError`` saying what it is."""
+    try:
+        num, den, *rest = text.split(" ")
+        if len(rest) % 2:
+            raise ValueError
+        values = [(rest[i], float(rest[i + 1])) for i in range(0, len(rest), 2)]
+        at = Fraction(int(num), int(den))
+    except (ValueError, ZeroDivisionError):
+        raise ValueError(f"not a values message: {short_repr(text)}") from None
+    if at < 0 or not all(math.isfinite(v) for _, v in values):
+        raise ValueError(
+            f"not a values message (a negative instant or a value not finite): {short_repr(text)}"
+        )
+    return at, values
 
 
 def readable(graph: RosGraph) -> set[str]:
