@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -96,7 +97,8 @@ def _world_of(rundir: Path) -> dict[str, Any] | None:
         return None
     try:
         return plot_context(read_world(path, trace_header(rundir / "trace.csv")))  # type: ignore[arg-type]
-    except (AmsaError, OSError):
+    except (AmsaError, OSError) as exc:
+        print(one_line(f"warning: {exc}; the paths are drawn without the world"), file=sys.stderr)
         return None
 
 
