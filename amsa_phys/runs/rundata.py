@@ -9,8 +9,9 @@ world schema; a built-in template resolves from the package's own registry (its 
 parameters judge the written values, its outputs name the world's buffers); any other
 template -- a ``module:Class`` or an installed plugin's name -- is *not* imported: it is named
 in one warning line, and its leaf keeps only what the run's own files declare (the written
-parameters, the trace's columns). Nothing here reaches :func:`~amsa_phys.model.template.
-resolve_template` for a name outside :data:`~amsa_phys.model.template.BUILTINS`.
+parameters that are finite numbers, the trace's columns). Nothing here reaches
+:func:`~amsa_phys.model.template.resolve_template` for a name outside
+:data:`~amsa_phys.model.template.BUILTINS`.
 
 API::
 
@@ -24,6 +25,7 @@ Warnings go to ``warn`` (default: one line on stderr, terminal-safe) and are kep
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -201,8 +203,12 @@ def _leaf(
     except (ValueError, ZeroDivisionError):
         raise doc.error((*kp, "freq"), "not a frequency") from None
     written = body.get("params") or {}
-    if cls is None:
-        params = dict(written)
+    if cls is None:  # judged by no template: only finite numbers are kept (a body's size)
+        params = {
+            str(k): v
+            for k, v in written.items()
+            if isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+        }
     else:
         declared = {p.name: p for p in cls.params}
         params = {name: p.default for name, p in declared.items()}

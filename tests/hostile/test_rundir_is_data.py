@@ -170,3 +170,29 @@ def test_adapt_over_a_sweep_with_a_kept_run_naming_a_module_imports_nothing(
     argv = ["adapt", str(sweep), "--scenario", str(ADAPT_FIXTURE / "sweep.yaml")]
     assert main([*argv, "-o", str(rules)]) == 0
     _no_marker(home)
+
+
+def test_a_not_imported_rovers_parameters_keep_only_numbers(
+    evil_run: tuple[Path, Path],
+) -> None:
+    """Nothing judges a not-imported template's parameters: text or a list where the replay
+    reads a body's size is left out (the default size drawn), never a ValueError."""
+    from amsa_phys.cli.view import load_run
+
+    _home, run = evil_run
+    text = (run / "scenario.yaml").read_text()
+    head, sep, rest = text.partition("    Follower:\n      template: controlledRobot\n")
+    assert sep
+    _params, _, tail = rest.partition("      inputs:\n")
+    bad = (
+        "      freq: 4\n      params:\n"
+        "        length: abc\n        width: [1, 2]\n        track: 0.7\n"
+    )
+    (run / "scenario.yaml").write_text(
+        f"{head}    Follower:\n      template: evilmod:Bot\n{bad}      inputs:\n{tail}"
+    )
+    notes: list[str] = []
+    assert read_run(run, warn=notes.append).world.leaves["Follower"].params == {"track": 0.7}
+    scene = load_run(run)
+    follower = next(r for r in scene.frame(scene.rows - 1).rovers if r.name == "Follower")
+    assert (follower.length, follower.width, follower.track) == (0.8, 0.6, 0.7)
