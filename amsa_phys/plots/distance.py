@@ -15,7 +15,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..palette import COLLISION, PHASE, REFERENCE, SIGNAL, hex_colour
-from ..runs.traceread import MAX_LINE_BYTES, read_rows
+from ..traceread import MAX_LINE_BYTES, read_rows
 from ..valuetext import value_text
 from .adaptmarks import adapt_switches
 from .save import save_png
@@ -51,7 +51,7 @@ def trace_header(path: Path) -> list[str]:
 def _read_trace(
     path: str, mtime_ns: int, size: int, keep: frozenset[str] | None = None
 ) -> tuple[list[str], np.ndarray]:
-    # streamed, judged row by row, decimated to a bounded size (runs/traceread.py)
+    # streamed, judged row by row, decimated to a bounded size (traceread.py)
     header, data, _stride = read_rows(Path(path), keep)
     data[~(np.abs(data) < PLOTTABLE)] = np.nan  # inf, nan and the unplottable
     data.flags.writeable = False  # shared between callers

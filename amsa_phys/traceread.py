@@ -9,6 +9,8 @@ kept (plus the last), so that at most about :data:`MAX_CELLS` values stay in mem
 the file's size. A picture a few thousand pixels wide cannot show more rows than that anyway,
 and the kept rows are the trace's own, never averaged: what is drawn is what the run wrote.
 Peak memory is a few blocks plus the kept values (tests/hostile/test_trace_memory.py).
+A top-level module because both ``plots`` and ``view`` (through ``cli``) read traces and the
+layers below ``runs`` may not import it.
 """
 
 from __future__ import annotations
@@ -22,9 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError
-from ..model.params import short_repr
-from ..model.schema import MAX_DURATION_S
+from .errors import ConfigError
+from .model.params import short_repr
+from .model.schema import MAX_DURATION_S
 
 #: bytes read at a time
 BLOCK_BYTES = 4 << 20
