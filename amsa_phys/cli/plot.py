@@ -3,14 +3,19 @@
 from __future__ import annotations
 
 import argparse
-import json
+import math
+import sys
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
 from ..errors import AmsaError, ConfigError, one_line
 from ..model.scenario import load_scenario
+from ..model.template import Kind
 from ..runs.plotjob import draw_run_plots, plot_context
+from ..runs.rundata import read_run, read_world
 from ..runs.rundir import check_output
+from ..runs.runfiles import read_metrics, trace_header
 from ..runs.sweep import read_results, unknown_metric
 
 
@@ -84,11 +89,16 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _world_of(rundir: Path) -> dict[str, Any] | None:
-    """The arena and GPS links from the run's resolved scenario.yaml (None if unreadable:
-    the paths are then drawn without the static world)."""
+    """The arena and GPS links from the run's resolved scenario.yaml, read as data (a
+    module it names is not imported: :mod:`amsa_phys.runs.rundata`); None if it is absent
+    or unreadable: the paths are then drawn without the static world."""
+    path = rundir / "scenario.yaml"
+    if not path.is_file():
+        return None
     try:
-        return plot_context(load_scenario(rundir / "scenario.yaml").world)
-    except (AmsaError, OSError):
+        return plot_context(read_world(path, trace_header(rundir / "trace.csv")))  # type: ignore[arg-type]
+    except (AmsaError, OSError) as exc:
+        print(one_line(f"warning: {exc}; the paths are drawn without the world"), file=sys.stderr)
         return None
 
 
@@ -133,8 +143,8 @@ def _sweep_scenario(sweepdir: Path) -> str:
         return name
     for metrics in sorted((sweepdir / "runs").glob("*/metrics.json"))[:1]:
         try:
-            found = json.loads(metrics.read_text()).get("scenario")
-        except (OSError, ValueError, AttributeError):
+            found = read_metrics(metrics).get("scenario")  # judged, at most 64 MiB read
+        except (AmsaError, OSError):
             found = None
         if isinstance(found, str) and found:
             return found
@@ -189,19 +199,22 @@ def _paper_run(source: Path, overrides: list[str] | None = None) -> Any:
     from ..plots.distance import read_trace
     from ..plots.paper import PaperRun
 
-    if source.is_dir():
-        for name in ("trace.csv", "metrics.json", "scenario.yaml"):
-            if not (source / name).is_file():
-                raise ConfigError(f"not a run directory: {name} is missing", file=source)
-        metrics = read_metrics(source / "metrics.json")
-        columns, data = read_trace(source / "trace.csv")
-        scenario = load_scenario(source / "scenario.yaml")
+    if source.is_dir():  # data only: nothing the run directory names is imported
+        run = read_run(source)
+        columns, data = read_trace(run.trace)
+        assert run.world is not None  # scenario.yaml is required
+        assert run.resolved is not None
+        kv, later = _run_kv(run, source)
+        name = one_line(str(run.resolved.get("name", source.name)))
+        label = name if kv is None else _kv_label(name, kv, later)
+        metrics = run.metrics
     else:
         from ..engine import interrupt
         from ..engine.tracemem import TraceMemory
         from ..runs.single import execute
 
         scenario = load_scenario(source, overrides)
+        kv, label = _kv(scenario), _label(source, scenario)
         memory = TraceMemory(list(scenario.world.buffers))
         with interrupt.deferred():
             ended = execute(scenario, memory, progress=False)
@@ -213,7 +226,7 @@ def _paper_run(source: Path, overrides: list[str] | None = None) -> Any:
     if not q or q["signal"] not in columns:
         raise ConfigError("the run has no quality signal to draw", file=source)
     t, d = data[:, 0], data[:, columns.index(q["signal"])]
-    return PaperRun(_label(source, scenario), _kv(scenario), t, d, metrics)
+    return PaperRun(label, kv, t, d, metrics)
 
 
 def _kv(scenario: Any) -> float | None:
@@ -252,48 +265,43 @@ def _label(source: Path, scenario: Any) -> str:
     kv = _kv(scenario)
     if kv is None:
         return one_line(str(scenario.name))
-    later = "".join(f", then {value:g} from {at:g} s" for at, value in _kv_changes(scenario))
-    return one_line(f"{scenario.name}: Kv = {kv:g}{later}")
+    return _kv_label(one_line(str(scenario.name)), kv, _kv_changes(scenario))
 
 
-def read_metrics(path: Path) -> dict[str, Any]:
-    """A run's ``metrics.json``, checked for what the plots read (one line if it is not)."""
+def _kv_label(name: str, kv: float, later: list[tuple[float, float]]) -> str:
+    after = "".join(f", then {value:g} from {at:g} s" for at, value in later)
+    return one_line(f"{name}: Kv = {kv:g}{after}")
+
+
+def _run_kv(run: Any, source: Path) -> tuple[float | None, list[tuple[float, float]]]:
+    """A run directory's controller Kv at t = 0 and its later changes, from the resolved
+    scenario as data (the world's value, its ``set:``, its ``timeline:``)."""
+    path = next(
+        (
+            p
+            for p, leaf in run.world.leaves.items()
+            if "Kv" in leaf.params and leaf.kind == Kind.CONTROLLER
+        ),
+        None,
+    )
+    if path is None:
+        return None, []
+    key = f"{path}.Kv"
+    where = source / "scenario.yaml"
     try:
-        metrics = json.loads(path.read_bytes())
-    except json.JSONDecodeError as exc:
-        raise ConfigError(f"invalid JSON: {exc.msg}", file=path, line=exc.lineno) from None
-    except UnicodeDecodeError:
-        raise ConfigError("invalid JSON: not UTF-8 text", file=path) from None
-    except OSError as exc:
-        raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
-    why = _metrics_problem(metrics)
-    if why is not None:
-        raise ConfigError(f"not a run's metrics: {why}", file=path)
-    return metrics
-
-
-def _metrics_problem(metrics: Any) -> str | None:
-    if not isinstance(metrics, dict):
-        return f"expected an object, got {type(metrics).__name__}"
-    phases = metrics.get("phases", [])
-    if not isinstance(phases, list):
-        return "phases is not a list"
-    for i, phase in enumerate(phases):
-        if not isinstance(phase, dict):
-            return f"phases[{i}] is not an object"
-        if not _is_number(phase.get("start")):
-            return f"phases[{i}].start is not a number"
-        if not isinstance(phase.get("set", {}), dict):
-            return f"phases[{i}].set is not an object"
-    quality = metrics.get("quality")
-    if quality is not None:
-        if not isinstance(quality, dict) or not isinstance(quality.get("signal"), str):
-            return "quality is not an object with a signal"
-        for key in ("reference", "tolerance"):
-            if not _is_number(quality.get(key)):
-                return f"quality.{key} is not a number"
-    return None
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
+        kv = float(run.world.leaves[path].params["Kv"])
+        initial = run.resolved.get("set") or {}
+        if isinstance(initial, dict) and key in initial:
+            kv = float(initial[key])
+        later = []
+        for entry in run.resolved.get("timeline") or []:
+            sets = entry.get("set") or {} if isinstance(entry, dict) else {}
+            if key in sets:
+                later.append((float(Fraction(str(entry["at"]))), float(sets[key])))
+    except (TypeError, ValueError, KeyError, ZeroDivisionError, AttributeError):
+        why = f"not a resolved scenario: {key} or its changes are not numbers"
+        raise ConfigError(why, file=where) from None
+    if not all(math.isfinite(v) for pair in [(kv, 0.0), *later] for v in pair):
+        why = f"not a resolved scenario: {key} or its changes are not finite"
+        raise ConfigError(why, file=where)
+    return kv, later

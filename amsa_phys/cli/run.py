@@ -60,6 +60,15 @@ def run(args: argparse.Namespace) -> int:
             plotter.close()
 
 
+def _bag_apart(bag: Path, out: Path) -> None:
+    """Refuse, before running, a ``--bag`` that is the run directory or holds it: the run
+    would end, then fail writing the bag."""
+    where = bag.resolve()
+    run_dir = out.resolve()
+    if where == run_dir or where in run_dir.parents:
+        raise ConfigError("is the run directory (--out): name another file", key="--bag", file=bag)
+
+
 def _run(
     args: argparse.Namespace,
     record: RecordOptions | None,
@@ -96,6 +105,8 @@ def _run(
     warn_if_trace_is_large(scenario)
     bag_path = _target(args.bag, (".mcap",), "--bag", args.force) if args.bag else None
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
+    if bag_path is not None:
+        _bag_apart(bag_path, out)
     prepare_run_dir(out, args.force, inputs=input_files(scenario))
     bag: BagRecorder | None = None
     if bag_path is not None:  # mcap and the message tables (~60 ms) only for --bag

@@ -7,8 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError, one_line
-from ..model.scenario import load_scenario
-from .plot import read_metrics
+from ..runs.rundata import read_run
 
 RUN_FILES = ("trace.csv", "metrics.json", "scenario.yaml")
 
@@ -48,15 +47,11 @@ def load_run(rundir: Path) -> Any:
             else (" (it kept no run: sweep again with --keep-runs)")
         )
         raise ConfigError(f"a sweep directory: view one of its kept runs{hint}", file=rundir)
-    for name in RUN_FILES:
-        if not (rundir / name).is_file():
-            raise ConfigError(f"not a run directory: {name} is missing", file=rundir)
-    metrics = read_metrics(rundir / "metrics.json")
-    columns, data = read_trace(rundir / "trace.csv")
+    run = read_run(rundir)  # data only: nothing the run directory names is imported
+    columns, data = read_trace(run.trace)
     if len(data) == 0:
-        raise ConfigError("the trace has no row: nothing to replay", file=rundir / "trace.csv")
-    scenario = load_scenario(rundir / "scenario.yaml")
-    return ReplayScene(columns, data, metrics, scenario.world)
+        raise ConfigError("the trace has no row: nothing to replay", file=run.trace)
+    return ReplayScene(columns, data, run.metrics, run.world)
 
 
 def _size(text: str) -> tuple[int, int]:

@@ -10,7 +10,14 @@ So while a run is going (:func:`deferred`), the signal handler only notes the re
 ``Simulation.advance`` raises KeyboardInterrupt when it returns: every simulated second in a
 headless run, every frame in the window and in a recording, which is well under a
 wall-clock second for any world this project ships. A second signal raises at once: the user
-insists (a component stuck in an endless loop never returns from ``advance``).
+insists. A component stuck in an endless loop never returns from ``advance``, so one signal
+must do too: while a run steps (:func:`stepping`), a request not honoured within
+:data:`GRACE_S` raises KeyboardInterrupt where the main thread is (a SIGALRM timer), as the
+second signal would; the run then finalises its outputs the same way.
+
+A KeyboardInterrupt a component raises *itself* is not the user's: :func:`users_interrupt`
+tells them apart (the user's always went through :func:`request` first while a run defers),
+and the engine makes the component's own a run fault naming it (``engine/tasks.py``).
 
 Only the main thread can own signal handlers, and a SIGINT handler somebody else installed (a
 sweep worker ignores SIGINT; a host application has its own; a shell script's ``cmd &`` starts
@@ -34,9 +41,17 @@ from contextlib import contextmanager
 from types import FrameType
 from typing import Any
 
+_MAIN = threading.main_thread().ident
+
 _installed = 0  # deferrals whose handler is in place (nested runs share one request)
 _requested = False
 _external: Any = None  # a worker process's stop flag, set by its parent (multiprocessing.Event)
+_stepping = 0  # main-thread runs inside ``advance`` (:func:`stepping`)
+_alarm: Any = None  # the SIGALRM handler replaced while the grace timer is armed
+
+#: how long (s) a stop request may wait for the run to reach a whole instant before it is
+#: raised where the main thread is: a stuck component must not ignore the first Ctrl-C
+GRACE_S = 0.5
 
 
 def request(signum: int | None = None, frame: FrameType | None = None) -> None:
@@ -49,6 +64,54 @@ def request(signum: int | None = None, frame: FrameType | None = None) -> None:
     if not _installed or _requested:
         raise KeyboardInterrupt
     _requested = True
+    if _stepping:
+        _arm()
+
+
+def _arm() -> None:
+    """Raise the request where the main thread is if ``advance`` has not returned by then."""
+    global _alarm
+    if _alarm is None:
+        _alarm = signal.signal(signal.SIGALRM, _overdue)
+    signal.setitimer(signal.ITIMER_REAL, GRACE_S)
+
+
+def _disarm() -> None:
+    global _alarm
+    if _alarm is not None:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, _alarm)
+        _alarm = None
+
+
+def _overdue(signum: int, frame: FrameType | None) -> None:
+    if _stepping and _requested:
+        raise KeyboardInterrupt
+
+
+def users_interrupt() -> bool:
+    """Whether a KeyboardInterrupt now is the user's: a stop was requested (a signal noted,
+    or this worker's parent's), or no run defers interrupts (nobody noted them: it may be)."""
+    return requested() or (not _installed and _external is None)
+
+
+@contextmanager
+def stepping() -> Iterator[None]:
+    """Around a run's ``advance`` in the main thread: a stop requested meanwhile is raised
+    after :data:`GRACE_S` if the step does not return (a component stuck in a loop)."""
+    global _stepping
+    if threading.get_ident() != _MAIN:
+        yield
+        return
+    _stepping += 1
+    if _requested and _installed:  # asked between two steps: this one gets the grace too
+        _arm()
+    try:
+        yield
+    finally:
+        _stepping -= 1
+        if not _stepping:
+            _disarm()
 
 
 def requested() -> bool:

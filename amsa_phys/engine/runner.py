@@ -297,7 +297,7 @@ class Simulation(ReadAPI, LiveChanges):
         to ``until_tick`` has run whole. The store's lock is held meanwhile: a write from
         another thread (:meth:`write`) lands between calls, never inside an instant.
         """
-        with self.store.lock:
+        with self.store.lock, interrupt.stepping():
             self._advance(until_tick)
         if interrupt.requested():
             raise KeyboardInterrupt

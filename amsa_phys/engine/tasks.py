@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import RunFault
 from ..model.params import short_repr
 from ..model.template import Template
-from . import batch
+from . import batch, interrupt
 from .timing import DelayLine
 
 #: What a component's code may raise that is its fault, not the engine's: any exception,
@@ -105,12 +105,27 @@ def checked_writes(
     targets = task.writes
     try:
         for key, value in out.items():
-            number = float(value)
+            number = value if value.__class__ is float else as_number(value)
             if number - number != 0.0:  # inf or nan
                 raise ValueError
             into[targets[key]] = number
     except OUTPUT_ERRORS:
         raise bad_output(who(task.path), now, targets, out) from None
+
+
+def as_number(value: Any) -> float:
+    """An output's value as a float: a number (bool and numpy's too), never text (``float``
+    alone would take ``"10"`` and ``b"nan"``: the documented contract is a mapping of numbers)."""
+    if isinstance(value, str | bytes | bytearray):
+        raise TypeError("text is not a number")
+    return float(value)
+
+
+def own_interrupt(who: str, now: Fraction) -> RunFault:
+    """The fault for a KeyboardInterrupt a component raised itself. One out of a step is the
+    user's only if :mod:`.interrupt` noted a Ctrl-C or SIGTERM (or nobody defers them, so it
+    cannot tell); otherwise it is the component's, a fault like any exception it raises."""
+    return RunFault(who, now, "raised KeyboardInterrupt() itself (not a Ctrl-C: a fault)")
 
 
 def in_run(fault: RunFault, run: int | None) -> RunFault:
@@ -131,7 +146,7 @@ def bad_output(who: str, now: Fraction, targets: Mapping[str, Any], out: Any) ->
         if key not in targets:
             return RunFault(who, now, f"published unknown output {short_repr(key)}")
         try:
-            number = float(value)
+            number = as_number(value)
         except OverflowError:
             return RunFault(who, now, f"output {key} is too large for a float")
         except (TypeError, ValueError):
@@ -203,17 +218,25 @@ class Steppers:
                 out = comp.do_step(now, inp)
             except RunFault:
                 raise
+            except KeyboardInterrupt as exc:  # the user's Ctrl-C, or the component's own
+                if interrupt.users_interrupt():
+                    raise
+                raise own_interrupt(who(path), now) from exc
             except COMPONENT_ERRORS as exc:  # inlined :meth:`_call`, as in :meth:`step`
                 raise RunFault(who(path), now, f"do_step raised {exc!r}") from exc
-            if out:  # checked_writes, inlined as in :meth:`step`
-                try:
-                    for key, value in out.items():
-                        number = float(value)
-                        if number - number != 0.0:  # inf or nan
-                            raise ValueError
-                        values[targets[key]] = number
-                except OUTPUT_ERRORS:
-                    raise bad_output(who(path), now, targets, out) from None
+            if not out:
+                if out.__class__ is not dict and not isinstance(out, Mapping):
+                    raise bad_output(who(path), now, targets, out)
+                return
+            # checked_writes, inlined as in :meth:`step`
+            try:
+                for key, value in out.items():
+                    number = value if value.__class__ is float else as_number(value)
+                    if number - number != 0.0:  # inf or nan
+                        raise ValueError
+                    values[targets[key]] = number
+            except OUTPUT_ERRORS:
+                raise bad_output(who(path), now, targets, out) from None
 
         return step
 
@@ -222,6 +245,10 @@ class Steppers:
             return task.comp.do_step(now, inp)
         except RunFault:
             raise
+        except KeyboardInterrupt as exc:  # the user's Ctrl-C, or the component's own
+            if interrupt.users_interrupt():
+                raise
+            raise own_interrupt(self.who(task.path), now) from exc
         except COMPONENT_ERRORS as exc:  # a component's own bug or bad configuration
             raise RunFault(self.who(task.path), now, f"do_step raised {exc!r}") from exc
 
@@ -233,18 +260,26 @@ class Steppers:
             out = task.comp.do_step(now, inp)
         except RunFault:
             raise
+        except KeyboardInterrupt as exc:  # the user's Ctrl-C, or the component's own
+            if interrupt.users_interrupt():
+                raise
+            raise own_interrupt(self.who(task.path), now) from exc
         except COMPONENT_ERRORS as exc:  # inlined :meth:`_call`: the hot path
             raise RunFault(self.who(task.path), now, f"do_step raised {exc!r}") from exc
-        if out:  # checked_writes(task, out, values, now, self.who), inlined (module doc)
-            targets = task.writes
-            try:
-                for key, value in out.items():
-                    number = float(value)
-                    if number - number != 0.0:  # inf or nan
-                        raise ValueError
-                    values[targets[key]] = number
-            except OUTPUT_ERRORS:
-                raise bad_output(self.who(task.path), now, targets, out) from None
+        if not out:
+            if out.__class__ is not dict and not isinstance(out, Mapping):
+                raise bad_output(self.who(task.path), now, task.writes, out)
+            return
+        # checked_writes(task, out, values, now, self.who), inlined (module doc)
+        targets = task.writes
+        try:
+            for key, value in out.items():
+                number = value if value.__class__ is float else as_number(value)
+                if number - number != 0.0:  # inf or nan
+                    raise ValueError
+                values[targets[key]] = number
+        except OUTPUT_ERRORS:
+            raise bad_output(self.who(task.path), now, targets, out) from None
 
     def step_delayed(self, task: Task, now: Fraction) -> None:
         """:meth:`step` for a Leaf with latency or jitter: its outputs go into its delay
@@ -256,9 +291,15 @@ class Steppers:
             out = task.comp.do_step(now, inp)
         except RunFault:
             raise
+        except KeyboardInterrupt as exc:  # the user's Ctrl-C, or the component's own
+            if interrupt.users_interrupt():
+                raise
+            raise own_interrupt(self.who(task.path), now) from exc
         except COMPONENT_ERRORS as exc:  # inlined :meth:`_call`: once per step of the Leaf
             raise RunFault(self.who(task.path), now, f"do_step raised {exc!r}") from exc
         if not out:
+            if out.__class__ is not dict and not isinstance(out, Mapping):
+                raise bad_output(self.who(task.path), now, task.writes, out)
             return
         writes: dict[Any, float] = {}
         checked_writes(task, out, writes, now, self.who)
@@ -281,6 +322,8 @@ class Steppers:
             inp[port] = values[at] if names is None else np.array([values[n] for n in names])
         out = self._call(task, now, inp)
         if not out:
+            if out.__class__ is not dict and not isinstance(out, Mapping):
+                raise bad_output(self.who(task.path), now, task.writes, out)
             return
         writes: list[tuple[Any, float]] = []
         scalars: dict[str, Any] = {}
@@ -339,6 +382,10 @@ class Steppers:
             )
         except RunFault:
             raise
+        except KeyboardInterrupt as exc:  # the user's Ctrl-C, or the component's own
+            if interrupt.users_interrupt():
+                raise
+            raise own_interrupt(who(group.paths[0]), now) from exc
         except COMPONENT_ERRORS as exc:
             raise RunFault(who(group.paths[0]), now, f"step_many raised {exc!r}") from exc
         except (TypeError, ValueError) as exc:  # not a pair (outputs, published)

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import functools
-import os
-import warnings
 from pathlib import Path
 from typing import Any
 
@@ -16,9 +14,8 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ..errors import ConfigError
-from ..model.params import short_repr
 from ..palette import COLLISION, PHASE, REFERENCE, SIGNAL, hex_colour
+from ..traceread import MAX_LINE_BYTES, read_rows
 from ..valuetext import value_text
 from .adaptmarks import adapt_switches
 from .save import save_png
@@ -46,93 +43,19 @@ def read_trace(path: Path, keep: frozenset[str] | None = None) -> tuple[list[str
 def trace_header(path: Path) -> list[str]:
     """The column names on a trace's first line (what :func:`read_trace` may ``keep``)."""
     with open(path, "rb") as fh:
-        return fh.readline().decode("utf-8", "replace").rstrip("\n").split(",")
+        head = fh.readline(MAX_LINE_BYTES)
+    return head.decode("utf-8", "replace").rstrip("\n").split(",")
 
 
 @functools.lru_cache(maxsize=2)
 def _read_trace(
     path: str, mtime_ns: int, size: int, keep: frozenset[str] | None = None
 ) -> tuple[list[str], np.ndarray]:
-    with open(path, "rb") as fh:  # the checks read the first line and the last byte only
-        head = fh.readline()
-        fh.seek(-1 if size else 0, os.SEEK_END)
-        whole = fh.read(1) == b"\n"
-    try:
-        header = head.decode("utf-8").rstrip("\n").split(",")
-    except UnicodeDecodeError as exc:
-        raise ConfigError(f"not a trace: not UTF-8 text (byte {exc.start})", file=path) from None
-    if header[0] != "t":
-        raise ConfigError("not a whole trace: no header line starting with t", file=path, line=1)
-    if not whole:  # a row cut short, as a killed writer would leave it
-        raise ConfigError("not a whole trace: cut short", file=path, line=_newlines(path) + 1)
-    cols = None
-    if keep is not None:
-        cols = [i for i, name in enumerate(header) if i == 0 or name in keep]
-        if not _rows_as_wide_as(path, len(header)):  # usecols alone would not see it
-            line, problem = _bad_row(path, len(header))
-            raise ConfigError(f"not a whole trace: {problem}", file=path, line=line)
-    try:
-        with warnings.catch_warnings():  # a header alone: no rows, not a warning
-            warnings.simplefilter("ignore")
-            data = np.loadtxt(
-                path, delimiter=",", skiprows=1, ndmin=2, encoding="utf-8", usecols=cols
-            )
-    except (ValueError, UnicodeDecodeError):
-        data = np.empty((0, 0))  # found below, with its line
-    width = len(header) if cols is None else len(cols)
-    if data.size == 0 and _newlines(path) == 1:  # the header alone: a run that faulted at 0
-        data = np.empty((0, width))
-    if data.shape[1:] != (width,):
-        line, problem = _bad_row(path, len(header))
-        raise ConfigError(f"not a whole trace: {problem}", file=path, line=line)
-    if cols is not None:
-        header = [header[i] for i in cols]
+    # streamed, judged row by row, decimated to a bounded size (traceread.py)
+    header, data, _stride = read_rows(Path(path), keep)
     data[~(np.abs(data) < PLOTTABLE)] = np.nan  # inf, nan and the unplottable
     data.flags.writeable = False  # shared between callers
     return header, data
-
-
-def _rows_as_wide_as(path: str, width: int) -> bool:
-    """Whether every line of the file has ``width - 1`` commas (counted on the bytes at
-    once: ~30 ms for a 36 MB trace, where a Python loop over its rows takes a second)."""
-    raw = np.fromfile(path, dtype=np.uint8)
-    ends = np.flatnonzero(raw == ord("\n"))
-    commas = np.flatnonzero(raw == ord(","))
-    per_line = np.diff(np.searchsorted(commas, ends), prepend=0)
-    return bool((per_line == width - 1).all())
-
-
-def _newlines(path: str) -> int:
-    with open(path, "rb") as fh:
-        return sum(chunk.count(b"\n") for chunk in iter(lambda: fh.read(1 << 20), b""))
-
-
-def _bad_row(path: str, width: int) -> tuple[int, str]:
-    """The first row (as a file line) that is not ``width`` numbers, and what is wrong."""
-    with open(path, "rb") as fh:
-        fh.readline()
-        for line, raw in enumerate(fh, start=2):
-            try:
-                row = raw.decode("utf-8").rstrip("\n")
-            except UnicodeDecodeError:
-                return line, "not UTF-8 text"
-            problem = _row_problem(row, width)
-            if problem:
-                return line, problem
-    return 1, "unreadable"
-
-
-def _row_problem(row: str, width: int) -> str:
-    """What is wrong with one row of a trace ("" if nothing)."""
-    cells = row.split(",")
-    if len(cells) != width:
-        return f"{len(cells)} values where the header names {width}"
-    for cell in cells:
-        try:
-            float(cell)
-        except ValueError:
-            return f"{short_repr(cell)} is not a number"
-    return ""
 
 
 NOTE_PT = 7.5  # phase notes' font size

@@ -88,6 +88,7 @@ class View:
 def choose_view(paths: list[np.ndarray]) -> View:
     """The lateral-offset frame when every path hugs one straight line, else to scale."""
     pts = np.concatenate([p for p in paths if p.size]) if paths else np.empty((0, 2))
+    pts = pts[np.isfinite(pts).all(axis=1)]  # a damaged trace's gaps (NaN) carry no route
     if len(pts) < 3:
         return View()
     origin = pts.mean(axis=0)

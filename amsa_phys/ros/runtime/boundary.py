@@ -33,7 +33,8 @@ from collections.abc import Iterable, Mapping
 from fractions import Fraction
 from typing import Any
 
-from ...errors import AmsaError
+from ...errors import AmsaError, one_line
+from ...model.params import short_repr
 from ...stdmsgs import DEFAULT_ORIGIN, Context, Source, build, geodetic_to_enu, quaternion_yaw
 from ...stdmsgs.build import static_transform, transform
 from .. import names
@@ -247,7 +248,11 @@ class BoundaryNode:
         if msg.data == FLUSH:  # the run's values are all handled (one publisher: in order)
             self.flushed.publish(self.String(FLUSH))
             return
-        at, values = parse_values(msg.data)
+        try:
+            at, values = parse_values(msg.data)
+        except ValueError as exc:  # not the simulator's: said, dropped, the node goes on
+            self.rospy.logerr(one_line(f"{NODE}: {VALUES}: {exc}"))
+            return
         with self.lock:
             for buffer, value in values:
                 if buffer in self.readers:
@@ -286,10 +291,21 @@ def format_values(t: Fraction, values: Iterable[tuple[str, float]]) -> str:
 
 
 def parse_values(text: str) -> tuple[Fraction, list[tuple[str, float]]]:
-    """A :data:`VALUES` message: the instant and the values."""
-    num, den, *rest = text.split(" ")
-    values = [(rest[i], float(rest[i + 1])) for i in range(0, len(rest), 2)]
-    return Fraction(int(num), int(den)), values
+    """A :data:`VALUES` message: the instant and the values. Anything else on the topic
+    (another publisher's text, a torn message) is ``ValueError`` saying what it is."""
+    try:
+        num, den, *rest = text.split(" ")
+        if len(rest) % 2:
+            raise ValueError
+        values = [(rest[i], float(rest[i + 1])) for i in range(0, len(rest), 2)]
+        at = Fraction(int(num), int(den))
+    except (ValueError, ZeroDivisionError):
+        raise ValueError(f"not a values message: {short_repr(text)}") from None
+    if at < 0 or not all(math.isfinite(v) for _, v in values):
+        raise ValueError(
+            f"not a values message (a negative instant or a value not finite): {short_repr(text)}"
+        )
+    return at, values
 
 
 def readable(graph: RosGraph) -> set[str]:
@@ -309,7 +325,31 @@ def read_fields(
     src: Source, msg: Any, origin: tuple[float, float], scan: ScanShape | None = None
 ) -> dict[str, Any] | None:
     """A standard message's fields as the stream's Leaf outputs them (None: drop it;
-    ``scan``: a lidar Leaf's declared scan, to which a LaserScan is fitted)."""
+    ``scan``: a lidar Leaf's declared scan, to which a LaserScan is fitted).
+
+    A driver's message is input from outside, so it is judged: one whose numbers are not
+    finite (a NaN latitude, an infinite quaternion) or a scan with more than
+    :data:`MAX_SCAN_RANGES` ranges or a non-finite geometry is dropped, as a lost fix is:
+    a NaN reaching the controller side would reach the robot's wheel commands."""
+    fields = _fields(src, msg, origin, scan)
+    if fields is None:
+        return None
+    for value in fields.values():
+        if isinstance(value, list):
+            continue  # ranges: made finite by the scan's own rules
+        if not math.isfinite(value):
+            return None
+    return fields
+
+
+#: the most ranges a driver's LaserScan may hold (720 is a common driver's; fitting costs
+#: beams x ranges, so a scan of millions would stall the boundary)
+MAX_SCAN_RANGES = 65_536
+
+
+def _fields(
+    src: Source, msg: Any, origin: tuple[float, float], scan: ScanShape | None
+) -> dict[str, Any] | None:
     role = src.role.name
     if role == "NavSatFix":
         if msg.status.status <= NO_FIX:
@@ -325,10 +365,16 @@ def read_fields(
         pose = msg.pose.pose
         return {"x": pose.position.x, "y": pose.position.y, "yaw": quaternion_yaw(pose.orientation)}
     if role == "LaserScan":
+        geometry = (msg.angle_min, msg.angle_increment, msg.range_min, msg.range_max)
+        if len(msg.ranges) > MAX_SCAN_RANGES or not all(map(math.isfinite, geometry)):
+            return None
         if scan is not None:
             return {"ranges": fit_scan(msg, scan)}
         far = msg.range_max
-        return {"ranges": [far if math.isinf(r) or r > far else r for r in msg.ranges]}
+        near = msg.range_min
+        # no return (inf) and an erroneous one (NaN) read as nothing within reach; too
+        # close (-inf, REP 117) as the nearest the driver measures
+        return {"ranges": [max(r, near) if r <= far else far for r in msg.ranges]}
     return None
 
 

@@ -8,7 +8,8 @@ arguments given (``mode:=lockstep`` unless ``mode:=`` is one of them, and ``out:
 ``runs/SCENARIO-STAMP`` in the current directory unless given), then judges the run directory
 the simulator wrote, exactly as ``amsa-phys run`` judges its own: the expectations of the
 run's ``scenario.yaml`` against its ``metrics.json`` and ``trace.csv``. Exit 0: every check
-passed; 1: a check failed; 2: the run faulted or wrote nothing; 130: interrupted.
+passed; 1: a check failed; 2: the run faulted, wrote nothing, or a required node died
+(killed or crashed: the launch names it); 130: interrupted.
 
 roslaunch's output passes through this script (``launchout``), which notes its ``error: ``
 lines: when the run did not start, the last line names the first of them (the node that
@@ -45,6 +46,16 @@ def judge(out: Path, seen: launchout.Seen | None = None) -> tuple[int, list[str]
         return 2, [f"{SCRIPT}: no run in {out} (metrics.json missing): the run did not start{why}"]
     metrics = json.loads(metrics_file.read_text())
     status = str(metrics.get("status", ""))
+    if status == "interrupted" and seen is not None and seen.died:
+        # the launch ended because a required node died (killed, crashed): the run's
+        # fault, not the user's Ctrl-C, which roslaunch's own shutdown looks like to the
+        # simulator
+        return 2, [
+            one_line(
+                f"{SCRIPT}: node {seen.died[0]} died mid-run and ended the launch; "
+                f"outputs so far in {out}"
+            )
+        ]
     if status == "interrupted":
         return 130, [f"{SCRIPT}: the run was interrupted; outputs so far in {out}"]
     if status != "completed":

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from ...engine import interrupt
-from ...errors import AmsaError, Interrupted, RunFault
+from ...errors import AmsaError, Interrupted, RunFault, one_line
 from ...runs.expect import check_expectations
 from ...runs.rundir import default_run_dir, prepare_run_dir
 from ...runs.single import run_scenario
@@ -32,6 +32,7 @@ def main() -> None:
     code = 0
     try:
         cfg = load_config(rospy)
+        check_seed(rospy)
         scenario, folded = records.fold_server_values(rospy, cfg.scenario)
         for change in folded:
             print(f"amsa_simulator: {change.key}={change.value} (parameter server)", flush=True)
@@ -91,6 +92,27 @@ def main() -> None:
     rospy.signal_shutdown("the run is over")
     ending.end_launch(code)  # a passing run: roslaunch ends the launch, without alarm
     sys.exit(code)
+
+
+#: the largest seed, as everywhere else (``--seed``, a scenario's ``seed:``)
+MAX_SEED = 2**63 - 1
+
+
+def check_seed(rospy: Any) -> None:
+    """Refuse, before anything is written, a ``/amsa/seed`` that is not a seed: the C++
+    sensors seed their random streams from it, and a hand-edited launch file holding ``-1``
+    or text had faulted the run at its first step, naming the sensor, not the parameter
+    (and one beyond 2^63 - 1, which no other part of amsa-phys takes, ran)."""
+    if not rospy.has_param("/amsa/seed"):
+        return  # a launch file of the user's own: each C++ sensor says so at its first step
+    text = str(rospy.get_param("/amsa/seed"))
+    if not (text.isascii() and text.isdigit() and int(text) <= MAX_SEED):
+        raise AmsaError(
+            one_line(
+                f"/amsa/seed: expected a seed, 0 to 2^63 - 1 in digits, got {text!r} "
+                "(export the package again with --seed N rather than editing its launch file)"
+            )
+        )
 
 
 def _summary(metrics: dict[str, Any], out_dir: Path) -> None:
