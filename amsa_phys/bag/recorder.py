@@ -253,14 +253,17 @@ class BagRecorder:
 
 def _timeline_events(scenario: Scenario) -> list[tuple[Fraction, str, str]]:
     """The scenario's phase starts and in-phase changes as (at, kind, detail), in time order."""
-    out: list[tuple[Fraction, str, str]] = []
-    for i, phase in enumerate(scenario.phases):
-        sets = ", ".join(f"{c.key}={c.value!r}" for c in phase.changes)
-        label = f" ({phase.label})" if phase.label else ""
-        out.append((phase.at, "phase", f"phase {i}{label} starts: {sets}".rstrip(": ")))
-        for step in phase.within:
-            sets = ", ".join(f"{c.key}={c.value!r}" for c in step.changes)
-            label = f" ({step.label})" if step.label else ""
-            out.append((step.at, "change", f"in phase {i}{label}: {sets}"))
-    out.sort(key=lambda p: p[0])
+    timeline = scenario.timeline
+    first = timeline.phases[0]
+    sets = ", ".join(f"{c.key}={c.value!r}" for c in first.changes)
+    label = f" ({first.label})" if first.label else ""
+    out = [(first.at, "phase", f"phase 0{label} starts: {sets}".rstrip(": "))]
+    for point in timeline.points():
+        sets = ", ".join(f"{c.key}={c.value!r}" for c in point.changes)
+        label = f" ({point.label})" if point.label else ""
+        if point.starts_phase:
+            text = f"phase {point.phase}{label} starts: {sets}".rstrip(": ")
+            out.append((point.at, "phase", text))
+        else:
+            out.append((point.at, "change", f"in phase {point.phase}{label}: {sets}"))
     return out

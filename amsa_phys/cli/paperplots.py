@@ -66,7 +66,7 @@ def plot_starts(args: argparse.Namespace) -> int:
             raise ConfigError("the scenario's controller has no Kv", file=src)
         kvs.append(kv)
         leader_x = float(scenario.world.leaves["Leader"].params["x"])
-        for change in scenario.phases[0].changes:
+        for change in scenario.timeline.initial:
             if change.key == "Leader.x":
                 leader_x = float(change.value)
         for gap in paperstart.GAPS:

@@ -126,7 +126,7 @@ def with_overrides(scenario: Scenario, overrides: list[str], doc: YamlDoc | None
             _refuse_conflict(given, key.strip(), text, raw.strip())
     in_file = len(scenario.timeline.initial)
     timeline = scenario.timeline.with_initial(added)
-    out = dataclasses.replace(scenario, world=world, phases=list(timeline.phases))
+    out = dataclasses.replace(scenario, world=world, timeline=timeline)
     check_phases(out, doc, in_file)
     return out
 

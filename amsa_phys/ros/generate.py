@@ -297,7 +297,7 @@ def _simulator_doc(graph: RosGraph) -> str:
 def _params_yaml(scenario: Scenario) -> str:
     """The ROS parameters at t = 0: the world's values with the scenario's ``set:``."""
     values = {path: dict(leaf.params) for path, leaf in scenario.world.leaves.items()}
-    for change in scenario.phases[0].changes:
+    for change in scenario.timeline.initial:
         values[change.leaf][change.param] = change.value
     phases = run_phases(scenario.world, scenario.seed)
     tree: dict[str, Any] = {}

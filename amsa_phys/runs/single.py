@@ -205,11 +205,11 @@ def execute(
         if record is not None:
             from ..view.recorder import Recorder
 
-            recorder = Recorder(sim, record, scenario.quality, scenario.planned_bounds)
+            recorder = Recorder(sim, record, scenario.quality, scenario.timeline.planned)
         if snapshot is not None:
             from ..view.recorder import Snapshot
 
-            still = Snapshot(sim, snapshot, scenario.quality, scenario.planned_bounds)
+            still = Snapshot(sim, snapshot, scenario.quality, scenario.timeline.planned)
         if window:
             driver = window if callable(window) else _open_window
             idle = driver(sim, scenario, recorder) or 0.0
@@ -334,7 +334,7 @@ def _open_window(sim: Simulation, scenario: Scenario, recorder: Recorder | None)
         scenario.quality,
         title=scenario.name,
         recorder=recorder,
-        planned=scenario.planned_bounds,
+        planned=scenario.timeline.planned,
     ).run()
 
 

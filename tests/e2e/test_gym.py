@@ -86,7 +86,7 @@ def test_the_agent_acting_as_the_controller_reproduces_the_run_bit_for_bit() -> 
     scenario = ap.load(SCENARIO1, duration=60)
     leaf = scenario.world.leaves["MyFollowerController"]
     params = dict(leaf.params)
-    params.update({c.param: c.value for c in scenario.phases[0].changes if c.leaf == leaf.path})
+    params.update({c.param: c.value for c in scenario.timeline.initial if c.leaf == leaf.path})
     law = FollowerController(leaf.path, params)
     law.initialize(None)
     env = FollowEnv(

@@ -16,14 +16,14 @@ import pytest
 
 from amsa_phys.engine.metrics import block_metrics
 from amsa_phys.engine.runner import Simulation
-from amsa_phys.model.scenario import load_scenario
+from amsa_phys.model.scenario import Timeline, load_scenario
 
 SCENARIOS = Path(__file__).resolve().parent.parent.parent / "scenarios"
 
 
 def settled_metrics(name: str, kv: float) -> dict[str, Any]:
     sc = load_scenario(SCENARIOS / name, overrides=[f"MyFollowerController.Kv={kv}"], duration=200)
-    sc = dataclasses.replace(sc, phases=sc.phases[:1])
+    sc = dataclasses.replace(sc, timeline=Timeline.of(sc.timeline.phases[:1], sc.duration))
     r = Simulation.from_scenario(sc).run()
     return block_metrics(
         r.samples_t, r.samples_s, 100.0, 200.0, 15.0, 1.5, [e.t for e in r.events], include_end=True

@@ -119,7 +119,7 @@ def test_an_in_phase_timeline_entry_changes_the_run_but_not_the_phases(tmp_path:
     text = path.read_text().replace("timeline:\n", "timeline:\n" + inner)
     path.write_text(text)
     scenario = load_scenario(path)
-    assert len(scenario.phases) == 2
+    assert len(scenario.timeline.phases) == 2
     out = tmp_path / "run"
     assert main(["run", str(path), "--headless", "-q", "--out", str(out)]) == 0
     metrics = json.loads((out / "metrics.json").read_text())

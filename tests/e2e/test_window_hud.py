@@ -24,7 +24,7 @@ def window(overrides: list[str] | None = None, duration: float = 20) -> Window:
     scenario = load_scenario(SCENARIO, overrides, duration=duration)
     sim = Simulation.from_scenario(scenario)
     sim.initialize()
-    return Window(sim, scenario.quality, size=(800, 450), planned=scenario.planned_bounds)
+    return Window(sim, scenario.quality, size=(800, 450), planned=scenario.timeline.planned)
 
 
 def test_a_parameter_set_twice_is_listed_once_with_the_value_in_force() -> None:

@@ -9,7 +9,7 @@ from typing import Any
 
 import toys
 
-from amsa_phys.model.scenario import Change, Phase, load_scenario
+from amsa_phys.model.scenario import Change, Phase, Timeline, load_scenario
 from amsa_phys.model.world import with_leaf
 from amsa_phys.physics.templates import ControlledRobot, FreeRobot
 from amsa_phys.runs.batched import unbatchable
@@ -47,10 +47,11 @@ def _scenario(tmp_path: Path, template: type, change_later: bool = False) -> Any
     path.write_text(SCENARIO)
     sc = load_scenario(path)
     leaf = dataclasses.replace(sc.world.leaves["R"], template=template)
-    phases = list(sc.phases)
+    phases = list(sc.timeline.phases)
     if change_later:
         phases.append(Phase(Fraction(1), [Change("R", "anything", 1.0)]))
-    return dataclasses.replace(sc, world=with_leaf(sc.world, leaf), phases=phases)
+    timeline = Timeline.of(phases, sc.duration)
+    return dataclasses.replace(sc, world=with_leaf(sc.world, leaf), timeline=timeline)
 
 
 def test_a_user_template_is_refused_unless_it_declares_itself_batchable(tmp_path: Path) -> None:

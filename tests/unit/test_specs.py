@@ -50,7 +50,7 @@ def test_set_frequency_returns_a_new_world_and_leaves_the_shared_one() -> None:
 
 def test_configuring_and_sweeping_never_change_the_loaded_scenario() -> None:
     base = load_scenario(SCEN)
-    phases = [(p.at, list(p.changes), list(p.within)) for p in base.phases]
+    phases = [(p.at, list(p.changes), list(p.within)) for p in base.timeline.phases]
     world = base.world
     cut = shortened(base, Fraction(5))
     assert cut.duration == 5
@@ -59,7 +59,7 @@ def test_configuring_and_sweeping_never_change_the_loaded_scenario() -> None:
     physics = apply_setting(base, "physics.ground.friction", 0.3)
     assert swept.timeline.initial[-1].value == 0.2
     assert physics.world.physics["ground"]["friction"] == 0.3
-    assert [(p.at, list(p.changes), list(p.within)) for p in base.phases] == phases
+    assert [(p.at, list(p.changes), list(p.within)) for p in base.timeline.phases] == phases
     assert base.world is world
     assert world.physics["ground"]["friction"] != 0.3
 
@@ -77,18 +77,21 @@ def test_two_jobs_of_one_cached_scenario_do_not_see_each_others_values() -> None
 
 def test_a_scenario_is_frozen_down_to_its_sequences() -> None:
     scenario = load_scenario(SCEN)
-    for name, value in (("seed", 3), ("duration", Fraction(1)), ("phases", ())):
+    for name, value in (("seed", 3), ("timeline", None)):
         with pytest.raises(dataclasses.FrozenInstanceError):
             setattr(scenario, name, value)
+    with pytest.raises(AttributeError):  # the duration is the timeline's: no second copy
+        scenario.duration = Fraction(1)  # type: ignore[misc]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        scenario.timeline.duration = Fraction(1)  # type: ignore[misc]
     with pytest.raises(AttributeError):  # a tuple: nobody appends to a shared one
-        scenario.phases.append(scenario.phases[0])  # type: ignore[attr-defined]
+        scenario.timeline.phases.append(scenario.timeline.phases[0])  # type: ignore[attr-defined]
     with pytest.raises(AttributeError):
         scenario.expect.append(None)  # type: ignore[attr-defined]
     with pytest.raises(dataclasses.FrozenInstanceError):
         scenario.quality.reference = 1.0  # type: ignore[union-attr,misc]
     # a list given to the constructor (the builder's, a user's replace) is stored as a tuple
-    again = dataclasses.replace(scenario, phases=list(scenario.phases), trace_columns=["*"])
-    assert isinstance(again.phases, tuple)
+    again = dataclasses.replace(scenario, trace_columns=["*"])
     assert again.trace_columns == ("*",)
 
 
@@ -98,7 +101,7 @@ def test_runs_of_a_sweep_leave_its_cached_scenario_as_loaded() -> None:
 
     shared = sweep._shortened(str(SCEN), 3.0)  # what every job of this process starts from
     before = resolved_scenario(shared)
-    phases = shared.phases
+    timeline = shared.timeline
     rows = [
         sweep.run_job(job(0, (("MyFollowerController.Kv", 0.1),))),
         sweep.run_job(job(1, (("MyFollowerController.Kv", 0.3), ("physics.gravity", 3.0)))),
@@ -106,7 +109,7 @@ def test_runs_of_a_sweep_leave_its_cached_scenario_as_loaded() -> None:
     assert [r["error"] for r in rows] == ["", ""]
     assert sweep._shortened(str(SCEN), 3.0) is shared  # the cache was used, not reloaded
     assert resolved_scenario(shared) == before  # world, parameters, timeline, expectations
-    assert shared.phases is phases
+    assert shared.timeline is timeline
     assert shared.seed == load_scenario(SCEN).seed
 
 

@@ -53,7 +53,7 @@ def scenario(tmp_path: Path, body: str) -> Path:
 def test_a_scenario_sets_a_leafs_frequency_for_the_whole_run(tmp_path: Path) -> None:
     s = load_scenario(scenario(tmp_path, 'set: {MyNormalizePower.freq: "10/3", Leader.x: 12.0}\n'))
     assert s.world.leaves["MyNormalizePower"].freq == Fraction(10, 3)
-    assert [c.key for c in s.phases[0].changes] == ["Leader.x"]  # not a parameter change
+    assert [c.key for c in s.timeline.initial] == ["Leader.x"]  # not a parameter change
     resolved = resolved_scenario(s)
     assert "MyNormalizePower.freq" not in resolved["set"]
     assert resolved["world"]["components"]["MyNormalizePower"]["freq"] == 10 / 3
