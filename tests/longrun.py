@@ -8,6 +8,8 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import sigint
+
 FIXTURE = Path(__file__).resolve().parent / "fixtures" / "mde_short.yaml"
 
 #: Every long run started, so that ``conftest.py`` can stop any a failed test left running.
@@ -72,7 +74,7 @@ def start_long_run(out: Path, **popen: object) -> subprocess.Popen[str]:
             "-q",
         ],
         text=True,
-        **popen,
+        **{"preexec_fn": sigint.at_default, **popen},
     )  # type: ignore[call-overload]
     STARTED.append(proc)
     wait_until("the run wrote trace rows", lambda: has_rows(out / "trace.csv.tmp"), proc)

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import pytest
 import ros_prebuild
+import sigint
 
 LAUNCH_TIMEOUT = 120  # s of wall time before a launch is declared hung (and killed)
 
@@ -72,6 +73,7 @@ class Launch:
             text=True,
             env=env,
             start_new_session=True,
+            preexec_fn=sigint.at_default,
         )
         self.lines: list[str] = []
         self.watchdog = threading.Timer(LAUNCH_TIMEOUT, self.kill)

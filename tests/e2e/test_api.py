@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import os
-import signal
 import subprocess
 import sys
 from fractions import Fraction
@@ -275,11 +274,7 @@ def test_a_fault_raises_the_cli_message_with_the_run_so_far() -> None:
     assert partial.trace["t"][-1] == 0.95  # every whole instant before the fault
 
 
-@pytest.mark.usefixtures("toys_importable")
-@pytest.mark.skipif(
-    signal.getsignal(signal.SIGINT) is not signal.default_int_handler,
-    reason="Python's own SIGINT handler is replaced in this process",
-)
+@pytest.mark.usefixtures("toys_importable", "python_sigint")
 def test_ctrl_c_stops_between_instants_and_keeps_the_run() -> None:
     with pytest.raises(ap.Interrupted) as err:
         ap.run(toy("toys:CtrlC", {"at": 2.5}, 100))

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+import sigint
 from longrun import wait_until
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
@@ -270,7 +271,7 @@ def test_ctrl_c_leaves_a_finalised_bag(tmp_path: Path) -> None:
     out, bag = tmp_path / "int", tmp_path / "int.mcap"
     cmd = [sys.executable, "-m", "amsa_phys", "run", str(FIXTURE), "--headless", "--no-plot"]
     cmd += ["-q", "--duration", "100000", "--out", str(out), "--bag", str(bag)]
-    proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True, preexec_fn=sigint.at_default)
     try:
         tmp = bag.with_name(bag.name + ".tmp")
         wait_until(  # the event, asserted: a run that exits or hangs first fails here

@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import sigint
 
 from amsa_phys.cli.main import main
 from amsa_phys.falsify.objective import build_objective
@@ -218,6 +219,7 @@ def test_interrupt_keeps_every_finished_row(tmp_path: Path, how: str) -> None:
         [sys.executable, "-m", "amsa_phys", "falsify", str(RESONANCE), *BOX, "--budget", "5000",
          "-j", "1", "--out", str(out)],
         stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True, start_new_session=True,
+        preexec_fn=sigint.at_default,
     )  # fmt: skip
     try:
         assert proc.stderr is not None

@@ -9,6 +9,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
+import sigint
 
 from amsa_phys.cli.main import main
 
@@ -80,6 +81,7 @@ def test_pytest_collects_scenarios_in_a_users_project(tmp_path: Path) -> None:
     assert "Traceback" not in proc.stdout
 
 
+@pytest.mark.usefixtures("python_sigint")  # toys:CtrlC interrupts this process
 def test_ctrl_c_stops_the_whole_suite_not_just_one_scenario(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -121,6 +123,7 @@ def test_ctrl_c_stops_a_parallel_suite_promptly(tmp_path: Path, how: str) -> Non
         stdout=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        preexec_fn=sigint.at_default,
     )
     try:
         wait_until(  # both workers running, however loaded the machine

@@ -6,6 +6,7 @@ import csv
 from pathlib import Path
 
 import pytest
+import sigint
 
 from amsa_phys.cli.main import main
 
@@ -240,6 +241,7 @@ def test_ctrl_c_keeps_every_finished_row(tmp_path: Path, how: str) -> None:
             stderr=terminal.child_end,
             text=True,
             start_new_session=True,
+            preexec_fn=sigint.at_default,
         )
     os.close(terminal.child_end)
     some_rows = re.compile(r"\b[1-9][0-9]*/2000\b")  # the bar past 0/2000

@@ -15,6 +15,7 @@ from pathlib import Path
 import imageio_ffmpeg
 import numpy as np
 import pytest
+import sigint
 
 from amsa_phys.cli.main import main
 
@@ -201,6 +202,7 @@ def test_ctrl_c_during_a_recording_leaves_a_playable_video(tmp_path: Path) -> No
         ],
         env=env,
         start_new_session=True,  # its own group, so killpg does not hit pytest
+        preexec_fn=sigint.at_default,
         stderr=subprocess.PIPE,
         text=True,
     )

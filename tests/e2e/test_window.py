@@ -166,6 +166,7 @@ def test_a_window_without_a_display_is_refused_clearly(tmp_path: Path) -> None:
     assert not (tmp_path / "w").exists()
 
 
+@pytest.mark.usefixtures("python_sigint")
 def test_ctrl_c_in_the_terminal_stops_a_paused_window(tmp_path: Path) -> None:
     import json
     import os

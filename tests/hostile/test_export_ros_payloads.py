@@ -21,6 +21,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import sigint
 
 from amsa_phys.cli.main import main
 from amsa_phys.ros import generate
@@ -41,7 +42,10 @@ def _ros_missing() -> str | None:
     return None
 
 
-pytestmark = pytest.mark.skipif(_ros_missing() is not None, reason=str(_ros_missing()))
+pytestmark = [
+    pytest.mark.ros,
+    pytest.mark.skipif(_ros_missing() is not None, reason=str(_ros_missing())),
+]
 
 #: (file name, scenario name): every payload touches ``MARK`` in its working directory.
 CASES = [
@@ -109,6 +113,7 @@ def test_payloads_never_run_at_catkin_make_or_roslaunch(
                 "AMSA_PHYS_PYTHON": sys.executable,
             },
             start_new_session=True,
+            preexec_fn=sigint.at_default,
         )
         try:
             text, _ = proc.communicate(timeout=LAUNCH_TIMEOUT)

@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import sigint
 from longrun import start_long_run
 
 from amsa_phys.cli.main import main
@@ -31,6 +32,7 @@ def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
         text=True,
         env=ENV,
         check=False,
+        preexec_fn=sigint.at_default,  # some runs here interrupt themselves (toys:CtrlC)
     )
 
 

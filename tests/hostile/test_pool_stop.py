@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 import pytest
+import sigint
 
 TESTS = Path(__file__).resolve().parent.parent
 
@@ -76,6 +77,7 @@ def start_stuck(tmp_path: Path, command: str, grace: float) -> tuple[subprocess.
         text=True,
         env=env,
         start_new_session=True,
+        preexec_fn=sigint.at_default,
     )
     wait_for("two workers are stuck", lambda: len(list(tmp_path.glob("stuck.*"))) == 2)
     return proc, mark

@@ -16,6 +16,8 @@ from amsa_phys.errors import Interrupted
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.runs.single import run_scenario
 
+pytestmark = pytest.mark.usefixtures("python_sigint")  # these tests interrupt themselves
+
 ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO = ROOT / "tests" / "fixtures" / "mde_short.yaml"
 

@@ -19,6 +19,7 @@ import sys
 import textwrap
 
 import pytest
+import sigint
 
 from amsa_phys.ros.runtime.launchout import Seen, run
 
@@ -137,7 +138,11 @@ def test_sigterm_to_the_script_stops_the_launch_as_ctrl_c() -> None:
         "print('verdict', code, flush=True)\n"
     )
     proc = subprocess.Popen(
-        [sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, start_new_session=True
+        [sys.executable, "-c", script],
+        stdout=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        preexec_fn=sigint.at_default,
     )
     try:
         assert proc.stdout is not None

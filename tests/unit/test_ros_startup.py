@@ -20,6 +20,7 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
+import sigint
 
 from amsa_phys.cli.main import main
 from amsa_phys.ros.runtime import startup
@@ -51,6 +52,7 @@ def test_a_node_stopped_while_it_starts_says_nothing(
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         env={"PATH": "/usr/bin:/bin", "PYTHONPATH": str(fake)},
+        preexec_fn=sigint.at_default,
     )
     try:
         assert proc.stdout is not None
