@@ -66,6 +66,7 @@ class Prebuilder:
         self._finished: dict[Key, _Build] = {}
         self._proc: subprocess.Popen[bytes] | None = None
         self._stopped = False
+        self.cpu = 0.0  # seconds of CPU its finished commands spent
         self._halt = threading.Event()
         self._thread = threading.Thread(target=self._run, name="ros-prebuild", daemon=True)
 
@@ -115,7 +116,17 @@ class Prebuilder:
                     env=env,
                     start_new_session=True,  # its own process group: reniced or ended whole
                 )
-        if self._proc.wait() != 0:
+        # os.wait4: the command's CPU (with its waited-for descendants'), which is no test's
+        # (tests/tiers.py takes it off the CPU budget of the test running meanwhile)
+        try:
+            _, status, usage = os.wait4(self._proc.pid, 0)
+        except ChildProcessError:  # reaped by a poll() of take() or stop() (a ROS test's)
+            self._proc.wait()
+        else:
+            self._proc.returncode = os.waitstatus_to_exitcode(status)
+            with self._lock:
+                self.cpu += usage.ru_utime + usage.ru_stime
+        if self._proc.returncode != 0:
             output = build.log.read_text(errors="replace")[-3000:]
             build.error = f"{' '.join(command)} failed ({self._proc.returncode}):\n{output}"
             return True
@@ -155,6 +166,7 @@ class Prebuilder:
 
 
 _active: Prebuilder | None = None
+_spent = 0.0  # the CPU of the builders stopped so far
 
 
 def start(root: Path, wanted: list[Key]) -> Prebuilder:
@@ -170,8 +182,14 @@ def take(key: Key) -> _Build | None:
     return None if _active is None else _active.take(key)
 
 
+def cpu_spent() -> float:
+    """CPU seconds the session's background builds have spent so far (finished commands)."""
+    return _spent + (0.0 if _active is None else _active.cpu)
+
+
 def stop() -> None:
-    global _active
+    global _active, _spent
     if _active is not None:
         _active.stop()
+        _spent += _active.cpu
         _active = None

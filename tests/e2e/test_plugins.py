@@ -85,6 +85,7 @@ def _cli(cwd: Path, *args: str) -> subprocess.CompletedProcess[str]:
     )
 
 
+@pytest.mark.build  # pip installs a plugin package
 def test_an_installed_plugin_runs_by_its_short_name(installed_plugin: None, tmp_path: Path) -> None:
     scenario = tmp_path / "s.yaml"
     scenario.write_text(
@@ -108,6 +109,7 @@ def test_an_installed_plugin_runs_by_its_short_name(installed_plugin: None, tmp_
     ).read_bytes()
 
 
+@pytest.mark.build  # pip installs a plugin package
 def test_templates_lists_where_each_template_comes_from(
     installed_plugin: None, tmp_path: Path
 ) -> None:
@@ -120,6 +122,7 @@ def test_templates_lists_where_each_template_comes_from(
     assert gps.endswith("[built-in]")
 
 
+@pytest.mark.build  # pip installs a plugin package
 def test_a_misspelt_plugin_name_suggests_it(installed_plugin: None, tmp_path: Path) -> None:
     scenario = tmp_path / "s.yaml"
     scenario.write_text("world:\n  components:\n    C: {template: TinyCountr}\nduration: 1\n")

@@ -44,7 +44,10 @@ PKG = "mdeChallenge"
 FREE_BOUNDS = {"max_distance": 1.0, "final_distance": 1.0, "mean_error": 0.5}
 
 
-pytestmark = pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing()))
+pytestmark = [
+    pytest.mark.ros,
+    pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing())),
+]
 launcher = ros_launch.launcher  # the fixture
 
 

@@ -37,7 +37,10 @@ SCENARIO = ROOT / "scenarios" / "obstacle_course.yaml"
 PKG = "obstacleCourse"  # the world's name
 DURATION = "12"  # s: past the first obstacle (the avoider turns), a few seconds of launch
 
-pytestmark = pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing()))
+pytestmark = [
+    pytest.mark.ros,
+    pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing())),
+]
 launcher = ros_launch.launcher  # the fixture
 
 

@@ -44,7 +44,10 @@ STANDARD = {
     "tf2_msgs/msg/TFMessage",
 }
 
-pytestmark = pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing()))
+pytestmark = [
+    pytest.mark.ros,
+    pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing())),
+]
 launcher = ros_launch.launcher  # the fixture
 
 #: the simulator's launch-prefix: it starts once the recorder is connected to every topic

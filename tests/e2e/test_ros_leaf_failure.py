@@ -36,7 +36,10 @@ ROOT = Path(__file__).resolve().parent.parent.parent
 PKG = "mdeChallenge"
 BAD_KV = "error: /MyFollowerController: /MyFollowerController/Kv: -5 is below the minimum 0"
 
-pytestmark = pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing()))
+pytestmark = [
+    pytest.mark.ros,
+    pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing())),
+]
 launcher = ros_launch.launcher  # the fixture
 
 

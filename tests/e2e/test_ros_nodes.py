@@ -40,7 +40,10 @@ ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO = ROOT / "tests" / "fixtures" / "ros_nodes.yaml"
 PKG = "rosNodes"
 
-pytestmark = pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing()))
+pytestmark = [
+    pytest.mark.ros,
+    pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing())),
+]
 launcher = ros_launch.launcher  # the fixture
 
 

@@ -41,7 +41,10 @@ def _missing() -> str | None:
     return None
 
 
-pytestmark = pytest.mark.skipif(_missing() is not None, reason=str(_missing()))
+pytestmark = [
+    pytest.mark.ros,
+    pytest.mark.skipif(_missing() is not None, reason=str(_missing())),
+]
 launcher = ros_launch.launcher  # the fixture
 
 #: The robot: a leader 15 m ahead driving straight at 0.2 m/s, a follower obeying its wheel

@@ -26,7 +26,10 @@ from ros_launch import Launch, package_edit, ros_missing
 ROOT = Path(__file__).resolve().parent.parent.parent
 PKG = "mdeChallenge"
 
-pytestmark = pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing()))
+pytestmark = [
+    pytest.mark.ros,
+    pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing())),
+]
 launcher = ros_launch.launcher  # the fixture
 
 

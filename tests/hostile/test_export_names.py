@@ -204,6 +204,7 @@ def _renamed(pkg: Path) -> Path:
     return pkg
 
 
+@pytest.mark.build  # g++ compiles the generated node
 @pytest.mark.skipif(shutil.which("g++") is None, reason="g++ is not installed")
 @pytest.mark.skipif(not Path("/usr/include/ros/ros.h").exists(), reason="roscpp is not installed")
 @pytest.mark.skipif(

@@ -187,6 +187,7 @@ def test_the_path_in_use_is_said_and_forced_pure_wins(monkeypatch: pytest.Monkey
     assert why == ("compiled (C)" if on else why)
 
 
+@pytest.mark.build  # pip installs the package
 def test_an_install_without_a_c_compiler_succeeds_and_runs_pure(tmp_path: Path) -> None:
     """``CC=false``: the optional extension fails to build, the install does not."""
     src = tmp_path / "src"

@@ -9,6 +9,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import pytest
+
 from amsa_phys.cli import reference
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -31,6 +33,7 @@ def test_cli_reference_lists_every_command_and_option() -> None:
     assert "| `--debug` |" not in text.split("### `amsa-phys run`")[1]
 
 
+@pytest.mark.docs
 def test_the_manual_builds_strictly(tmp_path: Path) -> None:
     env = {**os.environ, "NO_MKDOCS_2_WARNING": "1"}
     done = subprocess.run(
@@ -89,6 +92,7 @@ def test_every_picture_is_shown_and_made_by_the_assets_command() -> None:
     assert shown == recipes, f"shown but not made, or made but not shown: {shown ^ recipes}"
 
 
+@pytest.mark.docs
 def test_the_assets_command_lists_and_makes_a_picture(tmp_path: Path) -> None:
     script = [sys.executable, str(ROOT / "docs" / "make_assets.py")]
     listed = subprocess.run([*script, "--list"], capture_output=True, text=True, check=True)
