@@ -53,8 +53,6 @@ from .timing import DelayLine, run_phases
 #: in its place (the ROS simulator's remote Leaves), see :class:`Simulation`.
 Wrap = Callable[[str, Template], Template]
 
-#: Kept for importers of the names this module used to define (``engine/tasks.py`` owns them)
-_Task = Task
 __all__ = ["COMPONENT_ERRORS", "Context", "Event", "RunResult", "Simulation", "Task", "Wrap"]
 
 

@@ -31,7 +31,7 @@ class Quality:
     reference: float
     tolerance: float
     #: seconds the signal must stay in the band for ``settling_time`` (None: the default,
-    #: ``engine/metrics.default_dwell`` of each block)
+    #: ``model/metrics.default_dwell`` of each block)
     dwell: float | None = None
 
 

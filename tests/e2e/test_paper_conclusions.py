@@ -14,8 +14,8 @@ from typing import Any
 
 import pytest
 
-from amsa_phys.engine.metrics import block_metrics
 from amsa_phys.engine.runner import Simulation
+from amsa_phys.model.metrics import block_metrics
 from amsa_phys.model.scenario import Timeline, load_scenario
 
 SCENARIOS = Path(__file__).resolve().parent.parent.parent / "scenarios"

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from amsa_phys.engine.clock import fraction_gcd
-from amsa_phys.engine.metrics import block_metrics
 from amsa_phys.errors import ConfigError
+from amsa_phys.model.metrics import block_metrics
 from amsa_phys.model.params import Param
 from amsa_phys.model.yamlio import parse_yaml
 
