@@ -33,7 +33,7 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from .. import __version__
+from .._version import __version__
 from ..engine.runner import Simulation
 from ..model.scenario import Scenario, traced_columns
 from ..stdmsgs import (
@@ -48,7 +48,7 @@ from ..stdmsgs import (
     transform,
 )
 from ..stdmsgs.names import unique
-from .writer import _DOUBLE, BagWriter, scalar_prefix, split_ns
+from .writer import DOUBLE, BagWriter, scalar_prefix, split_ns
 
 EVENTS_TOPIC = "/amsa/events"
 TF_TOPIC = "/tf"
@@ -185,7 +185,7 @@ class BagRecorder:
         ns = ns_of(now)
         self._flush_events(now)
         prefix = scalar_prefix(ns)
-        pack = _DOUBLE.pack
+        pack = DOUBLE.pack
         write_raw = w.write_raw
         for cid, col in self._scalars:
             write_raw(cid, prefix + pack(values[col]), ns)

@@ -75,7 +75,7 @@ def recording_options(args: argparse.Namespace) -> RecordOptions | None:
         raise ConfigError(f"{args.speedup}: must be above 0 and at most 10000", key="--speedup")
     if args.record is None:
         return None
-    path = _target(args.record, FORMATS, "--record", args.force)
+    path = recording_target(args.record, FORMATS, "--record", args.force)
     from ..view.recorder import RecordOptions
 
     return RecordOptions(path, size, args.fps, speedup)
@@ -87,7 +87,7 @@ def snapshot_options(args: argparse.Namespace) -> SnapshotOptions | None:
         if args.snapshot_at is not None:
             raise ConfigError("needs --snapshot FILE.png", key="--snapshot-at")
         return None
-    path = _target(args.snapshot, (".png",), "--snapshot", args.force)
+    path = recording_target(args.snapshot, (".png",), "--snapshot", args.force)
     at = None
     if args.snapshot_at is not None:
         if not 0 <= args.snapshot_at < 1e9:
@@ -98,7 +98,7 @@ def snapshot_options(args: argparse.Namespace) -> SnapshotOptions | None:
     return SnapshotOptions(path, parse_size(args.size), at)
 
 
-def _target(name: str, formats: tuple[str, ...], flag: str, force: bool) -> Path:
+def recording_target(name: str, formats: tuple[str, ...], flag: str, force: bool) -> Path:
     """An output file we may write: known extension, existing writable directory, no clobber."""
     path = Path(name)
     if path.suffix.lower() not in formats:

@@ -8,7 +8,7 @@ from typing import Any
 
 from ..errors import ConfigError, one_line
 from ..model.scenario import load_scenario
-from .plot import read_metrics
+from .paperruns import read_metrics
 
 RUN_FILES = ("trace.csv", "metrics.json", "scenario.yaml")
 

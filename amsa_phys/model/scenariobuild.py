@@ -214,7 +214,7 @@ def _expectations(
 def _check_whole(doc: YamlDoc, data: dict[str, Any], scenario: Scenario) -> None:
     """What only the whole scenario shows: rates that cannot be scheduled, a size that would
     not load again once written out in full."""
-    why = _cycle_problem(scenario)
+    why = scenario_cycle_problem(scenario)
     if why is not None:
         raise doc.error(("log_rate",) if "log_rate" in data else ("world",), why)
     size = written_values(scenario.world, data)
@@ -252,7 +252,7 @@ def _trace_patterns(doc: YamlDoc, data: dict[str, Any], world: WorldSpec) -> lis
     return patterns
 
 
-def _effective_log_rate(rate: Fraction, world: WorldSpec) -> Fraction:
+def effective_log_rate(rate: Fraction, world: WorldSpec) -> Fraction:
     """The trace is never sampled slower than the fastest sensor (design.md)."""
     sensors = [leaf.freq for leaf in world.leaves.values() if leaf.kind is Kind.SENSOR]
     return max([rate, *sensors])
@@ -269,11 +269,11 @@ def _nearby_file(path: Path) -> str:
     return f" (did you mean {same_stem[0]}?)" if same_stem else did_you_mean(path.name, names)
 
 
-def _cycle_problem(scenario: Scenario) -> str | None:
+def scenario_cycle_problem(scenario: Scenario) -> str | None:
     """Why the world's rates with the trace's cannot be scheduled (``model/rates.py``)."""
     world = scenario.world
     rates = [leaf.freq for leaf in world.leaves.values()]
-    rates += [Fraction(str(world.physics["rate"])), _effective_log_rate(scenario.log_rate, world)]
+    rates += [Fraction(str(world.physics["rate"])), effective_log_rate(scenario.log_rate, world)]
     return cycle_problem(rates)
 
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .. import __version__
+from .._version import __version__
 from ..engine.timing import run_phases
 from ..errors import ConfigError
 from ..model.scenario import Scenario

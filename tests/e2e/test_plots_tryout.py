@@ -142,11 +142,11 @@ def test_a_live_change_label_is_not_under_the_legend_and_has_an_entry(
     ],
 )
 def test_a_paper_panel_title_names_every_kv_it_shows(scenario: str, title: str) -> None:
-    from amsa_phys.cli.plot import _label
+    from amsa_phys.cli.paperruns import run_label
     from amsa_phys.model.scenario import load_scenario
 
     path = ROOT / "scenarios" / scenario
-    assert _label(path, load_scenario(path)) == title
+    assert run_label(path, load_scenario(path)) == title
 
 
 def test_a_rover_box_is_framed_in_its_trajectory_colour() -> None:

@@ -2,7 +2,12 @@
 
 * imports flow one way: model -> engine -> physics|sensors|control|interop -> plots|view -> runs
   -> ros -> cli|api -> gym, relative imports of any depth resolved;
-* no import circle, inside a package included;
+* no import circle, inside a package included, an import inside a function counted (it
+  only hides the circle until the function runs); ``if TYPE_CHECKING:`` imports excepted;
+* nothing points back up to the package root (``amsa_phys/__init__.py``, ``__main__``), and
+  the root's own modules (``errors``, ``_version``, ...) import only each other;
+* no module imports another module's private name (``from .x import _y``): join the two
+  modules or publish the name;
 * no production module writes another module's globals or patches another module's class
   (``batch.ENABLED = ...``, ``PhysicsWorld.step = ...``): such a write changes every user of
   that module, in whatever order the imports ran;
@@ -71,11 +76,13 @@ def imports_of(
     top_level: bool = False,
     pkg: Path = PKG,
     known: set[str] | None = None,
+    typing: bool = True,
 ) -> set[str]:
     """The ``amsa_phys`` modules ``path`` imports, relative imports of any depth resolved
     (``from ...engine import x`` in ``ros/runtime/``), ``from pkg import module`` as the
     module. ``top_level``: only imports run when the module loads (not those inside
-    functions, nor under ``if TYPE_CHECKING:``) — the ones that can make a circle."""
+    functions, nor under ``if TYPE_CHECKING:``); ``typing=False``: every import that runs,
+    late ones included, none under ``if TYPE_CHECKING:`` — the ones that make a circle."""
     known = KNOWN if known is None else known
     tree = parse(path.read_text() if source is None else source)
     me = module_name(path, pkg)
@@ -98,8 +105,16 @@ def imports_of(
 
     if top_level:
         collect(tree.body)
-    else:
+    elif typing:
         nodes = list(ast.walk(tree))
+    else:
+        hidden = {
+            id(inner)
+            for node in ast.walk(tree)
+            if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
+            for inner in ast.walk(node)
+        }
+        nodes = [node for node in ast.walk(tree) if id(node) not in hidden]
     found = set()
     for node in nodes:
         if isinstance(node, ast.Import):
@@ -153,10 +168,10 @@ def test_relative_imports_of_any_depth_are_seen() -> None:
 
 
 def circles(pkg: Path = PKG) -> list[list[str]]:
-    """Groups of modules that import each other when they load (Tarjan's components)."""
+    """Groups of modules that import each other, at load or later (Tarjan's components)."""
     known = known_modules(pkg)
     graph = {
-        module_name(p, pkg): imports_of(p, top_level=True, pkg=pkg, known=known) & known
+        module_name(p, pkg): imports_of(p, pkg=pkg, known=known, typing=False) & known
         for p in pkg.rglob("*.py")
     }
     index: dict[str, int] = {}
@@ -191,6 +206,61 @@ def circles(pkg: Path = PKG) -> list[list[str]]:
 
 def test_no_import_circles_even_inside_a_package() -> None:
     assert circles() == []
+
+
+#: the package root: what nothing inside the package may import
+ROOT_PACKAGE = {"amsa_phys", "amsa_phys.__main__"}
+
+
+def root_problems(pkg: Path = PKG, known: set[str] | None = None) -> list[str]:
+    """Arrows back up to the package root, and root modules importing from the layers."""
+    known = known_modules(pkg) if known is None else known
+    roots = {module_name(p, pkg) for p in pkg.glob("*.py")} - ROOT_PACKAGE
+    out = []
+    for path in sorted(pkg.rglob("*.py")):
+        me = module_name(path, pkg)
+        if me in ROOT_PACKAGE:
+            continue
+        found = imports_of(path, pkg=pkg, known=known, typing=False)
+        out += [f"{path.relative_to(pkg)} imports {m}" for m in sorted(found & ROOT_PACKAGE)]
+        if me in roots:
+            out += [f"{path.relative_to(pkg)} imports {m}" for m in sorted(found - roots)]
+    return out
+
+
+def test_nothing_points_back_up_to_the_package_root() -> None:
+    assert root_problems() == []
+
+
+def private_imports(pkg: Path = PKG) -> list[str]:
+    """``from .x import _y``: a private name of one module imported by another (a private
+    module, ``from . import _step``, is a module, not a name, and is not counted)."""
+    known = known_modules(pkg)
+    out = []
+    for path in sorted(pkg.rglob("*.py")):
+        me = module_name(path, pkg)
+        package = me if path.name == "__init__.py" else me.rpartition(".")[0]
+        for node in ast.walk(parse(path.read_text())):
+            if not isinstance(node, ast.ImportFrom):
+                continue
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - (node.level - 1)]
+                full = ".".join([*base, *([node.module] if node.module else [])])
+            else:
+                full = node.module or ""
+            if full != "amsa_phys" and not full.startswith("amsa_phys."):
+                continue
+            for alias in node.names:
+                private = alias.name.startswith("_") and not alias.name.startswith("__")
+                # ``from . import _step``: a module of the package (here a C extension)
+                module = f"{full}.{alias.name}" in known or (node.level and not node.module)
+                if private and not module:
+                    out.append(f"{path.relative_to(pkg)}:{node.lineno} imports {alias.name}")
+    return out
+
+
+def test_no_module_imports_another_modules_private_name() -> None:
+    assert private_imports() == []
 
 
 def test_only_physics_imports_pymunk() -> None:
@@ -365,6 +435,8 @@ def test_the_checks_pass_on_an_unchanged_copy(scratch: Path) -> None:
     assert known == KNOWN
     assert circles(scratch) == []
     assert write_problems(scratch) == []
+    assert root_problems(scratch) == []
+    assert private_imports(scratch) == []
     modules = sorted(p for p in scratch.rglob("*.py") if p.parent != scratch)
     assert [p for m in modules for p in layer_problems(m, scratch, known)] == []
 
@@ -391,16 +463,31 @@ def test_a_circle_inside_one_package_is_caught(scratch: Path) -> None:
     assert circles(scratch) == [CIRCLE]
 
 
-def test_a_late_import_is_no_circle(scratch: Path) -> None:
-    """An import inside a function or under TYPE_CHECKING runs after both modules loaded."""
+def test_a_late_import_is_a_circle_too_but_a_type_checking_one_is_not(scratch: Path) -> None:
+    """An import inside a function only hides a circle until the function runs; one under
+    TYPE_CHECKING never runs."""
     terrain = scratch / "physics" / "terrain.py"
-    add_line(terrain, "def _late():\n    from .zones import FrictionZone\n    return FrictionZone")
     add_line(
         terrain, "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from . import zones"
     )
     assert circles(scratch) == []
-    add_line(terrain, "class _Eager:\n    from .zones import GradeZone")  # runs at load
+    add_line(terrain, "def _late():\n    from .zones import FrictionZone\n    return FrictionZone")
     assert circles(scratch) == [CIRCLE]
+
+
+def test_an_arrow_back_up_to_the_root_is_caught(scratch: Path) -> None:
+    add_line(scratch / "runs" / "single.py", "def _v():\n    from .. import __version__")
+    add_line(scratch / "errors.py", "from .model import params")
+    assert root_problems(scratch) == [
+        "errors.py imports amsa_phys.model.params",
+        "runs/single.py imports amsa_phys",
+    ]
+
+
+def test_a_private_name_from_another_module_is_caught(scratch: Path) -> None:
+    add_line(scratch / "runs" / "single.py", "from ..model.scenariobuild import _world")
+    lines = len((scratch / "runs" / "single.py").read_text().splitlines())
+    assert private_imports(scratch) == [f"runs/single.py:{lines} imports _world"]
 
 
 @pytest.mark.parametrize(
