@@ -17,14 +17,11 @@ import pytest
 import ros_launch
 import yaml
 from ros_launch import Launch, build_workspace, package_edit, ros_missing
+from windowdrive import live_change
 
 from amsa_phys.cli.main import main
-from amsa_phys.engine.runner import Simulation
-from amsa_phys.model.scenario import Scenario, load_scenario
+from amsa_phys.model.scenario import load_scenario
 from amsa_phys.runs.single import run_scenario
-from amsa_phys.view.pg import pygame
-from amsa_phys.view.recorder import Recorder
-from amsa_phys.view.window import Window
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO = ROOT / "tests" / "fixtures" / "ros_steps.yaml"  # built in the background (conftest)
@@ -86,29 +83,8 @@ def test_a_change_inside_a_phase_runs_under_ros_as_in_process(
     assert _rows(out) == _rows(ref), _first_difference(out, ref)
 
 
-def live_change_at_sixty_seconds(sim: Simulation, scenario: Scenario, rec: Recorder | None) -> None:
-    """Run to 60 s, set MyFollowerController.Kv = 0.1 in the panel, run to the end."""
-    w = Window(sim, scenario.quality, size=(320, 240))
-
-    def press(key: int, text: str = "") -> None:
-        pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=key, mod=0, unicode=text))
-
-    for _ in range(3):
-        press(pygame.K_RIGHTBRACKET)  # x8: the run is two minutes of simulated time
-    while sim.now < 60:
-        w.frame(0.1)
-    press(pygame.K_p)
-    w.frame(0.0)
-    while w.panel.row.key != "MyFollowerController.Kv":
-        press(pygame.K_DOWN)
-        w.frame(0.0)
-    for ch in "0.1":
-        press(pygame.K_PERIOD if ch == "." else ord(ch), ch)
-    press(pygame.K_RETURN)
-    w.frame(0.0)
-    press(pygame.K_p)
-    while not w.finished:
-        w.frame(0.1)
+#: run to 60 s, set MyFollowerController.Kv = 0.1 in the panel, run at x8 to the end
+live_change_at_sixty_seconds = live_change("MyFollowerController.Kv", "0.1", at=60, faster=3)
 
 
 def test_a_live_change_from_the_window_replays_under_ros(

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from windowdrive import live_change, press
 
 from amsa_phys.cli.main import main
 from amsa_phys.engine.runner import Simulation
@@ -48,29 +49,8 @@ def scenario_file(tmp_path: Path, extra: str = "") -> Path:
     return path
 
 
-def press(key: int, text: str = "") -> None:
-    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=key, mod=0, unicode=text))
-
-
-def live_change_at_two_seconds(sim: Simulation, scenario: Scenario, rec: Recorder | None) -> None:
-    """Run to 2 s, set MyFollowerController.Kv = 0.2 in the panel, run to the end."""
-    w = Window(sim, scenario.quality, size=(320, 240))
-    while sim.now < 2:
-        w.frame(0.1)
-    press(pygame.K_p)
-    w.frame(0.0)
-    while w.panel.row.key != "MyFollowerController.Kv":
-        press(pygame.K_DOWN)
-        w.frame(0.0)
-    for ch in "0.2":
-        press(pygame.K_PERIOD if ch == "." else ord(ch), ch)
-    press(pygame.K_RETURN)
-    w.frame(0.0)
-    press(pygame.K_p)  # close the panel, then run at x8 to the end
-    for _ in range(3):
-        press(pygame.K_RIGHTBRACKET)
-    while not w.finished:
-        w.frame(0.1)
+#: run to 2 s, set MyFollowerController.Kv = 0.2 in the panel, run at x8 to the end
+live_change_at_two_seconds = live_change("MyFollowerController.Kv", "0.2", at=2, faster=3)
 
 
 def phases_of(metrics: dict) -> list[tuple[float, float]]:
