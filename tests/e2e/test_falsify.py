@@ -74,6 +74,7 @@ def search_worst(name: str, seed: int) -> tuple[float, int]:
     return float(progress.verdicts[k].value), len(progress.rows)
 
 
+@pytest.mark.slow  # 150 runs a case: 10-12 s of CPU each for resonance (over the 10 s budget)
 @pytest.mark.parametrize("seed", [1, 2, 3])
 @pytest.mark.parametrize("name", ["fig5", "resonance"])
 def test_budget_150_finds_the_grids_worst_within_5_percent(name: str, seed: int) -> None:

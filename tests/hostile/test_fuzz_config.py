@@ -22,6 +22,7 @@ from contextlib import redirect_stderr, redirect_stdout
 from pathlib import Path
 from typing import Any
 
+import pytest
 import yaml
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
@@ -138,6 +139,7 @@ def mutated(draw: st.DrawFn) -> str:
     return text
 
 
+@pytest.mark.slow  # hundreds of mutated scenarios validated and run: 11 s of CPU
 @settings(
     max_examples=EXAMPLES,
     deadline=None,  # speed is the benchmarks' business; a loaded CI box must not fail this
