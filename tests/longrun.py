@@ -48,7 +48,7 @@ def wait_until(
 
 def has_rows(trace_tmp: Path) -> bool:
     """Whether a trace being written holds data rows: the header and the first chunk of
-    rows reach the file together (``engine/recorder.py`` writes rows 256 at a time)."""
+    rows reach the file together (``engine/tracefile.py`` writes rows 256 at a time)."""
     try:
         return trace_tmp.stat().st_size > 0
     except FileNotFoundError:

@@ -18,7 +18,7 @@ from ..errors import ConfigError
 from ..view.encoder import FORMATS
 
 if TYPE_CHECKING:
-    from ..view.recorder import RecordOptions, SnapshotOptions
+    from ..view.video import RecordOptions, SnapshotOptions
 
 MAX_SIDE = 7680
 
@@ -76,7 +76,7 @@ def recording_options(args: argparse.Namespace) -> RecordOptions | None:
     if args.record is None:
         return None
     path = recording_target(args.record, FORMATS, "--record", args.force)
-    from ..view.recorder import RecordOptions
+    from ..view.video import RecordOptions
 
     return RecordOptions(path, size, args.fps, speedup)
 
@@ -93,7 +93,7 @@ def snapshot_options(args: argparse.Namespace) -> SnapshotOptions | None:
         if not 0 <= args.snapshot_at < 1e9:
             raise ConfigError(f"{args.snapshot_at}: must be 0 or more", key="--snapshot-at")
         at = Fraction(str(args.snapshot_at))
-    from ..view.recorder import SnapshotOptions
+    from ..view.video import SnapshotOptions
 
     return SnapshotOptions(path, parse_size(args.size), at)
 

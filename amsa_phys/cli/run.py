@@ -23,7 +23,7 @@ from .report import print_summary
 
 if TYPE_CHECKING:  # pygame is imported only by runs that draw, mcap only by --bag
     from ..bag import BagRecorder
-    from ..view.recorder import RecordOptions, SnapshotOptions
+    from ..view.video import RecordOptions, SnapshotOptions
 
 
 def add_args(p: argparse.ArgumentParser) -> None:

@@ -28,8 +28,8 @@ from .mouse import pan_zoom
 from .panel import ParamPanel
 from .pg import pygame
 from .plotpane import LiveSeries, SignalPicker, draw_side_panes, picker_key
-from .recorder import Recorder
 from .scene import Frame, Scene
+from .video import Recorder
 
 SPEEDS = (1 / 16, 1 / 8, 1 / 4, 1 / 2, 1, 2, 4, 8, 16, 32, 64, 128, 256)
 MAX_REAL_DT = 0.1  # seconds of wall clock a single frame may cover

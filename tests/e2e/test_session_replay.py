@@ -23,7 +23,7 @@ from amsa_phys.model.scenario import Expectation, Scenario, load_scenario
 from amsa_phys.runs.expect import check_expectations
 from amsa_phys.runs.single import run_scenario
 from amsa_phys.view.pg import pygame
-from amsa_phys.view.recorder import Recorder
+from amsa_phys.view.video import Recorder
 from amsa_phys.view.window import Window
 
 ROOT = Path(__file__).resolve().parent.parent.parent

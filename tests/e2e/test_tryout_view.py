@@ -181,7 +181,7 @@ def test_a_picture_at_a_logged_instant_shows_that_instants_sample(tmp_path: Path
     from fractions import Fraction
 
     from amsa_phys.view.drive import advance
-    from amsa_phys.view.recorder import Snapshot, SnapshotOptions
+    from amsa_phys.view.video import Snapshot, SnapshotOptions
 
     class Seen(Snapshot):
         """The snapshot, noting what it drew (the HUD's value then: the metrics live on)."""

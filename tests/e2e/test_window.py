@@ -13,7 +13,7 @@ from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import Scenario, load_scenario
 from amsa_phys.runs.single import run_scenario
 from amsa_phys.view.pg import pygame
-from amsa_phys.view.recorder import Recorder
+from amsa_phys.view.video import Recorder
 from amsa_phys.view.window import Window
 
 ROOT = Path(__file__).resolve().parent.parent.parent

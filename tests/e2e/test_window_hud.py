@@ -124,7 +124,7 @@ def test_the_snapshot_and_video_hud_count_phases_like_the_window(
 ) -> None:
     """``--duration`` with ``--snapshot``: the still's HUD says what the window's says."""
     from amsa_phys.cli.main import main
-    from amsa_phys.view import recorder
+    from amsa_phys.view import video as recorder
 
     seen: list[str] = []
 

@@ -20,7 +20,7 @@ import pytest
 
 from amsa_phys.atomic import write_atomic
 from amsa_phys.cli.main import main
-from amsa_phys.engine.recorder import TraceWriter
+from amsa_phys.engine.tracefile import TraceWriter
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 WORLD = ROOT / "worlds" / "mde_challenge.yaml"

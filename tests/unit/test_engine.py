@@ -240,7 +240,7 @@ def test_an_instant_with_no_exact_decimal_replays_exactly(tmp_path: Path) -> Non
     the float would land just after the 3 Hz step at 7/3 and the replay would differ."""
     import yaml
 
-    from amsa_phys.engine.recorder import TraceWriter
+    from amsa_phys.engine.tracefile import TraceWriter
     from amsa_phys.model.scenario import Change
     from amsa_phys.runs.resolve import resolved_scenario
 

@@ -19,8 +19,8 @@ import pytest
 from regimes import DT, every_regime, make_rovers
 
 from amsa_phys.engine import schedule
-from amsa_phys.engine.recorder import TraceWriter, format_rows
 from amsa_phys.engine.runner import Simulation
+from amsa_phys.engine.tracefile import TraceWriter, format_rows
 from amsa_phys.model.scenario import Change, load_scenario
 from amsa_phys.physics import bodyio
 from amsa_phys.physics.bodyio import BodyIO
