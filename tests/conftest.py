@@ -17,11 +17,12 @@ ROOT = Path(__file__).resolve().parent.parent
 collect_ignore_glob = ["fixtures/*", "golden/*.yaml"]
 
 # the markers of slow kinds and the CPU budget of the quick tier (tests/tiers.py); SIGINT at
-# its default for tests that interrupt (tests/sigint.py)
-pytest_plugins = ["tiers", "sigint", "pytester"]
+# its default for tests that interrupt (tests/sigint.py); the session's catkin builds in the
+# background (tests/ros_prebuild.py)
+pytest_plugins = ["tiers", "sigint", "pytester", "ros_prebuild"]
 
 #: the distributions whose ``amsa_phys.templates`` entry points a test may see: the project
-#: and the plugin tests/e2e/test_plugins.py installs. A user's plugin installed in the same
+#: and the plugin tests/model/test_plugins.py installs. A user's plugin installed in the same
 #: environment must not change what a test sees (a "did you mean" naming it)
 OWN_DISTRIBUTIONS = frozenset({"amsa-phys", "amsa-phys-tiny-rovers-test"})
 

@@ -24,7 +24,7 @@ import pytest
 #: the markers of the slow kinds: a test carrying one is outside the quick tier
 SLOW_KINDS = ("ros", "ros2", "build", "docs", "slow")
 #: seconds of CPU an unmarked test may spend (setup and call, children included); the ini
-#: option ``cpu_budget_s`` changes it (tests/unit/test_tiers.py runs a suite with a small one)
+#: option ``cpu_budget_s`` changes it (tests/structure/test_tiers.py runs a suite with a small one)
 BUDGET_S = 10.0
 #: fixtures that launch a ROS package: their tests are ``ros`` whatever their file says
 ROS_FIXTURES = frozenset({"launcher", "ros_short_workspace", "ros_short_checked"})

@@ -43,7 +43,7 @@ def rows(path: Path) -> list[dict[str, str]]:
 
 
 #: The executor of each acceptance search: the rows are the same bits whichever runs them
-#: (tests/unit/test_falsify_evaluate.py, tests/e2e/test_batch_sweep.py), so each problem uses
+#: (tests/falsify/test_falsify_evaluate.py, tests/runs/test_batch_sweep.py), so each problem uses
 #: the cheaper one. Fig. 5's follower starts 1 m behind the leader, its chassis within reach,
 #: so a batch makes every one of its runs again alone (the batch's pass is wasted: a search
 #: cost 18-20 s of CPU batched, 3.6 s alone); the resonance example's runs stay apart and

@@ -3,7 +3,7 @@
 Like the paper's figures, each Kv is run as its own experiment from the scenario's initial
 state (its timeline removed), for 200 s, and judged on the last 100 s. Scenarios 1 and 2
 start the follower at the reference distance; the paper's own start and its numbers are
-tests/e2e/test_paper_figures.py's.
+tests/plots/test_paper_figures.py's.
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ small host program stands for the two kinds of process: ``container`` reads the 
 the host ``dlopen``s locally (``RTLD_LOCAL``, as a plugin). Checked: a failure gives 2 in
 both, also when the library is unloaded before ``main`` returns; no failure gives 0; a
 variable inherited from a parent process is not taken for this one's. The launches
-themselves are ``tests/e2e/test_ros_leaf_failure.py``. Skipped where there is no C++
+themselves are ``tests/ros/test_ros_leaf_failure.py``. Skipped where there is no C++
 compiler.
 """
 

@@ -1,6 +1,6 @@
 """What ``export ros`` generates for the C++ nodes, checked without building them.
 
-The lockstep tests (tests/e2e/test_ros_nodes.py) need ROS; these say, anywhere, that every
+The lockstep tests (tests/ros/test_ros_nodes.py) need ROS; these say, anywhere, that every
 C++ body names its template's ports, that a body reads its inputs in the template's order
 whatever order the world lists them in, that a Leaf with an optional input left unlinked
 runs its Python twin, and that the launch file gives the C++ sensors the scenario's seed.

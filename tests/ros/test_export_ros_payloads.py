@@ -5,7 +5,7 @@ and the generated files), a package whose scenario names and file names carry th
 payloads (a newline then ``!radians`` code for roslaunch's rosparam loader, a newline then
 ``execute_process`` for catkin_make, ``\"\"\"`` then code for the Python nodes) is built with
 catkin and launched; the run completes and no payload's marker file exists anywhere.
-Launched in a private network namespace (``unshare -n``) as tests/e2e/test_ros.py does.
+Launched in a private network namespace (``unshare -n``) as tests/ros/test_ros.py does.
 Skipped, with the reason, where ROS, catkin, unshare or root is missing.
 """
 

@@ -7,7 +7,7 @@ and launched in lockstep for its first 12 s: the lidar's 31 ranges travel from t
 ``amsa-phys run --duration 12`` byte for byte with the C++ ReactiveAvoider (the default) and
 with its Python twin (``cpp:=false``). Mutation-checked: the C++ body's beam directions
 computed as ``k * delta / div + lo`` instead of numpy's ``k * step + lo`` (last-bit
-differences) fails the C++ case (``tests/unit/test_cpp_avoider.py`` compares the body with
+differences) fails the C++ case (``tests/ros/test_cpp_avoider.py`` compares the body with
 the template bit for bit on random scans, where rarer differences show).
 
 With ``sim:=false`` a robot of the test's own publishes a 360-beam ``sensor_msgs/LaserScan``

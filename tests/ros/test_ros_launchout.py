@@ -5,7 +5,7 @@ reads: every byte of both streams arrives on the same stream, unchanged; the chi
 terminal where the user has one (else the nodes' lines would wait in a pipe's buffer until
 they exit); and the last line's pointer names the first ``error: `` line, not a Python
 exception's ``...Error: `` nor a line that merely mentions an error. The e2e test
-(``tests/e2e/test_ros_leaf_failure.py``) checks it on a real launch.
+(``tests/ros/test_ros_leaf_failure.py``) checks it on a real launch.
 """
 
 from __future__ import annotations

@@ -45,14 +45,14 @@ launcher = ros_launch.launcher  # the fixture
 
 @pytest.fixture(scope="module")
 def workspace(ros_short_workspace: Path) -> Path:
-    """The session's build of ros_short (tests/e2e/conftest.py), edited only through
+    """The session's build of ros_short (tests/ros/conftest.py), edited only through
     ``package_edit``."""
     return ros_short_workspace
 
 
 @pytest.fixture(scope="module")
 def checked(ros_short_checked: Path) -> Path:
-    """Runs ``rosrun PKG run_lockstep`` on the session's build (tests/e2e/conftest.py)."""
+    """Runs ``rosrun PKG run_lockstep`` on the session's build (tests/ros/conftest.py)."""
     return ros_short_checked
 
 

@@ -1,7 +1,7 @@
 """``run_lockstep``'s verdict on a run directory, without ROS: the exit code a CI reads.
 
 The run directories are ``amsa-phys run``'s own (the ROS simulator writes the same files);
-the e2e test (``tests/e2e/test_ros.py``) launches the script for real.
+the e2e test (``tests/ros/test_ros.py``) launches the script for real.
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ when a C++ Leaf has failed. The script must end with 130 and print nothing (it u
 a ``KeyboardInterrupt`` traceback of 20–30 lines). Mutation-checked: without the script's
 handler (``files/node.py.in``) each case fails with the traceback; without
 :func:`startup.started` restoring the handlers, the hand-back test fails (and the
-simulator's Ctrl-C during a run, ``tests/e2e/test_ros.py``, would lose its outputs).
+simulator's Ctrl-C during a run, ``tests/ros/test_ros.py``, would lose its outputs).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Pipelined lockstep through ``rosrun PKG run_lockstep``, as a CI runs it: the exit code.
 
-``run_lockstep``'s verdict on a run directory is unit-tested (tests/unit/test_ros_runcheck.py)
-and a pipelined divergence's fault by roslaunch (tests/e2e/test_ros_nodes.py); here the script
+``run_lockstep``'s verdict on a run directory is unit-tested (tests/ros/test_ros_runcheck.py)
+and a pipelined divergence's fault by roslaunch (tests/ros/test_ros_nodes.py); here the script
 itself drives a pipelined run of one small build (``tests/fixtures/ros_short.yaml``, every
 remote Leaf in the C++ container): Ctrl-C in the middle exits 130 with the outputs kept and no
 process left, and a node that does not do what the model's template does (the launch file's
@@ -35,14 +35,14 @@ launcher = ros_launch.launcher  # the fixture
 
 @pytest.fixture(scope="module")
 def workspace(ros_short_workspace: Path) -> Path:
-    """The session's build of ros_short (tests/e2e/conftest.py), edited only through
+    """The session's build of ros_short (tests/ros/conftest.py), edited only through
     ``package_edit``."""
     return ros_short_workspace
 
 
 @pytest.fixture(scope="module")
 def checked(ros_short_checked: Path) -> Path:
-    """Runs ``rosrun PKG run_lockstep`` on the session's build (tests/e2e/conftest.py)."""
+    """Runs ``rosrun PKG run_lockstep`` on the session's build (tests/ros/conftest.py)."""
     return ros_short_checked
 
 
