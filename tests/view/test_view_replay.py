@@ -271,8 +271,15 @@ def xdisplay() -> Iterator[str]:
 
 
 def _x(display: str, *argv: str) -> str:
+    """An X tool's output ("" if it fails or hangs: ``import`` grabbing a window can wait on
+    the X server for ever on a loaded machine; the caller's poll then tries again)."""
     env = {**os.environ, "DISPLAY": display}
-    done = subprocess.run(argv, env=env, capture_output=True, text=True, check=False)
+    try:
+        done = subprocess.run(
+            argv, env=env, capture_output=True, text=True, check=False, timeout=X_TIMEOUT_S / 4
+        )
+    except subprocess.TimeoutExpired:
+        return ""
     return done.stdout.strip()
 
 
