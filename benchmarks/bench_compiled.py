@@ -58,8 +58,8 @@ def pure(on: bool) -> Iterator[None]:
 
 def scenario1_seconds(duration: float) -> float:
     """Wall seconds of scenario1 through the engine, trace written (bench_run's engine run)."""
-    from amsa_phys.engine.recorder import TraceWriter
     from amsa_phys.engine.runner import Simulation
+    from amsa_phys.engine.tracefile import TraceWriter
     from amsa_phys.model.scenario import load_scenario
 
     sc = load_scenario(SCENARIO1, duration=duration)

@@ -29,8 +29,8 @@ from amsa_phys.view.camera import Camera
 from amsa_phys.view.draw import Renderer
 from amsa_phys.view.drive import advance
 from amsa_phys.view.encoder import VideoEncoder
-from amsa_phys.view.recorder import PIX_FMT, Recorder, RecordOptions, new_surface
 from amsa_phys.view.scene import Scene
+from amsa_phys.view.video import PIX_FMT, Recorder, RecordOptions, new_surface
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIO = ROOT / "scenarios" / "scenario2.yaml"

@@ -20,8 +20,8 @@ from pathlib import Path
 import pymunk
 import yaml
 
-from amsa_phys.engine.recorder import TraceWriter
 from amsa_phys.engine.runner import Simulation
+from amsa_phys.engine.tracefile import TraceWriter
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.physics import compiled
 from amsa_phys.physics.bodyio import BodyIO

@@ -16,6 +16,33 @@ ROOT = Path(__file__).resolve().parent.parent
 # broken and deliberately failing scenario files are inputs of tests, not tests themselves
 collect_ignore_glob = ["fixtures/*", "golden/*.yaml"]
 
+# the markers of slow kinds and the CPU budget of the quick tier (tests/tiers.py); SIGINT at
+# its default for tests that interrupt (tests/sigint.py); the session's catkin builds in the
+# background (tests/ros_prebuild.py)
+pytest_plugins = ["tiers", "sigint", "pytester", "ros_prebuild"]
+
+#: the distributions whose ``amsa_phys.templates`` entry points a test may see: the project
+#: and the plugin tests/model/test_plugins.py installs. A user's plugin installed in the same
+#: environment must not change what a test sees (a "did you mean" naming it)
+OWN_DISTRIBUTIONS = frozenset({"amsa-phys", "amsa-phys-tiny-rovers-test"})
+
+
+@pytest.fixture(autouse=True)
+def _no_foreign_plugins(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Template plugins of other installed packages are invisible to the tests (in-process)."""
+    from amsa_phys.model import plugins
+
+    real = plugins.installed
+
+    def own() -> dict[str, list[plugins.Plugin]]:
+        found = {
+            name: [p for p in registered if p.distribution in OWN_DISTRIBUTIONS]
+            for name, registered in real().items()
+        }
+        return {name: registered for name, registered in found.items() if registered}
+
+    monkeypatch.setattr(plugins, "installed", own)
+
 
 @pytest.fixture(autouse=True)
 def _no_leftover_long_runs() -> Iterator[None]:

@@ -5,7 +5,7 @@
 runs each problem's grid (the same points as the ``amsa-phys sweep`` command stored beside
 it) and rewrites ``tests/fixtures/falsify_grids.json`` with its worst point and value and the
 wall time it took. The dynamics change from time to time (another branch's physics): after
-such a change, run this and commit the fixture; ``tests/e2e/test_falsify.py``'s slow test
+such a change, run this and commit the fixture; ``tests/falsify/test_falsify.py``'s slow test
 recomputes a grid and compares it with the fixture.
 """
 

@@ -8,6 +8,8 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import sigint
+
 FIXTURE = Path(__file__).resolve().parent / "fixtures" / "mde_short.yaml"
 
 #: Every long run started, so that ``conftest.py`` can stop any a failed test left running.
@@ -46,7 +48,7 @@ def wait_until(
 
 def has_rows(trace_tmp: Path) -> bool:
     """Whether a trace being written holds data rows: the header and the first chunk of
-    rows reach the file together (``engine/recorder.py`` writes rows 256 at a time)."""
+    rows reach the file together (``engine/tracefile.py`` writes rows 256 at a time)."""
     try:
         return trace_tmp.stat().st_size > 0
     except FileNotFoundError:
@@ -72,7 +74,7 @@ def start_long_run(out: Path, **popen: object) -> subprocess.Popen[str]:
             "-q",
         ],
         text=True,
-        **popen,
+        **{"preexec_fn": sigint.at_default, **popen},
     )  # type: ignore[call-overload]
     STARTED.append(proc)
     wait_until("the run wrote trace rows", lambda: has_rows(out / "trace.csv.tmp"), proc)

@@ -1,6 +1,6 @@
 """Rovers in every regime of the wheel model, for the tests that hold two force paths equal.
 
-Shared by ``unit/test_fast_paths.py``, ``test_compiled_step.py`` and
+Shared by ``engine/test_fast_paths.py``, ``test_compiled_step.py`` and
 ``test_column_forces.py``; importable as ``regimes`` through pytest's ``pythonpath``
 (pyproject.toml), like ``toys``, so no test edits ``sys.path``.
 """

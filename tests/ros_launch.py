@@ -1,6 +1,6 @@
 """Launching an exported ROS package in a test: a private network, no process left behind.
 
-Shared by ``tests/e2e/test_ros*.py``. Every launch runs in a private network namespace
+Shared by the ROS tests (``tests/ros/``). Every launch runs in a private network namespace
 (``unshare -n``: roscpp listens on all interfaces) and every process it starts carries a
 token in its environment, so a test can prove none is left behind (and end stragglers by
 their id).
@@ -23,6 +23,7 @@ from pathlib import Path
 
 import pytest
 import ros_prebuild
+import sigint
 
 LAUNCH_TIMEOUT = 120  # s of wall time before a launch is declared hung (and killed)
 
@@ -72,6 +73,7 @@ class Launch:
             text=True,
             env=env,
             start_new_session=True,
+            preexec_fn=sigint.at_default,
         )
         self.lines: list[str] = []
         self.watchdog = threading.Timer(LAUNCH_TIMEOUT, self.kill)
@@ -163,7 +165,7 @@ def build_workspace(ws: Path, scenario: Path, pkg: str, install: bool = False) -
 def package_edit(path: Path, text: str) -> Iterator[Path]:
     """``path`` holds ``text`` inside the block; afterwards what it held before (or nothing,
     if it did not exist), whether the block passed or failed. Tests edit a workspace shared
-    by the session (``ros_short_workspace`` in tests/e2e/conftest.py) this way, so that the
+    by the session (``ros_short_workspace`` in tests/ros/conftest.py) this way, so that the
     next test launches the package as it was built."""
     before = path.read_text() if path.exists() else None
     try:

@@ -1,8 +1,8 @@
 """Building the session's catkin workspaces in the background, while the tests before them run.
 
-A catkin build of an exported package costs 15-60 s of compiler time, and the ROS e2e files
+A catkin build of an exported package costs 15-60 s of compiler time, and the ROS test files
 come in the middle of the suite: while the tests before them run in pytest's one process, a
-2-core machine has a core to spare. ``tests/e2e/conftest.py`` starts a :class:`Prebuilder`
+2-core machine has a core to spare. The session fixture below starts a :class:`Prebuilder`
 for the packages the collected tests will build, one after the other, at the lowest CPU
 priority (the tests running meanwhile keep theirs); :func:`ros_launch.build_workspace` then
 takes the one it was about to build: finished, it is used at once; under way, it is put back
@@ -20,10 +20,21 @@ import signal
 import subprocess
 import sys
 import threading
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import pytest
+
 Key = tuple[Path, str, bool]  # (scenario, package name, catkin_make install as well)
+
+#: ``ros_short_workspace``'s build (tests/ros/conftest.py): tests/fixtures/ros_short.yaml as
+#: package mdeChallenge, installed too
+ROS_SHORT: Key = (
+    Path(__file__).resolve().parent / "fixtures" / "ros_short.yaml",
+    "mdeChallenge",
+    True,
+)
 
 
 def build_commands(
@@ -66,6 +77,7 @@ class Prebuilder:
         self._finished: dict[Key, _Build] = {}
         self._proc: subprocess.Popen[bytes] | None = None
         self._stopped = False
+        self.cpu = 0.0  # seconds of CPU its finished commands spent
         self._halt = threading.Event()
         self._thread = threading.Thread(target=self._run, name="ros-prebuild", daemon=True)
 
@@ -115,7 +127,17 @@ class Prebuilder:
                     env=env,
                     start_new_session=True,  # its own process group: reniced or ended whole
                 )
-        if self._proc.wait() != 0:
+        # os.wait4: the command's CPU (with its waited-for descendants'), which is no test's
+        # (tests/tiers.py takes it off the CPU budget of the test running meanwhile)
+        try:
+            _, status, usage = os.wait4(self._proc.pid, 0)
+        except ChildProcessError:  # reaped by a poll() of take() or stop() (a ROS test's)
+            self._proc.wait()
+        else:
+            self._proc.returncode = os.waitstatus_to_exitcode(status)
+            with self._lock:
+                self.cpu += usage.ru_utime + usage.ru_stime
+        if self._proc.returncode != 0:
             output = build.log.read_text(errors="replace")[-3000:]
             build.error = f"{' '.join(command)} failed ({self._proc.returncode}):\n{output}"
             return True
@@ -155,6 +177,7 @@ class Prebuilder:
 
 
 _active: Prebuilder | None = None
+_spent = 0.0  # the CPU of the builders stopped so far
 
 
 def start(root: Path, wanted: list[Key]) -> Prebuilder:
@@ -170,8 +193,72 @@ def take(key: Key) -> _Build | None:
     return None if _active is None else _active.take(key)
 
 
+def cpu_spent() -> float:
+    """CPU seconds the session's background builds have spent so far (finished commands)."""
+    return _spent + (0.0 if _active is None else _active.cpu)
+
+
 def stop() -> None:
-    global _active
+    global _active, _spent
     if _active is not None:
         _active.stop()
+        _spent += _active.cpu
         _active = None
+
+
+# -- the pytest side: registered by tests/conftest.py (``pytest_plugins``), so that the builds
+# start at the session's first test, whatever folder it is in
+
+
+def _skipped(item: pytest.Item) -> bool:
+    """Marked to be skipped whatever happens (a skipif whose condition is already True)."""
+    for mark in item.iter_markers():
+        if mark.name == "skip" or (mark.name == "skipif" and mark.args and mark.args[0] is True):
+            return True
+    return False
+
+
+def _builds_wanted(items: list[pytest.Item]) -> list[tuple[Path, str, bool]]:
+    """The catkin builds the collected tests will ask for, in the order they will: the
+    session's ros_short, and the ``SCENARIO`` as ``PKG`` of every module that imports
+    ``build_workspace`` (a module building something else builds it in the foreground)."""
+    wanted: list[tuple[Path, str, bool]] = []
+    for item in items:
+        module = getattr(item, "module", None)
+        if module is None or _skipped(item):
+            continue
+        if "ros_short_workspace" in getattr(item, "fixturenames", ()):
+            key = (ROS_SHORT[0].resolve(), *ROS_SHORT[1:])
+        elif getattr(getattr(module, "build_workspace", None), "__module__", "") == "ros_launch":
+            scenario, pkg = getattr(module, "SCENARIO", None), getattr(module, "PKG", None)
+            if not isinstance(scenario, Path) or not isinstance(pkg, str):
+                continue
+            key = (scenario.resolve(), pkg, False)
+        else:
+            continue
+        if key not in wanted:
+            wanted.append(key)
+    return wanted
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _ros_prebuild(
+    request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
+) -> Iterator[None]:
+    """The session's catkin builds start in the background at the session's first test, at
+    the lowest CPU priority, while the tests before the ROS files run; whatever is still
+    building when the session ends is ended."""
+    wanted = _builds_wanted(request.session.items)
+    if wanted:
+        from ros_launch import ros_missing
+
+        if ros_missing() is not None:
+            wanted = []
+    if not wanted:
+        yield
+        return
+    start(tmp_path_factory.mktemp("ros_prebuild"), wanted)
+    try:
+        yield
+    finally:
+        stop()

@@ -9,7 +9,7 @@ symbols and ``.rodata``: no tool beyond Python) so that
 
 - ``python tests/ziggurat_tables.py > amsa_phys/ros/files/amsa_ziggurat.h`` writes the C++
   nodes' copy (``amsa_rng.h`` draws with it), and
-- ``tests/unit/test_cpp_rng.py`` checks that copy against the installed numpy, entry by
+- ``tests/ros/test_cpp_rng.py`` checks that copy against the installed numpy, entry by
   entry, bit for bit.
 
 The tables are numpy's (BSD-3-Clause); the copy says so.
@@ -99,7 +99,7 @@ def header(t: dict[str, tuple[int | float, ...]]) -> str:
         "// numpy's ziggurat tables for Generator.standard_normal (numpy's",
         "// random/src/distributions/ziggurat_constants.h, BSD-3-Clause, Copyright (c) 2005-2025",
         f"// NumPy Developers), read from the installed numpy {np.__version__}'s libnpyrandom.a",
-        "// by tests/ziggurat_tables.py. Do not edit: tests/unit/test_cpp_rng.py checks every",
+        "// by tests/ziggurat_tables.py. Do not edit: tests/ros/test_cpp_rng.py checks every",
         "// entry against the installed numpy.",
         "#pragma once",
         "#include <cstdint>",

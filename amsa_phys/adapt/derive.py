@@ -132,7 +132,7 @@ def _base_values(scenario: Scenario) -> dict[str, Any]:
         for path, leaf in scenario.world.leaves.items()
         for k, v in leaf.params.items()
     }
-    out.update({c.key: c.value for c in scenario.phases[0].changes})
+    out.update({c.key: c.value for c in scenario.timeline.initial})
     return out
 
 

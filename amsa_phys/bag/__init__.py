@@ -5,7 +5,7 @@ messages and topics come from :mod:`amsa_phys.stdmsgs`. See the README's "Every 
 bag".
 """
 
-from .recorder import EVENTS_TOPIC, TF_TOPIC, BagRecorder
+from .runbag import EVENTS_TOPIC, TF_TOPIC, BagRecorder
 from .writer import BagWriter, scalar_cdr
 
 __all__ = ["EVENTS_TOPIC", "TF_TOPIC", "BagRecorder", "BagWriter", "scalar_cdr"]

@@ -28,7 +28,7 @@ from ..stdmsgs.defs import msgdef, schema_name
 from .cdr import CDR_LE, encoder
 
 _STAMP = struct.Struct("<iII")
-_DOUBLE = struct.Struct("<d")
+DOUBLE = struct.Struct("<d")
 _NS = 1_000_000_000
 
 
@@ -66,7 +66,7 @@ def scalar_prefix(ns: int) -> bytes:
 
 def scalar_cdr(ns: int, value: float) -> bytes:
     """The CDR of an ``amsa_msgs/msg/Scalar`` stamped ``ns`` holding ``value``."""
-    return scalar_prefix(ns) + _DOUBLE.pack(value)
+    return scalar_prefix(ns) + DOUBLE.pack(value)
 
 
 class BagWriter:

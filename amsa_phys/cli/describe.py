@@ -154,7 +154,7 @@ def scenario_start(scenario: Scenario, in_file: int) -> dict[str, dict[str, tupl
     """Each parameter phase 0 sets, with its source: the first ``in_file`` changes are the
     scenario's ``set:``, the rest ``--set``."""
     start: dict[str, dict[str, tuple[Any, Source]]] = {}
-    for i, change in enumerate(scenario.phases[0].changes):
+    for i, change in enumerate(scenario.timeline.initial):
         source = "scenario set" if i < in_file else "--set"
         start.setdefault(change.leaf, {})[change.param] = (change.value, source)
     return start
@@ -166,7 +166,7 @@ def run(args: argparse.Namespace) -> int:
     if kind == "world" and args.overrides:
         raise ConfigError("only for a scenario: a world has no t = 0 to set", key="--set")
     if kind == "scenario":
-        in_file = len(obj.phases[0].changes)
+        in_file = len(obj.timeline.initial)
         physics_from = {
             f"{k}.{sub}" if isinstance(v, dict) else k: "scenario physics"
             for k, v in (obj.data.get("physics") or {}).items()
@@ -185,14 +185,15 @@ def run(args: argparse.Namespace) -> int:
         if obj.quality:
             q = obj.quality
             print(f"quality: {q.signal} vs {q.reference:g} ± {q.tolerance:g}")
-        for i, phase in enumerate(obj.phases):
-            # a --set of a key the file's set: already gives replaces it: show the value in force
-            final = {c.key: c.value for c in phase.changes}
-            changes = ", ".join(f"{k}={v!r}" for k, v in final.items()) or "-"
-            print(f"phase {i} at {float(phase.at):g} s: {changes}")
-            for step in phase.within:
-                inner = ", ".join(f"{c.key}={c.value!r}" for c in step.changes)
-                print(f"  change at {float(step.at):g} s (same phase): {inner}")
+        # a --set of a key the file's set: already gives replaces it: show the value in force
+        final = {c.key: c.value for c in obj.timeline.initial}
+        print("phase 0 at 0 s: " + (", ".join(f"{k}={v!r}" for k, v in final.items()) or "-"))
+        for point in obj.timeline.points():
+            changes = ", ".join(f"{c.key}={c.value!r}" for c in point.changes)
+            if point.starts_phase:
+                print(f"phase {point.phase} at {float(point.at):g} s: {changes or '-'}")
+            else:
+                print(f"  change at {float(point.at):g} s (same phase): {changes}")
         for e in obj.expect:
             print(f"expect {describe_what(e)} {describe_bound(e)}")
         for line in describe_rules(obj.adapt):

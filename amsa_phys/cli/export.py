@@ -15,8 +15,8 @@ from ..interop.exporter import export_world
 from ..model.configure import with_overrides
 from ..model.scenario import (
     DEFAULT_LOG_RATE_HZ,
-    Phase,
     Scenario,
+    Timeline,
     load_scenario,
 )
 from ..model.template import Kind
@@ -93,11 +93,10 @@ def _load(path: str, args: argparse.Namespace) -> Scenario:
         path=Path(path),
         name=world.name,
         world=world,
-        duration=Fraction(str(args.duration or WORLD_DURATION)),
+        timeline=Timeline.of([], Fraction(str(args.duration or WORLD_DURATION))),
         seed=args.seed or 0,
         log_rate=rate,
         quality=None,
-        phases=[Phase(Fraction(0), [])],
     )
     # the scenario's own path for --set: physics settings, frequencies, and a key set twice
     # refused in one line (as `run` and a scenario file do)

@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
         duration_option(args.duration)
     space = build_space(scenario, args.ranges, args.grid)
     end = args.duration if args.duration is not None else float(scenario.duration)
-    n_phases = sum(1 for p in scenario.phases if p.at < end)
+    n_phases = len(scenario.timeline.phases_before(end))
     if args.metric is not None:
         why = unknown_metric(args.metric, n_phases)
         if why is not None:

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Literal, NoReturn
 
-from .. import __version__
+from .._version import __version__
 from ..errors import AmsaError, one_line
 
 # One BLAS thread unless the user chose otherwise, set before any command imports numpy.

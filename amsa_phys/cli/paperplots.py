@@ -1,7 +1,7 @@
 """``amsa-phys plot --paper fig6-sensed`` and ``fig5-start``: the figures of issue 31 (5, 6).
 
 Each runs the paper's scenarios many times over (every GPS loss rate; every initial gap),
-in memory, through ``plot``'s own :func:`~amsa_phys.cli.plot._paper_run`, and hands the
+in memory, through :func:`~amsa_phys.cli.paperruns.paper_run`, and hands the
 runs to a drawing module (``plots/paperloss.py``, ``plots/paperstart.py``).
 """
 
@@ -14,7 +14,7 @@ from typing import Any
 from ..errors import ConfigError, one_line
 from ..model.scenario import load_scenario
 from ..runs.rundir import check_output
-from .plot import _kv, _paper_run, _paper_scenarios
+from .paperruns import kv_at_start, paper_run, paper_scenarios
 
 
 def plot_losses(args: argparse.Namespace) -> int:
@@ -23,7 +23,7 @@ def plot_losses(args: argparse.Namespace) -> int:
 
     sources = [Path(s) for s in args.rundir]
     if not sources:
-        sources = [_paper_scenarios("fig6-sensed")[0], _paper_scenarios("fig6")[0]]
+        sources = [paper_scenarios("fig6-sensed")[0], paper_scenarios("fig6")[0]]
     for src in sources:
         if src.is_dir():
             raise ConfigError(
@@ -35,7 +35,7 @@ def plot_losses(args: argparse.Namespace) -> int:
     panels = []
     for src in sources:
         runs = [
-            (loss, _paper_run(src, [f"LeaderGPS.lostDataGPS={loss}"]))
+            (loss, paper_run(src, [f"LeaderGPS.lostDataGPS={loss}"]))
             for loss in paperloss.LOSS_RATES
         ]
         panels.append((runs[0][1].label, runs))
@@ -49,7 +49,7 @@ def plot_starts(args: argparse.Namespace) -> int:
     """``--paper fig5-start``: each Fig. 5 scenario from every initial gap."""
     from ..plots import paperstart  # matplotlib: only once the runs are in
 
-    sources = [Path(s) for s in args.rundir] or _paper_scenarios("fig5")
+    sources = [Path(s) for s in args.rundir] or paper_scenarios("fig5")
     for src in sources:
         if src.is_dir():
             raise ConfigError(
@@ -61,16 +61,16 @@ def plot_starts(args: argparse.Namespace) -> int:
     kvs = []
     for src in sources:
         scenario = load_scenario(src)
-        kv = _kv(scenario)
+        kv = kv_at_start(scenario)
         if kv is None:
             raise ConfigError("the scenario's controller has no Kv", file=src)
         kvs.append(kv)
         leader_x = float(scenario.world.leaves["Leader"].params["x"])
-        for change in scenario.phases[0].changes:
+        for change in scenario.timeline.initial:
             if change.key == "Leader.x":
                 leader_x = float(change.value)
         for gap in paperstart.GAPS:
-            run = _paper_run(src, [f"Follower.x={leader_x - gap!r}", "Follower.y=0"])
+            run = paper_run(src, [f"Follower.x={leader_x - gap!r}", "Follower.y=0"])
             table[(gap, kv)] = run.metrics["overall"]
     kvs.sort(reverse=True)
     paperstart.start_figure(table, paperstart.GAPS, tuple(kvs), out)

@@ -18,7 +18,7 @@ from ..errors import ConfigError
 from ..view.encoder import FORMATS
 
 if TYPE_CHECKING:
-    from ..view.recorder import RecordOptions, SnapshotOptions
+    from ..view.video import RecordOptions, SnapshotOptions
 
 MAX_SIDE = 7680
 
@@ -75,8 +75,8 @@ def recording_options(args: argparse.Namespace) -> RecordOptions | None:
         raise ConfigError(f"{args.speedup}: must be above 0 and at most 10000", key="--speedup")
     if args.record is None:
         return None
-    path = _target(args.record, FORMATS, "--record", args.force)
-    from ..view.recorder import RecordOptions
+    path = recording_target(args.record, FORMATS, "--record", args.force)
+    from ..view.video import RecordOptions
 
     return RecordOptions(path, size, args.fps, speedup)
 
@@ -87,18 +87,18 @@ def snapshot_options(args: argparse.Namespace) -> SnapshotOptions | None:
         if args.snapshot_at is not None:
             raise ConfigError("needs --snapshot FILE.png", key="--snapshot-at")
         return None
-    path = _target(args.snapshot, (".png",), "--snapshot", args.force)
+    path = recording_target(args.snapshot, (".png",), "--snapshot", args.force)
     at = None
     if args.snapshot_at is not None:
         if not 0 <= args.snapshot_at < 1e9:
             raise ConfigError(f"{args.snapshot_at}: must be 0 or more", key="--snapshot-at")
         at = Fraction(str(args.snapshot_at))
-    from ..view.recorder import SnapshotOptions
+    from ..view.video import SnapshotOptions
 
     return SnapshotOptions(path, parse_size(args.size), at)
 
 
-def _target(name: str, formats: tuple[str, ...], flag: str, force: bool) -> Path:
+def recording_target(name: str, formats: tuple[str, ...], flag: str, force: bool) -> Path:
     """An output file we may write: known extension, existing writable directory, no clobber."""
     path = Path(name)
     if path.suffix.lower() not in formats:

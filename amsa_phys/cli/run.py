@@ -19,12 +19,12 @@ from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
 from ..runs.suite import input_files
 from .options import add_bag, add_no_adapt, add_output, add_scenario_overrides, add_trace_columns
-from .recording import _target, add_recording, recording_options, snapshot_options
+from .recording import add_recording, recording_options, recording_target, snapshot_options
 from .report import print_summary
 
 if TYPE_CHECKING:  # pygame is imported only by runs that draw, mcap only by --bag
     from ..bag import BagRecorder
-    from ..view.recorder import RecordOptions, SnapshotOptions
+    from ..view.video import RecordOptions, SnapshotOptions
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -103,7 +103,7 @@ def _run(
             key="--snapshot-at",
         )
     warn_if_trace_is_large(scenario)
-    bag_path = _target(args.bag, (".mcap",), "--bag", args.force) if args.bag else None
+    bag_path = recording_target(args.bag, (".mcap",), "--bag", args.force) if args.bag else None
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
     if bag_path is not None:
         _bag_apart(bag_path, out)

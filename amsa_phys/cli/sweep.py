@@ -123,7 +123,7 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
                 raise doc.error(("sweep", "contexts", name, key), str(exc)) from None
     metric = args.metric or section.get("metric", "rms_error")
     end = args.duration if args.duration is not None else scenario.duration
-    why = unknown_metric(metric, sum(1 for p in scenario.phases if p.at < end))
+    why = unknown_metric(metric, len(scenario.timeline.phases_before(end)))
     if why is not None:
         if args.metric is None:
             raise doc.error(("sweep", "metric"), why)

@@ -30,7 +30,7 @@ def run(args: argparse.Namespace) -> int:
             print(
                 one_line(
                     f"ok: {path} (scenario: {plural(len(obj.world.leaves), 'component')}, "
-                    f"{plural(len(obj.phases), 'phase')}, {float(obj.duration):g} s)"
+                    f"{plural(len(obj.timeline.phases), 'phase')}, {float(obj.duration):g} s)"
                 )
             )
             for line in describe_rules(obj.adapt):  # what each rule reads and sets, checked

@@ -53,8 +53,6 @@ from .timing import DelayLine, run_phases
 #: in its place (the ROS simulator's remote Leaves), see :class:`Simulation`.
 Wrap = Callable[[str, Template], Template]
 
-#: Kept for importers of the names this module used to define (``engine/tasks.py`` owns them)
-_Task = Task
 __all__ = ["COMPONENT_ERRORS", "Context", "Event", "RunResult", "Simulation", "Task", "Wrap"]
 
 
@@ -81,6 +79,7 @@ class Simulation(ReadAPI, LiveChanges):
         seed: int = 0,
         duration: Fraction = Fraction(10),
         phases: Sequence[Phase] = (),
+        timeline: Timeline | None = None,
         log_rate: Fraction = Fraction(20),
         quality_signal: str | None = None,
         trace: Callable[[float, list[float]], None] | None = None,
@@ -93,18 +92,18 @@ class Simulation(ReadAPI, LiveChanges):
     ) -> None:
         self.world = world
         self.seed = seed
-        self.duration = Fraction(duration)
+        self.duration = Fraction(timeline.duration if timeline is not None else duration)
         #: ``runs``: a batch of runs of ``world``'s structure (``multirun.py``) stepped
         #: together, each with its own parameters, timeline and seed; the store then holds
         #: one row per run in every column. Alone: the batch of one (``world``, ``phases``)
         self.worlds = [sc.world for sc in runs] or [world]
         self.seeds = [sc.seed for sc in runs] or [seed]
-        #: each run's timeline (``model/timeline.py``): the only reader of the phases here
-        self.timelines = [Timeline.of(sc.phases, self.duration) for sc in runs] or [
-            Timeline.of(phases, self.duration)
-        ]
+        #: each run's timeline (``model/timeline.py``): the scenario's own, planned bounds
+        #: included (a world run alone: one made of ``phases`` and ``duration``)
+        if timeline is None:
+            timeline = Timeline.of(phases, self.duration)
+        self.timelines = [sc.timeline for sc in runs] or [timeline]
         self.timeline = self.timelines[0]
-        self.phases = list(self.timeline.phases)
         self.log_rate = Fraction(log_rate)
         self.shared: dict[str, Any] = {}
         self.events: list[Event] = []
@@ -162,8 +161,7 @@ class Simulation(ReadAPI, LiveChanges):
         scenario to a Simulation (``from_scenario``; the ROS simulator's ``RosSimulation``)."""
         return {
             "seed": scenario.seed,
-            "duration": scenario.duration,
-            "phases": scenario.phases,
+            "timeline": scenario.timeline,
             "log_rate": scenario.log_rate,
             "quality_signal": scenario.quality.signal if scenario.quality else None,
             "columns": traced_columns(scenario),

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .recorder import TraceWriter
+from .tracefile import TraceWriter
 
 
 class TraceMemory:

@@ -34,12 +34,12 @@ from ..model.scenario import Scenario
 from ..model.template import Template
 
 
-class _Stop(BaseException):
+class EpisodeStop(BaseException):
     """Ends the run from inside the stand-in's step (not an Exception: the engine must not
     turn it into a RunFault)."""
 
 
-_STOP = object()
+STOP = object()
 #: What the run's greenlet returns when the run is over (or was stopped)
 _ENDED = object()
 
@@ -99,7 +99,7 @@ class Episode:
     def _main(self) -> object:
         try:
             self.sim.run()
-        except _Stop:
+        except EpisodeStop:
             return _ENDED
         return _ENDED  # an exception goes to the parent: raised by switch()
 
@@ -112,8 +112,8 @@ class Episode:
         self.t = t
         self.inputs = inp  # type: ignore[assignment]
         answer = self._agent.switch(inp)
-        if answer is _STOP:
-            raise _Stop
+        if answer is STOP:
+            raise EpisodeStop
         return answer  # type: ignore[no-any-return]
 
     # -- the agent's side -----------------------------------------------------------------
@@ -150,5 +150,5 @@ class Episode:
         self.done = True
         if run.dead or greenlet.getcurrent() is not self._agent or sys.is_finalizing():
             return
-        with contextlib.suppress(_Stop, greenlet.error):
-            run.switch(_STOP)
+        with contextlib.suppress(EpisodeStop, greenlet.error):
+            run.switch(STOP)

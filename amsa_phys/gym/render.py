@@ -13,8 +13,8 @@ from ..model.scenario import Quality
 from ..view.camera import Camera
 from ..view.draw import Renderer
 from ..view.pg import pygame
-from ..view.recorder import new_surface
 from ..view.scene import Scene
+from ..view.video import new_surface
 
 #: the template name of the agent's stand-in (``episode.stand_in``)
 AGENT_TEMPLATE = "agent"

@@ -37,7 +37,7 @@ import numpy as np
 from ..engine.multirun import MultiRun
 from ..model.scenario import Scenario
 from ..model.template import Template
-from .episode import _STOP, _Stop
+from .episode import STOP, EpisodeStop
 from .solo import Solo
 from .veccolumns import EpisodeColumns
 
@@ -153,7 +153,7 @@ class VecEpisode:
     def _main(self) -> tuple[str, Any, Any]:
         try:
             self.sim.run()
-        except _Stop:
+        except EpisodeStop:
             return ("stopped", None, None)
         return ("done", None, None)  # an exception goes to the parent: raised by switch()
 
@@ -168,8 +168,8 @@ class VecEpisode:
         for j, port in enumerate(self.observed):
             rows[:, j] = inputs[port]
         answer = self._agent.switch(("ask", t, rows if order is None else rows[order]))
-        if answer is _STOP:
-            raise _Stop
+        if answer is STOP:
+            raise EpisodeStop
         if back is None:
             return answer, None
         return {name: col[back] for name, col in answer.items()}, None
@@ -292,5 +292,5 @@ class VecEpisode:
         self.done = True
         if run.dead or greenlet.getcurrent() is not self._agent or sys.is_finalizing():
             return
-        with contextlib.suppress(_Stop, greenlet.error):
-            run.switch(_STOP)
+        with contextlib.suppress(EpisodeStop, greenlet.error):
+            run.switch(STOP)

@@ -13,8 +13,11 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
 
+from . import schema
+from .changes import resolve_change
+from .ruleshapes import FILE
 from .suggest import did_you_mean
-from .yamlio import KeyPath, YamlDoc
+from .yamlio import KeyPath, YamlDoc, load_yaml
 
 #: The trace column holding the number (1-based) of the rule that fired last (0: none yet).
 RULE_COLUMN = "adapt.rule"
@@ -50,50 +53,11 @@ class Rule:
         return f"rule {self.number}" + (f" ({self.label})" if self.label else "")
 
 
-RULES: dict[str, Any] = {
-    "type": "array",
-    "items": {
-        "type": "object",
-        "additionalProperties": False,
-        "required": ["when", "set"],
-        "properties": {
-            "when": {
-                "type": "object",
-                "minProperties": 1,
-                "additionalProperties": {
-                    "type": "object",
-                    "additionalProperties": False,
-                    "anyOf": [{"required": ["below"]}, {"required": ["above"]}],
-                    "properties": {"below": {"type": "number"}, "above": {"type": "number"}},
-                },
-            },
-            "set": {"type": "object", "minProperties": 1},
-            "hold": {"type": "number", "minimum": 0},
-            "label": {"type": "string"},
-        },
-    },
-}
-
-#: ``adapt:`` in a scenario: the rules, or the name of a rules file (``amsa-phys adapt -o``)
-SCHEMA: dict[str, Any] = {**RULES, "type": ["array", "string"], "minLength": 1}
-
-#: A rules file: ``adapt:`` and nothing else (its comments say where the rules came from).
-FILE: dict[str, Any] = {
-    "type": "object",
-    "additionalProperties": False,
-    "required": ["adapt"],
-    "properties": {"adapt": RULES},
-}
-
-
 def load_rules(doc: YamlDoc, entries: list[dict[str, Any]] | str, world: Any) -> list[Rule]:
     """A scenario's ``adapt:`` as rules: written inline, or in the file it names (resolved
     against the scenario's folder; errors then point into that file)."""
     if not isinstance(entries, str):
         return parse_rules(doc, entries, world)
-    from . import schema  # schema imports this module's shapes
-    from .yamlio import load_yaml
-
     path = doc.path.parent / entries
     if not path.is_file():
         raise doc.error(("adapt",), f"rules file not found: {path}")
@@ -103,9 +67,7 @@ def load_rules(doc: YamlDoc, entries: list[dict[str, Any]] | str, world: Any) ->
 
 
 def parse_rules(doc: YamlDoc, entries: list[dict[str, Any]], world: Any) -> list[Rule]:
-    """The ``adapt:`` entries of ``doc`` as rules (shape already checked by ``SCHEMA``)."""
-    from .scenario import resolve_change  # scenario imports this module
-
+    """The ``adapt:`` entries of ``doc`` as rules (shape checked by ``ruleshapes.SCHEMA``)."""
     rules = []
     for i, entry in enumerate(entries):
         kp: KeyPath = ("adapt", i)

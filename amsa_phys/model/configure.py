@@ -20,10 +20,10 @@ from .changes import PHYSICS_PREFIX, parse_physics_override, parse_setting, with
 from .params import short_repr
 from .rates import MAX_RATE_HZ, MIN_RATE_HZ
 from .scenariobuild import (
-    _cycle_problem,
-    _effective_log_rate,
     build_scenario,
     check_phases,
+    effective_log_rate,
+    scenario_cycle_problem,
     trace_problem,
 )
 from .scenariospec import Scenario, shortened
@@ -54,7 +54,7 @@ def configure_scenario(
     if overrides:
         scenario = with_overrides(scenario, overrides, doc)
     return dataclasses.replace(
-        scenario, log_rate=_effective_log_rate(scenario.log_rate, scenario.world)
+        scenario, log_rate=effective_log_rate(scenario.log_rate, scenario.world)
     )
 
 
@@ -78,7 +78,7 @@ def with_log_rate(scenario: Scenario, log_rate: float) -> Scenario:
             f"({MIN_RATE_HZ:g} to {MAX_RATE_HZ:g} Hz)",
             key="--log-rate",
         )
-    why = _cycle_problem(out)
+    why = scenario_cycle_problem(out)
     if why is not None:
         raise ConfigError(why, key="--log-rate")
     return out
@@ -126,7 +126,7 @@ def with_overrides(scenario: Scenario, overrides: list[str], doc: YamlDoc | None
             _refuse_conflict(given, key.strip(), text, raw.strip())
     in_file = len(scenario.timeline.initial)
     timeline = scenario.timeline.with_initial(added)
-    out = dataclasses.replace(scenario, world=world, phases=list(timeline.phases))
+    out = dataclasses.replace(scenario, world=world, timeline=timeline)
     check_phases(out, doc, in_file)
     return out
 

@@ -19,7 +19,7 @@ from .worldspec import DEFAULT_FREQ_HZ, BufferSpec, LeafSpec
 from .yamlio import KeyPath
 
 
-def _data_buffer(
+def data_buffer(
     name: str,
     ref: str,
     leaves: dict[str, LeafSpec],
@@ -91,7 +91,7 @@ class Copy:
         return value
 
 
-def _build_leaf(
+def build_leaf(
     path: str, body: dict[str, Any], kp: KeyPath, err: Any, copy: Copy | None = None
 ) -> LeafSpec:
     ref = body["template"]
@@ -151,7 +151,7 @@ def _build_leaf(
     )
 
 
-def _link_inputs(
+def link_inputs(
     leaf: LeafSpec,
     inputs: dict[str, str],
     kp: KeyPath,

@@ -171,7 +171,7 @@ def _metrics(
     q = scenario.quality
     collisions = [e.t for e in result.events if e.kind == "collision"]
     inner = _changes_within(scenario, sim.live_changes)
-    kept = [p for i, p in enumerate(scenario.phases) if i == 0 or float(p.at) < end]
+    kept = scenario.timeline.phases_before(end)
     phases = []
     for i, phase in enumerate(kept):
         last = i + 1 == len(kept)

@@ -10,6 +10,7 @@ and key of what it refuses.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -23,7 +24,7 @@ from .rates import cycle_problem
 from .scenariospec import DEFAULT_LOG_RATE_HZ, DEFAULT_TOLERANCE, Expectation, Quality, Scenario
 from .suggest import did_you_mean
 from .template import Kind
-from .timeline import Phase, Step
+from .timeline import Phase, Step, Timeline
 from .wording import plural
 from .world import WorldSpec, build_world, load_world, resolved_values
 from .yamlio import MAX_NODES, YamlDoc
@@ -45,11 +46,10 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
         path=doc.path,
         name=str(data.get("name", doc.path.stem)),
         world=world,
-        duration=duration,
+        timeline=Timeline.of(phases, duration),
         seed=int(data.get("seed", 0)),
         log_rate=Fraction(str(data.get("log_rate", DEFAULT_LOG_RATE_HZ))),
         quality=quality,
-        phases=phases,
         expect=_expectations(doc, data, world, len(phases), quality, duration),
         data=data,
         trace_columns=_trace_patterns(doc, data, world),
@@ -214,7 +214,7 @@ def _expectations(
 def _check_whole(doc: YamlDoc, data: dict[str, Any], scenario: Scenario) -> None:
     """What only the whole scenario shows: rates that cannot be scheduled, a size that would
     not load again once written out in full."""
-    why = _cycle_problem(scenario)
+    why = scenario_cycle_problem(scenario)
     if why is not None:
         raise doc.error(("log_rate",) if "log_rate" in data else ("world",), why)
     size = written_values(scenario.world, data)
@@ -252,7 +252,7 @@ def _trace_patterns(doc: YamlDoc, data: dict[str, Any], world: WorldSpec) -> lis
     return patterns
 
 
-def _effective_log_rate(rate: Fraction, world: WorldSpec) -> Fraction:
+def effective_log_rate(rate: Fraction, world: WorldSpec) -> Fraction:
     """The trace is never sampled slower than the fastest sensor (design.md)."""
     sensors = [leaf.freq for leaf in world.leaves.values() if leaf.kind is Kind.SENSOR]
     return max([rate, *sensors])
@@ -269,11 +269,11 @@ def _nearby_file(path: Path) -> str:
     return f" (did you mean {same_stem[0]}?)" if same_stem else did_you_mean(path.name, names)
 
 
-def _cycle_problem(scenario: Scenario) -> str | None:
+def scenario_cycle_problem(scenario: Scenario) -> str | None:
     """Why the world's rates with the trace's cannot be scheduled (``model/rates.py``)."""
     world = scenario.world
     rates = [leaf.freq for leaf in world.leaves.values()]
-    rates += [Fraction(str(world.physics["rate"])), _effective_log_rate(scenario.log_rate, world)]
+    rates += [Fraction(str(world.physics["rate"])), effective_log_rate(scenario.log_rate, world)]
     return cycle_problem(rates)
 
 
@@ -318,10 +318,9 @@ def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = 
         where = ("set",) if entry is None else ("timeline", entry, "set")
         return doc.error((*where, change.written_key), message)
 
-    steps: list[tuple[bool, int | None, list[Change]]] = []  # (at t = 0, entry, changes)
-    for i, phase in enumerate(scenario.phases):
-        steps.append((i == 0, phase.entry, phase.changes))
-        steps += [(False, s.entry, s.changes) for s in phase.within]
+    timeline = scenario.timeline
+    steps: list[tuple[bool, int | None, Sequence[Change]]] = [(True, None, timeline.initial)]
+    steps += [(False, p.entry, p.changes) for p in timeline.points()]  # (at t = 0, entry, ...)
     for initial, entry, changes in steps:
         last: dict[str, tuple[int, Change]] = {}
         for j, change in enumerate(changes):

@@ -1,8 +1,9 @@
 """A loaded scenario as data: the quality signal, the expectations, the Scenario itself.
 
 Built by ``scenariobuild.py`` from a file, configured by ``configure.py`` (pure transforms:
-each returns a new Scenario), read everywhere else. Its phases are the Timeline's
-(``timeline.py``); its parameter changes are ``changes.py``'s.
+each returns a new Scenario), read everywhere else. It holds a Timeline (``timeline.py``:
+phases, the changes inside them, duration, the file's plan when cut short) and every reader
+asks that Timeline; its parameter changes are ``changes.py``'s.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from typing import Any
 
 from . import tracecols
 from .adaptrules import RULE_COLUMN, Rule
-from .timeline import Phase, Timeline
+from .timeline import Timeline
 from .world import WorldSpec
 
 DEFAULT_LOG_RATE_HZ = 20
@@ -30,7 +31,7 @@ class Quality:
     reference: float
     tolerance: float
     #: seconds the signal must stay in the band for ``settling_time`` (None: the default,
-    #: ``engine/metrics.default_dwell`` of each block)
+    #: ``model/metrics.default_dwell`` of each block)
     dwell: float | None = None
 
 
@@ -67,17 +68,14 @@ class Scenario:
     path: Path
     name: str
     world: WorldSpec
-    duration: Fraction
+    #: the phases, the changes inside them, the duration and (cut short by ``--duration``)
+    #: the file's plan: the one owner of "what changes when"; every reader asks it
+    timeline: Timeline
     seed: int
     log_rate: Fraction
     quality: Quality | None
-    phases: tuple[Phase, ...]
     expect: tuple[Expectation, ...] = ()
     data: dict[str, Any] = field(default_factory=dict)
-    #: when ``--duration`` shortened the run: the file's phase starts followed by its
-    #: duration. The phase the run stops in (and the run as a whole) is then cut short: its
-    #: metrics are partial and its checks skipped, not judged as if it were complete.
-    planned_bounds: tuple[Fraction, ...] | None = None
     #: ``trace_columns:`` glob patterns (None: trace every Data buffer); see
     #: :func:`traced_columns` for what is kept
     trace_columns: tuple[str, ...] | None = None
@@ -88,15 +86,15 @@ class Scenario:
         # a list given by the builder or a caller becomes a tuple: nobody can append to the
         # phases or the expectations of a Scenario someone else holds
         # (a replace passes tuples already: only a list costs a copy, ~1 µs a sweep's job)
-        for name in ("phases", "expect", "adapt", "planned_bounds", "trace_columns"):
+        for name in ("expect", "adapt", "trace_columns"):
             value = getattr(self, name)
             if value is not None and type(value) is not tuple:
                 object.__setattr__(self, name, tuple(value))
 
     @property
-    def timeline(self) -> Timeline:
-        """The scenario's phases, duration and planned bounds as one frozen Timeline."""
-        return Timeline.of(self.phases, self.duration, self.planned_bounds)
+    def duration(self) -> Fraction:
+        """How long the run lasts: the timeline's (a read, never a second copy)."""
+        return self.timeline.duration
 
 
 def traced_columns(scenario: Scenario) -> list[str]:
@@ -119,10 +117,7 @@ def shortened(scenario: Scenario, duration: Fraction) -> Scenario:
     cut short (partial) rather than judged as if it were complete (``Timeline.cut``). A new
     Scenario: the given one (perhaps cached and shared) is untouched.
     """
-    cut = scenario.timeline.cut(duration)
-    return dataclasses.replace(
-        scenario, duration=cut.duration, phases=cut.phases, planned_bounds=cut.planned
-    )
+    return dataclasses.replace(scenario, timeline=scenario.timeline.cut(duration))
 
 
 def without_adapt(scenario: Scenario) -> Scenario:

@@ -14,9 +14,10 @@ import sys
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
-from .adaptrules import SCHEMA as ADAPT
 from .params import number_text_hint, short_repr, yaml_type
 from .rates import MAX_RATE_HZ, MIN_PHYSICS_RATE_HZ, MIN_RATE_HZ
+from .ruleshapes import FILE as RULES_FILE
+from .ruleshapes import SCHEMA as ADAPT
 from .suggest import did_you_mean
 from .yamlio import KeyPath, YamlDoc
 
@@ -459,9 +460,12 @@ def _first_nonfinite(data: Any, path: KeyPath) -> KeyPath | None:
 
 
 def _shape_names() -> dict[int, str]:
-    from .adaptrules import FILE
-
-    return {id(WORLD): "world", id(SCENARIO): "scenario", id(PHYSICS): "physics", id(FILE): "rules"}
+    return {
+        id(WORLD): "world",
+        id(SCENARIO): "scenario",
+        id(PHYSICS): "physics",
+        id(RULES_FILE): "rules",
+    }
 
 
 #: id of a schema -> its generated check (``python -m amsa_phys.model.shapegen``)

@@ -92,8 +92,6 @@ class Timeline:
     ) -> Timeline:
         """A timeline of ``phases`` (none: one empty phase 0) lasting ``duration``."""
         if not phases:
-            from .scenario import Phase
-
             phases = [Phase(Fraction(0), [])]
         return cls(
             tuple(phases),
@@ -133,6 +131,11 @@ class Timeline:
             if (before is None or p.at < before) and any(c.key == key for c in p.changes)
         )
 
+    def phases_before(self, end: Fraction | float) -> tuple[Phase, ...]:
+        """The phases that start before ``end`` (phase 0 always): those a run stopped at
+        ``end`` has entered."""
+        return self.phases[:1] + tuple(p for p in self.phases[1:] if p.at < end)
+
     def phase_at(self, t: Fraction | float) -> int:
         """The phase in force at time ``t`` (a phase holds from its start, inclusive)."""
         return max(0, bisect.bisect_right(self.starts, t) - 1)
@@ -171,6 +174,11 @@ class Timeline:
             within = [s for s in phase.within if s.at < t]
             phases.append(phase if len(within) == len(phase.within) else _with_steps(phase, within))
         return Timeline(tuple(phases), t, planned)
+
+    def with_start(self, changes: Iterable[Change]) -> Timeline:
+        """The same timeline with ``changes`` as the values at t = 0, in place of phase 0's."""
+        phase0 = dataclasses.replace(self.phases[0], changes=list(changes))
+        return dataclasses.replace(self, phases=(phase0, *self.phases[1:]))
 
     def with_initial(self, changes: Iterable[Change]) -> Timeline:
         """The same timeline with ``changes`` added to the values at t = 0 (after the file's:

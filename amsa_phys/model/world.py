@@ -15,7 +15,7 @@ from typing import Any
 from ..errors import ConfigError
 from . import schema
 from .dataflow import execution_order
-from .leafbuild import Copy, _build_leaf, _data_buffer, _link_inputs, array_size
+from .leafbuild import Copy, array_size, build_leaf, data_buffer, link_inputs
 from .rates import cycle_problem
 from .suggest import did_you_mean
 from .worldspec import (
@@ -127,7 +127,7 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
                 parent.children.append(node)
                 walk(body["components"], node, (*kp, "components"), copy)
                 continue
-            leaf = _build_leaf(path, body, kp, err, copy)
+            leaf = build_leaf(path, body, kp, err, copy)
             if path in leaves:
                 raise err(kp, f"component {path} is defined twice (a counted copy's name?)")
             leaves[path] = leaf
@@ -150,7 +150,7 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
 
     for path, (inputs, kp) in raw_inputs.items():
         leaf = leaves[path]
-        _link_inputs(leaf, inputs, kp, leaves, err, arrays)
+        link_inputs(leaf, inputs, kp, leaves, err, arrays)
 
     schedule = list(data.get("schedule", []))
     for i, item in enumerate(schedule):
@@ -164,7 +164,7 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
     order = execution_order(leaves, schedule, err)
     composites = {c.path for c in _composites(root)}
     names = {
-        name: _data_buffer(name, ref, leaves, buffers, composites, err)
+        name: data_buffer(name, ref, leaves, buffers, composites, err)
         for name, ref in data.get("data", {}).items()
     }
     return WorldSpec(

@@ -26,7 +26,7 @@ import numpy as np
 
 from .bodyio import STATE, BodyIO, locked_step, substeps
 from .fewrovers import FewRovers
-from .fleet import _GROUND_ROWS, Fleet
+from .fleet import GROUND_ROWS, Fleet
 from .forces import Folded, fold, per_kind
 from .rover import DiffDriveRover
 from .step_path import describe, extension
@@ -51,8 +51,8 @@ def check_layout(ext: Any) -> tuple[str, ...]:
         problems.append(f"plan constants {unknown or fields} unknown to forces.fold")
     if ext.SLIP_SPEED_MIN != SLIP_SPEED_MIN:
         problems.append(f"SLIP_SPEED_MIN {ext.SLIP_SPEED_MIN} != wheel.py's {SLIP_SPEED_MIN}")
-    if list(ext.GROUND_ROWS) != _GROUND_ROWS or len(_GROUND_ROWS) != ext.GROUND_TERMS:
-        problems.append(f"ground rows {ext.GROUND_ROWS} != fleet._GROUND_ROWS {_GROUND_ROWS}")
+    if list(ext.GROUND_ROWS) != GROUND_ROWS or len(GROUND_ROWS) != ext.GROUND_TERMS:
+        problems.append(f"ground rows {ext.GROUND_ROWS} != fleet.GROUND_ROWS {GROUND_ROWS}")
     if not hasattr(ext, "Columns"):  # older builds: no batch step, Stepper takes 7 functions
         problems.append("no Columns (the batch's step)")
     if problems:
@@ -218,7 +218,7 @@ class CompiledFewRovers(FewRovers):
             self.rims,
             (2, 1),
             self._ground,
-            (len(_GROUND_ROWS), tuple(range(len(_GROUND_ROWS)))),
+            (len(GROUND_ROWS), tuple(range(len(GROUND_ROWS)))),
             self.state,
             dt,
             self._max2,
@@ -263,7 +263,7 @@ class CompiledFewRovers(FewRovers):
     def set_ground(self, k: int, terms: list[float]) -> None:
         """Rover ``k``'s ground terms (``ground_list``) from the next step on."""
         super().set_ground(k, terms)
-        width = len(_GROUND_ROWS)
+        width = len(GROUND_ROWS)
         self._ground[width * k : width * (k + 1)] = array.array("d", terms)
 
     def kinematics(self, k: int) -> list[float]:
@@ -336,7 +336,7 @@ class CompiledFleet(Fleet):
             self.rims,
             (1, n),
             self.ground,
-            (1, tuple(row * n for row in _GROUND_ROWS)),
+            (1, tuple(row * n for row in GROUND_ROWS)),
             self.state,
             dt,
             self.max_speed * self.max_speed * (1 - 1e-12),

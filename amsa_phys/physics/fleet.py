@@ -32,7 +32,7 @@ from .wheel import step_constants
 BATCH_MIN = 40
 #: Where ``forces.ground_list``'s seven terms go in :attr:`Fleet.ground`'s rows: the left and
 #: right wheel of each term next to each other, so each term is one (2, n) view.
-_GROUND_ROWS = [0, 2, 4, 1, 3, 5, 6, 7, 8]
+GROUND_ROWS = [0, 2, 4, 1, 3, 5, 6, 7, 8]
 
 
 class Fleet:
@@ -58,9 +58,9 @@ class Fleet:
         for i, r in enumerate(rovers):
             r.attach_power_slot(self.drives, i)
         self.rims = np.zeros((2, n))
-        self.ground = np.zeros((len(_GROUND_ROWS), n))
+        self.ground = np.zeros((len(GROUND_ROWS), n))
         if grounds:  # set_ground for every rover, in one assignment
-            self.ground[_GROUND_ROWS] = np.array(grounds, dtype=np.float64).T
+            self.ground[GROUND_ROWS] = np.array(grounds, dtype=np.float64).T
         self._out = np.frombuffer(io.forces, dtype=np.float64).reshape(-1, 3)
         start = int(self.rows[0]) if n else 0
         consecutive = n > 0 and bool((self.rows == np.arange(start, start + n)).all())
@@ -95,7 +95,7 @@ class Fleet:
 
     def set_ground(self, k: int, terms: list[float]) -> None:
         """Rover ``k``'s ground terms (``forces.ground_list``) from the next step on."""
-        self.ground[_GROUND_ROWS, k] = terms
+        self.ground[GROUND_ROWS, k] = terms
 
     def kinematics(self, k: int) -> list[float]:
         """Rover ``k``'s six state floats after the last step."""
@@ -139,7 +139,7 @@ class Fleet:
         rows = state.tolist()
         drive_l, drive_r = self.drives.tolist()
         rim_l, rim_r = self.rims.tolist()
-        grounds = self.ground[_GROUND_ROWS].T.tolist()
+        grounds = self.ground[GROUND_ROWS].T.tolist()
         out = self._out[self._span] if self._span is not None else self._gather
         results = [
             rover_step(plan, gnd, dt, row[2], row[3], row[4], row[5], ul, ur, dl, dr)

@@ -121,11 +121,6 @@ class WheelModel:
         """``c = F_stall / v_free``: motor force lost per m/s of rim speed (N s/m)."""
         return self.stall_force_n / self.free_speed_mps
 
-    def motor_force(self, power_pct: float, u: float) -> float:
-        """Motor force at the ground (N) at rim speed ``u``, current-limited."""
-        f = self.drive_force(power_pct) - self.back_emf() * u
-        return max(-self.max_force_n, min(self.max_force_n, f))
-
     # -- ground ---------------------------------------------------------------------------
     def resistance(self, crr: float) -> float:
         """``R = Crr rollingCoef m g / 2 + jointFriction / r`` (N at the rim) on ground ``crr``:
@@ -175,10 +170,6 @@ class WheelModel:
         deadband if that is larger (and never below it: the driver outputs nothing there)."""
         static = 100.0 * self.resistance(crr) / (self.stall_force_n * self.efficiency)
         return max(static, self.deadband_pct)
-
-    def saturation_slip(self, mu: float) -> float:
-        """Slip ratio at which the longitudinal force reaches ``mu_x N``: ``mu_x c_x``."""
-        return mu * self.traction_coef * self.slip_long
 
 
 def scrub_moment(

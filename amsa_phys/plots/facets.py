@@ -25,6 +25,14 @@ import numpy as np
 from matplotlib.patches import Rectangle
 
 from .save import save_png
+from .sweepmarks import (
+    NEVER_COLOUR,
+    SCENARIO_KEY,
+    left_out_text,
+    mark_nevers,
+    nevers,
+    text_colour_on,
+)
 
 #: Most panels drawn; past it the panels follow one axis (see the module docstring).
 MAX_PANELS = 16
@@ -62,14 +70,6 @@ def plot_facets(
     ``rows`` are every run (grid points without a value are drawn grey), ``ok`` the runs
     with a value of ``metric``; ``numeric_axes`` the axes whose values are all numbers.
     """
-    from .summary import (
-        NEVER_COLOUR,
-        SCENARIO_KEY,
-        left_out_text,
-        mark_nevers,
-        nevers,
-        text_colour_on,
-    )
 
     def count(axis: str) -> int:
         return len({r[axis] for r in rows})

@@ -35,14 +35,14 @@ from .graphgeom import (
     BOX_W,
     Point,
     Segments,
-    _along,
-    _crosses,
-    _hits_box,
-    _overlapping,
-    _quadratic,
-    _rounded,
-    _through,
     detour,
+    hits_box,
+    line_crosses,
+    overlapping,
+    passes_through,
+    point_along,
+    quadratic_curve,
+    rounded_path,
 )
 from .graphmodel import (
     KIND_COLOURS,
@@ -223,7 +223,7 @@ def _layout(
         placed.append(extent)
         conflicts += cost
         for i, box in enumerate(box_extents):  # a line through a component is a conflict too
-            if i not in ends and _crosses(shown[ab], box.expanded(0.98, 0.9)):
+            if i not in ends and line_crosses(shown[ab], box.expanded(0.98, 0.9)):
                 conflicts += OVERLAP_COST
     handles = [
         FancyBboxPatch((0, 0), 1, 1, fc=c, ec="0.2", label=k) for k, c in KIND_COLOURS.items()
@@ -296,22 +296,22 @@ def _routes(
         if (a, b) in start:
             line = [(x0 + BOX_W / 2, y0 + start[(a, b)]), (x1 - BOX_W / 2, y1 + end[(a, b)])]
             others = [pos[n] for n in pos if n not in (a, b)]
-            if any(_through(line, c) for c in others):  # past a third box: around it
+            if any(passes_through(line, c) for c in others):  # past a third box: around it
                 line = detour(line[0], line[1], others, DETOUR_GAP, CORNER) or line
             out[(a, b)] = line
             continue
         p0, p2 = (x0, y0 + BOX_H / 2), (x1, y1 + BOX_H / 2)
         peak = max(p0[1], p2[1]) + ARC_RISE  # the curve's midpoint; the control is twice as high
         mid = ((p0[0] + p2[0]) / 2, (p0[1] + p2[1]) / 2)
-        arc = _quadratic(p0, (mid[0], 2 * peak - mid[1]), p2)
-        if not any(_hits_box(arc, pos[n]) for n in pos if n not in (a, b)):
+        arc = quadratic_curve(p0, (mid[0], 2 * peak - mid[1]), p2)
+        if not any(hits_box(arc, pos[n]) for n in pos if n not in (a, b)):
             out[(a, b)] = arc
             continue
         lane = top + ARC_RISE + LANE_STEP * lanes
         lanes += 1
         side = x1 - BOX_W / 2 - 0.5 - LANE_STEP * (lanes - 1)
         corners = [p0, (x0, lane), (side, lane), (side, y1), (x1 - BOX_W / 2, y1)]
-        out[(a, b)] = _rounded(corners, CORNER)
+        out[(a, b)] = rounded_path(corners, CORNER)
     return out
 
 
@@ -349,10 +349,10 @@ def _place_label(
     covered = np.array([[b.x0, b.y0, b.x1, b.y1] for b in (*boxes, *placed)]).reshape(-1, 4)
     best: tuple[int, Bbox, Point] | None = None
     for t in ALONG:
-        spot = _along(line, t)
+        spot = point_along(line, t)
         dx, dy = ax.transData.transform(spot) - origin
         extent = size.translated(dx, dy)
-        cost = OVERLAP_COST * _overlapping(extent, covered)
+        cost = OVERLAP_COST * overlapping(extent, covered)
         if cost < (best[0] if best is not None else 1 << 30):
             cost += lines.crossing(extent, own)
         if best is None or cost < best[0]:

@@ -16,7 +16,7 @@ Point = tuple[float, float]
 BOX_W, BOX_H = 3.0, 0.9  # a component, in data units (0.9 inch each)
 
 
-def _quadratic(p0: Point, c: Point, p2: Point, n: int = 40) -> list[Point]:
+def quadratic_curve(p0: Point, c: Point, p2: Point, n: int = 40) -> list[Point]:
     """The quadratic Bezier from ``p0`` to ``p2`` with control ``c`` as ``n + 1`` points."""
     pts = []
     for k in range(n + 1):
@@ -31,7 +31,7 @@ def _quadratic(p0: Point, c: Point, p2: Point, n: int = 40) -> list[Point]:
     return pts
 
 
-def _rounded(corners: list[Point], r: float) -> list[Point]:
+def rounded_path(corners: list[Point], r: float) -> list[Point]:
     """A polyline through ``corners`` with each inner corner rounded (radius about ``r``)."""
     out = [corners[0]]
     for prev, here, nxt in zip(corners, corners[1:], corners[2:], strict=False):
@@ -40,7 +40,7 @@ def _rounded(corners: list[Point], r: float) -> list[Point]:
         k = min(r, d_in / 2, d_out / 2)
         a = _toward(here, prev, k)
         b = _toward(here, nxt, k)
-        out += _quadratic(a, here, b, 8)
+        out += quadratic_curve(a, here, b, 8)
     out.append(corners[-1])
     return out
 
@@ -52,7 +52,7 @@ def _toward(p: Point, q: Point, k: float) -> Point:
     return (p[0] + dx * k / length, p[1] + dy * k / length)
 
 
-def _hits_box(line: list[Point], centre: Point) -> bool:
+def hits_box(line: list[Point], centre: Point) -> bool:
     """Whether the polyline passes through, or within 0.3 of, the box centred at ``centre``.
 
     The margin keeps an arc from threading the gap between two rows of boxes.
@@ -60,10 +60,10 @@ def _hits_box(line: list[Point], centre: Point) -> bool:
     x, y = centre
     w, h = BOX_W / 2 + 0.3, BOX_H / 2 + 0.3
     box = Bbox.from_extents(x - w, y - h, x + w, y + h)
-    return _crosses(np.asarray(line), box)
+    return line_crosses(np.asarray(line), box)
 
 
-def _crosses(line: np.ndarray, box: Bbox) -> bool:
+def line_crosses(line: np.ndarray, box: Bbox) -> bool:
     """Whether any segment of the polyline ``line`` (N x 2) meets the rectangle ``box``."""
     a, b = line[:-1], line[1:]
     near = (  # segments whose own bounding box meets the rectangle: the only candidates
@@ -99,7 +99,7 @@ def _segment_meets(x0: float, y0: float, x1: float, y1: float, box: Bbox) -> boo
     return True
 
 
-def _along(line: list[Point], t: float) -> Point:
+def point_along(line: list[Point], t: float) -> Point:
     """The point a fraction ``t`` of the way along the polyline, by length."""
     arr = np.asarray(line)
     seg = np.hypot(*np.diff(arr, axis=0).T)
@@ -143,7 +143,7 @@ class Segments:
         return len(hit)
 
 
-def _overlapping(extent: Bbox, others: np.ndarray) -> int:
+def overlapping(extent: Bbox, others: np.ndarray) -> int:
     """How many of ``others`` (N x 4: x0, y0, x1, y1) ``extent`` overlaps (as
     ``Bbox.overlaps``: touching edges do not count)."""
     if not len(others):
@@ -158,11 +158,11 @@ def _overlapping(extent: Bbox, others: np.ndarray) -> int:
     )
 
 
-def _through(line: list[Point], centre: Point, margin: float = 0.05) -> bool:
+def passes_through(line: list[Point], centre: Point, margin: float = 0.05) -> bool:
     """Whether the polyline crosses the box centred at ``centre`` (grown by ``margin``)."""
     x, y = centre
     w, h = BOX_W / 2 + margin, BOX_H / 2 + margin
-    return _crosses(np.asarray(line), Bbox.from_extents(x - w, y - h, x + w, y + h))
+    return line_crosses(np.asarray(line), Bbox.from_extents(x - w, y - h, x + w, y + h))
 
 
 def detour(
@@ -189,6 +189,6 @@ def detour(
             (p1[0] - gap, p1[1]),
             p1,
         ]
-        if not any(_through(corners, c) for c in others):
-            return _rounded(corners, corner)
+        if not any(passes_through(corners, c) for c in others):
+            return rounded_path(corners, corner)
     return None

@@ -81,7 +81,7 @@ def _verdict(value: float | None, paper: float, unit: str) -> tuple[str, str]:
     return f"{value:.1f} {unit} ({gap:+.0f} %)", GOOD if reached(value, paper) else BAD
 
 
-def _band(ax: plt.Axes, run: PaperRun) -> None:
+def seed_band(ax: plt.Axes, run: PaperRun) -> None:
     ref, tol = run.reference, run.tolerance
     ax.axhspan(ref - tol, ref + tol, color=GOOD, alpha=0.12, lw=0)
     ax.axhline(ref, color=GOOD, lw=1, ls="--")
@@ -97,7 +97,7 @@ def fig5(runs: list[PaperRun], out: Path, title: str = "") -> Path:
     fig, axes = plt.subplots(rows, cols, figsize=(13, 3.9 * rows + 0.6), squeeze=False)
     top = max([float(np.nanmax(r.d)) for r in runs if r.d.size] + [20.0])
     for ax, run in zip(axes.flat, runs, strict=False):
-        _band(ax, run)
+        seed_band(ax, run)
         ax.plot(run.t, run.d, color=FOLLOWER, lw=1.3)
         ax.set_ylim(0, top * 1.18)
         m = run.metrics["overall"]
@@ -134,7 +134,7 @@ def fig5(runs: list[PaperRun], out: Path, title: str = "") -> Path:
                 )
         else:
             lines.append((f"max after approach {_num(peak)} m, settled {_num(settle)} s", "0.1"))
-        _notes(ax, lines)
+        draw_notes(ax, lines)
     for ax in list(axes.flat)[n:]:
         ax.set_visible(False)
     fig.suptitle(title or "Fig. 5, nominal context: each Kv alone from the same start", y=0.995)
@@ -144,7 +144,7 @@ def fig5(runs: list[PaperRun], out: Path, title: str = "") -> Path:
 def fig6(run: PaperRun, out: Path, title: str = "") -> Path:
     """Fig. 6: one run, Kv = 0.35 then 0.05 from t = 100 s, with the paper's two claims."""
     fig, ax = plt.subplots(figsize=(13, 4.6))
-    _band(ax, run)
+    seed_band(ax, run)
     ax.plot(run.t, run.d, color=FOLLOWER, lw=1.3)
     top = max(float(np.nanmax(run.d)) if run.d.size else 20.0, FIG6["peak"])
     ax.set_ylim(0, top * 1.25)
@@ -174,7 +174,7 @@ def fig6(run: PaperRun, out: Path, title: str = "") -> Path:
     if late.size:
         text, colour = _verdict(float(late.mean()), FIG6["plateau"], "m")
         lines.append((f"here (t > {switch + 50:g} s): mean {text}, std {late.std():.2f} m", colour))
-    _notes(ax, lines)
+    draw_notes(ax, lines)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("distance (m)")
     ax.set_title(run.label, fontsize=11, loc="left")
@@ -191,7 +191,7 @@ def _after_approach(run: PaperRun) -> np.ndarray:
     return mask
 
 
-def _notes(ax: plt.Axes, lines: list[tuple[str, str]]) -> None:
+def draw_notes(ax: plt.Axes, lines: list[tuple[str, str]]) -> None:
     """Lines of text at the top right of a panel, each in its colour."""
     for k, (text, colour) in enumerate(lines):
         ax.text(

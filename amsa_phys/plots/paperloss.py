@@ -18,7 +18,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .paper import FIG6, PaperRun, _band, _notes
+from .paper import FIG6, PaperRun, draw_notes, seed_band
 from .save import save_png
 
 #: The loss rates drawn (percent of the leader's fixes lost); 10 is the paper's Fig. 6.
@@ -38,7 +38,7 @@ def fig6_losses(panels: list[tuple[str, list[tuple[int, PaperRun]]]], out: Path)
     """One panel per wiring (title, [(loss %, run), ...]): distance against time per loss."""
     fig, axes = plt.subplots(len(panels), 1, figsize=(13, 4.2 * len(panels)), squeeze=False)
     for ax, (title, runs) in zip(axes[:, 0], panels, strict=True):
-        _band(ax, runs[0][1])
+        seed_band(ax, runs[0][1])
         top = FIG6["peak"]
         lines = []
         base = plateau(runs[0][1])
@@ -64,7 +64,7 @@ def fig6_losses(panels: list[tuple[str, list[tuple[int, PaperRun]]]], out: Path)
         ax.set_ylabel("distance (m)")
         ax.set_title(title, fontsize=11, loc="left")
         ax.legend(loc="lower right", fontsize=8)
-        _notes(ax, lines)
+        draw_notes(ax, lines)
     fig.suptitle(
         "Fig. 6 at each GPS loss rate: the controller's distance from the GPS fixes (sensed) "
         "vs the true distance (the paper's wiring)"

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .. import __version__
+from .._version import __version__
 from ..engine.timing import run_phases
 from ..errors import ConfigError
 from ..model.scenario import Scenario
@@ -297,7 +297,7 @@ def _simulator_doc(graph: RosGraph) -> str:
 def _params_yaml(scenario: Scenario) -> str:
     """The ROS parameters at t = 0: the world's values with the scenario's ``set:``."""
     values = {path: dict(leaf.params) for path, leaf in scenario.world.leaves.items()}
-    for change in scenario.phases[0].changes:
+    for change in scenario.timeline.initial:
         values[change.leaf][change.param] = change.value
     phases = run_phases(scenario.world, scenario.seed)
     tree: dict[str, Any] = {}

@@ -8,7 +8,7 @@ roslaunch's rosparam loader reads as YAML, as double-quoted YAML scalars.
 
 from __future__ import annotations
 
-from .. import __version__
+from .._version import __version__
 from . import boundary, names
 from .cppnode import hz, plugin
 from .graph import RosGraph

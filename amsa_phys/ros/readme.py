@@ -6,7 +6,7 @@ free text such as file names), so a name cannot break the Markdown around it.
 
 from __future__ import annotations
 
-from .. import __version__
+from .._version import __version__
 from . import names
 from .cppnode import hz
 from .graph import RosGraph

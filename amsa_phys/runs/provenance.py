@@ -13,7 +13,7 @@ import math
 from fractions import Fraction
 from typing import Any
 
-from .. import __version__
+from .._version import __version__
 
 #: force models whose whole step (or, for a batch's columns, whose force pass) is the C one
 COMPILED_MODELS = ("CompiledFewRovers", "CompiledFleet", "ColumnForces")

@@ -19,8 +19,8 @@ import yaml
 
 from ..atomic import write_atomic
 from ..engine import interrupt
-from ..engine.recorder import TraceWriter
 from ..engine.runner import Simulation
+from ..engine.tracefile import TraceWriter
 from ..errors import Interrupted, OutputError, RunFault, one_line
 from ..model.metrics import compute_metrics
 from ..model.scenario import Expectation, Scenario, traced_columns
@@ -32,7 +32,7 @@ from .provenance import provenance
 from .resolve import resolved_scenario
 
 if TYPE_CHECKING:  # pygame is imported only by runs that draw
-    from ..view.recorder import Recorder, RecordOptions, Snapshot, SnapshotOptions
+    from ..view.video import Recorder, RecordOptions, Snapshot, SnapshotOptions
 
 
 #: libyaml's emitter when PyYAML has it: the same text as ``yaml.safe_dump``, 3-4x faster (a
@@ -203,13 +203,13 @@ def execute(
     try:
         sim.initialize()
         if record is not None:
-            from ..view.recorder import Recorder
+            from ..view.video import Recorder
 
-            recorder = Recorder(sim, record, scenario.quality, scenario.planned_bounds)
+            recorder = Recorder(sim, record, scenario.quality, scenario.timeline.planned)
         if snapshot is not None:
-            from ..view.recorder import Snapshot
+            from ..view.video import Snapshot
 
-            still = Snapshot(sim, snapshot, scenario.quality, scenario.planned_bounds)
+            still = Snapshot(sim, snapshot, scenario.quality, scenario.timeline.planned)
         if window:
             driver = window if callable(window) else _open_window
             idle = driver(sim, scenario, recorder) or 0.0
@@ -334,7 +334,7 @@ def _open_window(sim: Simulation, scenario: Scenario, recorder: Recorder | None)
         scenario.quality,
         title=scenario.name,
         recorder=recorder,
-        planned=scenario.planned_bounds,
+        planned=scenario.timeline.planned,
     ).run()
 
 

@@ -261,9 +261,7 @@ def apply_setting(scenario: Scenario, key: str, value: Any) -> Scenario:
         nested = physics_setting(key, value, option=f"--grid {key}")
         return dataclasses.replace(scenario, world=with_physics(scenario.world, nested))
     change = resolve_change(key, value, scenario.world)
-    return dataclasses.replace(
-        scenario, phases=list(scenario.timeline.with_initial([change]).phases)
-    )
+    return dataclasses.replace(scenario, timeline=scenario.timeline.with_initial([change]))
 
 
 def timeline_overlaps(keys: list[str], scenario: Scenario, end: Fraction) -> list[str]:
@@ -279,7 +277,7 @@ def timeline_overlaps(keys: list[str], scenario: Scenario, end: Fraction) -> lis
         if times:
             when = ", ".join(f"{float(t):g}" for t in sorted(times))
             first = min(times)
-            starts = [p.at for p in scenario.phases]
+            starts = list(scenario.timeline.starts)
             reach = (
                 (
                     "phase 0 only"

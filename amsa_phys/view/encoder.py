@@ -103,7 +103,7 @@ def ffmpeg_args(
 
 
 class VideoEncoder:
-    """One video being written. ``submit`` frames, then ``close`` (or ``abort``)."""
+    """One video being written. ``submit`` frames, then ``close``."""
 
     def __init__(self, path: Path, size: tuple[int, int], fps: int, pix_fmt: str = "bgr0") -> None:
         if size[0] % 2 or size[1] % 2:
@@ -206,16 +206,6 @@ class VideoEncoder:
             raise OutputError(self.path, reason(exc)) from None
         self._log.close()
         return self.path
-
-    def abort(self) -> None:
-        """Stop ffmpeg and remove the partial file (a failed start, not an interrupt)."""
-        with contextlib.suppress(Exception):
-            self._queue.put_nowait(None)
-        self._proc.kill()
-        self._proc.wait()
-        with contextlib.suppress(OSError):
-            self._proc.stdin.close()  # type: ignore[union-attr]
-        self.tmp.unlink(missing_ok=True)
 
     def _failure(self) -> str:
         self._log.seek(0)

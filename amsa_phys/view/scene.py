@@ -134,12 +134,12 @@ def describe_phase(
     and so does a timeline step that starts no phase (``new_phase: false``) once applied
     (``Kv=0.15 at 20.0 s``): the HUD never shows a value the run is not using. ``planned``:
     the file's phase starts and duration when ``--duration`` shortened the run
-    (``Scenario.planned_bounds``): the count is then the file's, and the line says where
+    (``Timeline.planned``): the count is then the file's, and the line says where
     this run stops. ``replaced``: components an agent stands in for (the Gymnasium env):
     their parameters are set but act on nothing, so they are not listed as if they did
     (the env's status box says ``agent: MyFollowerController``).
     """
-    phase = sim.phases[sim.phase_index]
+    phase = sim.timeline.phases[sim.phase_index]
     live: dict[tuple[str, str], tuple[Any, Any, str]] = {}
     # changes made inside this phase and already in force: the timeline's
     # ``new_phase: false`` steps, then the window's live changes (in time order)
@@ -159,7 +159,7 @@ def describe_phase(
     parts += [
         f"{p}={value_text(v)} {how} {float(at):.1f} s" for (_, p), (at, v, how) in live.items()
     ]
-    count = len(planned) - 1 if planned else len(sim.phases)
+    count = len(planned) - 1 if planned else len(sim.timeline.phases)
     text = phase_line(sim.phase_index, count, phase.label, float(phase.at), parts)
     if planned and sim.duration < planned[-1]:
         text += f" (run stops at {float(sim.duration):g} s of {float(planned[-1]):g})"
@@ -370,7 +370,7 @@ class Scene:
             metrics=m,
             quality=self.quality,
             phase_index=sim.phase_index,
-            phase_count=len(sim.phases),
+            phase_count=len(sim.timeline.phases),
             phase_text=describe_phase(sim, self.planned, self.replaced),
             duration=float(sim.duration),
             scans=self.scans(),

@@ -35,8 +35,8 @@ from .plotpane import (
     picker_key,
     reaches_pane,
 )
-from .recorder import Recorder
 from .scene import Frame, Scene
+from .video import Recorder
 
 SPEEDS = (1 / 16, 1 / 8, 1 / 4, 1 / 2, 1, 2, 4, 8, 16, 32, 64, 128, 256)
 MAX_REAL_DT = 0.1  # seconds of wall clock a single frame may cover

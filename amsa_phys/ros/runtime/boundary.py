@@ -119,7 +119,7 @@ class Outbound:
         if at is None:
             now = rospy.Time.now()
             stamp, t_s = (now.secs, now.nsecs), now.to_sec()
-        else:  # as the bag stamps it (``bag/recorder.py``)
+        else:  # as the bag stamps it (``bag/runbag.py``)
             ns = rosio.to_ns(at)
             stamp, t_s = (ns // 10**9, ns % 10**9), float(at)
         ctx = Context(stamp, t_s, self.period, self.node.origin)

@@ -27,7 +27,7 @@ def start_values(scenario: Scenario) -> dict[tuple[str, str], Any]:
         for path, leaf in scenario.world.leaves.items()
         for name, value in leaf.params.items()
     }
-    for change in scenario.phases[0].changes:
+    for change in scenario.timeline.initial:
         values[(change.leaf, change.param)] = change.value
     return values
 
@@ -40,7 +40,7 @@ def fold_server_values(rospy: Any, scenario: Scenario) -> tuple[Scenario, list[C
     nobody edited anything: the run is then the file's, byte for byte).
     """
     start = start_values(scenario)
-    changes = list(scenario.phases[0].changes)
+    changes = list(scenario.timeline.initial)
     folded = []
     for path, leaf in scenario.world.leaves.items():
         for name, value in rosio.read_params(rospy, leaf).items():
@@ -52,8 +52,7 @@ def fold_server_values(rospy: Any, scenario: Scenario) -> tuple[Scenario, list[C
             folded.append(change)
     if not folded:
         return scenario, folded
-    phase0 = replace(scenario.phases[0], changes=changes)  # phases are frozen: a new one
-    return replace(scenario, phases=(phase0, *scenario.phases[1:])), folded
+    return replace(scenario, timeline=scenario.timeline.with_start(changes)), folded
 
 
 def _same(a: Any, b: Any) -> bool:

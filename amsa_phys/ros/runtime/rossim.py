@@ -54,6 +54,10 @@ class RosSimulation(Simulation):
         graph = link.graph
         #: the adapt rules' changes (the very objects the engine applies when one fires)
         self.rule_changes = {id(c) for rule in scenario.adapt for c in rule.changes}
+        #: the timeline's changes, each with the number of its point (1-based): the scenario
+        #: node announces how many points it has applied, a phase's start or a step inside one
+        points = enumerate(self.timeline.points(), start=1)
+        self.point_of = {id(c): k for k, point in points for c in point.changes}
         # the parameter cache's values of every Leaf, as last seen (free mode: a change of the
         # cache is an edit, recorded as an event whether the Leaf steps here or in its node;
         # timeline changes are applied apart, at their instant)
@@ -104,7 +108,7 @@ class RosSimulation(Simulation):
                 del self.live[i]
                 super().apply_change(change)
                 return
-        value = self.link.phase_value(self.phase_index, self.now, change)
+        value = self.link.point_value(self.point_of[id(change)], self.now, change)
         super().apply_change(Change(change.leaf, change.param, value))
 
     def _apply_adapt(self) -> None:

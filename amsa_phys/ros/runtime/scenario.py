@@ -1,10 +1,12 @@
 """The scenario node: the timeline applied to the parameter server, in simulated time.
 
-It follows ``/clock``; when simulated time reaches a phase's start it sets that phase's
-parameters (``/Leaf/param``, each value judged when the scenario was loaded) and announces
-the phase number on ``/amsa/phase``. The simulator waits for that announcement at the
-phase's instant before any component due then runs, so in lockstep the change lands exactly
-where ``amsa-phys run`` applies it; in free mode the nodes pick it up at their next step.
+It follows ``/clock``; when simulated time reaches one of the timeline's points (a phase's
+start or a change inside a phase, ``new_phase: false``: ``Timeline.points``) it sets that
+point's parameters (``/Leaf/param``, each value judged when the scenario was loaded) and
+announces how many points it has applied on ``/amsa/phase``. The simulator waits for that
+count at the point's instant before any component due then runs, so in lockstep the change
+lands exactly where ``amsa-phys run`` applies it; in free mode the nodes pick it up at their
+next step.
 """
 
 from __future__ import annotations
@@ -39,13 +41,14 @@ def main() -> None:
         rosio.fail(rospy, notready.message(names.SCENARIO, gate, started))
     keep: Any = rosio.announce_ready(rospy, names.SCENARIO)
     startup.started(rospy)
-    for k, phase in enumerate(cfg.scenario.phases[1:], start=1):
-        if not clock.wait_until(rosio.to_ns(phase.at)):
+    for k, point in enumerate(cfg.scenario.timeline.points(), start=1):
+        if not clock.wait_until(rosio.to_ns(point.at)):
             return
-        for change in phase.changes:
+        for change in point.changes:
             rospy.set_param(names.param(change.leaf, change.param), rosio.ros_value(change.value))
         ack.publish(String(str(k)))
-        text = ", ".join(f"{c.key}={c.value}" for c in phase.changes)
-        print(f"{names.SCENARIO}: phase {k} at t={float(phase.at):g} s: {text}", flush=True)
+        what = f"phase {point.phase}" if point.starts_phase else f"in phase {point.phase}"
+        text = ", ".join(f"{c.key}={c.value}" for c in point.changes)
+        print(f"{names.SCENARIO}: {what} at t={float(point.at):g} s: {text}", flush=True)
     rospy.spin()
     del keep

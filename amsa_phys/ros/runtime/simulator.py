@@ -6,11 +6,12 @@ order (so latency models, a compiled physics step or new templates carry over un
 The Leaves that need the shared pymunk world step in this process and publish their outputs
 on their topics; every other Leaf is a :class:`RemoteLeaf` whose ``do_step`` is a round trip
 to its node (lockstep) or nothing at all (free: the node runs on its own timer and this
-process only listens). Timeline changes are the scenario node's: at a phase's instant the
-simulator publishes ``/clock`` and waits until the scenario node has put the phase's values
-on the parameter server, then applies them from there. It publishes ``/clock`` (simulated
-time, latched), writes the run directory (trace.csv, metrics.json, scenario.yaml, plots)
-exactly as ``amsa-phys run`` does, and exits, which ends the launch.
+process only listens). Timeline changes are the scenario node's: at a timeline point's
+instant (a phase's start or a change inside a phase) the simulator publishes ``/clock`` and
+waits until the scenario node has put the point's values on the parameter server, then
+applies them from there. It publishes ``/clock`` (simulated time, latched), writes the
+run directory (trace.csv, metrics.json, scenario.yaml, plots) exactly as ``amsa-phys run``
+does, and exits, which ends the launch.
 """
 
 from __future__ import annotations
@@ -72,8 +73,10 @@ class Link:
         self.received: dict[str, list[Any]] = {}
         self.replies: dict[str, list[str] | None] = {}
         self.ready: set[str] = set()
-        self.phase_acked = 0
-        self.phase_asked = 0
+        #: how many of the timeline's points the scenario node has applied (``/amsa/phase``),
+        #: and the most the simulator has waited for
+        self.points_acked = 0
+        self.points_asked = 0
         self.seq = 0
         #: lockstep: the Leaves asked and not yet answered (path -> instant, sequence number)
         self.asked: dict[str, tuple[Fraction, str]] = {}
@@ -177,7 +180,7 @@ class Link:
 
     def _on_phase(self, msg: Any) -> None:
         with self.cond:
-            self.phase_acked = max(self.phase_acked, int(msg.data))
+            self.points_acked = max(self.points_acked, int(msg.data))
             self.cond.notify_all()
 
     def _on_ready(self, msg: Any) -> None:
@@ -338,8 +341,8 @@ class Link:
             return {}
         if self.graph.bag or self.last_clock < 0:
             # lockstep: no node steps by /clock (each request carries its instant), the
-            # scenario node gets it at each phase's instant (phase_value); a bag's recorder
-            # stamps messages by it, so it ticks at every step only when bag:= records
+            # scenario node gets it at each timeline point's instant (point_value); a bag's
+            # recorder stamps messages by it, so it ticks at every step only when bag:= records
             self.publish_clock(t)
         asked = self.asked.get(path)
         if asked is None or asked[0] != t:
@@ -481,11 +484,13 @@ class Link:
             raise KeyboardInterrupt
         self.publish_clock(t)
 
-    def phase_value(self, phase: int, t: Fraction, change: Change) -> Any:
-        """The value the scenario node set for ``change`` when phase ``phase`` began at ``t``."""
-        if phase > self.phase_asked:
-            self.phase_asked = phase
+    def point_value(self, point: int, t: Fraction, change: Change) -> Any:
+        """The value the scenario node set for ``change`` when it applied the timeline's
+        ``point``-th point (1-based, ``Timeline.points``: a phase's start or a change inside
+        a phase) at ``t``."""
+        if point > self.points_asked:
+            self.points_asked = point
             self.publish_clock(t)
-        self._wait(lambda: self.phase_acked >= phase, names.SCENARIO, t, f"phase {phase}")
+        self._wait(lambda: self.points_acked >= point, names.SCENARIO, t, f"timeline point {point}")
         leaf = self.graph.leaf(change.leaf)
         return rosio.read_param(self.rospy, change.leaf, leaf.template.param(change.param))

@@ -1,0 +1,92 @@
+"""The suite's tiers: a marker per slow kind of test, and a CPU budget for every other test.
+
+The quick tier is everything unmarked (``pytest -m "not (ros or ros2 or build or docs or
+slow)"``): no catkin build, no ROS launch, no pip install, no docs build. It stays quick only
+if nothing slow slips in unmarked, so an unmarked test that spends more than
+:data:`BUDGET_S` seconds of CPU (its own process's and its children's, from ``getrusage``:
+wall time would make the check fail on a loaded machine) fails, naming the markers to use.
+The CPU of the session's background catkin builds (``ros_prebuild.py``) is not a test's and
+is taken off.
+
+A test that uses a launch fixture (:data:`ROS_FIXTURES`) is marked ``ros`` even if its file
+forgets to say so. The markers are registered in pyproject.toml; this module is loaded by
+``tests/conftest.py`` (``pytest_plugins``).
+"""
+
+from __future__ import annotations
+
+import resource
+import sys
+from collections.abc import Generator
+
+import pytest
+
+#: the markers of the slow kinds: a test carrying one is outside the quick tier
+SLOW_KINDS = ("ros", "ros2", "build", "docs", "slow")
+#: seconds of CPU an unmarked test may spend (setup and call, children included); the ini
+#: option ``cpu_budget_s`` changes it (tests/structure/test_tiers.py runs a suite with a small one)
+BUDGET_S = 10.0
+#: fixtures that launch a ROS package: their tests are ``ros`` whatever their file says
+ROS_FIXTURES = frozenset({"launcher", "ros_short_workspace", "ros_short_checked"})
+
+_SPENT = pytest.StashKey[float]()
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addini("cpu_budget_s", "CPU seconds an unmarked test may spend", default=str(BUDGET_S))
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """A test using a launch fixture is a ROS test."""
+    for item in items:
+        if ROS_FIXTURES & set(getattr(item, "fixturenames", ())) and "ros" not in item.keywords:
+            item.add_marker(pytest.mark.ros)
+
+
+def cpu_seconds() -> float:
+    """CPU seconds of this process and its waited-for children, less the background
+    builds' (not any test's)."""
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    total = own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+    prebuild = sys.modules.get("ros_prebuild")
+    return total - (prebuild.cpu_spent() if prebuild is not None else 0.0)
+
+
+def unmarked(item: pytest.Item) -> bool:
+    """Whether ``item`` belongs to the quick tier."""
+    return not any(item.get_closest_marker(kind) for kind in SLOW_KINDS)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_setup(item: pytest.Item) -> Generator[None, None, None]:
+    start = cpu_seconds()
+    yield
+    item.stash[_SPENT] = cpu_seconds() - start
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_call(item: pytest.Item) -> Generator[None, None, None]:
+    start = cpu_seconds()
+    yield
+    item.stash[_SPENT] = item.stash.get(_SPENT, 0.0) + cpu_seconds() - start
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(
+    item: pytest.Item, call: pytest.CallInfo[None]
+) -> Generator[None, pytest.TestReport, None]:
+    """A passing unmarked test over budget is reported failed, saying why."""
+    outcome = yield
+    report = outcome.get_result()
+    if call.when != "call" or not report.passed or not unmarked(item):
+        return
+    spent = item.stash.get(_SPENT, 0.0)
+    budget = float(item.config.getini("cpu_budget_s"))
+    if spent > budget:
+        report.outcome = "failed"
+        report.longrepr = (
+            f"{item.nodeid} spent {spent:.1f} s of CPU (its process and children), over the "
+            f"{budget:g} s of an unmarked test: make it cheaper, or mark it with the kind "
+            f"that makes it slow ({', '.join(SLOW_KINDS)}; docs/development.md, the tiers)"
+        )
