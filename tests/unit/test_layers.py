@@ -23,7 +23,9 @@ import pytest
 
 PKG = Path(__file__).resolve().parent.parent.parent / "amsa_phys"
 LAYER = {
+    "stl": -1,  # STL syntax and monitor: numpy and text only, read by the loader and engine
     "model": 0,
+    "requirements": 0.5,  # objective names (metrics, robustness.NAME) and their sense
     "engine": 1,
     "physics": 2,
     "sensors": 2,
