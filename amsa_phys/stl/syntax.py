@@ -147,7 +147,7 @@ class _Parser:
 
     def where(self) -> str:
         if self.i >= len(self.toks):
-            return "at the end"
+            return "the end"
         return f"{self.toks[self.i][1]!r} at column {self.toks[self.i][2]}"
 
     def take(self, want: str | None = None) -> str:
@@ -221,8 +221,8 @@ class _Parser:
 
     def comparison(self) -> Node:
         start = self.i
+        first: tuple[int, FormulaError] | None = None
         if self.peek() == "(":  # a parenthesised formula, or arithmetic: try a formula first
-            save = self.i
             self.take("(")
             try:
                 inner = self.formula()
@@ -230,9 +230,17 @@ class _Parser:
                 arithmetic = ("+", "-", "*", "/", *COMPARISONS)
                 if inner.is_formula and self.peek() not in arithmetic:
                     return inner
-            except FormulaError:
-                pass
-            self.i = save
+            except FormulaError as exc:
+                first = (self.i, exc)
+            self.i = start
+        try:
+            return self.arithmetic_comparison(start)
+        except FormulaError:
+            if first is not None and first[0] >= self.i:  # the formula reading got further
+                raise first[1] from None
+            raise
+
+    def arithmetic_comparison(self, start: int) -> Node:
         left = self.sum()
         if self.peek() in COMPARISONS:
             op = self.take()
