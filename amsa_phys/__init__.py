@@ -24,6 +24,7 @@ _LAZY = {
     "TraceSizeWarning": ".api.memory",
     "OverrideWarning": ".runs.overrides",
     "load": ".api.source",
+    "falsify": ".api.falsify",
     "validate": ".api.source",
     "AmsaError": ".errors",
     "ConfigError": ".errors",
@@ -47,6 +48,7 @@ __all__ = [  # noqa: RUF022  grouped as the README lists them
     "OverrideWarning",
     "load",
     "validate",
+    "falsify",
     "AmsaError",
     "ConfigError",
     "RunFault",
@@ -62,6 +64,7 @@ __all__ = [  # noqa: RUF022  grouped as the README lists them
 ]
 
 if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eagerly
+    from .api.falsify import falsify
     from .api.memory import TraceSizeWarning
     from .api.result import Run, run
     from .api.source import load, validate

@@ -56,7 +56,7 @@ def row_metrics(row: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _has_metrics(row: dict[str, Any]) -> bool:
+def has_metrics(row: dict[str, Any]) -> bool:
     return any(k in row for k in METRICS)
 
 
@@ -85,7 +85,7 @@ class Objective:
 
     def judge(self, row: dict[str, Any]) -> Verdict:
         """The verdict on one result row."""
-        if not _has_metrics(row):  # its settings broke a rule before it ran
+        if not has_metrics(row):  # its settings broke a rule before it ran
             return Verdict(None, math.inf, False, row.get("error", ""))
         fault = row.get("error", "")
         if self.requirements:
