@@ -13,6 +13,7 @@ from pathlib import Path
 from ..atomic import write_atomic
 from ..engine import interrupt
 from ..errors import ConfigError, Interrupted, one_line
+from ..falsify import counterexample
 from ..falsify.objective import Objective, build_objective, requirement_objective
 from ..falsify.outputs import describe_value, headline, write_results, write_worst
 from ..falsify.search import Progress, Settings, search
@@ -197,7 +198,7 @@ def run(args: argparse.Namespace) -> int:
             args.scheduler,
             stop_at_violation=objective.falsifies and not args.search_on,
         )
-        trial, found = _one_search(args, settings, objective, space, keys, name, here, k)
+        trial, found = _one_search(args, settings, objective, space, scenario, name, here, k)
         trials.append(trial)
         violated = violated or found
     summary = summarize(trials, args.budget, objective.label)
@@ -218,6 +219,46 @@ def run(args: argparse.Namespace) -> int:
     return 1 if violated else 0
 
 
+def _counterexample(
+    settings: Settings,
+    objective: Objective,
+    space: Space,
+    scenario: Scenario,
+    progress: Progress,
+    name: str,
+    out: Path,
+) -> str:
+    """worst.yaml as the falsifying context closest to nominal (``falsify/counterexample``),
+    its run in counterexample/, counterexample.png; what to add to the printed line."""
+    keys = [d.key for d in space.dims]
+    nom = counterexample.nominal(space, scenario)
+    found = counterexample.minimise(space, objective, settings, progress, nom)
+    if found is None:
+        return ""
+    row, verdict, point = found
+    row = {**row, **dict(point)}
+    gap = counterexample.distance(point, nom, space)
+    what = ", ".join(f"{k}={v}" for k, v in point)
+    text = f"closest falsifying context to nominal: {what} ({verdict.why}; {gap:.3g} box widths)"
+    write_worst(
+        row, keys, settings, f"{text}\nreplay: amsa-phys run worst.yaml", out / "worst.yaml"
+    )
+    run_dir = counterexample.replay(settings, point, out / "counterexample")
+    req = objective.requirements[0]
+    metrics = json.loads((run_dir / "metrics.json").read_text()).get("requirements") or {}
+    if len(objective.requirements) > 1:  # the requirement this context breaks most
+        req = min(
+            objective.requirements,
+            key=lambda n: (metrics.get(n) or {}).get("robustness") or math.inf,
+        )
+    entry = metrics.get(req) or {}
+    counterexample.plot(run_dir, req, out / "counterexample.png", one_line(name))
+    when = ""
+    if entry.get("instant") is not None:
+        when = f", broken at t={entry['instant']:g} s by {entry.get('atom', '?')}"
+    return f"; {text}{when}"
+
+
 def _cpu() -> float:
     """CPU seconds of this process and its finished children (worker pools)."""
     me = resource.getrusage(resource.RUSAGE_SELF)
@@ -230,12 +271,13 @@ def _one_search(
     settings: Settings,
     objective: Objective,
     space: Space,
-    keys: list[str],
+    scenario: Scenario,
     name: str,
     out: Path,
     k: int,
 ) -> tuple[Trial, bool]:
     """One trial: search, write its files in ``out``; (its outcome, whether it violated)."""
+    keys = [d.key for d in space.dims]
     progress = Progress()
     if args.resume:
         progress.cached = read_cached(out / "results.csv")
@@ -275,13 +317,17 @@ def _one_search(
         line += f"; first violation at run {first} ({first + 1} simulations)"
     with interrupt.sigterm_as_ctrl_c(), interrupt.deferred():
         write_results(progress.rows, keys, out / "results.csv")
+        raw = "worst.yaml"
+        if worst is not None and objective.falsifies and first is not None and not interrupted:
+            raw = "worst_raw.yaml"
+            line += _counterexample(settings, objective, space, scenario, progress, name, out)
         if worst is not None:
             write_worst(
                 progress.rows[worst],
                 keys,
                 settings,
-                f"{line}\nreplay: amsa-phys run worst.yaml",
-                out / "worst.yaml",
+                f"{line}\nreplay: amsa-phys run {raw}",
+                out / raw,
             )
         _plot(progress, objective, name, out, interrupted, args.budget)
         late = interrupt.requested()

@@ -142,6 +142,8 @@ def resolved_scenario(
         out["expect"] = []
         for e in kept:
             fields = (
+                ("stl", e.stl),
+                ("name", e.name),
                 ("metric", e.metric),
                 ("trace", e.trace),
                 ("phase", e.phase),

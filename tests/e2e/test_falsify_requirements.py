@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import yaml
 
 from amsa_phys.cli.main import main
 
@@ -133,3 +134,35 @@ def test_resume_after_ctrl_c_loses_no_finished_run(
     final = {r["run"]: r for r in rows(out / "results.csv")}
     for r in kept:
         assert final[r["run"]] == r
+
+
+def test_minimised_counterexample_still_falsifies_and_is_no_further_from_nominal(
+    scenario: Path, tmp_path: Path
+) -> None:
+    from amsa_phys.falsify.counterexample import distance, nominal
+    from amsa_phys.falsify.space import build_space
+    from amsa_phys.model.scenario import load_scenario
+
+    out = tmp_path / "cx"
+    assert falsify(scenario, out, "--budget", "150", "--requirement", "band") == 1
+    replay = tmp_path / "replay"
+    main(["run", str(out / "worst.yaml"), "--headless", "--out", str(replay)])
+    rob = json.loads((replay / "metrics.json").read_text())["requirements"]["band"]
+    assert rob["robustness"] < 0  # the minimised context, replayed, still falsifies
+    sc = load_scenario(scenario)
+    space = build_space(sc, [BOX[1], BOX[3]], [])
+    nom = nominal(space, sc)
+    keys = [d.key for d in space.dims]
+
+    def point(path: Path) -> tuple:
+        doc = yaml.safe_load(path.read_text())
+        return tuple((k, doc["set"][k]) for k in keys)  # the searched values, set at t = 0
+
+    table = rows(out / "results.csv")
+    raw_rob = min(float(r["robustness.band"]) for r in table)
+    assert raw_rob < 0
+    raw_worst = next(r for r in table if float(r["robustness.band"]) == raw_rob)
+    raw_point = tuple((k, float(raw_worst[k])) for k in keys)
+    assert distance(point(out / "worst.yaml"), nom, space) <= distance(raw_point, nom, space)
+    assert (out / "worst_raw.yaml").is_file()
+    assert (out / "counterexample.png").stat().st_size > 0

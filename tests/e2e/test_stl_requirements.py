@@ -86,6 +86,8 @@ def test_robustness_verdict_and_instant_in_metrics_test_and_junit(
     code = main(["run", str(path), "--headless", "--out", str(out)])
     assert code == 1  # the tight requirement fails: the follower starts 15 m behind and drifts
     req = json.loads((out / "metrics.json").read_text())["requirements"]
+    assert main(["validate", str(out / "scenario.yaml")]) == 0  # the requirements written back
+    assert "always[20:40]" in (out / "scenario.yaml").read_text()
     trace = list(csv.DictReader(io.StringIO((out / "trace.csv").read_text())))
     dist = [(float(r["t"]), float(r[DIST])) for r in trace]
     band = min(3.5 - abs(d - 15) for t, d in dist if 20 <= t <= 40)
