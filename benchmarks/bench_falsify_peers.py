@@ -5,7 +5,8 @@ the same budget, over the same simulator: PSY-TaLiRo's cost function calls ``ams
 in this process and computes the same robustness from the run's metrics that ``ap.falsify``
 computes from its result row. amsa-phys runs its generations in this process one run after
 another (``executor="local"``, one worker): for generations of 6-30 runs that costs a
-third to a fifth of the CPU of a batch (measured: 0.7 s against 2.2-3.3 s for 20 runs). Each problem is searched in N trials (seeds 1..N); a trial
+third to a fifth of the CPU of a batch (measured: 0.7 s against 2.2-3.3 s for 20 runs).
+Each problem is searched in N trials (seeds 1..N); a trial
 stops at its first falsifying run (PSY-TaLiRo's ``min_cost=0``; amsa-phys's default). The
 table: falsification rate, mean simulations to the first violation (over falsified trials),
 CPU seconds per trial (this process and its children).
