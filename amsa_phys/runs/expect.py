@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..model.scenario import Expectation
+from ..stl.requirement import reads_until
 
 #: how a trace check that saw no logged sample begins its note
 NO_SAMPLE = "no sample"
@@ -144,6 +145,11 @@ def _stl_check(e: Expectation, metrics: dict[str, Any]) -> Check:
     (judged on the run's samples; ``stl/requirement.py``), with the instant and
     the comparison that set it."""
     entry = (metrics.get("requirements") or {}).get(e.name)
+    reached = float(metrics.get("simulated", 0.0))
+    until = reads_until(str(e.stl))
+    if until > reached + 1e-9:  # its windows were cut by the run's end: not judged
+        why = f"it reads until t={until:g} s; the run ended at t={reached:g} s"
+        return Check(e, None, True, skipped=True, why=why)
     if entry is None:
         return Check(e, None, False, note="not judged: the run kept no samples of it")
     rob = entry.get("robustness")

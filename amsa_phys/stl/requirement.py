@@ -78,6 +78,12 @@ def check_formula(
     return node
 
 
+def reads_until(formula: str) -> float:
+    """The last instant (s) a formula reads from t = 0: a run that ends before it cannot
+    judge it (its windows would be cut short)."""
+    return float(horizon(parse(formula))[1])
+
+
 def _check_sampling(node: Node, period: Fraction) -> None:
     from .monitor import samples
 

@@ -128,3 +128,13 @@ def test_batched_and_pool_sweeps_give_the_same_robustness(tmp_path: Path) -> Non
             assert a[name] != ""
             assert abs(float(a[name]) - float(b[name])) <= 1e-12
     assert len({r["robustness.band"] for r in got["batch"]}) == 4  # each run its own column
+
+
+def test_a_run_cut_before_a_formulas_end_skips_it_and_its_replay_loads(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = scenario(tmp_path, f'{{stl: "always[20:40]({DIST} <= 15.5)", name: tight}}')
+    out = tmp_path / "short"
+    assert main(["run", str(path), "--headless", "--duration", "30", "--out", str(out)]) == 0
+    assert "requirement tight: skipped (it reads until t=40 s" in capsys.readouterr().out
+    assert main(["validate", str(out / "scenario.yaml")]) == 0
