@@ -62,3 +62,15 @@ def test_bad_arguments_are_config_errors(scenario: Path) -> None:
         ap.falsify(scenario, BOX, budget=5, seed=-1)
     with pytest.raises(ap.ConfigError):
         ap.falsify(scenario, {"Leader.changePeriod": "x"}, budget=5)
+
+
+def test_ap_run_reports_the_requirements_as_the_command_does(
+    scenario: Path, tmp_path: Path
+) -> None:
+    import json
+
+    got = ap.run(scenario).metrics["requirements"]
+    assert main(["run", str(scenario), "--headless", "--out", str(tmp_path / "r")]) in (0, 1)
+    want = json.loads((tmp_path / "r" / "metrics.json").read_text())["requirements"]
+    assert got == want
+    assert set(got["band"]) >= {"formula", "robustness", "verdict", "instant"}
