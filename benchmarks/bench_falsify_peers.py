@@ -72,6 +72,7 @@ PROBLEMS: dict[str, dict[str, Any]] = {
         },
         "duration": 120.0,
         "executor": "local",  # its rovers start within reach: a batch runs them alone anyway
+        "ints": ("MyNormalizePower.motorCoef",),  # an int parameter: PSY-TaLiRo's floats rounded
         "row": lambda r: 4.8 - r["rms_error"],
         "metrics": lambda m: 4.8 - m["overall"]["rms_error"],
     },
@@ -120,7 +121,9 @@ def psy_trial(p: dict[str, Any], budget: int, seed: int, optimizer: str) -> dict
 
     @staliro.costfunc
     def cost(inputs: Any) -> float:
-        values = {k: float(inputs.static[k]) for k in names}
+        values: dict[str, float | int] = {k: float(inputs.static[k]) for k in names}
+        for k in p.get("ints", ()):
+            values[k] = round(values[k])
         run = ap.run(p["scenario"], duration=p["duration"], set=values)
         return float(p["metrics"](run.metrics))
 
