@@ -72,7 +72,8 @@ PROBLEMS: dict[str, dict[str, Any]] = {
         },
         "duration": 120.0,
         "executor": "local",  # its rovers start within reach: a batch runs them alone anyway
-        "ints": ("MyNormalizePower.motorCoef",),  # an int parameter: PSY-TaLiRo's floats rounded
+        # int parameters: PSY-TaLiRo's floats rounded (ap.falsify searches them as integers)
+        "ints": ("MyNormalizePower.motorCoef", "LeaderGPS.lostDataGPS"),
         "row": lambda r: 4.8 - r["rms_error"],
         "metrics": lambda m: 4.8 - m["overall"]["rms_error"],
     },
@@ -167,13 +168,14 @@ def main() -> None:
     parser.add_argument("--budget", type=int, default=150)
     parser.add_argument("--problems", default=",".join(PROBLEMS))
     parser.add_argument("--out", default="bench_falsify_peers.json")
+    parser.add_argument("--tools", default="amsa-phys,dual-annealing,uniform-random")
     args = parser.parse_args()
     load0 = os.getloadavg()
     results: dict[str, Any] = {"budget": args.budget, "load_before": load0, "problems": {}}
     for name in args.problems.split(","):
         p = PROBLEMS[name]
         results["problems"][name] = {}
-        for tool in ("amsa-phys", "dual-annealing", "uniform-random"):
+        for tool in args.tools.split(","):
             trials = []
             for seed in range(1, args.trials + 1):
                 if tool == "amsa-phys":
