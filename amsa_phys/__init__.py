@@ -25,6 +25,7 @@ _LAZY = {
     "OverrideWarning": ".runs.overrides",
     "ReferenceWarning": ".runs.references",
     "load": ".api.source",
+    "falsify": ".api.falsify",
     "validate": ".api.source",
     "AmsaError": ".errors",
     "ConfigError": ".errors",
@@ -49,6 +50,7 @@ __all__ = [  # noqa: RUF022  grouped as the README lists them
     "ReferenceWarning",
     "load",
     "validate",
+    "falsify",
     "AmsaError",
     "ConfigError",
     "RunFault",
@@ -64,6 +66,7 @@ __all__ = [  # noqa: RUF022  grouped as the README lists them
 ]
 
 if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eagerly
+    from .api.falsify import falsify
     from .api.memory import TraceSizeWarning
     from .api.result import Run, run
     from .api.source import load, validate

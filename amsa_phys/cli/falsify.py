@@ -3,24 +3,43 @@
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import resource
 import sys
 from fractions import Fraction
 from pathlib import Path
 
+from ..atomic import write_atomic
 from ..engine import interrupt
 from ..errors import ConfigError, Interrupted, one_line
-from ..falsify.objective import Objective, build_objective
+from ..falsify import counterexample
+from ..falsify.objective import Objective, build_objective, requirement_objective
 from ..falsify.outputs import describe_value, headline, write_results, write_worst
 from ..falsify.search import Progress, Settings, search
-from ..falsify.space import build_space
+from ..falsify.space import Space, build_space
+from ..falsify.trials import (
+    Trial,
+    check_same_search,
+    plot_trials,
+    read_cached,
+    read_trial,
+    summarize,
+    write_trial,
+)
 from ..model.configure import duration_option
-from ..model.scenario import load_scenario
+from ..model.scenario import Scenario, load_scenario
+from ..model.schema import MAX_SEED
+from ..requirements.objective import requirement_of
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.suite import input_files
 from ..runs.sweep import MAX_RUNS, timeline_overlaps, unknown_metric
+from ..stl.requirement import reads_until
 from .options import add_jobs
 from .progress import bar as progress_bar
+
+#: Most trials one command runs (each is a whole search).
+MAX_TRIALS = 1000
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -51,6 +70,30 @@ def add_args(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="minimise the robustness of the scenario's expect: checks on metrics",
     )
+    goal.add_argument(
+        "--requirement",
+        metavar="NAME",
+        help="minimise the robustness of the scenario's STL requirement NAME (all: the least "
+        "of every one); stops at the first falsifying run",
+    )
+    p.add_argument(
+        "--search-on",
+        action="store_true",
+        help="with --requirement: spend the whole budget on the worst case after a violation",
+    )
+    p.add_argument(
+        "--trials",
+        type=int,
+        default=1,
+        metavar="N",
+        help="repeat the search with seeds S..S+N-1; report the falsification rate and "
+        "simulations to falsify (summary.json, trials.png)",
+    )
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue an interrupted search in --out DIR, running no finished run again",
+    )
     p.add_argument("--seed", type=int, default=1, help="the search's seed (default 1)")
     add_jobs(p)
     p.add_argument(
@@ -65,8 +108,37 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--force", action="store_true", help="replace an existing --out directory")
 
 
+def check_seed(seed: int, trials: int) -> None:
+    """Seeds are 0..2**63-1 everywhere; N trials use S..S+N-1."""
+    if trials < 1 or trials > MAX_TRIALS:
+        raise ConfigError(f"must be in 1..{MAX_TRIALS}", key="--trials")
+    if not 0 <= seed <= MAX_SEED - (trials - 1):
+        top = MAX_SEED - (trials - 1)
+        raise ConfigError(
+            f"must be an integer from 0 to {top}"
+            + (" (2**63 - 1)" if trials == 1 else f" (2**63 - 1 less the {trials - 1} more trials)")
+            + f", got {seed}",
+            key="--seed",
+        )
+
+
+def _objective(
+    args: argparse.Namespace, scenario: Scenario, n_phases: int
+) -> tuple[Objective, list[str]]:
+    if args.requirement is not None:
+        return requirement_objective(list(scenario.expect), args.requirement, "--requirement"), []
+    if args.metric is not None and requirement_of(args.metric) is None:
+        why = unknown_metric(args.metric, n_phases)
+        if why is not None:
+            raise ConfigError(why, key="--metric")
+    return build_objective(list(scenario.expect), args.metric, args.expect, n_phases)
+
+
 def run(args: argparse.Namespace) -> int:
     """Search; write results.csv, worst.yaml, convergence.png; exit 1 on a violation."""
+    check_seed(args.seed, args.trials)
+    if args.resume and not args.out:
+        raise ConfigError("--resume continues the search in --out DIR: give it", key="--resume")
     scenario = load_scenario(args.scenario)
     if args.budget < 1 or args.budget > MAX_RUNS:
         raise ConfigError(f"must be in 1..{MAX_RUNS:,}", key="--budget")
@@ -79,36 +151,150 @@ def run(args: argparse.Namespace) -> int:
     space = build_space(scenario, args.ranges, args.grid)
     end = args.duration if args.duration is not None else float(scenario.duration)
     n_phases = len(scenario.timeline.phases_before(end))
-    if args.metric is not None:
-        why = unknown_metric(args.metric, n_phases)
-        if why is not None:
-            raise ConfigError(why, key="--metric")
-    objective, warnings = build_objective(scenario.expect, args.metric, args.expect, n_phases)
+    objective, warnings = _objective(args, scenario, n_phases)
+    for e in scenario.expect:  # a window cut by a shorter run judges fewer samples
+        if e.stl is not None and e.name in objective.requirements and reads_until(e.stl) > end:
+            warnings.append(
+                f"the requirement {e.name} reads until t={reads_until(e.stl):g} s: runs of "
+                f"{end:g} s cut its windows, so its robustness judges only what they log"
+            )
+    if args.search_on and not objective.falsifies:
+        warnings.append("--search-on only matters with --requirement: the whole budget is spent")
     keys = [d.key for d in space.dims]
     warnings += timeline_overlaps(keys, scenario, Fraction(str(end)))
     for warning in warnings:
         print(one_line(f"warning: {warning}"), file=sys.stderr)
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-falsify")
-    prepare_run_dir(out, args.force, inputs=input_files(scenario))
-    settings = Settings(
-        Path(args.scenario).resolve(),
-        args.budget,
-        args.seed,
-        scenario.seed,
-        args.duration,
-        args.executor,
-        args.jobs,
-        args.scheduler,
-    )
-    progress = Progress()
-    interrupted = False
+    if args.resume:
+        if not out.is_dir():
+            raise ConfigError("not a directory to resume", file=out, key="--resume")
+    else:
+        prepare_run_dir(out, args.force, inputs=input_files(scenario))
+    record = {
+        "scenario": str(Path(args.scenario).resolve()),
+        "ranges": args.ranges,
+        "grids": args.grid,
+        "budget": args.budget,
+        "seed": args.seed,
+        "trials": args.trials,
+        "objective": objective.label,
+        "requirements": list(objective.requirements),
+        "stop_at_violation": objective.falsifies and not args.search_on,
+        "duration": args.duration,
+    }
+    check_same_search(out / "falsify.json", record, args.resume)
+    trials: list[Trial] = []
+    violated = False
+    for k in range(args.trials):
+        here = out if args.trials == 1 else out / f"trial-{k + 1:03d}"
+        done = read_trial(here / "trial.json") if args.resume else None
+        if done is not None:
+            trials.append(done)
+            violated = violated or done.falsified
+            continue
+        here.mkdir(exist_ok=True)
+        settings = Settings(
+            Path(args.scenario).resolve(),
+            args.budget,
+            args.seed + k,
+            scenario.seed,
+            args.duration,
+            args.executor,
+            args.jobs,
+            args.scheduler,
+            stop_at_violation=objective.falsifies and not args.search_on,
+        )
+        trial, found = _one_search(args, settings, objective, space, scenario, name, here, k)
+        trials.append(trial)
+        violated = violated or found
+    summary = summarize(trials, args.budget, objective.label)
+    write_atomic(out / "summary.json", json.dumps(summary, indent=1) + "\n")
+    if args.trials > 1:
+        plot_trials(summary, out / "trials.png", one_line(name))
+        rate = summary["falsification_rate"]
+        line = f"falsified {summary['falsified']} of {len(trials)} trials ({rate:.0%})"
+        if summary["mean_simulations"] is not None:
+            line += (
+                f", {summary['mean_simulations']:.1f} simulations on average to the first "
+                f"violation (median {summary['median_simulations']:g})"
+            )
+        least = summary["robustness_not_falsified"]["min"]
+        if least is not None:
+            line += f"; least {objective.label} reached when not falsified {least:.6g}"
+        print(one_line(f"{line}; summary in {out / 'summary.json'}"))
+    return 1 if violated else 0
 
-    bar = progress_bar(args.budget, "run")
+
+def _counterexample(
+    settings: Settings,
+    objective: Objective,
+    space: Space,
+    scenario: Scenario,
+    progress: Progress,
+    name: str,
+    out: Path,
+) -> str:
+    """worst.yaml as the falsifying context closest to nominal (``falsify/counterexample``),
+    its run in counterexample/, counterexample.png; what to add to the printed line."""
+    keys = [d.key for d in space.dims]
+    nom = counterexample.nominal(space, scenario)
+    found = counterexample.minimise(space, objective, settings, progress, nom)
+    if found is None:
+        return ""
+    row, verdict, point = found
+    row = {**row, **dict(point)}
+    gap = counterexample.distance(point, nom, space)
+    what = ", ".join(f"{k}={v}" for k, v in point)
+    text = f"closest falsifying context to nominal: {what} ({verdict.why}; {gap:.3g} box widths)"
+    write_worst(
+        row, keys, settings, f"{text}\nreplay: amsa-phys run worst.yaml", out / "worst.yaml"
+    )
+    run_dir = counterexample.replay(settings, point, out / "counterexample")
+    req = objective.requirements[0]
+    metrics = json.loads((run_dir / "metrics.json").read_text()).get("requirements") or {}
+    if len(objective.requirements) > 1:  # the requirement this context breaks most
+        req = min(
+            objective.requirements,
+            key=lambda n: (metrics.get(n) or {}).get("robustness") or math.inf,
+        )
+    entry = metrics.get(req) or {}
+    counterexample.plot(run_dir, req, out / "counterexample.png", one_line(name))
+    when = ""
+    if entry.get("instant") is not None:
+        when = f", broken at t={entry['instant']:g} s by {entry.get('atom', '?')}"
+    return f"; {text}{when}"
+
+
+def _cpu() -> float:
+    """CPU seconds of this process and its finished children (worker pools)."""
+    me = resource.getrusage(resource.RUSAGE_SELF)
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+def _one_search(
+    args: argparse.Namespace,
+    settings: Settings,
+    objective: Objective,
+    space: Space,
+    scenario: Scenario,
+    name: str,
+    out: Path,
+    k: int,
+) -> tuple[Trial, bool]:
+    """One trial: search, write its files in ``out``; (its outcome, whether it violated)."""
+    keys = [d.key for d in space.dims]
+    progress = Progress()
+    if args.resume:
+        progress.cached = read_cached(out / "results.csv")
+    interrupted = False
+    cpu0 = _cpu()
+    bar = progress_bar(args.budget, "run" if args.trials == 1 else f"trial {k + 1} run")
 
     def said(generation: int) -> None:  # a line per generation, above the progress bar
-        k = progress.worst()
-        worst = describe_value(progress.verdicts[k].value) if k is not None else "none"
+        w = progress.worst()
+        worst = describe_value(progress.verdicts[w].value) if w is not None else "none"
         type(bar).write(
             f"generation {generation} done: {len(progress.rows)} runs, worst "
             f"{objective.label} {worst}",
@@ -133,25 +319,39 @@ def run(args: argparse.Namespace) -> int:
         if worst is not None
         else f"no run of {len(progress.rows)} could be judged"
     )
+    first = progress.first_violation()
+    if first is not None and settings.stop_at_violation:
+        line += f"; first violation at run {first} ({first + 1} simulations)"
     with interrupt.sigterm_as_ctrl_c(), interrupt.deferred():
         write_results(progress.rows, keys, out / "results.csv")
+        raw = "worst.yaml"
+        if worst is not None and objective.falsifies and first is not None and not interrupted:
+            raw = "worst_raw.yaml"
+            line += _counterexample(settings, objective, space, scenario, progress, name, out)
         if worst is not None:
             write_worst(
                 progress.rows[worst],
                 keys,
                 settings,
-                f"{line}\nreplay: amsa-phys run worst.yaml",
-                out / "worst.yaml",
+                f"{line}\nreplay: amsa-phys run {raw}",
+                out / raw,
             )
         _plot(progress, objective, name, out, interrupted, args.budget)
         late = interrupt.requested()
     print(f"{line}; results in {out}")
+    if args.resume:
+        print(f"resumed: {progress.reused} finished runs taken from results.csv", file=sys.stderr)
     failed = [r for r in progress.rows if r["error"]]
     for r in failed[:5]:
         print(one_line(f"run {r['run']}: {r['error']}"), file=sys.stderr)
     if interrupted or late:
-        raise Interrupted(f"falsify interrupted; {len(progress.rows)} finished rows kept in {out}")
-    return 1 if worst is not None and progress.verdicts[worst].violated else 0
+        raise Interrupted(
+            f"falsify interrupted; {len(progress.rows)} finished rows kept in {out} "
+            "(--resume continues)"
+        )
+    trial = Trial.of(settings.seed, progress, _cpu() - cpu0)
+    write_trial(trial, out / "trial.json")
+    return trial, worst is not None and progress.verdicts[worst].violated
 
 
 def _plot(

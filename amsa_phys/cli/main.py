@@ -57,6 +57,7 @@ COMMANDS = {
         "falsify",
         "Falsification: search a box of context parameters for the worst case with CMA-ES.",
     ),
+    "monitor": ("monitor", "Evaluate an STL formula's robustness on a finished run's trace."),
     "graph": (
         "graph",
         "Draw the architecture of a world or scenario, components coloured by kind.",

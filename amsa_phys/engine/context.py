@@ -69,3 +69,6 @@ class RunResult:
     samples_t: np.ndarray
     samples_s: np.ndarray
     events: list[Event] = field(default_factory=list)
+    #: the STL requirements' entries of ``metrics.json`` (``stl/requirement.py``),
+    #: when the run's requirements were judged with its samples; None: no requirement
+    requirements: dict[str, Any] | None = None

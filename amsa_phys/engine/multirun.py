@@ -42,6 +42,7 @@ from ..model.scenario import Change, Scenario
 from . import batch
 from .rng import component_rng
 from .runner import Context, Event, RunResult, Simulation
+from .signals import RequirementWatch
 from .tasks import Task
 
 
@@ -156,6 +157,8 @@ class MultiRun(Simulation):
         self._q_rows: list[np.ndarray] = []
         if self._q_index:
             self.add_log_listener(self._sample)
+        #: the runs' STL requirements, judged as one batch (a column per run)
+        self.watch = RequirementWatch.of(base, self)
 
     def _sample(self, t_s: float, values: Any) -> None:
         """One quality sample of every run: a copy of the signal's column (one C call)."""
@@ -192,10 +195,12 @@ class MultiRun(Simulation):
         table = np.array(self._q_rows, dtype=np.float64).reshape(shape)
         column = {k: j for j, k in enumerate(self._q_index)}
         t_end = float(self.now)
+        judged = self.watch.judged() if self.watch else None
         out = []
         for i, run in enumerate(self.runs):
             j = column.get(i)
             samples = table[:, j].copy() if j is not None else np.zeros(0)
             times = t if j is not None else np.zeros(0)
-            out.append(BatchShare(RunResult(t_end, times, samples, list(run.events))))
+            reqs = judged[i] if judged is not None else None
+            out.append(BatchShare(RunResult(t_end, times, samples, list(run.events), reqs)))
         return out

@@ -45,6 +45,7 @@ from .delivery import Deliveries
 from .instants import InstantSource, TimelineSource
 from .livechanges import LiveChanges
 from .log import RunLog
+from .signals import RequirementWatch
 from .store import BufferStore, ReadAPI
 from .tasks import COMPONENT_ERRORS, Steppers, Task, in_run
 from .timing import DelayLine, run_phases
@@ -148,12 +149,21 @@ class Simulation(ReadAPI, LiveChanges):
         self._steppers = Steppers(self.store.data, self._send, self._who, self.store.col)
         #: ``adapt:`` rules (``engine/adapt.py``), asked at every instant with components
         self._adapt = AdaptRules(adapt, self._param_value) if adapt else None
+        #: the STL requirements judged after the run (:meth:`watch_requirements`)
+        self.watch: RequirementWatch | None = None
         self._build()
 
     @classmethod
     def from_scenario(cls, scenario: Scenario, **kw: Any) -> Simulation:
-        """A Simulation configured by a loaded scenario."""
-        return cls(scenario.world, **cls.scenario_kwargs(scenario), **kw)
+        """A Simulation configured by a loaded scenario (sampling what its STL requirements
+        read, so :meth:`result` judges them)."""
+        sim = cls(scenario.world, **cls.scenario_kwargs(scenario), **kw)
+        sim.watch_requirements(scenario)
+        return sim
+
+    def watch_requirements(self, scenario: Scenario) -> None:
+        """Sample what ``scenario``'s STL requirements read; :meth:`result` judges them."""
+        self.watch = RequirementWatch.of(scenario, self)
 
     @staticmethod
     def scenario_kwargs(scenario: Scenario) -> dict[str, Any]:
@@ -467,13 +477,14 @@ class Simulation(ReadAPI, LiveChanges):
         self.log.listeners.append(fn)
 
     def result(self) -> RunResult:
-        """Samples and events so far."""
+        """Samples and events so far (and the requirements judged, if any)."""
         samples_t, samples_s = self.log.samples()
         return RunResult(
             t_end=float(self.now),
             samples_t=samples_t,
             samples_s=samples_s,
             events=list(self.events),
+            requirements=self.watch.judged()[0] if self.watch else None,
         )
 
     def _who(self, path: str) -> str:

@@ -16,6 +16,7 @@ from typing import Any
 
 from ..errors import ConfigError
 from ..model.scenario import METRICS, Expectation
+from ..requirements.objective import column, objective_value, requirement_of, unknown_objective
 from ..runs.expect import check_expectations, describe_bound, describe_what
 
 _PHASE = re.compile(r"phase(\d+)\.(.+)")
@@ -34,8 +35,10 @@ class Verdict:
 
 
 def row_metrics(row: dict[str, Any]) -> dict[str, Any]:
-    """A result row's metric columns back as a ``metrics.json``-shaped document."""
+    """A result row's metric columns back as a ``metrics.json``-shaped document (with each
+    ``robustness.NAME`` as its requirement's entry)."""
     phases: list[dict[str, Any]] = []
+    reqs: dict[str, Any] = {}
     for key, value in row.items():
         m = _PHASE.fullmatch(key)
         if m is not None:
@@ -43,10 +46,17 @@ def row_metrics(row: dict[str, Any]) -> dict[str, Any]:
             while len(phases) <= i:
                 phases.append({})
             phases[i][m.group(2)] = value
-    return {"overall": {k: row.get(k) for k in METRICS}, "phases": phases}
+        name = requirement_of(key)
+        if name is not None:
+            ok = value is not None and value >= 0
+            reqs[name] = {"robustness": value, "verdict": "pass" if ok else "fail"}
+    out = {"overall": {k: row.get(k) for k in METRICS}, "phases": phases}
+    if reqs:
+        out["requirements"] = reqs
+    return out
 
 
-def _has_metrics(row: dict[str, Any]) -> bool:
+def has_metrics(row: dict[str, Any]) -> bool:
     return any(k in row for k in METRICS)
 
 
@@ -57,17 +67,29 @@ class Objective:
 
     metric: str | None
     checks: tuple[Expectation, ...]
+    #: STL requirements whose least robustness is minimised (``--requirement``); a run
+    #: falsifies when it is below 0
+    requirements: tuple[str, ...] = ()
 
     @property
     def label(self) -> str:
         """What the value column and the plot's axis are called."""
+        if len(self.requirements) == 1:
+            return column(self.requirements[0])
         return self.metric or "robustness"
+
+    @property
+    def falsifies(self) -> bool:
+        """Whether this objective is a requirement's robustness (stop at the first < 0)."""
+        return bool(self.requirements)
 
     def judge(self, row: dict[str, Any]) -> Verdict:
         """The verdict on one result row."""
-        if not _has_metrics(row):  # its settings broke a rule before it ran
+        if not has_metrics(row):  # its settings broke a rule before it ran
             return Verdict(None, math.inf, False, row.get("error", ""))
         fault = row.get("error", "")
+        if self.requirements:
+            return self._judge_requirements(row, fault)
         checks = check_expectations(list(self.checks), row_metrics(row))
         failed = [c for c in checks if not c.skipped and not c.passed]
         why = "; ".join(c.describe() for c in failed)
@@ -77,11 +99,29 @@ class Objective:
             value = row.get(self.metric)
             score = -math.inf if fault or value is None else -float(value)
             return Verdict(value, score, bool(fault or failed), why)
-        margins = [margin(c.expectation, c.value) for c in checks if not c.skipped]
+        margins = [
+            (c.value if c.value is not None else -math.inf)
+            if c.expectation.stl is not None
+            else margin(c.expectation, c.value)
+            for c in checks
+            if not c.skipped
+        ]
         value = min(margins) if margins else math.inf
         if fault:
             value = -math.inf
         return Verdict(value, value, bool(fault or failed), why)
+
+    def _judge_requirements(self, row: dict[str, Any], fault: str) -> Verdict:
+        """The least robustness of the requirements (a fault, or a robustness that is not a
+        finite number, is the worst there is: -inf)."""
+        values = []
+        for name in self.requirements:
+            value, _ = objective_value(row, column(name))
+            values.append((-math.inf if value is None else value, name))
+        value, name = min(values) if not fault else (-math.inf, self.requirements[0])
+        violated = value < 0
+        why = fault or (f"requirement {name}: robustness {value:.6g}" if violated else "")
+        return Verdict(value, value, violated, why)
 
 
 def margin(e: Expectation, value: float | None) -> float:
@@ -113,6 +153,9 @@ def build_objective(
     warnings = []
     usable = []
     for e in expect:
+        if e.stl is not None:
+            usable.append(e)  # judged from its robustness.NAME column
+            continue
         if e.trace is not None:
             if use_expect:
                 warnings.append(
@@ -136,4 +179,25 @@ def build_objective(
             )
         return Objective(None, tuple(usable)), warnings
     name = metric or "rms_error"
-    return Objective(name, tuple(e for e in usable if _check_metric(e) == name)), warnings
+    if requirement_of(name) is not None:
+        return requirement_objective(expect, requirement_of(name) or "", "--metric"), warnings
+    return Objective(
+        name, tuple(e for e in usable if e.stl is None and _check_metric(e) == name)
+    ), warnings
+
+
+def requirement_objective(expect: list[Expectation], name: str, option: str) -> Objective:
+    """The objective of ``--requirement NAME`` (``all``: the least robustness of every STL
+    requirement of the scenario), judged before any run."""
+    names = [str(e.name) for e in expect if e.stl is not None]
+    if not names:
+        raise ConfigError(
+            "the scenario has no STL requirement: add an expect: {stl: ..., name: ...}",
+            key=option,
+        )
+    if name == "all":
+        return Objective(None, (), tuple(names))
+    why = unknown_objective(column(name), 0, names)
+    if why is not None:
+        raise ConfigError(why, key=option)
+    return Objective(None, (), (name,))

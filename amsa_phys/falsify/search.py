@@ -17,6 +17,7 @@ order. Same seed, same points, same rows, whatever the executor or ``-j``.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -65,6 +66,9 @@ class Settings:
     optimizer: str = "cma"
     #: CMA-ES's first population (None: its default, 4 + 3 ln(dimensions))
     popsize: int | None = None
+    #: stop after the generation holding the first violation (``--requirement``), instead
+    #: of spending the whole budget on the worst case
+    stop_at_violation: bool = False
 
 
 @dataclass
@@ -76,6 +80,16 @@ class Progress:
     score_of: dict[tuple[tuple[str, Any], ...], float] = field(default_factory=dict)
     #: called with the generation's number once its runs are all in (a progress line)
     on_generation: Callable[[int], None] | None = None
+    #: rows of an interrupted search, by run number (``--resume``): the search replays
+    #: itself (it is deterministic) and takes these instead of running them again
+    cached: dict[int, dict[str, Any]] = field(default_factory=dict)
+    #: how many rows were taken from ``cached`` instead of run
+    reused: int = 0
+
+    def first_violation(self) -> int | None:
+        """The run number of the first violating run (in run order), or None."""
+        runs = [r["run"] for r, v in zip(self.rows, self.verdicts, strict=True) if v.violated]
+        return min(runs) if runs else None
 
     def add(
         self, row: dict[str, Any], verdict: Verdict, point: tuple[tuple[str, Any], ...]
@@ -217,7 +231,7 @@ def search(
     c0 = stratified_choices(rng, n0, [len(d.choices) for d in space.categorical])
     points = [space.decode(list(u), list(c)) for u, c in zip(u0, c0, strict=True)]
     yield from _evaluate(points, 0, objective, settings, progress)
-    if len(progress.rows) >= budget:
+    if len(progress.rows) >= budget or _found(settings, progress):
         return
     first = [progress.score_of[p] for p in points]
     best = min(range(n0), key=lambda i: (first[i], i))
@@ -233,6 +247,8 @@ def search(
         fresh = list(dict.fromkeys(p for p in decoded if p not in progress.score_of))
         fresh = fresh[: budget - len(progress.rows)]
         yield from _evaluate(fresh, generation, objective, settings, progress)
+        if _found(settings, progress):
+            return
         if not fresh:  # converged on points already run: look elsewhere
             cma.restart([space.encode(p) for p in progress.score_of])
             best_here, stalled = math.inf, 0
@@ -253,6 +269,11 @@ def search(
             best_here, stalled = math.inf, 0
 
 
+def _found(settings: Settings, progress: Progress) -> bool:
+    """Whether the search stops now: told to stop at a violation, and one was found."""
+    return settings.stop_at_violation and any(v.violated for v in progress.verdicts)
+
+
 def _evaluate(
     points: list[tuple[tuple[str, Any], ...]],
     generation: int,
@@ -260,19 +281,31 @@ def _evaluate(
     settings: Settings,
     progress: Progress,
 ) -> Iterator[dict[str, Any]]:
-    """One generation as one ``evaluate`` call; rows numbered on from the previous ones."""
+    """One generation as one ``evaluate`` call; rows numbered on from the previous ones
+    (a row of an interrupted search, ``progress.cached``, is taken instead of run again)."""
     offset = len(progress.rows)
-    small = settings.executor == "batch" and len(points) < SMALL_GENERATION
-    rows = evaluate(
-        settings.scenario,
-        [(p, settings.run_seed) for p in points],
-        duration=settings.duration,
-        executor=settings.executor,
-        workers=1 if small else settings.workers,
-        scheduler=settings.scheduler,
+    todo = [i for i in range(len(points)) if offset + i not in progress.cached]
+    small = settings.executor == "batch" and len(todo) < SMALL_GENERATION
+    ran: Iterator[dict[str, Any]] = iter(())
+    if todo:
+        done = evaluate(
+            settings.scenario,
+            [(points[i], settings.run_seed) for i in todo],
+            duration=settings.duration,
+            executor=settings.executor,
+            workers=1 if small else settings.workers,
+            scheduler=settings.scheduler,
+        )
+        ran = ({**row, "index": todo[row["index"]]} for row in done)
+    kept = (
+        {**progress.cached[offset + i], **dict(points[i]), "index": i}
+        for i in range(len(points))
+        if offset + i in progress.cached
     )
-    for row in rows:
+    for row in itertools.chain(kept, ran):
         i = row.pop("index")
+        if offset + i in progress.cached:
+            progress.reused += 1
         row["run"] = offset + i
         row["generation"] = generation
         verdict = objective.judge(row)

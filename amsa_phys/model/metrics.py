@@ -139,6 +139,9 @@ def compute_metrics(
     """
     with np.errstate(over="ignore", invalid="ignore"):  # overflow is reported, not warned
         metrics = _metrics(scenario, sim, result, wall_s, status, idle_s)
+    judged = getattr(result, "requirements", None)
+    if judged is not None:  # STL requirements (``stl/``), judged on the samples
+        metrics["requirements"] = judged
     return _finite(metrics)
 
 

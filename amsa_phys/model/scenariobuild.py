@@ -154,8 +154,13 @@ def _expectations(
     expect = []
     for i, e in enumerate(data.get("expect", [])):
         kp = ("expect", i)
+        if "stl" in e:
+            expect.append(_requirement(doc, data, e, kp, world, duration, expect))
+            continue
+        if "name" in e:
+            raise doc.error((*kp, "name"), "only an stl requirement takes a name")
         if ("metric" in e) == ("trace" in e):
-            raise doc.error(kp, "give exactly one of 'metric' or 'trace'")
+            raise doc.error(kp, "give exactly one of 'metric', 'trace' or 'stl'")
         if "trace" in e:
             if e["trace"] not in world.buffers:
                 raise doc.error(
@@ -209,6 +214,48 @@ def _expectations(
             Expectation(e["metric"], e.get("phase"), e.get("below"), e.get("above"), doc.line(kp))
         )
     return expect
+
+
+def _requirement(
+    doc: YamlDoc,
+    data: dict[str, Any],
+    e: dict[str, Any],
+    kp: tuple[Any, ...],
+    world: WorldSpec,
+    duration: Fraction,
+    earlier: list[Expectation],
+) -> Expectation:
+    """``{stl: FORMULA, name: NAME}``: an STL requirement, refused at load if a run could not
+    judge it (``stl.requirement.check_formula``). The name is required: it is the
+    ``robustness.NAME`` column of a sweep and the argument of ``falsify --requirement``, so
+    it must not change when another entry is added above it."""
+    from ..stl.requirement import NAME, check_formula
+
+    extra = sorted(set(e) - {"stl", "name"})
+    if extra:
+        raise doc.error(
+            (*kp, extra[0]), f"an stl requirement takes only stl and name, not {extra[0]}"
+        )
+    if "name" not in e:
+        raise doc.error(
+            kp,
+            "an stl requirement needs a name (its robustness.NAME column and --requirement NAME)",
+        )
+    name = e["name"]
+    if not NAME.fullmatch(name):
+        raise doc.error(
+            (*kp, "name"),
+            f"{name!r} is not a requirement name: letters, digits, _ and -, "
+            "starting with a letter or _, at most 64",
+        )
+    if any(x.name == name for x in earlier):
+        raise doc.error((*kp, "name"), f"the requirement name {name!r} is used twice")
+    log_rate = Fraction(str(data.get("log_rate", DEFAULT_LOG_RATE_HZ)))
+    try:
+        check_formula(e["stl"], world.buffers, log_rate, duration, did_you_mean)
+    except ValueError as exc:
+        raise doc.error((*kp, "stl"), str(exc)) from None
+    return Expectation(None, None, None, None, doc.line(kp), stl=e["stl"], name=name)
 
 
 def _check_whole(doc: YamlDoc, data: dict[str, Any], scenario: Scenario) -> None:

@@ -40,7 +40,9 @@ class Expectation:
     """A bound on a run.
 
     Either ``metric`` (overall, or of ``phase``) must be ``below`` and/or ``above`` a bound,
-    or every sample of the Data ``trace`` in [``after``, ``before``] must be.
+    or every sample of the Data ``trace`` in [``after``, ``before``] must be, or the STL
+    formula ``stl`` (named ``name``) must hold: robustness at t = 0 at least 0
+    (``stl/``).
     """
 
     metric: str | None
@@ -51,6 +53,8 @@ class Expectation:
     trace: str | None = None
     after: float | None = None
     before: float | None = None
+    stl: str | None = None
+    name: str | None = None
 
 
 @dataclass(frozen=True)
@@ -100,10 +104,11 @@ class Scenario:
 def traced_columns(scenario: Scenario) -> list[str]:
     """The Data buffers the scenario's trace holds, in world order (``model/tracecols``).
 
-    The quality signal and every ``expect: {trace: ...}`` column are always kept: the run
-    reads them back.
+    The quality signal, every ``expect: {trace: ...}`` column and every signal of an STL
+    requirement are always kept: the run reads them back.
     """
     required = [e.trace for e in scenario.expect if e.trace]
+    required += [s for r in requirements(scenario) for s in r.signals]
     if scenario.quality:
         required.append(scenario.quality.signal)
     columns = tracecols.selected(scenario.trace_columns, list(scenario.world.buffers), required)
@@ -123,3 +128,14 @@ def shortened(scenario: Scenario, duration: Fraction) -> Scenario:
 def without_adapt(scenario: Scenario) -> Scenario:
     """``scenario`` as if it had no ``adapt:`` section (``--no-adapt``, ``adapt=False``)."""
     return dataclasses.replace(scenario, adapt=())
+
+
+def requirements(scenario: Scenario) -> list[Any]:
+    """The scenario's STL requirements (``stl.requirement.Requirement``), in file
+    order: parsed again from the checked text (cheap, and the Scenario stays plain data)."""
+    from ..stl.requirement import Requirement
+    from ..stl.syntax import parse
+
+    return [
+        Requirement(str(e.name), e.stl, parse(e.stl)) for e in scenario.expect if e.stl is not None
+    ]

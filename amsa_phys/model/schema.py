@@ -275,8 +275,14 @@ SCENARIO: dict[str, Any] = {
             "items": {
                 "type": "object",
                 "additionalProperties": False,
-                "anyOf": [{"required": ["below"]}, {"required": ["above"]}],
+                "anyOf": [
+                    {"required": ["below"]},
+                    {"required": ["above"]},
+                    {"required": ["stl"]},
+                ],
                 "properties": {
+                    "stl": {"type": "string", "minLength": 1},
+                    "name": {"type": "string"},
                     "metric": {"type": "string"},
                     "trace": {"type": "string"},
                     "phase": {"type": "integer", "minimum": 0},

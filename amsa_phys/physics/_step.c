@@ -241,7 +241,7 @@ static void wheel_pair(const double u[2], const double v[2], const double f0[2],
     out[3] = upr;
 }
 
-/* ---- wheel.slide: a sliding tyre solved with its rim ----------------------------------- */
+/* ---- sliding.slide: a sliding tyre solved with its rim ----------------------------------- */
 #define SLIDE_ITERATIONS 100
 
 typedef struct {
@@ -309,7 +309,7 @@ static void slide(double u, double v, double f0, double res, double ivs, double 
     *up_out = up;
 }
 
-/* ---- wheel.patch_scrub: both patches' turn-slip moment, each capped at its own torque -- */
+/* ---- scrub.patch_scrub: both patches' turn-slip moment, each capped at its own torque -- */
 static double patch_scrub(double w, double torque, double kl, double kr, double ksum, double tl,
                           double tr, double ts, double dt_i)
 {
@@ -445,7 +445,7 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
             fxl = pair[0], upl = pair[1], fxr = pair[2], upr = pair[3];
         }
     }
-    /* scrub: each patch capped at its Coulomb torque (wheel.patch_scrub) */
+    /* scrub: each patch capped at its Coulomb torque (scrub.patch_scrub) */
     double isum = ivl + ivr;
     double torque = (fxr - fxl) * h;
     double kphl = sphi * ivl;

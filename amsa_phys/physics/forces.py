@@ -45,11 +45,11 @@ from operator import attrgetter
 from typing import Any, NamedTuple, TypeVar
 
 from .rover import DiffDriveRover
+from .scrub import patch_scrub
+from .sliding import slide_pair
 from .wheel import (
     SLIP_SPEED_MIN,
     TORSION,
-    patch_scrub,
-    slide_pair,
     step_constants,
     wheel_pair,
 )
@@ -322,7 +322,7 @@ def rover_step(
         ):
             fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kl, kr), sc)
     # scrub: the patches' turn-slip moment, implicit in the yaw rate, each patch capped at its
-    # Coulomb torque (wheel.patch_scrub; the caps in proportion to the patches' lateral grip)
+    # Coulomb torque (scrub.patch_scrub; the caps in proportion to the patches' lateral grip)
     isum = ivl + ivr
     torque = (fxr - fxl) * h
     kphl = sphi * ivl
@@ -402,7 +402,7 @@ def rover_step(
         t3 = fxr * ixr
         t4 = fyr * iyr
     # friction ellipse per wheel: a tyre the gripping solve puts beyond it slides, and the
-    # tyre law is solved with its rim instead (wheel.slide)
+    # tyre law is solved with its rim instead (sliding.slide)
     sat_l = t1 * t1 + t2 * t2 > 1.0
     sat_r = t3 * t3 + t4 * t4 > 1.0
     if sat_l or sat_r:

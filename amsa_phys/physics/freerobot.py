@@ -19,7 +19,7 @@ from ..model.template import Kind
 from .robots import POSE_OUTPUTS, ControlledRobot, Robot
 from .rover import wrap_angle
 from .roverparams import ROVER_PARAMS
-from .wheel import scrub_moment
+from .scrub import scrub_moment
 
 BEHAVIORS = {"straight": 1, "circle": 2, "speedChanges": 3, "random": 4, "waypoints": 5}
 

@@ -15,11 +15,11 @@ import math
 
 from .forces import GRIP_FLOOR_N, LOAD_FLOOR
 from .rover import DiffDriveRover
+from .sliding import slide
 from .wheel import (
     TORSION,
     WheelModel,
     rim_and_tyre,
-    slide,
     slip_speed,
     step_constants,
     wheel_pair,
@@ -85,7 +85,7 @@ def reference_forces(
     sat = (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1 or (fxr * inv[2]) ** 2 + (
         fyr * inv[3]
     ) ** 2 > 1
-    if sat:  # a sliding tyre: the tyre law solved with its rim (wheel.slide)
+    if sat:  # a sliding tyre: the tyre law solved with its rim (sliding.slide)
         side0 = vy * math.cos(a) - vx * math.sin(a)
         ky1 = wm.load_n / wm.slip_lat
         hub = (v_fwd - w * rover.half_track, v_fwd + w * rover.half_track)

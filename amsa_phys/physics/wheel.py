@@ -2,7 +2,8 @@
 
 This module is the readable statement of the wheel model and its closed forms;
 ``forces.rover_step`` (the pure path's one copy, which ``_step.c`` mirrors) inlines the same
-arithmetic and is tested against :func:`rim_and_tyre`, :func:`wheel_pair` and :func:`slide`.
+arithmetic and is tested against :func:`rim_and_tyre`, :func:`wheel_pair` and
+``sliding.slide``.
 
 Forces are expressed at the ground (N), speeds at the rim (m/s): the wheel's spin state is its
 rim speed ``u = omega * r`` (what an encoder measures), and its inertia acts as a mass
@@ -58,7 +59,7 @@ in these rare branches each wheel is solved alone (:func:`rim_and_tyre`), the ot
 from the joint pass taken as known. A tyre that this gripping solve puts beyond its friction
 ellipse *slides*: its force is then the tyre law itself, solved together with its rim by
 :func:`slide` (scaling the gripping solve's forces onto the ellipse instead made a drift depend
-on the physics step, issue 31).
+on the physics step).
 """
 
 from __future__ import annotations
@@ -170,65 +171,6 @@ class WheelModel:
         deadband if that is larger (and never below it: the driver outputs nothing there)."""
         static = 100.0 * self.resistance(crr) / (self.stall_force_n * self.efficiency)
         return max(static, self.deadband_pct)
-
-
-def scrub_moment(
-    w: float, v_l: float, v_r: float, model: WheelModel, mu_l: float, mu_r: float
-) -> float:
-    """Steady scrub moment (N m) on a rover turning at ``w`` with hub speeds ``v_l``, ``v_r``.
-
-    Each tyre's patch resists the yaw with a turn-slip moment linear in ``w / max(|v|,
-    v_min)`` of stiffness ``(3 pi/16) a^2 N / c_x`` (the brush model's: the same bristles
-    that give the slip stiffness ``N / c_x``, twisted over a patch of radius ``a``), capped at
-    the patch's Coulomb torque ``(3 pi/16) a mu N``. On a circle of radius ``R`` both wheels
-    roll, so the moment is about ``(3 pi/8) a^2 N / (c_x R)``: small at speed, the full patch
-    torque when turning in place (each wheel then rolls on a circle of radius track/2).
-    """
-    kx = model.load_n / model.slip_long
-    kphi = TORSION * model.patch_radius_m**2 * kx * (1 / slip_speed(v_l) + 1 / slip_speed(v_r))
-    limit = model.scrub_limit(mu_l) + model.scrub_limit(mu_r)
-    return max(-limit, min(limit, -kphi * w))
-
-
-def patch_scrub(
-    w: float,
-    torque: float,
-    kl: float,
-    kr: float,
-    ksum: float,
-    tl: float,
-    tr: float,
-    ts: float,
-    dt_i: float,
-) -> float:
-    """Both patches' turn-slip moment for one step, implicit in the yaw rate, each patch
-    capped at its own Coulomb torque: the sum ``S`` with ``w+ = w + (torque + S) dt_i``,
-    ``S_i = -k_i w+`` clamped to ``+-t_i``.
-
-    Why per patch: capping the sum at ``t_l + t_r`` lets the slow hub's patch, whose turn-slip
-    stiffness ``k_i ~ 1 / max(|v_i|, v_min)`` is the larger, twist past its own Coulomb
-    torque whenever the fast hub's stays under its own: in a drift whose inner hub runs slowly
-    the scrub was 2.7 N m (26 %) above the documented law's, and the drift settled 6 % off
-    its yaw rate at every physics rate. ``k_i`` the turn-slip stiffness (N m s), ``t_i``
-    the caps (N m), ``ts`` their sum as the caller has it (returned as such when both bind,
-    so a turn in place keeps its bits), ``dt_i = dt / I``. The yaw rate is monotone in
-    ``S``, so the patch with the lower threshold ``t_i / k_i`` saturates first.
-    """
-    base = w + torque * dt_i
-    scrub = -ksum * base / (1.0 + ksum * dt_i)
-    wn = base / (1.0 + ksum * dt_i)
-    if -tl <= kl * wn <= tl and -tr <= kr * wn <= tr:
-        return scrub
-    if kl * tr >= kr * tl:
-        t1, k2, t2 = tl, kr, tr
-    else:
-        t1, k2, t2 = tr, kl, tl
-    s1 = -t1 if base > 0.0 else t1
-    wn = (base + s1 * dt_i) / (1.0 + k2 * dt_i)
-    s2 = -k2 * wn
-    if s2 > t2 or s2 < -t2:  # both patches at their Coulomb torque
-        return -ts if base > 0.0 else ts
-    return s1 + s2
 
 
 # -- one step, per wheel (the reference the fast paths are checked against) -------------------
@@ -441,156 +383,6 @@ def wheel_pair(
     return fxl, upl, fxr, upr
 
 
-#: Bisection steps of :func:`slide`'s rim solve at most (a double's bracket is exhausted
-#: sooner unless the root is within ~1e-30 of zero; the loop also stops there).
-SLIDE_ITERATIONS = 100
-
-
-def slide(
-    u: float,
-    v: float,
-    f0: float,
-    res: float,
-    ivs: float,
-    tyre: tuple[float, float, float, float],
-    side: float,
-    fy_cap: float,
-    s: StepConstants,
-) -> tuple[float, float, float]:
-    """One step of a wheel whose tyre slides: ``(F_x, F_y, u+)``.
-
-    Why not the gripping solve scaled back onto the ellipse: the gripping solve's forces are
-    the ones that would cancel each slip *within the step* (the longitudinal one through the
-    1 kg rim, the lateral one through the whole body), so their ratio, and with it the
-    direction of the scaled force, was set by the masses and the step instead of by the
-    slip: a steady drift's yaw rate moved by 12 % between 100 and 1,600 Hz (issue 31).
-    Here the tyre law itself, ``F = (N kappa / c_x, -N tan(alpha) / c_y) / max(1, |q|)``
-    with ``q`` the two forces over their grips (the friction ellipse), is solved with the
-    rim's next speed: ``M_w (u+ - u) / dt = F_m(u+) - R sign(u+) - F_x(u+)`` (backward Euler;
-    the motor on its curve or at its current limit, the rim stuck at zero if its resistance
-    holds it). The left side rises with ``u+`` and the right side falls, so the root is
-    unique; bisection finds it, the same operations in C and Python. The lateral slip
-    ``side * ivs`` (sideways velocity over the slip speed) is the step's start value: the
-    body is ~30 times the rim's mass, so its lateral slip moves slowly; the lateral force is
-    capped by ``fy_cap``, the gripping solve's (which cancels the sideways velocity within
-    the step), so that a slide ending within the step does not overshoot into the other
-    side. ``tyre`` is ``(N / c_x, N / c_y, 1 / grip_x, 1 / grip_y)``; ``ivs`` is ``1 /
-    max(|v|, v_min)``.
-    """
-    kx, ky, ix, iy = tyre
-    qy = -ky * side * ivs * iy
-
-    def tyre_x(up: float) -> tuple[float, float]:
-        """The tyre's longitudinal force and the ellipse's scale at rim speed ``up``."""
-        fx = kx * (up - v) * ivs
-        qx = fx * ix
-        qq = qx * qx + qy * qy
-        scale = 1.0 / math.sqrt(qq) if qq > 1.0 else 1.0
-        return fx * scale, scale
-
-    def excess(up: float, fr: float) -> float:
-        """``M_w (u+ - u)/dt - F_m(u+) + R_dir + F_x(u+)``: zero at the step's rim speed."""
-        fm = f0 - s.c * up
-        if fm > s.f_max:
-            fm = s.f_max
-        elif fm < -s.f_max:
-            fm = -s.f_max
-        return s.mw * (up - u) - fm + fr + tyre_x(up)[0]
-
-    f0_lim = f0 if -s.f_max <= f0 <= s.f_max else (s.f_max if f0 > 0 else -s.f_max)
-    need = s.mw * u + f0_lim - tyre_x(0.0)[0]
-    if -res <= need <= res:
-        up = 0.0
-    else:
-        reach = (s.f_max + 1.0 / ix) / s.mw  # |F_m| <= f_max and |F_x| <= grip
-        if need > 0:
-            lo, hi, fr = 0.0, u + reach, res
-        else:
-            lo, hi, fr = u - reach, 0.0, -res
-        for _ in range(SLIDE_ITERATIONS):
-            mid = 0.5 * (lo + hi)
-            if mid <= lo or mid >= hi:
-                break
-            if excess(mid, fr) > 0.0:
-                hi = mid
-            else:
-                lo = mid
-        up = 0.5 * (lo + hi)
-    fx, scale = tyre_x(up)
-    fy = -ky * side * ivs * scale
-    if abs(fy_cap) < abs(fy):
-        fy = fy_cap
-    return fx, fy, up
-
-
 def slip_speed(v: float) -> float:
     """``max(|v|, v_min)``: the speed slips are measured against."""
     return max(abs(v), SLIP_SPEED_MIN)
-
-
-def slide_pair(
-    sat: tuple[bool, bool],
-    left: tuple[float, ...],
-    right: tuple[float, ...],
-    tyre: tuple[float, float, float],
-    side: float,
-    cancel: float,
-    s: StepConstants,
-) -> tuple[float, float, float, float, float, float]:
-    """Both wheels when at least one tyre slides: ``(F_xL, F_yL, u_L+, F_xR, F_yR, u_R+)``.
-
-    Each sliding tyre's force is the tyre law solved with its rim (:func:`slide`); a wheel
-    that still grips is solved again (:func:`rim_and_tyre`) with its hub moved by the sliding
-    one's force through the yaw, not by the gripping solve's for it. The lateral
-    force a gripping tyre gave in the gripping solve was its share (by stiffness) of the force
-    that brings the body's sideways velocity to its implicit end value with *both* tyres
-    gripping; once the other slides, that share is wrong, and capping the sliding tyre at its
-    own share held its force far below the tyre law whenever the other hub ran slowly (its
-    stiffness ``~1 / max(|v|, v_min)`` took nearly all the share): a heavy rover's drift
-    settled 4 % off the law at every rate. So: no tyre, nor both together, pushes past
-    ``cancel``, the force that cancels the sideways velocity within the step (no overshoot
-    into the other side); a tyre that still grips takes, implicitly and with its own
-    stiffness, what the sliding one leaves (``(cancel - F_s) k / (1 + k)``, ``k = N dt /
-    (c_y m max(|v|, v_min))``), and slides too if that puts it beyond its ellipse.
-
-    ``left``/``right``: ``(u, v, f0, res, ivs, 1/grip_x, 1/grip_y, F_x, F_y, u+)``, the last
-    three the gripping solve's; ``tyre``: ``(N / c_x, N / c_y, N dt / (c_y m))``; ``side`` the
-    sideways velocity at the step's start (the sliding tyres' lateral slip).
-    """
-    kx, ky, ky_dt_m = tyre
-    sat_l, sat_r = sat
-    ul, vl, f0l, rl, ivl, ixl, iyl, fxl, fyl, upl = left
-    ur, vr, f0r, rr, ivr, ixr, iyr, fxr, fyr, upr = right
-    if sat_l:
-        fxl, fyl, upl = slide(ul, vl, f0l, rl, ivl, (kx, ky, ixl, iyl), side, cancel, s)
-    if sat_r:
-        fxr, fyr, upr = slide(ur, vr, f0r, rr, ivr, (kx, ky, ixr, iyr), side, cancel, s)
-    # a gripping wheel again, its hub moved by the sliding one's force (the joint solve had
-    # the other's gripping force, ~1/dt, which made this one's an O(1) error)
-    if sat_l and not sat_r:
-        fxr, upr = rim_and_tyre(ur, vr + s.e2 * fxl, f0r, rr, kx * ivr, s)
-    elif sat_r and not sat_l:
-        fxl, upl = rim_and_tyre(ul, vl + s.e2 * fxr, f0l, rl, kx * ivl, s)
-    if not sat_r:  # the gripping tyre takes, implicitly, what the sliding one leaves
-        kg = ky_dt_m * ivr
-        fyr = (cancel - fyl) * kg / (1.0 + kg)
-        t3 = fxr * ixr
-        t4 = fyr * iyr
-        if t3 * t3 + t4 * t4 > 1.0:
-            sat_r = True
-            fxr, fyr, upr = slide(ur, vr, f0r, rr, ivr, (kx, ky, ixr, iyr), side, cancel, s)
-    elif not sat_l:
-        kg = ky_dt_m * ivl
-        fyl = (cancel - fyr) * kg / (1.0 + kg)
-        t1 = fxl * ixl
-        t2 = fyl * iyl
-        if t1 * t1 + t2 * t2 > 1.0:
-            sat_l = True
-            fxl, fyl, upl = slide(ul, vl, f0l, rl, ivl, (kx, ky, ixl, iyl), side, cancel, s)
-    if sat_l and sat_r:  # both sliding: together not past the cancelling force either
-        f_lat = fyl + fyr
-        if f_lat * cancel > 0.0 and abs(f_lat) > abs(cancel):
-            q = cancel / f_lat
-            fyl = fyl * q
-            fyr = fyr * q
-    return fxl, fyl, upl, fxr, fyr, upr

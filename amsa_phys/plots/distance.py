@@ -14,8 +14,8 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from ..engine.traceread import MAX_LINE_BYTES, read_rows
 from ..palette import COLLISION, PHASE, REFERENCE, SIGNAL, hex_colour
-from ..traceread import MAX_LINE_BYTES, read_rows
 from ..valuetext import value_text
 from .adaptmarks import adapt_switches
 from .save import save_png

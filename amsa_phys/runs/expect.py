@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..model.scenario import Expectation
+from ..stl.requirement import reads_until
 
 #: how a trace check that saw no logged sample begins its note
 NO_SAMPLE = "no sample"
@@ -73,7 +74,10 @@ class Check:
 
 
 def describe_what(e: Expectation) -> str:
-    """What an expectation measures: ``max_distance (phase 1)`` or ``Comp.out in [30, end] s``."""
+    """What an expectation measures: ``max_distance (phase 1)``, ``Comp.out in [30, end] s``
+    or ``requirement band``."""
+    if e.stl is not None:
+        return f"requirement {e.name}"
     if e.trace is not None:
         lo = f"{e.after:g}" if e.after is not None else "0"
         hi = f"{e.before:g}" if e.before is not None else "end"
@@ -82,7 +86,9 @@ def describe_what(e: Expectation) -> str:
 
 
 def describe_bound(e: Expectation) -> str:
-    """An expectation's bounds: ``below 26 and above 2``."""
+    """An expectation's bounds: ``below 26 and above 2`` (an STL requirement: its formula)."""
+    if e.stl is not None:
+        return "robustness >= 0"
     parts = []
     if e.below is not None:
         parts.append(f"below {e.below:g}")
@@ -105,6 +111,9 @@ def check_expectations(
     columns: tuple[list[str], np.ndarray] | None = None
     end = float(metrics.get("simulated", 0.0))
     for e in expect:
+        if e.stl is not None:
+            checks.append(_stl_check(e, metrics))
+            continue
         if e.trace is not None:
             if columns is None:
                 columns = _read(trace)
@@ -131,6 +140,27 @@ def check_expectations(
     return checks
 
 
+def _stl_check(e: Expectation, metrics: dict[str, Any]) -> Check:
+    """An STL requirement's check: its robustness from ``metrics.json``'s ``requirements``
+    (judged on the run's samples; ``stl/requirement.py``), with the instant and
+    the comparison that set it."""
+    entry = (metrics.get("requirements") or {}).get(e.name)
+    reached = float(metrics.get("simulated", 0.0))
+    until = reads_until(str(e.stl))
+    if until > reached + 1e-9:  # its windows were cut by the run's end: not judged
+        why = f"it reads until t={until:g} s; the run ended at t={reached:g} s"
+        return Check(e, None, True, skipped=True, why=why)
+    if entry is None:
+        return Check(e, None, False, note="not judged: the run kept no samples of it")
+    rob = entry.get("robustness")
+    note = ""
+    if entry.get("instant") is not None:
+        note = f"set at t={entry['instant']:g} s by {entry.get('atom', '?')}"
+    if entry.get("note"):
+        note = f"{entry['note']}; {note}" if note else entry["note"]
+    return Check(e, rob, entry.get("verdict") == "pass", note=note, stat="robustness")
+
+
 def skip_reason(e: Expectation, metrics: dict[str, Any]) -> str | None:
     """Why a metric check cannot be judged on this run, or None if it can.
 
@@ -139,7 +169,7 @@ def skip_reason(e: Expectation, metrics: dict[str, Any]) -> str | None:
     phase, and half a phase would fail (or pass) for the wrong reason -- unless it has already
     failed for good (:func:`already_broken`), which the caller checks.
     """
-    if e.trace is not None:
+    if e.trace is not None or e.stl is not None:
         return None
     reached = metrics.get("simulated", 0.0)
     if e.phase is not None and e.phase >= len(metrics["phases"]):
@@ -171,7 +201,7 @@ def already_broken(e: Expectation, metrics: dict[str, Any]) -> tuple[float, str]
     that check is FAIL, not skipped (a skipped check passes). Any other partial check stays
     skipped (:func:`skip_reason`).
     """
-    if e.metric not in MONOTONE or e.trace is not None:
+    if e.metric not in MONOTONE or e.trace is not None or e.stl is not None:
         return None
     if e.phase is not None and e.phase >= len(metrics["phases"]):
         return None  # never reached: nothing measured

@@ -11,6 +11,7 @@ from ..model.adaptrules import written_rules
 from ..model.scenario import Change, Expectation, Scenario
 from ..model.timing import TIMING_KEYS, LeafTiming
 from ..model.world import LeafSpec
+from ..stl.requirement import reads_until
 
 
 def _number(x: Fraction | float) -> float | int:
@@ -137,11 +138,18 @@ def resolved_scenario(
             out["timeline"].append(item)
     if scenario.adapt:
         out["adapt"] = written_rules(scenario.adapt)
-    kept = [e for e in scenario.expect if not any(e is d for d in drop)]
+    written = float(duration if duration is not None else scenario.duration)
+    kept = [  # an STL window past the written end: its loader would refuse the file
+        e
+        for e in scenario.expect
+        if not any(e is d for d in drop) and (e.stl is None or reads_until(e.stl) <= written)
+    ]
     if kept:
         out["expect"] = []
         for e in kept:
             fields = (
+                ("stl", e.stl),
+                ("name", e.name),
                 ("metric", e.metric),
                 ("trace", e.trace),
                 ("phase", e.phase),

@@ -39,6 +39,7 @@ from ..model.scenario import (
     with_physics,
 )
 from ..model.yamlio import parse_value
+from ..requirements.objective import column
 from .pool import WORKER_LOST, imap_resilient
 
 # results.csv's columns and reader live in results.py; importers of sweep still find them
@@ -339,12 +340,15 @@ def prepare_job(job: Job) -> Scenario:
 
 
 def fill_metrics(row: dict[str, Any], metrics: dict[str, Any]) -> dict[str, Any]:
-    """Put a run's ``metrics.json`` document into its result row (overall, then phases)."""
+    """Put a run's ``metrics.json`` document into its result row (overall, then phases,
+    then each STL requirement's robustness as ``robustness.NAME``)."""
     for k in METRIC_KEYS:
         row[k] = metrics["overall"].get(k)
     for i, phase in enumerate(metrics["phases"]):
         for k in METRIC_KEYS:
             row[f"phase{i}.{k}"] = phase.get(k)
+    for name, entry in (metrics.get("requirements") or {}).items():
+        row[column(name)] = entry.get("robustness")
     return row
 
 

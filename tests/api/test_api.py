@@ -97,7 +97,9 @@ def test_run_holds_metrics_trace_events_and_resolved_scenario_in_memory(tmp_path
     assert run.checks[0].describe().startswith("rms_error (phase 0): skipped (phase 0 was cut")
     assert run.checks[1].skipped
     assert run.passed  # nothing failed, as the CLI's exit 0 says ...
-    assert run.skipped == run.checks[:2]  # ... and nothing of the phases was judged
+    # ... and nothing of the phases was judged, nor the requirement that reads until 200 s
+    assert run.skipped == [*run.checks[:2], run.checks[3]]
+    assert run.checks[3].what == "requirement band_after_150"
 
 
 def test_a_mapping_runs_like_the_file_and_the_resolved_scenario_replays(tmp_path: Path) -> None:

@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 from rig import ON_AXLE, drive
 
-from amsa_phys.physics import forces, wheel
+from amsa_phys.physics import forces, sliding, wheel
 
 G = 9.81
 #: the ground of every run
@@ -226,7 +226,7 @@ def shared_cap_slide_pair(
     out = []
     for slid, (u, v, f0, res, ivs, ix, iy, fx, fy, up) in zip(sat, (left, right), strict=True):
         if slid:
-            fx, fy, up = wheel.slide(u, v, f0, res, ivs, (tyre[0], tyre[1], ix, iy), side, fy, s)
+            fx, fy, up = sliding.slide(u, v, f0, res, ivs, (tyre[0], tyre[1], ix, iy), side, fy, s)
         out += [fx, fy, up]
     return out[0], out[1], out[2], out[3], out[4], out[5]
 

@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 from rig import ON_AXLE, drive
 
-from amsa_phys.physics import forces, wheel
+from amsa_phys.physics import forces, sliding
 
 RATES = [100, 200, 400, 800]
 #: the rovers whose convergence is held (mass, tyres, geometry); measured position orders
@@ -84,7 +84,7 @@ def test_mutation_without_solving_the_gripping_wheel_again_it_does_not_converge(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # the gripping wheel keeps the joint solve's force and rim speed (unless it slides too)
-    real = wheel.slide_pair
+    real = sliding.slide_pair
 
     def keep_gripping_force(sat, left, right, tyre, side, cancel, s):  # type: ignore[no-untyped-def]
         if sat[0] != sat[1]:  # the mutant: the gripping wheel's force and rim as they were

@@ -5,7 +5,7 @@ friction ellipse: the forces that would cancel each slip within the step (the lo
 one through the 1 kg rim, the lateral one through the 30 kg body), whose ratio depended on
 the step and the masses. A steady drift's yaw rate moved by 12 % between 100 and 1,600 Hz
 when the issue was filed (the old scheme run as a mutant on today's model: 21 %).
-``wheel.slide`` solves the tyre law with the rim instead. These tests hold the steady drift
+``sliding.slide`` solves the tyre law with the rim instead. These tests hold the steady drift
 and the convergence of a skid's pose to the targets of the issue; each has a mutation test
 that runs the old scheme (:func:`old_slide`) and shows it fails. A straight spin-up's peak
 slip is held to its target too (at the bottom); the old scheme passes that one as well (within
@@ -22,8 +22,9 @@ import numpy as np
 import pytest
 from rig import ON_AXLE, drive
 
-from amsa_phys.physics import wheel
-from amsa_phys.physics.wheel import StepConstants, rim_and_tyre, slide
+from amsa_phys.physics import sliding
+from amsa_phys.physics.sliding import slide
+from amsa_phys.physics.wheel import StepConstants, rim_and_tyre
 
 #: A rover whose motors out-pull its tyres (600 N stall force a wheel, 40 N m current limit):
 #: left/right power 60/20 % spins the outer wheel and drags the inner one, a steady drift.
@@ -45,7 +46,7 @@ def old_slide(
     fy_cap: float,
     s: StepConstants,
 ) -> tuple[float, float, float]:
-    """The pre-issue-31 scheme, as a mutant of ``wheel.slide``: the gripping solve's forces
+    """The earlier scheme, as a mutant of ``sliding.slide``: the gripping solve's forces
     scaled onto the ellipse, the rim re-solved with that force held fixed."""
     kx, _ky, ix, iy = tyre
     fx, _ = rim_and_tyre(u, v, f0, res, kx * ivs, s)
@@ -72,7 +73,7 @@ def old_slide(
 
 def mutate(monkeypatch: pytest.MonkeyPatch) -> None:
     """Run the pure Python model (the C step is held equal to it) with the old scheme."""
-    monkeypatch.setattr(wheel, "slide", old_slide)
+    monkeypatch.setattr(sliding, "slide", old_slide)
     monkeypatch.setenv("AMSA_PHYS_PURE", "1")
 
 
@@ -217,7 +218,7 @@ def rim_not_resolved(
     fy_cap: float,
     s: StepConstants,
 ) -> tuple[float, float, float]:
-    """A mutant of ``wheel.slide``: the tyre's forces of the slide, but the rim's next speed of
+    """A mutant of ``sliding.slide``: the tyre's forces of the slide, but the rim's next speed of
     the gripping solve (as if the tyre held): the rim is dragged along with the ground."""
     fx, fy, _ = slide(u, v, f0, res, ivs, tyre, side, fy_cap, s)
     _, up = rim_and_tyre(u, v, f0, res, tyre[0] * ivs, s)
@@ -228,7 +229,7 @@ def test_mutation_spin_up_check_fails_when_the_sliding_rim_is_not_solved(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # measured +254 %, +102 % and +57 % (and a peak slip of 0.6-34 cm/s, not 1.3-5.5 m/s)
-    monkeypatch.setattr(wheel, "slide", rim_not_resolved)
+    monkeypatch.setattr(sliding, "slide", rim_not_resolved)
     monkeypatch.setenv("AMSA_PHYS_PURE", "1")
     runs = spin_up_errors(tmp_path)
     assert max(abs(err) for _, err in runs) > 0.03, runs

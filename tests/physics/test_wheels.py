@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from rig import ON_AXLE, drive
 
-from amsa_phys.physics import wheel
+from amsa_phys.physics import sliding
 from amsa_phys.physics.space import wheel_model
 from amsa_phys.physics.templates import rover_params
 from amsa_phys.physics.wheel import SLIP_SPEED_MIN, TORSION
@@ -95,7 +95,7 @@ def test_mutation_friction_circle_check_fails_with_separate_caps(
 ) -> None:
     """The old model capped the two directions separately: up to sqrt(2) mu N a wheel."""
 
-    real = wheel.slide
+    real = sliding.slide
 
     def separate_caps(
         u: float, v: float, f0: float, res: float, ivs: float, tyre: Any, side: float, *rest: Any
@@ -105,7 +105,7 @@ def test_mutation_friction_circle_check_fails_with_separate_caps(
         fx, fy = kx * (up - v) * ivs, -ky * side * ivs
         return max(-1 / ix, min(1 / ix, fx)), max(-1 / iy, min(1 / iy, fy)), up
 
-    monkeypatch.setattr(wheel, "slide", separate_caps)
+    monkeypatch.setattr(sliding, "slide", separate_caps)
     monkeypatch.setenv("AMSA_PHYS_PURE", "1")  # the Python model (the C copy is held equal to it)
     tr, mu = skid(tmp_path)
     along, across = body_forces(tr, 30.0)

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from amsa_phys.cli.main import main
-from amsa_phys.traceread import read_rows
+from amsa_phys.engine.traceread import read_rows
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO = ROOT / "tests" / "fixtures" / "mde_short.yaml"

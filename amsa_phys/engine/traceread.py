@@ -24,9 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ConfigError
-from .model.params import short_repr
-from .model.schema import MAX_DURATION_S
+from ..errors import ConfigError
+from ..model.params import short_repr
+from ..model.schema import MAX_DURATION_S
 
 #: bytes read at a time
 BLOCK_BYTES = 4 << 20

@@ -1,0 +1,83 @@
+"""The samples an STL requirement reads, kept in memory at every logged instant.
+
+A requirement reads a few signals (``Component.output``) of every logged instant; the trace
+file has them too, but a sweep or a falsification writes no trace, and the batched engine's
+runs share one store. This listener copies the named buffers of every run out of the store
+at each logged instant (one fancy-indexed copy, as the quality samples are taken), so a
+requirement is judged the same way whatever the executor.
+"""
+
+from __future__ import annotations
+
+from array import array
+from collections.abc import Callable, Sequence
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+
+
+class SignalSampler:
+    """``names`` of each of ``runs`` runs, sampled at every logged instant of a simulation."""
+
+    def __init__(self, names: Sequence[str], runs: int, at: Callable[[str, int], int]) -> None:
+        self.names = list(names)
+        self.runs = runs
+        self._where = np.array([at(n, r) for n in self.names for r in range(runs)], dtype=np.intp)
+        self._t = array("d")
+        self._rows: list[np.ndarray] = []
+
+    def listener(self, col: np.ndarray) -> Callable[[float, Any], None]:
+        """The log listener reading ``col`` (the store's array)."""
+        where = self._where
+        rows = self._rows
+        times = self._t
+
+        def sample(t_s: float, _values: Any) -> None:
+            rows.append(col[where])  # fancy indexing copies
+            times.append(t_s)
+
+        return sample
+
+    def table(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """The logged instants and each signal as a ``(samples, runs)`` array."""
+        n = min(len(self._t), len(self._rows))  # equal even if Ctrl-C fell between appends
+        t = np.array(self._t[:n], dtype=np.float64)
+        shape = (n, len(self.names), self.runs)
+        data = np.array(self._rows[:n], dtype=np.float64).reshape(shape)
+        return t, {name: data[:, k, :] for k, name in enumerate(self.names)}
+
+
+class RequirementWatch:
+    """A simulation's STL requirements and the sampler of their signals."""
+
+    def __init__(
+        self, requirements: Sequence[Any], sampler: SignalSampler, period: Fraction, runs: int
+    ) -> None:
+        self.requirements = list(requirements)
+        self.sampler = sampler
+        self.period = period
+        self.runs = runs
+
+    @classmethod
+    def of(cls, scenario: Any, sim: Any) -> RequirementWatch | None:
+        """Watch ``scenario``'s requirements in ``sim`` (every run of a batch: they share
+        the scenario's requirements); None if it has none."""
+        from ..model.scenariospec import requirements
+        from ..stl.requirement import signals_of
+
+        reqs = requirements(scenario)
+        if not reqs:
+            return None
+        runs = len(sim.timelines)
+        names = signals_of(reqs)
+        sampler = SignalSampler(names, runs, sim.store.at)  # no names: still the instants
+        sim.add_log_listener(sampler.listener(sim.store.col))
+        return cls(reqs, sampler, 1 / Fraction(sim.log_rate), runs)
+
+    def judged(self) -> list[dict[str, Any]]:
+        """Every run's requirements judged in one pass, one column per run."""
+        from ..stl.requirement import judge
+
+        t, cols = self.sampler.table()
+        return judge(self.requirements, t, cols, self.period, self.runs)

@@ -1,0 +1,163 @@
+"""A sliding tyre solved with its rim: the tyre law where the gripping solve cannot hold.
+
+Beside ``wheel.py``'s gripping solve (both rims and tyres by backward Euler), a tyre whose
+forces leave its friction ellipse slides: :func:`slide` solves the tyre law together with
+its rim's next speed, and :func:`slide_pair` solves the two tyres of a rover together (a
+sliding tyre beside a gripping one, the sideways cap that stops a slide overshooting within
+the step). ``forces.rover_step`` inlines the same arithmetic and ``_step.c`` mirrors it.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .wheel import StepConstants, rim_and_tyre
+
+#: Bisection steps of :func:`slide`'s rim solve at most (a double's bracket is exhausted
+#: sooner unless the root is within ~1e-30 of zero; the loop also stops there).
+SLIDE_ITERATIONS = 100
+
+
+def slide(
+    u: float,
+    v: float,
+    f0: float,
+    res: float,
+    ivs: float,
+    tyre: tuple[float, float, float, float],
+    side: float,
+    fy_cap: float,
+    s: StepConstants,
+) -> tuple[float, float, float]:
+    """One step of a wheel whose tyre slides: ``(F_x, F_y, u+)``.
+
+    Why not the gripping solve scaled back onto the ellipse: the gripping solve's forces are
+    the ones that would cancel each slip *within the step* (the longitudinal one through the
+    1 kg rim, the lateral one through the whole body), so their ratio, and with it the
+    direction of the scaled force, was set by the masses and the step instead of by the
+    slip: a steady drift's yaw rate moved by 12 % between 100 and 1,600 Hz (issue 31).
+    Here the tyre law itself, ``F = (N kappa / c_x, -N tan(alpha) / c_y) / max(1, |q|)``
+    with ``q`` the two forces over their grips (the friction ellipse), is solved with the
+    rim's next speed: ``M_w (u+ - u) / dt = F_m(u+) - R sign(u+) - F_x(u+)`` (backward Euler;
+    the motor on its curve or at its current limit, the rim stuck at zero if its resistance
+    holds it). The left side rises with ``u+`` and the right side falls, so the root is
+    unique; bisection finds it, the same operations in C and Python. The lateral slip
+    ``side * ivs`` (sideways velocity over the slip speed) is the step's start value: the
+    body is ~30 times the rim's mass, so its lateral slip moves slowly; the lateral force is
+    capped by ``fy_cap``, the gripping solve's (which cancels the sideways velocity within
+    the step), so that a slide ending within the step does not overshoot into the other
+    side. ``tyre`` is ``(N / c_x, N / c_y, 1 / grip_x, 1 / grip_y)``; ``ivs`` is ``1 /
+    max(|v|, v_min)``.
+    """
+    kx, ky, ix, iy = tyre
+    qy = -ky * side * ivs * iy
+
+    def tyre_x(up: float) -> tuple[float, float]:
+        """The tyre's longitudinal force and the ellipse's scale at rim speed ``up``."""
+        fx = kx * (up - v) * ivs
+        qx = fx * ix
+        qq = qx * qx + qy * qy
+        scale = 1.0 / math.sqrt(qq) if qq > 1.0 else 1.0
+        return fx * scale, scale
+
+    def excess(up: float, fr: float) -> float:
+        """``M_w (u+ - u)/dt - F_m(u+) + R_dir + F_x(u+)``: zero at the step's rim speed."""
+        fm = f0 - s.c * up
+        if fm > s.f_max:
+            fm = s.f_max
+        elif fm < -s.f_max:
+            fm = -s.f_max
+        return s.mw * (up - u) - fm + fr + tyre_x(up)[0]
+
+    f0_lim = f0 if -s.f_max <= f0 <= s.f_max else (s.f_max if f0 > 0 else -s.f_max)
+    need = s.mw * u + f0_lim - tyre_x(0.0)[0]
+    if -res <= need <= res:
+        up = 0.0
+    else:
+        reach = (s.f_max + 1.0 / ix) / s.mw  # |F_m| <= f_max and |F_x| <= grip
+        if need > 0:
+            lo, hi, fr = 0.0, u + reach, res
+        else:
+            lo, hi, fr = u - reach, 0.0, -res
+        for _ in range(SLIDE_ITERATIONS):
+            mid = 0.5 * (lo + hi)
+            if mid <= lo or mid >= hi:
+                break
+            if excess(mid, fr) > 0.0:
+                hi = mid
+            else:
+                lo = mid
+        up = 0.5 * (lo + hi)
+    fx, scale = tyre_x(up)
+    fy = -ky * side * ivs * scale
+    if abs(fy_cap) < abs(fy):
+        fy = fy_cap
+    return fx, fy, up
+
+
+def slide_pair(
+    sat: tuple[bool, bool],
+    left: tuple[float, ...],
+    right: tuple[float, ...],
+    tyre: tuple[float, float, float],
+    side: float,
+    cancel: float,
+    s: StepConstants,
+) -> tuple[float, float, float, float, float, float]:
+    """Both wheels when at least one tyre slides: ``(F_xL, F_yL, u_L+, F_xR, F_yR, u_R+)``.
+
+    Each sliding tyre's force is the tyre law solved with its rim (:func:`slide`); a wheel
+    that still grips is solved again (:func:`rim_and_tyre`) with its hub moved by the sliding
+    one's force through the yaw, not by the gripping solve's for it. The lateral
+    force a gripping tyre gave in the gripping solve was its share (by stiffness) of the force
+    that brings the body's sideways velocity to its implicit end value with *both* tyres
+    gripping; once the other slides, that share is wrong, and capping the sliding tyre at its
+    own share held its force far below the tyre law whenever the other hub ran slowly (its
+    stiffness ``~1 / max(|v|, v_min)`` took nearly all the share): a heavy rover's drift
+    settled 4 % off the law at every rate. So: no tyre, nor both together, pushes past
+    ``cancel``, the force that cancels the sideways velocity within the step (no overshoot
+    into the other side); a tyre that still grips takes, implicitly and with its own
+    stiffness, what the sliding one leaves (``(cancel - F_s) k / (1 + k)``, ``k = N dt /
+    (c_y m max(|v|, v_min))``), and slides too if that puts it beyond its ellipse.
+
+    ``left``/``right``: ``(u, v, f0, res, ivs, 1/grip_x, 1/grip_y, F_x, F_y, u+)``, the last
+    three the gripping solve's; ``tyre``: ``(N / c_x, N / c_y, N dt / (c_y m))``; ``side`` the
+    sideways velocity at the step's start (the sliding tyres' lateral slip).
+    """
+    kx, ky, ky_dt_m = tyre
+    sat_l, sat_r = sat
+    ul, vl, f0l, rl, ivl, ixl, iyl, fxl, fyl, upl = left
+    ur, vr, f0r, rr, ivr, ixr, iyr, fxr, fyr, upr = right
+    if sat_l:
+        fxl, fyl, upl = slide(ul, vl, f0l, rl, ivl, (kx, ky, ixl, iyl), side, cancel, s)
+    if sat_r:
+        fxr, fyr, upr = slide(ur, vr, f0r, rr, ivr, (kx, ky, ixr, iyr), side, cancel, s)
+    # a gripping wheel again, its hub moved by the sliding one's force (the joint solve had
+    # the other's gripping force, ~1/dt, which made this one's an O(1) error)
+    if sat_l and not sat_r:
+        fxr, upr = rim_and_tyre(ur, vr + s.e2 * fxl, f0r, rr, kx * ivr, s)
+    elif sat_r and not sat_l:
+        fxl, upl = rim_and_tyre(ul, vl + s.e2 * fxr, f0l, rl, kx * ivl, s)
+    if not sat_r:  # the gripping tyre takes, implicitly, what the sliding one leaves
+        kg = ky_dt_m * ivr
+        fyr = (cancel - fyl) * kg / (1.0 + kg)
+        t3 = fxr * ixr
+        t4 = fyr * iyr
+        if t3 * t3 + t4 * t4 > 1.0:
+            sat_r = True
+            fxr, fyr, upr = slide(ur, vr, f0r, rr, ivr, (kx, ky, ixr, iyr), side, cancel, s)
+    elif not sat_l:
+        kg = ky_dt_m * ivl
+        fyl = (cancel - fyr) * kg / (1.0 + kg)
+        t1 = fxl * ixl
+        t2 = fyl * iyl
+        if t1 * t1 + t2 * t2 > 1.0:
+            sat_l = True
+            fxl, fyl, upl = slide(ul, vl, f0l, rl, ivl, (kx, ky, ixl, iyl), side, cancel, s)
+    if sat_l and sat_r:  # both sliding: together not past the cancelling force either
+        f_lat = fyl + fyr
+        if f_lat * cancel > 0.0 and abs(f_lat) > abs(cancel):
+            q = cancel / f_lat
+            fyl = fyl * q
+            fyr = fyr * q
+    return fxl, fyl, upl, fxr, fyr, upr
