@@ -14,6 +14,7 @@ below 0.1).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
 import time
@@ -100,7 +101,7 @@ class Follower(Node):
         if self.mode == "die" and self.steps == 20:
             sys.exit(0)
         if self.mode == "late" and self.steps == 20:
-            time.sleep(3.0)
+            time.sleep(8.0)  # well past the run's 3 s timeout
         left, right, speed = self.law(float(t), inp)
         if self.mode == "nan" and self.steps == 20:
             left = math.nan
@@ -166,10 +167,8 @@ def main() -> None:
     args = ap.parse_args()
     rclpy.init()
     node = Follower(args.mode)
-    try:
+    with contextlib.suppress(KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
         rclpy.spin(node)
-    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
-        pass
 
 
 if __name__ == "__main__":
