@@ -76,7 +76,10 @@ def _ros2(doc: YamlDoc, data: dict[str, Any], world: WorldSpec) -> tuple[str, ..
         return ()
     from . import externals as external  # names only
 
-    paths = external.parse_list(data["ros2"], "ros2")
+    try:
+        paths = external.parse_list(data["ros2"], "ros2")
+    except ConfigError as exc:  # where in the file, as every other key's problem
+        raise doc.error(("ros2",), exc.message) from None
     why = external.problem(world, paths)
     if why is not None:
         raise doc.error(("ros2",), why)

@@ -84,7 +84,16 @@ class ExternalLeaf:
         return self.node + "/set_parameters"
 
 
-_PARAM_TYPES = {"float": "double", "int": "integer", "bool": "bool", "str": "string"}
+#: a template parameter's type as a ROS 2 parameter's (an enum: its value's; points: the
+#: [x, y] pairs flattened)
+_PARAM_TYPES = {
+    "float": "double",
+    "int": "integer",
+    "bool": "bool",
+    "str": "string",
+    "enum": "integer or string",
+    "points": "double_array",
+}
 
 
 def describe(world: WorldSpec, paths: Iterable[str]) -> list[ExternalLeaf]:
@@ -136,6 +145,8 @@ def table(leaves: Sequence[ExternalLeaf], timeout_s: float = DEFAULT_TIMEOUT_S) 
         for w in leaf.outputs:
             lines.append(f"    out  {w.port:<24} {w.topic}  {w.type}  {DATA_QOS}")
         for p in leaf.params:
-            rng = "" if p.lo is None and p.hi is None else f"  [{p.lo:g}, {p.hi:g}]"
+            lo = "-inf" if p.lo is None else f"{p.lo:g}"
+            hi = "inf" if p.hi is None else f"{p.hi:g}"
+            rng = "" if p.lo is None and p.hi is None else f"  [{lo}, {hi}]"
             lines.append(f"    param {p.name:<23} {p.type}{rng}  via {leaf.set_parameters}")
     return lines
