@@ -96,8 +96,15 @@ _PARAM_TYPES = {
 }
 
 
-def describe(world: WorldSpec, paths: Iterable[str]) -> list[ExternalLeaf]:
-    """Each external Leaf's wiring, in world order (``paths`` already judged)."""
+def describe(
+    world: WorldSpec, paths: Iterable[str], private_inputs: bool = False
+) -> list[ExternalLeaf]:
+    """Each external Leaf's wiring, in world order (``paths`` already judged).
+
+    ``private_inputs``: each input on a topic of the Leaf's own (``names.input_topic``)
+    instead of its producer's: ``ros2 lockstep`` remaps an exported node's subscriptions
+    there, so that amsa-phys delivers every input (delays included) even between two nodes.
+    """
     wanted = set(paths)
     out = []
     for path, leaf in world.leaves.items():
@@ -108,7 +115,8 @@ def describe(world: WorldSpec, paths: Iterable[str]) -> list[ExternalLeaf]:
             if producer(world, buffer) == path:
                 continue  # a Leaf reading its own output keeps it: no topic
             typ = ARRAY if buffer in world.arrays else SCALAR
-            inputs.append(Wire(port, names.topic(buffer), typ, buffer))
+            where = names.input_topic(path, port) if private_inputs else names.topic(buffer)
+            inputs.append(Wire(port, where, typ, buffer))
         outputs = []
         for p in leaf.template.outputs:
             buffer = f"{path}.{p.name}"

@@ -35,6 +35,12 @@ def topic(buffer: str) -> str:
     return ns(buffer)
 
 
+def input_topic(path: str, port: str) -> str:
+    """Where ``ros2 lockstep`` delivers a node's input ``port`` (remapped from the producer's
+    topic): ``/amsa/in/Team/Leader/port``."""
+    return "/amsa/in" + ns(path) + "/" + port
+
+
 def param(path: str, name: str) -> str:
     """The ROS parameter of a Leaf's parameter."""
     return f"{ns(path)}/{name}"

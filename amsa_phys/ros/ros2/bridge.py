@@ -31,7 +31,7 @@ from ...engine.runner import Simulation
 from ...errors import RunFault
 from ...model.scenario import Scenario
 from ...model.template import Template
-from .. import external
+from .. import external, names
 from ..external import ExternalLeaf as Wiring
 from . import env
 
@@ -56,6 +56,8 @@ class Bridge:
         timeout_s: float,
         now: Callable[[], Fraction],
         arrays: Mapping[str, Sequence[str]],
+        watch: Callable[[], str | None] | None = None,
+        step_topics: bool = False,
     ) -> None:
         rclpy = env.rclpy()
         from rclpy.executors import SingleThreadedExecutor
@@ -66,6 +68,8 @@ class Bridge:
         self.rclpy = rclpy
         self.timeout_s = float(timeout_s)
         self._now = now
+        #: says why the nodes cannot answer any more (a process amsa-phys started exited)
+        self._watch = watch or (lambda: None)
         #: array port -> its element buffers (the length a message must have)
         self.arrays = {k: len(v) for k, v in arrays.items()}
         self.context = rclpy.Context()
@@ -90,6 +94,10 @@ class Bridge:
         self.subs: dict[str, Any] = {}
         self.inbox: dict[str, deque[Any]] = {}
         self.clients: dict[str, Any] = {}
+        #: ``step_topics``: each node's step trigger (``names.step_topic``, a Clock of the
+        #: instant published after its inputs), so nodes at different rates never take
+        #: another's ``/clock`` for theirs (an exported package's nodes under lockstep)
+        self.step_pubs: dict[str, Any] = {}
         #: per node: steps asked, answers received (every output of a step), params set
         self.counts: dict[str, dict[str, int]] = {}
         from rcl_interfaces.srv import SetParameters
@@ -108,6 +116,10 @@ class Bridge:
                     self.types[w.type], w.topic, lambda m, box=box: box.append(m), qos
                 )
             self.clients[leaf.path] = self.node.create_client(SetParameters, leaf.set_parameters)
+            if step_topics:
+                self.step_pubs[leaf.path] = self.node.create_publisher(
+                    Clock, names.step_topic(leaf.path), qos
+                )
 
     # -- start ----------------------------------------------------------------------------
     def connect(self, leaf: Wiring) -> None:
@@ -120,6 +132,7 @@ class Bridge:
             if missing is None:
                 return
             self._check_types(leaf)
+            self._check_watch(leaf)
             if time.monotonic() >= deadline:
                 raise self._fault(
                     leaf,
@@ -134,6 +147,9 @@ class Bridge:
         for w in leaf.inputs:
             if self.pubs[w.topic].get_subscription_count() < 1:
                 return f"no subscriber on {w.topic}"
+        step = self.step_pubs.get(leaf.path)
+        if step is not None and step.get_subscription_count() < 1:
+            return f"no subscriber on {names.step_topic(leaf.path)}"
         for w in leaf.outputs:
             if self.subs[w.topic].get_publisher_count() < 1:
                 return f"no publisher on {w.topic}"
@@ -180,13 +196,12 @@ class Bridge:
                 )
         if self.last_clock != t:
             self.last_clock = t
-            msg = self.Clock()
-            whole = math.floor(t)
-            msg.clock.sec = int(whole)
-            msg.clock.nanosec = round((t - whole) * 1_000_000_000)
-            self.clock_pub.publish(msg)
+            self.clock_pub.publish(self._clock_msg(t))
         for w in leaf.inputs:
             self.pubs[w.topic].publish(self._pack(w, inp[w.port]))
+        step = self.step_pubs.get(leaf.path)
+        if step is not None:  # an exported node's own trigger, after its inputs
+            step.publish(self._clock_msg(t))
         self.counts[leaf.path]["steps"] += 1
         waiting = [w for w in leaf.outputs]
         deadline = time.monotonic() + self.timeout_s
@@ -206,11 +221,19 @@ class Bridge:
             if all(not self.inbox[w.topic] for w in waiting):
                 self._check_types(leaf, t)
                 self._check_alive(leaf, waiting, t)
+                self._check_watch(leaf, t)
         out: dict[str, Any] = {}
         for w in leaf.outputs:
             out[w.port] = self._unpack(leaf, w, self.inbox[w.topic].popleft(), t)
         self.counts[leaf.path]["answers"] += 1
         return out
+
+    def _clock_msg(self, t: Fraction) -> Any:
+        msg = self.Clock()
+        whole = math.floor(t)
+        msg.clock.sec = int(whole)
+        msg.clock.nanosec = round((t - whole) * 1_000_000_000)
+        return msg
 
     def _pack(self, w: external.Wire, value: Any) -> Any:
         cls = self.types[w.type]
@@ -262,6 +285,11 @@ class Bridge:
                 raise self._fault(
                     leaf, f"the node left the graph: no publisher on {w.topic} any more", t
                 )
+
+    def _check_watch(self, leaf: Wiring, t: Fraction | None = None) -> None:
+        why = self._watch()
+        if why is not None:
+            raise self._fault(leaf, why, t)
 
     def _fault(self, leaf: Wiring, why: str, t: Fraction | None = None) -> NodeFault:
         return NodeFault(f"ROS 2 node {leaf.node}", self._now() if t is None else t, why)
@@ -335,13 +363,25 @@ class ExternalSimulation(Simulation):
     """The engine with the scenario's ``ros2:`` Leaves stepped by the user's nodes.
 
     Every Leaf is called on its own (``grouping=False``): a node answers for one Leaf.
+    ``private_inputs``: each node's inputs on topics of its own (``names.input_topic``, an
+    exported package's nodes remapped to them by ``ros2 lockstep``), so nodes wired to each
+    other see what the engine delivers (a producer's latency included).
     :meth:`close` leaves the graph; :meth:`external_report` is the count of every node's
     steps and answers, for ``metrics.json``.
     """
 
-    def __init__(self, scenario: Scenario, timeout_s: float, **kw: Any) -> None:
-        wirings = external.describe(scenario.world, scenario.ros2)
-        self.bridge = Bridge(wirings, timeout_s, lambda: self.now, scenario.world.arrays)
+    def __init__(
+        self,
+        scenario: Scenario,
+        timeout_s: float,
+        private_inputs: bool = False,
+        watch: Callable[[], str | None] | None = None,
+        **kw: Any,
+    ) -> None:
+        wirings = external.describe(scenario.world, scenario.ros2, private_inputs)
+        self.bridge = Bridge(
+            wirings, timeout_s, lambda: self.now, scenario.world.arrays, watch, private_inputs
+        )
         by_path = {w.path: w for w in wirings}
 
         def wrap(path: str, comp: Template) -> Any:
