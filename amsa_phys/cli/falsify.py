@@ -68,6 +68,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Search; write results.csv, worst.yaml, convergence.png; exit 1 on a violation."""
     scenario = load_scenario(args.scenario)
+    if scenario.ros2:  # a user's ROS 2 node answers one run at a time, each run in turn
+        args.executor, args.jobs = "local", 1
     if args.budget < 1 or args.budget > MAX_RUNS:
         raise ConfigError(f"must be in 1..{MAX_RUNS:,}", key="--budget")
     if args.jobs < 1:

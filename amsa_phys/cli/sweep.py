@@ -85,6 +85,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
 def build_plan(args: argparse.Namespace) -> SweepPlan:
     """Merge the scenario's ``sweep:`` section with the command line (which wins)."""
     scenario = load_scenario(args.scenario)
+    args.ros2_serial = bool(scenario.ros2)
     if args.duration is not None:  # refused once, before a job is built (not in every row)
         duration_option(args.duration)
     doc = load_yaml(args.scenario)
@@ -241,6 +242,8 @@ def rows_from(jobs: list[Job], args: argparse.Namespace) -> Iterator[dict[str, A
     """Result rows as they come from the chosen executor (batched unless ``local``)."""
     if args.executor == "local":
         return iter_local(jobs, min(args.jobs, len(jobs)))
+    if getattr(args, "ros2_serial", False):  # a user's ROS 2 node answers one run at a time
+        return iter_local(jobs, 1)
     units, notes = plan_units(jobs, args.jobs, args.batch_size)
     for note in notes:
         print(one_line(f"note: {note}"), file=sys.stderr)

@@ -25,7 +25,6 @@ from typing import Any, TypeVar
 import numpy as np
 
 from ..engine import interrupt
-from ..engine.runner import Simulation
 from ..errors import AmsaError, ConfigError
 from ..model.scenario import (
     PHYSICS_PREFIX,
@@ -46,7 +45,7 @@ from .results import metric_names as metric_names
 from .results import read_results as read_results
 from .results import unknown_metric as unknown_metric
 from .rundir import prepare_run_dir
-from .single import compute_metrics, run_scenario
+from .single import compute_metrics, default_simulation, run_scenario
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -346,13 +345,17 @@ def run_job(job: Job) -> dict[str, Any]:
                 row["error"] = str(exc)
                 metrics = json.loads((out / "metrics.json").read_text())
         else:
-            sim = Simulation.from_scenario(scenario)
+            # the engine's; with ros2: Leaves, the ROS 2 bridge's (left when the run ends)
+            sim = default_simulation(scenario, None)  # type: ignore[arg-type]
             try:
                 sim.run()
                 status = "completed"
             except AmsaError as exc:
                 status = f"fault: {exc}"
                 row["error"] = str(exc)
+            finally:
+                if scenario.ros2:
+                    sim.close()  # type: ignore[attr-defined]
             metrics = compute_metrics(scenario, sim, sim.result(), 1.0, status)
     except (AmsaError, ValueError) as exc:
         row["error"] = str(exc)

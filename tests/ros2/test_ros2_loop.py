@@ -9,6 +9,7 @@ running. Runs inside ``unshare -n`` with a domain of the test's own (``ros2net.p
 
 from __future__ import annotations
 
+import csv
 import json
 import subprocess
 import sys
@@ -121,4 +122,27 @@ def test_a_node_breaking_the_contract_is_one_line_exit_2_trace_kept(
     ref = in_process(tmp_path, "--duration", "10", *extra).read_bytes()
     assert ref.startswith(trace)
     assert (out / "metrics.json").exists()
+    assert res.leftovers == []
+
+
+def test_falsify_over_a_users_node_accounts_for_every_answer(tmp_path: Path) -> None:
+    data = yaml.safe_load(SCENARIO.read_text())
+    data["world"] = str((SCENARIO.parent / data["world"]).resolve())
+    data["ros2"] = [LEAF]
+    scenario = tmp_path / "ctx.yaml"
+    scenario.write_text(yaml.safe_dump(data))
+    out = tmp_path / "falsify"
+    budget, duration = 4, 20
+    args = ["falsify", str(scenario), "--range", "Leader.cruisePower=5:9"]
+    args += ["--range", "MyNormalizePower.motorCoef=70:100", "--budget", str(budget)]
+    args += ["--metric", "rms_error", "--duration", str(duration), "--out", str(out)]
+    res = run_with_nodes(tmp_path, args, [[]])
+    assert res.rc in (0, 1), res.stdout + res.stderr + res.node_log
+    with (out / "results.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == budget
+    assert all(not r["error"] for r in rows), [r["error"] for r in rows]
+    # the node served every run, each from t = 0, and answered every step of each:
+    # 4 Hz over [0, 20] s is 81 steps a run
+    assert f"FOLLOWER runs={budget} steps={budget * (4 * duration + 1)}" in res.node_log
     assert res.leftovers == []

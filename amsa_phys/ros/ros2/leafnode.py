@@ -133,6 +133,7 @@ def main(path: str, scenario_file: str) -> None:
                     self.inp[port] = self.last_out.get(buffer.rpartition(".")[2], 0.0)
             self.fresh: set[str] = set()
             self.t: Fraction | None = None
+            self.last_t: Fraction | None = None  # of the last step: earlier, a new run
             self.triggered = "--amsa-step" in sys.argv
             if self.triggered:
                 self.create_subscription(Clock, names.step_topic(path), self._amsa_on_trigger, qos)
@@ -196,6 +197,10 @@ def main(path: str, scenario_file: str) -> None:
             self._amsa_step(t)
 
         def _amsa_step(self, t: Fraction) -> None:
+            if self.last_t is not None and t < self.last_t:  # a new run: a fresh component
+                self.comp = leaf.template(path, dict(vars(self.comp.p)))
+                self.comp.initialize(NodeContext(scenario.seed, path, world))
+            self.last_t = t
             out = self.comp.do_step(t, dict(self.inp)) or {}
             for port, (w, pub) in self.pubs.items():
                 value = out.get(port, self.last_out[port])
