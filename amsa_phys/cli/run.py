@@ -92,6 +92,10 @@ def _run(
     if args.no_adapt:
         scenario = without_adapt(scenario)
     scenario = with_ros2(scenario, args.ros2, args.ros2_timeout)
+    if scenario.ros2:  # before the run directory is made: one line if rclpy is missing
+        from ..ros.ros2 import env
+
+        env.rclpy()
     for note in timeline_notes(scenario, args.overrides, "--set"):  # as the sweep warns
         print(one_line(f"warning: {note}"), file=sys.stderr)
     if snapshot is not None and snapshot.at is not None and snapshot.at > scenario.duration:

@@ -23,9 +23,10 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from ..model.externals import parse_list, problem, producer
-from ..model.scenariospec import DEFAULT_ROS2_TIMEOUT_S
+from ..model.scenariospec import DEFAULT_ROS2_TIMEOUT_S, Scenario
 from ..model.world import WorldSpec
 from . import names
 
@@ -133,6 +134,18 @@ def describe(
         )
         out.append(ExternalLeaf(path, names.ns(path), tuple(inputs), tuple(outputs), params))
     return out
+
+
+def start_values(scenario: Scenario) -> dict[str, dict[str, Any]]:
+    """Every Leaf's parameters at t = 0: the world's values with the scenario's ``set:``.
+
+    What both targets' parameter files hold (ROS 1's rosparam YAML, ROS 2's
+    ``ros__parameters``) and what an exported ROS 2 node declares.
+    """
+    values = {path: dict(leaf.params) for path, leaf in scenario.world.leaves.items()}
+    for change in scenario.phases[0].changes:
+        values[change.leaf][change.param] = change.value
+    return values
 
 
 def _bound(value: object) -> float | None:

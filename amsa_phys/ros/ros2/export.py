@@ -22,6 +22,7 @@ from ...errors import ConfigError
 from ...model.scenario import Scenario
 from ...runs.resolve import resolved_scenario
 from .. import names
+from ..external import start_values
 from ..graph import classify
 from ..quote import Code, check_name, fill, py_string, yaml_comment, yaml_dump
 
@@ -137,10 +138,7 @@ def generate(scenario: Scenario, source: str, out: Path) -> Package2:
 def _params_yaml(scenario: Scenario, remote: list[str]) -> str:
     """``ros__parameters`` of every node at t = 0 (the world's values, the scenario's set:),
     ``use_sim_time`` on: keyed by the node's full name."""
-    values = {path: dict(scenario.world.leaves[path].params) for path in remote}
-    for change in scenario.phases[0].changes:
-        if change.leaf in values:
-            values[change.leaf][change.param] = change.value
+    values = start_values(scenario)  # as the ROS 1 export's (external.py)
     tree: dict[str, Any] = {}
     for path in remote:
         params: dict[str, Any] = {"use_sim_time": True}

@@ -92,10 +92,7 @@ def main(path: str, scenario_file: str) -> None:
     world = scenario.world
     leaf = world.leaves[path]
     (wiring,) = external.describe(world, [path])
-    values = dict(leaf.params)
-    for change in scenario.phases[0].changes:
-        if change.leaf == path:
-            values[change.param] = change.value
+    values = external.start_values(scenario)[path]
     qos = QoSProfile(
         depth=10,
         reliability=ReliabilityPolicy.RELIABLE,
