@@ -15,6 +15,7 @@ import functools
 import itertools
 import json
 import math
+import os
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -378,6 +379,31 @@ def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
     lost = functools.partial(job_row, error=f"{WORKER_LOST}, twice, running this job")
     for _, row in imap_resilient(run_job, jobs, workers, lost, in_flight=2 * workers):
         yield row
+
+
+def run_lane(lane: tuple[int, list[Job]]) -> list[dict[str, Any]]:
+    """The runs of one ROS 2 domain, one after another: a user's node in that domain answers
+    one run at a time (``ros2:`` Leaves)."""
+    domain, jobs = lane
+    os.environ["ROS_DOMAIN_ID"] = str(domain)  # read when each run's bridge starts
+    return [run_job(job) for job in jobs]
+
+
+def iter_ros2_lanes(jobs: list[Job], lanes: int) -> Iterator[dict[str, Any]]:
+    """Rows of a sweep whose scenario has ``ros2:`` Leaves: ``lanes`` ROS 2 domains in
+    parallel (``ROS_DOMAIN_ID`` and the ``lanes - 1`` after it, a copy of the user's node in
+    each), every ``lanes``-th job in the same domain, a domain's runs in turn."""
+    if lanes <= 1:
+        yield from iter_local(jobs, 1)
+        return
+    base = int(os.environ.get("ROS_DOMAIN_ID") or 0)
+    groups = [(base + k, jobs[k::lanes]) for k in range(lanes)]
+
+    def lost(lane: tuple[int, list[Job]]) -> list[dict[str, Any]]:
+        return [job_row(j, error=f"{WORKER_LOST}, twice, running this job") for j in lane[1]]
+
+    for _, rows in imap_resilient(run_lane, groups, lanes, lost, in_flight=lanes):
+        yield from rows
 
 
 def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:

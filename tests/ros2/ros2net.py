@@ -67,14 +67,20 @@ def leftovers(token: str) -> list[int]:
     return found
 
 
-def run_with_nodes(tmp: Path, amsa_args: list[str], nodes: list[list[str]]) -> Outcome:
-    """Start each node (``nodes``: argument lists of ``follower_node.py``), then
-    ``amsa-phys AMSA_ARGS`` with the ROS 2 venv's python; stop the nodes; report."""
+def run_with_nodes(
+    tmp: Path, amsa_args: list[str], nodes: list[list[str]], domains: list[int] | None = None
+) -> Outcome:
+    """Start each node (``nodes``: argument lists of ``follower_node.py``; ``domains``: each
+    one's ROS_DOMAIN_ID after the test's own, default 0), then ``amsa-phys AMSA_ARGS`` with
+    the ROS 2 venv's python; stop the nodes; report."""
     token = uuid.uuid4().hex
     out, err, log = tmp / "amsa.out", tmp / "amsa.err", tmp / "node.log"
     lines = ["set -u", "ip link set lo up", "pids=()"]
-    for args in nodes:
-        cmd = " ".join(shlex.quote(str(a)) for a in [PY, NODE, *args])
+    for i, args in enumerate(nodes):
+        shift = domains[i] if domains else 0
+        cmd = f"ROS_DOMAIN_ID=$((ROS_DOMAIN_ID + {shift})) " + " ".join(
+            shlex.quote(str(a)) for a in [PY, NODE, *args]
+        )
         lines.append(f"{cmd} >>{shlex.quote(str(log))} 2>&1 & pids+=($!)")
     amsa = " ".join(shlex.quote(str(a)) for a in [PY, "-m", "amsa_phys", *amsa_args])
     lines.append(f"{amsa} >{shlex.quote(str(out))} 2>{shlex.quote(str(err))}; rc=$?")

@@ -146,3 +146,38 @@ def test_falsify_over_a_users_node_accounts_for_every_answer(tmp_path: Path) -> 
     # 4 Hz over [0, 20] s is 81 steps a run
     assert f"FOLLOWER runs={budget} steps={budget * (4 * duration + 1)}" in res.node_log
     assert res.leftovers == []
+
+
+def test_sweep_over_two_domains_gives_the_in_process_sweep(tmp_path: Path) -> None:
+    data = yaml.safe_load(SCENARIO.read_text())
+    data["world"] = str((SCENARIO.parent / data["world"]).resolve())
+    plain = tmp_path / "plain.yaml"
+    plain.write_text(yaml.safe_dump(data))
+    data["ros2"] = [LEAF]
+    external = tmp_path / "ctx.yaml"
+    external.write_text(yaml.safe_dump(data))
+    grid = ["--grid", "Leader.cruisePower=5,6,7,8", "--duration", "20", "--executor", "local"]
+    ref = tmp_path / "ref"
+    subprocess.run(
+        [sys.executable, "-m", "amsa_phys", "sweep", str(plain), *grid, "--out", str(ref)],
+        check=True,
+        capture_output=True,
+        env={"SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg", "PATH": "/usr/bin:/bin"},
+    )
+    out = tmp_path / "ros2"
+    args = ["sweep", str(external), *grid, "-j", "2", "--out", str(out)]
+    # -j 2: two domains, the test's own and the next, a copy of the node in each
+    res = run_with_nodes(tmp_path, args, [[], []], domains=[0, 1])
+    assert res.rc == 0, res.stdout + res.stderr + res.node_log
+
+    def rows(d: Path) -> list[dict[str, str]]:
+        with (d / "results.csv").open() as f:
+            return sorted(csv.DictReader(f), key=lambda r: int(r["run"]))
+
+    got, want = rows(out), rows(ref)
+    assert len(got) == 4
+    assert all(not r["error"] for r in got), [r["error"] for r in got]
+    assert got == want
+    # each node served its domain's two runs, 81 steps each
+    assert res.node_log.count("FOLLOWER runs=2 steps=162") == 2, res.node_log
+    assert res.leftovers == []
