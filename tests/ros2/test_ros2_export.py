@@ -10,6 +10,7 @@ is generated and parsed here, not run. Everything ROS 2 runs with ``.venv-ros2``
 from __future__ import annotations
 
 import ast
+import contextlib
 import os
 import random
 import subprocess
@@ -53,14 +54,20 @@ def in_netns(tmp: Path, body: str) -> tuple[int, str, list[int]]:
         "ROS_DOMAIN_ID": str(random.randint(1, 100)),
     }
     env.pop("VIRTUAL_ENV", None)
-    proc = subprocess.run(
-        ["unshare", "-n", "bash", str(script)],
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=WALL_LIMIT_S,
-    )
-    return proc.returncode, proc.stdout + proc.stderr, leftovers(token)
+    log = tmp / "netns.log"  # a file, not a pipe: a straggler holding it cannot hang us
+    with log.open("w") as f:
+        proc = subprocess.run(
+            ["unshare", "-n", "bash", str(script)],
+            env=env,
+            stdout=f,
+            stderr=subprocess.STDOUT,
+            timeout=WALL_LIMIT_S,
+        )
+    left = leftovers(token)
+    for pid in left:  # a straggler fails the test, and is not left running after it
+        with contextlib.suppress(OSError):
+            os.kill(pid, 9)
+    return proc.returncode, log.read_text(), left
 
 
 @pytest.mark.parametrize("name", ["scenario1", "adaptive"])
@@ -142,4 +149,38 @@ def test_a_node_refuses_a_parameter_out_of_its_range(
     assert rc == 0, text
     line = next(x for x in text.splitlines() if x.startswith("RESULT"))
     assert line == f"RESULT {accepted} 0.0 10.0", text
+    assert left == []
+
+
+def test_a_package_node_that_dies_is_the_runs_fault_and_every_node_is_stopped(
+    tmp_path: Path,
+) -> None:
+    pkg, out = tmp_path / "pkg", tmp_path / "lock"
+    amsa("export", "ros2", str(ROOT / "scenarios" / "scenario1.yaml"), "-o", str(pkg))
+    node = pkg / "mde_challenge" / "MyNormalizePower.py"
+    # the node dies at its 40th step, mid-run (a user's edit gone wrong)
+    node.write_text(
+        node.read_text().replace(
+            "def main():",
+            "import amsa_phys.control.normalize as _n\n"
+            "_step = _n.NormalizePower.do_step\n"
+            "_count = [0]\n\n\n"
+            "def _dying(self, t, inp):\n"
+            "    _count[0] += 1\n"
+            "    if _count[0] == 40:\n"
+            "        raise SystemExit(7)\n"
+            "    return _step(self, t, inp)\n\n\n"
+            "_n.NormalizePower.do_step = _dying\n\n\n"
+            "def main():",
+        )
+    )
+    rc, text, left = in_netns(
+        tmp_path, f"$PY -m amsa_phys ros2 lockstep {pkg} --out {out} --no-plot -q --ros2-timeout 5"
+    )
+    assert rc == 2, text
+    errors = [line for line in text.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1, text
+    assert "MyNormalizePower" in errors[0], errors
+    rows = (out / "trace.csv").read_bytes().count(b"\n") - 1
+    assert rows > 1  # the instants before the fault are kept
     assert left == []
