@@ -22,6 +22,7 @@ from ..engine import interrupt
 from ..engine.runner import Event
 from ..engine.tracemem import TraceMemory
 from ..errors import ConfigError, Interrupted
+from ..model.configure import with_ros2
 from ..model.scenario import Scenario, traced_columns
 from ..runs.expect import Check, check_expectations
 from ..runs.rundir import default_run_dir, prepare_run_dir
@@ -124,6 +125,8 @@ def run(
     progress: bool = False,
     bag: str | os.PathLike[str] | None = None,
     adapt: bool = True,
+    ros2: str | Sequence[str] | None = None,
+    ros2_timeout: float | None = None,
 ) -> Run:
     """Run a scenario (a file path or a mapping) as ``amsa-phys run --headless`` does.
 
@@ -138,7 +141,8 @@ def run(
     :class:`~amsa_phys.errors.Interrupted`. A fault or an interrupt carries the run up to
     that instant as the exception's ``run`` attribute (inspect it, or ``save`` it).
     ``bag`` also writes the run as a ROS 2 MCAP bag there (``--bag``; an existing file is
-    refused), finalised whatever ended the run.
+    refused), finalised whatever ended the run. ``ros2`` is ``--ros2``: these Leaves are
+    your ROS 2 nodes, stepped in lockstep (needs rclpy; ``docs/ros2.md``).
     """
     scenario = load(
         source,
@@ -150,6 +154,7 @@ def run(
         base_dir=base_dir,
         adapt=adapt,
     )
+    scenario = with_ros2(scenario, ros2, ros2_timeout)
     columns = traced_columns(scenario)
     check_trace_memory(scenario, columns)  # warn above 1 GB, refuse above the machine's RAM
     memory = TraceMemory(columns)

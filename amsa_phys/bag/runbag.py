@@ -125,7 +125,9 @@ class BagRecorder:
     def simulation(self, scenario: Scenario, trace: Any) -> Simulation:
         """A :data:`~amsa_phys.runs.single.SimulationFactory`: the engine's Simulation with
         this recorder attached."""
-        sim = Simulation.from_scenario(scenario, trace=trace)
+        from ..runs.single import default_simulation  # a ros2: scenario's Leaves too
+
+        sim = default_simulation(scenario, trace)
         self.attach(sim)
         return sim
 

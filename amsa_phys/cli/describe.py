@@ -8,9 +8,11 @@ from typing import Any
 from ..errors import ConfigError, one_line
 from ..model import timing
 from ..model.adaptrules import describe_rules
+from ..model.configure import with_ros2
 from ..model.scenario import PHYSICS_PREFIX, Scenario, load_scenario
 from ..model.wording import plural
 from ..model.world import LeafSpec, WorldSpec
+from ..ros import external as ros_external
 from ..runs.expect import describe_bound, describe_what
 from ..valuetext import value_text
 from .loading import load_any
@@ -26,6 +28,12 @@ def add_args(p: argparse.ArgumentParser) -> None:
         default=[],
         metavar="Comp.param=V",
         help="scenario only: show the values as `run --set` would start them",
+    )
+    p.add_argument(
+        "--ros2",
+        metavar="COMP[,COMP]",
+        help="scenario only: the topics, message types, QoS and parameters of these Leaves "
+        "as your ROS 2 nodes (run --ros2); the scenario's ros2: without it",
     )
 
 
@@ -165,6 +173,8 @@ def run(args: argparse.Namespace) -> int:
     kind, obj = load_any(args.file)
     if kind == "world" and args.overrides:
         raise ConfigError("only for a scenario: a world has no t = 0 to set", key="--set")
+    if kind == "world" and args.ros2:
+        raise ConfigError("only for a scenario: run a scenario with --ros2", key="--ros2")
     if kind == "scenario":
         in_file = len(obj.timeline.initial)
         physics_from = {
@@ -198,6 +208,12 @@ def run(args: argparse.Namespace) -> int:
             print(f"expect {describe_what(e)} {describe_bound(e)}")
         for line in describe_rules(obj.adapt):
             print(f"adapt {line}")
+        obj = with_ros2(obj, args.ros2)
+        if obj.ros2:
+            for line in ros_external.table(
+                ros_external.describe(obj.world, obj.ros2), obj.ros2_timeout
+            ):
+                print(line)
         print(
             "values in force at t = 0, each with where it comes from: default (the "
             "template's), world, scenario set, --set"

@@ -54,6 +54,18 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     ros.add_argument("--force", action="store_true", help="replace a DIR amsa-phys made")
     add_scenario_overrides(ros)
+    ros2 = sub.add_parser(
+        "ros2",
+        help="a ROS 2 package (ament_python): an rclpy node per Leaf, parameters, launch.py",
+        description="A ROS 2 package (package.xml format 3, ament_python): an rclpy node per "
+        "Leaf outside the physics, a std_msgs/msg/Float64 topic per Data, a ROS 2 parameter "
+        "per Parameter (range-checked), ros__parameters YAML, launch/NAME.launch.py; "
+        "amsa-phys ros2 lockstep runs it against the simulator.",
+    )
+    ros2.add_argument("scenario", metavar="SCENARIO", help="the scenario")
+    ros2.add_argument("-o", "--out", required=True, metavar="DIR", help="the package directory")
+    ros2.add_argument("--force", action="store_true", help="replace a DIR amsa-phys made")
+    add_scenario_overrides(ros2)
     amsa = sub.add_parser(
         "amsa",
         help="the original AMSA files (.amsacore XMI, .amsatemplate)",
@@ -70,6 +82,8 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if args.target == "amsa":
         return _amsa(args, out)
+    if args.target == "ros2":
+        return _ros2(args, out)
     return _ros(args, out)
 
 
@@ -126,6 +140,30 @@ def _ros(args: argparse.Namespace, out: Path) -> int:
         f"{', '.join(package.local) or 'none'}{cpp}); launch files: {', '.join(package.launch)}"
     )
     print(f"build it in a catkin workspace (WS/src/{package.name}): see {out / 'README.md'}")
+    return 0
+
+
+def _ros2(args: argparse.Namespace, out: Path) -> int:
+    from ..ros.ros2.export import generate as generate2
+
+    scenario = _load(args.scenario, args)
+    if "world" not in (scenario.data or {}):
+        raise ConfigError(
+            "expected a scenario (a world has no timeline to run)", file=args.scenario
+        )
+    staged = staged_dir(out, args.force, input_files(scenario))
+    try:
+        package = generate2(scenario, args.scenario, staged)
+        _commit(staged, out, args.force)
+    except BaseException:
+        discard_staged(staged)
+        raise
+    print(
+        f"wrote ROS 2 package {package.name} in {out}: {len(package.nodes)} rclpy nodes "
+        f"({', '.join(package.nodes) or 'none'}; physics in amsa-phys: "
+        f"{', '.join(package.local) or 'none'})"
+    )
+    print(f"run it against the simulator: amsa-phys ros2 lockstep {out} --out RUNDIR")
     return 0
 
 

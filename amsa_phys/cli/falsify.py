@@ -140,6 +140,8 @@ def run(args: argparse.Namespace) -> int:
     if args.resume and not args.out:
         raise ConfigError("--resume continues the search in --out DIR: give it", key="--resume")
     scenario = load_scenario(args.scenario)
+    if scenario.ros2:  # a user's ROS 2 node answers one run at a time, each run in turn
+        args.executor, args.jobs = "local", 1
     if args.budget < 1 or args.budget > MAX_RUNS:
         raise ConfigError(f"must be in 1..{MAX_RUNS:,}", key="--budget")
     if args.jobs < 1:

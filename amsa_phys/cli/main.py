@@ -66,6 +66,10 @@ COMMANDS = {
         "export",
         "Export a scenario as a ROS package, or a world as the original AMSA files.",
     ),
+    "ros2": (
+        "ros2",
+        "ROS 2: run an exported package's nodes against the simulator (lockstep).",
+    ),
     "import": (
         "imports",
         "Import an original AMSA model (.amsacore + .amsatemplate) as a world file.",

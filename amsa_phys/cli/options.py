@@ -81,3 +81,20 @@ def add_no_adapt(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="turn the scenario's adapt: rules off (compare with fixed parameters)",
     )
+
+
+def add_ros2(p: argparse.ArgumentParser) -> None:
+    """--ros2 and --ros2-timeout: Leaves stepped by a user's ROS 2 nodes."""
+    p.add_argument(
+        "--ros2",
+        metavar="COMP[,COMP]",
+        help="these Leaves are your ROS 2 nodes: their inputs are published, their outputs "
+        "awaited, in lockstep on /clock (replaces the scenario's ros2:; needs rclpy, "
+        "docs/ros2.md; describe --ros2 lists the topics)",
+    )
+    p.add_argument(
+        "--ros2-timeout",
+        type=float,
+        metavar="S",
+        help="wall seconds a ROS 2 node may take to answer a step (default 10)",
+    )

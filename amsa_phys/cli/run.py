@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 from ..engine import interrupt
 from ..errors import ConfigError, one_line
+from ..model.configure import with_ros2
 from ..model.scenario import Scenario, load_scenario, traced_columns, without_adapt
 from ..model.tracecols import LARGE_TRACE_BYTES, estimate_trace_bytes, size_text
 from ..runs.expect import check_expectations
@@ -18,7 +19,14 @@ from ..runs.references import reference_notes
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
 from ..runs.suite import input_files
-from .options import add_bag, add_no_adapt, add_output, add_scenario_overrides, add_trace_columns
+from .options import (
+    add_bag,
+    add_no_adapt,
+    add_output,
+    add_ros2,
+    add_scenario_overrides,
+    add_trace_columns,
+)
 from .recording import add_recording, recording_options, recording_target, snapshot_options
 from .report import print_summary
 
@@ -41,6 +49,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
     add_output(p)
     add_recording(p)
     add_bag(p)
+    add_ros2(p)
     p.add_argument(
         "--no-plot", action="store_true", help="skip the plots (distance.png, trajectory.png)"
     )
@@ -92,6 +101,11 @@ def _run(
     )
     if args.no_adapt:
         scenario = without_adapt(scenario)
+    scenario = with_ros2(scenario, args.ros2, args.ros2_timeout)
+    if scenario.ros2:  # before the run directory is made: one line if rclpy is missing
+        from ..ros.ros2 import env
+
+        env.rclpy()
     for note in timeline_notes(scenario, args.overrides, "--set"):  # as the sweep warns
         print(one_line(f"warning: {note}"), file=sys.stderr)
     for note in reference_notes(scenario):

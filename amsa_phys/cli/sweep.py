@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import csv
 import io
+import os
 import sys
 from collections.abc import Iterator
 from fractions import Fraction
@@ -29,6 +30,7 @@ from ..runs.sweep import (
     check_size,
     deterministic_points,
     iter_local,
+    iter_ros2_lanes,
     parse_grid,
     parse_range,
     timeline_overlaps,
@@ -58,6 +60,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--seeds", type=int, help="seeds per grid point (default 1)")
     add_jobs(p)
+    p.set_defaults(jobs=None)  # all cores unless given; a ros2: scenario's runs: one domain
     p.add_argument(
         "--executor",
         choices=("batch", "local", "dask"),
@@ -85,6 +88,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
 def build_plan(args: argparse.Namespace) -> SweepPlan:
     """Merge the scenario's ``sweep:`` section with the command line (which wins)."""
     scenario = load_scenario(args.scenario)
+    args.ros2_serial = bool(scenario.ros2)
     if args.duration is not None:  # refused once, before a job is built (not in every row)
         duration_option(args.duration)
     doc = load_yaml(args.scenario)
@@ -165,6 +169,9 @@ def warn_same_seeds(plan: SweepPlan, scenario: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the sweep; results.csv and summary.png; Ctrl-C keeps every finished row."""
+    args.jobs_given = args.jobs is not None
+    if args.jobs is None:
+        args.jobs = os.cpu_count() or 1
     plan = build_plan(args)
     for warning in plan.warnings:
         print(f"warning: {warning}", file=sys.stderr)
@@ -254,6 +261,9 @@ def _summary(
 
 def rows_from(jobs: list[Job], args: argparse.Namespace) -> Iterator[dict[str, Any]]:
     """Result rows as they come from the chosen executor (batched unless ``local``)."""
+    if getattr(args, "ros2_serial", False):  # a user's ROS 2 node answers one run at a time
+        # -j N: N domains from ROS_DOMAIN_ID, a copy of the node in each; without -j, one
+        return iter_ros2_lanes(jobs, min(args.jobs if args.jobs_given else 1, len(jobs)))
     if args.executor == "local":
         return iter_local(jobs, min(args.jobs, len(jobs)))
     units, notes = plan_units(jobs, args.jobs, args.batch_size)

@@ -14,7 +14,7 @@ from ..runs.junit import write_junit
 from ..runs.pool import WORKER_LOST, imap_resilient
 from ..runs.rundir import check_output
 from ..runs.suite import ScenarioResult, find_scenarios, run_dir_names, run_scenario_job
-from .options import add_jobs
+from .options import add_jobs, add_ros2
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -28,6 +28,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--junit", metavar="FILE", help="also write JUnit XML")
     add_jobs(p)
     p.add_argument("--out", metavar="DIR", help="keep each run's directory under DIR")
+    add_ros2(p)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -50,14 +51,22 @@ def run(args: argparse.Namespace) -> int:
     if args.junit:  # before the suite runs, not after (its folder is made, as pytest does)
         check_output(Path(args.junit), "--junit", make_parent=True)
     with interrupt.sigterm_as_ctrl_c():
-        results = _run_all(files, min(args.jobs, len(files)), args.out)
+        # a ROS 2 node answers one run at a time: the scenarios run one after another
+        jobs = 1 if args.ros2 else min(args.jobs, len(files))
+        results = _run_all(files, jobs, args.out, args.ros2, args.ros2_timeout)
     print_table(results)
     if args.junit:
         write_junit(results, Path(args.junit))
     return 0 if all(r.passed for r in results) else 1
 
 
-def _run_all(files: list[Path], jobs: int, out: str | None) -> list[ScenarioResult]:
+def _run_all(
+    files: list[Path],
+    jobs: int,
+    out: str | None,
+    ros2: str | None = None,
+    ros2_timeout: float | None = None,
+) -> list[ScenarioResult]:
     """Every scenario's result, in the order given; Ctrl-C stops the whole suite.
 
     A suite cut short reports nothing (a partial table would read as a smaller suite that
@@ -71,7 +80,7 @@ def _run_all(files: list[Path], jobs: int, out: str | None) -> list[ScenarioResu
     job_list = list(zip(paths, names, strict=True))
     try:
         with interrupt.deferred():  # Ctrl-C raised between completions, not in a pool's locks
-            _run_each(job_list, jobs, out, done)
+            _run_each(job_list, jobs, out, done, ros2, ros2_timeout)
             interrupt.check()  # a Ctrl-C noted after the last completion still stops it
     except KeyboardInterrupt:
         raise Interrupted(
@@ -85,8 +94,10 @@ def _run_each(
     jobs: int,
     out: str | None,
     done: dict[int, ScenarioResult],
+    ros2: str | None = None,
+    ros2_timeout: float | None = None,
 ) -> None:
-    run = functools.partial(run_scenario_job, out_root=out)
+    run = functools.partial(run_scenario_job, out_root=out, ros2=ros2, ros2_timeout=ros2_timeout)
     if jobs == 1:
         for i, job in enumerate(job_list):
             done[i] = run(job)

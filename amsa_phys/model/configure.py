@@ -104,6 +104,26 @@ def with_trace_columns(scenario: Scenario, trace_columns: Any) -> Scenario:
     return dataclasses.replace(scenario, trace_columns=patterns)
 
 
+def with_ros2(scenario: Scenario, raw: Any, timeout: float | None = None) -> Scenario:
+    """``scenario`` with ``--ros2 COMP,...`` (replacing its ``ros2:``) and ``--ros2-timeout``."""
+    from . import externals as external  # names only
+
+    out = scenario
+    if raw is not None:
+        paths = external.parse_list(raw, "--ros2")
+        why = external.problem(scenario.world, paths)
+        if why is not None:
+            raise ConfigError(why, key="--ros2")
+        out = dataclasses.replace(out, ros2=paths)
+    if timeout is not None:
+        if not (isinstance(timeout, (int, float)) and 0 < timeout <= 3600):
+            raise ConfigError(
+                f"expected seconds in (0, 3600], got {short_repr(timeout)}", key="--ros2-timeout"
+            )
+        out = dataclasses.replace(out, ros2_timeout=float(timeout))
+    return out
+
+
 def with_overrides(scenario: Scenario, overrides: list[str], doc: YamlDoc | None) -> Scenario:
     """``scenario`` with ``--set`` overrides: physics settings and Leaf frequencies change
     the world, parameter changes join phase 0 after the file's ``set:``; then the templates'

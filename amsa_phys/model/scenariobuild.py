@@ -21,7 +21,14 @@ from .adaptrules import load_rules
 from .changes import Change, set_changes, with_physics
 from .metrics import METRICS
 from .rates import cycle_problem
-from .scenariospec import DEFAULT_LOG_RATE_HZ, DEFAULT_TOLERANCE, Expectation, Quality, Scenario
+from .scenariospec import (
+    DEFAULT_LOG_RATE_HZ,
+    DEFAULT_ROS2_TIMEOUT_S,
+    DEFAULT_TOLERANCE,
+    Expectation,
+    Quality,
+    Scenario,
+)
 from .suggest import did_you_mean
 from .template import Kind
 from .timeline import Phase, Step, Timeline
@@ -54,11 +61,29 @@ def build_scenario(doc: YamlDoc, check_rules: bool = True) -> Scenario:
         data=data,
         trace_columns=_trace_patterns(doc, data, world),
         adapt=load_rules(doc, data.get("adapt", []), world),
+        ros2=_ros2(doc, data, world),
+        ros2_timeout=float(data.get("ros2_timeout", DEFAULT_ROS2_TIMEOUT_S)),
     )
     _check_whole(doc, data, scenario)
     if check_rules:
         check_phases(scenario, doc)
     return scenario
+
+
+def _ros2(doc: YamlDoc, data: dict[str, Any], world: WorldSpec) -> tuple[str, ...]:
+    """``ros2:``: the Leaves a user's ROS 2 nodes step, judged as ``--ros2`` is."""
+    if "ros2" not in data:
+        return ()
+    from . import externals as external  # names only
+
+    try:
+        paths = external.parse_list(data["ros2"], "ros2")
+    except ConfigError as exc:  # where in the file, as every other key's problem
+        raise doc.error(("ros2",), exc.message) from None
+    why = external.problem(world, paths)
+    if why is not None:
+        raise doc.error(("ros2",), why)
+    return paths
 
 
 def _world(doc: YamlDoc, data: dict[str, Any]) -> WorldSpec:

@@ -20,6 +20,8 @@ from .timeline import Timeline
 from .world import WorldSpec
 
 DEFAULT_LOG_RATE_HZ = 20
+#: Wall seconds a user's ROS 2 node may take to answer a step (``ros2_timeout:``)
+DEFAULT_ROS2_TIMEOUT_S = 10.0
 DEFAULT_TOLERANCE = 1.5
 
 
@@ -85,12 +87,16 @@ class Scenario:
     trace_columns: tuple[str, ...] | None = None
     #: ``adapt:`` reconfiguration rules (``model/adaptrules.py``); empty with ``--no-adapt``
     adapt: tuple[Rule, ...] = ()
+    #: ``ros2:`` Leaves stepped by a user's ROS 2 nodes (``ros/external.py``), and how long
+    #: (wall seconds) a node may take to answer
+    ros2: tuple[str, ...] = ()
+    ros2_timeout: float = DEFAULT_ROS2_TIMEOUT_S
 
     def __post_init__(self) -> None:
         # a list given by the builder or a caller becomes a tuple: nobody can append to the
         # phases or the expectations of a Scenario someone else holds
         # (a replace passes tuples already: only a list costs a copy, ~1 µs a sweep's job)
-        for name in ("expect", "adapt", "trace_columns"):
+        for name in ("expect", "adapt", "trace_columns", "ros2"):
             value = getattr(self, name)
             if value is not None and type(value) is not tuple:
                 object.__setattr__(self, name, tuple(value))

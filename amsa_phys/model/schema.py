@@ -257,6 +257,14 @@ SCENARIO: dict[str, Any] = {
             },
         },
         "adapt": ADAPT,  # reconfiguration rules (model/adaptrules.py)
+        # Leaves stepped by a user's ROS 2 nodes (ros/external.py)
+        "ros2": {
+            "type": ["array", "string"],
+            "minItems": 1,
+            "minLength": 1,
+            "items": {"type": "string", "minLength": 1},
+        },
+        "ros2_timeout": {"type": "number", "exclusiveMinimum": 0, "maximum": 3600},
         "sweep": {
             "type": "object",
             "additionalProperties": False,

@@ -46,6 +46,7 @@ from .cppnode import (
     manifest_export,
     plugins_xml,
 )
+from .external import start_values
 from .graph import RosGraph, classify
 from .launchxml import launch_xml
 from .quote import Code, check_name, cmake_arg, fill, py_string, yaml_comment, yaml_dump
@@ -296,9 +297,7 @@ def _simulator_doc(graph: RosGraph) -> str:
 
 def _params_yaml(scenario: Scenario) -> str:
     """The ROS parameters at t = 0: the world's values with the scenario's ``set:``."""
-    values = {path: dict(leaf.params) for path, leaf in scenario.world.leaves.items()}
-    for change in scenario.timeline.initial:
-        values[change.leaf][change.param] = change.value
+    values = start_values(scenario)  # as the ROS 2 export's (external.py)
     phases = run_phases(scenario.world, scenario.seed)
     tree: dict[str, Any] = {}
     for path, params in values.items():

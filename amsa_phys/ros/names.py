@@ -9,21 +9,14 @@ live under ``/amsa/``; the simulator and scenario nodes are ``/amsa_simulator`` 
 
 from __future__ import annotations
 
-import re
-
 from ..errors import ConfigError
+
+# the names amsa-phys itself takes on a ROS graph, both targets' (model/rosnames.py: the
+# scenario loader judges ros2: names with them, below this layer)
+from ..model.rosnames import BASE, CONTAINER, RESERVED, SCENARIO, SIMULATOR
 from ..model.world import WorldSpec
 
-#: A ROS graph resource base name: a letter, then letters, digits and underscores.
-BASE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
-SIMULATOR = "amsa_simulator"
-SCENARIO = "amsa_scenario"
-#: Names a top-level component may not take (the framework's nodes and namespaces).
-RESERVED = {"amsa", SIMULATOR, SCENARIO, "clock", "rosout", "rosout_agg", "amsa_bag"}
-RESERVED.update({"amsa_boundary", "amsa_adapt"})  # the boundary and adapt nodes
-#: The process that hosts every C++ Leaf (a nodelet manager: ros/files/amsa_leaves.cpp).
-CONTAINER = "amsa_leaves"
-RESERVED.add(CONTAINER)
+__all__ = ["BASE", "CONTAINER", "RESERVED", "SCENARIO", "SIMULATOR"]
 #: The package's script that launches a scenario and exits with its verdict (``runcheck.py``).
 RUN_LOCKSTEP = "run_lockstep"
 
@@ -40,6 +33,12 @@ def ns(path: str) -> str:
 def topic(buffer: str) -> str:
     """The topic of a Data buffer ``Component.output``."""
     return ns(buffer)
+
+
+def input_topic(path: str, port: str) -> str:
+    """Where ``ros2 lockstep`` delivers a node's input ``port`` (remapped from the producer's
+    topic): ``/amsa/in/Team/Leader/port``."""
+    return "/amsa/in" + ns(path) + "/" + port
 
 
 def param(path: str, name: str) -> str:

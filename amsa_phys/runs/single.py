@@ -7,6 +7,7 @@ directory never holds a half-written file under its final name.
 
 from __future__ import annotations
 
+import importlib
 import json
 import sys
 import time
@@ -93,7 +94,18 @@ TraceFn = Callable[[float, list[float]], None]
 SimulationFactory = Callable[[Scenario, TraceFn], Simulation]
 
 
-def _default_simulation(scenario: Scenario, trace: TraceFn) -> Simulation:
+#: Who builds the Simulation of a scenario with ``ros2:`` Leaves: the ROS 2 target, a layer
+#: above this one (it needs rclpy, imported only then), found by name as a plugin is; every
+#: command that runs scenarios (run, test, sweep, falsify) reaches it through the scenario.
+ROS2_SIMULATION = "amsa_phys.ros.ros2.bridge:ExternalSimulation"
+
+
+def default_simulation(scenario: Scenario, trace: TraceFn) -> Simulation:
+    """The engine's Simulation of ``scenario``; with ``ros2:`` Leaves, the ROS 2 bridge's."""
+    if scenario.ros2:  # Leaves stepped by a user's ROS 2 nodes: rclpy only then
+        module, _, name = ROS2_SIMULATION.partition(":")
+        external = getattr(importlib.import_module(module), name)
+        return external(scenario, scenario.ros2_timeout, trace=trace)  # type: ignore[no-any-return]
     return Simulation.from_scenario(scenario, trace=trace)
 
 
@@ -193,7 +205,7 @@ def execute(
     ``simulation`` builds the Simulation (the ROS export's simulator node steps its Leaves
     through their nodes); by default the engine's own.
     """
-    sim = (simulation or _default_simulation)(scenario, trace.write)
+    sim = (simulation or default_simulation)(scenario, trace.write)
     status = "completed"
     error: BaseException | None = None
     recorder: Recorder | None = None
@@ -226,6 +238,9 @@ def execute(
     except KeyboardInterrupt as exc:
         status, error = "interrupted", exc
     wall = time.perf_counter() - t0
+    external = getattr(sim, "external_report", None)  # a ROS 2 run: each node's answers
+    if external is not None:
+        sim.close()  # type: ignore[attr-defined]  # leave the ROS 2 graph
     # Each output is written even if another could not be (a full disk): metrics.json
     # above all. The first failure is raised once the run's own error, if any, is.
     unwritten: list[OutputError] = []
@@ -243,6 +258,8 @@ def execute(
     result = sim.result()
     metrics = compute_metrics(scenario, sim, result, wall, status, idle_s=idle)
     metrics.update(provenance(sim))  # which code and which physics step made this run
+    if external is not None:
+        metrics["ros2"] = external()
     if video is not None:
         metrics["video"] = video
     if still is not None:

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import AmsaError
+from ..model.configure import with_ros2
 from ..model.scenario import Scenario, load_scenario
 from ..model.yamlio import load_yaml
 from .expect import Check, check_expectations
@@ -110,7 +111,11 @@ def input_files(scenario: Scenario) -> list[Path]:
 
 
 def run_scenario_file(
-    path: str, out_root: str | None = None, dir_name: str | None = None
+    path: str,
+    out_root: str | None = None,
+    dir_name: str | None = None,
+    ros2: str | None = None,
+    ros2_timeout: float | None = None,
 ) -> ScenarioResult:
     """Load, run and check one scenario (safe to call in a worker process).
 
@@ -120,7 +125,7 @@ def run_scenario_file(
     t0 = time.perf_counter()
     result = ScenarioResult(path=path, name=Path(path).stem)
     try:
-        scenario = load_scenario(path)
+        scenario = with_ros2(load_scenario(path), ros2, ros2_timeout)
         result.name = scenario.name
         if not scenario.expect:
             result.error = "no expect: section"
@@ -140,6 +145,11 @@ def run_scenario_file(
     return result
 
 
-def run_scenario_job(job: tuple[str, str | None], out_root: str | None) -> ScenarioResult:
+def run_scenario_job(
+    job: tuple[str, str | None],
+    out_root: str | None,
+    ros2: str | None = None,
+    ros2_timeout: float | None = None,
+) -> ScenarioResult:
     """:func:`run_scenario_file` for a ``(path, dir_name)`` pair (a pool maps one argument)."""
-    return run_scenario_file(job[0], out_root, job[1])
+    return run_scenario_file(job[0], out_root, job[1], ros2, ros2_timeout)

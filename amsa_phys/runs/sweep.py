@@ -15,6 +15,7 @@ import functools
 import itertools
 import json
 import math
+import os
 import re
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -26,7 +27,6 @@ from typing import Any, TypeVar
 import numpy as np
 
 from ..engine import interrupt
-from ..engine.runner import Simulation
 from ..errors import AmsaError, ConfigError
 from ..model.scenario import (
     PHYSICS_PREFIX,
@@ -48,7 +48,7 @@ from .results import metric_names as metric_names
 from .results import read_results as read_results
 from .results import unknown_metric as unknown_metric
 from .rundir import prepare_run_dir
-from .single import compute_metrics, run_scenario
+from .single import compute_metrics, default_simulation, run_scenario
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -365,13 +365,17 @@ def run_job(job: Job) -> dict[str, Any]:
                 row["error"] = str(exc)
                 metrics = json.loads((out / "metrics.json").read_text())
         else:
-            sim = Simulation.from_scenario(scenario)
+            # the engine's; with ros2: Leaves, the ROS 2 bridge's (left when the run ends)
+            sim = default_simulation(scenario, None)  # type: ignore[arg-type]
             try:
                 sim.run()
                 status = "completed"
             except AmsaError as exc:
                 status = f"fault: {exc}"
                 row["error"] = str(exc)
+            finally:
+                if scenario.ros2:
+                    sim.close()  # type: ignore[attr-defined]
             metrics = compute_metrics(scenario, sim, sim.result(), 1.0, status)
     except (AmsaError, ValueError) as exc:
         row["error"] = str(exc)
@@ -394,6 +398,31 @@ def iter_local(jobs: list[Job], workers: int) -> Iterator[dict[str, Any]]:
     lost = functools.partial(job_row, error=f"{WORKER_LOST}, twice, running this job")
     for _, row in imap_resilient(run_job, jobs, workers, lost, in_flight=2 * workers):
         yield row
+
+
+def run_lane(lane: tuple[int, list[Job]]) -> list[dict[str, Any]]:
+    """The runs of one ROS 2 domain, one after another: a user's node in that domain answers
+    one run at a time (``ros2:`` Leaves)."""
+    domain, jobs = lane
+    os.environ["ROS_DOMAIN_ID"] = str(domain)  # read when each run's bridge starts
+    return [run_job(job) for job in jobs]
+
+
+def iter_ros2_lanes(jobs: list[Job], lanes: int) -> Iterator[dict[str, Any]]:
+    """Rows of a sweep whose scenario has ``ros2:`` Leaves: ``lanes`` ROS 2 domains in
+    parallel (``ROS_DOMAIN_ID`` and the ``lanes - 1`` after it, a copy of the user's node in
+    each), every ``lanes``-th job in the same domain, a domain's runs in turn."""
+    if lanes <= 1:
+        yield from iter_local(jobs, 1)
+        return
+    base = int(os.environ.get("ROS_DOMAIN_ID") or 0)
+    groups = [(base + k, jobs[k::lanes]) for k in range(lanes)]
+
+    def lost(lane: tuple[int, list[Job]]) -> list[dict[str, Any]]:
+        return [job_row(j, error=f"{WORKER_LOST}, twice, running this job") for j in lane[1]]
+
+    for _, rows in imap_resilient(run_lane, groups, lanes, lost, in_flight=lanes):
+        yield from rows
 
 
 def iter_dask(jobs: list[Job], scheduler: str) -> Iterator[dict[str, Any]]:

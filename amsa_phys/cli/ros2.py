@@ -1,0 +1,63 @@
+"""``amsa-phys ros2 lockstep PKG --out RUNDIR``: an exported ROS 2 package in the loop."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ..engine import interrupt
+from ..errors import one_line
+from ..runs.expect import check_expectations
+from ..runs.rundir import default_run_dir, prepare_run_dir
+from ..runs.single import run_scenario
+from .report import print_summary
+
+
+def add_args(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``amsa-phys ros2``."""
+    sub = p.add_subparsers(dest="action", required=True, metavar="ACTION")
+    lock = sub.add_parser(
+        "lockstep",
+        help="run an exported ROS 2 package's nodes against the simulator, in lockstep",
+        description="Start every node of a package made by `amsa-phys export ros2` (no ros2 "
+        "launch needed), run its scenario with those Leaves stepped by the nodes, and write "
+        "the run directory: trace.csv byte for byte as `amsa-phys run` writes it.",
+    )
+    lock.add_argument("package", metavar="PKG", help="the package directory")
+    lock.add_argument("--out", metavar="DIR", help="run directory (default runs/<scenario>-...)")
+    lock.add_argument("--force", action="store_true", help="replace an existing --out")
+    lock.add_argument(
+        "--ros2-timeout",
+        type=float,
+        metavar="S",
+        help="wall seconds a node may take to answer a step (default 10)",
+    )
+    lock.add_argument("--no-plot", action="store_true", help="skip the plots")
+    lock.add_argument("-q", "--quiet", action="store_true", help="no summary table")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Start the nodes, run, stop the nodes, report."""
+    from ..ros.ros2 import env
+    from ..ros.ros2.lockstep import nodes_running, plan, simulation
+
+    env.rclpy("ros2 lockstep")
+    the_plan = plan(Path(args.package), args.ros2_timeout)
+    scenario = the_plan.scenario
+    out = Path(args.out) if args.out else default_run_dir(scenario.name)
+    prepare_run_dir(out, args.force)
+    with interrupt.sigterm_as_ctrl_c(), nodes_running(the_plan.commands) as procs:
+        outcome = run_scenario(
+            scenario, out, plot=not args.no_plot, simulation=simulation(the_plan, procs)
+        )
+    if not args.quiet:
+        print_summary(outcome.metrics, out, sys.stdout)
+    checks = check_expectations(scenario.expect, outcome.metrics, out / "trace.csv")
+    for check in checks:
+        print(one_line(f"expect {check.describe()}"))
+    failed = [c.what for c in checks if not c.passed]
+    if failed:
+        sys.stdout.flush()
+        print(one_line(f"error: {len(failed)} of {len(checks)} checks failed"), file=sys.stderr)
+    return 1 if failed else 0

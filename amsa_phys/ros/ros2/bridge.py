@@ -1,0 +1,419 @@
+"""A user's ROS 2 nodes as Leaves of a run: inputs published, outputs awaited, on ``/clock``.
+
+The engine runs as in ``amsa-phys run``; each external Leaf (``ros/external.py``) is built,
+then passed through the ``wrap=`` hook, which puts an :class:`ExternalLeaf` in its place.
+Stepping it is one round trip over ROS 2: ``/clock`` at the instant, one message on every
+input topic, then one message awaited on every output topic (``external.py`` states the
+contract). Parameters are the node's: all of them set through its ``set_parameters``
+service before the first step, and each change at the instant the scenario makes it; a
+refused value ends the run.
+
+Everything a node can do wrong ends the run with one line naming the node and the topic, a
+:class:`NodeFault` (exit 2: the node under test is the user's input): no answer within the
+timeout (never, or late), a non-finite value, an array of the wrong length, a publisher of
+another message type on an output topic, the node gone, an answer nobody asked for. The
+trace holds every instant before it.
+
+One thread: the bridge spins its own executor only while it waits, so the callbacks run
+between two engine calls and nothing is shared with another thread.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import deque
+from collections.abc import Callable, Mapping, Sequence
+from fractions import Fraction
+from typing import Any
+
+from ...engine.runner import Simulation
+from ...errors import RunFault
+from ...model.scenario import Scenario
+from ...model.template import Template
+from .. import external, names
+from ..external import ExternalLeaf as Wiring
+from . import env
+
+#: How long one idle wait lasts before the bridge looks at the graph (a node gone, a
+#: publisher of the wrong type): a poll of the graph, not a sleep.
+_LOOK_S = 0.2
+
+
+class NodeFault(RunFault):
+    """An external node broke the lockstep contract (exit 2: the node is the user's input)."""
+
+    exit_code = 2
+
+
+class Bridge:
+    """amsa-phys's node on the ROS 2 graph: ``/clock``, the external Leaves' topics, their
+    parameter services, and the count of each node's steps and answers."""
+
+    def __init__(
+        self,
+        leaves: Sequence[Wiring],
+        timeout_s: float,
+        now: Callable[[], Fraction],
+        arrays: Mapping[str, Sequence[str]],
+        watch: Callable[[], str | None] | None = None,
+        step_topics: bool = False,
+    ) -> None:
+        rclpy = env.rclpy()
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+        from rosgraph_msgs.msg import Clock
+        from std_msgs.msg import Float64, Float64MultiArray
+
+        self.rclpy = rclpy
+        self.timeout_s = float(timeout_s)
+        self._now = now
+        #: says why the nodes cannot answer any more (a process amsa-phys started exited)
+        self._watch = watch or (lambda: None)
+        #: array port -> its element buffers (the length a message must have)
+        self.arrays = {k: len(v) for k, v in arrays.items()}
+        self.context = rclpy.Context()
+        rclpy.init(args=[], context=self.context)
+        self.node = rclpy.create_node(
+            external.BRIDGE_NODE, context=self.context, start_parameter_services=False
+        )
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        qos = QoSProfile(
+            depth=10,
+            reliability=ReliabilityPolicy.RELIABLE,
+            durability=DurabilityPolicy.VOLATILE,
+            history=HistoryPolicy.KEEP_LAST,
+        )
+        self.Clock = Clock
+        self.types = {external.SCALAR: Float64, external.ARRAY: Float64MultiArray}
+        self.clock_pub = self.node.create_publisher(Clock, "/clock", qos)
+        self.last_clock: Fraction | None = None
+        self.leaves = {leaf.path: leaf for leaf in leaves}
+        self.pubs: dict[str, Any] = {}
+        self.subs: dict[str, Any] = {}
+        self.inbox: dict[str, deque[Any]] = {}
+        self.clients: dict[str, Any] = {}
+        #: ``step_topics``: each node's step trigger (``names.step_topic``, a Clock of the
+        #: instant published after its inputs), so nodes at different rates never take
+        #: another's ``/clock`` for theirs (an exported package's nodes under lockstep)
+        self.step_pubs: dict[str, Any] = {}
+        #: per node: steps asked, answers received (every output of a step), params set
+        self.counts: dict[str, dict[str, int]] = {}
+        from rcl_interfaces.srv import SetParameters
+
+        for leaf in leaves:
+            self.counts[leaf.path] = {"steps": 0, "answers": 0, "params_set": 0}
+            for w in leaf.inputs:
+                if w.topic not in self.pubs:
+                    self.pubs[w.topic] = self.node.create_publisher(
+                        self.types[w.type], w.topic, qos
+                    )
+            for w in leaf.outputs:
+                box: deque[Any] = deque()
+                self.inbox[w.topic] = box
+                self.subs[w.topic] = self.node.create_subscription(
+                    self.types[w.type], w.topic, lambda m, box=box: box.append(m), qos
+                )
+            self.clients[leaf.path] = self.node.create_client(SetParameters, leaf.set_parameters)
+            if step_topics:
+                self.step_pubs[leaf.path] = self.node.create_publisher(
+                    Clock, names.step_topic(leaf.path), qos
+                )
+
+    # -- start ----------------------------------------------------------------------------
+    def connect(self, leaf: Wiring) -> None:
+        """Wait until the node listens on every input and ``/clock``, publishes every output
+        and offers its parameter service (else a fault naming what is missing)."""
+        wait = max(self.timeout_s, external.START_TIMEOUT_S)
+        deadline = time.monotonic() + wait
+        while True:
+            missing = self._missing(leaf)
+            if missing is None:
+                return
+            self._check_types(leaf)
+            self._check_watch(leaf)
+            if time.monotonic() >= deadline:
+                raise self._fault(
+                    leaf,
+                    f"{missing} within {wait:g} s: is the node {leaf.node} running "
+                    f"(ROS_DOMAIN_ID, the node's name)?",
+                )
+            self.executor.spin_once(timeout_sec=0.05)
+
+    def _missing(self, leaf: Wiring) -> str | None:
+        if self.clock_pub.get_subscription_count() < 1:
+            return "no subscriber on /clock"
+        for w in leaf.inputs:
+            if self.pubs[w.topic].get_subscription_count() < 1:
+                return f"no subscriber on {w.topic}"
+        step = self.step_pubs.get(leaf.path)
+        if step is not None and step.get_subscription_count() < 1:
+            return f"no subscriber on {names.step_topic(leaf.path)}"
+        for w in leaf.outputs:
+            if self.subs[w.topic].get_publisher_count() < 1:
+                return f"no publisher on {w.topic}"
+        if leaf.params and not self.clients[leaf.path].service_is_ready():
+            return f"no service {leaf.set_parameters}"
+        return None
+
+    # -- parameters -----------------------------------------------------------------------
+    def set_params(self, leaf: Wiring, values: Mapping[str, Any]) -> None:
+        """Set the node's parameters through its service; a refusal is the run's fault."""
+        from rclpy.parameter import Parameter
+
+        if not values:
+            return
+        from rcl_interfaces.srv import SetParameters
+
+        req = SetParameters.Request()
+        req.parameters = [
+            Parameter(k, value=_param_value(v)).to_parameter_msg() for k, v in values.items()
+        ]
+        future = self.clients[leaf.path].call_async(req)
+        self.executor.spin_until_future_complete(future, timeout_sec=self.timeout_s)
+        if not future.done():
+            raise self._fault(
+                leaf, f"{leaf.set_parameters} did not answer within {self.timeout_s:g} s"
+            )
+        for (name, value), result in zip(values.items(), future.result().results, strict=False):
+            if not result.successful:
+                why = result.reason or "refused"
+                raise self._fault(leaf, f"refused parameter {name}={value!r} ({why})")
+        self.counts[leaf.path]["params_set"] += len(values)
+
+    # -- one step ---------------------------------------------------------------------------
+    def step(self, leaf: Wiring, t: Fraction, inp: Mapping[str, Any]) -> dict[str, Any]:
+        """Publish ``/clock`` and the inputs at ``t``; wait for one message per output."""
+        self.executor.spin_once(timeout_sec=0)  # anything the node sent unasked is here now
+        for w in leaf.outputs:
+            if self.inbox[w.topic]:
+                raise self._fault(
+                    leaf,
+                    f"published on {w.topic} before its inputs of t={float(t):g} s "
+                    "(a node answers each step exactly once)",
+                    t,
+                )
+        if self.last_clock != t:
+            self.last_clock = t
+            self.clock_pub.publish(self._clock_msg(t))
+        for w in leaf.inputs:
+            self.pubs[w.topic].publish(self._pack(w, inp[w.port]))
+        step = self.step_pubs.get(leaf.path)
+        if step is not None:  # an exported node's own trigger, after its inputs
+            step.publish(self._clock_msg(t))
+        self.counts[leaf.path]["steps"] += 1
+        waiting = [w for w in leaf.outputs]
+        deadline = time.monotonic() + self.timeout_s
+        while True:
+            waiting = [w for w in waiting if not self.inbox[w.topic]]
+            if not waiting:
+                break
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise self._fault(
+                    leaf,
+                    f"no message on {waiting[0].topic} within {self.timeout_s:g} s "
+                    f"of its inputs of t={float(t):g} s",
+                    t,
+                )
+            self.executor.spin_once(timeout_sec=min(left, _LOOK_S))
+            if all(not self.inbox[w.topic] for w in waiting):
+                self._check_types(leaf, t)
+                self._check_alive(leaf, waiting, t)
+                self._check_watch(leaf, t)
+        out: dict[str, Any] = {}
+        for w in leaf.outputs:
+            out[w.port] = self._unpack(leaf, w, self.inbox[w.topic].popleft(), t)
+        self.counts[leaf.path]["answers"] += 1
+        return out
+
+    def _clock_msg(self, t: Fraction) -> Any:
+        msg = self.Clock()
+        whole = math.floor(t)
+        msg.clock.sec = int(whole)
+        msg.clock.nanosec = round((t - whole) * 1_000_000_000)
+        return msg
+
+    def _pack(self, w: external.Wire, value: Any) -> Any:
+        cls = self.types[w.type]
+        if w.type == external.SCALAR:
+            return cls(data=float(value))
+        from std_msgs.msg import MultiArrayDimension
+
+        data = [float(v) for v in value]
+        msg = cls(data=data)
+        msg.layout.dim = [MultiArrayDimension(label=w.port, size=len(data), stride=len(data))]
+        return msg
+
+    def _unpack(self, leaf: Wiring, w: external.Wire, msg: Any, t: Fraction) -> Any:
+        if w.type == external.SCALAR:
+            value = float(msg.data)
+            if not math.isfinite(value):
+                raise self._fault(leaf, f"published {value!r} on {w.topic}", t)
+            return value
+        data = tuple(float(v) for v in msg.data)[msg.layout.data_offset :]
+        size = self.arrays[w.buffer]
+        if len(data) != size:
+            raise self._fault(
+                leaf, f"published {len(data)} values on {w.topic}, the port declares {size}", t
+            )
+        bad = [v for v in data if not math.isfinite(v)]
+        if bad:
+            raise self._fault(leaf, f"published {bad[0]!r} on {w.topic}", t)
+        return data
+
+    # -- what went wrong --------------------------------------------------------------------
+    def _check_types(self, leaf: Wiring, t: Fraction | None = None) -> None:
+        """A publisher of another type on an output topic never matches: say so at once."""
+        for w in leaf.outputs:
+            want = w.type
+            for info in self.node.get_publishers_info_by_topic(w.topic):
+                if info.node_name == external.BRIDGE_NODE:
+                    continue
+                if info.topic_type != want:
+                    raise self._fault(
+                        leaf,
+                        f"publishes {info.topic_type} on {w.topic}, expected {want}",
+                        t,
+                    )
+
+    def _check_alive(self, leaf: Wiring, waiting: Sequence[external.Wire], t: Fraction) -> None:
+        """The node gone (its publishers left the graph) while a step waits for it."""
+        for w in waiting:
+            if self.subs[w.topic].get_publisher_count() < 1:
+                raise self._fault(
+                    leaf, f"the node left the graph: no publisher on {w.topic} any more", t
+                )
+
+    def _check_watch(self, leaf: Wiring, t: Fraction | None = None) -> None:
+        why = self._watch()
+        if why is not None:
+            raise self._fault(leaf, why, t)
+
+    def _fault(self, leaf: Wiring, why: str, t: Fraction | None = None) -> NodeFault:
+        return NodeFault(f"ROS 2 node {leaf.node}", self._now() if t is None else t, why)
+
+    # -- end --------------------------------------------------------------------------------
+    def close(self) -> None:
+        """Leave the graph (idempotent)."""
+        if self.context is None:
+            return
+        try:
+            self.executor.shutdown(timeout_sec=0)
+            self.node.destroy_node()
+        finally:
+            self.rclpy.try_shutdown(context=self.context)
+            self.context = None
+
+    def report(self) -> dict[str, Any]:
+        """What each node was asked and answered (``metrics.json``'s ``ros2``)."""
+        return {
+            self.leaves[p].node: {**c, "complete": c["steps"] == c["answers"]}
+            for p, c in self.counts.items()
+        }
+
+
+def _param_value(value: Any) -> Any:
+    """A parameter value as ROS 2 types it (``points``, pairs: a flat list of doubles)."""
+    if isinstance(value, (tuple, list)):
+        flat: list[float] = []
+        for v in value:
+            if isinstance(v, (tuple, list)):
+                flat.extend(float(x) for x in v)
+            else:
+                flat.append(float(v))
+        return flat
+    return value
+
+
+class ExternalLeaf:
+    """In the engine, a Leaf that is a user's ROS 2 node: stepping it is a round trip.
+
+    Everything but stepping and parameter changes is the built component's own (its ``p``
+    holds the values the node was given), so the engine and the metrics see the Leaf as in
+    an in-process run.
+    """
+
+    def __init__(self, comp: Template, wiring: Wiring, bridge: Bridge) -> None:
+        self._comp = comp
+        self._wiring = wiring
+        self._bridge = bridge
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._comp, name)
+
+    def initialize(self, ctx: Any) -> None:
+        """Wait for the node, then give it every parameter's value."""
+        self._bridge.connect(self._wiring)
+        self._bridge.set_params(
+            self._wiring, {p.name: getattr(self._comp.p, p.name) for p in self._wiring.params}
+        )
+
+    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+        """The node's step."""
+        return self._bridge.step(self._wiring, t, inp)
+
+    def on_param_change(self, name: str, value: Any) -> None:
+        """The node's parameter, set now (before anything steps at this instant)."""
+        self._bridge.set_params(self._wiring, {name: value})
+
+
+class ExternalSimulation(Simulation):
+    """The engine with the scenario's ``ros2:`` Leaves stepped by the user's nodes.
+
+    Every Leaf is called on its own (``grouping=False``): a node answers for one Leaf.
+    ``private_inputs``: each node's inputs on topics of its own (``names.input_topic``, an
+    exported package's nodes remapped to them by ``ros2 lockstep``), so nodes wired to each
+    other see what the engine delivers (a producer's latency included).
+    :meth:`close` leaves the graph; :meth:`external_report` is the count of every node's
+    steps and answers, for ``metrics.json``.
+    """
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        timeout_s: float,
+        private_inputs: bool = False,
+        watch: Callable[[], str | None] | None = None,
+        **kw: Any,
+    ) -> None:
+        wirings = external.describe(scenario.world, scenario.ros2, private_inputs)
+        self.bridge = Bridge(
+            wirings, timeout_s, lambda: self.now, scenario.world.arrays, watch, private_inputs
+        )
+        by_path = {w.path: w for w in wirings}
+
+        def wrap(path: str, comp: Template) -> Any:
+            if path in by_path:
+                return ExternalLeaf(comp, by_path[path], self.bridge)
+            return comp
+
+        try:
+            super().__init__(
+                scenario.world,
+                **Simulation.scenario_kwargs(scenario),
+                wrap=wrap,
+                grouping=False,
+                **kw,
+            )
+        except BaseException:
+            self.bridge.close()
+            raise
+
+    def close(self) -> None:
+        """Leave the ROS 2 graph."""
+        self.bridge.close()
+
+    def external_report(self) -> dict[str, Any]:
+        """Each node's steps and answers."""
+        return self.bridge.report()
+
+
+def simulation(timeout_s: float = external.DEFAULT_TIMEOUT_S) -> Callable[..., Simulation]:
+    """The factory ``runs/single.py`` calls for a scenario with ``ros2:`` Leaves."""
+
+    def make(scenario: Scenario, trace: Any) -> Simulation:
+        return ExternalSimulation(scenario, timeout_s, trace=trace)
+
+    return make

@@ -1,0 +1,165 @@
+"""``amsa-phys export ros2``: an ament_python package from a scenario.
+
+The package (``package.xml`` format 3) holds one rclpy node per Leaf that runs outside the
+physics (the ROS 1 export's remote Leaves, ``graph.classify``), each running the project's own
+template class (``leafnode.py``) under the names of ``ros/names.py`` and ``ros/external.py``
+(the same description the ROS 1 export and ``run --ros2`` use), a ``ros__parameters`` YAML
+keyed by node, a ``launch/NAME.launch.py`` (generated and parsed, not run here: no
+``ros2 launch``), the resolved scenario in ``config/`` and ``config/amsa.yaml``, the list
+``amsa-phys ros2 lockstep`` reads. Every name reaches a file through ``quote.py``'s escaper
+for that file's language; ROS names are judged first (``names.check_world``).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ... import __version__
+from ...errors import ConfigError
+from ...model.scenario import Scenario
+from ...runs.resolve import resolved_scenario
+from .. import names
+from ..external import start_values
+from ..graph import classify
+from ..quote import Code, check_name, fill, py_string, yaml_comment, yaml_dump
+
+FILES = Path(__file__).resolve().parent.parent / "files" / "ros2"
+#: A ROS 2 package name (REP 144): lower case letters, digits, underscores.
+PACKAGE = re.compile(r"^[a-z][a-z0-9_]*$")
+MANIFEST = "config/amsa.yaml"
+
+
+@dataclass
+class Package2:
+    """What was generated (for the command's report and the tests)."""
+
+    name: str
+    nodes: list[str]
+    local: list[str]
+    files: list[str]
+
+
+def package_name(world_name: str) -> str:
+    """``mdeChallenge`` -> ``mde_challenge`` (REP 144), or a ConfigError."""
+    snake = re.sub(r"(?<=[a-z0-9])([A-Z])", r"_\1", world_name).lower()
+    if not PACKAGE.match(snake):
+        raise ConfigError(
+            f"the root component's name {world_name!r} cannot name a ROS 2 package (a letter, "
+            "then letters, digits and _): rename the world",
+            key="world",
+        )
+    return snake
+
+
+def _fill(file: str, **values: Any) -> Code:
+    return fill((FILES / file).read_text(), **values)
+
+
+def generate(scenario: Scenario, source: str, out: Path) -> Package2:
+    """Write the package of ``scenario`` into the (staged, empty) directory ``out``."""
+    check_name(Path(source).name, "the file name", key=source)
+    check_name(scenario.name, "the scenario name", file=source, key="name")
+    world = scenario.world
+    names.check_world(world)
+    pkg = package_name(world.name)
+    local = classify(world, scenario.seed)
+    remote = [p for p in world.leaves if p not in local]
+    fname = re.sub(r"[^A-Za-z0-9_]", "_", scenario.name) or "scenario"
+    files: dict[str, str] = {}
+    src = Path(source).name
+    scripts = []
+    launch_nodes = []
+    for path in remote:
+        script = names.script(path)
+        leaf = world.leaves[path]
+        files[f"{pkg}/{script}.py"] = _fill(
+            "node.py.in",
+            title=f"ROS 2 node of Leaf {path} ({leaf.template.name()}).",
+            doc=(leaf.template.__doc__ or "").strip().splitlines()[0]
+            if leaf.template.__doc__
+            else "",
+            version=__version__,
+            source=src,
+            pkg=pkg,
+            path=path,
+            scenario=f"{fname}.yaml",
+        )
+        scripts.append(Code(f"            {py_string(f'{script} = {pkg}.{script}:main')},"))
+        ns = names.ns(path)
+        launch_nodes.append(
+            Code(
+                f"        Node(package=PACKAGE, executable={py_string(script)}, "
+                f"name={py_string(ns.rpartition('/')[2])}, "
+                f"namespace={py_string(ns.rpartition('/')[0] or '/')}, "
+                "parameters=[params, {'use_sim_time': True}]),"
+            )
+        )
+    files[f"{pkg}/__init__.py"] = ""
+    files[f"resource/{pkg}"] = ""
+    files["package.xml"] = _fill(
+        "package.xml.in",
+        pkg=pkg,
+        version=__version__,
+        source=src,
+        description=str(world.data.get("description") or f"The {world.name} system."),
+    )
+    files["setup.py"] = _fill(
+        "setup.py.in", pkg=pkg, version=__version__, scripts=Code("\n".join(scripts))
+    )
+    files["setup.cfg"] = _fill("setup.cfg.in", pkg=pkg)
+    files[f"launch/{fname}.launch.py"] = _fill(
+        "launch.py.in",
+        name=scenario.name,
+        version=__version__,
+        pkg=pkg,
+        params=f"{fname}_params.yaml",
+        nodes=Code("\n".join(launch_nodes)),
+    )
+    files[f"config/{fname}.yaml"] = yaml_dump(resolved_scenario(scenario))
+    files[f"config/{fname}_params.yaml"] = _params_yaml(scenario, remote)
+    files[MANIFEST] = yaml_dump(
+        {
+            "package": pkg,
+            "scenario": f"{fname}.yaml",
+            "params": f"{fname}_params.yaml",
+            "nodes": [{"leaf": p, "module": f"{pkg}/{names.script(p)}.py"} for p in remote],
+        }
+    )
+    for rel, text in files.items():
+        target = out / rel
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(text)
+    return Package2(pkg, remote, local, sorted(files))
+
+
+def _params_yaml(scenario: Scenario, remote: list[str]) -> str:
+    """``ros__parameters`` of every node at t = 0 (the world's values, the scenario's set:),
+    ``use_sim_time`` on: keyed by the node's full name."""
+    values = start_values(scenario)  # as the ROS 1 export's (external.py)
+    tree: dict[str, Any] = {}
+    for path in remote:
+        params: dict[str, Any] = {"use_sim_time": True}
+        for name, value in values[path].items():
+            params[name] = _plain(value)
+        tree[names.ns(path)] = {"ros__parameters": params}
+    head = (
+        f"# ROS 2 parameters of {yaml_comment(scenario.name)} at t = 0 (the world's values and\n"
+        "# the scenario's set:); amsa-phys sets them along the timeline through each node's\n"
+        "# set_parameters service.\n"
+    )
+    return head + yaml_dump(tree)
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, tuple):
+        flat: list[Any] = []
+        for v in value:
+            flat.extend(_plain(v) if isinstance(v, tuple) else [v])
+        return flat
+    return value
+
+
+__all__ = ["MANIFEST", "Package2", "generate", "package_name"]

@@ -1,0 +1,117 @@
+"""Running amsa-phys and a user's rclpy node together, in a private network, for a test.
+
+The ROS 2 wheels live in ``.venv-ros2`` (never the test suite's own venv: ROS 1's message
+packages share their names), so everything ROS 2 runs as that venv's python, in ``unshare -n``
+with only loopback up and a ROS_DOMAIN_ID of the test's own. Every process carries a token in
+its environment: a test proves none is left behind.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import random
+import shlex
+import shutil
+import subprocess
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+PY = ROOT / ".venv-ros2" / "bin" / "python"
+NODE = Path(__file__).resolve().parent / "follower_node.py"
+WALL_LIMIT_S = 600  # a hung run is killed (and fails the test), never waited for forever
+
+
+def ros2_missing() -> str | None:
+    """Why the ROS 2 tests cannot run here, or None."""
+    if not PY.exists():
+        return f"{PY} is missing (.ci/run makes it: pip install -e '.[ros2]' in .venv-ros2)"
+    probe = subprocess.run([PY, "-c", "import rclpy, amsa_phys"], capture_output=True)
+    if probe.returncode != 0:
+        return f"rclpy or amsa_phys is not importable in {PY}"
+    for tool in ("unshare", "ip"):
+        if shutil.which(tool) is None:
+            return f"{tool} is not installed"
+    if os.geteuid() != 0:
+        return "unshare -n (a private network for DDS) needs root"
+    if subprocess.run(["unshare", "-n", "true"], capture_output=True).returncode != 0:
+        return "unshare -n is not permitted here"
+    return None
+
+
+@dataclass
+class Outcome:
+    """What the amsa-phys command did, and what was left running after it."""
+
+    rc: int
+    stdout: str
+    stderr: str
+    node_log: str
+    leftovers: list[int]
+
+
+def leftovers(token: str) -> list[int]:
+    """Processes whose environment holds ``token``."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            env = (entry / "environ").read_bytes()
+        except OSError:
+            continue
+        if f"AMSA_ROS2_TEST={token}".encode() in env.split(b"\0"):
+            found.append(int(entry.name))
+    return found
+
+
+def run_with_nodes(
+    tmp: Path, amsa_args: list[str], nodes: list[list[str]], domains: list[int] | None = None
+) -> Outcome:
+    """Start each node (``nodes``: argument lists of ``follower_node.py``; ``domains``: each
+    one's ROS_DOMAIN_ID after the test's own, default 0), then ``amsa-phys AMSA_ARGS`` with
+    the ROS 2 venv's python; stop the nodes; report."""
+    token = uuid.uuid4().hex
+    out, err, log = tmp / "amsa.out", tmp / "amsa.err", tmp / "node.log"
+    lines = ["set -u", "ip link set lo up", "pids=()"]
+    for i, args in enumerate(nodes):
+        shift = domains[i] if domains else 0
+        cmd = f"ROS_DOMAIN_ID=$((ROS_DOMAIN_ID + {shift})) " + " ".join(
+            shlex.quote(str(a)) for a in [PY, NODE, *args]
+        )
+        lines.append(f"{cmd} >>{shlex.quote(str(log))} 2>&1 & pids+=($!)")
+    amsa = " ".join(shlex.quote(str(a)) for a in [PY, "-m", "amsa_phys", *amsa_args])
+    lines.append(f"{amsa} >{shlex.quote(str(out))} 2>{shlex.quote(str(err))}; rc=$?")
+    lines.append('for p in "${pids[@]}"; do kill "$p" 2>/dev/null; wait "$p" 2>/dev/null; done')
+    lines.append("exit $rc")
+    script = tmp / "run.sh"
+    script.write_text("\n".join(lines) + "\n")
+    env = {
+        **os.environ,
+        "AMSA_ROS2_TEST": token,
+        "ROS_DOMAIN_ID": str(random.randint(1, 100)),
+        "SDL_VIDEODRIVER": "dummy",
+        "MPLBACKEND": "Agg",
+        "PYTHONUNBUFFERED": "1",
+    }
+    env.pop("VIRTUAL_ENV", None)
+    try:
+        proc = subprocess.run(
+            ["unshare", "-n", "bash", str(script)], env=env, cwd=tmp, timeout=WALL_LIMIT_S
+        )
+        rc = proc.returncode
+    except subprocess.TimeoutExpired:
+        rc = -1
+    left = leftovers(token)
+    for pid in left:  # a straggler fails the test, and is not left running after it
+        with contextlib.suppress(OSError):
+            os.kill(pid, 9)
+    return Outcome(
+        rc,
+        out.read_text() if out.exists() else "",
+        err.read_text() if err.exists() else "",
+        log.read_text() if log.exists() else "",
+        left,
+    )
