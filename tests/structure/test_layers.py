@@ -316,6 +316,9 @@ ALLOWED_WRITES = {
     # its own module: importing the package binds amsa_phys.falsify, the public function's
     # name, so the package is made callable as that function
     ("falsify/__init__.py", "sys.modules[__name__].__class__"),
+    # a sweep's ROS 2 lane runs in a pool worker of its own: its process's domain, read when
+    # each run's bridge starts (the parent's environment is never touched)
+    ("runs/sweep.py", "os.environ['ROS_DOMAIN_ID']"),
 }
 
 

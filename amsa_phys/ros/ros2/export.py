@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ... import __version__
+from ..._version import __version__
 from ...errors import ConfigError
 from ...model.scenario import Scenario
 from ...runs.resolve import resolved_scenario
