@@ -9,10 +9,14 @@ from pathlib import Path
 
 import yaml
 
-from ..adapt.derive import Derivation, derive
+from ..adapt.derive import MARGIN, MIN_GAIN, Derivation, derive
+from ..adapt.sweepdir import read_sweep_scenario
 from ..atomic import write_atomic
-from ..errors import ConfigError
-from ..model.scenario import load_scenario
+from ..errors import ConfigError, one_line
+from ..model import schema
+from ..model.adaptrules import FILE, parse_rules
+from ..model.scenario import Scenario, load_scenario
+from ..model.yamlio import parse_yaml
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -20,8 +24,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("sweepdir", help="a sweep's output directory (its results.csv)")
     p.add_argument(
         "--scenario",
-        required=True,
-        help="the scenario the sweep ran (its sweep.contexts and the world's estimators)",
+        help="the scenario the sweep ran (default: the one the sweep directory records)",
     )
     p.add_argument("-o", "--output", required=True, metavar="RULES.yaml", help="rules file")
     p.add_argument(
@@ -32,52 +35,106 @@ def add_args(p: argparse.ArgumentParser) -> None:
         type=float,
         default=10.0,
         metavar="S",
-        help="each rule's hold time in seconds (default 10)",
+        help="each rule's hold time in seconds, and the least time between switches (default 10)",
+    )
+    p.add_argument(
+        "--margin",
+        type=float,
+        default=MARGIN,
+        metavar="M",
+        help="a chosen point's grid neighbours may be at most M worse (default 0.5: 50 %%; "
+        "inf: no margin)",
+    )
+    p.add_argument(
+        "--min-gain",
+        type=float,
+        default=MIN_GAIN,
+        metavar="G",
+        help="least gain of switching over the robust fixed choice worth rules (default 0.05)",
     )
     p.add_argument("--force", action="store_true", help="replace an existing rules file")
 
 
 def run(args: argparse.Namespace) -> int:
-    """Read the sweep, derive, write the rules file, print the table."""
-    results = Path(args.sweepdir) / "results.csv"
+    """Read the sweep, derive, write the rules file (or say why not), print the table."""
+    sweepdir = Path(args.sweepdir)
+    results = sweepdir / "results.csv"
     if not results.is_file():
         raise ConfigError(
-            f"no results.csv in {args.sweepdir} (is it a sweep's --out?)", key="adapt"
+            f"no results.csv in {one_line(str(sweepdir))} (is it a sweep's --out?)", key="adapt"
         )
     if not (args.hold >= 0 and math.isfinite(args.hold)):
         raise ConfigError(f"must be a number of seconds >= 0, got {args.hold}", key="--hold")
+    if not args.margin >= 0:
+        raise ConfigError(f"must be >= 0 (or inf), got {args.margin}", key="--margin")
+    if not (0 <= args.min_gain < 1):
+        raise ConfigError(f"must be in [0, 1), got {args.min_gain}", key="--min-gain")
     out = Path(args.output)
     if out.exists() and not args.force:
-        raise ConfigError(f"{out} exists; use --force to replace it", key="-o")
-    scenario = load_scenario(args.scenario)
-    found = derive(results, scenario, args.metric, args.hold)
-    write_atomic(out, rules_text(found, args.sweepdir))
+        raise ConfigError(f"{one_line(str(out))} exists; use --force to replace it", key="-o")
+    scenario = load_scenario(args.scenario) if args.scenario else read_sweep_scenario(sweepdir)
+    found = derive(results, scenario, args.metric, args.hold, args.margin, args.min_gain)
     for line in table(found):
-        print(line)
+        print(one_line(line))
+    if found.refused:
+        print(one_line(f"no rules written: {found.refused}"))
+        return 0
+    text = rules_text(found, str(sweepdir))
+    _check_loads(text, out, scenario)
+    write_atomic(out, text)
     for problem in found.unplaced:
-        print(f"warning: no rule for {problem}", file=sys.stderr)
-    print(f"{len(found.rules)} rules written to {out}")
+        print(one_line(f"warning: no rule for {problem}"), file=sys.stderr)
+    print(one_line(f"{len(found.rules)} rules written to {out}"))
     return 0
 
 
 def table(found: Derivation) -> list[str]:
-    """The cells: context, estimator levels, best values and their metric."""
-    lines = [f"cell | estimator levels | best {', '.join(found.tuned)} | mean {found.metric}"]
+    """The cells: context, estimator levels, best values and their metric; then the gain."""
+    lines = [
+        f"cell | estimator levels | best {', '.join(found.tuned)} | mean {found.metric} | robust's"
+    ]
     for c in found.cells:
         levels = ", ".join(f"{k}={v:g}" for k, v in c.levels.items()) or "-"
         best = ", ".join(f"{v}" for v in c.best.values()) or "-"
-        lines.append(f"{c.name} | {levels} | {best} | {c.score:.4g}")
+        note = ""
+        if c.unsafe is not None:
+            lowest = ", ".join(f"{v}" for v in c.unsafe[0].values())
+            note = f" (not {lowest} at {c.unsafe[1]:.4g}: a neighbour is unstable or far worse)"
+        lines.append(f"{c.name} | {levels} | {best} | {c.score:.4g} | {c.robust_score:.4g}{note}")
+    if found.robust:
+        robust = ", ".join(f"{k}={v}" for k, v in found.robust.items())
+        lines.append(
+            f"robust fixed choice (least worst-case ratio to each context's best): {robust}, "
+            f"mean {found.robust_mean:.4g}; switching per context (oracle): "
+            f"{found.oracle_mean:.4g} ({100 * found.gain:.1f} % lower)"
+        )
     return lines
 
 
 def rules_text(found: Derivation, sweepdir: str) -> str:
-    """The rules file: the table as comments, then ``adapt:``."""
-    head = [f"# adapt: rules derived by `amsa-phys adapt {sweepdir}` ({found.metric}, lowest wins)"]
-    head += ["# estimator -> context parameter:"]
-    head += [f"#   {w.signal} ~ {w.key}" for w in found.watches]
-    head += [f"# {line}" for line in table(found)]
-    head += [f"# not placed: {p}" for p in found.unplaced]
+    """The rules file: the table as comments, then ``adapt:`` (written by the YAML emitter)."""
+    head = [
+        f"adapt: rules derived by `amsa-phys adapt {sweepdir}` ({found.metric}, lowest wins)",
+        "estimator -> context parameter:",
+    ]
+    head += [f"  {w.signal} ~ {w.key}" for w in found.watches]
+    head += table(found)
+    head += [f"not placed: {p}" for p in found.unplaced]
+    # a comment is one line whatever a name holds: newlines and control characters escaped
+    comments = "".join(f"# {one_line(line)}\n" for line in head)
     body = yaml.safe_dump(
         {"adapt": found.rules}, sort_keys=False, default_flow_style=None, width=100
     )
-    return "\n".join(head) + "\n" + body
+    return comments + body
+
+
+def _check_loads(text: str, out: Path, scenario: Scenario) -> None:
+    """Refuse to write rules that would not load (the loader's own checks, on the text)."""
+    try:
+        doc = parse_yaml(text, out)
+        schema.validate(doc.data, FILE, doc)
+        parse_rules(doc, doc.data["adapt"], scenario.world)
+    except ConfigError as exc:
+        raise ConfigError(
+            f"the derived rules would not load ({exc.message}); nothing written", file=out
+        ) from None

@@ -69,3 +69,5 @@ class RunResult:
     samples_t: np.ndarray
     samples_s: np.ndarray
     events: list[Event] = field(default_factory=list)
+    #: every ``adapt:`` switch of the run (``events`` keeps only the first ones)
+    adapt_switches: int = 0

@@ -476,6 +476,7 @@ class Simulation(ReadAPI, LiveChanges):
             samples_t=samples_t,
             samples_s=samples_s,
             events=list(self.events),
+            adapt_switches=self._adapt.switches if self._adapt is not None else 0,
         )
 
     def _who(self, path: str) -> str:
