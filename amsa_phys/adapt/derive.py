@@ -279,7 +279,7 @@ def _fallbacks(
                 "when": {valid: {"below": 0.5}},
                 "set": dict(robust),
                 "hold": _whole(hold),
-                "label": f"robust: {leaf} unsure",
+                "label": f"robust, {leaf} unsure",
             }
         )
     return out
