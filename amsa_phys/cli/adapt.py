@@ -53,6 +53,33 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="least gain of switching over the robust fixed choice worth rules (default 0.05)",
     )
     p.add_argument("--force", action="store_true", help="replace an existing rules file")
+    p.add_argument(
+        "--validate",
+        action="store_true",
+        help="score the rules on held-out context sequences against the robust fixed choice "
+        "and the oracle schedule; exit 1 if they lose",
+    )
+    p.add_argument(
+        "--sequences", type=int, default=5, metavar="N", help="held-out sequences (default 5)"
+    )
+    p.add_argument(
+        "--seeds", type=int, default=3, metavar="N", help="seeds per sequence (default 3)"
+    )
+    p.add_argument(
+        "--duration",
+        type=float,
+        default=600.0,
+        metavar="S",
+        help="length of a held-out sequence in seconds (default 600)",
+    )
+    p.add_argument(
+        "--tolerance",
+        type=float,
+        default=0.02,
+        metavar="T",
+        help="the rules lose on a sequence when their mean is more than T above the robust "
+        "choice's (default 0.02: 2 %%)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -69,6 +96,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"must be >= 0 (or inf), got {args.margin}", key="--margin")
     if not (0 <= args.min_gain < 1):
         raise ConfigError(f"must be in [0, 1), got {args.min_gain}", key="--min-gain")
+    if args.validate:
+        _check_validate_args(args)
     out = Path(args.output)
     if out.exists() and not args.force:
         raise ConfigError(f"{one_line(str(out))} exists; use --force to replace it", key="-o")
@@ -85,6 +114,65 @@ def run(args: argparse.Namespace) -> int:
     for problem in found.unplaced:
         print(one_line(f"warning: no rule for {problem}"), file=sys.stderr)
     print(one_line(f"{len(found.rules)} rules written to {out}"))
+    if args.validate:
+        return _validate(args, scenario, found)
+    return 0
+
+
+def _check_validate_args(args: argparse.Namespace) -> None:
+    """--validate's numbers, refused before any work."""
+    if not 1 <= args.sequences <= 1000:
+        raise ConfigError(f"must be 1..1000, got {args.sequences}", key="--sequences")
+    if not 1 <= args.seeds <= 1000:
+        raise ConfigError(f"must be 1..1000, got {args.seeds}", key="--seeds")
+    if not (60 <= args.duration <= 100_000 and math.isfinite(args.duration)):
+        raise ConfigError(f"must be 60..100000 seconds, got {args.duration}", key="--duration")
+    if not (0 <= args.tolerance < 1):
+        raise ConfigError(f"must be in [0, 1), got {args.tolerance}", key="--tolerance")
+
+
+def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -> int:
+    """Run the held-out sequences, print the table; 1 if the rules lose to the robust one."""
+    from ..adapt.validate import HEADER, loses, validate
+
+    contexts = dict(scenario.data.get("sweep", {}).get("contexts", {}))
+    if not contexts:
+        raise ConfigError(
+            "--validate draws held-out contexts from the sweep's contexts; this sweep has none",
+            key="--validate",
+        )
+    print(
+        one_line(
+            f"validating on {args.sequences} held-out sequences x {args.seeds} seeds "
+            f"({found.metric}, seed means, lower is better):"
+        )
+    )
+    print(HEADER)
+    rows = validate(
+        scenario,
+        found,
+        contexts,
+        args.sequences,
+        args.seeds,
+        args.duration,
+        report=lambda text: print(one_line(text), flush=True),
+    )
+    lost = loses(rows, args.tolerance)
+    if lost:
+        print(
+            one_line(
+                f"warning: the rules lose to the robust fixed choice on {len(lost)} of "
+                f"{len(rows)} held-out sequences (by more than {100 * args.tolerance:g} %)"
+            ),
+            file=sys.stderr,
+        )
+        return 1
+    print(
+        one_line(
+            f"the rules hold: never more than {100 * args.tolerance:g} % worse than the "
+            f"robust fixed choice on {len(rows)} held-out sequences"
+        )
+    )
     return 0
 
 
