@@ -35,7 +35,7 @@ class Axis:
         if self.choices:
             return self.choices[int(rng.integers(len(self.choices)))]
         value = float(rng.uniform(self.lo, self.hi))
-        return int(round(value)) if self.integer else round(value, 3)
+        return round(value) if self.integer else round(value, 3)
 
 
 def box(scenario: Scenario, contexts: dict[str, dict[str, Any]]) -> list[Axis]:
