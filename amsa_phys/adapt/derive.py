@@ -5,10 +5,10 @@ and/or of a grid axis on a parameter some estimator watches (``links.py``). Ever
 axis is *tuned*; a *point* is one combination of tuned values.
 
 Rules are only worth writing if switching beats keeping one good point, so three numbers
-come first. The **robust point** is the point whose worst cell is least bad, measured as
-its seed-mean metric over that cell's best (the worst-case regret ratio: contexts whose
-metric differs tenfold weigh alike); it is what the robot runs when the estimators are
-unsure. Each cell's **safe best** is its lowest seed-mean point whose grid neighbours
+come first. The **robust point** is the point whose worst cell is least bad (the least
+worst-case seed mean, as ``amsa-phys tune --measure worst`` minimises over the same
+contexts; ``robust=`` gives tune's answer instead); it is what the robot runs when the
+estimators are unsure. Each cell's **safe best** is its lowest seed-mean point whose grid neighbours
 (one step along each tuned axis) all finished and are at most ``margin`` worse: a gain one
 step below instability is never chosen, since the estimate that picks it is never exact
 (the robust point instead, when no safe point beats it there).
@@ -96,8 +96,10 @@ def derive(
     hold: float = 10.0,
     margin: float = MARGIN,
     min_gain: float = MIN_GAIN,
+    robust: dict[str, Any] | None = None,
 ) -> Derivation:
-    """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``."""
+    """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
+    is the fixed choice to fall back on (default: the sweep's least worst-case point)."""
     found = watches(scenario.world)
     watched = {w.key for w in found}
     contexts: dict[str, dict[str, Any]] = dict(scenario.data.get("sweep", {}).get("contexts", {}))
@@ -126,7 +128,21 @@ def derive(
                 ctx[a] = v
             name.append(str(v) if a == "context" else f"{a}={v}")
         cells[key] = Cell(", ".join(name), ctx)
+    given = robust
     robust = _robust(table, margin)
+    if given is not None:
+        if sorted(given) != sorted(table.tuned):
+            raise ConfigError(
+                f"must set exactly the tuned axes ({', '.join(table.tuned)})",
+                key="--robust",
+            )
+        robust = tuple(given[k] for k in table.tuned)
+        if not all(robust in by for by in table.stats.values()):
+            raise ConfigError(
+                "that point is not on the sweep's grid in every context (the "
+                "oracle and the margin compare grid points)",
+                key="--robust",
+            )
     for key, cell in cells.items():
         by_point = table.stats[key]
         cell.runs = sum(s.count + s.failed for s in by_point.values())
@@ -243,17 +259,16 @@ def _safe_best(table: SweepTable, cell: tuple[Any, ...], margin: float) -> tuple
 
 
 def _robust(table: SweepTable, margin: float) -> tuple[Any, ...] | None:
-    """The point minimising the worst regret ratio over the cells (safe ones first)."""
+    """The point with the least worst-case seed mean over the cells (safe ones first)."""
     cells = list(table.stats)
     common = set.intersection(*(set(table.stats[c]) for c in cells)) if cells else set()
     everywhere = [p for p in common if all(table.stats[c][p].stable for c in cells)]
     if not everywhere:
         return None
-    bests = {c: min(s.mean for s in table.stats[c].values() if s.stable) for c in cells}
 
     def worst(p: tuple[Any, ...]) -> tuple[float, float, tuple[Any, ...]]:
-        ratios = [table.stats[c][p].mean / bests[c] if bests[c] > 0 else 1.0 for c in cells]
-        return (max(ratios), statistics.fmean(table.stats[c][p].mean for c in cells), p)
+        means = [table.stats[c][p].mean for c in cells]
+        return (max(means), statistics.fmean(means), p)
 
     safe = [p for p in everywhere if all(_safe(table, c, p, margin) for c in cells)]
     return min(safe or everywhere, key=worst)

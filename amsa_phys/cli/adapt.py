@@ -52,6 +52,14 @@ def add_args(p: argparse.ArgumentParser) -> None:
         metavar="G",
         help="least gain of switching over the robust fixed choice worth rules (default 0.05)",
     )
+    p.add_argument(
+        "--robust",
+        action="append",
+        default=[],
+        metavar="Comp.param=V",
+        help="the fixed choice to fall back on and compare with (`amsa-phys tune`'s answer, "
+        "on the sweep's grid; default: the sweep's least worst-case point)",
+    )
     p.add_argument("--force", action="store_true", help="replace an existing rules file")
     p.add_argument(
         "--validate",
@@ -102,7 +110,8 @@ def run(args: argparse.Namespace) -> int:
     if out.exists() and not args.force:
         raise ConfigError(f"{one_line(str(out))} exists; use --force to replace it", key="-o")
     scenario = load_scenario(args.scenario) if args.scenario else read_sweep_scenario(sweepdir)
-    found = derive(results, scenario, args.metric, args.hold, args.margin, args.min_gain)
+    robust = _robust_option(args.robust, scenario)
+    found = derive(results, scenario, args.metric, args.hold, args.margin, args.min_gain, robust)
     for line in table(found):
         print(one_line(line))
     if found.refused:
@@ -117,6 +126,26 @@ def run(args: argparse.Namespace) -> int:
     if args.validate:
         return _validate(args, scenario, found)
     return 0
+
+
+def _robust_option(texts: list[str], scenario: Scenario) -> dict[str, object] | None:
+    """``--robust Comp.param=V`` values, judged as the parameter's own values."""
+    if not texts:
+        return None
+    from ..model.changes import resolve_change
+    from ..model.yamlio import parse_value
+
+    out: dict[str, object] = {}
+    for text in texts:
+        key, sep, raw = text.partition("=")
+        if not sep:
+            raise ConfigError(f"expected Comp.param=V, got {one_line(text)!r}", key="--robust")
+        try:
+            value = parse_value(raw, "--robust")
+            out[key.strip()] = resolve_change(key.strip(), value, scenario.world).value
+        except ValueError as exc:
+            raise ConfigError(str(exc), key=f"--robust {one_line(key.strip())}") from None
+    return out
 
 
 def _check_validate_args(args: argparse.Namespace) -> None:
@@ -192,7 +221,7 @@ def table(found: Derivation) -> list[str]:
     if found.robust:
         robust = ", ".join(f"{k}={v}" for k, v in found.robust.items())
         lines.append(
-            f"robust fixed choice (least worst-case ratio to each context's best): {robust}, "
+            f"robust fixed choice (least worst-case mean): {robust}, "
             f"mean {found.robust_mean:.4g}; switching per context (oracle): "
             f"{found.oracle_mean:.4g} ({100 * found.gain:.1f} % lower)"
         )

@@ -1,14 +1,15 @@
-"""The optimizer of ``amsa-phys tune``: bounded Brent for one parameter, CMA-ES for several.
+"""The optimizer of ``amsa-phys tune``: golden sections for one parameter, CMA-ES for several.
 
 The objective (a tail measure over contexts and seeds) is deterministic: every candidate is
 run on the same contexts with the same seeds (common random numbers), so two candidates
 differ by their parameters alone and the answer is reproducible. For one parameter (the
 usual case: a gain) a coarse grid over the range first brackets the best (the objective of
 a gain is steep near instability and may have a flat plateau, which misleads a local
-method started blind), then SciPy's bounded Brent method refines inside the best grid
-point's neighbours. For two or more, CMA-ES (the ``cmaes`` package, as ``falsify`` uses)
-searches the unit box, the best point of a Latin-hypercube-free start (the box's centre,
-step 0.3) kept across generations. Every evaluation counts against ``budget``.
+method started blind), then a golden-section search refines between the best grid
+point's neighbours (a dozen lines here rather than SciPy as a dependency; it needs no
+derivative and shrinks the bracket by 0.618 per evaluation). For two or more, CMA-ES (the
+``cmaes`` package, which ``falsify`` already uses) searches the unit box from its centre
+(step 0.3). Every evaluation counts against ``budget``.
 """
 
 from __future__ import annotations
@@ -72,22 +73,24 @@ def minimise(
 
 
 def _one(f: Callable[[tuple[float, ...]], float], bound: tuple[float, float], budget: int) -> None:
-    from scipy.optimize import minimize_scalar  # imported when tuning: `--help` stays fast
-
     lo, hi = bound
     n = max(2, min(budget, max(3, budget // 2)))
-    grid = list(np.linspace(lo, hi, n))
-    scores = [f((float(x),)) for x in grid]
+    grid = [float(x) for x in np.linspace(lo, hi, n)]
+    scores = [f((x,)) for x in grid]
     k = int(np.argmin(scores))
     a, b = grid[max(0, k - 1)], grid[min(n - 1, k + 1)]
-    left = budget - n
-    if left > 0 and b > a:
-        minimize_scalar(
-            lambda x: f((float(x),)),
-            bounds=(a, b),
-            method="bounded",
-            options={"maxiter": left, "xatol": 1e-3 * (hi - lo)},
-        )
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    c, d = b - ratio * (b - a), a + ratio * (b - a)
+    fc, fd = f((c,)), f((d,))
+    for _ in range(budget - n - 2):
+        if fc <= fd:
+            b, d, fd = d, c, fc
+            c = b - ratio * (b - a)
+            fc = f((c,))
+        else:
+            a, c, fc = c, d, fd
+            d = a + ratio * (b - a)
+            fd = f((d,))
 
 
 def _many(
