@@ -60,3 +60,37 @@ def test_worn_motors_are_seen_within_twenty_seconds() -> None:
         assert seen.size, seed
         assert seen[0] - 150 <= 20, seed
         assert np.all(d[(t > 150) & (t < 150 + 5)] > 0.7)  # not before the change shows
+
+
+class _Ctx:
+    rng = None
+    path = "M"
+
+
+def _motor(share: float, reverse: bool = False) -> dict:
+    """A MotorMonitor fed 60 s of a rover whose speed shows ``share`` of a 20 % command."""
+    from fractions import Fraction
+
+    from amsa_phys.control.estimators.motor import MotorMonitor
+
+    comp = MotorMonitor("M", {})
+    comp.initialize(_Ctx())
+    speed = (share * 20.0 - 2.9) / 100.0 * 5.5
+    out: dict = {}
+    for k in range(241):
+        t = k / 4
+        power = -20.0 if reverse and k % 40 == 0 else 20.0
+        inputs = {"powerL": power, "powerR": power, "posX": speed * t, "posY": 0.0}
+        out = dict(comp.do_step(Fraction(k, 4), inputs) or out)
+    return out
+
+
+def test_a_share_a_little_above_one_is_noise_published_as_one() -> None:
+    out = _motor(1.08)
+    assert out == {"delivered": 1.0, "valid": 1.0}
+
+
+def test_a_share_far_above_one_or_a_reversing_command_is_invalid() -> None:
+    assert _motor(1.5) == {"delivered": 1.0, "valid": 0.0}  # held at its start value
+    assert _motor(0.6, reverse=True)["valid"] == 0.0
+    assert _motor(0.6)["delivered"] == pytest.approx(0.6, abs=0.02)
