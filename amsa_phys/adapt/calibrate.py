@@ -73,7 +73,7 @@ def leader_table() -> list[str]:
                 ]
             shares = 100 * counts / counts.sum()
             lines.append(
-                f"| {name} | {noise * 100:g} cm | "
+                f"| {name} | {noise * 100:g} cm, {assumed * 100:g} cm | "
                 + " | ".join(f"{s:.0f} %" for s in shares)
                 + " |"
             )

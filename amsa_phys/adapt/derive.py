@@ -83,10 +83,11 @@ class Derivation:
 
     @property
     def gain(self) -> float:
-        """What the oracle schedule gains over the robust point (0.1: 10 % lower metric)."""
-        if not (self.robust_mean > 0):
+        """What the oracle schedule gains over the robust point (0.1: 10 % lower metric, or
+        10 % more robustness: a ``robustness.NAME`` objective is kept negated)."""
+        if not (self.robust_mean != 0 and math.isfinite(self.robust_mean)):
             return 0.0
-        return 1.0 - self.oracle_mean / self.robust_mean
+        return (self.robust_mean - self.oracle_mean) / abs(self.robust_mean)
 
 
 def derive(

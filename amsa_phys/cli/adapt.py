@@ -17,6 +17,7 @@ from ..model import schema
 from ..model.adaptrules import FILE, parse_rules
 from ..model.scenario import Scenario, load_scenario
 from ..model.yamlio import parse_yaml
+from ..tune.objective import ROBUSTNESS
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -28,7 +29,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("-o", "--output", required=True, metavar="RULES.yaml", help="rules file")
     p.add_argument(
-        "--metric", default="rms_error", help="the metric to minimise (default rms_error)"
+        "--metric",
+        default="rms_error",
+        help="the metric to minimise (default rms_error), or robustness.NAME to maximise",
     )
     p.add_argument(
         "--hold",
@@ -216,22 +219,30 @@ def table(found: Derivation) -> list[str]:
         note = ""
         if c.unsafe is not None:
             lowest = ", ".join(f"{v}" for v in c.unsafe[0].values())
-            note = f" (not {lowest} at {c.unsafe[1]:.4g}: a neighbour is unstable or far worse)"
-        lines.append(f"{c.name} | {levels} | {best} | {c.score:.4g} | {c.robust_score:.4g}{note}")
+            at = _shown(found, c.unsafe[1])
+            note = f" (not {lowest} at {at:.4g}: a neighbour is unstable or far worse)"
+        score, robust = _shown(found, c.score), _shown(found, c.robust_score)
+        lines.append(f"{c.name} | {levels} | {best} | {score:.4g} | {robust:.4g}{note}")
     if found.robust:
         robust = ", ".join(f"{k}={v}" for k, v in found.robust.items())
         lines.append(
             f"robust fixed choice (least worst-case mean): {robust}, "
-            f"mean {found.robust_mean:.4g}; switching per context (oracle): "
-            f"{found.oracle_mean:.4g} ({100 * found.gain:.1f} % lower)"
+            f"mean {_shown(found, found.robust_mean):.4g}; switching per context (oracle): "
+            f"{_shown(found, found.oracle_mean):.4g} ({100 * found.gain:.1f} % better)"
         )
     return lines
+
+
+def _shown(found: Derivation, value: float) -> float:
+    """A mean as the user's metric reads it (a robustness objective is kept negated)."""
+    return -value if found.metric.startswith(ROBUSTNESS) else value
 
 
 def rules_text(found: Derivation, sweepdir: str) -> str:
     """The rules file: the table as comments, then ``adapt:`` (written by the YAML emitter)."""
     head = [
-        f"adapt: rules derived by `amsa-phys adapt {sweepdir}` ({found.metric}, lowest wins)",
+        f"adapt: rules derived by `amsa-phys adapt {sweepdir}` ({found.metric}, "
+        + ("highest wins)" if found.metric.startswith(ROBUSTNESS) else "lowest wins)"),
         "estimator -> context parameter:",
     ]
     head += [f"  {w.signal} ~ {w.key}" for w in found.watches]
