@@ -21,6 +21,7 @@ from ..errors import ConfigError, one_line
 from ..model.changes import resolve_change
 from ..model.params import short_repr
 from ..model.world import WorldSpec
+from ..tune.objective import ROBUSTNESS
 
 #: Columns of every results.csv that are not metrics (never a ``--metric``).
 NOT_METRICS = ("run", "seed_index", "seed", "error")
@@ -117,6 +118,8 @@ def _read(
     context_axes = [a for a in axes if a == "context" or a in watched]
     tuned = [a for a in axes if a not in context_axes]
     table = SweepTable(axes, context_axes, tuned)
+    # a requirement's robustness is higher-is-better: kept negated, so lower wins throughout
+    sign = -1.0 if metric.startswith(ROBUSTNESS) else 1.0
     at = {name: fields.index(name) for name in fields}
     judged: dict[tuple[str, str], Any] = {}
     points = 0
@@ -160,7 +163,7 @@ def _read(
         if raw[at["error"]] or value is None:
             stats.failed += 1
         else:
-            stats.total += value
+            stats.total += sign * value
             stats.count += 1
         table.rows += 1
     return table
