@@ -17,6 +17,7 @@ from ..model import schema
 from ..model.adaptrules import FILE, parse_rules
 from ..model.scenario import Scenario, load_scenario
 from ..model.yamlio import parse_yaml
+from ..runs.rundir import check_output
 from ..tune.objective import ROBUSTNESS
 
 
@@ -109,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"must be in [0, 1), got {args.min_gain}", key="--min-gain")
     if args.validate:
         _check_validate_args(args)
-    out = Path(args.output)
+    out = check_output(Path(args.output), "-o")
     if out.exists() and not args.force:
         raise ConfigError(f"{one_line(str(out))} exists; use --force to replace it", key="-o")
     scenario = load_scenario(args.scenario) if args.scenario else read_sweep_scenario(sweepdir)
