@@ -42,6 +42,14 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="each rule's hold time in seconds, and the least time between switches (default 10)",
     )
     p.add_argument(
+        "--fallback-hold",
+        type=float,
+        default=None,
+        metavar="S",
+        help="seconds an estimator must stay unsure before the robust choice is set "
+        "(default: --hold)",
+    )
+    p.add_argument(
         "--margin",
         type=float,
         default=MARGIN,
@@ -104,6 +112,12 @@ def run(args: argparse.Namespace) -> int:
         )
     if not (args.hold >= 0 and math.isfinite(args.hold)):
         raise ConfigError(f"must be a number of seconds >= 0, got {args.hold}", key="--hold")
+    if args.fallback_hold is not None and not (
+        args.fallback_hold >= 0 and math.isfinite(args.fallback_hold)
+    ):
+        raise ConfigError(
+            f"must be a number of seconds >= 0, got {args.fallback_hold}", key="--fallback-hold"
+        )
     if not args.margin >= 0:
         raise ConfigError(f"must be >= 0 (or inf), got {args.margin}", key="--margin")
     if not (0 <= args.min_gain < 1):
@@ -115,7 +129,16 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"{one_line(str(out))} exists; use --force to replace it", key="-o")
     scenario = load_scenario(args.scenario) if args.scenario else read_sweep_scenario(sweepdir)
     robust = _robust_option(args.robust, scenario)
-    found = derive(results, scenario, args.metric, args.hold, args.margin, args.min_gain, robust)
+    found = derive(
+        results,
+        scenario,
+        args.metric,
+        args.hold,
+        args.margin,
+        args.min_gain,
+        robust,
+        args.fallback_hold,
+    )
     for line in table(found):
         print(one_line(line))
     if found.refused:
