@@ -1,21 +1,37 @@
-"""From a context sweep's ``results.csv`` to ``adapt:`` rules.
+"""From a context sweep's ``results.csv`` to ``adapt:`` rules that hold on unseen contexts.
 
 A *cell* is one context of the sweep: a value of its ``context`` axis (a named parameter set)
 and/or of a grid axis on a parameter some estimator watches (``links.py``). Every other
-axis is *tuned*. For each cell the tuned values with the lowest seed-mean metric are the
-cell's best. The cell's context parameters (the sweep's values over the scenario's own)
-give the level each estimator output settles to there (``Estimates.expected``: about
-0.01 x ``motorCoef`` for ``MotorMonitor.delivered``, 0.01 x ``lostDataGPS`` for
-``GPSLossMonitor.lossRate``, 0 straight / 0.5 random for ``LeaderMonitor.turning``). A rule
-per cell then conditions each output that differs between cells on the band around the
-cell's level: above the midpoint to the next lower level, below the midpoint to the next
-higher one. Cells are reported, not guessed, when an estimator cannot place them (a context
-parameter no estimator watches, a value its mapping does not know) or when two cells with
-different best values settle to the same levels.
+axis is *tuned*; a *point* is one combination of tuned values.
+
+Rules are only worth writing if switching beats keeping one good point, so three numbers
+come first. The **robust point** is the point whose worst cell is least bad (the least
+worst-case seed mean, as ``amsa-phys tune --measure worst`` minimises over the same
+contexts; ``robust=`` gives tune's answer instead); it is what the robot runs when the
+estimators are unsure. Each cell's **safe best** is its lowest seed-mean point whose grid neighbours
+(one step along each tuned axis) all finished and are at most ``margin`` worse: a gain one
+step below instability is never chosen, since the estimate that picks it is never exact
+(the robust point instead, when no safe point beats it there).
+The **oracle** is each cell's safe best, switched at the true instants; when its mean over
+the cells gains less than ``min_gain`` over the robust point's mean, there is nothing for
+adaptation to win and no rules are written (:attr:`Derivation.refused`).
+
+The cell's context parameters give the level each estimator output settles to there
+(``Estimates.expected``). A rule per cell conditions each output that differs between
+cells on a band around the cell's level: from the midpoint to the next level, less a
+``gap`` share of the distance on each side, so an estimate between two bands fires
+neither rule and the gain in force stays (hysteresis); each rule must hold for ``hold``
+seconds, and two switches are at least ``hold`` apart (dwell). Before them, one rule per
+estimator with a ``valid`` output sets the robust point once it has been 0 (unsure) for
+``fallback_hold`` seconds, and the cell rules require every such estimator to be sure. Cells
+are reported, not guessed, when an estimator cannot place them (a context parameter no
+estimator watches, a value its mapping does not know) or when two cells with different
+best values settle to the same levels.
 """
 
 from __future__ import annotations
 
+import math
 import statistics
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -24,8 +40,21 @@ from typing import Any
 
 from ..errors import ConfigError
 from ..model.scenario import Scenario
-from ..runs.sweep import read_results
 from .links import Watch, watches
+from .table import SweepTable, read_table
+
+#: Default safety margin: a best point's grid neighbours may be at most this much worse.
+MARGIN = 0.5
+#: Default least gain of the oracle schedule over the robust point worth adapting for.
+MIN_GAIN = 0.05
+#: Share of the distance between two levels left to no rule on each side of the midpoint.
+GAP = 0.1
+#: Seconds an estimator must stay unsure before the robust point is set (None: the rules'
+#: hold). A longer wait keeps a switch that blinds an estimator for a while (a high gain on
+#: very worn motors makes the loop reverse now and then) but leaves a wrong one in force
+#: longer: on the shipped box 60 s gained 20-25 % on very worn motors and lost 5-12 % on
+#: two other held-out sequences (``adapt --validate``), so the default stays the hold.
+FALLBACK_HOLD: float | None = None
 
 
 @dataclass
@@ -38,6 +67,9 @@ class Cell:
     score: float = float("nan")
     runs: int = 0
     levels: dict[str, float] = field(default_factory=dict)
+    #: the lowest mean, when the margin kept it from being the cell's best
+    unsafe: tuple[dict[str, Any], float] | None = None
+    robust_score: float = float("nan")
 
 
 @dataclass
@@ -50,75 +82,235 @@ class Derivation:
     rules: list[dict[str, Any]]
     unplaced: list[str]
     watches: list[Watch]
+    robust: dict[str, Any] = field(default_factory=dict)
+    robust_mean: float = float("nan")
+    oracle_mean: float = float("nan")
+    refused: str | None = None
+
+    @property
+    def gain(self) -> float:
+        """What the oracle schedule gains over the robust point (0.1: 10 % lower metric, or
+        10 % more robustness: a ``robustness.NAME`` objective is kept negated)."""
+        if not (self.robust_mean != 0 and math.isfinite(self.robust_mean)):
+            return 0.0
+        return (self.robust_mean - self.oracle_mean) / abs(self.robust_mean)
 
 
 def derive(
-    results: Path, scenario: Scenario, metric: str = "rms_error", hold: float = 10.0
+    results: Path,
+    scenario: Scenario,
+    metric: str = "rms_error",
+    hold: float = 10.0,
+    margin: float = MARGIN,
+    min_gain: float = MIN_GAIN,
+    robust: dict[str, Any] | None = None,
+    fallback_hold: float | None = FALLBACK_HOLD,
 ) -> Derivation:
-    """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``."""
-    rows, axes = read_results(results)
-    if rows and metric not in rows[0]:
-        raise ConfigError(f"no metric column {metric!r} in the sweep", file=results)
+    """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
+    is the fixed choice to fall back on (default: the sweep's least worst-case point)."""
     found = watches(scenario.world)
     watched = {w.key for w in found}
     contexts: dict[str, dict[str, Any]] = dict(scenario.data.get("sweep", {}).get("contexts", {}))
-    if "context" in axes and not contexts:
-        raise ConfigError(
-            "the sweep has a context axis but the scenario given has no sweep.contexts; "
-            "give the scenario the sweep ran",
-            file=results,
-        )
-    context_axes = [a for a in axes if a == "context" or a in watched]
-    tuned = [a for a in axes if a not in context_axes]
-    if not tuned:
+    table = read_table(results, metric, scenario.world, contexts, watched)
+    if not table.rows:
+        raise ConfigError("no runs in the sweep", file=results)
+    if not table.tuned:
         raise ConfigError("no tuned axis: every axis is a context", file=results)
-    if not context_axes:
+    if not table.context_axes:
         # one context only: there is nothing for a rule to tell apart (a Kv-only sweep)
         raise ConfigError(
-            f"no context axis: the sweep's axes ({', '.join(axes)}) are all tuned; sweep a "
-            "'context' axis (the scenario's sweep.contexts) or a parameter an estimator "
+            f"no context axis: the sweep's axes ({', '.join(table.axes)}) are all tuned; sweep "
+            "a 'context' axis (the scenario's sweep.contexts) or a parameter an estimator "
             "watches, so rules have contexts to tell apart",
             file=results,
         )
     base = _base_values(scenario)
     cells: dict[tuple[Any, ...], Cell] = {}
-    scores: dict[tuple[Any, ...], dict[tuple[Any, ...], list[float]]] = {}
-    for row in rows:
-        key = tuple(row[a] for a in context_axes)
-        if key not in cells:
-            ctx = dict(base)
-            name = []
-            for a, v in zip(context_axes, key, strict=True):
-                if a == "context":
-                    if v not in contexts:
-                        raise ConfigError(
-                            f"context {v!r} is not in the scenario's sweep.contexts", file=results
-                        )
-                    ctx.update(contexts[v])
-                else:
-                    ctx[a] = v
-                name.append(str(v) if a == "context" else f"{a}={v}")
-            cells[key] = Cell(", ".join(name), ctx)
-        value = row[metric]
-        if row["error"] or value is None:
-            continue
-        scores.setdefault(key, {}).setdefault(tuple(row[a] for a in tuned), []).append(value)
+    for key in table.stats:
+        ctx = dict(base)
+        name = []
+        for a, v in zip(table.context_axes, key, strict=True):
+            if a == "context":
+                ctx.update(contexts[v])
+            else:
+                ctx[a] = v
+            name.append(str(v) if a == "context" else f"{a}={v}")
+        cells[key] = Cell(", ".join(name), ctx)
+    given = robust
+    robust = _robust(table, margin)
+    if given is not None:
+        if sorted(given) != sorted(table.tuned):
+            raise ConfigError(
+                f"must set exactly the tuned axes ({', '.join(table.tuned)})",
+                key="--robust",
+            )
+        robust = tuple(given[k] for k in table.tuned)
+        if not all(robust in by for by in table.stats.values()):
+            raise ConfigError(
+                "that point is not on the sweep's grid in every context (the "
+                "oracle and the margin compare grid points)",
+                key="--robust",
+            )
     for key, cell in cells.items():
-        by_point = scores.get(key, {})
-        if not by_point:
+        by_point = table.stats[key]
+        cell.runs = sum(s.count + s.failed for s in by_point.values())
+        best = _safe_best(table, key, margin)
+        if (
+            robust is not None
+            and robust in by_point
+            and (best is None or by_point[robust].mean <= by_point[best].mean)
+        ):
+            best = robust  # never a choice worse than the fallback
+        if best is None:
             continue
-        best = min(by_point, key=lambda p: (statistics.fmean(by_point[p]), p))
-        cell.best = dict(zip(tuned, best, strict=True))
-        cell.score = statistics.fmean(by_point[best])
-        cell.runs = sum(len(v) for v in by_point.values())
-    unplaced = _place(list(cells.values()), found, watched)
+        cell.best = dict(zip(table.tuned, best, strict=True))
+        cell.score = by_point[best].mean
+        lowest = _lowest(by_point)
+        if lowest is not None and lowest != best:
+            cell.unsafe = (dict(zip(table.tuned, lowest, strict=True)), by_point[lowest].mean)
+        if robust is not None and robust in by_point:
+            cell.robust_score = by_point[robust].mean
+    derivation = Derivation(metric, table.tuned, list(cells.values()), [], [], found)
+    if robust is None:
+        derivation.refused = (
+            "no grid point finished in every context: there is no fixed choice to fall back "
+            "on, so no rules are written"
+        )
+        return derivation
+    derivation.robust = dict(zip(table.tuned, robust, strict=True))
+    scored = [c for c in cells.values() if c.best and math.isfinite(c.robust_score)]
+    derivation.robust_mean = statistics.fmean(c.robust_score for c in scored)
+    derivation.oracle_mean = statistics.fmean(c.score for c in scored)
+    if derivation.gain < min_gain:
+        derivation.refused = (
+            f"not worth adapting: switching to each context's best would lower the mean "
+            f"{metric} by {100 * derivation.gain:.1f} % over the robust choice "
+            f"({_show(derivation.robust)}), less than {100 * min_gain:g} %; run that "
+            "fixed choice instead"
+        )
+        return derivation
+    derivation.unplaced = _place(list(cells.values()), found, watched)
     placed = [
         c
         for c in cells.values()
-        if c.best and c.levels is not None and c.name not in _names(unplaced)
+        if c.best and c.levels is not None and c.name not in _names(derivation.unplaced)
     ]
-    rules = _rules(placed, hold)
-    return Derivation(metric, tuned, list(cells.values()), rules, unplaced, found)
+    # cells the estimators cannot tell apart run the robust point (a rule still brings the
+    # gain back to it when the context returns there)
+    groups: dict[tuple[tuple[str, float], ...], list[Cell]] = {}
+    for c in cells.values():
+        if c.best and c.levels and "looks to the estimators" in _why(derivation.unplaced, c.name):
+            groups.setdefault(tuple(sorted(c.levels.items())), []).append(c)
+    for group in groups.values():
+        placed.append(
+            Cell(
+                ", ".join(c.name for c in group) + " (alike: robust)",
+                {},
+                dict(derivation.robust),
+                levels=dict(group[0].levels),
+            )
+        )
+    wait = hold if fallback_hold is None else fallback_hold
+    derivation.rules = _fallbacks(scenario, found, placed, derivation.robust, wait)
+    sure = {signal: {"above": 0.5} for r in derivation.rules for signal in r["when"]}
+    derivation.rules += [{**r, "when": {**r["when"], **sure}} for r in _rules(placed, hold)]
+    return derivation
+
+
+def _why(unplaced: Sequence[str], name: str) -> str:
+    return " ".join(u for u in unplaced if u.split(":", 1)[0] == name)
+
+
+def _show(values: dict[str, Any]) -> str:
+    return ", ".join(f"{k}={v}" for k, v in values.items())
+
+
+def _lowest(by_point: dict[tuple[Any, ...], Any]) -> tuple[Any, ...] | None:
+    """The point with the lowest seed mean among those every run of which finished."""
+    stable = [p for p, s in by_point.items() if s.stable]
+    return min(stable, key=lambda p: (by_point[p].mean, p)) if stable else None
+
+
+def _neighbours(table: SweepTable, point: tuple[Any, ...]) -> list[tuple[Any, ...]]:
+    """The grid points one step from ``point`` along each tuned axis (in any cell)."""
+    values = [sorted({p[i] for by in table.stats.values() for p in by}) for i in range(len(point))]
+    out = []
+    for i, v in enumerate(point):
+        j = values[i].index(v)
+        for k in (j - 1, j + 1):
+            if 0 <= k < len(values[i]):
+                out.append((*point[:i], values[i][k], *point[i + 1 :]))
+    return out
+
+
+def _safe(table: SweepTable, cell: tuple[Any, ...], point: tuple[Any, ...], margin: float) -> bool:
+    """``point`` finished in ``cell`` and its neighbours did, none more than ``margin`` worse."""
+    by_point = table.stats[cell]
+    here = by_point.get(point)
+    if here is None or not here.stable:
+        return False
+    for other in _neighbours(table, point):
+        near = by_point.get(other)
+        if near is None:
+            continue  # not swept in this cell: nothing known against it
+        if not near.stable or near.mean > (1.0 + margin) * here.mean:
+            return False
+    return True
+
+
+def _safe_best(table: SweepTable, cell: tuple[Any, ...], margin: float) -> tuple[Any, ...] | None:
+    """The cell's lowest-mean safe point (None if none is safe)."""
+    by_point = table.stats[cell]
+    ranked = sorted(
+        (p for p, s in by_point.items() if s.stable), key=lambda p: (by_point[p].mean, p)
+    )
+    return next((p for p in ranked if _safe(table, cell, p, margin)), None)
+
+
+def _robust(table: SweepTable, margin: float) -> tuple[Any, ...] | None:
+    """The point with the least worst-case seed mean over the cells (safe ones first)."""
+    cells = list(table.stats)
+    common = set.intersection(*(set(table.stats[c]) for c in cells)) if cells else set()
+    everywhere = [p for p in common if all(table.stats[c][p].stable for c in cells)]
+    if not everywhere:
+        return None
+
+    def worst(p: tuple[Any, ...]) -> tuple[float, float, tuple[Any, ...]]:
+        means = [table.stats[c][p].mean for c in cells]
+        return (max(means), statistics.fmean(means), p)
+
+    safe = [p for p in everywhere if all(_safe(table, c, p, margin) for c in cells)]
+    return min(safe or everywhere, key=worst)
+
+
+def _fallbacks(
+    scenario: Scenario,
+    found: list[Watch],
+    placed: list[Cell],
+    robust: dict[str, Any],
+    hold: float,
+) -> list[dict[str, Any]]:
+    """One rule per estimator the cell rules read that says when it is unsure (``valid``)."""
+    used = {s for c in placed for s in c.levels}
+    out = []
+    for w in found:
+        leaf = w.signal.rpartition(".")[0]
+        valid = f"{leaf}.valid"
+        if w.signal not in used or valid not in scenario.world.buffers:
+            continue
+        out.append(
+            {
+                "when": {valid: {"below": 0.5}},
+                "set": dict(robust),
+                "hold": _whole(hold),
+                "label": f"robust, {leaf} unsure",
+            }
+        )
+    return out
+
+
+def _whole(hold: float) -> float | int:
+    return int(hold) if float(hold).is_integer() else hold
 
 
 def _names(unplaced: Sequence[str]) -> set[str]:
@@ -199,9 +391,11 @@ def _rules(cells: list[Cell], hold: float) -> list[dict[str, Any]]:
             i = ls.index(cell.levels[s])
             bound: dict[str, float] = {}
             if i > 0:
-                bound["above"] = round((ls[i - 1] + ls[i]) / 2, 6)
+                mid, step = (ls[i - 1] + ls[i]) / 2, ls[i] - ls[i - 1]
+                bound["above"] = round(mid + GAP * step, 6)
             if i < len(ls) - 1:
-                bound["below"] = round((ls[i] + ls[i + 1]) / 2, 6)
+                mid, step = (ls[i] + ls[i + 1]) / 2, ls[i + 1] - ls[i]
+                bound["below"] = round(mid - GAP * step, 6)
             when[s] = bound
         if not when:
             continue
@@ -212,8 +406,7 @@ def _rules(cells: list[Cell], hold: float) -> list[dict[str, Any]]:
         if key in seen:
             seen[key]["label"] += f", {cell.name}"
             continue
-        whole = int(hold) if float(hold).is_integer() else hold
-        rule = {"when": when, "set": dict(cell.best), "hold": whole, "label": cell.name}
+        rule = {"when": when, "set": dict(cell.best), "hold": _whole(hold), "label": cell.name}
         seen[key] = rule
         rules.append(rule)
     return rules

@@ -9,10 +9,16 @@ from pathlib import Path
 
 import yaml
 
-from ..adapt.derive import Derivation, derive
+from ..adapt.derive import MARGIN, MIN_GAIN, Derivation, derive
+from ..adapt.sweepdir import read_sweep_scenario
 from ..atomic import write_atomic
-from ..errors import ConfigError
-from ..model.scenario import load_scenario
+from ..errors import ConfigError, one_line
+from ..model import schema
+from ..model.adaptrules import FILE, parse_rules
+from ..model.scenario import Scenario, load_scenario
+from ..model.yamlio import parse_yaml
+from ..runs.rundir import check_output
+from ..tune.objective import ROBUSTNESS
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -20,64 +26,267 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("sweepdir", help="a sweep's output directory (its results.csv)")
     p.add_argument(
         "--scenario",
-        required=True,
-        help="the scenario the sweep ran (its sweep.contexts and the world's estimators)",
+        help="the scenario the sweep ran (default: the one the sweep directory records)",
     )
     p.add_argument("-o", "--output", required=True, metavar="RULES.yaml", help="rules file")
     p.add_argument(
-        "--metric", default="rms_error", help="the metric to minimise (default rms_error)"
+        "--metric",
+        default="rms_error",
+        help="the metric to minimise (default rms_error), or robustness.NAME to maximise",
     )
     p.add_argument(
         "--hold",
         type=float,
         default=10.0,
         metavar="S",
-        help="each rule's hold time in seconds (default 10)",
+        help="each rule's hold time in seconds, and the least time between switches (default 10)",
+    )
+    p.add_argument(
+        "--fallback-hold",
+        type=float,
+        default=None,
+        metavar="S",
+        help="seconds an estimator must stay unsure before the robust choice is set "
+        "(default: --hold)",
+    )
+    p.add_argument(
+        "--margin",
+        type=float,
+        default=MARGIN,
+        metavar="M",
+        help="a chosen point's grid neighbours may be at most M worse (default 0.5: 50 %%; "
+        "inf: no margin)",
+    )
+    p.add_argument(
+        "--min-gain",
+        type=float,
+        default=MIN_GAIN,
+        metavar="G",
+        help="least gain of switching over the robust fixed choice worth rules (default 0.05)",
+    )
+    p.add_argument(
+        "--robust",
+        action="append",
+        default=[],
+        metavar="Comp.param=V",
+        help="the fixed choice to fall back on and compare with (`amsa-phys tune`'s answer, "
+        "on the sweep's grid; default: the sweep's least worst-case point)",
     )
     p.add_argument("--force", action="store_true", help="replace an existing rules file")
+    p.add_argument(
+        "--validate",
+        action="store_true",
+        help="score the rules on held-out context sequences against the robust fixed choice "
+        "and the oracle schedule; exit 1 if they lose",
+    )
+    p.add_argument(
+        "--sequences", type=int, default=5, metavar="N", help="held-out sequences (default 5)"
+    )
+    p.add_argument(
+        "--seeds", type=int, default=3, metavar="N", help="seeds per sequence (default 3)"
+    )
+    p.add_argument(
+        "--duration",
+        type=float,
+        default=600.0,
+        metavar="S",
+        help="length of a held-out sequence in seconds (default 600)",
+    )
+    p.add_argument(
+        "--tolerance",
+        type=float,
+        default=0.02,
+        metavar="T",
+        help="the rules lose on a sequence when their mean is more than T above the robust "
+        "choice's (default 0.02: 2 %%)",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
-    """Read the sweep, derive, write the rules file, print the table."""
-    results = Path(args.sweepdir) / "results.csv"
+    """Read the sweep, derive, write the rules file (or say why not), print the table."""
+    sweepdir = Path(args.sweepdir)
+    results = sweepdir / "results.csv"
     if not results.is_file():
         raise ConfigError(
-            f"no results.csv in {args.sweepdir} (is it a sweep's --out?)", key="adapt"
+            f"no results.csv in {one_line(str(sweepdir))} (is it a sweep's --out?)", key="adapt"
         )
     if not (args.hold >= 0 and math.isfinite(args.hold)):
         raise ConfigError(f"must be a number of seconds >= 0, got {args.hold}", key="--hold")
-    out = Path(args.output)
+    if args.fallback_hold is not None and not (
+        args.fallback_hold >= 0 and math.isfinite(args.fallback_hold)
+    ):
+        raise ConfigError(
+            f"must be a number of seconds >= 0, got {args.fallback_hold}", key="--fallback-hold"
+        )
+    if not args.margin >= 0:
+        raise ConfigError(f"must be >= 0 (or inf), got {args.margin}", key="--margin")
+    if not (0 <= args.min_gain < 1):
+        raise ConfigError(f"must be in [0, 1), got {args.min_gain}", key="--min-gain")
+    if args.validate:
+        _check_validate_args(args)
+    out = check_output(Path(args.output), "-o")
     if out.exists() and not args.force:
-        raise ConfigError(f"{out} exists; use --force to replace it", key="-o")
-    scenario = load_scenario(args.scenario)
-    found = derive(results, scenario, args.metric, args.hold)
-    write_atomic(out, rules_text(found, args.sweepdir))
+        raise ConfigError(f"{one_line(str(out))} exists; use --force to replace it", key="-o")
+    scenario = load_scenario(args.scenario) if args.scenario else read_sweep_scenario(sweepdir)
+    robust = _robust_option(args.robust, scenario)
+    found = derive(
+        results,
+        scenario,
+        args.metric,
+        args.hold,
+        args.margin,
+        args.min_gain,
+        robust,
+        args.fallback_hold,
+    )
     for line in table(found):
-        print(line)
+        print(one_line(line))
+    if found.refused:
+        print(one_line(f"no rules written: {found.refused}"))
+        return 0
+    text = rules_text(found, str(sweepdir))
+    _check_loads(text, out, scenario)
+    write_atomic(out, text)
     for problem in found.unplaced:
-        print(f"warning: no rule for {problem}", file=sys.stderr)
-    print(f"{len(found.rules)} rules written to {out}")
+        print(one_line(f"warning: no rule for {problem}"), file=sys.stderr)
+    print(one_line(f"{len(found.rules)} rules written to {out}"))
+    if args.validate:
+        return _validate(args, scenario, found)
+    return 0
+
+
+def _robust_option(texts: list[str], scenario: Scenario) -> dict[str, object] | None:
+    """``--robust Comp.param=V`` values, judged as the parameter's own values."""
+    if not texts:
+        return None
+    from ..model.changes import resolve_change
+    from ..model.yamlio import parse_value
+
+    out: dict[str, object] = {}
+    for text in texts:
+        key, sep, raw = text.partition("=")
+        if not sep:
+            raise ConfigError(f"expected Comp.param=V, got {one_line(text)!r}", key="--robust")
+        try:
+            value = parse_value(raw, "--robust")
+            out[key.strip()] = resolve_change(key.strip(), value, scenario.world).value
+        except ValueError as exc:
+            raise ConfigError(str(exc), key=f"--robust {one_line(key.strip())}") from None
+    return out
+
+
+def _check_validate_args(args: argparse.Namespace) -> None:
+    """--validate's numbers, refused before any work."""
+    if not 1 <= args.sequences <= 1000:
+        raise ConfigError(f"must be 1..1000, got {args.sequences}", key="--sequences")
+    if not 1 <= args.seeds <= 1000:
+        raise ConfigError(f"must be 1..1000, got {args.seeds}", key="--seeds")
+    if not (60 <= args.duration <= 100_000 and math.isfinite(args.duration)):
+        raise ConfigError(f"must be 60..100000 seconds, got {args.duration}", key="--duration")
+    if not (0 <= args.tolerance < 1):
+        raise ConfigError(f"must be in [0, 1), got {args.tolerance}", key="--tolerance")
+
+
+def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -> int:
+    """Run the held-out sequences, print the table; 1 if the rules lose to the robust one."""
+    from ..adapt.validate import HEADER, loses, validate
+
+    contexts = dict(scenario.data.get("sweep", {}).get("contexts", {}))
+    if not contexts:
+        raise ConfigError(
+            "--validate draws held-out contexts from the sweep's contexts; this sweep has none",
+            key="--validate",
+        )
+    print(
+        one_line(
+            f"validating on {args.sequences} held-out sequences x {args.seeds} seeds "
+            f"({found.metric}, seed means, lower is better):"
+        )
+    )
+    print(HEADER)
+    rows = validate(
+        scenario,
+        found,
+        contexts,
+        args.sequences,
+        args.seeds,
+        args.duration,
+        report=lambda text: print(one_line(text), flush=True),
+    )
+    lost = loses(rows, args.tolerance)
+    if lost:
+        print(
+            one_line(
+                f"warning: the rules lose to the robust fixed choice on {len(lost)} of "
+                f"{len(rows)} held-out sequences (by more than {100 * args.tolerance:g} %)"
+            ),
+            file=sys.stderr,
+        )
+        return 1
+    print(
+        one_line(
+            f"the rules hold: never more than {100 * args.tolerance:g} % worse than the "
+            f"robust fixed choice on {len(rows)} held-out sequences"
+        )
+    )
     return 0
 
 
 def table(found: Derivation) -> list[str]:
-    """The cells: context, estimator levels, best values and their metric."""
-    lines = [f"cell | estimator levels | best {', '.join(found.tuned)} | mean {found.metric}"]
+    """The cells: context, estimator levels, best values and their metric; then the gain."""
+    lines = [
+        f"cell | estimator levels | best {', '.join(found.tuned)} | mean {found.metric} | robust's"
+    ]
     for c in found.cells:
         levels = ", ".join(f"{k}={v:g}" for k, v in c.levels.items()) or "-"
         best = ", ".join(f"{v}" for v in c.best.values()) or "-"
-        lines.append(f"{c.name} | {levels} | {best} | {c.score:.4g}")
+        note = ""
+        if c.unsafe is not None:
+            lowest = ", ".join(f"{v}" for v in c.unsafe[0].values())
+            at = _shown(found, c.unsafe[1])
+            note = f" (not {lowest} at {at:.4g}: a neighbour is unstable or far worse)"
+        score, robust = _shown(found, c.score), _shown(found, c.robust_score)
+        lines.append(f"{c.name} | {levels} | {best} | {score:.4g} | {robust:.4g}{note}")
+    if found.robust:
+        robust = ", ".join(f"{k}={v}" for k, v in found.robust.items())
+        lines.append(
+            f"robust fixed choice (least worst-case mean): {robust}, "
+            f"mean {_shown(found, found.robust_mean):.4g}; switching per context (oracle): "
+            f"{_shown(found, found.oracle_mean):.4g} ({100 * found.gain:.1f} % better)"
+        )
     return lines
 
 
+def _shown(found: Derivation, value: float) -> float:
+    """A mean as the user's metric reads it (a robustness objective is kept negated)."""
+    return -value if found.metric.startswith(ROBUSTNESS) else value
+
+
 def rules_text(found: Derivation, sweepdir: str) -> str:
-    """The rules file: the table as comments, then ``adapt:``."""
-    head = [f"# adapt: rules derived by `amsa-phys adapt {sweepdir}` ({found.metric}, lowest wins)"]
-    head += ["# estimator -> context parameter:"]
-    head += [f"#   {w.signal} ~ {w.key}" for w in found.watches]
-    head += [f"# {line}" for line in table(found)]
-    head += [f"# not placed: {p}" for p in found.unplaced]
+    """The rules file: the table as comments, then ``adapt:`` (written by the YAML emitter)."""
+    head = [
+        f"adapt: rules derived by `amsa-phys adapt {sweepdir}` ({found.metric}, "
+        + ("highest wins)" if found.metric.startswith(ROBUSTNESS) else "lowest wins)"),
+        "estimator -> context parameter:",
+    ]
+    head += [f"  {w.signal} ~ {w.key}" for w in found.watches]
+    head += table(found)
+    head += [f"not placed: {p}" for p in found.unplaced]
+    # a comment is one line whatever a name holds: newlines and control characters escaped
+    comments = "".join(f"# {one_line(line)}\n" for line in head)
     body = yaml.safe_dump(
         {"adapt": found.rules}, sort_keys=False, default_flow_style=None, width=100
     )
-    return "\n".join(head) + "\n" + body
+    return comments + body
+
+
+def _check_loads(text: str, out: Path, scenario: Scenario) -> None:
+    """Refuse to write rules that would not load (the loader's own checks, on the text)."""
+    try:
+        doc = parse_yaml(text, out)
+        schema.validate(doc.data, FILE, doc)
+        parse_rules(doc, doc.data["adapt"], scenario.world)
+    except ConfigError as exc:
+        raise ConfigError(
+            f"the derived rules would not load ({exc.message}); nothing written", file=out
+        ) from None

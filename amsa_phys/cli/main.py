@@ -78,6 +78,10 @@ COMMANDS = {
         "adapt",
         "Derive adapt: rules from a context sweep: best parameters per context, on estimators.",
     ),
+    "tune": (
+        "tune",
+        "Robust tuning: the controller parameters best in the worst case over a context set.",
+    ),
     "view": ("view", "Open the window on a finished run: play, pause, scrub, jump to events."),
 }
 

@@ -26,7 +26,7 @@ def _dwell_text(q: dict[str, Any]) -> str:
 SHOWN_SWITCHES = 5
 
 
-def adapt_line(switches: list[dict[str, Any]]) -> str:
+def adapt_line(switches: list[dict[str, Any]], total: int | None = None) -> str:
     """``adapt: 3 switches: at 40.1 s rule 2 (random leader): Kv=0.25; ...`` — the rules that
     fired, as live changes are shown in the table (the values without their estimates)."""
     parts = []
@@ -39,9 +39,12 @@ def adapt_line(switches: list[dict[str, Any]]) -> str:
             if p
         )
         parts.append(f"at {float(e['t']):g} s {rule}: {short}")
-    more = len(switches) - SHOWN_SWITCHES
+    n = max(len(switches), total or 0)  # total: every switch, listed or not
+    listed = min(len(switches), n)
+    more = listed - SHOWN_SWITCHES
     tail = f"; {more} more in metrics.json's events" if more > 0 else ""
-    n = len(switches)
+    if n > listed:
+        tail += f"; {n - listed} more not listed (metrics.json keeps the first events only)"
     return f"adapt: {n} switch{'es' if n != 1 else ''}: " + "; ".join(parts) + tail
 
 
@@ -89,7 +92,7 @@ def print_summary(metrics: dict[str, Any], out_dir: Path, stream: TextIO) -> Non
         print(one_line(text), file=stream)
     switches = [e for e in metrics.get("events") or [] if e.get("kind") == "adapt"]
     if switches:
-        print(one_line(adapt_line(switches)), file=stream)
+        print(one_line(adapt_line(switches, metrics.get("adapt_switches"))), file=stream)
     if metrics["overall"].get("partial"):
         print(
             f"(cut): the run stopped at t={metrics['simulated']:g} s, inside this block; "

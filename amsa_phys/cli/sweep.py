@@ -188,6 +188,13 @@ def run(args: argparse.Namespace) -> int:
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-sweep")
     prepare_run_dir(out, args.force, inputs=plan.inputs)
+    from ..adapt.sweepdir import write_sweep_scenario  # what `adapt SWEEPDIR` reads back
+
+    write_sweep_scenario(
+        out,
+        load_scenario(args.scenario),
+        {"contexts": plan.contexts, "metric": plan.metric, "seeds": plan.seeds},
+    )
     if args.keep_runs:
         plan.keep_dir = str((out / "runs").resolve())
     jobs = plan.jobs()

@@ -23,6 +23,11 @@ from typing import Any
 
 from ..model.adaptrules import Rule
 
+#: Firings kept in memory (the first ones); a run counts every switch in ``switches``.
+KEPT_FIRINGS = 1000
+#: Switch events a run records (metrics.json's events); later switches are counted only.
+MAX_SWITCH_EVENTS = 1000
+
 
 @dataclass(frozen=True)
 class Firing:
@@ -48,7 +53,10 @@ class AdaptRules:
         self._current = current
         self._since: list[Fraction | None] = [None] * len(self.rules)
         self._last_switch: Fraction | None = None
+        #: the first :data:`KEPT_FIRINGS` firings (memory stays bounded on any run length)
         self.fired: list[Firing] = []
+        #: every switch of the run, kept or not
+        self.switches = 0
 
     def due(self, now: Fraction, values: Mapping[str, float]) -> Firing | None:
         """The rule that fires at ``now`` (None if none); its state is updated either way."""
@@ -71,5 +79,7 @@ class AdaptRules:
             firing = Firing(now, rule, estimates)
         if firing is not None:
             self._last_switch = now
-            self.fired.append(firing)
+            self.switches += 1
+            if len(self.fired) < KEPT_FIRINGS:
+                self.fired.append(firing)
         return firing

@@ -72,3 +72,5 @@ class RunResult:
     #: the STL requirements' entries of ``metrics.json`` (``stl/requirement.py``),
     #: when the run's requirements were judged with its samples; None: no requirement
     requirements: dict[str, Any] | None = None
+    #: every ``adapt:`` switch of the run (``events`` keeps only the first ones)
+    adapt_switches: int = 0

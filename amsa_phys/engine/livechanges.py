@@ -17,6 +17,7 @@ from ..errors import RunFault
 from ..model.adaptrules import RULE_COLUMN
 from ..model.scenario import Change
 from . import schedule
+from .adapt import MAX_SWITCH_EVENTS
 from .context import Event
 from .tasks import COMPONENT_ERRORS, in_run
 
@@ -105,7 +106,8 @@ class LiveChanges:
         for change in firing.rule.changes:
             self.apply_change(change)
         self.values[RULE_COLUMN] = float(firing.rule.number)
-        self.record_event("adapt", firing.detail())
+        if self._adapt.switches <= MAX_SWITCH_EVENTS:  # later ones are counted, not kept
+            self.record_event("adapt", firing.detail())
 
     def _param_value(self, leaf: str, param: str) -> Any:
         """The value of ``leaf.param`` in force now."""

@@ -485,6 +485,7 @@ class Simulation(ReadAPI, LiveChanges):
             samples_s=samples_s,
             events=list(self.events),
             requirements=self.watch.judged()[0] if self.watch else None,
+            adapt_switches=self._adapt.switches if self._adapt is not None else 0,
         )
 
     def _who(self, path: str) -> str:

@@ -44,6 +44,9 @@ METRICS = (
 #: Metrics that count events rather than measure the signal (plotted as counts).
 COUNT_METRICS = frozenset({"collisions"})
 
+#: Events metrics.json lists (the first ones); ``events_truncated`` says when there were more.
+MAX_EVENTS = 1000
+
 
 def block_metrics(
     t: np.ndarray,
@@ -238,11 +241,26 @@ def _metrics(
         "quality": (_quality_json(q) if q else None),
         "overall": overall,
         "phases": phases,
-        "events": [{"t": e.t, "kind": e.kind, "detail": e.detail} for e in result.events[:1000]],
+        "events": [
+            {"t": e.t, "kind": e.kind, "detail": e.detail} for e in result.events[:MAX_EVENTS]
+        ],
+        **_event_counts(result),
         "wall_time_s": round(wall_s, 3),
         **({"paused_s": round(idle_s, 3)} if idle_s > 0 else {}),
         "real_time_factor": round(result.t_end / busy, 1) if busy > 0 else None,
     }
+
+
+def _event_counts(result: Any) -> dict[str, Any]:
+    """How many adapt switches the run made, and whether ``events`` left some out."""
+    switches = getattr(result, "adapt_switches", 0)
+    kept = sum(1 for e in result.events[:MAX_EVENTS] if e.kind == "adapt")
+    out: dict[str, Any] = {}
+    if switches:
+        out["adapt_switches"] = switches
+    if len(result.events) > MAX_EVENTS or switches > kept:
+        out["events_truncated"] = True
+    return out
 
 
 def _quality_json(q: Any) -> dict[str, Any]:

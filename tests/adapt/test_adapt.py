@@ -58,8 +58,9 @@ def test_the_adaptive_run_switches_and_marks_it(tmp_path: Path) -> None:
     assert main(["run", str(SCENARIO), "--headless", "-q", "--out", str(out)]) == 0
     metrics = json.loads((out / "metrics.json").read_text())
     switches = [e for e in metrics["events"] if e["kind"] == "adapt"]
-    # at least one switch into each of the contexts after the first
+    # a switch into each worn context (the random leader's best is the robust gain, in
+    # force from the start: nothing to switch)
     details = " ".join(e["detail"] for e in switches)
-    for label in ("random leader", "worn motors", "very worn motors"):
+    for label in ("worn motors", "very worn motors"):
         assert f"({label})" in details, details
     assert (out / "distance.png").stat().st_size > 0

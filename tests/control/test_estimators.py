@@ -101,10 +101,11 @@ def test_leader_monitor_circle_turns_all_the_time_at_its_rate() -> None:
         ({}, "LeaderGPSMonitor.lossRate", 0.0, 0.03),
         ({"MyNormalizePower.motorCoef": 50}, "MotorMonitor.delivered", 0.4, 0.6),
         ({"MyNormalizePower.motorCoef": 25}, "MotorMonitor.delivered", 0.18, 0.32),
-        ({"Leader.behavior": 4}, "LeaderMonitor.turning", 0.25, 1.0),
         ({"LeaderGPS.lostDataGPS": 20}, "LeaderGPSMonitor.lossRate", 0.12, 0.28),
     ],
-    ids=["nominal-motors", "straight", "no-loss", "worn50", "worn25", "random", "loss20"],
+    # the random leader: tests/adapt/test_estimators_known_contexts.py (where the estimate is
+    # sure, over six seeds: a random leader stops for whole windows)
+    ids=["nominal-motors", "straight", "no-loss", "worn50", "worn25", "loss20"],
 )
 def test_estimates_in_a_run_of_each_context(context, signal, lo, hi) -> None:
     """From t = 100 s to 160 s the estimate's mean is on the context's side of the

@@ -1,9 +1,10 @@
 """``adapt:`` rules in the exported package (issue 27 item 5).
 
-The adaptive scenario (``scenarios/adaptive.yaml``: context estimators, rules switching the
-controller's Kv) is exported, built and launched in lockstep for its first 70 s, in which
-two rules fire (t = 40.1 s and 57.1 s in-process): the run equals ``amsa-phys run --duration
-70`` byte for byte (trace.csv, with the rule column, and metrics.json with its adapt events),
+The adaptive world and its shipped rules (``tests/fixtures/ros_adaptive.yaml``: context
+estimators, rules switching the controller's Kv; worn motors from the start, very worn at
+45 s) are exported, built and launched in lockstep for 75 s, in which three rules fire
+(t = 10, 41.1 and 72.6 s in-process): the run equals ``amsa-phys run`` byte for byte
+(trace.csv, with the rule column, and metrics.json with its adapt events and switch count),
 with the rules fired inside the simulator (``rules:=sim``, the default) and by the
 ``amsa_adapt`` node, the one a robot runs with ``sim:=false`` (``rules:=node``: the
 simulator asks it at every instant; ``ros/runtime/adaptlink.py``). Mutation-checked: the
@@ -25,7 +26,7 @@ from ros_launch import build_workspace, ros_missing
 from amsa_phys.cli.main import main
 
 ROOT = Path(__file__).resolve().parent.parent.parent
-SCENARIO = ROOT / "scenarios" / "adaptive.yaml"
+SCENARIO = ROOT / "tests" / "fixtures" / "ros_adaptive.yaml"
 PKG = "mdeAdaptive"  # the world's name
 
 pytestmark = [
@@ -40,9 +41,9 @@ _metrics = ros_launch.metrics_without_wall
 
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """``amsa-phys run --duration 70``, in-process: the rules fire at least twice."""
+    """``amsa-phys run``, in-process: the rules fire at least twice."""
     ref = tmp_path_factory.mktemp("ref") / "run"
-    args = ["--headless", "-q", "--no-plot", "--duration", "70", "--out", str(ref)]
+    args = ["--headless", "-q", "--no-plot", "--out", str(ref)]
     assert main(["run", str(SCENARIO), *args]) == 0
     fired = [
         e for e in json.loads((ref / "metrics.json").read_text())["events"] if e["kind"] == "adapt"
@@ -64,8 +65,8 @@ def test_lockstep_fires_the_rules_where_amsa_phys_run_does(
     """``rules:=sim``: the simulator fires them; ``rules:=node``: the ``amsa_adapt`` node
     (the one a robot runs with ``sim:=false``) decides, asked at every instant."""
     out = workspace / f"lockstep_{rules}"
-    args = [f"out:={out}", "plots:=false", "duration:=70", f"rules:={rules}"]
-    text = launcher(workspace, "adaptive.launch", *args).finish()
+    args = [f"out:={out}", "plots:=false", f"rules:={rules}"]
+    text = launcher(workspace, "ros_adaptive.launch", *args).finish()
     assert "completed" in text or "partial" in text, text[-3000:]
     assert (f"amsa_adapt ({PKG}/amsa_adapt.py)" in text) == (rules == "node")
     assert (out / "trace.csv").read_bytes() == (reference / "trace.csv").read_bytes()

@@ -33,6 +33,15 @@ class LeaderMonitor(Template):
     t = 40 s): a straight leader's share stays at or below 0.36 (0 once its start is out of
     the window), the random leader's spans 0 to 1 (a run of small heading changes looks
     straight for a while). Until ``window`` seconds have passed, both outputs are 0.
+
+    A slow leader's segments are short, and the same fix noise is a larger course error on
+    them (about 2.45 ``fixNoise`` / (L ``spacing``) rad/s of rate for two segments of length L: a
+    straight leader at 0.06 m/s read as turning 70 % of the time when every segment over
+    ``minTravel`` counted), and a pair of segments gives a course rate only when
+    ``noiseFactor`` times that noise is within ``threshold`` (segments of at least 0.69 m at
+    the defaults: 0.17 m/s over 4 s); the shares are of those rates alone. ``valid`` is 1
+    when at least ``minShare`` of the window's seconds gave one, else 0: a leader too slow or
+    stopped to show a course says nothing about how it turns (``turning`` is then 0).
     """
 
     batchable = True  # each run's copy steps alone in a batch (no step_many needed)
@@ -48,6 +57,7 @@ class LeaderMonitor(Template):
     outputs = (
         Port("turning", 0.0, "share of the window spent turning (0..1)", ""),
         Port("turnRate", 0.0, "mean absolute course rate over the window", "rad/s"),
+        Port("valid", 0.0, "1 when the window holds enough courses to judge, else 0", ""),
     )
     params = (
         Param("window", "float", "length of the estimate's window", 30.0, 1.0, 3600.0, "s"),
@@ -64,13 +74,32 @@ class LeaderMonitor(Template):
             "rad/s",
         ),
         Param("minTravel", "float", "shortest segment with a course", 0.2, 0.0, 100.0, "m"),
+        Param("fixNoise", "float", "the GPS fixes' noise per axis", 0.015, 0.0, 10.0, "m"),
+        Param(
+            "noiseFactor",
+            "float",
+            "a course rate counts when its noise times this is within threshold",
+            1.5,
+            0.0,
+            100.0,
+            "",
+        ),
+        Param(
+            "minShare",
+            "float",
+            "share of the window's seconds with a course for a valid estimate",
+            0.25,
+            0.0,
+            1.0,
+            "",
+        ),
     )
     estimates = (
         Estimates(
             "turning",
             "behavior",
             ("freeRobot",),
-            levels=((1.0, 0.0), (2.0, 1.0), (3.0, 0.0), (4.0, 0.5)),
+            levels=((1.0, 0.0), (2.0, 1.0), (3.0, 0.0), (4.0, 0.35)),
         ),
     )
 
@@ -94,17 +123,22 @@ class LeaderMonitor(Template):
             if rate is not None:
                 self.rates.add(now, rate)
         rates = self.rates.items
-        if not rates or now - self.started < p.window - 1e-9:
-            return {"turning": 0.0, "turnRate": 0.0}
+        if now - self.started < p.window - 1e-9:
+            return {"turning": 0.0, "turnRate": 0.0, "valid": 0.0}
+        valid = 1.0 if rates and len(rates) >= p.minShare * p.window else 0.0
+        if not rates:
+            return {"turning": 0.0, "turnRate": 0.0, "valid": valid}
         n = len(rates)
         return {
             "turning": sum(1 for _, r in rates if r > p.threshold) / n,
             "turnRate": sum(r for _, r in rates) / n,
+            "valid": valid,
         }
 
     def _rate(self, now: float) -> float | None:
         """|course change| / ``spacing`` between the last two ``spacing``-s segments (None:
-        the track is too short, or a segment under ``minTravel``)."""
+        the track is too short, a segment under ``minTravel``, or too short for its course
+        rate's noise to be within ``threshold``)."""
         p = self.p
         points = {round(t - now, 6): xy for t, xy in self.track.items}
         a, b, c = (
@@ -114,9 +148,13 @@ class LeaderMonitor(Template):
         )
         if a is None or b is None or c is None:
             return None
-        if math.hypot(b[0] - a[0], b[1] - a[1]) < p.minTravel:
+        first_len = math.hypot(b[0] - a[0], b[1] - a[1])
+        second_len = math.hypot(c[0] - b[0], c[1] - b[1])
+        shortest = min(first_len, second_len)
+        if shortest < p.minTravel or shortest == 0.0:
             return None
-        if math.hypot(c[0] - b[0], c[1] - b[1]) < p.minTravel:
+        noise = math.sqrt(6.0) * p.fixNoise / (shortest * p.spacing)
+        if p.noiseFactor * noise > p.threshold:
             return None
         first = math.atan2(b[1] - a[1], b[0] - a[0])
         second = math.atan2(c[1] - b[1], c[0] - b[0])

@@ -31,6 +31,15 @@ class MotorMonitor(Template):
     oscillations within ~0.1. Below ``minPower`` % of mean command the ratio is noise, and
     the estimate is held; it starts at 1 (healthy motors) until ``window`` seconds of
     samples are in.
+
+    ``valid`` says whether the window's estimate can be trusted (1) or not (0): the model
+    above holds for a rover driving forward, so a window in which the command reversed (a
+    follower oscillating about its reference, reversing to back off) says nothing about the
+    motors -- its path length counts backward travel as forward and its mean command
+    cancels out, which read as delivered shares of 2 to 10 with healthy motors. A share above
+    ``maxShare`` is physically impossible (motors deliver at most what is commanded), so it
+    is invalid too. While invalid, ``delivered`` holds the last valid estimate; a valid one
+    between 1 and ``maxShare`` (noise about healthy motors) is published as 1.
     """
 
     batchable = True  # each run's copy steps alone in a batch (no step_many needed)
@@ -45,7 +54,10 @@ class MotorMonitor(Template):
         Port("posX", 0.0, "the rover's GPS fix, x", "m"),
         Port("posY", 0.0, "the rover's GPS fix, y", "m"),
     )
-    outputs = (Port("delivered", 1.0, "share of commanded power delivered (0..)", ""),)
+    outputs = (
+        Port("delivered", 1.0, "share of commanded power delivered (0..1)", ""),
+        Port("valid", 0.0, "1 when the window's estimate can be trusted, else 0", ""),
+    )
     params = (
         Param("window", "float", "length of the estimate's window", 30.0, 1.0, 3600.0, "s"),
         Param(
@@ -94,6 +106,15 @@ class MotorMonitor(Template):
             60.0,
             "s",
         ),
+        Param(
+            "maxShare",
+            "float",
+            "largest plausible share (noise above 1); a larger one is invalid",
+            1.15,
+            1.0,
+            10.0,
+            "",
+        ),
     )
     estimates = (Estimates("delivered", "motorCoef", ("NormalizePower",), scale=0.01),)
 
@@ -103,6 +124,7 @@ class MotorMonitor(Template):
         self.path: Window[float] = Window(self.p.window)
         self.fix: tuple[float, float, float] | None = None
         self.estimate = 1.0
+        self.valid = 0.0
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
         """The paper's doStep: add the command and (every ``spacing`` s) the path, estimate."""
@@ -125,9 +147,14 @@ class MotorMonitor(Template):
             # the speed's own share (first-order rover: P ~ v + tau dv/dt)
             speed += p.timeConstant * (self._edge_speed(-1) - self._edge_speed(0)) / span
             command = sum(v for _, v in self.power.items) / len(self.power)
-            if command >= p.minPower:
-                self.estimate = (p.frictionPower + 100.0 * speed / p.maxSpeed) / command
-        return {"delivered": self.estimate}
+            forward = min(v for _, v in self.power.items) > 0.0
+            self.valid = 0.0
+            if command >= p.minPower and forward:
+                share = (p.frictionPower + 100.0 * speed / p.maxSpeed) / command
+                if share <= p.maxShare:
+                    self.estimate = min(share, 1.0)
+                    self.valid = 1.0
+        return {"delivered": self.estimate, "valid": self.valid}
 
     def _edge_speed(self, end: int) -> float:
         """Mean speed over the first (``end`` 0) or last (-1) ``edge`` s of the window."""

@@ -12,6 +12,7 @@ from __future__ import annotations
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
+from ...engine.adapt import MAX_SWITCH_EVENTS
 from ...engine.runner import Simulation
 from ...model.adaptrules import RULE_COLUMN
 from ...model.scenario import Change, Scenario
@@ -126,7 +127,10 @@ class RosSimulation(Simulation):
         for change in rule.changes:
             self.apply_change(change)
         self.values[RULE_COLUMN] = float(number)
-        self.record_event("adapt", detail)
+        # counted and capped as the engine's own firings are (metrics.json's adapt_switches)
+        self._adapt.switches += 1
+        if self._adapt.switches <= MAX_SWITCH_EVENTS:
+            self.record_event("adapt", detail)
 
     def _live_params(self) -> None:
         """Free mode: a ``rosparam set`` lands at the next instant, recorded.

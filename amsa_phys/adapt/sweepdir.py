@@ -1,0 +1,75 @@
+"""The scenario a sweep directory records, written by ``sweep`` and read back as data.
+
+``amsa-phys adapt SWEEPDIR`` needs the scenario the sweep ran (its ``sweep.contexts``, its
+world's estimators and parameter values). The sweep writes it beside ``results.csv`` as
+``scenario.yaml``: the resolved scenario (world inlined, every parameter written out) plus
+its ``sweep:`` section. A sweep directory is data that users share, so reading it never
+imports a module it names: a world whose templates are not all built in is refused, with
+the way to go on (``--scenario`` with the scenario's own file, which the user runs).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from ..atomic import write_atomic
+from ..errors import ConfigError, one_line
+from ..model.scenario import Scenario, load_scenario
+from ..model.template import BUILTINS
+from ..model.yamlio import load_yaml
+from ..runs.resolve import resolved_scenario
+
+#: The file a sweep directory records its scenario in.
+NAME = "scenario.yaml"
+
+
+def write_sweep_scenario(out: Path, scenario: Scenario, sweep: dict[str, Any]) -> None:
+    """Record ``scenario`` (resolved) and its ``sweep`` section in the sweep directory."""
+    data = resolved_scenario(scenario)
+    data.pop("adapt", None)  # the sweep's runs are compared without rules of their own
+    data["sweep"] = sweep
+    head = "# the scenario this sweep ran (resolved), read back by `amsa-phys adapt`\n"
+    write_atomic(out / NAME, head + yaml.safe_dump(data, sort_keys=False, allow_unicode=False))
+
+
+def read_sweep_scenario(sweepdir: Path) -> Scenario:
+    """The scenario ``sweepdir`` records, loaded without importing any module it names."""
+    path = Path(sweepdir) / NAME
+    if not path.is_file():
+        raise ConfigError(
+            f"records no {NAME} (made before sweeps recorded their scenario?); give the "
+            "scenario the sweep ran with --scenario",
+            file=sweepdir,
+        )
+    doc = load_yaml(path)
+    world = doc.data.get("world") if isinstance(doc.data, dict) else None
+    if not isinstance(world, dict):
+        raise ConfigError("not a sweep's scenario: no world inlined", file=path)
+    for name, template in _templates(world.get("components")):
+        if template not in BUILTINS:
+            raise ConfigError(
+                f"component {one_line(name)} names template {one_line(str(template))!r}, not "
+                "built in; not imported: a sweep directory is data (give --scenario with the "
+                "scenario's own file to load it)",
+                file=path,
+            )
+    return load_scenario(path)
+
+
+def _templates(components: Any, prefix: str = "") -> list[tuple[str, Any]]:
+    """Every (component path, template) of a world's ``components`` (Composites walked)."""
+    out: list[tuple[str, Any]] = []
+    if not isinstance(components, dict):
+        return out
+    for name, body in components.items():
+        path = f"{prefix}{name}"
+        if not isinstance(body, dict):
+            continue
+        if "components" in body:
+            out += _templates(body["components"], f"{path}.")
+        if "template" in body:
+            out.append((path, body["template"]))
+    return out

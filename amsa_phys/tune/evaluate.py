@@ -1,0 +1,82 @@
+"""One scenario run under given contexts and settings, reduced to its objective value.
+
+``tune`` and ``adapt --validate`` evaluate many (context sequence, seed, settings) cases;
+each is an ordinary run of the user's scenario with its timeline replaced by the sequence,
+its ``set:`` extended by the settings and its rules on or off. Only the quality signal is
+traced: the metrics are all a case needs.
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+from ..errors import RunFault
+from ..model.scenario import Scenario
+from .contexts import Sequence
+from .objective import objective_value
+
+
+def case_data(
+    scenario: Scenario,
+    sequence: Sequence,
+    settings: dict[str, Any],
+    duration: float,
+    rules: list[dict[str, Any]] | None,
+) -> dict[str, Any]:
+    """The scenario mapping of one case (``rules`` None: no adaptation)."""
+    data = copy.deepcopy(scenario.data)
+    for key in ("sweep", "timeline", "adapt", "expect", "trace_columns"):
+        data.pop(key, None)
+    first = sequence.segments[0][1]
+    data["set"] = {**(data.get("set") or {}), **first, **settings}
+    data["duration"] = duration
+    timeline = sequence.timeline()
+    if timeline:
+        data["timeline"] = timeline
+    if rules:
+        data["adapt"] = copy.deepcopy(rules)
+    quality = data.get("quality") or {}
+    if quality.get("signal"):
+        data["trace_columns"] = [quality["signal"]]
+    return data
+
+
+def evaluate(
+    scenario: Scenario,
+    sequence: Sequence,
+    settings: dict[str, Any],
+    seed: int,
+    objective: str,
+    duration: float,
+    rules: list[dict[str, Any]] | None = None,
+    timeline_settings: list[tuple[float, dict[str, Any]]] | None = None,
+) -> float | None:
+    """The objective of one run (None: no value, or a fault: the worst there is).
+
+    ``timeline_settings`` adds settings at given instants (the oracle's switches).
+    """
+    import amsa_phys as ap  # the public front door: the same loader and checks as `run`
+
+    data = case_data(scenario, sequence, settings, duration, rules)
+    for at, sets in timeline_settings or []:
+        if at == 0:
+            data["set"].update(sets)
+            continue
+        entries = data.setdefault("timeline", [])
+        same = next((e for e in entries if e["at"] == at), None)
+        if same is None:
+            entries.append({"at": at, "set": dict(sets)})
+            entries.sort(key=lambda e: e["at"])
+        else:
+            same["set"].update(sets)
+    base = Path(scenario.path).parent if scenario.path else None
+    try:
+        run = ap.run(data, seed=seed, base_dir=base)
+    except RunFault:
+        return None
+    value, higher = objective_value(run.metrics, objective)
+    if value is None:
+        return None
+    return value if not higher else -value  # lower is better from here on
