@@ -38,9 +38,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..control.estimators.watches import Watch, watches
 from ..errors import ConfigError
 from ..model.scenario import Scenario
-from .links import Watch, watches
 from .table import SweepTable, read_table
 
 #: Default safety margin: a best point's grid neighbours may be at most this much worse.

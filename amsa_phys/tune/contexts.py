@@ -41,7 +41,7 @@ class Axis:
 def box(scenario: Scenario, contexts: dict[str, dict[str, Any]]) -> list[Axis]:
     """The axes the named ``contexts`` span (their parameters, at the scenario's values when a
     context leaves one out)."""
-    from ..adapt.links import watches  # which parameters are codes to an estimator
+    from ..control.estimators.watches import watches  # which parameters are codes to an estimator
 
     codes = {w.key for w in watches(scenario.world) if w.estimates.levels}
     keys = sorted({k for sets in contexts.values() for k in sets})
@@ -61,7 +61,7 @@ def box(scenario: Scenario, contexts: dict[str, dict[str, Any]]) -> list[Axis]:
 
 
 def _initial(scenario: Scenario, key: str, default: Any) -> Any:
-    for change in scenario.phases[0].changes:
+    for change in scenario.timeline.initial:
         if change.key == key:
             return change.value
     return default

@@ -12,8 +12,13 @@ import copy
 from pathlib import Path
 from typing import Any
 
+from ..engine import interrupt
+from ..engine.tracemem import TraceMemory
 from ..errors import RunFault
-from ..model.scenario import Scenario
+from ..model.configure import configure_scenario
+from ..model.scenario import Scenario, traced_columns
+from ..model.yamlio import YamlDoc
+from ..runs.single import execute
 from .contexts import Sequence
 from .objective import objective_value
 
@@ -57,8 +62,6 @@ def evaluate(
 
     ``timeline_settings`` adds settings at given instants (the oracle's switches).
     """
-    import amsa_phys as ap  # the public front door: the same loader and checks as `run`
-
     data = case_data(scenario, sequence, settings, duration, rules)
     for at, sets in timeline_settings or []:
         if at == 0:
@@ -71,12 +74,18 @@ def evaluate(
             entries.sort(key=lambda e: e["at"])
         else:
             same["set"].update(sets)
-    base = Path(scenario.path).parent if scenario.path else None
-    try:
-        run = ap.run(data, seed=seed, base_dir=base)
-    except RunFault:
+    # the loader `run` and `ap.run` use, on the case as a document beside the scenario's
+    # file (its relative paths resolve as the file's own)
+    where = Path(scenario.path) if scenario.path else Path("<tune>")
+    case = configure_scenario(YamlDoc(path=where, data=data), None, seed)
+    memory = TraceMemory(traced_columns(case))
+    with interrupt.deferred():
+        ended = execute(case, memory, progress=False)
+    if isinstance(ended.error, RunFault):
         return None
-    value, higher = objective_value(run.metrics, objective)
+    if ended.error is not None:
+        raise ended.error
+    value, higher = objective_value(ended.metrics, objective)
     if value is None:
         return None
     return value if not higher else -value  # lower is better from here on

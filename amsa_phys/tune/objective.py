@@ -12,29 +12,26 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from ..requirements.objective import ROBUSTNESS_PREFIX
+from ..requirements.objective import objective_value as shared_objective_value
+
 #: Prefix of an objective that is a requirement's robustness.
-ROBUSTNESS = "robustness."
+ROBUSTNESS = ROBUSTNESS_PREFIX
 
 
 def objective_value(metrics: dict[str, Any], name: str) -> tuple[float | None, bool]:
     """``(value, higher_is_better)`` of objective ``name`` in a run's ``metrics``.
 
-    ``value`` is None when the run has no finite value for it (never settled, a fault, an
-    unknown requirement). ``name`` is ``robustness.REQ``, a metric of the whole run
-    (``rms_error``) or of a phase (``phase1.rms_error``).
+    The one reading shared with ``falsify`` (:func:`amsa_phys.requirements.objective.
+    objective_value`), with what tuning needs on top: ``value`` is None when the run has no
+    finite value for it (never settled, a fault, an unknown requirement or metric), which
+    tuning scores as the worst there is.
     """
-    if name.startswith(ROBUSTNESS):
-        req = (metrics.get("requirements") or {}).get(name[len(ROBUSTNESS) :]) or {}
-        return _finite(req.get("robustness")), True
-    block: Any = metrics.get("overall") or {}
-    key = name
-    if name.startswith("phase") and "." in name:
-        head, _, key = name.partition(".")
-        try:
-            block = (metrics.get("phases") or [])[int(head[len("phase") :])]
-        except (ValueError, IndexError):
-            return None, False
-    return _finite(block.get(key) if isinstance(block, dict) else None), False
+    try:
+        value, higher = shared_objective_value(metrics, name)
+    except (KeyError, TypeError, ValueError):
+        return None, name.startswith(ROBUSTNESS)
+    return _finite(value), higher
 
 
 def _finite(value: Any) -> float | None:

@@ -13,8 +13,8 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 
-from ..control.estimators import Estimates
-from ..model.world import WorldSpec
+from ...model.world import WorldSpec
+from . import Estimates
 
 MAX_HOPS = 3
 

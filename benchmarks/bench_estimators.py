@@ -1,6 +1,6 @@
 """How right the context estimators are, on contexts and seeds no rule was derived from.
 
-``python -m amsa_phys.adapt.calibrate`` runs ``worlds/mde_adaptive.yaml`` in known contexts
+``python benchmarks/bench_estimators.py`` runs ``worlds/mde_adaptive.yaml`` in known contexts
 (held-out seeds 11-13, samples from t = 40 s, once every window is full) and prints, as
 Markdown tables for docs/adaptation.md:
 
@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[1]
 WORLD = ROOT / "worlds" / "mde_adaptive.yaml"
 SEEDS = (11, 12, 13)
 KV = 0.2  # the robust fixed gain of scenarios/adaptive_sweep.yaml
