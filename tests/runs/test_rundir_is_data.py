@@ -196,3 +196,16 @@ def test_a_not_imported_rovers_parameters_keep_only_numbers(
     scene = load_run(run)
     follower = next(r for r in scene.frame(scene.rows - 1).rovers if r.name == "Follower")
     assert (follower.length, follower.width, follower.track) == (0.8, 0.6, 0.7)
+
+
+def test_monitor_judges_a_formula_on_the_run_without_importing_what_it_names(
+    evil_run: tuple[Path, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``monitor RUNDIR FORMULA`` reads the trace's columns only: the module the run's
+    scenario names is neither imported nor needed to judge a formula over its signals."""
+    home, run = evil_run
+    formula = f"always(abs({REPLACED}.distanceFollowerToLeader) >= 0)"
+    assert main(["monitor", str(run), formula, "--json"]) == 0
+    _no_marker(home)
+    out = capsys.readouterr().out
+    assert '"robustness"' in out
