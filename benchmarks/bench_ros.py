@@ -12,7 +12,7 @@
 * the platoon world's launch: the peak of the summed resident memory of every process the
   launch started (sampled from ``/proc`` every 0.2 s), and its run time.
 
-Needs ROS 1 (roslaunch, catkin_make), ``unshare -n`` and root, as tests/e2e/test_ros.py does.
+Needs ROS 1 (roslaunch, catkin_make), ``unshare -n`` and root, as tests/ros/test_ros.py does.
 Compare ratios only: the machine is shared. Targets (issue 26): lockstep within 3x the
 in-process loop; the platoon's launch under 1 GB.
 Run: ``python benchmarks/bench_ros.py [--duration 500] [--platoon-duration 20]``.

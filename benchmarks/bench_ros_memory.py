@@ -13,7 +13,7 @@ nodes (scenario, boundary, Leaves), the C++ Leaves (the container, or a nodelet 
 each), and ROS itself (roslaunch, rosmaster, rosout). It also says whether the three traces
 are byte-identical.
 
-Needs ROS 1 (roslaunch, catkin_make), ``unshare -n`` and root, as tests/e2e/test_ros.py.
+Needs ROS 1 (roslaunch, catkin_make), ``unshare -n`` and root, as tests/ros/test_ros.py.
 Run: ``python benchmarks/bench_ros_memory.py [--duration 20]``.
 """
 

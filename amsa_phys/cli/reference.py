@@ -58,7 +58,13 @@ def _options(parser: argparse.ArgumentParser, skip: frozenset[str]) -> Iterator[
             continue
         if action.help == argparse.SUPPRESS or action.dest in skip:
             continue
+        # as --help prints it: argparse expands %(default)s and friends, and %% is a %
         help_text = action.help or ""
+        if "%" in help_text:
+            try:
+                help_text = help_text % {**vars(action), "prog": parser.prog}
+            except (KeyError, TypeError, ValueError):
+                help_text = help_text.replace("%%", "%")
         if action.choices and action.option_strings and "{" not in _flags(action):
             help_text += f" (one of {', '.join(map(str, action.choices))})"
         rows.append(f"| {_flags(action)} | {_cell(help_text)} |")

@@ -6,7 +6,7 @@ all of them) in the order the engine runs it — components (in the world's exec
 then the trace row, then the hooks (the physics step). :func:`runs` then folds runs of
 hook-only instants (the physics steps between two log rows) into one table entry, so the
 loop steps them without any per-instant check. No clock, no components, no numbers from
-the run: unit-testable on plain integers (``tests/unit/test_schedule.py``).
+the run: unit-testable on plain integers (``tests/engine/test_schedule.py``).
 """
 
 from __future__ import annotations

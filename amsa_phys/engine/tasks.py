@@ -13,7 +13,7 @@ the delivery heap), a Leaf with array ports, and a group of like copies stepped 
   refusals (:data:`OUTPUT_ERRORS`) and one message (:func:`bad_output`): the three copies
   this replaced had drifted apart. The scalar path (:meth:`Steppers.step`) runs the same
   loop inlined, because the call alone cost ~2 % of a headless run (CPU time, measured);
-  it uses the same exception set and message, and ``tests/unit/test_tasks.py`` holds the
+  it uses the same exception set and message, and ``tests/engine/test_tasks.py`` holds the
   two to the same verdict on every kind of bad output.
 """
 
@@ -199,7 +199,7 @@ class Steppers:
         positions are bound once, and up to two inputs are read into a dict display (a
         comprehension is a function call of its own on CPython 3.11). ~0.2 us less a
         component step, a tenth of a sensor's (issue 29). The same verdicts as :meth:`step`
-        (``tests/unit/test_tasks.py`` holds every path to them)."""
+        (``tests/engine/test_tasks.py`` holds every path to them)."""
         values, who, path, comp = self.values, self.who, task.path, task.comp
         reads, targets = task.reads, task.writes
         n = len(reads)

@@ -8,7 +8,7 @@ finite, within the run-length limit and never going back), and only every ``stri
 kept (plus the last), so that at most about :data:`MAX_CELLS` values stay in memory whatever
 the file's size. A picture a few thousand pixels wide cannot show more rows than that anyway,
 and the kept rows are the trace's own, never averaged: what is drawn is what the run wrote.
-Peak memory is a few blocks plus the kept values (tests/hostile/test_trace_memory.py).
+Peak memory is a few blocks plus the kept values (tests/runs/test_trace_memory.py).
 A top-level module because both ``plots`` and ``view`` (through ``cli``) read traces and the
 layers below ``runs`` may not import it.
 """

@@ -14,7 +14,7 @@ where they were before it, so they never move, never speed up and never fault.
 
 Freezing touches only the frozen rows (the force pass and the integration are per rover),
 so the other runs' floats are those of the columns without it, which are their single
-runs' (``tests/fidelity/test_columns.py``, ``tests/e2e/test_gym_vector.py``).
+runs' (``tests/physics/test_columns.py``, ``tests/gym/test_gym_vector.py``).
 """
 
 from __future__ import annotations

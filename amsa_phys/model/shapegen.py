@@ -6,7 +6,7 @@ plain Python once, here; the run path then imports only that code (and fastjsons
 exception module). The generated check is only a fast "is it valid?": a file it rejects is
 checked again by jsonschema, which alone words the error (``schema.validate``), so the messages
 — file, line, key — are unchanged and a disagreement can never accept a bad file silently
-(tests/unit/test_shapes.py holds the generated files to the schemas).
+(tests/model/test_shapes.py holds the generated files to the schemas).
 
 Regenerate after changing a schema: ``python -m amsa_phys.model.shapegen``.
 """

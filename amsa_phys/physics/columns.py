@@ -17,14 +17,14 @@ pymunk's broadphase quadratic). What is shared is the arithmetic:
   contacts (``cpBodyUpdatePosition`` then ``cpBodyUpdateVelocity``: ``p += v dt; a += w dt;
   v += (g + f / m) dt; w += t / I dt``, the same operations in the same order, so the same
   floats: given the same forces, a body ends each step where its Space would put it, bit
-  for bit; ``tests/fidelity/test_columns.py``).
+  for bit; ``tests/physics/test_columns.py``).
 
 With the compiled forces the integration, the contact screening below and the safety check
 run in the same C call as the forces (``_step.Columns``, ``ColumnForces.columns``): the
 numpy passes over 500-value columns cost more than the forces themselves (a 250-run batch's
 physics step ~65 µs, now ~35). The C step performs this module's numpy operations in the same
 order, so it gives the same floats and marks the same runs
-(``tests/fidelity/test_column_step.py``); the numpy code below remains the pure path's.
+(``tests/physics/test_column_step.py``); the numpy code below remains the pure path's.
 
 Contacts are where that stops: pymunk solves a contact with 10 sequential-impulse passes,
 which leave a residual that depends on the order of the contact points, and that order

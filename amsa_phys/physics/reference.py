@@ -3,9 +3,9 @@
 ``forces.rover_step`` (and ``_step.c``, its C twin) compute the same forces with the usual
 path inlined and constants folded for speed; this function reads pymunk's properties and
 calls ``wheel.py``'s functions per wheel, so a reader can check the model line by line
-against ``wheel.py``'s equations, and ``tests/unit/test_fast_paths.py`` holds the fast paths
+against ``wheel.py``'s equations, and ``tests/engine/test_fast_paths.py`` holds the fast paths
 to it in every regime. Slow (~10 µs a rover): it is also the "plain loop" of the benchmarks.
-Flat ground only (a slope's terms are the fast paths' alone; ``tests/fidelity/test_slopes.py``
+Flat ground only (a slope's terms are the fast paths' alone; ``tests/physics/test_slopes.py``
 holds them to closed forms).
 """
 

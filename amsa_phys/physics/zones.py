@@ -99,7 +99,7 @@ class GradeZone(Template):
     and the ground carries ``m g cos(angle)`` (its tyres' grip and rolling resistance scale
     with it). A rover holds on a slope while its rims' static resistance can hold the
     pull, rolls back above that, and climbs at the speed its motors allow
-    (``tests/fidelity/test_slopes.py``). The world stays a plane: a slope changes forces,
+    (``tests/physics/test_slopes.py``). The world stays a plane: a slope changes forces,
     not the height or the drawing.
     """
 

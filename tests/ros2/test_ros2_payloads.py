@@ -2,7 +2,7 @@
 
 With the refusal of hostile names switched off (only the escapers stand between the names and
 the generated files), packages whose scenario name, file name and world description carry the
-payloads of ``tests/hostile/test_export_ros_payloads.py`` (a newline then YAML tags for a
+payloads of ``tests/ros/test_export_ros_payloads.py`` (a newline then YAML tags for a
 parameter loader, ``\"\"\"`` then code for a Python docstring, XML for ``package.xml``) are
 generated, every Python file compiled and imported, ``setup.py`` run as colcon would ask it,
 and ``ros2 lockstep`` run on them (the nodes load the parameters file with rcl's YAML parser
