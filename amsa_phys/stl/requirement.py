@@ -124,8 +124,13 @@ def judge(
             continue
         ev = evaluate(req.node, {s: cols[s] for s in req.node.signals()}, period)
         rob = ev.robustness
+        until, ended = reads_until(req.formula), float(t[-1])
         for r in range(runs):
-            out[r][req.name] = _entry(req, float(rob[r]), _instant(ev, r, t))
+            entry = _entry(req, float(rob[r]), _instant(ev, r, t))
+            if until > ended + 1e-9:  # a run cut short: its windows were cut, so no verdict
+                entry["verdict"] = "skipped"
+                entry["note"] = f"it reads until t={until:g} s; the run ended at t={ended:g} s"
+            out[r][req.name] = entry
     return out
 
 

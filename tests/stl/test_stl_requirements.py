@@ -137,4 +137,8 @@ def test_a_run_cut_before_a_formulas_end_skips_it_and_its_replay_loads(
     out = tmp_path / "short"
     assert main(["run", str(path), "--headless", "--duration", "30", "--out", str(out)]) == 0
     assert "requirement tight: skipped (it reads until t=40 s" in capsys.readouterr().out
+    # metrics.json says the same: a robustness over the cut windows, but no verdict
+    entry = json.loads((out / "metrics.json").read_text())["requirements"]["tight"]
+    assert entry["verdict"] == "skipped"
+    assert entry["note"] == "it reads until t=40 s; the run ended at t=30 s"
     assert main(["validate", str(out / "scenario.yaml")]) == 0
