@@ -109,3 +109,49 @@ def test_the_trajectory_plot_reads_a_declared_fix(
     assert context["gps_of"] == {"Fixer": "Rover"}
     header = ["t", "Rover.posX", "Rover.posY", "Fixer.ex", "Fixer.ey"]
     assert {"Fixer.ex", "Fixer.ey"} <= plotted_columns(header, context["gps"])
+
+
+RANGER = '''
+from amsa_phys.physics.lidar import Lidar
+
+
+class Ranger(Lidar):
+    """A user's lidar under a name of its own: its scan mark comes with the class."""
+
+    template_name = "Ranger"
+'''
+SCAN_WORLD = """\
+name: ranger
+physics:
+  obstacles: [{type: box, x: 11, y: 0, width: 2, height: 30}]
+components:
+  Ctl: {template: ConstantPower, freq: 10, params: {left: 0, right: 0}}
+  Norm: {template: NormalizePower, freq: 10,
+         inputs: {powerL: Ctl.LeftPower, powerR: Ctl.RightPower}}
+  Rover: {template: controlledRobot, freq: 10,
+          inputs: {powerL: Norm.normalizedPowerL, powerR: Norm.normalizedPowerR}}
+  Eyes:
+    template: rangermod_{tag}:Ranger
+    freq: 10
+    params: {beams: 5, angle_min: -0.3, angle_max: 0.3, range_max: 15.0}
+    inputs: {posX: Rover.posX, posY: Rover.posY, heading: Rover.heading}
+"""
+
+
+def test_a_users_scan_template_is_drawn_as_beams(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The wall 10 m ahead echoes on every beam of a lidar the pictures know by its mark."""
+    tag = str(abs(hash(tmp_path)) % 10**8)
+    (tmp_path / f"rangermod_{tag}.py").write_text(RANGER)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    (tmp_path / "w.yaml").write_text(SCAN_WORLD.replace("{tag}", tag))
+    (tmp_path / "s.yaml").write_text("world: w.yaml\nduration: 5\n")
+    sim = Simulation.from_scenario(load_scenario(tmp_path / "s.yaml"))
+    sim.initialize()
+    scene, _, _ = _drawn(sim)
+    (scan,) = scene.frame().scans
+    assert scan.mount == "Rover"
+    assert len(scan.ranges) == 5
+    assert all(9.0 < r < 11.0 for r in scan.ranges)  # echoes off the wall, not range_max
+    assert scan.range_max == 15.0
