@@ -7,9 +7,9 @@ counts losses in the running component; a finished run has only its trace, so th
 the same red × as the window and the video (``palette.LOST_FIX``). Pure numpy, no drawing:
 a top-level module because both ``view`` and ``plots`` use it and must not import each other.
 
-Only a GPS that can lose samples (``lostDataGPS`` or ``burstLoss`` above 0 at some point of
-the run) is searched: a noiseless GPS on a parked rover also repeats its fix, and that is not
-a loss.
+Only a fix that can lose samples (one of its template's ``loss_params``, ``lostDataGPS`` or
+``burstLoss`` for the GPS, above 0 at some point of the run) is searched: a noiseless GPS on
+a parked rover also repeats its fix, and that is not a loss.
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from typing import Any
 
 import numpy as np
 
-#: the GPS parameters that make it drop samples
-LOSS_PARAMS = ("lostDataGPS", "burstLoss")
+from .templatemarks import Fix, marked
+
 #: how far (s) a trace row may sit from a sampling instant and still show that sample
 _EPS_S = 1e-9
 
@@ -36,36 +36,49 @@ class GpsLink:
     period_s: float
     #: the GPS can lose samples (its loss parameters, anywhere in the run, are above 0)
     lossy: bool
+    #: the trace columns of the fix (``path.port``, its template's :class:`Fix` mark)
+    x: str = ""
+    y: str = ""
+    #: the parameters that, above 0, make it lose samples
+    loss_params: tuple[str, ...] = ()
+
+    def made_lossy(self, lossy: set[tuple[str, str]]) -> bool:
+        """Whether it can lose samples, its own settings or the run's (:func:`lossy_in_run`)."""
+        return self.lossy or any((self.path, p) in lossy for p in self.loss_params)
 
 
-def gps_links(leaves: Mapping[str, Any], lossy_also: Iterable[str] = ()) -> list[GpsLink]:
-    """The GPS of a world (``WorldSpec.leaves``); ``lossy_also``: GPS paths the run made
-    lossy (:func:`lossy_in_run`: a loss switched on at 125 s)."""
+def gps_links(
+    leaves: Mapping[str, Any], lossy_also: Iterable[tuple[str, str]] = ()
+) -> list[GpsLink]:
+    """The position fixes of a world (``WorldSpec.leaves``), one per :class:`Fix` a template
+    declares; ``lossy_also``: ``(path, parameter)`` the run set above 0
+    (:func:`lossy_in_run`: a loss switched on at 125 s)."""
     lossy_also = set(lossy_also)
     out = []
-    for path, leaf in leaves.items():
-        if leaf.template.name() != "GPS":
-            continue
+    for path, leaf, fix in marked(leaves, Fix):
         params = dict(leaf.params)
-        lossy = any(params.get(p, 0) > 0 for p in LOSS_PARAMS) or path in lossy_also
-        source = leaf.inputs.get("posX", "")
-        rover = source[: -len(".posX")] if source.endswith(".posX") else None
+        loses = any(params.get(p, 0) > 0 or (path, p) in lossy_also for p in fix.loss_params)
+        source = leaf.inputs.get(fix.measures, "") if fix.measures else ""
+        rover = source.rpartition(".")[0] or None
         freq = float(leaf.freq) if leaf.freq else 0.0
-        out.append(GpsLink(path, rover, 1.0 / freq if freq > 0 else 0.0, lossy))
+        period = 1.0 / freq if freq > 0 else 0.0
+        x, y = f"{path}.{fix.x}", f"{path}.{fix.y}"
+        out.append(GpsLink(path, rover, period, loses, x, y, tuple(fix.loss_params)))
     return out
 
 
-def lossy_in_run(metrics: Mapping[str, Any]) -> set[str]:
-    """Components a run's ``metrics.json`` shows setting a loss parameter above 0 (in a
-    phase's ``set`` or a change inside a phase: ``--set``, the timeline, the window)."""
+def lossy_in_run(metrics: Mapping[str, Any]) -> set[tuple[str, str]]:
+    """``(component, parameter)`` a run's ``metrics.json`` shows set above 0 (in a phase's
+    ``set`` or a change inside a phase: ``--set``, the timeline, the window): a fix whose
+    template names that parameter among its ``loss_params`` can lose samples."""
     out = set()
     for phase in metrics.get("phases") or []:
         sets = [phase.get("set") or {}, *((c.get("set") or {}) for c in phase.get("changes") or [])]
         for values in sets:
             for key, value in values.items():
                 leaf, _, param = str(key).rpartition(".")
-                if param in LOSS_PARAMS and isinstance(value, int | float) and value > 0:
-                    out.add(leaf)
+                if isinstance(value, int | float) and value > 0:
+                    out.add((leaf, param))
     return out
 
 

@@ -94,7 +94,8 @@ def _world_of(rundir: Path) -> dict[str, Any] | None:
     if not path.is_file():
         return None
     try:
-        return plot_context(read_world(path, trace_header(rundir / "trace.csv")))  # type: ignore[arg-type]
+        world = read_world(path, trace_header(rundir / "trace.csv"))
+        return plot_context(world, world.resolved)  # type: ignore[arg-type]
     except (AmsaError, OSError) as exc:
         print(one_line(f"warning: {exc}; the paths are drawn without the world"), file=sys.stderr)
         return None

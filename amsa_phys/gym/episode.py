@@ -32,6 +32,7 @@ import greenlet
 from ..engine.runner import Simulation
 from ..model.scenario import Scenario
 from ..model.template import Template
+from ..templatemarks import StandIn
 
 
 class EpisodeStop(BaseException):
@@ -57,6 +58,8 @@ def stand_in(original: type[Template], exchange: Exchange) -> type[Template]:
         outputs = original.outputs
         params = original.params
         template_name = "agent"
+        #: its parameters act on nothing: the HUD does not list them as acting
+        marks = (StandIn(),)
 
         #: the paper's doStep, answered by the agent: ``exchange`` itself, not a method
         #: calling it (the engine calls ``do_step`` once per env-step: a frame less, issue 29)

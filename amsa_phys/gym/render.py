@@ -10,20 +10,18 @@ import numpy as np
 
 from ..engine.runner import Simulation
 from ..model.scenario import Quality
+from ..templatemarks import StandIn, marked
 from ..view.camera import Camera
 from ..view.draw import Renderer
 from ..view.pg import pygame
 from ..view.scene import Scene
 from ..view.video import new_surface
 
-#: the template name of the agent's stand-in (``episode.stand_in``)
-AGENT_TEMPLATE = "agent"
-
 
 def replaced_components(sim: Simulation) -> list[str]:
     """The components the agent stands in for: their parameters (a replaced controller's
     ``Kv=0.35``) act on nothing, so the HUD must not list them as if they did."""
-    return [p for p, leaf in sim.world.leaves.items() if leaf.template.name() == AGENT_TEMPLATE]
+    return [path for path, _, _ in marked(sim.world.leaves, StandIn)]
 
 
 class FrameSource:

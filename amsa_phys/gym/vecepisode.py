@@ -37,6 +37,7 @@ import numpy as np
 from ..engine.multirun import MultiRun
 from ..model.scenario import Scenario
 from ..model.template import Template
+from ..templatemarks import StandIn
 from .episode import STOP, EpisodeStop
 from .solo import Solo
 from .veccolumns import EpisodeColumns
@@ -64,6 +65,8 @@ def stand_in_many(original: type[Template], exchange: ExchangeMany) -> type[Temp
         outputs = original.outputs
         params = original.params
         template_name = "agent"
+        #: its parameters act on nothing: the HUD does not list them as acting
+        marks = (StandIn(),)
         batchable = True
 
         def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:

@@ -17,6 +17,7 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any, ClassVar, Protocol
 
+from ..templatemarks import Mark
 from .suggest import did_you_mean
 
 
@@ -145,6 +146,11 @@ class Template:
     batchable: ClassVar[bool | None] = None
     shares_physics: ClassVar[bool] = True
     batch_params_at_start: ClassVar[bool] = False
+    #: What the pictures draw of this template (``amsa_phys/templatemarks.py``): a position
+    #: fix on two output ports, a range scan, a zone of ground, a stand-in. The window, the
+    #: video, the plots and the Gymnasium renderer draw what is declared here, never by
+    #: template name, so a user's own GPS declaring a fix is drawn like the built-in one.
+    marks: ClassVar[tuple[Mark, ...]] = ()
 
     def __init__(self, path: str, params: Mapping[str, Any]) -> None:
         self.path = path

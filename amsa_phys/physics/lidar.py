@@ -18,6 +18,7 @@ import pymunk
 from ..engine import noise as nz
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
+from ..templatemarks import Scan
 from .space import physics_of
 
 _ALL = pymunk.ShapeFilter()
@@ -48,6 +49,8 @@ class Lidar(Template):
     batchable = True  # each run's copy steps alone in a batch (no step_many needed)
 
     kind = Kind.SENSOR
+    #: drawn as beams to each echo, in the colour of the rover it is mounted on
+    marks = (Scan(),)
     inputs = (
         Port("posX", 0.0, "x of the mount", "m"),
         Port("posY", 0.0, "y of the mount", "m"),

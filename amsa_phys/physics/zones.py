@@ -15,6 +15,7 @@ from typing import Any
 
 from ..model.params import Param
 from ..model.template import Kind, Template
+from ..templatemarks import Zone as ZoneMark
 from .space import physics_of
 from .terrain import Grade, Zone, polygon_area
 
@@ -34,6 +35,8 @@ class FrictionZone(Template):
     #: a zone changes the ground itself: the batch's column physics has one ground
     shares_physics = False
     kind = Kind.ENVIRONMENT
+    #: drawn as a patch of ground coloured by its friction, live, replayed and plotted
+    marks = (ZoneMark(),)
     params = (
         Param(
             "friction",

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -130,22 +131,34 @@ def draw_static_world(ax: Axes, physics: dict[str, Any] | None, view: View) -> b
     return drawn
 
 
-def plotted_columns(header: list[str]) -> frozenset[str]:
+def plotted_columns(
+    header: list[str], links: Sequence[Mapping[str, Any]] | None = None
+) -> frozenset[str]:
     """The trace columns the trajectory plot reads: positions, odometry and the GPS fixes
     it draws (a wide run's sample of its GPS: most of a 200-rover trace's columns are GPS
-    fixes, and parsing them was most of the plots' cost)."""
+    fixes, and parsing them was most of the plots' cost). ``links``: the world's fixes
+    (``plot_context``'s ``gps``)."""
     ends = (".posX", ".posY", ".odomX", ".odomY")
     keep = {c for c in header if c.endswith(ends)}
-    for comp in shown_gps(header, len(rover_names(header)) > GROUP_ABOVE):
-        keep |= {f"{comp}.gpsPosX", f"{comp}.gpsPosY"}
+    for _, x, y in shown_gps(header, len(rover_names(header)) > GROUP_ABOVE, links):
+        keep |= {x, y}
     return frozenset(keep)
 
 
-def shown_gps(header: list[str], grouped: bool) -> list[str]:
-    """The GPS components whose fixes are drawn: all, or in a wide run an evenly spaced
-    sample of at most :data:`MAX_GPS_TRACKS` (crosses along every path are a smear)."""
-    tracks = [c[: -len(".gpsPosX")] for c in header if c.endswith(".gpsPosX")]
-    tracks = [c for c in tracks if f"{c}.gpsPosY" in header]
+def shown_gps(
+    header: list[str], grouped: bool, links: Sequence[Mapping[str, Any]] | None = None
+) -> list[tuple[str, str, str]]:
+    """The fixes drawn, as ``(component, x column, y column)``: all, or in a wide run an
+    evenly spaced sample of at most :data:`MAX_GPS_TRACKS` (crosses along every path are a
+    smear). ``links``: the fixes the world's templates declare (``plot_context``'s ``gps``);
+    without the world (its ``scenario.yaml`` missing) the built-in GPS's columns."""
+    if links is None:
+        found = [c[: -len(".gpsPosX")] for c in header if c.endswith(".gpsPosX")]
+        tracks = [(c, f"{c}.gpsPosX", f"{c}.gpsPosY") for c in found]
+    else:
+        tracks = [(str(k["path"]), str(k["x"]), str(k["y"])) for k in links]
+    columns = set(header)
+    tracks = [t for t in tracks if t[1] in columns and t[2] in columns]
     if grouped and len(tracks) > MAX_GPS_TRACKS:
         tracks = tracks[:: -(-len(tracks) // MAX_GPS_TRACKS)]
     return tracks
@@ -188,10 +201,11 @@ def plot_trajectory(
     # a GPS of a rover the trace left out is still drawn in that rover's colour
     untraced = {r: _style(i, r) for i, r in enumerate(world.get("rovers") or [])}
     gps_style = style if grouped else {**untraced, **style}
-    _draw_gps(ax, header, data, view, gps_style, world.get("gps_of", {}), grouped)
+    links = world.get("gps")
+    _draw_gps(ax, header, data, view, gps_style, world.get("gps_of", {}), grouped, links)
     _draw_odometry(ax, header, data, view)
     _draw_goals(ax, world.get("goals", []), view)
-    _draw_lost_fixes(ax, header, data, view, paths, world.get("gps", []), metrics)
+    _draw_lost_fixes(ax, header, data, view, paths, links or [], metrics)
     hits = _collision_points(metrics, data, header, paths)
     if hits.size:
         p = view(hits)
@@ -346,11 +360,13 @@ def _draw_gps(
     style: dict[str, Style],
     gps_of: dict[str, str],
     grouped: bool,
+    links: Sequence[Mapping[str, Any]] | None,
 ) -> None:
     """GPS fixes as crosses in the measured rover's colour; in a wide run a sample of the
     GPS (:func:`shown_gps`), one artist per colour, at most :data:`MAX_FIXES` crosses."""
-    tracks = shown_gps(header, grouped)
-    cols = {c: (header.index(f"{c}.gpsPosX"), header.index(f"{c}.gpsPosY")) for c in tracks}
+    shown = shown_gps(header, grouped, links)
+    tracks = [c for c, _, _ in shown]
+    cols = {c: (header.index(x), header.index(y)) for c, x, y in shown}
 
     def colour(comp: str) -> str:
         rover = gps_of.get(comp, "")
@@ -393,8 +409,9 @@ def _draw_lost_fixes(
     points = []
     for link in links:
         path, rover = link["path"], link.get("rover")
-        cols = (f"{path}.gpsPosX", f"{path}.gpsPosY")
-        if not (link["lossy"] or path in lossy) or rover not in paths or cols[1] not in header:
+        cols = (link["x"], link["y"])
+        made = any((path, p) in lossy for p in link.get("loss_params") or ())
+        if not (link["lossy"] or made) or rover not in paths or not set(cols) <= set(header):
             continue
         fx, fy = data[:, header.index(cols[0])], data[:, header.index(cols[1])]
         rows = lost_fix_rows(data[:, 0], fx, fy, float(link["period_s"]))

@@ -48,6 +48,8 @@ if TYPE_CHECKING:  # multiprocessing (~8 ms of imports) only when a child is for
 
 from ..errors import one_line
 from ..palette import rover_names
+from ..templatemarks import Zone as ZoneMark
+from ..templatemarks import marked
 from ..tracemarks import gps_links
 
 #: How long the parent waits for the child's plots before drawing them itself.
@@ -78,7 +80,8 @@ def draw_run_plots(
         warnings.simplefilter("ignore")
         # both plots read one parse of only the columns they draw
         quality = metrics.get("quality") or {}
-        keep = plotted_columns(trace_header(trace)) | {str(quality.get("signal"))}
+        links = (world or {}).get("gps")
+        keep = plotted_columns(trace_header(trace), links) | {str(quality.get("signal"))}
         if quality:
             written.append(plot_distance(trace, metrics, distance, keep))
         written.append(plot_trajectory(trace, metrics, trajectory, world, keep))
@@ -90,12 +93,10 @@ def plot_context(world: WorldSpec, resolved: Any = None) -> dict[str, Any]:
     which rover each GPS measures (``gps_of``: GPS path -> rover path) and the goals rovers
     steer to (``goals``: x, y, radius), plain data. With the run's ``resolved`` scenario
     also its terrain zones, so the plots need not wait for ``scenario.yaml``."""
-    gps_of = {}
+    links = gps_links(world.leaves)
+    gps_of = {link.path: link.rover for link in links if link.rover}
     goals: dict[tuple[float, float], dict[str, float]] = {}
-    for path, leaf in world.leaves.items():
-        source = leaf.inputs.get("posX", "")
-        if leaf.template.name() == "GPS" and source.endswith(".posX"):
-            gps_of[path] = source[: -len(".posX")]
+    for leaf in world.leaves.values():
         goal = _goal_of(leaf.params)
         if goal is not None:  # a navigator and its monitor name the same goal: drawn once
             key = (goal["x"], goal["y"])
@@ -104,11 +105,12 @@ def plot_context(world: WorldSpec, resolved: Any = None) -> dict[str, Any]:
     # the world's rovers in order (colours by rank, whatever the trace keeps) and each GPS's
     # period and loss settings (trajectory.png marks its lost fixes, as the window does)
     context["rovers"] = rover_names(list(world.buffers))
-    context["gps"] = [vars(link) for link in gps_links(world.leaves)]
+    context["gps"] = [vars(link) for link in links]
     if resolved is not None:  # the run's resolved scenario: its zones go with the job
         from ..plots.zones import zones_of_resolved  # matplotlib-free
 
-        context["zones"] = zones_of_resolved(resolved)
+        declared = {path: mark for path, _, mark in marked(world.leaves, ZoneMark)}
+        context["zones"] = zones_of_resolved(resolved, declared)
     return context
 
 

@@ -66,6 +66,18 @@ class TemplateRef:
         """Whether the template is one of the package's own."""
         return self.cls is not None
 
+    @property
+    def marks(self) -> tuple[Any, ...]:
+        """What the built-in template declares the pictures draw of it (``Template.marks``);
+        none for a template not imported: its own declaration is never read."""
+        return self.cls.marks if self.cls is not None else ()
+
+    def param(self, name: str) -> Any:
+        """The built-in template's declared parameter ``name`` (KeyError when not imported)."""
+        if self.cls is None:
+            raise KeyError(name)
+        return self.cls.param(name)
+
 
 @dataclass(frozen=True)
 class RunLeaf:
@@ -92,6 +104,9 @@ class RunWorld:
     physics: dict[str, Any]
     leaves: dict[str, RunLeaf]
     buffers: list[str]
+    #: the resolved scenario it was read from, as plain data (the plots read its zones
+    #: and their changes without parsing the file again)
+    resolved: Any = field(default=None, repr=False, compare=False)
 
 
 @dataclass
@@ -185,6 +200,7 @@ def world_of(doc: YamlDoc, trace_columns: Sequence[str], warn: Warn) -> RunWorld
         physics=_merge(PHYSICS_DEFAULTS, world.get("physics") or {}),
         leaves=leaves,
         buffers=_buffers(leaves, trace_columns),
+        resolved=data,
     )
 
 

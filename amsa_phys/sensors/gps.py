@@ -13,6 +13,7 @@ from ..engine import noise as nz
 from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
+from ..templatemarks import Fix
 
 #: Slack when comparing float times (steps fall on a rational grid; floats of it round).
 _EPS = 1e-9
@@ -44,6 +45,8 @@ class GPS(Template):
     )
     #: the paper's names: ``noise`` (standard deviation) and ``bias`` (offset on both axes)
     param_aliases: ClassVar[Mapping[str, str]] = {"noise": "stddev", "bias": "mean"}
+    #: drawn as fixes in the measured rover's colour, a lost sample as a red cross
+    marks = (Fix("gpsPosX", "gpsPosY", "posX", "lost", ("lostDataGPS", "burstLoss")),)
 
     @classmethod
     def check_params(cls, values: Mapping[str, Any]) -> None:

@@ -22,7 +22,8 @@ from ..model.geometry import static_obstacles
 from ..model.scenario import Quality
 from ..model.world import WorldSpec
 from ..palette import rover_names, rover_ranks
-from ..tracemarks import gps_links, lossy_in_run, lost_fix_rows
+from ..templatemarks import Zone, marked
+from ..tracemarks import GpsLink, gps_links, lossy_in_run, lost_fix_rows
 from ..valuetext import value_text
 from .scene import (
     GPS_POINTS,
@@ -101,18 +102,17 @@ class ReplayScene:
                 lx, ly = x, y
         return np.asarray(keep, dtype=int)
 
-    def _gps_history(self) -> list[tuple[str, str | None, np.ndarray, np.ndarray]]:
-        """Per traced GPS: its path, rover, rows where a new fix appeared, rows of lost fixes."""
+    def _gps_history(self) -> list[tuple[GpsLink, str | None, np.ndarray, np.ndarray]]:
+        """Per traced fix: its link, rover, rows where a new fix appeared, rows of lost fixes."""
         out = []
         for link in gps_links(self.world.leaves, lossy_in_run(self.metrics)):
-            cx, cy = f"{link.path}.gpsPosX", f"{link.path}.gpsPosY"
-            if cx not in self.col or cy not in self.col:
+            if link.x not in self.col or link.y not in self.col:
                 continue
-            fx, fy = self.data[:, self.col[cx]], self.data[:, self.col[cy]]
+            fx, fy = self.data[:, self.col[link.x]], self.data[:, self.col[link.y]]
             new = np.flatnonzero(np.r_[True, (fx[1:] != fx[:-1]) | (fy[1:] != fy[:-1])])
             lost = lost_fix_rows(self.t, fx, fy, link.period_s) if link.lossy else new[:0]
             rover = link.rover if link.rover in self.ranks else None
-            out.append((link.path, rover, new, lost))
+            out.append((link, rover, new, lost))
         return out
 
     def _running_metrics(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
@@ -142,8 +142,8 @@ class ReplayScene:
             out.append(
                 Event(float(e["t"]), str(e.get("kind")), f"{e.get('kind')} {e.get('detail', '')}")
             )
-        for path, _, _, lost in self._gps:
-            out += [Event(float(self.t[r]), "lost fix", f"lost fix {path}") for r in lost]
+        for link, _, _, lost in self._gps:
+            out += [Event(float(self.t[r]), "lost fix", f"lost fix {link.path}") for r in lost]
         return sorted(out, key=lambda e: (e.t, e.kind))
 
     def _collision_points(self) -> list[tuple[float, tuple[float, float]]]:
@@ -162,21 +162,31 @@ class ReplayScene:
 
     def _zone_history(
         self,
-    ) -> tuple[list[ZoneView], list[tuple[float, str, str, float]]]:
+    ) -> tuple[list[ZoneView], list[tuple[float, str, int, float]]]:
         """The world's friction zones as declared, and every change to their values the
         run made (phase sets, in-phase and live changes: ``Mud.friction`` at 60 s), so a
         replayed zone shows the ground as it was at each instant, as the live window does."""
-        zones = [
-            ZoneView(
-                path,
-                tuple((float(x), float(y)) for x, y in leaf.params.get("polygon") or ()),
-                float(leaf.params.get("friction", 0.3)),
-                float(leaf.params.get("rollingResistance", 0.1)),
+        zones = []
+        #: (path, parameter) -> which value it sets (0 friction, 1 rolling resistance)
+        slot: dict[tuple[str, str], int] = {}
+        for path, leaf, mark in marked(self.world.leaves, Zone):
+            params, declared = leaf.params, leaf.template
+            polygon = params.get(mark.polygon) or ()
+            zones.append(
+                ZoneView(
+                    path,
+                    tuple((float(x), float(y)) for x, y in polygon),
+                    float(params.get(mark.friction, declared.param(mark.friction).default)),
+                    float(
+                        params.get(
+                            mark.rolling_resistance,
+                            declared.param(mark.rolling_resistance).default,
+                        )
+                    ),
+                )
             )
-            for path, leaf in self.world.leaves.items()
-            if leaf.template.name() == "frictionZone"
-        ]
-        names = {z.name for z in zones}
+            slot[(path, mark.friction)] = 0
+            slot[(path, mark.rolling_resistance)] = 1
         changes = []
         for p in self.phases:
             steps = [(float(p["start"]), p.get("set") or {})]
@@ -184,17 +194,17 @@ class ReplayScene:
             for at, sets in steps:
                 for key, value in sets.items():
                     leaf, _, param = str(key).rpartition(".")
-                    if leaf in names and param in ("friction", "rollingResistance"):
-                        changes.append((at, leaf, param, float(value)))
+                    if (leaf, param) in slot:
+                        changes.append((at, leaf, slot[(leaf, param)], float(value)))
         return zones, sorted(changes, key=lambda c: c[0])
 
     def zones(self, t: float) -> list[ZoneView]:
         """The zones with the values in force at ``t``."""
         now = {z.name: [z.friction, z.rolling_resistance] for z in self._zones}
-        for at, leaf, param, value in self._zone_changes:
+        for at, leaf, slot, value in self._zone_changes:
             if at > t:
                 break
-            now[leaf][0 if param == "friction" else 1] = value
+            now[leaf][slot] = value
         return [ZoneView(z.name, z.polygon, *now[z.name]) for z in self._zones]
 
     # -- reading -----------------------------------------------------------------------------
@@ -256,9 +266,9 @@ class ReplayScene:
             xy = self._xy(r.name)[rows]
             trails[r.name] = [*map(tuple, xy.tolist()), (r.x, r.y)]
         gps = []
-        for path, rover, new, lost in self._gps:
-            track = GpsTrack(path, rover)
-            fx, fy = self.col[f"{path}.gpsPosX"], self.col[f"{path}.gpsPosY"]
+        for link, rover, new, lost in self._gps:
+            track = GpsTrack(link.path, rover, link.x, link.y)
+            fx, fy = self.col[link.x], self.col[link.y]
             shown = new[: int(np.searchsorted(new, row, side="right"))][-GPS_POINTS:]
             track.fixes = deque(
                 zip(self.data[shown, fx].tolist(), self.data[shown, fy].tolist(), strict=True),

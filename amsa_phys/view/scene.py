@@ -19,6 +19,7 @@ from ..engine.runner import Simulation
 from ..model.geometry import Obstacle, static_obstacles
 from ..model.scenario import Quality
 from ..palette import rover_names
+from ..templatemarks import Fix, Scan, marked
 from ..valuetext import value_text
 
 #: Trail and GPS history kept per rover: bounded, so a long run draws in constant time.
@@ -62,6 +63,11 @@ class GpsTrack:
 
     path: str
     rover: str | None
+    #: the trace columns (``path.port``) of the fix, and the running component's counter of
+    #: lost samples ("": it counts none), as its template's :class:`Fix` mark declares
+    x: str = ""
+    y: str = ""
+    lost_count: str = ""
     fixes: deque[tuple[float, float]] = field(default_factory=lambda: deque(maxlen=GPS_POINTS))
     lost: deque[tuple[float, float]] = field(default_factory=lambda: deque(maxlen=LOST_POINTS))
     lost_total: int = 0
@@ -191,6 +197,14 @@ def adapt_text(sim: Simulation) -> str:
     return ""
 
 
+def fix_track(path: str, leaf: Any, fix: Fix) -> GpsTrack:
+    """The track of one declared fix: its columns, and the rover whose position the
+    ``measures`` port reads (its colour; where a lost fix is marked)."""
+    source = leaf.inputs.get(fix.measures, "") if fix.measures else ""
+    rover = source.rpartition(".")[0] or None
+    return GpsTrack(path, rover, f"{path}.{fix.x}", f"{path}.{fix.y}", fix.lost)
+
+
 class Scene:
     """Builds :class:`Frame` s from one Simulation, remembering trails and GPS history.
 
@@ -217,11 +231,10 @@ class Scene:
         self.obstacles = static_obstacles(sim.world.physics)
         self.trails: dict[str, deque[tuple[float, float]]] = {}
         self.gps: list[GpsTrack] = []
-        for path, leaf in sim.world.leaves.items():
-            if leaf.template.name() == "GPS":
-                source = leaf.inputs.get("posX", "")
-                self.gps.append(GpsTrack(path, source.rpartition(".")[0] or None))
-        self.lidars = [p for p, leaf in sim.world.leaves.items() if leaf.template.name() == "Lidar"]
+        for path, leaf, fix in marked(sim.world.leaves, Fix):
+            self.gps.append(fix_track(path, leaf, fix))
+        #: every declared scan: the component's path and what its template says it holds
+        self.lidars: list[tuple[str, Scan]] = [(p, m) for p, _, m in marked(sim.world.leaves, Scan)]
         self.metrics = LiveMetrics()
         self._last_fix: dict[str, tuple[float, float]] = {}
         #: where collisions happened (the midpoint of the rovers named), as the plots mark them
@@ -322,11 +335,12 @@ class Scene:
                     self.collisions.append((sum(xs) / len(xs), sum(ys) / len(ys)))
         self._events_seen = len(sim.events)
         for track in self.gps:
-            fix = (values[f"{track.path}.gpsPosX"], values[f"{track.path}.gpsPosY"])
-            if self._last_fix.get(track.path) != fix:
-                self._last_fix[track.path] = fix
+            fix = (values[track.x], values[track.y])
+            if self._last_fix.get(track.x) != fix:
+                self._last_fix[track.x] = fix
                 track.fixes.append(fix)
-            lost = int(getattr(sim.components.get(track.path), "lost", 0))
+            counted = sim.components.get(track.path) if track.lost_count else None
+            lost = int(getattr(counted, track.lost_count, 0)) if counted is not None else 0
             if lost > track.lost_total:
                 pos = where.get(track.rover or "")
                 if pos is not None:
@@ -382,14 +396,14 @@ class Scene:
     def scans(self) -> list[LidarScan]:
         """Each lidar's last published scan (none before its first)."""
         out = []
-        for path in self.lidars:
+        for path, mark in self.lidars:
             comp = self.sim.components.get(path)
-            scan = getattr(comp, "scan", None)
+            scan = getattr(comp, mark.latest, None)
             if comp is None or scan is None:
                 continue
             x, y, heading, ranges = scan
-            angles = (heading + comp.angles()).tolist()
-            out.append(
-                LidarScan(comp.mount, x, y, tuple(angles), tuple(ranges.tolist()), comp.p.range_max)
-            )
+            angles = (heading + getattr(comp, mark.angles)()).tolist()
+            reach = float(getattr(comp.p, mark.max_range))
+            mount = str(getattr(comp, mark.mount, ""))
+            out.append(LidarScan(mount, x, y, tuple(angles), tuple(ranges.tolist()), reach))
         return out
