@@ -122,6 +122,12 @@ class WheelModel:
         """``c = F_stall / v_free``: motor force lost per m/s of rim speed (N s/m)."""
         return self.stall_force_n / self.free_speed_mps
 
+    def motor_force(self, power_pct: float, u: float) -> float:
+        """Motor force at the ground (N) at rim speed ``u``, current-limited (the power
+        supply's current draw reads it: ``robots.py``)."""
+        f = self.drive_force(power_pct) - self.back_emf() * u
+        return max(-self.max_force_n, min(self.max_force_n, f))
+
     # -- ground ---------------------------------------------------------------------------
     def resistance(self, crr: float) -> float:
         """``R = Crr rollingCoef m g / 2 + jointFriction / r`` (N at the rim) on ground ``crr``:
