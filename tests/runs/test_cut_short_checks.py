@@ -43,8 +43,10 @@ def test_issue_command_collides_and_exits_1(
     # the setpoint moved away from quality.reference is warned about, then the failure
     warning, error = captured.err.splitlines()
     assert warning.startswith("warning: MyFollowerController.distanceRef is 0 m, but the run")
-    assert error == "error: 1 check of 4 failed: collisions"
-    assert captured.out.count(": skipped (") == 3
+    # the run's own requirement "never closer than 3 m" is broken for good too; the checks
+    # and the requirement reading the last phase are not judged
+    assert error == "error: 2 checks of 6 failed: collisions, requirement no_contact"
+    assert captured.out.count(": skipped (") == 4
 
 
 def test_api_run_is_not_passed() -> None:
@@ -56,12 +58,16 @@ def test_api_run_is_not_passed() -> None:
     assert run.metrics["overall"]["partial"] is True
     assert not run.passed
     failed = [c for c in run.checks if not c.passed]
-    assert [(c.expectation.metric, c.value, c.skipped) for c in failed] == [
-        ("collisions", 1, False)
+    assert [(c.expectation.metric or c.expectation.name, c.skipped) for c in failed] == [
+        ("collisions", False),
+        ("no_contact", False),  # "never closer than 3 m": broken when they touched
     ]
-    # the other three are still not judged
-    assert sorted(c.expectation.metric for c in run.skipped) == [
+    assert failed[0].value == 1
+    assert failed[1].value is not None and failed[1].value < 0
+    # the other four are still not judged
+    assert sorted(c.expectation.metric or c.expectation.name for c in run.skipped) == [
         "final_distance",
+        "holds_last_phase",
         "rms_error",
         "settling_time",
     ]
@@ -145,4 +151,4 @@ def test_the_replay_judges_the_failed_check_too(
     assert main([*replay, "--out", str(tmp_path / "r")]) == 1
     out, err = capsys.readouterr()
     assert "expect collisions = 1, below 1: FAIL\n" in out  # with the other verdicts
-    assert err.splitlines()[-1] == "error: 1 check of 1 failed: collisions"
+    assert err.splitlines()[-1] == "error: 2 checks of 2 failed: collisions, requirement no_contact"

@@ -173,7 +173,11 @@ def test_a_run_cut_by_duration_passes_and_its_scenario_replays(
     assert "partial" not in metrics["phases"][0]
     assert metrics["phases"][1]["partial"] is True
     doc = yaml.safe_load((out / "scenario.yaml").read_text())
-    assert doc["expect"] == [{"metric": "rms_error", "phase": 0, "above": 2.0}]
+    # what the cut run judged stays: phase 0's bound and the whole-run requirement
+    assert doc["expect"] == [
+        {"metric": "rms_error", "phase": 0, "above": 2.0},
+        {"stl": "always(MyDistanceMonitor.distanceFollowerToLeader >= 3)", "name": "no_contact"},
+    ]
     replay = tmp_path / "replay"
     assert main(["run", str(out / "scenario.yaml"), "--headless", "-q", "--out", str(replay)]) == 0
     assert capsys.readouterr().out.count("expect rms_error (phase 0) = ") == 1

@@ -167,7 +167,8 @@ def test_other_outputs_on_a_full_disk_exit_3_naming_the_file(
         out = full / "sw"
         argv = ["sweep", str(scen), "--grid", "MyFollowerController.Kv=0.1,0.2", "-j", "1"]
         assert main([*argv, "--out", str(out)]) == 3
-        assert one_line(capsys) == f"error: cannot write {out / 'results.csv'}: {ENOSPC}"
+        # the sweep's first file is the scenario it runs (adapt reads it back), then results
+        assert one_line(capsys) == f"error: cannot write {out / 'scenario.yaml'}: {ENOSPC}"
     names = [p.name for p in full.rglob("*") if p.is_file()]
     assert set(names) <= {".amsa-phys-run"}, names  # nothing torn under any name
 
