@@ -106,3 +106,20 @@ def test_a_rare_brief_reversal_still_gives_an_estimate() -> None:
     out = _motor(0.6, reverse=40)  # a twentieth of the command cancels out
     assert out["valid"] == 1.0
     assert out["delivered"] == pytest.approx(0.6, abs=0.05)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_worn_motors_stay_judged_under_their_own_cells_gain(seed: int) -> None:
+    """The worn cells' gains reverse the follower now and then; the estimate stays sure.
+
+    Refusing every window with a reversal blinded it under exactly the gain its rule set
+    (motors at 29 % under Kv 0.6: 1 % of samples sure), and the fallback undid the switch.
+    """
+    for coef, kv, low, high in ((29, 0.6, 0.0, 0.35), (50, 0.35, 0.4, 0.7)):
+        run = _run(seed, 300, **{"MyNormalizePower.motorCoef": coef, "MyFollowerController.Kv": kv})
+        after = run.trace["t"] >= 40
+        sure = run.trace["MotorMonitor.valid"][after] > 0.5
+        delivered = run.trace["MotorMonitor.delivered"][after][sure]
+        assert sure.mean() >= 0.4, (coef, kv)
+        # 5-95 % of the sure samples within the cell's band: its rule reads them as worn
+        assert low < np.percentile(delivered, 5) <= np.percentile(delivered, 95) < high, (coef, kv)
