@@ -31,6 +31,7 @@ best values settle to the same levels.
 
 from __future__ import annotations
 
+import itertools
 import math
 import statistics
 from collections.abc import Sequence
@@ -376,8 +377,21 @@ def _place(cells: list[Cell], found: list[Watch], watched: set[str]) -> list[str
     return problems
 
 
+def _band(ls: list[float], i: int) -> dict[str, float]:
+    """The band of level ``ls[i]``: from the midpoints to its neighbours, less the gap."""
+    bound: dict[str, float] = {}
+    if i > 0:
+        mid, step = (ls[i - 1] + ls[i]) / 2, ls[i] - ls[i - 1]
+        bound["above"] = round(mid + GAP * step, 6)
+    if i < len(ls) - 1:
+        mid, step = (ls[i] + ls[i + 1]) / 2, ls[i + 1] - ls[i]
+        bound["below"] = round(mid - GAP * step, 6)
+    return bound
+
+
 def _rules(cells: list[Cell], hold: float) -> list[dict[str, Any]]:
-    """One rule per placed cell (cells at the same levels with the same best share one)."""
+    """One rule per placed cell (cells at the same levels with the same best share one),
+    then one per combination of bands no cell has (:func:`_nearest_rules`)."""
     signals = sorted({s for c in cells for s in c.levels})
     levels = {s: sorted({c.levels[s] for c in cells if s in c.levels}) for s in signals}
     rules: list[dict[str, Any]] = []
@@ -388,15 +402,7 @@ def _rules(cells: list[Cell], hold: float) -> list[dict[str, Any]]:
             ls = levels[s]
             if len(ls) < 2 or s not in cell.levels:
                 continue
-            i = ls.index(cell.levels[s])
-            bound: dict[str, float] = {}
-            if i > 0:
-                mid, step = (ls[i - 1] + ls[i]) / 2, ls[i] - ls[i - 1]
-                bound["above"] = round(mid + GAP * step, 6)
-            if i < len(ls) - 1:
-                mid, step = (ls[i] + ls[i + 1]) / 2, ls[i + 1] - ls[i]
-                bound["below"] = round(mid - GAP * step, 6)
-            when[s] = bound
+            when[s] = _band(ls, ls.index(cell.levels[s]))
         if not when:
             continue
         key = (
@@ -409,4 +415,48 @@ def _rules(cells: list[Cell], hold: float) -> list[dict[str, Any]]:
         rule = {"when": when, "set": dict(cell.best), "hold": _whole(hold), "label": cell.name}
         seen[key] = rule
         rules.append(rule)
-    return rules
+    return rules + _nearest_rules(cells, levels, hold)
+
+
+def _nearest_rules(
+    cells: list[Cell], levels: dict[str, list[float]], hold: float
+) -> list[dict[str, Any]]:
+    """A rule for each combination of bands that no cell settles to: the nearest cell's best.
+
+    A sweep need not cover every combination of its estimators' levels (a random leader
+    with very worn motors, when it swept each alone). With no rule there, the gain in force
+    stays -- whatever the last context set -- or the robust one; the oracle schedule
+    ``adapt --validate`` compares with sets the nearest cell's best instead. So does this
+    rule: nearest in the estimators' levels, each output's distance a share of its span.
+    When two cells are equally near with different best values, no rule is written.
+    """
+    varying = [s for s, ls in levels.items() if len(ls) >= 2]
+    full = [c for c in cells if c.best and all(s in c.levels for s in varying)]
+    if not varying or not full:
+        return []
+    taken = {tuple(levels[s].index(c.levels[s]) for s in varying) for c in full}
+    span = {s: levels[s][-1] - levels[s][0] for s in varying}
+    out: list[dict[str, Any]] = []
+    for combo in itertools.product(*(range(len(levels[s])) for s in varying)):
+        if combo in taken:
+            continue
+
+        def distance(c: Cell, combo: tuple[int, ...] = combo) -> float:
+            return sum(
+                abs(c.levels[s] - levels[s][i]) / span[s]
+                for s, i in zip(varying, combo, strict=True)
+            )
+
+        least = min(distance(c) for c in full)
+        near = [c for c in full if math.isclose(distance(c), least)]
+        if len({tuple(sorted(c.best.items())) for c in near}) > 1:
+            continue  # equally near cells disagree: leave it to the gain in force
+        out.append(
+            {
+                "when": {s: _band(levels[s], i) for s, i in zip(varying, combo, strict=True)},
+                "set": dict(near[0].best),
+                "hold": _whole(hold),
+                "label": f"nearest {near[0].name} (no cell here)",
+            }
+        )
+    return out

@@ -248,6 +248,12 @@ def test_derive_from_a_fixture_sweep_gives_the_expected_table() -> None:
             "hold": 5,
             "label": "nominal, speed changes (alike: robust)",
         },
+        {  # no cell is worn with a random leader: worn and random are as near, and agree
+            "when": {turning: {"above": 0.21}, delivered: {"below": 0.7}, **sure},
+            "set": {"MyFollowerController.Kv": 0.4},
+            "hold": 5,
+            "label": "nearest worn (no cell here)",
+        },
     ]
     # straight at constant speed and with speed changes look alike: reported, robust rule
     assert sorted(u.split(":")[0] for u in found.unplaced) == ["nominal", "speed changes"]

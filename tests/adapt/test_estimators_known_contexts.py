@@ -67,8 +67,12 @@ class _Ctx:
     path = "M"
 
 
-def _motor(share: float, reverse: bool = False) -> dict:
-    """A MotorMonitor fed 60 s of a rover whose speed shows ``share`` of a 20 % command."""
+def _motor(share: float, reverse: int = 0) -> dict:
+    """A MotorMonitor fed 60 s of a rover whose speed shows ``share`` of a 20 % command.
+
+    ``reverse`` N: every Nth command is reversed (the rover, with its 10 s speed time
+    constant, keeps its speed).
+    """
     from fractions import Fraction
 
     from amsa_phys.control.estimators.motor import MotorMonitor
@@ -79,7 +83,7 @@ def _motor(share: float, reverse: bool = False) -> dict:
     out: dict = {}
     for k in range(241):
         t = k / 4
-        power = -20.0 if reverse and k % 40 == 0 else 20.0
+        power = -20.0 if reverse and k % reverse == 0 else 20.0
         inputs = {"powerL": power, "powerR": power, "posX": speed * t, "posY": 0.0}
         out = dict(comp.do_step(Fraction(k, 4), inputs) or out)
     return out
@@ -92,5 +96,30 @@ def test_a_share_a_little_above_one_is_noise_published_as_one() -> None:
 
 def test_a_share_far_above_one_or_a_reversing_command_is_invalid() -> None:
     assert _motor(1.5) == {"delivered": 1.0, "valid": 0.0}  # held at its start value
-    assert _motor(0.6, reverse=True)["valid"] == 0.0
+    # two thirds of the command cancel out: worn motors (0.3) would read as healthy (0.9)
+    assert _motor(0.3, reverse=3)["valid"] == 0.0
     assert _motor(0.6)["delivered"] == pytest.approx(0.6, abs=0.02)
+
+
+def test_a_rare_brief_reversal_still_gives_an_estimate() -> None:
+    """A high gain on worn motors reverses now and then: the motors are still judged."""
+    out = _motor(0.6, reverse=40)  # a twentieth of the command cancels out
+    assert out["valid"] == 1.0
+    assert out["delivered"] == pytest.approx(0.6, abs=0.05)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_worn_motors_stay_judged_under_their_own_cells_gain(seed: int) -> None:
+    """The worn cells' gains reverse the follower now and then; the estimate stays sure.
+
+    Refusing every window with a reversal blinded it under exactly the gain its rule set
+    (motors at 29 % under Kv 0.6: 1 % of samples sure), and the fallback undid the switch.
+    """
+    for coef, kv, low, high in ((29, 0.6, 0.0, 0.35), (50, 0.35, 0.4, 0.7)):
+        run = _run(seed, 300, **{"MyNormalizePower.motorCoef": coef, "MyFollowerController.Kv": kv})
+        after = run.trace["t"] >= 40
+        sure = run.trace["MotorMonitor.valid"][after] > 0.5
+        delivered = run.trace["MotorMonitor.delivered"][after][sure]
+        assert sure.mean() >= 0.4, (coef, kv)
+        # 5-95 % of the sure samples within the cell's band: its rule reads them as worn
+        assert low < np.percentile(delivered, 5) <= np.percentile(delivered, 95) < high, (coef, kv)

@@ -33,10 +33,15 @@ class MotorMonitor(Template):
     samples are in.
 
     ``valid`` says whether the window's estimate can be trusted (1) or not (0): the model
-    above holds for a rover driving forward, so a window in which the command reversed (a
-    follower oscillating about its reference, reversing to back off) says nothing about the
-    motors -- its path length counts backward travel as forward and its mean command
-    cancels out, which read as delivered shares of 2 to 10 with healthy motors. A share above
+    above holds for a rover driving forward, so a window whose commands largely cancel out
+    (a follower oscillating about its reference, reversing to back off) says nothing about
+    the motors -- its path length counts backward travel as forward and its mean command
+    shrinks towards 0, which read as delivered shares of 2 to 10 with healthy motors. A few
+    brief reversals do not move a rover whose speed has a 10 s time constant backward, and
+    the ratio stays right; so the window is judged by how much of its command cancels out
+    (1 - mean / mean magnitude, at most ``maxReverse``), not by whether any command
+    reversed: a high gain on worn motors reverses now and then, and refusing every such
+    window blinded the estimate exactly where the gain it chose was running. A share above
     ``maxShare`` is physically impossible (motors deliver at most what is commanded), so it
     is invalid too. While invalid, ``delivered`` holds the last valid estimate; a valid one
     between 1 and ``maxShare`` (noise about healthy motors) is published as 1.
@@ -107,6 +112,15 @@ class MotorMonitor(Template):
             "s",
         ),
         Param(
+            "maxReverse",
+            "float",
+            "largest share of the window's command that may cancel out (reversals)",
+            0.1,
+            0.0,
+            1.0,
+            "",
+        ),
+        Param(
             "maxShare",
             "float",
             "largest plausible share (noise above 1); a larger one is invalid",
@@ -147,7 +161,9 @@ class MotorMonitor(Template):
             # the speed's own share (first-order rover: P ~ v + tau dv/dt)
             speed += p.timeConstant * (self._edge_speed(-1) - self._edge_speed(0)) / span
             command = sum(v for _, v in self.power.items) / len(self.power)
-            forward = min(v for _, v in self.power.items) > 0.0
+            magnitude = sum(abs(v) for _, v in self.power.items) / len(self.power)
+            # forward enough: at most maxReverse of the command cancels out (0: none reversed)
+            forward = command >= (1.0 - p.maxReverse) * magnitude
             self.valid = 0.0
             if command >= p.minPower and forward:
                 share = (p.frictionPower + 100.0 * speed / p.maxSpeed) / command
