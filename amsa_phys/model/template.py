@@ -228,6 +228,7 @@ BUILTINS: dict[str, str] = {
     "controlledRobot": "amsa_phys.physics.templates:ControlledRobot",
     "GPS": "amsa_phys.sensors.gps:GPS",
     "GNSS": "amsa_phys.physics.gnss:GNSS",
+    "gpsDeniedZone": "amsa_phys.physics.gnss:GpsDeniedZone",
     "Compass": "amsa_phys.sensors.compass:Compass",
     "IMU": "amsa_phys.sensors.imu:IMU",
     "WheelOdometry": "amsa_phys.sensors.odometry:WheelOdometry",

@@ -20,6 +20,7 @@ from ..engine import noise as nz
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
 from .space import physics_of
+from .terrain import Zone, polygon_area
 
 _ALL = pymunk.ShapeFilter()
 #: Slack when comparing float times (steps fall on a rational grid; floats of it round).
@@ -46,7 +47,8 @@ class GNSS(Template):
 
     **Outages**: no fix where the visible sky falls below ``minSky`` (share), inside the
     denied rectangle [``deniedXMin``, ``deniedXMax``] × [``deniedYMin``, ``deniedYMax``]
-    (a tunnel, a covered yard; empty by default), or for a lost sample (``lostDataGPS`` %).
+    (a tunnel, a covered yard; empty by default), inside any ``gpsDeniedZone`` of the world,
+    or for a lost sample (``lostDataGPS`` %).
     Nothing published: readers keep the stale fix.
 
     **Timing**: ``fixTime`` is the receiver's stamp of the published fix: its true
@@ -117,6 +119,7 @@ class GNSS(Template):
     def initialize(self, ctx: Any) -> None:
         """Find the world; split the streams: noise channel, multipath, loss, jitter."""
         self.physics = physics_of(ctx)
+        self.zones = denied_zones(ctx)
         chan, mp, loss, jit = ctx.rng.spawn(4)
         self.noise = nz.Channel(chan, 2)
         self.mp_start = mp.standard_normal(2).tolist()
@@ -173,6 +176,7 @@ class GNSS(Template):
         denied = (
             visible <= 0
             or visible < p.minSky
+            or any(z.contains(px, py) for z in self.zones.values())
             or (
                 p.deniedXMin <= px <= p.deniedXMax
                 and p.deniedYMin <= py <= p.deniedYMax
@@ -202,6 +206,62 @@ class GNSS(Template):
         while len(hist) > 1 and hist[1][0] <= due:
             hist.popleft()
         return hist[0], hist[0][0] <= due
+
+
+def denied_zones(ctx: Any) -> dict[str, Zone]:
+    """The run's ``gpsDeniedZone`` polygons by component path (shared by its receivers)."""
+    return ctx.shared("gpsDenied", lambda sim: {})
+
+
+class GpsDeniedZone(Template):
+    """A region with no satellite fix (a tunnel, a covered yard, under a bridge).
+
+    Every ``GNSS`` receiver whose true position is inside ``polygon`` publishes nothing, so
+    its readers keep the last fix; the plain ``GPS`` template ignores it. Change
+    ``polygon`` in a timeline to move the zone.
+    """
+
+    batchable = True  # each run's copy steps alone in a batch
+
+    template_name = "gpsDeniedZone"
+    kind = Kind.ENVIRONMENT
+    params = (
+        Param(
+            "polygon",
+            "points",
+            "the zone's corners [[x, y], ...] in order (at least 3, not crossing)",
+            (),
+            unit="m",
+        ),
+    )
+
+    @classmethod
+    def check_params(cls, values: Mapping[str, Any]) -> None:
+        """A zone needs a polygon with an area."""
+        pts = values.get("polygon", ())
+        if len(pts) < 3:
+            raise ValueError(f"polygon needs at least 3 corners, got {len(pts)}")
+        if abs(polygon_area(pts)) < 1e-9:
+            raise ValueError("polygon has no area (its corners are on one line)")
+
+    def initialize(self, ctx: Any) -> None:
+        """Register the zone with the run's receivers (it lives beside the physics)."""
+        self.check_params(self.p.as_dict())
+        physics_of(ctx)  # the zone belongs to the simulated world (ROS: the simulator node)
+        self.zones = denied_zones(ctx)
+        self._register()
+
+    def _register(self) -> None:
+        self.zones[self.path] = Zone(self.path, tuple(map(tuple, self.p.polygon)), 0.0, 0.0)
+
+    def on_param_change(self, name: str, value: Any) -> None:
+        """A moved polygon applies from the next fix."""
+        self.check_params(self.p.as_dict())
+        self._register()
+
+    def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+        """Nothing to publish: the zone acts through the receivers."""
+        return {}
 
 
 def unit_gauss_markov(tau: float, dt: float) -> tuple[float, float]:

@@ -5,6 +5,8 @@ and the time stamps (a constant offset, a drift, the jitter's spread)."""
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -22,7 +24,11 @@ FREQ = 4
 
 
 def gnss_run(
-    tmp_path: Path, gnss: dict[str, Any], x: float, duration: float = 400
+    tmp_path: Path,
+    gnss: dict[str, Any],
+    x: float,
+    duration: float = 400,
+    others: dict[str, Any] | None = None,
 ) -> tuple[np.ndarray, list[str], Simulation]:
     """A still rover at (x, 0) beside (or far from) the wall; the trace at the GNSS's rate."""
     world = {
@@ -48,6 +54,7 @@ def gnss_run(
                 "params": {"obstacleHeight": HEIGHT, "elevationMask": MASK, **gnss},
                 "inputs": {"posX": "Rover.posX", "posY": "Rover.posY"},
             },
+            **(others or {}),
         },
     }
     path = tmp_path / "gnss.yaml"
@@ -182,3 +189,32 @@ def test_sync_drift_and_stamp_jitter(tmp_path: Path) -> None:
     err = col(rows, cols, "Fix.fixTime") - rows[:, 0]
     assert abs(err.mean()) < 4 * 0.02 / math.sqrt(len(err))
     assert abs(err.std() / 0.02 - 1) < 0.1
+
+
+def test_a_gps_denied_zone_holds_every_fix_inside_it(tmp_path: Path) -> None:
+    """A gpsDeniedZone (a tunnel) over the rover: no fix; the same zone 5 m away: every fix."""
+    tunnel = [[-65, -3], [-55, -3], [-55, 3], [-65, 3]]
+    zone = {"Tunnel": {"template": "gpsDeniedZone", "params": {"polygon": tunnel}}}
+    rows, cols, sim = gnss_run(tmp_path, {"stddev": 0.2}, -60, 20, zone)
+    assert np.all(col(rows, cols, "Fix.gpsPosX") == 0.0)
+    assert sim.components["Fix"].lost == len(rows)
+    rows, cols, _ = gnss_run(tmp_path, {"stddev": 0.2}, -50, 20, zone)
+    assert held_share(rows, cols) == 0.0
+
+
+def test_a_zone_without_area_is_refused_naming_it(tmp_path: Path) -> None:
+    """Two corners: one line naming the zone and the polygon, exit 2, no traceback."""
+    zone = {"Tunnel": {"template": "gpsDeniedZone", "params": {"polygon": [[0, 0], [1, 1]]}}}
+    world = {"components": zone}
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump({"world": world, "duration": 1}))
+    proc = subprocess.run(
+        [sys.executable, "-m", "amsa_phys", "validate", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 2
+    assert "Tunnel" in proc.stderr
+    assert "polygon" in proc.stderr
+    assert "Traceback" not in proc.stderr
