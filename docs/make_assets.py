@@ -36,6 +36,10 @@ RECIPES: dict[str, list[tuple[str, ...]]] = {
     "paper_fig6_sensed.png": [(AMSA, "plot", "--paper", "fig6-sensed", "-o", "{out}")],
     "paper_fig5_start.png": [(AMSA, "plot", "--paper", "fig5-start", "-o", "{out}")],
     "paper_fig7.png": [(AMSA, "plot", "--paper", "fig7", "-o", "{out}")],
+    "paper_fig6_urban_distance.png": [
+        (AMSA, "run", "scenarios/paper_fig6_urban.yaml", "--headless", "-q", "--out", "{tmp}/run"),
+        ("copy", "{tmp}/run/distance.png"),
+    ],
     "scenario1_distance.png": [
         (AMSA, "run", "scenarios/scenario1.yaml", "--headless", "-q", "--out", "{tmp}/run"),
         ("copy", "{tmp}/run/distance.png"),

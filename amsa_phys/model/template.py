@@ -233,6 +233,8 @@ BUILTINS: dict[str, str] = {
     "freeRobot": "amsa_phys.physics.templates:FreeRobot",
     "controlledRobot": "amsa_phys.physics.templates:ControlledRobot",
     "GPS": "amsa_phys.sensors.gps:GPS",
+    "GNSS": "amsa_phys.physics.gnss:GNSS",
+    "gpsDeniedZone": "amsa_phys.physics.gnss:GpsDeniedZone",
     "Compass": "amsa_phys.sensors.compass:Compass",
     "IMU": "amsa_phys.sensors.imu:IMU",
     "WheelOdometry": "amsa_phys.sensors.odometry:WheelOdometry",
