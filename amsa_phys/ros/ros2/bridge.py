@@ -400,6 +400,7 @@ class ExternalSimulation(Simulation):
         except BaseException:
             self.bridge.close()
             raise
+        self.watch_requirements(scenario)  # the STL requirements, judged as in process
 
     def close(self) -> None:
         """Leave the ROS 2 graph."""

@@ -50,6 +50,7 @@ class RosSimulation(Simulation):
             # every Leaf is called on its own: a node per Leaf, a topic per output
             grouping=False,
         )
+        self.watch_requirements(scenario)  # the STL requirements, judged as in process
         self.link = link
         link.attach(self)
         graph = link.graph
