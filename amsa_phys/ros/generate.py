@@ -29,7 +29,7 @@ from typing import Any
 from .._version import __version__
 from ..engine.timing import run_phases
 from ..errors import ConfigError
-from ..model.rosnames import FRAMEWORK, P_SEED, PHASE
+from ..model.rosnames import FRAMEWORK, PHASE
 from ..model.scenario import Scenario
 from ..model.world import WorldSpec
 from ..runs.resolve import resolved_scenario
@@ -226,7 +226,8 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         )
         files[f"include/{pkg}/amsa_leaf_node.h"] = _fill(
             "amsa_leaf_node.h",
-            seed_missing=f"{P_SEED} is not on the parameter server (a string of digits)",
+            seed_missing=FRAMEWORK["p_seed"]
+            + " is not on the parameter server (a string of digits)",
         )
         files[f"include/{pkg}/amsa_pymath.h"] = (FILES / "amsa_pymath.h").read_text()
         for header in (
