@@ -50,6 +50,8 @@ class RosSimulation(Simulation):
             # every Leaf is called on its own: a node per Leaf, a topic per output
             grouping=False,
         )
+        # the STL requirements sampled as in process, so metrics.json judges them the same
+        self.watch_requirements(scenario)
         self.link = link
         link.attach(self)
         graph = link.graph
