@@ -4,7 +4,8 @@ The hook into a run is one log listener (``Simulation.add_log_listener``): at ev
 instant the recorder sees every Data buffer, the exact simulated time, the components (their
 live parameters) and the events so far. From that it writes:
 
-* every traced Data buffer as an ``amsa_msgs/msg/Scalar`` on ``/amsa/data/<path>/<port>``,
+* every traced Data buffer as an ``amsa_msgs/msg/Scalar`` on ``rosnames.DATA`` then
+  ``/<path>/<port>``,
   one per trace row, the very values of ``trace.csv``;
 * the standard messages of :mod:`amsa_phys.stdmsgs` on their topics, each at the trace
   instants at which a new step of its Leaf became visible (so at the sensor's own rate when
@@ -14,7 +15,7 @@ live parameters) and the events so far. From that it writes:
 * ``/tf`` (``tf2_msgs/msg/TFMessage``): each robot's true pose, ``<robot>/odom`` ->
   ``<robot>/base_link``, at its own instants, and ``/tf_static`` once at the start: ``map`` ->
   ``<robot>/odom``, the identity (REP 105's tree; ``stdmsgs/build.py`` says why);
-* ``/amsa/events`` (``amsa_msgs/msg/Event``): phase starts with their ``set``, changes inside
+* ``rosnames.EVENTS`` (``amsa_msgs/msg/Event``): phase starts with their ``set``, changes inside
   a phase, and the run's events (collisions, live changes...), at their own instants.
 
 Every time in the bag (``header.stamp``, MCAP ``log_time`` and ``publish_time``) is
@@ -35,6 +36,7 @@ from typing import Any
 
 from .._version import __version__
 from ..engine.runner import Simulation
+from ..model.rosnames import EVENTS
 from ..model.scenario import Scenario, traced_columns
 from ..stdmsgs import (
     DEFAULT_ORIGIN,
@@ -50,7 +52,7 @@ from ..stdmsgs import (
 from ..stdmsgs.names import unique
 from .writer import DOUBLE, BagWriter, scalar_prefix, split_ns
 
-EVENTS_TOPIC = "/amsa/events"
+EVENTS_TOPIC = EVENTS
 TF_TOPIC = "/tf"
 TF_STATIC_TOPIC = "/tf_static"
 SCALAR = "amsa_msgs/Scalar"

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..model.rosnames import P_SIM
 from ..stdmsgs import Source, find_sources
 from .graph import RosGraph
 
@@ -29,8 +30,8 @@ from .graph import RosGraph
 #: simulator's own (true poses) or the controller side's (wheel commands).
 SENSOR_ROLES = frozenset({"NavSatFix", "Heading", "Imu", "Odometry", "LaserScan"})
 
-#: The launch argument and parameter that choose the side (``/amsa/sim``).
-SIM_PARAM = "/amsa/sim"
+#: The launch argument and parameter that choose the side.
+SIM_PARAM = P_SIM
 
 #: The name of the boundary node.
 NODE = "amsa_boundary"

@@ -29,6 +29,7 @@ from typing import Any
 from .._version import __version__
 from ..engine.timing import run_phases
 from ..errors import ConfigError
+from ..model.rosnames import FRAMEWORK, PHASE
 from ..model.scenario import Scenario
 from ..model.world import WorldSpec
 from ..runs.resolve import resolved_scenario
@@ -49,7 +50,16 @@ from .cppnode import (
 from .external import start_values
 from .graph import RosGraph, classify
 from .launchxml import launch_xml
-from .quote import Code, check_name, cmake_arg, fill, py_string, yaml_comment, yaml_dump
+from .quote import (
+    Code,
+    check_name,
+    cmake_arg,
+    fill,
+    holes,
+    py_string,
+    yaml_comment,
+    yaml_dump,
+)
 from .readme import readme
 
 FILES = Path(__file__).parent / "files"
@@ -59,7 +69,11 @@ PACKAGE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 
 def _fill(file: str, **values: Any) -> Code:
-    return fill((FILES / file).read_text(), **values)
+    """``files/FILE`` with its holes filled: the caller's values, and for every hole named
+    after a framework name (``@@{p_seed:cpp_string}``) that name from the one registry."""
+    text = (FILES / file).read_text()
+    used = holes(text)
+    return fill(text, **{k: v for k, v in FRAMEWORK.items() if k in used}, **values)
 
 
 @dataclass
@@ -169,7 +183,7 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         names.SCENARIO,
         f"{names.SCENARIO}: the scenario node of {pkg}.",
         "Applies the scenario's timeline to the parameter server at the phases' instants\n"
-        "(simulated time, /clock) and announces each phase on /amsa/phase.",
+        f"(simulated time, /clock) and announces each phase on {PHASE}.",
         "scenario",
         Code(""),
     )
@@ -205,12 +219,16 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
     for tname, paths in cpp_templates(graph, cpp).items():
         files[f"src/leaves/{tname}.cpp"] = cpp_leaf(graph, tname, paths, pkg, source, bodies)
     if cpp:
-        files[f"src/{names.CONTAINER}.cpp"] = (FILES / "amsa_leaves.cpp").read_text()
+        files[f"src/{names.CONTAINER}.cpp"] = _fill("amsa_leaves.cpp")
         files["nodelet_plugins.xml"] = plugins_xml(graph, pkg, cpp)
         files[f"config/{names.CONTAINER}.yaml"] = leaves_yaml(
             graph, pkg, cpp, boundary.plan(graph).controller
         )
-        files[f"include/{pkg}/amsa_leaf_node.h"] = (FILES / "amsa_leaf_node.h").read_text()
+        files[f"include/{pkg}/amsa_leaf_node.h"] = _fill(
+            "amsa_leaf_node.h",
+            seed_missing=FRAMEWORK["p_seed"]
+            + " is not on the parameter server (a string of digits)",
+        )
         files[f"include/{pkg}/amsa_pymath.h"] = (FILES / "amsa_pymath.h").read_text()
         for header in (
             "amsa_noise.h",
@@ -221,7 +239,7 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
             "amsa_wiring.h",
             "amsa_exit.h",
         ):
-            files[f"include/{pkg}/{header}"] = (FILES / header).read_text()
+            files[f"include/{pkg}/{header}"] = _fill(header)
     launches = []
     for scenario, fname in zip(scenarios, unique_names(s.name for s in scenarios), strict=True):
         files[f"config/{fname}.yaml"] = yaml_dump(resolved_scenario(scenario))

@@ -76,7 +76,7 @@ class RosGraph:
     world: WorldSpec
     local: frozenset[str]
     bag: bool = False
-    #: the Leaves hosted together in one process (the C++ container, ``/amsa/container``)
+    #: the Leaves hosted together in one process (the C++ container, ``names.P_CONTAINER``)
     shared: frozenset[str] = frozenset()
     #: the signals the adapt node reads when it runs the rules beside the simulator
     #: (``rules:=node``): it is one more subscriber of each
@@ -95,7 +95,7 @@ class RosGraph:
         container (checked against the world)."""
         local = frozenset(local)
         shared = frozenset(shared)
-        for what, leaves in (("/amsa/local", local), ("/amsa/container", shared)):
+        for what, leaves in ((names.P_LOCAL, local), (names.P_CONTAINER, shared)):
             unknown = sorted(leaves - set(world.leaves))
             if unknown:
                 raise ConfigError(f"unknown Leaf {unknown[0]!r} in {what}")

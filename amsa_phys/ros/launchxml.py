@@ -9,6 +9,7 @@ roslaunch's rosparam loader reads as YAML, as double-quoted YAML scalars.
 from __future__ import annotations
 
 from .._version import __version__
+from ..model.rosnames import NAMESPACE_BASE, P_PIPELINE, P_RULES
 from . import boundary, names
 from .cppnode import hz, plugin
 from .graph import RosGraph
@@ -36,7 +37,7 @@ _ARGS = """\
 
 _HEAD = """\
   <param name="/use_sim_time" value="true"/>
-  <group ns="amsa">
+  <group ns="@@{namespace:xml_attr}">
     <param name="scenario" value="$(find @@{pkg:xml_attr})/config/@@{fname:xml_attr}.yaml"/>
     <param if="$(arg sim)" name="mode" value="$(arg mode)"/>
     <param unless="$(arg sim)" name="mode" value="free"/>
@@ -72,7 +73,7 @@ _HEAD = """\
 
 
 def _container(cpp: list[str]) -> Code:
-    """``/amsa/container``: the Leaves in the C++ container when it runs (cpp and
+    """``rosnames.P_CONTAINER``: the Leaves in the C++ container when it runs (cpp and
     cpp_container), else none; every node counts its subscribers (processes) by it."""
     if not cpp:
         return Code("")
@@ -87,7 +88,7 @@ def _container(cpp: list[str]) -> Code:
 
 
 def _pipeline(adapt: bool) -> str:
-    """The ``pipeline`` argument and ``/amsa/pipeline``: lockstep asks the C++ container for
+    """The ``pipeline`` argument and ``rosnames.P_PIPELINE``: lockstep asks the C++ container for
     many instants at once, checking each answer against the in-process template
     (``runtime/pipeline.py``), when every remote Leaf is in the container, no bag records the
     topics, the boundary node does not run (its Python publishers could not keep up with a
@@ -103,7 +104,11 @@ def _pipeline(adapt: bool) -> str:
         " container: ask it for many instants at once, each answer checked bit for bit"
         " against the Leaf&apos;s in-process template (false: wait for every instant&apos;s"
         ' answers, the nodes&apos; values driving the run)"/>\n'
-        f'  <param name="/amsa/pipeline" type="bool" value="$(eval {when})"/>'
+        + fill(
+            '  <param name="@@{name:xml_attr}" type="bool" value="$(eval @@{when:code})"/>',
+            name=P_PIPELINE,
+            when=Code(when),
+        )
     )
 
 
@@ -123,7 +128,7 @@ def launch_xml(
 ) -> str:
     """The launch file of the scenario whose config files are ``config/FNAME*.yaml``
     (``adapt``: it has ``adapt:`` rules, run by the adapt node when ``sim:=false``; ``seed``:
-    the scenario's, ``/amsa/seed``, read by the C++ sensors for their random streams)."""
+    the scenario's, ``rosnames.P_SEED``, read by the C++ sensors for their random streams)."""
     data_topics = " ".join(graph.data_topics())
     local = [p for p in graph.world.leaves if p in graph.local]
     lines = [
@@ -162,6 +167,7 @@ def launch_xml(
             boundary=boundary.NODE,
             seed=str(seed),
             container=_container(cpp),
+            namespace=NAMESPACE_BASE,
         )
     )
     if adapt:
@@ -170,13 +176,14 @@ def launch_xml(
                 '  <arg name="rules" default="sim" doc="lockstep: sim fires the adapt: rules'
                 " inside the simulator; node asks the amsa_adapt node (the one sim:=false"
                 ' runs), for comparison"/>\n'
-                '  <param name="/amsa/rules" value="$(arg rules)"/>\n'
+                '  <param name="@@{rules:xml_attr}" value="$(arg rules)"/>\n'
                 "  <!-- adapt: rules (sim:=false, or rules:=node in lockstep; else they fire"
                 " inside the simulator) -->\n"
                 "  <node if=\"$(eval not arg('sim') or (arg('rules') == 'node' and"
                 ' arg(\'mode\') == \'lockstep\'))" pkg="@@{pkg:xml_attr}" type="amsa_adapt.py"'
                 ' name="amsa_adapt" required="true" output="screen"/>',
                 pkg=pkg,
+                rules=P_RULES,
             )
         )
     if cpp and set(cpp) == set(graph.remote):

@@ -3,8 +3,8 @@
 A Leaf ``Team.Leader`` is the node ``/Team/Leader``; its output ``posX`` is the topic
 ``/Team/Leader/posX`` (``std_msgs/Float64``) and its parameter ``x`` the parameter
 ``/Team/Leader/x`` — the node's private names (``~posX``, ``~x``). The framework's own topics
-live under ``/amsa/``; the simulator and scenario nodes are ``/amsa_simulator`` and
-``/amsa_scenario``.
+live under ``rosnames.NAMESPACE`` (every one spelled only in ``model/rosnames.py``); the
+simulator and scenario nodes are ``/amsa_simulator`` and ``/amsa_scenario``.
 """
 
 from __future__ import annotations
@@ -13,16 +13,55 @@ from ..errors import ConfigError
 
 # the names amsa-phys itself takes on a ROS graph, both targets' (model/rosnames.py: the
 # scenario loader judges ros2: names with them, below this layer)
-from ..model.rosnames import BASE, CONTAINER, RESERVED, SCENARIO, SIMULATOR
+from ..model.rosnames import (
+    BASE,
+    CONTAINER,
+    DONE,
+    IN,
+    P_BAG,
+    P_BOUNDARY,
+    P_CONTAINER,
+    P_LOCAL,
+    P_MODE,
+    P_PIPELINE,
+    P_RULES,
+    P_SCENARIO,
+    P_SEED,
+    P_SIM,
+    P_TIMEOUT,
+    PHASE,
+    READY,
+    RESERVED,
+    SCENARIO,
+    SIMULATOR,
+    STEP,
+)
 from ..model.world import WorldSpec
 
-__all__ = ["BASE", "CONTAINER", "RESERVED", "SCENARIO", "SIMULATOR"]
+__all__ = [
+    "BASE",
+    "CONTAINER",
+    "PHASE",
+    "P_BAG",
+    "P_BOUNDARY",
+    "P_CONTAINER",
+    "P_LOCAL",
+    "P_MODE",
+    "P_PIPELINE",
+    "P_RULES",
+    "P_SCENARIO",
+    "P_SEED",
+    "P_SIM",
+    "P_TIMEOUT",
+    "READY",
+    "RESERVED",
+    "SCENARIO",
+    "SIMULATOR",
+]
 #: The package's script that launches a scenario and exits with its verdict (``runcheck.py``).
 RUN_LOCKSTEP = "run_lockstep"
 
 CLOCK = "/clock"
-READY = "/amsa/ready"
-PHASE = "/amsa/phase"
 
 
 def ns(path: str) -> str:
@@ -37,8 +76,8 @@ def topic(buffer: str) -> str:
 
 def input_topic(path: str, port: str) -> str:
     """Where ``ros2 lockstep`` delivers a node's input ``port`` (remapped from the producer's
-    topic): ``/amsa/in/Team/Leader/port``."""
-    return "/amsa/in" + ns(path) + "/" + port
+    topic): ``rosnames.IN`` then ``/Team/Leader/port``."""
+    return IN + ns(path) + "/" + port
 
 
 def param(path: str, name: str) -> str:
@@ -48,12 +87,12 @@ def param(path: str, name: str) -> str:
 
 def step_topic(path: str) -> str:
     """Where the simulator tells a node to step (lockstep)."""
-    return "/amsa/step" + ns(path)
+    return STEP + ns(path)
 
 
 def done_topic(path: str) -> str:
     """Where a node says it has stepped (lockstep)."""
-    return "/amsa/done" + ns(path)
+    return DONE + ns(path)
 
 
 def script(path: str) -> str:

@@ -186,6 +186,12 @@ def py_string(text: str) -> str:
     return repr(str(text))
 
 
+def py_dstring(text: str) -> str:
+    """A double-quoted Python string literal (reads back to ``text``): for a file whose
+    house style quotes so, where :func:`py_string`'s ``repr`` would pick single quotes."""
+    return '"' + py_doc(text).replace("\n", "\\n") + '"'
+
+
 def py_comment(text: str) -> str:
     """Text after ``#``: one line."""
     return _one_line(text)
@@ -231,6 +237,7 @@ ESCAPERS: dict[str, Callable[[str], str]] = {
     "cpp_string": cpp_string,
     "cpp_comment": cpp_comment,
     "py_string": py_string,
+    "py_dstring": py_dstring,
     "py_comment": py_comment,
     "py_doc": py_doc,
     "sh_word": sh_word,
@@ -239,6 +246,11 @@ ESCAPERS: dict[str, Callable[[str], str]] = {
 }
 
 _HOLE = re.compile(r"@@\{(\w+):(\w+)\}")
+
+
+def holes(text: str) -> set[str]:
+    """The names of the holes ``text`` has (a file filled from a registry takes just these)."""
+    return {m.group(1) for m in _HOLE.finditer(text)}
 
 
 def fill(text: str, /, **values: Any) -> Code:

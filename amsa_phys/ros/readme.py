@@ -7,6 +7,7 @@ free text such as file names), so a name cannot break the Markdown around it.
 from __future__ import annotations
 
 from .._version import __version__
+from ..model.rosnames import DONE, DONE_CONTAINER, PHASE, READY, STEP, STEP_CONTAINER
 from . import names
 from .cppnode import hz
 from .graph import RosGraph
@@ -120,11 +121,12 @@ Physical Leaves (@@{local:code}) share one pymunk world, so they step inside
 @@{rows:code}
 """
 
-_FRAMEWORK = """
-Framework topics: `/clock`, `/amsa/step/LEAF` and `/amsa/done/LEAF` (lockstep requests and
+_FRAMEWORK_TEXT = """
+Framework topics: `/clock`, @@{step_leaf:md_code} and @@{done_leaf:md_code} (lockstep requests and
 answers, `std_msgs/String`; for the C++ Leaves in `amsa_leaves`, one message a wave on
-`/amsa/step/amsa_leaves` and `/amsa/done/amsa_leaves`), `/amsa/phase` (the scenario node's
-announcements), `/amsa/ready` (start-up handshake: ROS 1 drops what is published before a subscriber
+@@{step_container:md_code} and @@{done_container:md_code}), @@{phase:md_code} (the scenario node's
+announcements), @@{ready:md_code} (start-up handshake: ROS 1 drops what is published \
+before a subscriber
 connects, so the run starts once every publisher has all its subscribers).
 
 ## Your own node
@@ -132,12 +134,23 @@ connects, so the run starts once every publisher has all its subscribers).
 A node of your own may replace a Leaf's node (same name in the launch file). It must subscribe
 to the Leaf's input topics and publish its outputs (`std_msgs/Float64`; an array port's
 `std_msgs/Float64MultiArray` of exactly its length), and in free mode step
-on simulated time (`use_sim_time` is set). It need not announce itself on `/amsa/ready` nor
+on simulated time (`use_sim_time` is set). It need not announce itself on @@{ready:md_code} nor
 read its parameters: in free mode the simulator waits for it by its topics (each output
 connected to the simulator, with the subscribers the graph expects). Lockstep needs the step
-protocol (`/amsa/step/LEAF`, `/amsa/done/LEAF`: see `include/PKG/amsa_leaf_node.h` where a C++
+protocol (@@{step_leaf:md_code}, @@{done_leaf:md_code}: see \
+`include/PKG/amsa_leaf_node.h` where a C++
 node exists, or amsa-phys's `ros/runtime/leaf.py`) and the announcement.
 """
+#: The README's framework section, its names from the one registry (model/rosnames.py).
+_FRAMEWORK = fill(
+    _FRAMEWORK_TEXT,
+    step_leaf=STEP + "/LEAF",
+    done_leaf=DONE + "/LEAF",
+    step_container=STEP_CONTAINER,
+    done_container=DONE_CONTAINER,
+    phase=PHASE,
+    ready=READY,
+)
 
 
 _CPP_ARGS = (

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import re
 
+from ..model.rosnames import DATA
+
 _BAD = re.compile(r"[^A-Za-z0-9_]")
 
 
@@ -35,5 +37,5 @@ def unique(name: str, taken: set[str]) -> str:
 
 
 def data_topic(buffer: str) -> str:
-    """The topic of a Data buffer's stamped scalar: ``/amsa/data/<path>/<port>``."""
-    return "/amsa/data/" + ros_path(buffer)
+    """The topic of a Data buffer's stamped scalar: ``rosnames.DATA`` then ``/<path>/<port>``."""
+    return DATA + "/" + ros_path(buffer)

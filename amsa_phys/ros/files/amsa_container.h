@@ -2,7 +2,7 @@
 //
 // Every C++ Leaf of a package in one process (amsa_leaves, a nodelet manager) is asked by
 // the simulator through one topic, a wave at a time (Dispatcher, below), and announces
-// itself on /amsa/ready through one latched publisher of the process (ReadyBoard). The
+// itself on @@{ready:cpp_comment} through one latched publisher of the process (ReadyBoard). The
 // Leaves are Steppable: amsa_leaf_node.h's LeafNode.
 #pragma once
 
@@ -21,7 +21,7 @@
 
 namespace amsa {
 
-// /amsa/ready of this process: one latched publisher (ROS 1 keeps one latched message per
+// @@{ready:cpp_comment} of this process: one latched publisher (ROS 1 keeps one latched message per
 // topic and process), whose message lists every Leaf of the process that is ready so far.
 class ReadyBoard {
  public:
@@ -30,7 +30,7 @@ class ReadyBoard {
     std::lock_guard<std::mutex> lock(board.mutex_);
     if (!board.pub_) {
       ros::NodeHandle nh;
-      board.pub_ = nh.advertise<std_msgs::String>("/amsa/ready", 1, true);
+      board.pub_ = nh.advertise<std_msgs::String>(@@{ready:cpp_string}, 1, true);
     }
     board.ready_.insert(path);
     std_msgs::String m;
@@ -62,11 +62,11 @@ class Steppable {
 
 
 // Lockstep in the container: the simulator asks the container's Leaves of a wave in one
-// message on /amsa/step/amsa_leaves, a line each: "/LEAF step SEQ NUM DEN C1..Cn" (or
+// message on @@{step_container:cpp_comment}, a line each: "/LEAF step SEQ NUM DEN C1..Cn" (or
 // "/LEAF param SEQ NAME"), in the engine's order; a count "N+" is N plus what the input's
 // producer, a Leaf asked earlier in the same message, publishes on it in this step (its
 // reader is stepped once the producer has answered). Once every Leaf of the message has
-// answered, one message on /amsa/done/amsa_leaves holds the answers, "/LEAF ANSWER" a line;
+// answered, one message on @@{done_container:cpp_comment} holds the answers, "/LEAF ANSWER" a line;
 // a step's answer is "done SEQ I J .. | VI VJ ..": the outputs published and their values
 // (C hex floats), which the simulator records instead of subscribing to those topics.
 class Dispatcher {
@@ -95,7 +95,7 @@ class Dispatcher {
   };
 
   void onBatch(const std::string& text);
-  // Pipelined lockstep (/amsa/pipeline): the message is many instants of "call" and "set"
+  // Pipelined lockstep (@@{p_pipeline:cpp_comment}): the message is many instants of "call" and "set"
   // lines, which carry their inputs' values; each is run at once, in order, on this thread,
   // and one message answers them all (the simulator checks every value it gets back).
   static bool pipelined(const std::string& text);
@@ -118,9 +118,9 @@ inline void Dispatcher::add(Steppable* leaf) {
     producers_[leaf->outputTopic(k)] = std::make_pair(leaf->nodeName(), k);
   if (!sub_) {
     ros::NodeHandle nh;
-    done_ = nh.advertise<std_msgs::String>("/amsa/done/amsa_leaves", 1000);
+    done_ = nh.advertise<std_msgs::String>(@@{done_container:cpp_string}, 1000);
     sub_ = nh.subscribe<std_msgs::String>(
-        "/amsa/step/amsa_leaves", 1000,
+        @@{step_container:cpp_string}, 1000,
         [this](const std_msgs::String::ConstPtr& m) { onBatch(m->data); }, ros::VoidConstPtr(),
         ros::TransportHints().tcpNoDelay());
   }

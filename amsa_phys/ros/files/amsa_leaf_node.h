@@ -13,14 +13,14 @@
 //    of another length fails the step that reads it, naming the topic;
 //  - parameters ~param (the nodelet's private namespace, /Leaf/param in the launch files),
 //    checked against the template's [min, max] whenever they change;
-//  - lockstep: "step SEQ NUM DEN C1..Cn" on /amsa/step/Leaf: step at t = NUM/DEN once each
+//  - lockstep: "step SEQ NUM DEN C1..Cn" on @@{step:cpp_comment}/Leaf: step at t = NUM/DEN once each
 //    input topic has carried Ci messages, reading message number Ci of each (a delayed
 //    producer's later messages are kept until they are due), publish the outputs, answer
-//    "done SEQ I.." on /amsa/done/Leaf; "param SEQ NAME" re-reads one parameter;
+//    "done SEQ I.." on @@{done:cpp_comment}/Leaf; "param SEQ NAME" re-reads one parameter;
 //  - free: step at the Leaf's own rate in simulated time (/clock), from its timer's phase
 //    (parameter ~amsa_phase, "NUM/DEN" seconds), with the latest inputs, on a thread of its
 //    own inside the process;
-//  - start-up: wait until every publisher has its subscribers, then say so on /amsa/ready
+//  - start-up: wait until every publisher has its subscribers, then say so on @@{ready:cpp_comment}
 //    (one latched message per process listing every ready Leaf, separated by spaces).
 //
 // The interface of a template's C++ body (files/cpp/TEMPLATE.inc, pasted into the class):
@@ -28,7 +28,7 @@
 // p("name") (values_ holds them); an array input port's numbers with array(PORT) (in[] holds
 // 0 there), an array output's written into arrayOut(PORT); kPath is the Leaf's path (its
 // random stream's key) and
-// seed() the scenario's seed (/amsa/seed). Unchanged from the one-executable-per-Leaf nodes,
+// seed() the scenario's seed (@@{p_seed:cpp_comment}). Unchanged from the one-executable-per-Leaf nodes,
 // where kPath and seed() were file-level names of each executable.
 //
 // ~amsa_wiring: the Leaf's path, rate, topics and ports (format in amsa_wiring.h).
@@ -169,18 +169,18 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
     outputs_ = w.outputs;
     std::string mode = "lockstep";
     bool bag = false;
-    ros::param::get("/amsa/mode", mode);
+    ros::param::get(@@{p_mode:cpp_string}, mode);
     bool sim = true;
-    ros::param::get("/amsa/sim", sim);
-    ros::param::get("/amsa/bag", bag);
-    ros::param::get("/amsa/timeout", timeout_);
+    ros::param::get(@@{p_sim:cpp_string}, sim);
+    ros::param::get(@@{p_bag:cpp_string}, bag);
+    ros::param::get(@@{p_timeout:cpp_string}, timeout_);
     // pipelined lockstep: the container's requests carry the inputs' values (call)
     bool pipeline = false;
-    ros::param::get("/amsa/pipeline", pipeline);
-    // /amsa/container: the Leaves sharing the container process (subscribers count so)
+    ros::param::get(@@{p_pipeline:cpp_string}, pipeline);
+    // @@{p_container:cpp_comment}: the Leaves sharing the container process (subscribers count so)
     bool shared = false;
     XmlRpc::XmlRpcValue container;
-    if (ros::param::get("/amsa/container", container) &&
+    if (ros::param::get(@@{p_container:cpp_string}, container) &&
         container.getType() == XmlRpc::XmlRpcValue::TypeArray)
       for (int i = 0; i < container.size(); ++i)
         if (container[i].getType() == XmlRpc::XmlRpcValue::TypeString &&
@@ -233,9 +233,9 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
     if (shared_) {
       Dispatcher::get().add(this);
     } else if (lockstep_) {
-      done_ = nh.advertise<std_msgs::String>("/amsa/done" + getName(), 1000, wake, ros::SubscriberStatusCallback());
+      done_ = nh.advertise<std_msgs::String>(@@{done:cpp_string} + getName(), 1000, wake, ros::SubscriberStatusCallback());
       step_sub_ = nh.subscribe<std_msgs::String>(
-          "/amsa/step" + getName(), 1000,
+          @@{step:cpp_string} + getName(), 1000,
           [this](const std_msgs::String::ConstPtr& m) { submit(m->data); },
           ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
     }
@@ -256,11 +256,11 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
   // holds 0 there), and an array output port's, which doStep fills to the port's length.
   const std::vector<double>& array(std::size_t port) const { return arrays_in_.at(port); }
   std::vector<double>& arrayOut(std::size_t port) { return arrays_out_.at(port); }
-  // The scenario's seed (/amsa/seed, from the launch file): the root of every random stream.
+  // The scenario's seed (@@{p_seed:cpp_comment}, from the launch file): the root of every random stream.
   std::string seed() const {
     std::string value;
-    if (!ros::param::get("/amsa/seed", value))
-      throw std::runtime_error("/amsa/seed is not on the parameter server (a string of digits)");
+    if (!ros::param::get(@@{p_seed:cpp_string}, value))
+      throw std::runtime_error(@@{seed_missing:cpp_string});
     return value;
   }
   std::map<std::string, double> values_;
@@ -319,7 +319,7 @@ class LeafNode : public nodelet::Nodelet, public Steppable {
     if (lockstep_ && !shared_ && done_.getNumSubscribers() < 1)
       add(done_.getTopic(), static_cast<int>(done_.getNumSubscribers()), 1);
     if (shared_ && !Dispatcher::get().connected())  // the container answers for its Leaves
-      add("/amsa/done/amsa_leaves", 0, 1);
+      add(@@{done_container:cpp_string}, 0, 1);
     char secs[32];
     std::snprintf(secs, sizeof secs, "%.1f", waited);
     return std::string("gave up after ") + secs + " s waiting for the readers of " + topics +

@@ -12,10 +12,10 @@ Every firing is logged (``rosout``) with the estimates that triggered it, as the
 ``rules:=node`` (lockstep, with the simulator) runs the rules here instead of in the
 simulator, so this very node is checked against ``amsa-phys run``: at every instant at which
 the engine would ask its rules, the simulator sends ``due SEQ NUM DEN C1..Cn`` on
-``/amsa/step/amsa_adapt`` (the instant, and how many messages of each signal's topic, in
+``names.step_topic(NODE)`` (the instant, and how many messages of each signal's topic, in
 sorted order, are visible then, as a Leaf's step request says); the node evaluates the rules
 on message number Ci of each, puts a firing's values on the parameter server, and answers on
-``/amsa/done/amsa_adapt`` ``done SEQ`` or ``fire SEQ RULE DETAIL`` (the rule's number and the
+``names.done_topic(NODE)`` ``done SEQ`` or ``fire SEQ RULE DETAIL`` (the rule's number and the
 event's text); the simulator applies the rule's changes then, as the engine does.
 """
 

@@ -35,6 +35,7 @@ from typing import Any
 
 from ...errors import AmsaError, one_line
 from ...model.params import short_repr
+from ...model.rosnames import BOUNDARY_FLUSHED, BOUNDARY_VALUES
 from ...stdmsgs import DEFAULT_ORIGIN, Context, Source, build, geodetic_to_enu, quaternion_yaw
 from ...stdmsgs.build import static_transform, transform
 from .. import names
@@ -52,13 +53,13 @@ CLOCK_PERIOD = 0.005
 
 #: lockstep: the simulator's ``NUM DEN BUFFER VALUE ...`` per Leaf step (std_msgs/String):
 #: the step's instant (a fraction of seconds) and the values it wrote that this node reads
-VALUES = "/amsa/boundary/values"
+VALUES = BOUNDARY_VALUES
 #: Lockstep's end: the simulator sends :data:`FLUSH` on :data:`VALUES` after the run's last
 #: values and waits for the answer on :data:`FLUSHED` (latched) before it ends the launch, so
 #: the boundary has published every standard message of the run (a loaded machine's boundary
 #: may lag seconds behind the simulator; shutting the launch down at once lost the tail).
 FLUSH = "flush"
-FLUSHED = "/amsa/boundary/flushed"
+FLUSHED = BOUNDARY_FLUSHED
 
 
 def ros1_classes() -> dict[str, Any]:

@@ -1,4 +1,5 @@
-"""What every node reads at start: the scenario file and the graph's settings under ``/amsa``."""
+"""What every node reads at start: the scenario file and the graph's settings under
+``rosnames.NAMESPACE``."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ from typing import Any
 
 from ...errors import ConfigError
 from ...model.scenario import Scenario, load_scenario
+from .. import names
 from ..graph import RosGraph
 
 MODES = ("lockstep", "free")
@@ -14,7 +16,7 @@ MODES = ("lockstep", "free")
 
 @dataclass
 class NodeConfig:
-    """The launch's ``/amsa/*`` parameters and the scenario they point to."""
+    """The launch's graph-wide parameters (``rosnames.P_*``) and the scenario they point to."""
 
     scenario: Scenario
     graph: RosGraph
@@ -29,35 +31,36 @@ class NodeConfig:
 
 
 def load_config(rospy: Any) -> NodeConfig:
-    """Read ``/amsa/{scenario,mode,local,bag,timeout,container,rules,pipeline}``; load the
+    """Read the graph-wide parameters (scenario, mode, local, bag, timeout, container, rules,
+    pipeline, sim, boundary: ``rosnames.P_*``); load the
     scenario."""
     try:
-        path = rospy.get_param("/amsa/scenario")
-        mode = rospy.get_param("/amsa/mode", "lockstep")
-        local = rospy.get_param("/amsa/local", [])
-        bag = bool(rospy.get_param("/amsa/bag", False))
-        timeout = float(rospy.get_param("/amsa/timeout", 60.0))
-        shared = rospy.get_param("/amsa/container", [])  # the C++ Leaves in one process
+        path = rospy.get_param(names.P_SCENARIO)
+        mode = rospy.get_param(names.P_MODE, "lockstep")
+        local = rospy.get_param(names.P_LOCAL, [])
+        bag = bool(rospy.get_param(names.P_BAG, False))
+        timeout = float(rospy.get_param(names.P_TIMEOUT, 60.0))
+        shared = rospy.get_param(names.P_CONTAINER, [])  # the C++ Leaves in one process
     except KeyError as exc:
         raise ConfigError(
             "is not on the parameter server (start the nodes with roslaunch)", key=str(exc)
         ) from None
     if mode not in MODES:
-        raise ConfigError(f"expected lockstep or free, got {mode!r}", key="/amsa/mode")
+        raise ConfigError(f"expected lockstep or free, got {mode!r}", key=names.P_MODE)
     scenario = load_scenario(path)
-    rules = str(rospy.get_param("/amsa/rules", "sim"))
+    rules = str(rospy.get_param(names.P_RULES, "sim"))
     if rules not in ("sim", "node"):
-        raise ConfigError(f"expected sim or node, got {rules!r}", key="/amsa/rules")
-    sim = bool(rospy.get_param("/amsa/sim", True))
+        raise ConfigError(f"expected sim or node, got {rules!r}", key=names.P_RULES)
+    sim = bool(rospy.get_param(names.P_SIM, True))
     node = rules == "node" and bool(scenario.adapt) and sim and mode == "lockstep"
     signals = sorted({c.signal for r in scenario.adapt for c in r.when}) if node else []
     graph = RosGraph.of(scenario.world, local, bag, shared, signals)
     pipeline = (
-        bool(rospy.get_param("/amsa/pipeline", False))
+        bool(rospy.get_param(names.P_PIPELINE, False))
         and mode == "lockstep"
         and sim
         and not bag
-        and not bool(rospy.get_param("/amsa/boundary", False))
+        and not bool(rospy.get_param(names.P_BOUNDARY, False))
         and not node
         and set(graph.remote) == set(graph.shared)
     )

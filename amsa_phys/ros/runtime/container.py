@@ -1,9 +1,9 @@
 """Lockstep with the C++ container: the simulator's side of one message a wave.
 
 The C++ Leaves hosted by ``amsa_leaves`` (``graph.shared``) are not asked one topic each:
-the requests of a wave go out in one message on ``/amsa/step/amsa_leaves``, a line a Leaf
+the requests of a wave go out in one message on ``rosnames.STEP_CONTAINER``, a line a Leaf
 (``/LEAF step SEQ NUM DEN C1..Cn``, ``/LEAF param SEQ NAME``), and the container answers
-for all of them in one message on ``/amsa/done/amsa_leaves`` (``/LEAF ANSWER`` a line; the
+for all of them in one message on ``rosnames.DONE_CONTAINER`` (``/LEAF ANSWER`` a line; the
 protocol's other half is ``files/amsa_leaf_node.h``'s Dispatcher). A step's answer carries
 the values the Leaf published (``done SEQ I J .. | VI VJ ..``, C hex floats), so the
 simulator takes them from it instead of subscribing to each output. Split from

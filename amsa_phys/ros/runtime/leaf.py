@@ -6,14 +6,14 @@ published on ``/Leaf/output``; parameters are read from ``/Leaf/param`` and judg
 template (type, [min, max], rules between parameters) whenever they change.
 
 **lockstep** (reproduces ``amsa-phys run``): the simulator sends ``step SEQ NUM DEN C1..Cn``
-on ``/amsa/step/Leaf`` — the instant as an exact fraction and, for each input topic, how many
+on ``names.step_topic(Leaf)`` — the instant as an exact fraction and, for each input topic, how many
 of its messages the Leaf sees at that instant (all it has carried so far, less those a
 producer's ``latency`` still holds in flight in the engine). The node steps once it has
 received at least that many on each (messages on different topics travel on different
 connections, so a count, not arrival order, says an input is current) and reads message
 number C of each — the latest, unless a delayed producer has published later ones it must
 not see yet (it keeps those until they are due) —, publishes its outputs, then
-answers ``done SEQ I..`` (the outputs it published) on ``/amsa/done/Leaf``.
+answers ``done SEQ I..`` (the outputs it published) on ``names.done_topic(Leaf)``.
 ``param SEQ NAME`` re-reads one parameter (a timeline change, at its exact instant). The
 steps are driven by whichever callback completes the condition last: no thread ever blocks
 waiting for another.

@@ -3,7 +3,7 @@
 In lockstep the simulator waits, at every instant, for the answers of the nodes stepped at
 it: a round trip through rospy and roscpp per instant (0.24-0.31 ms on loopback here), which
 alone makes a run of scenario1 ~5x its in-process loop however little the nodes compute.
-When every remote Leaf is a C++ Leaf of the container (``graph.shared``; ``/amsa/pipeline``,
+When every remote Leaf is a C++ Leaf of the container (``graph.shared``; ``names.P_PIPELINE``,
 set by the launch file), the simulator need not wait: it steps each Leaf's in-process
 template (its *twin*, the very code ``amsa-phys run`` steps) and queues, for the Leaf's node,
 a request that carries the inputs the twin was given (``call SEQ NUM DEN V1..Vn``, C hex

@@ -1,6 +1,6 @@
-"""Free mode: when a node that does not announce itself on ``/amsa/ready`` is ready.
+"""Free mode: when a node that does not announce itself on ``names.READY`` is ready.
 
-Every generated node says on ``/amsa/ready`` that its publishers have all their subscribers
+Every generated node says on ``names.READY`` that its publishers have all their subscribers
 (ROS 1 drops what is published before a subscriber connects). A user's own node need not: in
 free mode the simulator waits for its topics instead: each output the node publishes is
 connected to the simulator and has as many subscribers registered with the master as the

@@ -3,7 +3,7 @@
 The handshake: ROS 1 drops what is published before a subscriber has connected, so every
 node creates its publishers with a listener and waits (on a condition, woken by each new
 connection) until each has the number of subscribers the graph says it will have
-(``graph.RosGraph.subscribers``); then it says so on the latched topic ``/amsa/ready``. The
+(``graph.RosGraph.subscribers``); then it says so on the latched topic ``names.READY``. The
 simulator starts the run only when every node has, and its own publishers are connected too.
 """
 
@@ -111,7 +111,7 @@ def make_publisher(
 
 
 def announce_ready(rospy: Any, who: str) -> Any:
-    """Say on the latched ``/amsa/ready`` that ``who`` is connected (keep the publisher)."""
+    """Say on the latched ``names.READY`` that ``who`` is connected (keep the publisher)."""
     _, String, _ = msgs()
     pub = make_publisher(rospy, names.READY, String, latch=True)
     pub.publish(String(who))

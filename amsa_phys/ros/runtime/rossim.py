@@ -50,7 +50,8 @@ class RosSimulation(Simulation):
             # every Leaf is called on its own: a node per Leaf, a topic per output
             grouping=False,
         )
-        self.watch_requirements(scenario)  # the STL requirements, judged as in process
+        # the STL requirements sampled as in process, so metrics.json judges them the same
+        self.watch_requirements(scenario)
         self.link = link
         link.attach(self)
         graph = link.graph

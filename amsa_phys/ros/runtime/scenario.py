@@ -3,7 +3,7 @@
 It follows ``/clock``; when simulated time reaches one of the timeline's points (a phase's
 start or a change inside a phase, ``new_phase: false``: ``Timeline.points``) it sets that
 point's parameters (``/Leaf/param``, each value judged when the scenario was loaded) and
-announces how many points it has applied on ``/amsa/phase``. The simulator waits for that
+announces how many points it has applied on ``names.PHASE``. The simulator waits for that
 count at the point's instant before any component due then runs, so in lockstep the change
 lands exactly where ``amsa-phys run`` applies it; in free mode the nodes pick it up at their
 next step.

@@ -99,17 +99,17 @@ MAX_SEED = 2**63 - 1
 
 
 def check_seed(rospy: Any) -> None:
-    """Refuse, before anything is written, a ``/amsa/seed`` that is not a seed: the C++
+    """Refuse, before anything is written, a ``names.P_SEED`` that is not a seed: the C++
     sensors seed their random streams from it, and a hand-edited launch file holding ``-1``
     or text had faulted the run at its first step, naming the sensor, not the parameter
     (and one beyond 2^63 - 1, which no other part of amsa-phys takes, ran)."""
-    if not rospy.has_param("/amsa/seed"):
+    if not rospy.has_param(names.P_SEED):
         return  # a launch file of the user's own: each C++ sensor says so at its first step
-    text = str(rospy.get_param("/amsa/seed"))
+    text = str(rospy.get_param(names.P_SEED))
     if not (text.isascii() and text.isdigit() and int(text) <= MAX_SEED):
         raise AmsaError(
             one_line(
-                f"/amsa/seed: expected a seed, 0 to 2^63 - 1 in digits, got {text!r} "
+                f"{names.P_SEED}: expected a seed, 0 to 2^63 - 1 in digits, got {text!r} "
                 "(export the package again with --seed N rather than editing its launch file)"
             )
         )

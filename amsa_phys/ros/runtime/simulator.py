@@ -73,7 +73,7 @@ class Link:
         self.received: dict[str, list[Any]] = {}
         self.replies: dict[str, list[str] | None] = {}
         self.ready: set[str] = set()
-        #: how many of the timeline's points the scenario node has applied (``/amsa/phase``),
+        #: how many of the timeline's points the scenario node has applied (``names.PHASE``),
         #: and the most the simulator has waited for
         self.points_acked = 0
         self.points_asked = 0
@@ -89,9 +89,9 @@ class Link:
         #: lockstep: the buffers the boundary node reads, each Leaf step's values of them
         #: published with the step's instant (``boundary.py``: its messages' stamps)
         self.boundary_reads = readable(self.graph) if self.lockstep else set()
-        # boundary:=true (/amsa/boundary): the run starts once the boundary node listens, or
+        # boundary:=true (names.P_BOUNDARY): the run starts once the boundary node listens, or
         # a fast (pipelined) run could be over before its first standard message
-        told = self.boundary_reads and bool(rospy.get_param("/amsa/boundary", False))
+        told = self.boundary_reads and bool(rospy.get_param(names.P_BOUNDARY, False))
         self.values_pub = (
             (
                 self.gate.publisher(VALUES, String, 1)
@@ -194,7 +194,7 @@ class Link:
     def wait_ready(self, timeout: float) -> list[str]:
         """Wait for every node and our own publishers' subscribers.
 
-        A node is ready when it says so on ``/amsa/ready`` (every generated node does, once
+        A node is ready when it says so on ``names.READY`` (every generated node does, once
         its publishers have all their subscribers). In free mode a node that does not (a
         user's own node) is ready once its topics are: each output it publishes is connected
         to this process and has as many subscribers registered with the master as the graph
