@@ -22,7 +22,6 @@ from ..runs.runfiles import read_metrics
 __all__ = ["paper_run", "paper_scenarios", "read_metrics"]
 
 
-
 def paper_scenarios(figure: str) -> list[Path]:
     """The shipped scenarios of a figure, found under ./scenarios."""
     pattern = {"fig5": "paper_fig5_kv*.yaml", "fig6-sensed": "paper_fig6_sensed.yaml"}.get(
