@@ -41,12 +41,15 @@ def _ramming(duration: float = 55) -> Scenario:
 
 def _run(scenario: Scenario, batched: bool, monkeypatch: pytest.MonkeyPatch) -> dict:
     """Everything a user sees of a run: trace rows, events, collisions, the end (or fault)."""
-    separations: list[dict] = []  # the step each contact ended at, as each ended
+    # the step each contact ended at, as each ended; kept with the world that said it: a world
+    # of an earlier run, freed by the garbage collector during this one, reports its own
+    # contacts' ends then (pymunk calls separate as a Space goes), which are not this run's
+    separations: list[tuple[PhysicsWorld, dict]] = []
     separate = PhysicsWorld._on_separate
 
     def recording(self: PhysicsWorld, *args) -> None:  # type: ignore[no-untyped-def]
         separate(self, *args)
-        separations.append(dict(self._apart_since))
+        separations.append((self, dict(self._apart_since)))
 
     with monkeypatch.context() as m:
         m.setattr(PhysicsWorld, "_on_separate", recording)
@@ -65,7 +68,7 @@ def _run(scenario: Scenario, batched: bool, monkeypatch: pytest.MonkeyPatch) -> 
             "events": [(e.t, e.kind, e.detail) for e in sim.events],
             "collisions": physics.collisions,
             "steps": physics._steps,
-            "separations": separations,
+            "separations": [apart for world, apart in separations if world is physics],
             "fault": fault,
             "now": sim.now,
         }
