@@ -20,7 +20,7 @@ from ..engine import noise as nz
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
 from .space import physics_of
-from .terrain import Zone, polygon_area
+from .terrain import POLYGON, Zone, check_polygon
 
 _ALL = pymunk.ShapeFilter()
 #: Slack when comparing float times (steps fall on a rational grid; floats of it round).
@@ -225,24 +225,12 @@ class GpsDeniedZone(Template):
 
     template_name = "gpsDeniedZone"
     kind = Kind.ENVIRONMENT
-    params = (
-        Param(
-            "polygon",
-            "points",
-            "the zone's corners [[x, y], ...] in order (at least 3, not crossing)",
-            (),
-            unit="m",
-        ),
-    )
+    params = (POLYGON,)
 
     @classmethod
     def check_params(cls, values: Mapping[str, Any]) -> None:
         """A zone needs a polygon with an area."""
-        pts = values.get("polygon", ())
-        if len(pts) < 3:
-            raise ValueError(f"polygon needs at least 3 corners, got {len(pts)}")
-        if abs(polygon_area(pts)) < 1e-9:
-            raise ValueError("polygon has no area (its corners are on one line)")
+        check_polygon(values)
 
     def initialize(self, ctx: Any) -> None:
         """Register the zone with the run's receivers (it lives beside the physics)."""

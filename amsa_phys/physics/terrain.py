@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from ..model.params import Param
+
 
 @dataclass
 class Zone:
@@ -203,3 +205,23 @@ def polygon_area(points: Sequence[Sequence[float]]) -> float:
     for (x0, y0), (x1, y1) in zip(points, [*points[1:], points[0]], strict=True):
         total += x0 * y1 - x1 * y0
     return total / 2
+
+
+#: The corners of a zone on the ground, declared the same by every zone template (friction,
+#: grade, GPS-denied): one parameter, so the three read, check and document it alike.
+POLYGON = Param(
+    "polygon",
+    "points",
+    "the zone's corners [[x, y], ...] in order (at least 3, not crossing)",
+    (),
+    unit="m",
+)
+
+
+def check_polygon(values: Any) -> None:
+    """A zone needs a polygon with an area (``ValueError`` naming what is wrong)."""
+    pts = values.get("polygon", ())
+    if len(pts) < 3:
+        raise ValueError(f"polygon needs at least 3 corners, got {len(pts)}")
+    if abs(polygon_area(pts)) < 1e-9:
+        raise ValueError("polygon has no area (its corners are on one line)")

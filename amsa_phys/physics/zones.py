@@ -17,7 +17,7 @@ from ..model.params import Param
 from ..model.template import Kind, Template
 from ..templatemarks import Zone as ZoneMark
 from .space import physics_of
-from .terrain import Grade, Zone, polygon_area
+from .terrain import POLYGON, Grade, Zone, check_polygon
 
 
 class FrictionZone(Template):
@@ -56,23 +56,13 @@ class FrictionZone(Template):
             0.0,
             1.0,
         ),
-        Param(
-            "polygon",
-            "points",
-            "the zone's corners [[x, y], ...] in order (at least 3, not crossing)",
-            (),
-            unit="m",
-        ),
+        POLYGON,
     )
 
     @classmethod
     def check_params(cls, values: Mapping[str, Any]) -> None:
         """A zone needs a polygon with an area."""
-        pts = values.get("polygon", ())
-        if len(pts) < 3:
-            raise ValueError(f"polygon needs at least 3 corners, got {len(pts)}")
-        if abs(polygon_area(pts)) < 1e-9:
-            raise ValueError("polygon has no area (its corners are on one line)")
+        check_polygon(values)
 
     def initialize(self, ctx: Any) -> None:
         """Register the zone with the run's physics world."""
@@ -123,13 +113,7 @@ class GradeZone(Template):
             7.0,
             "rad",
         ),
-        Param(
-            "polygon",
-            "points",
-            "the zone's corners [[x, y], ...] in order (at least 3, not crossing)",
-            (),
-            unit="m",
-        ),
+        POLYGON,
     )
 
     @classmethod
