@@ -14,15 +14,14 @@ from fractions import Fraction
 from typing import Any
 
 import numpy as np
-import pymunk
 
 from ..engine import noise as nz
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
+from .lidar import cast_rays
 from .space import physics_of
 from .terrain import POLYGON, Zone, check_polygon
 
-_ALL = pymunk.ShapeFilter()
 #: Slack when comparing float times (steps fall on a rational grid; floats of it round).
 _EPS = 1e-9
 
@@ -142,7 +141,7 @@ class GNSS(Template):
         reach = max(reach, 3.0 * p.multipathRange)
         az = np.linspace(0.0, 2 * math.pi, p.skyRays, endpoint=False)
         rovers = {r.body for r in self.physics.rovers}
-        d = sky_rays(self.physics.space, (x, y), az, reach, rovers)
+        d = cast_rays(self.physics.space, (x, y), az, reach, rovers, miss=math.inf)
         return blocked_share(d, h, mask), float(d.min()) if len(d) else math.inf
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
@@ -267,30 +266,3 @@ def blocked_share(dist: np.ndarray, height: float, mask: float) -> float:
     elev = np.arctan2(height, np.maximum(dist, 1e-9))
     share = np.clip((elev - mask) / (math.pi / 2 - mask), 0.0, 1.0)
     return float(share.mean())
-
-
-def sky_rays(
-    space: pymunk.Space,
-    origin: tuple[float, float],
-    angles: np.ndarray,
-    reach: float,
-    ignore: set[pymunk.Body],
-) -> np.ndarray:
-    """Distance to the nearest obstacle or wall along each azimuth (``inf``: none within reach)."""
-    ox, oy = origin
-    out = np.full(len(angles), math.inf)
-    for i, a in enumerate(angles.tolist()):
-        end = (ox + reach * math.cos(a), oy + reach * math.sin(a))
-        best = 1.0
-        for hit in space.segment_query((ox, oy), end, 0.0, _ALL):
-            shape = hit.shape
-            if (
-                hit.alpha < best
-                and shape is not None
-                and shape.body not in ignore
-                and not shape.sensor
-            ):
-                best = hit.alpha
-        if best < 1.0:
-            out[i] = best * reach
-    return out

@@ -8,7 +8,7 @@ sensor, and its noise model is the one every sensor shares (``engine/noise.py``)
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from fractions import Fraction
 from typing import Any
 
@@ -158,8 +158,13 @@ class Lidar(Template):
         """The paper's doStep: one scan, or none if lost."""
         p = self.p
         x, y, heading = inp["posX"], inp["posY"], inp["heading"]
+        own = self._own_body()
         true = cast_rays(
-            self.physics.space, (x, y), heading + self.angles(), p.range_max, self._own_body()
+            self.physics.space,
+            (x, y),
+            heading + self.angles(),
+            p.range_max,
+            () if own is None else (own,),
         )
         noisy = self.noise.apply_array(true, float(t), p)
         dropped = self.drop.random(p.beams) * 100.0 < p.dropout
@@ -176,28 +181,31 @@ def cast_rays(
     space: pymunk.Space,
     origin: tuple[float, float],
     angles: np.ndarray,
-    max_range: float,
-    ignore: pymunk.Body | None,
+    reach: float,
+    ignore: Collection[pymunk.Body] = (),
+    miss: float | None = None,
 ) -> np.ndarray:
-    """Distance to the nearest shape along each ray from ``origin`` (``max_range``: none).
+    """Distance to the nearest shape along each ray from ``origin`` (``miss``, by default
+    ``reach``: none within reach).
 
-    Shapes of body ``ignore`` (the mount rover) and sensor shapes (terrain zones, if any)
-    are not seen. One pymunk segment query per ray: a C call that returns every hit.
+    Shapes of the bodies in ``ignore`` (the mount rover; a GNSS receiver's rovers) and sensor
+    shapes (terrain zones, if any) are not seen. One pymunk segment query per ray: a C call
+    that returns every hit. The lidar's beams and a GNSS receiver's sky both cast here.
     """
     ox, oy = origin
-    out = np.full(len(angles), max_range)
+    out = np.full(len(angles), reach if miss is None else miss)
     for i, a in enumerate(angles.tolist()):
-        end = (ox + max_range * math.cos(a), oy + max_range * math.sin(a))
+        end = (ox + reach * math.cos(a), oy + reach * math.sin(a))
         best = 1.0
         for hit in space.segment_query((ox, oy), end, 0.0, _ALL):
             shape = hit.shape
             if (
                 hit.alpha < best
                 and shape is not None
-                and shape.body is not ignore
+                and shape.body not in ignore
                 and not shape.sensor
             ):
                 best = hit.alpha
         if best < 1.0:
-            out[i] = best * max_range
+            out[i] = best * reach
     return out
