@@ -72,6 +72,11 @@ class RunView:
         """A subsystem step of this run, stepped by the batch."""
         self._sim.add_hook(rate_hz, fn, name)
 
+    def batch_hook(self, fn: Callable[[], None], many: Callable[[int, Any], int]) -> None:
+        """Let the batch's hook ``fn`` take a run of its instants in one call
+        (``Simulation.batch_hook``: the column physics' steps)."""
+        self._sim.batch_hook(fn, many)
+
     def record_event(self, kind: str, detail: str) -> None:
         """An event of this run at the current simulated time."""
         self.events.append(Event(float(self._sim.now), kind, detail))

@@ -12,7 +12,10 @@ world or going too fast would fault the whole batch. So from the step where a ru
 within reach, its rovers are *frozen*: after every integration their rows are put back to
 where they were before it, so they never move, never speed up and never fault.
 
-Freezing touches only the frozen rows (the force pass and the integration are per rover),
+With the compiled step the freezing is done in C, in the same call as the forces and the
+integration, and a run of physics steps between the agent's instants is one call
+(``ColumnPhysics.step_many``); the numpy path below is the pure one. Freezing touches only
+the frozen rows (the force pass and the integration are per rover),
 so the other runs' floats are those of the columns without it, which are their single
 runs' (``tests/physics/test_columns.py``, ``tests/gym/test_gym_vector.py``).
 """
@@ -35,12 +38,17 @@ class EpisodeColumns(ColumnPhysics):
         self._seen = 0
         self._frozen: np.ndarray | None = None  # rover rows of the touched runs
 
+    FREEZE = True  # the fused C step holds the touched runs' rows (``advance_many``)
+
     def _start(self) -> Any:
-        """The batch's set-up without the fused C step: that step screens for reach inside C
-        and never calls :meth:`_contacts`, where the freezing happens (and it checks the
-        frozen rows for faults before they could be put back). The forces stay C's."""
+        """The batch's set-up. The fused C step freezes in C (``_step.Columns.advance_many``
+        with ``freeze``: a touched run's rovers are not integrated, the same rows the numpy
+        path puts back in :meth:`_contacts`); an extension built before that method has only
+        the plain step, which would move and check the frozen rows: then the numpy path
+        (the forces stay C's)."""
         model = super()._start()
-        self._fused = None
+        if not hasattr(self._fused, "advance_many"):
+            self._fused = None
         return model
 
     def _contacts(self, dt: float) -> None:

@@ -10,6 +10,11 @@ step (one duration for all); the ``step`` after that starts new episodes (seeds 
 the env's generator) and returns their first observations with reward 0 and
 ``terminated = truncated = False``, ignoring the action. Like the single env, it belongs to
 the thread that calls ``reset``.
+
+Below :data:`~amsa_phys.gym.vecsingles.SINGLES_BELOW` envs a batch's fixed cost per step
+is more than the runs' own work: the envs are then single envs stepped in turn
+(``gym/vecsingles.py``: each a :class:`FollowEnv`), the same episodes bit for bit.
+``stepping="batch"`` or ``"single"`` chooses either path whatever the size.
 """
 
 from __future__ import annotations
@@ -25,6 +30,10 @@ from ..errors import ConfigError
 from . import args
 from .follow import FollowEnv
 from .vecepisode import VecEpisode
+from .vecsingles import SINGLES_BELOW, Singles
+
+#: the ``stepping`` argument's values
+STEPPINGS = ("auto", "batch", "single")
 
 #: memory one sub-environment holds per component of its world: 1,000 envs of the default
 #: scenario (8 components) took the process from 56 to 212 MB by their first steps
@@ -50,15 +59,28 @@ def check_size(num_envs: int, components: int) -> None:
 
 
 class FollowVecEnv(gymnasium.vector.VectorEnv):
-    """``num_envs`` FollowEnv episodes stepped as one batch (arguments as FollowEnv's)."""
+    """``num_envs`` FollowEnv episodes stepped as one batch (arguments as FollowEnv's), or,
+    below :data:`SINGLES_BELOW` envs or with ``stepping="single"``, as single envs in turn."""
 
     metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}  # noqa: RUF012
 
-    def __init__(self, num_envs: int = 1, scenario: Any = None, **kwargs: Any) -> None:
+    def __init__(
+        self, num_envs: int = 1, scenario: Any = None, *, stepping: str = "auto", **kwargs: Any
+    ) -> None:
         if not isinstance(num_envs, int) or isinstance(num_envs, bool) or num_envs < 1:
             raise ConfigError(
                 f"num_envs must be a whole number >= 1, got {num_envs!r}", key="num_envs"
             )
+        if stepping not in STEPPINGS:
+            raise ConfigError(
+                f"stepping must be one of {', '.join(STEPPINGS)}, got {stepping!r}",
+                key="stepping",
+            )
+        #: how the episodes step: "batch" (one batched simulation) or "single" (each env a
+        #: single env, in turn); "auto" chose by the number of envs (:data:`SINGLES_BELOW`)
+        self.stepping = stepping
+        if stepping == "auto":
+            self.stepping = "single" if num_envs < SINGLES_BELOW else "batch"
         if kwargs.get("render_mode") is not None or kwargs.get("record_trace"):
             raise ConfigError(
                 "the vector env neither renders nor records traces; use FollowEnv",
@@ -80,6 +102,11 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         self.action_space = batch_space(self.single_action_space, num_envs)
         self.metadata = {**self.metadata, "render_fps": self.single.metadata["render_fps"]}
         self._episode: VecEpisode | None = None
+        #: the single envs of ``stepping="single"`` (the first is :attr:`single`)
+        self._singles: Singles | None = None
+        if self.stepping == "single":
+            more = [FollowEnv(scenario, **kwargs) for _ in range(num_envs - 1)]
+            self._singles = Singles([self.single, *more])
         self._seen = np.zeros(num_envs, dtype=np.int64)
         self._autoreset = False
 
@@ -104,6 +131,10 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         drawn = [s if s is not None else int(self.np_random.integers(0, 2**31 - 1)) for s in seeds]
         self.close_extras()
         single = self.single
+        self._autoreset = False
+        if self._singles is not None:
+            self._episode = self._singles  # type: ignore[assignment]
+            return self._singles.start(drawn)
         self._episode = VecEpisode(
             single._scenario, single.path, drawn, single.observed, single.acted
         )
@@ -130,6 +161,11 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         acted = self.single.acted
         if a.shape != (n, len(acted)):
             raise ValueError(f"expected actions of shape ({n}, {len(acted)}), got {a.shape}")
+        if self._singles is not None:
+            obs, reward, info = self._singles.step(a)
+            done = self._singles.done
+            self._autoreset = done
+            return obs, reward, np.zeros(n, dtype=bool), np.full(n, done), info
         scale = self.single.action_scale
         episode = self._episode
         episode.step(a * scale)
@@ -158,6 +194,6 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         }
 
     def close_extras(self, **kwargs: Any) -> None:
-        """Stop the batch's worker thread."""
+        """Stop the episodes in progress (the batch's greenlet, or the single envs')."""
         if self._episode is not None:
             self._episode.close()

@@ -16,12 +16,15 @@ from amsa_phys.gym.vector import FollowVecEnv  # noqa: E402
 ROOT = Path(__file__).resolve().parent.parent.parent
 SCENARIO2 = str(ROOT / "scenarios" / "scenario2.yaml")
 SCENARIO1 = str(ROOT / "scenarios" / "scenario1.yaml")
+#: both ways the vector env steps: one batched simulation, or single envs in turn
+STEPPINGS = ["batch", "single"]
 
 
+@pytest.mark.parametrize("stepping", STEPPINGS)
 @pytest.mark.parametrize("observation", ["relative", "absolute"])
-def test_vector_env_equals_single_envs_step_for_step(observation: str) -> None:
+def test_vector_env_equals_single_envs_step_for_step(observation: str, stepping: str) -> None:
     seeds = [11, 12, 13]
-    vec = FollowVecEnv(3, SCENARIO2, duration=6, observation=observation)
+    vec = FollowVecEnv(3, SCENARIO2, duration=6, observation=observation, stepping=stepping)
     obs, info = vec.reset(seed=seeds)
     assert info["seed"].tolist() == seeds
     actions = np.random.default_rng(1).uniform(-1, 1, size=(24, 3, 2))
@@ -51,7 +54,7 @@ def test_vector_env_equals_single_envs_step_for_step(observation: str) -> None:
 
 def test_collisions_cost_the_run_that_collides() -> None:
     # full power from 15 m behind a straight leader rams it: the same step as alone
-    vec = FollowVecEnv(2, SCENARIO1, duration=60)
+    vec = FollowVecEnv(2, SCENARIO1, duration=60, stepping="batch")
     vec.reset(seed=[1, 2])
     single = FollowEnv(SCENARIO1, duration=60)
     single.reset(seed=1)
@@ -67,8 +70,9 @@ def test_collisions_cost_the_run_that_collides() -> None:
     single.close()
 
 
-def test_next_step_autoreset() -> None:
-    vec = FollowVecEnv(2, SCENARIO1, duration=1)
+@pytest.mark.parametrize("stepping", STEPPINGS)
+def test_next_step_autoreset(stepping: str) -> None:
+    vec = FollowVecEnv(2, SCENARIO1, duration=1, stepping=stepping)
     assert vec.metadata["autoreset_mode"] is gymnasium.vector.AutoresetMode.NEXT_STEP
     vec.reset(seed=5)
     truncated = np.zeros(2, dtype=bool)
@@ -107,6 +111,8 @@ def test_make_vec_uses_it_and_an_int_seed_seeds_each_env() -> None:
 def test_bad_arguments() -> None:
     with pytest.raises(ap.ConfigError, match="num_envs"):
         FollowVecEnv(0, SCENARIO1)
+    with pytest.raises(ap.ConfigError, match="stepping must be one of auto, batch, single"):
+        FollowVecEnv(2, SCENARIO1, stepping="columns")
     vec = FollowVecEnv(2, SCENARIO1, duration=1)
     with pytest.raises(ap.ConfigError, match="expected 2 seeds"):
         vec.reset(seed=[1])
@@ -118,7 +124,7 @@ def test_every_component_steps_as_columns_and_the_rovers_are_columns() -> None:
     """The vector env rides the batch's columns: every component, the robots included,
     steps as one group of all runs, its ports slices of the store's array, and the rovers
     of all runs are the column physics' rows (no run's Space is stepped)."""
-    vec = FollowVecEnv(3, SCENARIO2, duration=2)
+    vec = FollowVecEnv(3, SCENARIO2, duration=2, stepping="batch")
     vec.reset(seed=5)
     episode = vec._episode
     assert episode is not None
@@ -161,7 +167,7 @@ def test_runs_that_come_within_reach_continue_alone_exactly_as_the_single_env() 
     actions[:, 0] = 1.0  # full power from the start: rams the leader
     actions[60:, 3] = 1.0  # full power from 15 s on: rams it later
     seeds = [21, 22, 23, 24]
-    vec = FollowVecEnv(n, duration=40)
+    vec = FollowVecEnv(n, duration=40, stepping="batch")
     obs, _ = vec.reset(seed=seeds)
     seen = [(obs, np.zeros(n), np.zeros(n, dtype=bool), None)]
     for a in actions:
@@ -193,7 +199,7 @@ def test_a_seed_gives_the_same_episode_whatever_the_batch_and_its_order() -> Non
     actions = {5: 0.2, 6: 1.0, 7: -0.3}  # seed -> constant action (seed 6 rams its leader)
 
     def run(seeds: list[int]) -> dict[int, list[np.ndarray]]:
-        vec = FollowVecEnv(len(seeds), SCENARIO2, duration=30)
+        vec = FollowVecEnv(len(seeds), SCENARIO2, duration=30, stepping="batch")
         obs, _ = vec.reset(seed=seeds)
         rows = {s: [obs[i]] for i, s in enumerate(seeds)}
         a = np.array([[actions[s]] * 2 for s in seeds])
@@ -215,7 +221,7 @@ def test_a_run_within_reach_stops_moving_in_the_columns() -> None:
     """Once a run is found within reach its rows in the columns are no longer used; they
     are frozen, so a follower passing through its leader there (no contacts in columns)
     can never fly off and fault the whole batch (``gym/veccolumns.py``)."""
-    vec = FollowVecEnv(2, SCENARIO1, duration=60)
+    vec = FollowVecEnv(2, SCENARIO1, duration=60, stepping="batch")
     vec.reset(seed=[1, 2])
     episode = vec._episode
     assert episode is not None
@@ -235,10 +241,11 @@ def test_a_run_within_reach_stops_moving_in_the_columns() -> None:
     vec.close()
 
 
-def test_stepping_from_another_thread_is_refused() -> None:
+@pytest.mark.parametrize("stepping", STEPPINGS)
+def test_stepping_from_another_thread_is_refused(stepping: str) -> None:
     import threading
 
-    vec = FollowVecEnv(2, SCENARIO1, duration=5)
+    vec = FollowVecEnv(2, SCENARIO1, duration=5, stepping=stepping)
     vec.reset(seed=3)
     caught: list[BaseException] = []
 
@@ -312,7 +319,7 @@ def test_a_world_columns_cannot_hold_runs_each_space_and_still_equals_the_single
             "tolerance": 1.5,
         },
     }
-    vec = FollowVecEnv(2, scenario)
+    vec = FollowVecEnv(2, scenario, stepping="batch")
     vec.reset(seed=[3, 4])
     episode = vec._episode
     assert episode is not None
@@ -342,7 +349,7 @@ def test_many_runs_within_reach_at_once_go_alone_together_and_equal_the_single_e
     actions[0, :, 0] = np.linspace(0.9, 1.0, n)  # one first step each: their own episodes
     actions[:, 5] = 0.0
     seeds = list(range(30, 36))
-    vec = FollowVecEnv(n, SCENARIO1, duration=30)
+    vec = FollowVecEnv(n, SCENARIO1, duration=30, stepping="batch")
     vec.reset(seed=seeds)
     seen = [vec.step(a) for a in actions]
     episode = vec._episode
@@ -365,12 +372,13 @@ def test_many_runs_within_reach_at_once_go_alone_together_and_equal_the_single_e
             assert info["collisions"][i] == s_info["collisions"]
 
 
-def test_a_fault_is_raised_by_step_then_reset_is_needed() -> None:
+@pytest.mark.parametrize("stepping", STEPPINGS)
+def test_a_fault_is_raised_by_step_then_reset_is_needed(stepping: str) -> None:
     """A run's fault (a non-finite action, refused by the engine as the single env's)
     is raised by the step that meets it; the batch then needs a reset, like the single env."""
     from amsa_phys.errors import RunFault
 
-    vec = FollowVecEnv(2, SCENARIO1, duration=5)
+    vec = FollowVecEnv(2, SCENARIO1, duration=5, stepping=stepping)
     vec.reset(seed=1)
     vec.step(np.zeros((2, 2)))
     with pytest.raises(RunFault, match="agent"):
@@ -385,7 +393,7 @@ def test_a_fault_is_raised_by_step_then_reset_is_needed() -> None:
 def test_after_the_autoreset_every_run_is_back_in_the_columns() -> None:
     """The runs that went alone in one episode start the next one in the columns, and
     that episode is again the single env's."""
-    vec = FollowVecEnv(2, SCENARIO1, duration=30)
+    vec = FollowVecEnv(2, SCENARIO1, duration=30, stepping="batch")
     vec.reset(seed=[8, 9])
     ram = np.array([[1.0, 1.0], [0.0, 0.0]])
     for _ in range(120):
