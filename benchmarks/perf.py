@@ -26,7 +26,10 @@ Targets:
 * the engine (``bench_engine.py``): batched sweep >= 5x the process pool
   for scenario1 and scenario2 at 1,000 runs of 60 s, 1,000 scenario2 runs <= 5 s; the
   1,000-rover platoon >= 40x real time with the cost per rover-step flat from 200 to 1,000
-  rovers; the API run of scenario1; the vector env >= 50,000 env-steps/s at 1,000 envs.
+  rovers; the API run of scenario1; the vector env >= 50,000 env-steps/s at 1,000 envs;
+* speed for learning and search (``bench_speed.py``): the single env against CartPole-v1 and
+  LunarLander-v3, the vector env at 1 to 1,000 envs against ``SyncVectorEnv``, ``ap.run``
+  against the compiled step alone, the whole process against ``python -c pass``.
 """
 
 from __future__ import annotations
@@ -53,6 +56,7 @@ import bench_engine
 import bench_plots
 import bench_record
 import bench_run
+import bench_speed
 import bench_sweep
 import results
 import yaml
@@ -435,7 +439,19 @@ TARGETS: dict[str, Callable[[int], None]] = {
     # the column store and the run axis (bench_engine.py): batched vs pool for
     # scenario1 and scenario2, the 1,000-rover platoon, the API run, the vector env
     "engine": lambda reps: [bench_engine.TARGETS[n](reps) for n in bench_engine.TARGETS],
+    # the speed table: each row against its baseline, load taken per row (bench_speed.py)
+    "speed": lambda reps: bench_speed.run_all(reps, report, _mark_row("speed")),
 }
+
+
+def _mark_row(target: str) -> Callable[[], None]:
+    """What a benchmark calls before each row, so that the row's load is its own."""
+
+    def mark() -> None:
+        if RECORDER is not None:
+            RECORDER.start(target)
+
+    return mark
 
 
 def main() -> None:
