@@ -21,9 +21,11 @@ import numpy as np
 from .follow import FollowEnv
 
 #: Fewer envs than this step as single envs; this many or more as one batch. Measured on
-#: 2 shared cores (random actions, CPU time): the batch gave 0.5x the single envs' speed
-#: at 4 envs, ~1x at 8, 1.7-2x at 16 (``benchmarks/bench_speed.py`` measures both paths).
-SINGLES_BELOW = 12
+#: 2 shared cores (random actions, CPU time, each path against SyncVectorEnv in the same
+#: sitting): at 8 envs both paths ~1.04x SyncVectorEnv, at 10 the batch 1.26x and the
+#: single envs 1.14x, at 12 the batch 1.5x (``benchmarks/bench_speed.py``). A faster
+#: single env moves the crossing up: re-measure both paths before changing it.
+SINGLES_BELOW = 10
 
 
 class Singles:

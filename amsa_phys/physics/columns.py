@@ -127,6 +127,7 @@ class ColumnPhysics:
         self._touched = np.zeros(0, dtype=np.uint8)
         #: the whole step in C (``compiled.ColumnForces.columns``), when the forces are C's
         self._fused: Any = None
+        self._powers: Any = None
 
     @property
     def touched(self) -> set[int]:
@@ -159,6 +160,17 @@ class ColumnPhysics:
         force model's drives (the only reader in a batch: no window draws the rovers'
         ``power_l``). A rover's wheel (and deadband) is fixed in a batch (``batched.py``)."""
         model = self._model or self._start()
+        powers = self._powers
+        if powers is not None:  # the same rule in one C call (``_step.column_powers``)
+            f64 = np.float64
+            powers(
+                np.ascontiguousarray(left, dtype=f64),
+                np.ascontiguousarray(right, dtype=f64),
+                np.ascontiguousarray(index, dtype=np.int64),
+                self._band,
+                model.drives,
+            )
+            return
         left = np.where(np.isnan(left), -100.0, np.clip(left, -100.0, 100.0))
         right = np.where(np.isnan(right), -100.0, np.clip(right, -100.0, 100.0))
         band = self._band[index]
@@ -210,6 +222,10 @@ class ColumnPhysics:
         # run of a batch: one physics setting); rover pairs within each run
         self._radius = np.array([_radius(r.shape) for r in self.rovers])
         self._band = np.array([r.wheel.deadband_pct for r in self.rovers])
+        #: ``_step.column_powers`` with the compiled forces (their drives are C-contiguous)
+        self._powers = getattr(_compiled_step(), "column_powers", None)
+        if self._powers is not None and not model.drives.flags.c_contiguous:
+            self._powers = None
         statics = [s for s in first.space.shapes if s.body.body_type == pymunk.Body.STATIC]
         self._boxes = np.array([[s.bb.left, s.bb.bottom, s.bb.right, s.bb.top] for s in statics])
         pairs = [
@@ -328,6 +344,13 @@ class ColumnPhysics:
             if near.any():
                 out.update(self._run[near].tolist())
         return out
+
+
+def _compiled_step() -> Any:
+    """The C extension when a batch's forces are compiled (not under ``AMSA_PHYS_PURE``)."""
+    from . import compiled
+
+    return compiled._step if compiled.columns_compiled() else None
 
 
 def _body_state(body: pymunk.Body) -> list[float]:
