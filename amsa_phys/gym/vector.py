@@ -173,23 +173,27 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         new = collisions - self._seen
         self._seen = collisions
         q = self.single.quality
-        reward = -np.abs(episode.signals(q.signal) - q.reference) / q.tolerance
+        signal = episode.signals(q.signal)  # read once: the reward's and the info's
+        reward = -np.abs(signal - q.reference) / q.tolerance
         reward = reward - self.single.collision_penalty * new + 0.0
         truncated = np.full(n, episode.done)
         self._autoreset = episode.done
-        return self._observations(), reward, np.zeros(n, dtype=bool), truncated, self._info()
+        info = self._info(signal.copy())
+        return self._observations(), reward, np.zeros(n, dtype=bool), truncated, info
 
     def _observations(self) -> np.ndarray:
         episode = self._episode
         assert episode is not None
         return self.single.observer.of_rows(episode.observed_rows())
 
-    def _info(self) -> dict[str, Any]:
+    def _info(self, signal: np.ndarray | None = None) -> dict[str, Any]:
         episode = self._episode
         assert episode is not None
+        if signal is None:
+            signal = episode.signals(self.single.quality.signal)
         return {
             "t": np.full(self.num_envs, float(episode.t)),
-            "signal": episode.signals(self.single.quality.signal),
+            "signal": signal,
             "collisions": self._seen.copy(),
         }
 
