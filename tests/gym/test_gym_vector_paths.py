@@ -143,3 +143,40 @@ def test_runs_of_steps_are_taken_in_one_call(monkeypatch: pytest.MonkeyPatch) ->
     vec.close()
     assert sum(calls) == 4 * 25  # every physics step of the 4 vector steps...
     assert len(calls) <= 4 * 5  # ...in a few calls (between the log's and the Leader's rows)
+
+
+@pytest.mark.parametrize("stepping", ["batch", "single"])
+def test_a_rover_leaving_the_world_faults_as_in_the_single_env(
+    tmp_path: Path, stepping: str
+) -> None:
+    """A physics fault inside a run of steps taken in one C call is reported at its own
+    step, as the single env reports it: the same message (rover, time, place)."""
+    from amsa_phys.errors import RunFault
+    from amsa_phys.gym import FollowEnv
+
+    path = tmp_path / "small.yaml"
+    path.write_text(
+        f"world: {ROOT / 'worlds' / 'mde_challenge.yaml'}\nduration: 60\nseed: 1\n"
+        "physics:\n  extent: 25\n"
+        "set: {Leader.cruisePower: 100}\n"
+        "quality: {signal: MyDistanceMonitor.distanceFollowerToLeader, reference: 15, "
+        "tolerance: 1.5}\n"
+    )
+    turn = np.array([0.3, 0.2])  # the leader, at full power from 15 m, leaves the world
+
+    def fault(env: Any, action: np.ndarray) -> str:
+        env.reset(seed=[4, 5] if action.ndim == 2 else 4)
+        try:
+            for _ in range(240):
+                env.step(action)
+        except RunFault as exc:
+            return str(exc)
+        finally:
+            env.close()
+        raise AssertionError("no fault")
+
+    single = fault(FollowEnv(str(path)), turn)
+    assert "in Leader: body left the world" in single
+    assert not single.startswith("run fault at t=0.")  # well into the run: mid-run of steps
+    vec = FollowVecEnv(2, str(path), stepping=stepping)
+    assert fault(vec, np.array([turn, turn])) == single
