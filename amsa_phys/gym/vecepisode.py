@@ -3,8 +3,9 @@
 The runs are one :class:`~amsa_phys.engine.multirun.MultiRun` as a batched sweep makes
 them: every component's copies in the N runs are one group stepped as arrays over the
 store's columns (each run with its own seed tree, parameters and events), and the rovers
-of all runs are columns too (``physics/columns.py``: one C force pass and one numpy
-integration per physics step for every rover, instead of N pymunk Spaces). The agent
+of all runs are columns too (``physics/columns.py``: every rover's forces and integration
+in one C call, the physics steps between two instants with components in one call,
+instead of N pymunk Spaces; numpy on the pure path). The agent
 replaces the same component in every run: its copies form one group, so the batch pauses
 once per *vector* step, at the exact place in the instant where the component would run,
 with every run's inputs as one array (a greenlet, as the single env's ``gym/episode.py``).
