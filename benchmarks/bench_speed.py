@@ -128,7 +128,8 @@ def single(reps: int, report: Report, quick: bool, mark: Mark = _nothing) -> Non
     cart_ratio = [o / c for o, c in zip(r_ours, r_cart, strict=True)]
     context = (
         f"amsa_phys/Follow-v0 {statistics.median(r_ours):,.0f} env-steps/s; CartPole-v1 "
-        f"{statistics.median(r_cart):,.0f} (Follow-v0 / CartPole-v1 {med(cart_ratio)})"
+        f"{statistics.median(r_cart):,.0f}, Follow-v0 / CartPole-v1 "
+        f"{statistics.median(cart_ratio):.3g}"
     )
     if lander is None:
         report("single env / LunarLander-v3", f"skipped; {why}; {context}", ">= 1.0", False)
