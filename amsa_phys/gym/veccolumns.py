@@ -42,9 +42,9 @@ class EpisodeColumns(ColumnPhysics):
 
     def _start(self) -> Any:
         """The batch's set-up. The fused C step freezes in C (``_step.Columns.advance_many``
-        with ``freeze``: a touched run's rovers are not integrated, the same rows the numpy
-        path puts back in :meth:`_contacts`); an extension built before that method has only
-        the plain step, which would move and check the frozen rows: then the numpy path
+        with ``freeze``: after each step the touched runs' rows are put back, as the numpy
+        path puts them back in :meth:`_contacts`); an extension built before that method has
+        only the plain step, which would leave the frozen rows moving: then the numpy path
         (the forces stay C's)."""
         model = super()._start()
         if not hasattr(self._fused, "advance_many"):

@@ -1180,43 +1180,43 @@ static int Columns_init(Columns *c, PyObject *args, PyObject *kwds)
  * Python call per step (the hook, the model, the screening's bookkeeping) cost ~60 us each
  * whatever the batch's size, more than the arithmetic of a small batch. The engine hands a
  * run of physics-only instants to one call (Simulation.batch_hook); this takes them here.
- * Each step is Columns_advance's, in the same order (so the same floats), with one
- * addition when ``freeze`` is true: a rover whose run is marked touched (this step's
- * screening included) is not integrated, so its row stays where it was before the step, as
- * gym/veccolumns.py's EpisodeColumns puts it back in numpy (its forces are still computed:
- * its rims advance as there). Frozen rows pass the safety check as they passed the last.
- * Stops after the first step whose check fails: returns (steps taken, whether all passed). */
+ * Each step IS Columns_advance (called, not copied: whatever that step does, these do), and
+ * with ``freeze`` the rows of every rover whose run is marked touched (this step's
+ * screening included) are then put back where they were before the step, as
+ * gym/veccolumns.py's EpisodeColumns puts them back in numpy (their forces and rims are
+ * computed as there). Stops after the first step whose check fails (a frozen row may fail
+ * it before it is put back: the caller looks for the violation in the rows as they are):
+ * returns (steps taken, whether all passed). */
 static PyObject *Columns_advance_many(Columns *c, PyObject *args)
 {
     Py_ssize_t count;
     int freeze;
     if (!PyArg_ParseTuple(args, "np", &count, &freeze))
         return NULL;
-    Stepper *st = &c->st;
-    const double dt = st->dt;
-    double *s = st->state;
+    const Py_ssize_t n = c->st.n;
+    double *s = c->st.state;
+    double *before = NULL;
+    if (freeze && n > 0 && (before = PyMem_Malloc(6 * n * sizeof(double))) == NULL)
+        return PyErr_NoMemory();
     Py_ssize_t done = 0;
     int ok = 1;
     while (done < count && ok) {
-        Columns_screen(c);
-        for (Py_ssize_t k = 0; k < st->n; k++) {
-            double *f = c->forces + 3 * k;
-            rover_forces(st, k, f);
-            if (freeze && c->touched[c->run[k]])
-                continue;
-            double *r = s + 6 * k;
-            r[0] = r[0] + (r[3] + 0.0) * dt;
-            r[1] = r[1] + (r[4] + 0.0) * dt;
-            r[2] = r[2] + (r[5] + 0.0) * dt;
-            r[3] = r[3] + (0.0 + f[0] * c->m_inv[k]) * dt;
-            r[4] = r[4] + (0.0 + f[1] * c->m_inv[k]) * dt;
-            r[5] = r[5] + f[2] * c->i_inv[k] * dt;
-            double v2 = r[3] * r[3] + r[4] * r[4];
-            if (!(v2 <= c->max2 && fabs(r[0]) <= c->extent && fabs(r[1]) <= c->extent))
-                ok = 0;
+        if (freeze)
+            memcpy(before, s, 6 * n * sizeof(double));
+        PyObject *passed = Columns_advance(c, NULL);
+        if (passed == NULL) {
+            PyMem_Free(before);
+            return NULL;
         }
+        ok = passed == Py_True;
+        Py_DECREF(passed);
+        if (freeze)
+            for (Py_ssize_t k = 0; k < n; k++)
+                if (c->touched[c->run[k]])
+                    memcpy(s + 6 * k, before + 6 * k, 6 * sizeof(double));
         done++;
     }
+    PyMem_Free(before);
     return Py_BuildValue("(nO)", done, ok ? Py_True : Py_False);
 }
 
