@@ -68,20 +68,26 @@ class Singles:
                 "step() must be called from the thread that called reset() (the envs' "
                 "episodes belong to it)"
             )
-        obs = []
-        rewards = []
-        infos = []
+        n = self.n
+        obs: np.ndarray | None = None
+        rewards, t, signal = np.empty(n), np.empty(n), np.empty(n)
+        collisions = np.empty(n, dtype=np.int64)
         try:
-            for env, a in zip(self.envs, actions, strict=True):
+            for i, (env, a) in enumerate(zip(self.envs, actions, strict=True)):
                 o, r, _, truncated, info = env.step(a)
-                obs.append(o)
-                rewards.append(r)
-                infos.append(info)
+                if obs is None:  # fresh arrays each step: the caller may keep the last ones
+                    obs = np.empty((n, len(o)))
+                obs[i] = o
+                rewards[i] = r
+                t[i] = info["t"]
+                signal[i] = info["signal"]
+                collisions[i] = info["collisions"]
         except BaseException:
             self.done = True
             raise
         self.done = truncated
-        return np.stack(obs), np.array(rewards, dtype=np.float64), self._gather(infos)
+        assert obs is not None
+        return obs, rewards, {"t": t, "signal": signal, "collisions": collisions}
 
     @staticmethod
     def _gather(infos: Sequence[dict[str, Any]]) -> dict[str, Any]:
