@@ -48,6 +48,7 @@ class Observer:
             )
         self.mode = mode
         self.raw_names = [p.name for p in ports]
+        self._in_c: tuple[Any, ...] | None = None
         if mode == "absolute":
             self.names = list(self.raw_names)
             self.low = np.full(len(ports), -np.inf)
@@ -85,6 +86,7 @@ class Observer:
         self.speed_mps = speed_mps
         self.low = np.full(len(self.names), -1.0)
         self.high = np.full(len(self.names), 1.0)
+        self._in_c = _rows_in_c(self)
 
     def __call__(self, raw: np.ndarray) -> np.ndarray:
         """The observation of one raw input vector (float64, within ``low``..``high``)."""
@@ -103,6 +105,11 @@ class Observer:
         rows = np.asarray(rows, dtype=np.float64)
         if self.mode == "absolute":
             return rows.copy()
+        if self._in_c is not None:  # the same arithmetic in one C call (``_step.c``)
+            observe, own, pairs, rest, scales = self._in_c
+            out = np.empty((len(rows), len(self.names)))
+            observe(np.ascontiguousarray(rows), own, pairs, rest, scales, out, self.range_m)
+            return out
         cols: list[np.ndarray] = []
         if self.own is not None:
             ox, oy, oh = self.own
@@ -160,3 +167,21 @@ class Observer:
                 v = math.tanh(v)
             append(v if -1.0 <= v <= 1.0 else (1.0 if v > 1.0 else -1.0))
         return np.array(out, dtype=np.float64)
+
+
+def _rows_in_c(observer: Observer) -> tuple[Any, ...] | None:
+    """``_step.observe_rows`` and its column plan, where the compiled extension has it and
+    every input is a position, a metre or a speed (the rest, angles and ``tanh``, stay in
+    numpy); None otherwise (``AMSA_PHYS_PURE=1`` included)."""
+    from ..physics import compiled
+
+    if not compiled.columns_compiled() or not hasattr(compiled._step, "observe_rows"):
+        return None
+    if any(unit not in ("m", "m/s") for _, unit in observer.rest) or not observer.names:
+        return None
+    scale = {"m": observer.range_m, "m/s": observer.speed_mps}
+    own = np.array(observer.own or (), dtype=np.int64)
+    pairs = np.array([c for pair in observer.relative for c in pair], dtype=np.int64)
+    rest = np.array([i for i, _ in observer.rest], dtype=np.int64)
+    scales = np.array([scale[u] for _, u in observer.rest], dtype=np.float64)
+    return compiled._step.observe_rows, own, pairs, rest, scales
