@@ -13,6 +13,7 @@ the boundary's documented one line and never reach a data topic. Everything runs
 
 from __future__ import annotations
 
+import ast
 import contextlib
 import json
 import math
@@ -183,3 +184,28 @@ def test_the_robot_side_stops_cleanly(robot_run: dict) -> None:
     assert "robot side: MyGpsDistance, MyFollowerController, MyNormalizePower" in robot_run["amsa"]
     assert "Traceback" not in robot_run["text"]
     assert robot_run["left"] == []
+
+
+def _launch_nodes(pkg: Path) -> dict[str, str]:
+    """Each Node of the launch file by executable: its condition's class, or ``""``."""
+    (launch,) = (pkg / "launch").glob("*.launch.py")
+    nodes: dict[str, str] = {}
+    for call in ast.walk(ast.parse(launch.read_text())):
+        if isinstance(call, ast.Call) and getattr(call.func, "id", "") == "Node":
+            kw = {k.arg: k.value for k in call.keywords}
+            exe = kw["executable"]
+            cond = kw.get("condition")
+            assert isinstance(exe, ast.Constant)
+            nodes[exe.value] = cond.func.id if isinstance(cond, ast.Call) else ""  # type: ignore[attr-defined]
+    return nodes
+
+
+def test_the_launch_files_sim_false_starts_the_controller_side_and_the_boundary(
+    tmp_path: Path,
+) -> None:
+    nodes = _launch_nodes(export(tmp_path))
+    always = sorted(n for n, c in nodes.items() if c == "")
+    assert always == ["MyFollowerController", "MyGpsDistance", "MyNormalizePower"]
+    assert nodes["amsa_boundary"] == "UnlessCondition"  # sim:=false only
+    sim_only = {"LeaderGPS", "FollowerGPS", "FollowerCompass", "MyDistanceMonitor"}
+    assert {n for n, c in nodes.items() if c == "IfCondition"} == sim_only
