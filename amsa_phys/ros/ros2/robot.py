@@ -106,6 +106,28 @@ def table(robot: Robot) -> list[str]:
     return lines
 
 
+def markdown(robot: Robot) -> list[str]:
+    """:func:`table` as the docs' Markdown table (a test compares the docs with it)."""
+    rows = [
+        "| topic | type | direction | frame_id | QoS | data topics |",
+        "|---|---|---|---|---|---|",
+        f"| `/clock` | `{external.CLOCK_TYPE}` | boundary → nodes, drivers | | {COMMAND_QOS} | |",
+    ]
+    for s in robot.inbound:
+        data = ", ".join(f"`{names.topic(d)}`" for d in _data(robot.world, s))
+        rows.append(
+            f"| `{s.topic}` | `{ROS2_TYPE[s.role.msg]}` | driver → boundary | `{s.frame_id}` "
+            f"| {SENSOR_QOS} | {data} |"
+        )
+    for s in robot.outbound:
+        data = ", ".join(f"`{names.topic(b)}`" for b in buffers_of(s))
+        rows.append(
+            f"| `{s.topic}` | `{ROS2_TYPE[s.role.msg]}` | boundary → motors | `{s.frame_id}` "
+            f"| {COMMAND_QOS} | {data} |"
+        )
+    return rows
+
+
 def _data(world: WorldSpec, src: Source) -> list[str]:
     """The Data a stream's fields go to: scalars, and an array field's port (once)."""
     element = {e: a for a, elements in world.arrays.items() for e in elements}
