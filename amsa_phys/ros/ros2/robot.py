@@ -139,6 +139,21 @@ def _data(world: WorldSpec, src: Source) -> list[str]:
     return out
 
 
+def qos(text: str) -> Any:
+    """The rclpy profile a QoS line of the docs' table states (``RELIABLE, VOLATILE,
+    KEEP_LAST(10)``): the table and the node cannot disagree."""
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+    reliability, durability, history = (part.strip() for part in text.split(","))
+    depth = int(history.removeprefix("KEEP_LAST(").removesuffix(")"))
+    return QoSProfile(
+        depth=depth,
+        reliability=ReliabilityPolicy[reliability],
+        durability=DurabilityPolicy[durability],
+        history=HistoryPolicy.KEEP_LAST,
+    )
+
+
 def fill(msg: Any, fields: Mapping[str, Any]) -> Any:
     """A ROS 2 message from ``stdmsgs``'s dict of its fields (nested dicts: sub-messages)."""
     for key, value in fields.items():
@@ -166,7 +181,6 @@ class Boundary:
     """The node's subscriptions and publishers (``node``: an rclpy node of name ``NODE``)."""
 
     def __init__(self, node: Any, scenario: Scenario, robot: Robot, check_frames: bool) -> None:
-        from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
         from std_msgs.msg import Float64, Float64MultiArray
 
         self.node = node
@@ -176,18 +190,7 @@ class Boundary:
         self.params = external.start_values(scenario)
         self.classes = _classes()
         self.Float64, self.Array = Float64, Float64MultiArray
-        reliable = QoSProfile(
-            depth=10,
-            reliability=ReliabilityPolicy.RELIABLE,
-            durability=DurabilityPolicy.VOLATILE,
-            history=HistoryPolicy.KEEP_LAST,
-        )
-        best_effort = QoSProfile(
-            depth=10,
-            reliability=ReliabilityPolicy.BEST_EFFORT,
-            durability=DurabilityPolicy.VOLATILE,
-            history=HistoryPolicy.KEEP_LAST,
-        )
+        reliable, best_effort = qos(COMMAND_QOS), qos(SENSOR_QOS)  # as the docs' table says
         self.lock = threading.Lock()
         self.stamp = (0, 0)  # the last /clock published
         #: per sensor topic: the reasons said since its last good message (one line each)
