@@ -62,9 +62,10 @@ def follower_law(lx: float, ly: float, fx: float, fy: float, h: float) -> tuple[
     return tuple(min(100.0, max(-100.0, p)) * COEF / 100 for p in (forward - turn, forward + turn))  # type: ignore[return-value]
 
 
-def export(tmp: Path) -> Path:
-    scenario = tmp / "robot_check.yaml"
-    scenario.write_text(SCENARIO)
+def export(tmp: Path, scenario: Path | None = None) -> Path:
+    if scenario is None:
+        scenario = tmp / "robot_check.yaml"
+        scenario.write_text(SCENARIO)
     pkg = tmp / "pkg"
     subprocess.run(
         [PY, "-m", "amsa_phys", "export", "ros2", str(scenario), "-o", str(pkg)],
@@ -75,7 +76,9 @@ def export(tmp: Path) -> Path:
     return pkg
 
 
-def on_robot(tmp: Path, pkg: Path, robot_args: list[str]) -> tuple[int, str, str, list[int]]:
+def on_robot(
+    tmp: Path, pkg: Path, robot_args: list[str], robot: Path = ROBOT
+) -> tuple[int, str, str, list[int]]:
     """``amsa-phys ros2 robot PKG`` and the fake robot in a private network; the robot's end
     stops amsa-phys (SIGTERM). Returns amsa-phys's exit status, its output, the log of
     everything, and the processes left behind."""
@@ -85,7 +88,7 @@ def on_robot(tmp: Path, pkg: Path, robot_args: list[str]) -> tuple[int, str, str
     script.write_text(
         "set -m\nip link set lo up\n"  # job control: the background job keeps its SIGINT
         f"{PY} -m amsa_phys ros2 robot {pkg} --speed 4 >{amsa_log} 2>&1 & AMSA=$!\n"
-        f"{PY} {ROBOT} {' '.join(robot_args)}\n"
+        f"{PY} {robot} {' '.join(robot_args)}\n"
         "kill -TERM $AMSA; wait $AMSA; echo AMSA_RC=$?\n"
     )
     env = {
@@ -209,3 +212,35 @@ def test_the_launch_files_sim_false_starts_the_controller_side_and_the_boundary(
     assert nodes["amsa_boundary"] == "UnlessCondition"  # sim:=false only
     sim_only = {"LeaderGPS", "FollowerGPS", "FollowerCompass", "MyDistanceMonitor"}
     assert {n for n, c in nodes.items() if c == "IfCondition"} == sim_only
+
+
+def test_every_sensor_stream_reaches_its_data_topics(tmp_path: Path) -> None:
+    """The obstacle course's rover: a LaserScan, a NavSatFix, the compass's and an IMU's Imu,
+    a wheel odometry's Odometry, each in its documented frame, become the values the Leaves
+    would output; the pilot (ReactiveAvoider) then commands the wheels."""
+    pkg = export(tmp_path, ROOT / "scenarios" / "obstacle_course.yaml")
+    out = tmp_path / "streams.json"
+    rc, amsa_out, text, left = on_robot(
+        tmp_path, pkg, [str(out)], Path(__file__).resolve().parent / "streams_node.py"
+    )
+    assert out.exists(), amsa_out + text[-4000:]
+    got = json.loads(out.read_text())
+    last = got["last"]
+    want = {
+        "/Gps/gpsPosX": 4.0,
+        "/Gps/gpsPosY": -1.5,
+        "/Heading/compassHeading": 0.7,
+        "/Odometry/odomX": 3.0,
+        "/Odometry/odomY": -2.0,
+        "/Odometry/odomHeading": -0.4,
+        "/Imu/gyroZ": 0.25,
+        "/Imu/accelX": 0.5,
+        "/Imu/accelY": -0.1,
+    }
+    for topic, value in want.items():
+        assert last.get(topic) == pytest.approx(value, abs=1e-6), (topic, last, amsa_out)
+    assert last["/Scanner/ranges"] == got["ranges"]  # the declared beams: beam for beam
+    assert len(got["commands"]) >= 3, amsa_out
+    assert "robot side: Pilot, Drive" in amsa_out
+    assert rc == 0, amsa_out
+    assert left == []
