@@ -244,3 +244,60 @@ def test_every_sensor_stream_reaches_its_data_topics(tmp_path: Path) -> None:
     assert "robot side: Pilot, Drive" in amsa_out
     assert rc == 0, amsa_out
     assert left == []
+
+
+def test_a_controller_node_that_exits_stops_the_robot_side_with_one_line(tmp_path: Path) -> None:
+    pkg = export(tmp_path)
+    node = pkg / "mde_challenge_sensed" / "MyNormalizePower.py"
+    # it dies once the boundary, started last, is on the graph: every node is running
+    dying = (
+        "def main():\n"
+        "    import rclpy\n"
+        "    rclpy.init()\n"
+        "    n = rclpy.create_node('dying')\n"
+        "    while 'amsa_boundary' not in n.get_node_names():\n"
+        "        rclpy.spin_once(n, timeout_sec=0.1)\n"
+        "    raise SystemExit(7)\n\n\n"
+        "def _main():"
+    )
+    node.write_text(node.read_text().replace("def main():", dying))
+    token = uuid.uuid4().hex
+    env = {**os.environ, **ENV, "AMSA_ROS2_TEST": token}
+    env["ROS_DOMAIN_ID"] = str(random.randint(1, 100))
+    env.pop("VIRTUAL_ENV", None)
+    res = subprocess.run(
+        ["unshare", "-n", "bash", "-c", f"ip link set lo up\n{PY} -m amsa_phys ros2 robot {pkg}"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=WALL_LIMIT_S,
+    )
+    assert res.returncode == 2, res.stdout + res.stderr
+    errors = [line for line in res.stderr.splitlines() if line.startswith("error:")]
+    assert errors == ["error: ROS 2 node MyNormalizePower exited with status 7"], res.stderr
+    assert "Traceback" not in res.stderr
+    assert leftovers(token) == []
+
+
+@pytest.mark.parametrize(
+    ("scenario", "args", "says"),
+    [
+        ("scenario1.yaml", [], "no node of this package can run on a robot"),
+        ("paper_fig6_sensed.yaml", ["--speed", "0"], "--speed: expected a positive number"),
+        ("paper_fig6_sensed.yaml", ["--speed", "nan"], "--speed: expected a positive number"),
+    ],
+)
+def test_a_package_without_a_robot_side_or_a_bad_speed_is_one_line(
+    tmp_path: Path, scenario: str, args: list[str], says: str
+) -> None:
+    pkg = export(tmp_path, ROOT / "scenarios" / scenario)
+    res = subprocess.run(
+        [PY, "-m", "amsa_phys", "ros2", "robot", str(pkg), *args],
+        capture_output=True,
+        text=True,
+        env={**os.environ, **ENV},
+        timeout=WALL_LIMIT_S,
+    )
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert len(res.stderr.splitlines()) == 1, res.stderr
+    assert says in res.stderr
