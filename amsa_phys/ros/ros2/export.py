@@ -45,6 +45,8 @@ class Package2:
     nodes: list[str]
     local: list[str]
     files: list[str]
+    #: the controller side: the nodes ``sim:=false`` / ``ros2 robot`` start on a robot
+    robot: list[str]
 
 
 def package_name(world_name: str) -> str:
@@ -77,7 +79,8 @@ def generate(scenario: Scenario, source: str, out: Path) -> Package2:
     src = Path(source).name
     scripts = []
     launch_nodes = []
-    controller = set(boundary_plan(RosGraph.of(world, local)).controller)
+    side = boundary_plan(RosGraph.of(world, local)).controller
+    controller = set(side)
     for path in remote:
         script = names.script(path)
         leaf = world.leaves[path]
@@ -147,7 +150,7 @@ def generate(scenario: Scenario, source: str, out: Path) -> Package2:
         target = out / rel
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_text(text)
-    return Package2(pkg, remote, local, sorted(files))
+    return Package2(pkg, remote, local, sorted(files), side)
 
 
 def _params_yaml(scenario: Scenario, remote: list[str]) -> str:
