@@ -301,3 +301,24 @@ def test_a_package_without_a_robot_side_or_a_bad_speed_is_one_line(
     assert res.returncode == 2, res.stdout + res.stderr
     assert len(res.stderr.splitlines()) == 1, res.stderr
     assert says in res.stderr
+
+
+def test_the_controller_drives_a_robot_in_closed_loop(tmp_path: Path) -> None:
+    """The robot obeys the commands with its own kinematics behind its own leader (straight at
+    0.2 m/s, 25 m ahead): after 40 s of the boundary's /clock the follower has caught up and
+    holds the band (15 ± 1.5 m, the scenario family's tolerance)."""
+    pkg = export(tmp_path)
+    out = tmp_path / "drive.json"
+    rc, amsa_out, text, left = on_robot(
+        tmp_path, pkg, ["40", str(out)], Path(__file__).resolve().parent / "drive_node.py"
+    )
+    assert out.exists(), amsa_out + text[-4000:]
+    got = json.loads(out.read_text())
+    log = got["log"]
+    assert got["commands"] > 50, amsa_out  # obeyed commands all along
+    assert log[0][1] > 24.0  # it started 10 m too far
+    assert log[-1][2] > 15.0, log[-1]  # it moved: 10 m closed, and the leader drove 8 m on
+    last = [d for t, d, _, _ in log if t >= log[-1][0] - 10]
+    assert all(abs(d - REF) < 1.5 for d in last), (min(last), max(last))
+    assert rc == 0, amsa_out
+    assert left == []
