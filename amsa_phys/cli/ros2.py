@@ -63,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
 def _robot(args: argparse.Namespace) -> int:
     """Print what the boundary reads and writes, start the nodes, wait for Ctrl-C."""
     from ..ros.ros2 import env, robotrun
-    from ..ros.ros2.robot import table
+    from ..ros.ros2.robotplan import table
 
     env.rclpy("ros2 robot")
     the_plan = robotrun.plan(Path(args.package), args.speed, not args.no_frame_check)

@@ -1,4 +1,4 @@
-"""The docs' table of the robot boundary's topics is the code's (``robot.markdown``).
+"""The docs' table of the robot boundary's topics is the code's (``robotplan.markdown``).
 
 No ROS needed: the table comes from the shared description (``ros/boundary.py``'s plan and
 ``stdmsgs``' streams), so renaming a topic or changing a QoS without the docs fails here.
@@ -10,7 +10,7 @@ from pathlib import Path
 
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.ros.graph import classify
-from amsa_phys.ros.ros2.robot import markdown, robot_of
+from amsa_phys.ros.ros2.robotplan import markdown, robot_of
 
 ROOT = Path(__file__).resolve().parents[2]
 MARK = "<!-- robot-table: paper_fig6_sensed "

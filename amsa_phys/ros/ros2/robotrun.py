@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ...errors import AmsaError, ConfigError
 from .lockstep import nodes_running, read_package
-from .robot import Robot, robot_of
+from .robotplan import Robot, robot_of
 
 #: How often the starter looks whether a node exited (a poll of the processes, wall s)
 LOOK_S = 0.2
