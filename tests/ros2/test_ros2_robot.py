@@ -322,3 +322,25 @@ def test_the_controller_drives_a_robot_in_closed_loop(tmp_path: Path) -> None:
     assert all(abs(d - REF) < 1.5 for d in last), (min(last), max(last))
     assert rc == 0, amsa_out
     assert left == []
+
+
+@pytest.mark.parametrize("param", ["speed:=-1.0", "speed:=inf", "check_frames:=maybe"])
+def test_the_boundary_node_refuses_a_bad_parameter_in_one_line(tmp_path: Path, param: str) -> None:
+    """What a launch argument gives the node (``speed:=``, ``check_frames:=``) is judged."""
+    pkg = export(tmp_path)
+    script = pkg / "mde_challenge_sensed" / "amsa_boundary.py"
+    env = {**os.environ, **ENV, "ROS_DOMAIN_ID": str(random.randint(1, 100))}
+    env.pop("VIRTUAL_ENV", None)
+    res = subprocess.run(
+        ["unshare", "-n", "bash", "-c", f"ip link set lo up\n{PY} {script} --ros-args -p {param}"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=WALL_LIMIT_S,
+    )
+    assert res.returncode == 2, res.stdout + res.stderr
+    lines = res.stderr.splitlines()
+    assert len(lines) == 1, res.stderr
+    assert lines[0].startswith("error: amsa_boundary: speed must be a positive number and ")
+    name, _, value = param.partition(":=")
+    assert f"{name}={value!r}" in lines[0] or f"{name}={float(value)!r}" in lines[0], lines
