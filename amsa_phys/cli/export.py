@@ -164,6 +164,8 @@ def _ros2(args: argparse.Namespace, out: Path) -> int:
         f"{', '.join(package.local) or 'none'})"
     )
     print(f"run it against the simulator: amsa-phys ros2 lockstep {out} --out RUNDIR")
+    if package.robot:
+        print(f"on a robot ({', '.join(package.robot)}): amsa-phys ros2 robot {out}")
     return 0
 
 

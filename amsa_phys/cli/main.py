@@ -68,7 +68,7 @@ COMMANDS = {
     ),
     "ros2": (
         "ros2",
-        "ROS 2: run an exported package's nodes against the simulator (lockstep).",
+        "ROS 2: run an exported package's nodes against the simulator (lockstep), or on a robot.",
     ),
     "import": (
         "imports",

@@ -1,4 +1,5 @@
-"""``amsa-phys ros2 lockstep PKG --out RUNDIR``: an exported ROS 2 package in the loop."""
+"""``amsa-phys ros2 lockstep PKG --out RUNDIR``: an exported ROS 2 package in the loop;
+``amsa-phys ros2 robot PKG``: its controller side and robot boundary on a robot."""
 
 from __future__ import annotations
 
@@ -35,9 +36,51 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     lock.add_argument("--no-plot", action="store_true", help="skip the plots")
     lock.add_argument("-q", "--quiet", action="store_true", help="no summary table")
+    robot = sub.add_parser(
+        "robot",
+        help="run an exported ROS 2 package's controller side on a robot (sim:=false)",
+        description="Start the controller side of a package made by `amsa-phys export ros2` "
+        "and its robot boundary, without the simulator (the launch file's sim:=false, no ros2 "
+        "launch needed): the robot's drivers' standard messages in, the wheel commands out as "
+        "sensor_msgs/JointState, /clock from the wall clock. Runs until Ctrl-C.",
+    )
+    robot.add_argument("package", metavar="PKG", help="the package directory")
+    robot.add_argument(
+        "--speed", type=float, default=1.0, metavar="X", help="/clock runs X times the wall clock"
+    )
+    robot.add_argument(
+        "--no-frame-check",
+        action="store_true",
+        help="accept a driver's message whatever its header.frame_id",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
+    """The action's own function."""
+    return _robot(args) if args.action == "robot" else _lockstep(args)
+
+
+def _robot(args: argparse.Namespace) -> int:
+    """Print what the boundary reads and writes, start the nodes, wait for Ctrl-C."""
+    from ..ros.ros2 import env, robotrun
+    from ..ros.ros2.robotplan import table
+
+    env.rclpy("ros2 robot")
+    the_plan = robotrun.plan(Path(args.package), args.speed, not args.no_frame_check)
+    side = ", ".join(the_plan.robot.plan.controller)
+    print(f"robot side: {side} and amsa_boundary; standard messages:")
+    for line in table(the_plan.robot):
+        print(line)
+    sys.stdout.flush()
+    try:
+        with interrupt.sigterm_as_ctrl_c():
+            robotrun.run(the_plan)
+    except KeyboardInterrupt:
+        print("stopped: every node ended")
+    return 0
+
+
+def _lockstep(args: argparse.Namespace) -> int:
     """Start the nodes, run, stop the nodes, report."""
     from ..ros.ros2 import env
     from ..ros.ros2.lockstep import nodes_running, plan, simulation

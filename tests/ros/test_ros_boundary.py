@@ -6,9 +6,8 @@ from pathlib import Path
 from types import SimpleNamespace
 
 from amsa_phys.model.scenario import load_scenario
-from amsa_phys.ros.boundary import plan
+from amsa_phys.ros.boundary import NO_FIX, plan, read_fields
 from amsa_phys.ros.graph import RosGraph, classify
-from amsa_phys.ros.runtime.boundary import NO_FIX, read_fields
 from amsa_phys.stdmsgs import DEFAULT_ORIGIN, enu_to_geodetic, yaw_quaternion
 
 ROOT = Path(__file__).resolve().parent.parent.parent

@@ -13,10 +13,9 @@ from types import SimpleNamespace
 import pytest
 
 from amsa_phys.model.scenario import load_scenario
-from amsa_phys.ros.boundary import plan
+from amsa_phys.ros.boundary import MAX_SCAN_RANGES, plan, read_fields
 from amsa_phys.ros.graph import RosGraph, classify
 from amsa_phys.ros.runtime.arrays import ScanShape
-from amsa_phys.ros.runtime.boundary import MAX_SCAN_RANGES, read_fields
 from amsa_phys.stdmsgs import DEFAULT_ORIGIN, enu_to_geodetic, yaw_quaternion
 
 ROOT = Path(__file__).resolve().parent.parent.parent

@@ -102,7 +102,7 @@ def test_the_package_is_ament_python_with_ros2_parameters_and_a_launch_file(
         for n in ast.walk(launch)
         if isinstance(n, ast.Call) and getattr(n.func, "id", "") == "Node"
     ]
-    assert len(nodes) == 6  # the Leaves outside the physics
+    assert len(nodes) == 7  # the Leaves outside the physics, and the robot boundary
     ast.parse((pkg / "setup.py").read_text())
     params = yaml.safe_load((pkg / "config" / "scenario1_params.yaml").read_text())
     follower = params["/MyFollowerController"]["ros__parameters"]

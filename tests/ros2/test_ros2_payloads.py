@@ -6,7 +6,8 @@ payloads of ``tests/ros/test_export_ros_payloads.py`` (a newline then YAML tags 
 parameter loader, ``\"\"\"`` then code for a Python docstring, XML for ``package.xml``) are
 generated, every Python file compiled and imported, ``setup.py`` run as colcon would ask it,
 and ``ros2 lockstep`` run on them (the nodes load the parameters file with rcl's YAML parser
-and the resolved scenario): everything completes and no payload's marker file exists.
+and the resolved scenario), and ``ros2 robot`` (the robot boundary's script, the controller
+side's nodes) on the sensed world's: everything completes and no payload's marker file exists.
 """
 
 from __future__ import annotations
@@ -105,6 +106,79 @@ def test_payloads_never_run_when_the_package_is_generated_imported_and_run(
     assert res.returncode == 0, res.stdout + res.stderr
     assert "mde_challenge" in res.stdout  # setup.py answered
     assert (work / "run" / "trace.csv").exists()
+    marks = [p for p in tmp_path.rglob("MARK")] + list(Path.cwd().glob("MARK"))
+    assert marks == []
+    assert leftovers(token) == []
+
+
+#: waits until the robot side's nodes are on the graph (they read the parameters file and
+#: the resolved scenario at start), then prints them
+PROBE = """
+import time, rclpy
+rclpy.init()
+n = rclpy.create_node("probe")
+want = {"amsa_boundary", "MyGpsDistance", "MyFollowerController", "MyNormalizePower"}
+end = time.monotonic() + 300
+while not want <= set(n.get_node_names()) and time.monotonic() < end:
+    rclpy.spin_once(n, timeout_sec=0.2)
+print("UP", sorted(want & set(n.get_node_names())))
+"""
+
+
+@pytest.mark.parametrize("case", range(len(CASES)))
+def test_payloads_never_run_when_the_package_runs_on_a_robot(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, case: int
+) -> None:
+    """The robot side (``ros2 robot``: the boundary node's script, the controller side's
+    nodes, the manifest's ``local``) of a package whose names carry the payloads."""
+    monkeypatch.setattr(export, "check_name", lambda *_a, **_k: None)  # the escapers alone
+    fname, name = CASES[case]
+    world = tmp_path / "world.yaml"
+    data = yaml.safe_load((ROOT / "worlds" / "mde_challenge_sensed.yaml").read_text())
+    data["description"] = name
+    world.write_text(yaml.safe_dump(data, sort_keys=False))
+    (tmp_path / "scenarios").mkdir()
+    scenario = tmp_path / "scenarios" / fname
+    scenario.write_text(
+        f"name: {json.dumps(name)}\nworld: {json.dumps(str(world))}\nduration: 2\nseed: 1\n"
+    )
+    from amsa_phys.model.scenario import load_scenario
+
+    pkg = tmp_path / "pkg"
+    pkg.mkdir()
+    export.generate(load_scenario(scenario), str(scenario), pkg)
+    assert (pkg / "mde_challenge_sensed" / "amsa_boundary.py").exists()
+    (tmp_path / "probe.py").write_text(PROBE)
+    work = tmp_path / "work"
+    work.mkdir()
+    token = uuid.uuid4().hex
+    env = {
+        **os.environ,
+        "AMSA_ROS2_TEST": token,
+        "ROS_DOMAIN_ID": str(random.randint(1, 100)),
+        "SDL_VIDEODRIVER": "dummy",
+        "MPLBACKEND": "Agg",
+    }
+    env.pop("VIRTUAL_ENV", None)
+    body = (
+        "set -m\nip link set lo up\n"
+        f"{PY} -m amsa_phys ros2 robot {pkg} & AMSA=$!\n"
+        f"{PY} {tmp_path / 'probe.py'}\n"
+        "kill -TERM $AMSA; wait $AMSA; echo AMSA_RC=$?\n"
+    )
+    res = subprocess.run(
+        ["unshare", "-n", "bash", "-c", body],
+        cwd=work,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=WALL_LIMIT_S,
+    )
+    out = res.stdout + res.stderr
+    assert (
+        "UP ['MyFollowerController', 'MyGpsDistance', 'MyNormalizePower', 'amsa_boundary']" in out
+    ), out
+    assert "AMSA_RC=0" in out, out
     marks = [p for p in tmp_path.rglob("MARK")] + list(Path.cwd().glob("MARK"))
     assert marks == []
     assert leftovers(token) == []

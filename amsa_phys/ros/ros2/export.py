@@ -6,8 +6,11 @@ template class (``leafnode.py``) under the names of ``ros/names.py`` and ``ros/e
 (the same description the ROS 1 export and ``run --ros2`` use), a ``ros__parameters`` YAML
 keyed by node, a ``launch/NAME.launch.py`` (generated and parsed, not run here: no
 ``ros2 launch``), the resolved scenario in ``config/`` and ``config/amsa.yaml``, the list
-``amsa-phys ros2 lockstep`` reads. Every name reaches a file through ``quote.py``'s escaper
-for that file's language; ROS names are judged first (``names.check_world``).
+``amsa-phys ros2 lockstep`` and ``ros2 robot`` read. The robot boundary (``robot.py``) is
+the node ``amsa_boundary``: the launch file's ``sim:=false`` starts it with the controller
+side (``ros/boundary.py``'s plan, ROS 1's ``sim:=false``) and nothing else. Every name
+reaches a file through ``quote.py``'s escaper for that file's language; ROS names are
+judged first (``names.check_world``).
 """
 
 from __future__ import annotations
@@ -22,8 +25,10 @@ from ...errors import ConfigError
 from ...model.scenario import Scenario
 from ...runs.resolve import resolved_scenario
 from .. import names
+from ..boundary import NODE as BOUNDARY
+from ..boundary import plan as boundary_plan
 from ..external import start_values
-from ..graph import classify
+from ..graph import RosGraph, classify
 from ..quote import Code, check_name, fill, py_string, yaml_comment, yaml_dump
 
 FILES = Path(__file__).resolve().parent.parent / "files" / "ros2"
@@ -40,6 +45,8 @@ class Package2:
     nodes: list[str]
     local: list[str]
     files: list[str]
+    #: the controller side: the nodes ``sim:=false`` / ``ros2 robot`` start on a robot
+    robot: list[str]
 
 
 def package_name(world_name: str) -> str:
@@ -72,6 +79,8 @@ def generate(scenario: Scenario, source: str, out: Path) -> Package2:
     src = Path(source).name
     scripts = []
     launch_nodes = []
+    side = boundary_plan(RosGraph.of(world, local)).controller
+    controller = set(side)
     for path in remote:
         script = names.script(path)
         leaf = world.leaves[path]
@@ -94,9 +103,15 @@ def generate(scenario: Scenario, source: str, out: Path) -> Package2:
                 f"        Node(package=PACKAGE, executable={py_string(script)}, "
                 f"name={py_string(ns.rpartition('/')[2])}, "
                 f"namespace={py_string(ns.rpartition('/')[0] or '/')}, "
-                "parameters=[params, {'use_sim_time': True}]),"
+                "parameters=[params, {'use_sim_time': True}]"
+                + ("" if path in controller else ", condition=IfCondition(SIM)")
+                + "),"
             )
         )
+    files[f"{pkg}/{BOUNDARY}.py"] = _fill(
+        "boundary.py.in", version=__version__, source=src, pkg=pkg, scenario=f"{fname}.yaml"
+    )
+    scripts.append(Code(f"            {py_string(f'{BOUNDARY} = {pkg}.{BOUNDARY}:main')},"))
     files[f"{pkg}/__init__.py"] = ""
     files[f"resource/{pkg}"] = ""
     files["package.xml"] = _fill(
@@ -117,6 +132,7 @@ def generate(scenario: Scenario, source: str, out: Path) -> Package2:
         pkg=pkg,
         params=f"{fname}_params.yaml",
         nodes=Code("\n".join(launch_nodes)),
+        boundary=BOUNDARY,
     )
     files[f"config/{fname}.yaml"] = yaml_dump(resolved_scenario(scenario))
     files[f"config/{fname}_params.yaml"] = _params_yaml(scenario, remote)
@@ -126,13 +142,15 @@ def generate(scenario: Scenario, source: str, out: Path) -> Package2:
             "scenario": f"{fname}.yaml",
             "params": f"{fname}_params.yaml",
             "nodes": [{"leaf": p, "module": f"{pkg}/{names.script(p)}.py"} for p in remote],
+            "local": list(local),
+            "boundary": f"{pkg}/{BOUNDARY}.py",
         }
     )
     for rel, text in files.items():
         target = out / rel
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_text(text)
-    return Package2(pkg, remote, local, sorted(files))
+    return Package2(pkg, remote, local, sorted(files), side)
 
 
 def _params_yaml(scenario: Scenario, remote: list[str]) -> str:

@@ -15,6 +15,7 @@ whenever a full set has arrived.
 
 from __future__ import annotations
 
+import math
 import sys
 from fractions import Fraction
 from pathlib import Path
@@ -75,7 +76,8 @@ def main(path: str, scenario_file: str) -> None:
     instant, published by ``ros2 lockstep`` with the inputs of each of the Leaf's steps) and
     one new message on each input, in whatever order they arrive. Without it (a robot), the
     node steps on each full set of inputs at the latest ``/clock`` (a Leaf without inputs: at
-    each ``/clock`` on its own grid, its phase plus a whole number of periods).
+    the first ``/clock`` at or past each instant of its own grid, its phase plus a whole
+    number of periods, as that instant).
     """
     rclpy = env.rclpy("node")
     from rcl_interfaces.msg import SetParametersResult
@@ -131,6 +133,9 @@ def main(path: str, scenario_file: str) -> None:
             self.fresh: set[str] = set()
             self.t: Fraction | None = None
             self.last_t: Fraction | None = None  # of the last step: earlier, a new run
+            #: an inputless Leaf on /clock: the index of its last grid instant (a /clock
+            #: from the wall clock, as on a robot, seldom falls on the instant itself)
+            self.grid: int | None = None
             self.triggered = "--amsa-step" in sys.argv
             if self.triggered:
                 self.create_subscription(Clock, names.step_topic(path), self._amsa_on_trigger, qos)
@@ -170,9 +175,11 @@ def main(path: str, scenario_file: str) -> None:
 
         def _amsa_on_clock(self, msg: Any) -> None:
             self.t = Fraction(msg.clock.sec) + Fraction(msg.clock.nanosec, 1_000_000_000)
-            if not wiring.inputs:
-                if ((self.t - phase) * leaf.freq).denominator == 1:
-                    self._amsa_step(self.t)
+            if not wiring.inputs:  # on its grid: at the first /clock at or past each instant
+                k = math.floor((self.t - phase) * leaf.freq)
+                if self.t >= phase and k != self.grid:
+                    self.grid = k
+                    self._amsa_step(phase + Fraction(k) / leaf.freq)
             else:
                 self._amsa_maybe_step()
 

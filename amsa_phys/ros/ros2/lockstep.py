@@ -38,7 +38,20 @@ class Plan:
     commands: dict[str, list[str]]
 
 
-def plan(pkg: Path, timeout_s: float | None = None) -> Plan:
+@dataclasses.dataclass
+class Package:
+    """An exported package as its manifest says: the scenario, parameters and node scripts."""
+
+    scenario: Scenario
+    params: Path
+    #: each Leaf's node script, in the manifest's order
+    scripts: dict[str, Path]
+    #: the Leaves of the simulator (``local``), and the boundary node's script
+    local: list[str]
+    boundary: Path | None
+
+
+def read_package(pkg: Path) -> Package:
     """Read the package's manifest and scenario (one line naming the file if either is bad)."""
     manifest = pkg / MANIFEST
     if not manifest.is_file():
@@ -54,20 +67,33 @@ def plan(pkg: Path, timeout_s: float | None = None) -> Plan:
         if not isinstance(data.get(key), str) or "/" in data[key] or data[key].startswith("."):
             raise doc.error((key,), "expected a file name in config/")
     scenario = load_scenario(pkg / "config" / data["scenario"])
-    params = pkg / "config" / data["params"]
-    leaves = []
-    commands: dict[str, list[str]] = {}
-    wirings = {}
+
+    def script(value: Any, where: tuple[Any, ...]) -> Path:
+        path = (pkg / value).resolve() if isinstance(value, str) else None
+        if path is None or pkg.resolve() not in path.parents or not path.is_file():
+            raise doc.error(where, "expected a file of the package")
+        return path
+
+    scripts: dict[str, Path] = {}
     for i, node in enumerate(data["nodes"]):
         leaf = node.get("leaf") if isinstance(node, dict) else None
         module = node.get("module") if isinstance(node, dict) else None
         if leaf not in scenario.world.leaves or not isinstance(module, str):
             raise doc.error(("nodes", i), "expected a Leaf of the package's world and its module")
-        script = (pkg / module).resolve()
-        if pkg.resolve() not in script.parents or not script.is_file():
-            raise doc.error(("nodes", i, "module"), "expected a file of the package")
-        leaves.append(leaf)
-        wirings[leaf] = script
+        scripts[leaf] = script(module, ("nodes", i, "module"))
+    local = data.get("local", [])
+    if not isinstance(local, list) or any(p not in scenario.world.leaves for p in local):
+        raise doc.error(("local",), "expected the Leaves of the package's world in the simulator")
+    boundary = script(data["boundary"], ("boundary",)) if "boundary" in data else None
+    return Package(scenario, pkg / "config" / data["params"], scripts, local, boundary)
+
+
+def plan(pkg: Path, timeout_s: float | None = None) -> Plan:
+    """Read the package; each node's command for lockstep (inputs remapped, own trigger)."""
+    package = read_package(pkg)
+    scenario = package.scenario
+    leaves = list(package.scripts)
+    commands: dict[str, list[str]] = {}
     described = external.describe(scenario.world, leaves, private_inputs=True)
     for wiring in described:
         remaps = []
@@ -75,11 +101,11 @@ def plan(pkg: Path, timeout_s: float | None = None) -> Plan:
             remaps += ["-r", f"{names.topic(w.buffer)}:={w.topic}"]
         commands[wiring.path] = [
             sys.executable,
-            str(wirings[wiring.path]),
+            str(package.scripts[wiring.path]),
             "--amsa-step",
             "--ros-args",
             "--params-file",
-            str(params),
+            str(package.params),
             *remaps,
         ]
     scenario = dataclasses.replace(scenario, ros2=tuple(leaves))

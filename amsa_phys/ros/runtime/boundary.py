@@ -18,7 +18,8 @@ per robot, as in the bag: ``map`` -> ``<robot>/odom`` (identity, latched on ``/t
 
 In (``sim:=false``): a message on a sensor stream's topic becomes the data topics of its
 fields (a NavSatFix's latitude and longitude back to the plane's x and y at the same
-origin; a fix with status NO_FIX is dropped, as a lost fix), and this node publishes
+origin; a fix with status NO_FIX is dropped, as a lost fix; ``ros/boundary.py``'s
+``judge`` is the mapping, shared with ROS 2's boundary node), and this node publishes
 ``/clock`` from the wall clock (times ``speed:=``), since no simulator does: every node
 of the package steps on ``/clock`` (``use_sim_time``), so a real robot's drivers stamp
 with it too.
@@ -36,17 +37,14 @@ from typing import Any
 from ...errors import AmsaError, one_line
 from ...model.params import short_repr
 from ...model.rosnames import BOUNDARY_FLUSHED, BOUNDARY_VALUES
-from ...stdmsgs import DEFAULT_ORIGIN, Context, Source, build, geodetic_to_enu, quaternion_yaw
+from ...stdmsgs import DEFAULT_ORIGIN, Context, Source, build
 from ...stdmsgs.build import static_transform, transform
 from .. import names
-from ..boundary import NODE, SIM_PARAM, plan
+from ..boundary import NODE, SIM_PARAM, buffers_of, plan, read_fields
 from ..graph import RosGraph
 from . import rosio, startup
-from .arrays import ScanShape, array_msg, fit_scan, pack, unpack
+from .arrays import ScanShape, array_msg, pack, unpack
 from .config import load_config
-
-#: NavSatStatus.STATUS_NO_FIX: a fix the receiver says it does not have
-NO_FIX = -1
 
 #: ``/clock`` period with ``sim:=false`` (wall seconds): finer than any Leaf's period
 CLOCK_PERIOD = 0.005
@@ -312,71 +310,6 @@ def parse_values(text: str) -> tuple[Fraction, list[tuple[str, float]]]:
 def readable(graph: RosGraph) -> set[str]:
     """Every buffer the boundary publishes from with the simulator (what :data:`VALUES` carries)."""
     return {b for src in plan(graph).sources for b in buffers_of(src)}
-
-
-def buffers_of(src: Source) -> list[str]:
-    """Every Data buffer a stream's fields read (an array field's elements, in order)."""
-    out: list[str] = []
-    for buf in src.buffers.values():
-        out.extend(buf if isinstance(buf, tuple) else [buf])
-    return out
-
-
-def read_fields(
-    src: Source, msg: Any, origin: tuple[float, float], scan: ScanShape | None = None
-) -> dict[str, Any] | None:
-    """A standard message's fields as the stream's Leaf outputs them (None: drop it;
-    ``scan``: a lidar Leaf's declared scan, to which a LaserScan is fitted).
-
-    A driver's message is input from outside, so it is judged: one whose numbers are not
-    finite (a NaN latitude, an infinite quaternion) or a scan with more than
-    :data:`MAX_SCAN_RANGES` ranges or a non-finite geometry is dropped, as a lost fix is:
-    a NaN reaching the controller side would reach the robot's wheel commands."""
-    fields = _fields(src, msg, origin, scan)
-    if fields is None:
-        return None
-    for value in fields.values():
-        if isinstance(value, list):
-            continue  # ranges: made finite by the scan's own rules
-        if not math.isfinite(value):
-            return None
-    return fields
-
-
-#: the most ranges a driver's LaserScan may hold (720 is a common driver's; fitting costs
-#: beams x ranges, so a scan of millions would stall the boundary)
-MAX_SCAN_RANGES = 65_536
-
-
-def _fields(
-    src: Source, msg: Any, origin: tuple[float, float], scan: ScanShape | None
-) -> dict[str, Any] | None:
-    role = src.role.name
-    if role == "NavSatFix":
-        if msg.status.status <= NO_FIX:
-            return None  # a lost fix: the GPS Leaf publishes nothing either
-        x, y = geodetic_to_enu(msg.latitude, msg.longitude, origin)
-        return {"x": x, "y": y}
-    if role == "Heading":
-        return {"yaw": quaternion_yaw(msg.orientation)}
-    if role == "Imu":
-        acc = msg.linear_acceleration
-        return {"gyro_z": msg.angular_velocity.z, "accel_x": acc.x, "accel_y": acc.y}
-    if role == "Odometry":
-        pose = msg.pose.pose
-        return {"x": pose.position.x, "y": pose.position.y, "yaw": quaternion_yaw(pose.orientation)}
-    if role == "LaserScan":
-        geometry = (msg.angle_min, msg.angle_increment, msg.range_min, msg.range_max)
-        if len(msg.ranges) > MAX_SCAN_RANGES or not all(map(math.isfinite, geometry)):
-            return None
-        if scan is not None:
-            return {"ranges": fit_scan(msg, scan)}
-        far = msg.range_max
-        near = msg.range_min
-        # no return (inf) and an erroneous one (NaN) read as nothing within reach; too
-        # close (-inf, REP 117) as the nearest the driver measures
-        return {"ranges": [max(r, near) if r <= far else far for r in msg.ranges]}
-    return None
 
 
 def main() -> None:
