@@ -100,3 +100,20 @@ def test_a_negative_dwell_is_a_one_line_error(tmp_path: Path, capsys) -> None:
     assert len(err.splitlines()) == 1
     assert err.startswith(f"error: {path}:"), err
     assert "dwell" in err, err
+
+
+def test_derived_fallbacks_wait_the_estimators_window_unless_told() -> None:
+    """Default: the estimator's window (30 s); ``fallback_dwell`` replaces it, and a dwell
+    no longer than the hold is left out (the hold is the least gap anyway)."""
+    from amsa_phys.adapt.derive import derive
+
+    fixture = ROOT / "tests" / "fixtures" / "adapt"
+    scenario = load_scenario(fixture / "sweep.yaml")
+
+    def dwells(**kw: float) -> list:
+        found = derive(fixture / "results.csv", scenario, "rms_error", 5, float("inf"), 0.0, **kw)
+        return [r.get("dwell") for r in found.rules if r["label"].startswith("robust")]
+
+    assert dwells() == [30, 30]
+    assert dwells(fallback_dwell=45) == [45, 45]
+    assert dwells(fallback_dwell=5) == [None, None]
