@@ -7,7 +7,7 @@ Markdown tables for docs/adaptation.md:
 * ``LeaderMonitor``: a confusion table. True behaviour (straight at the MDE speed, a slow
   straight leader, speed changes, random; at the GPS's noise and at twice it, with the
   monitor's ``fixNoise`` told or not) against what
-  the rules read: *straight* (``turning`` below 0.14), *turning* (above 0.21), *between*
+  the rules read: *straight* (``turning`` below 0.08), *turning* (above 0.12), *between*
   (neither: no rule fires) or *unsure* (``valid`` 0: the fallback).
 * ``MotorMonitor``: error bands. For motors delivering 100 % down to 25 % (levels between
   the sweep's too), the share of valid samples and the 5th-95th percentile of the estimate.
@@ -66,9 +66,9 @@ def leader_table() -> list[str]:
                 turning = run.trace["LeaderMonitor.turning"][keep]
                 valid = run.trace["LeaderMonitor.valid"][keep] > 0.5
                 counts += [
-                    np.sum(valid & (turning < 0.14)),
-                    np.sum(valid & (turning > 0.21)),
-                    np.sum(valid & (turning >= 0.14) & (turning <= 0.21)),
+                    np.sum(valid & (turning < 0.08)),
+                    np.sum(valid & (turning > 0.12)),
+                    np.sum(valid & (turning >= 0.08) & (turning <= 0.12)),
                     np.sum(~valid),
                 ]
             shares = 100 * counts / counts.sum()
@@ -126,10 +126,10 @@ def delay_table() -> list[str]:
             "MotorMonitor.delivered",
             lambda x: x < 0.7,
         ),
-        "leader straight -> random (turning above 0.21)": (
+        "leader straight -> random (turning above 0.12)": (
             {"Leader.behavior": 4},
             "LeaderMonitor.turning",
-            lambda x: x > 0.21,
+            lambda x: x > 0.12,
         ),
     }
     lines = ["| change at 150 s | delay, seeds 11 / 12 / 13 |", "| --- | --- |"]

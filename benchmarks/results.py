@@ -214,8 +214,25 @@ def _num(x: float) -> str:
     return f"{x:.4g}"
 
 
+#: Blocks rendered from a results file of their own by the code that wrote it (not perf.json):
+#: ``amsa-phys adapt --validate --results FILE`` writes the held-out validation's table.
+OWN_TABLES = {"adapt-validate": ROOT / "scenarios" / "rules" / "adaptive_rules.validate.json"}
+
+
+def _own_table(target: str) -> str:
+    """The table of a block in :data:`OWN_TABLES`, rendered as its writer renders it."""
+    from amsa_phys.adapt.validate import markdown
+
+    path = OWN_TABLES[target]
+    if not path.exists():
+        return f"*Not measured yet: no {path.relative_to(ROOT)}.*\n"
+    return markdown(json.loads(path.read_text()))
+
+
 def render(targets: list[str], rows: list[dict[str, Any]] | None = None) -> str:
     """The markdown table of the targets' rows, or a line saying they are still to measure."""
+    if len(targets) == 1 and targets[0] in OWN_TABLES:
+        return _own_table(targets[0])
     rows = load() if rows is None else rows
     mine = [r for r in rows if r["target"] in targets]
     command = f"python -m benchmarks.perf --save --only {' '.join(targets)}"

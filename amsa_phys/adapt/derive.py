@@ -23,7 +23,10 @@ cells on a band around the cell's level: from the midpoint to the next level, le
 neither rule and the gain in force stays (hysteresis); each rule must hold for ``hold``
 seconds, and two switches are at least ``hold`` apart (dwell). Before them, one rule per
 estimator with a ``valid`` output sets the robust point once it has been 0 (unsure) for
-``fallback_hold`` seconds, and the cell rules require every such estimator to be sure. Cells
+``fallback_hold`` seconds, but never within the estimator's own ``window`` seconds of a
+switch (the rule's ``dwell``: a switch's transient stays in the window that long, and a
+gain that is right for the context may blind the estimate while it settles), and the cell
+rules require every such estimator to be sure. Cells
 are reported, not guessed, when an estimator cannot place them (a context parameter no
 estimator watches, a value its mapping does not know) or when two cells with different
 best values settle to the same levels.
@@ -56,6 +59,12 @@ GAP = 0.1
 #: longer: on the shipped box 60 s gained 20-25 % on very worn motors and lost 5-12 % on
 #: two other held-out sequences (``adapt --validate``), so the default stays the hold.
 FALLBACK_HOLD: float | None = None
+#: Seconds after a switch before a fallback may fire (None: each estimator's ``window``).
+#: Switching to a high gain with the follower far behind makes the loop reverse for a few
+#: seconds; the motor estimate turns unsure until that leaves its window, and a fallback
+#: after the hold alone undid every switch to very worn motors' gain within ~22 s
+#: (``adapt --validate`` on the shipped box: 8 % gained there instead of 22-30 %).
+FALLBACK_DWELL: float | None = None
 
 
 @dataclass
@@ -106,6 +115,7 @@ def derive(
     min_gain: float = MIN_GAIN,
     robust: dict[str, Any] | None = None,
     fallback_hold: float | None = FALLBACK_HOLD,
+    fallback_dwell: float | None = FALLBACK_DWELL,
 ) -> Derivation:
     """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
     is the fixed choice to fall back on (default: the sweep's least worst-case point)."""
@@ -212,7 +222,7 @@ def derive(
             )
         )
     wait = hold if fallback_hold is None else fallback_hold
-    derivation.rules = _fallbacks(scenario, found, placed, derivation.robust, wait)
+    derivation.rules = _fallbacks(scenario, found, placed, derivation.robust, wait, fallback_dwell)
     sure = {signal: {"above": 0.5} for r in derivation.rules for signal in r["when"]}
     derivation.rules += [{**r, "when": {**r["when"], **sure}} for r in _rules(placed, hold)]
     return derivation
@@ -290,8 +300,11 @@ def _fallbacks(
     placed: list[Cell],
     robust: dict[str, Any],
     hold: float,
+    dwell: float | None = None,
 ) -> list[dict[str, Any]]:
-    """One rule per estimator the cell rules read that says when it is unsure (``valid``)."""
+    """One rule per estimator the cell rules read that says when it is unsure (``valid``),
+    firing after ``hold`` s of it but not within ``dwell`` s of a switch (None: the
+    estimator's ``window`` parameter; a dwell at or below the hold is left out)."""
     used = {s for c in placed for s in c.levels}
     out = []
     for w in found:
@@ -299,15 +312,26 @@ def _fallbacks(
         valid = f"{leaf}.valid"
         if w.signal not in used or valid not in scenario.world.buffers:
             continue
-        out.append(
-            {
-                "when": {valid: {"below": 0.5}},
-                "set": dict(robust),
-                "hold": _whole(hold),
-                "label": f"robust, {leaf} unsure",
-            }
-        )
+        rule: dict[str, Any] = {
+            "when": {valid: {"below": 0.5}},
+            "set": dict(robust),
+            "hold": _whole(hold),
+        }
+        wait = dwell if dwell is not None else _window(scenario, leaf)
+        if wait is not None and wait > hold:
+            rule["dwell"] = _whole(wait)
+        rule["label"] = f"robust, {leaf} unsure"
+        out.append(rule)
     return out
+
+
+def _window(scenario: Scenario, leaf: str) -> float | None:
+    """The estimator's ``window`` in seconds, if it has one (how long a transient stays in)."""
+    value = scenario.world.leaves[leaf].params.get("window")
+    for change in scenario.timeline.initial:
+        if change.key == f"{leaf}.window":
+            value = change.value
+    return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
 
 
 def _whole(hold: float) -> float | int:

@@ -14,10 +14,12 @@ choice's.
 
 from __future__ import annotations
 
+import datetime
 import math
+import os
 import statistics
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from ..model.scenario import Scenario
@@ -34,6 +36,8 @@ class Row:
     robust: float
     oracle: float
     adaptive: float
+    #: each way's value per seed (seeds 1..n), so a results file shows the spread
+    seeds: dict[str, list[float]] = field(default_factory=dict)
 
     @property
     def change(self) -> float:
@@ -89,7 +93,8 @@ def validate(
             }
             for way, value in cases.items():
                 ways[way].append(math.inf if value is None else value)
-        row = Row(sequence, *(statistics.fmean(ways[w]) for w in ("robust", "oracle", "adaptive")))
+        means = (statistics.fmean(ways[w]) for w in ("robust", "oracle", "adaptive"))
+        row = Row(sequence, *means, seeds={w: list(v) for w, v in ways.items()})
         rows.append(row)
         if report is not None:
             report(line(row))
@@ -110,3 +115,55 @@ HEADER = "robust | oracle | rules | rules vs robust | held-out sequence"
 def loses(rows: list[Row], tolerance: float) -> list[Row]:
     """The sequences on which the rules are more than ``tolerance`` worse than robust."""
     return [r for r in rows if r.change > tolerance]
+
+
+def results(rows: list[Row], found: Derivation, settings: dict[str, Any]) -> dict[str, Any]:
+    """The scored rules as a results file: what ``--results`` writes and the docs render.
+
+    ``settings`` says how they were scored (sequences, seeds, duration, tolerance, the
+    command); the machine's load and the date say in which sitting (the numbers do not
+    depend on them: every run is a pure function of scenario and seed).
+    """
+    return {
+        "metric": found.metric,
+        "robust": dict(found.robust),
+        "settings": settings,
+        "load": [round(x, 2) for x in os.getloadavg()],
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "rows": [
+            {
+                "sequence": r.sequence.describe(),
+                "segments": [[at, sets] for at, sets in r.sequence.segments],
+                "robust": r.robust,
+                "oracle": r.oracle,
+                "rules": r.adaptive,
+                "change": r.change,
+                "seeds": r.seeds,
+            }
+            for r in rows
+        ],
+    }
+
+
+def markdown(doc: dict[str, Any]) -> str:
+    """The docs' table of a results file (seed means; the rules' change against robust)."""
+    robust = ", ".join(f"{k.rsplit('.', 1)[-1]} {v}" for k, v in doc["robust"].items())
+    lines = [
+        f"| robust {robust} | oracle | rules | rules vs robust | held-out sequence |",
+        "| --- | --- | --- | --- | --- |",
+    ]
+    for r in doc["rows"]:
+        change = "" if not math.isfinite(r["change"]) else f"{100 * r['change']:+.1f} %"
+        lines.append(
+            f"| {r['robust']:.4g} | {r['oracle']:.4g} | {r['rules']:.4g} "
+            f"| {change.replace('-', '−')} | {r['sequence']} |"
+        )
+    s = doc["settings"]
+    load = "–".join(f"{x:g}" for x in doc["load"])
+    lines += [
+        "",
+        f"*{s['sequences']} sequences × {s['seeds']} seeds of {s['duration']:g} s, "
+        f"{doc['metric']} seed means (load {load}, {doc['date'][:10]}). Regenerate, DIR "
+        f"the sweep's output: `{s['command']}`.*",
+    ]
+    return "\n".join(lines) + "\n"

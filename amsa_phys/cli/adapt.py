@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import shlex
 import sys
 from pathlib import Path
 
@@ -50,6 +52,14 @@ def add_args(p: argparse.ArgumentParser) -> None:
         "(default: --hold)",
     )
     p.add_argument(
+        "--fallback-dwell",
+        type=float,
+        default=None,
+        metavar="S",
+        help="seconds after a switch before the robust choice may be set for an unsure "
+        "estimator (default: the estimator's window)",
+    )
+    p.add_argument(
         "--margin",
         type=float,
         default=MARGIN,
@@ -93,6 +103,11 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="length of a held-out sequence in seconds (default 600)",
     )
     p.add_argument(
+        "--results",
+        metavar="FILE.json",
+        help="with --validate: also write the table, per seed, as a results file (JSON)",
+    )
+    p.add_argument(
         "--tolerance",
         type=float,
         default=0.02,
@@ -118,6 +133,12 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(
             f"must be a number of seconds >= 0, got {args.fallback_hold}", key="--fallback-hold"
         )
+    if args.fallback_dwell is not None and not (
+        args.fallback_dwell >= 0 and math.isfinite(args.fallback_dwell)
+    ):
+        raise ConfigError(
+            f"must be a number of seconds >= 0, got {args.fallback_dwell}", key="--fallback-dwell"
+        )
     if not args.margin >= 0:
         raise ConfigError(f"must be >= 0 (or inf), got {args.margin}", key="--margin")
     if not (0 <= args.min_gain < 1):
@@ -125,6 +146,10 @@ def run(args: argparse.Namespace) -> int:
     if args.validate:
         _check_validate_args(args)
     out = check_output(Path(args.output), "-o")
+    if args.results is not None:
+        if not args.validate:
+            raise ConfigError("needs --validate (it holds the validation's table)", key="--results")
+        check_output(Path(args.results), "--results")
     if out.exists() and not args.force:
         raise ConfigError(f"{one_line(str(out))} exists; use --force to replace it", key="-o")
     scenario = load_scenario(args.scenario) if args.scenario else read_sweep_scenario(sweepdir)
@@ -138,6 +163,7 @@ def run(args: argparse.Namespace) -> int:
         args.min_gain,
         robust,
         args.fallback_hold,
+        args.fallback_dwell,
     )
     for line in table(found):
         print(one_line(line))
@@ -189,7 +215,7 @@ def _check_validate_args(args: argparse.Namespace) -> None:
 
 def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -> int:
     """Run the held-out sequences, print the table; 1 if the rules lose to the robust one."""
-    from ..adapt.validate import HEADER, loses, validate
+    from ..adapt.validate import HEADER, loses, results, validate
 
     contexts = dict(scenario.data.get("sweep", {}).get("contexts", {}))
     if not contexts:
@@ -213,6 +239,16 @@ def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -
         args.duration,
         report=lambda text: print(one_line(text), flush=True),
     )
+    if args.results is not None:
+        settings = {
+            "sequences": args.sequences,
+            "seeds": args.seeds,
+            "duration": args.duration,
+            "tolerance": args.tolerance,
+            "command": _command(args),
+        }
+        doc = results(rows, found, settings)
+        write_atomic(Path(args.results), json.dumps(doc, indent=1) + "\n")
     lost = loses(rows, args.tolerance)
     if lost:
         print(
@@ -230,6 +266,22 @@ def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -
         )
     )
     return 0
+
+
+def _command(args: argparse.Namespace) -> str:
+    """The ``adapt --validate`` command line that regenerates a results file."""
+    # DIR: the sweep's output directory (a temporary one, as a rule: not worth naming)
+    words = ["amsa-phys", "adapt", "DIR", "-o", args.output, "--force", "--validate"]
+    words += ["--sequences", str(args.sequences), "--seeds", str(args.seeds)]
+    if args.duration != 600.0:
+        words += ["--duration", f"{args.duration:g}"]
+    for flag, value in (("--hold", args.hold), ("--fallback-hold", args.fallback_hold)):
+        if value is not None and not (flag == "--hold" and value == 10.0):
+            words += [flag, f"{value:g}"]
+    if args.fallback_dwell is not None:
+        words += ["--fallback-dwell", f"{args.fallback_dwell:g}"]
+    words += ["--results", args.results]
+    return shlex.join(one_line(w) for w in words)
 
 
 def table(found: Derivation) -> list[str]:

@@ -9,9 +9,10 @@ see it, and the run stays a pure function of (scenario, seed): the replay of its
 
 Semantics (README, "Adaptive reconfiguration"): a rule's conditions must hold at every
 instant evaluated for ``hold`` seconds (hysteresis: a condition that flickers restarts the
-count); then, if no rule fired in the last ``hold`` seconds (the least time between two
-switches) and the rule's values are not already in force, it fires: its changes are
-applied, once. Rules are tried in file order and at most one fires per instant.
+count); then, if no rule fired in the last ``dwell`` seconds (the least time between two
+switches; ``hold`` unless the rule says) and the rule's values are not already in force, it
+fires: its changes are applied, once. Rules are tried in file order and at most one fires
+per instant.
 """
 
 from __future__ import annotations
@@ -71,7 +72,7 @@ class AdaptRules:
             since = self._since[i]
             if firing is not None or since is None or now - since < rule.hold:
                 continue
-            if self._last_switch is not None and now - self._last_switch < rule.hold:
+            if self._last_switch is not None and now - self._last_switch < rule.least_gap:
                 continue
             if all(self._current(c.leaf, c.param) == c.value for c in rule.changes):
                 continue  # already in force: nothing to switch

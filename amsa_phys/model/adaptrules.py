@@ -1,7 +1,8 @@
 """Reconfiguration rules (a scenario's ``adapt:``): parsed, checked, written back.
 
 A rule says: when every condition on the context estimators' outputs has held for ``hold``
-seconds, set these parameters. The engine (``engine/adapt.py``) evaluates the rules; this
+seconds, and no rule has switched in the last ``dwell`` seconds (default: ``hold``), set
+these parameters. The engine (``engine/adapt.py``) evaluates the rules; this
 module only turns the YAML into :class:`Rule` values, judging what each names (the Data a
 condition reads must exist, the values set go through the same ``Param.check`` as a
 timeline's) so a bad rule is a one-line error before anything runs.
@@ -40,13 +41,26 @@ class Condition:
 
 @dataclass(frozen=True)
 class Rule:
-    """One ``adapt:`` entry: conditions (all must hold), changes, hold time in seconds."""
+    """One ``adapt:`` entry: conditions (all must hold), changes, hold time in seconds.
+
+    ``dwell`` is the least time since the last switch (by any rule) before this one may
+    fire; None: ``hold``. A fallback that waits out a switch's own transient has a dwell
+    longer than its hold: it still reacts within ``hold`` of unsureness, but never in the
+    first ``dwell`` seconds after a switch, while the estimate's window still holds the
+    transient the switch itself caused.
+    """
 
     number: int  # 1-based, as events and the trace name it
     when: tuple[Condition, ...]
     changes: tuple[Any, ...]  # model.scenario.Change
     hold: Fraction
     label: str = ""
+    dwell: Fraction | None = None
+
+    @property
+    def least_gap(self) -> Fraction:
+        """Seconds since the last switch before this rule may fire (``dwell``, or ``hold``)."""
+        return self.hold if self.dwell is None else self.dwell
 
     def name(self) -> str:
         """``rule 2`` or ``rule 2 (worn motors)``."""
@@ -108,9 +122,9 @@ def parse_rules(doc: YamlDoc, entries: list[dict[str, Any]], world: Any) -> list
                     "a rule cannot change it",
                 )
         hold = Fraction(str(entry.get("hold", 0)))
-        rules.append(
-            Rule(i + 1, tuple(conditions), tuple(changes), hold, str(entry.get("label", "")))
-        )
+        dwell = Fraction(str(entry["dwell"])) if "dwell" in entry else None
+        label = str(entry.get("label", ""))
+        rules.append(Rule(i + 1, tuple(conditions), tuple(changes), hold, label, dwell))
     return rules
 
 
@@ -136,6 +150,8 @@ def written_rules(rules: list[Rule]) -> list[dict[str, Any]]:
             "set": {c.key: c.value for c in rule.changes},
             "hold": _number(rule.hold),
         }
+        if rule.dwell is not None:
+            item["dwell"] = _number(rule.dwell)
         if rule.label:
             item["label"] = rule.label
         out.append(item)
@@ -148,7 +164,8 @@ def describe_rules(rules: list[Rule]) -> list[str]:
     for rule in rules:
         conds = " and ".join(_condition_text(c) for c in rule.when)
         sets = ", ".join(f"{c.key}={c.value}" for c in rule.changes)
-        lines.append(f"{rule.name()}: when {conds} for {float(rule.hold):g} s: set {sets}")
+        dwell = "" if rule.dwell is None else f", {float(rule.dwell):g} s after a switch"
+        lines.append(f"{rule.name()}: when {conds} for {float(rule.hold):g} s{dwell}: set {sets}")
     return lines
 
 

@@ -28,6 +28,7 @@ RULES: dict[str, Any] = {
             },
             "set": {"type": "object", "minProperties": 1},
             "hold": {"type": "number", "minimum": 0},
+            "dwell": {"type": "number", "minimum": 0},
             "label": {"type": "string"},
         },
     },

@@ -61,9 +61,9 @@ def test_uncovered_band_combinations_get_the_nearest_cells_best(tmp_path: Path) 
     sure = {"MotorMonitor.valid": {"above": 0.5}, "LeaderMonitor.valid": {"above": 0.5}}
     assert [(r["when"], r["set"]) for r in rules] == [
         # worn motors, straight leader: very worn is a third of the delivered span away
-        ({DELIVERED: {"above": 0.4, "below": 0.7}, TURNING: {"below": 0.14}, **sure}, {KV: 0.6}),
+        ({DELIVERED: {"above": 0.4, "below": 0.7}, TURNING: {"below": 0.08}, **sure}, {KV: 0.6}),
         # very worn motors, random leader: worn random (a third away), not very worn
-        ({DELIVERED: {"below": 0.35}, TURNING: {"above": 0.21}, **sure}, {KV: 0.35}),
+        ({DELIVERED: {"below": 0.35}, TURNING: {"above": 0.12}, **sure}, {KV: 0.35}),
     ]
 
 

@@ -211,7 +211,7 @@ def test_derive_from_a_fixture_sweep_gives_the_expected_table() -> None:
     assert table == {
         "nominal": (0.2, 0.55, {delivered: 1.0, turning: 0.0}),
         "worn": (0.4, 0.6, {delivered: 0.5, turning: 0.0}),
-        "random": (0.4, 0.35, {delivered: 1.0, turning: 0.35}),
+        "random": (0.4, 0.35, {delivered: 1.0, turning: 0.2}),
         "speed changes": (0.1, 0.5, {delivered: 1.0, turning: 0.0}),
     }
     assert found.robust == {"MyFollowerController.Kv": 0.2}
@@ -222,34 +222,36 @@ def test_derive_from_a_fixture_sweep_gives_the_expected_table() -> None:
             "when": {"MotorMonitor.valid": {"below": 0.5}},
             "set": robust,
             "hold": 5,
+            "dwell": 30,  # the estimator's window: a switch's transient stays in it that long
             "label": "robust, MotorMonitor unsure",
         },
         {
             "when": {"LeaderMonitor.valid": {"below": 0.5}},
             "set": robust,
             "hold": 5,
+            "dwell": 30,
             "label": "robust, LeaderMonitor unsure",
         },
         {
-            "when": {turning: {"below": 0.14}, delivered: {"below": 0.7}, **sure},
+            "when": {turning: {"below": 0.08}, delivered: {"below": 0.7}, **sure},
             "set": {"MyFollowerController.Kv": 0.4},
             "hold": 5,
             "label": "worn",
         },
         {
-            "when": {turning: {"above": 0.21}, delivered: {"above": 0.8}, **sure},
+            "when": {turning: {"above": 0.12}, delivered: {"above": 0.8}, **sure},
             "set": {"MyFollowerController.Kv": 0.4},
             "hold": 5,
             "label": "random",
         },
         {
-            "when": {turning: {"below": 0.14}, delivered: {"above": 0.8}, **sure},
+            "when": {turning: {"below": 0.08}, delivered: {"above": 0.8}, **sure},
             "set": robust,
             "hold": 5,
             "label": "nominal, speed changes (alike: robust)",
         },
         {  # no cell is worn with a random leader: worn and random are as near, and agree
-            "when": {turning: {"above": 0.21}, delivered: {"below": 0.7}, **sure},
+            "when": {turning: {"above": 0.12}, delivered: {"below": 0.7}, **sure},
             "set": {"MyFollowerController.Kv": 0.4},
             "hold": 5,
             "label": "nearest worn (no cell here)",

@@ -27,7 +27,7 @@ def test_a_slow_straight_leader_is_not_turning(seed: int) -> None:
     """At 0.06 m/s the fix noise is most of a segment's course: no turns, and unsure."""
     run = _run(seed, **{"Leader.cruisePower": 4.0})
     after = run.trace["t"] >= 40
-    assert run.trace["LeaderMonitor.turning"][after].max() < 0.14
+    assert run.trace["LeaderMonitor.turning"][after].max() < 0.08  # the straight band
     assert run.trace["LeaderMonitor.valid"][after].max() == 0.0
 
 
@@ -41,14 +41,15 @@ def test_healthy_motors_never_read_above_one(seed: int) -> None:
 
 
 def test_a_random_leader_turns_where_its_estimate_is_sure() -> None:
-    """Over six seeds, the mean where valid is above the derived straight/random midpoint."""
+    """Over six seeds, the mean where valid is above the derived straight/random midpoint
+    (0.1: the random leader's level is 0.2)."""
     means = []
     for seed in range(1, 7):
         run = _run(seed, duration=300, **{"Leader.behavior": 4})
         t = run.trace["t"]
         sure = (t >= 40) & (run.trace["LeaderMonitor.valid"] > 0.5)
         means.append(float(run.trace["LeaderMonitor.turning"][sure].mean()))
-    assert sum(m > 0.175 for m in means) >= 5, means
+    assert sum(m > 0.1 for m in means) >= 5, means
 
 
 def test_worn_motors_are_seen_within_twenty_seconds() -> None:

@@ -97,7 +97,7 @@ def test_leader_monitor_circle_turns_all_the_time_at_its_rate() -> None:
     ("context", "signal", "lo", "hi"),
     [
         ({}, "MotorMonitor.delivered", 0.75, 1.5),
-        ({}, "LeaderMonitor.turning", 0.0, 0.25),
+        ({}, "LeaderMonitor.turning", 0.0, 0.08),
         ({}, "LeaderGPSMonitor.lossRate", 0.0, 0.03),
         ({"MyNormalizePower.motorCoef": 50}, "MotorMonitor.delivered", 0.4, 0.6),
         ({"MyNormalizePower.motorCoef": 25}, "MotorMonitor.delivered", 0.18, 0.32),

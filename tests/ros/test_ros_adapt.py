@@ -3,7 +3,7 @@
 The adaptive world and its shipped rules (``tests/fixtures/ros_adaptive.yaml``: context
 estimators, rules switching the controller's Kv; worn motors from the start, very worn at
 45 s) are exported, built and launched in lockstep for 75 s, in which three rules fire
-(t = 10, 41.1 and 72.6 s in-process): the run equals ``amsa-phys run`` byte for byte
+(t = 10, 42.1 and 72.1 s in-process): the run equals ``amsa-phys run`` byte for byte
 (trace.csv, with the rule column, and metrics.json with its adapt events and switch count),
 with the rules fired inside the simulator (``rules:=sim``, the default) and by the
 ``amsa_adapt`` node, the one a robot runs with ``sim:=false`` (``rules:=node``: the

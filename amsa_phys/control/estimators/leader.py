@@ -21,27 +21,31 @@ class LeaderMonitor(Template):
     the difference over ``spacing`` is a course rate (overlapping segments: ~30 rates in a
     30 s window, so the share moves in steps of ~0.03). ``turnRate`` is the mean absolute
     rate over ``window`` seconds; ``turning`` the share of those rates above ``threshold``
-    (0 for a straight leader, 1 for one that keeps turning, about 0.5 for the random
+    (0 for a straight leader, 1 for one that keeps turning, about 0.2 for the random
     behaviour, which turns to a new heading every ``changePeriod`` s and then drives
     straight). A segment shorter than ``minTravel`` (a stopped leader, or only held fixes)
     gives no course. Fixes are taken at the first step at least a second after the previous
     one: run it at a rate whose period divides 1 s (the MDE world's 4 Hz).
 
-    Noise: the MDE GPS's 1.5 cm per fix over a 0.9 m segment (4 s at 0.22 m/s) is 0.024 rad
-    of course, so a straight leader's rates scatter by ~0.008 rad/s and the default
-    threshold (0.02 rad/s) sits at 2.5 of those. Measured on the MDE world (seeds 1-3, from
-    t = 40 s): a straight leader's share stays at or below 0.36 (0 once its start is out of
-    the window), the random leader's spans 0 to 1 (a run of small heading changes looks
-    straight for a while). Until ``window`` seconds have passed, both outputs are 0.
+    Noise: a rate's noise is about 2.45 ``fixNoise`` / (L ``spacing``) rad/s for two
+    segments of length L (the middle fix counts twice): 0.0104 rad/s for the MDE GPS's 1.5
+    cm over 0.88 m (4 s at 0.22 m/s), measured 1.0-1.08 of that on a straight leader. A rate
+    counts only when ``noiseFactor`` times its noise is within ``threshold`` (segments of at
+    least 0.69 m at the defaults: 0.17 m/s over 4 s; a straight leader at 0.06 m/s read as
+    turning 70 % of the time when every segment over ``minTravel`` counted), so
+    ``threshold`` is at least 2.25 standard deviations of a counted rate's noise (2.9 at the
+    MDE speed): a straight leader's rate exceeds it 0.4-2.4 % of the time (Gaussian noise).
+    Both matter because one bad fix enters three rates (weights 1, -2, 1) and moves the
+    share in steps of a tenth: at 0.02 rad/s and 1.5 (1.9 deviations at the MDE speed, 5-6 %
+    of rates) a straight leader read as turning 0.27 for a window now and then (seeds 1 and
+    5 of the MDE world). Measured there (seeds 1-6, from t = 40 s): a straight leader's
+    share stays at or below 0.065, the random leader's averages 0.15-0.27 where valid (a run
+    of small heading changes looks straight for a while). Until ``window`` seconds have
+    passed, both outputs are 0.
 
-    A slow leader's segments are short, and the same fix noise is a larger course error on
-    them (about 2.45 ``fixNoise`` / (L ``spacing``) rad/s of rate for two segments of length L: a
-    straight leader at 0.06 m/s read as turning 70 % of the time when every segment over
-    ``minTravel`` counted), and a pair of segments gives a course rate only when
-    ``noiseFactor`` times that noise is within ``threshold`` (segments of at least 0.69 m at
-    the defaults: 0.17 m/s over 4 s); the shares are of those rates alone. ``valid`` is 1
-    when at least ``minShare`` of the window's seconds gave one, else 0: a leader too slow or
-    stopped to show a course says nothing about how it turns (``turning`` is then 0).
+    The shares are of counted rates alone. ``valid`` is 1 when at least ``minShare`` of the
+    window's seconds gave one, else 0: a leader too slow or stopped to show a course says
+    nothing about how it turns (``turning`` is then 0).
     """
 
     batchable = True  # each run's copy steps alone in a batch (no step_many needed)
@@ -68,7 +72,7 @@ class LeaderMonitor(Template):
             "threshold",
             "float",
             "course rate above which the leader turns",
-            0.02,
+            0.03,
             0.0,
             10.0,
             "rad/s",
@@ -79,7 +83,7 @@ class LeaderMonitor(Template):
             "noiseFactor",
             "float",
             "a course rate counts when its noise times this is within threshold",
-            1.5,
+            2.25,
             0.0,
             100.0,
             "",
@@ -99,7 +103,7 @@ class LeaderMonitor(Template):
             "turning",
             "behavior",
             ("freeRobot",),
-            levels=((1.0, 0.0), (2.0, 1.0), (3.0, 0.0), (4.0, 0.35)),
+            levels=((1.0, 0.0), (2.0, 1.0), (3.0, 0.0), (4.0, 0.2)),
         ),
     )
 
