@@ -26,7 +26,14 @@ Targets:
 * the engine (``bench_engine.py``): batched sweep >= 5x the process pool
   for scenario1 and scenario2 at 1,000 runs of 60 s, 1,000 scenario2 runs <= 5 s; the
   1,000-rover platoon >= 40x real time with the cost per rover-step flat from 200 to 1,000
-  rovers; the API run of scenario1; the vector env >= 50,000 env-steps/s at 1,000 envs.
+  rovers; the API run of scenario1; the vector env >= 50,000 env-steps/s at 1,000 envs;
+* benchmarks that need more than this package, each saying so in its rows where what it needs
+  is missing: the exported ROS 1 package (``bench_ros.py``: lockstep pipelined within 3x the
+  in-process loop, the build, the platoon's launch under 1 GiB), ROS 2 (``bench_ros2.py``),
+  IR-SIM (``bench_irsim.py``), the falsification search (``bench_falsify.py``) and PSY-TaLiRo
+  beside it (``bench_falsify_peers.py``); and ``--bag`` (``bench_bag.py``), the window's
+  frame (``bench_view.py``), and the test suite's duration and memory with the MDE package's
+  build (``bench_suite.py``).
 """
 
 from __future__ import annotations
@@ -69,21 +76,19 @@ def med(xs: list[float]) -> str:
     return f"{statistics.median(xs):.4g} (min {min(xs):.4g}, max {max(xs):.4g})"
 
 
-def verdict(ok: bool) -> str:
-    return "PASS" if ok else "MISS"
-
-
 #: The sitting's rows when ``--save`` is given (``report`` adds each line to it).
 RECORDER: results.Recorder | None = None
 #: Standard output while ``--save`` records (the PASS/MISS lines other benchmarks print).
 TEE: results.Tee | None = None
 
 
-def report(name: str, measured: str, target: str, ok: bool) -> None:
+def report(name: str, measured: str, target: str, ok: bool | None, skipped: bool = False) -> None:
+    """Print a figure's line and, with ``--save``, record it (``ok`` None: no aim; ``skipped``:
+    not measurable here, ``measured`` saying why)."""
     with results.quiet(TEE):
-        print(f"{verdict(ok)}  {name:34s} {measured}   target {target}", flush=True)
+        results.print_report(name, measured, target, ok, skipped)
     if RECORDER is not None:
-        RECORDER.add(name, measured, target, ok)
+        RECORDER.add(name, measured, target, ok, skipped)
 
 
 # -- headless run ----------------------------------------------------------------------------
@@ -419,6 +424,17 @@ def batched(reps: int) -> None:
     bench_batch.targets()
 
 
+def _bench(name: str) -> Any:
+    """A benchmark module imported when its target runs (ROS's, IR-SIM's, PSY-TaLiRo's
+    benchmarks import what the others never need)."""
+    import importlib
+
+    return importlib.import_module(name)
+
+
+#: The ``suite`` target's choices (``--suite-tiers``, ``--suite-tests``)
+SUITE: dict[str, Any] = {"tiers": ("quick", "full"), "paths": ()}
+
 TARGETS: dict[str, Callable[[int], None]] = {
     "headless": headless,
     "process": process,
@@ -435,7 +451,22 @@ TARGETS: dict[str, Callable[[int], None]] = {
     # the column store and the run axis (bench_engine.py): batched vs pool for
     # scenario1 and scenario2, the 1,000-rover platoon, the API run, the vector env
     "engine": lambda reps: [bench_engine.TARGETS[n](reps) for n in bench_engine.TARGETS],
+    # the exported ROS 1 package: lockstep, its floor, the build, the platoon's memory
+    "ros": lambda reps: _bench("bench_ros").perf(reps, report),
+    "ros2": lambda reps: _bench("bench_ros2").perf(reps, report),
+    "irsim": lambda reps: _bench("bench_irsim").perf(reps, report),
+    "bag": lambda reps: _bench("bench_bag").perf(reps, report),
+    "view": lambda reps: _bench("bench_view").perf(reps, report),
+    "falsify": lambda reps: _bench("bench_falsify").perf(reps, report),
+    "falsify_peers": lambda reps: _bench("bench_falsify_peers").perf(reps, report),
+    # the test suite's tiers (once each) and the exported MDE package's build
+    "suite": lambda reps: _bench("bench_suite").perf(reps, report, **SUITE),
 }
+
+
+#: The most repetitions of the targets that take minutes each (the memory's hour-long runs,
+#: ROS launches, the whole test suite): ``--reps`` above it is cut to it
+REPS_CAP = {"memory": 3, "ros": 2, "ros2": 3, "suite": 1}
 
 
 def main() -> None:
@@ -444,11 +475,26 @@ def main() -> None:
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--only", nargs="*", choices=list(TARGETS), default=list(TARGETS))
     ap.add_argument(
+        "--suite-tiers",
+        nargs="*",
+        choices=["quick", "full"],
+        default=["quick", "full"],
+        help="the test suite's tiers the suite target runs (default both)",
+    )
+    ap.add_argument(
+        "--suite-tests",
+        nargs="*",
+        default=[],
+        metavar="PATH",
+        help="run only these tests in each tier (to check the suite target itself)",
+    )
+    ap.add_argument(
         "--save",
         action="store_true",
         help="write the figures to benchmarks/results/perf.json and regenerate the docs' tables",
     )
     args = ap.parse_args()
+    SUITE.update(tiers=tuple(args.suite_tiers), paths=tuple(args.suite_tests))
     global RECORDER, TEE
     if args.save:
         RECORDER = results.Recorder(args.reps)
@@ -460,9 +506,11 @@ def main() -> None:
         flush=True,
     )
     for name in args.only:
+        reps = max(1, min(args.reps, REPS_CAP.get(name, args.reps)))
         if RECORDER is not None:
             RECORDER.start(name)
-        TARGETS[name](args.reps if name != "memory" else max(1, min(args.reps, 3)))
+            RECORDER.reps = reps
+        TARGETS[name](reps)
     if RECORDER is not None:
         RECORDER.save()
         results.write_pages()

@@ -1,0 +1,134 @@
+"""The test suite's duration and memory, and the build of the exported MDE package.
+
+What a contributor waits for, measured the way the README states it: the quick tier
+(``pytest -m "not (ros or ros2 or build or docs or slow)"``) and the full suite (``pytest``,
+what CI runs), each in a child process: its wall time, the CPU of pytest and everything it
+started (compilers, ROS launches), the peak resident memory of the largest of those processes,
+and the counts from the run's JUnit XML (a run with failures still gives its time; the row
+says how many failed). Then ``catkin_make`` of the exported MDE package (scenario1), against
+one roscpp compile unit compiled alone in the same sitting (``bench_ros.build_cost``).
+
+One repetition (the full suite takes long); the machine's load before and after is recorded
+with each row. Measure on a quiet machine, and compare the CPU figures, which the load moves
+less than the wall time.
+
+Run: ``python -m benchmarks.perf --save --only suite`` (both tiers and the build), or a part:
+``--suite-tiers quick``, or a subset of the tests to check the measurement itself:
+``--suite-tests tests/docs/test_user_text.py`` (rows then name the subset).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import results
+
+ROOT = Path(__file__).resolve().parent.parent
+#: The tiers as the README names them: the arguments each adds to ``pytest``
+TIERS = {
+    "quick": ["-m", "not (ros or ros2 or build or docs or slow)"],
+    "full": [],
+}
+#: Runs the measured command and prints its wall seconds, CPU seconds (itself and every
+#: descendant it waited for) and peak RSS (KiB, the largest of those processes), as the kernel
+#: accounts them; a small launcher, so the benchmark's own pages are never counted.
+_LAUNCH = (
+    "import os, subprocess, sys, time\n"
+    "t0 = time.perf_counter()\n"
+    "p = subprocess.Popen(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)\n"
+    "_, status, ru = os.wait4(p.pid, 0)\n"
+    "print(time.perf_counter() - t0, ru.ru_utime + ru.ru_stime, ru.ru_maxrss,\n"
+    "      os.waitstatus_to_exitcode(status))\n"
+)
+
+
+def measure(argv: list[str]) -> tuple[float, float, float, int]:
+    """(wall s, CPU s, peak RSS MiB, exit code) of a command and its descendants."""
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg"}
+    out = subprocess.run(
+        [sys.executable, "-c", _LAUNCH, *argv],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=ROOT,
+        env=env,
+    )
+    wall, cpu, rss, code = out.stdout.split()
+    return float(wall), float(cpu), int(rss) / 1024, int(code)
+
+
+def counts(junit: Path) -> dict[str, int]:
+    """tests, failures, errors and skipped of a JUnit XML report (zeros when it is missing)."""
+    keys = ("tests", "failures", "errors", "skipped")
+    total = dict.fromkeys(keys, 0)
+    if not junit.exists():
+        return total
+    root = ET.parse(junit).getroot()
+    suites = [root] if root.tag == "testsuite" else root.findall("testsuite")
+    for suite in suites:
+        for k in keys:
+            total[k] += int(suite.get(k, 0))
+    return total
+
+
+def tier(name: str, paths: list[str], tmp: Path, report: results.Report) -> tuple[float, float]:
+    """Run one tier (or ``paths`` of it) and report its rows; (wall, CPU) seconds."""
+    junit = tmp / f"{name}.xml"
+    argv = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *TIERS[name]]
+    argv += [f"--junitxml={junit}", *paths]
+    wall, cpu, rss, code = measure(argv)
+    n = counts(junit)
+    what = "the quick tier" if name == "quick" else "the full suite"
+    if paths:
+        what += f" (only {' '.join(paths)})"
+    tally = (
+        f"{n['tests']} tests, {n['skipped']} skipped, {n['failures'] + n['errors']} failed; "
+        f"pytest exit {code}"
+    )
+    ok = None if code in (0, 1) else False  # 1: tests failed; anything else: it did not run
+    report(f"pytest, {what}: wall, minutes", f"{wall / 60:.3g}; {tally}", "", ok)
+    report(f"pytest, {what}: CPU of pytest and its children, minutes", f"{cpu / 60:.3g}", "", ok)
+    report(f"pytest, {what}: peak RSS of its largest process, MiB", f"{rss:.0f}", "", ok)
+    return wall, cpu
+
+
+def perf(
+    reps: int,
+    report: results.Report = results.print_report,
+    tiers: tuple[str, ...] = ("quick", "full"),
+    paths: tuple[str, ...] = (),
+    build: bool = True,
+) -> None:
+    """The tiers asked for, then the MDE package's build (``reps`` compile units of baseline)."""
+    import bench_ros
+
+    with tempfile.TemporaryDirectory(prefix="bench-suite-") as tmp_s:
+        tmp = Path(tmp_s)
+        took = {name: tier(name, list(paths), tmp, report) for name in tiers}
+        if "quick" in took and "full" in took:
+            q, f = took["quick"], took["full"]
+            report(
+                "pytest, the full suite / the quick tier, wall",
+                f"{f[0] / q[0]:.3g}; CPU {f[1] / q[1]:.3g}x",
+                "",
+                None,
+            )
+        if not build:
+            return
+        why = bench_ros.missing()
+        if why:
+            report("catkin_make of the exported MDE package", why, "", None, skipped=True)
+            return
+        t0 = time.perf_counter()
+        bench_ros.build_cost(
+            ROOT / "scenarios" / "scenario1.yaml", tmp, reps, report, "MDE package (scenario1)"
+        )
+        print(f"info  build measured in {time.perf_counter() - t0:.0f} s", flush=True)
