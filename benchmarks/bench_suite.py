@@ -12,9 +12,9 @@ One repetition (the full suite takes long); the machine's load before and after 
 with each row. Measure on a quiet machine, and compare the CPU figures, which the load moves
 less than the wall time.
 
-Run: ``python -m benchmarks.perf --save --only suite`` (both tiers and the build), or a part:
-``--suite-tiers quick``, or a subset of the tests to check the measurement itself:
-``--suite-tests tests/docs/test_user_text.py`` (rows then name the subset).
+Run: ``python -m benchmarks.perf --save --only suite`` (both tiers and the build), or some
+parts: ``--suite quick build``, or a subset of the tests to check the measurement itself:
+``--suite quick --suite-tests tests/docs/test_user_text.py`` (rows then name the subset).
 """
 
 from __future__ import annotations
@@ -37,6 +37,8 @@ TIERS = {
     "quick": ["-m", "not (ros or ros2 or build or docs or slow)"],
     "full": [],
 }
+#: What the suite target measures: the tiers and the MDE package's build
+PARTS = (*TIERS, "build")
 #: Runs the measured command and prints its wall seconds, CPU seconds (itself and every
 #: descendant it waited for) and peak RSS (KiB, the largest of those processes), as the kernel
 #: accounts them; a small launcher, so the benchmark's own pages are never counted.
@@ -91,7 +93,7 @@ def tier(name: str, paths: list[str], tmp: Path, report: results.Report) -> tupl
         what += f" (only {' '.join(paths)})"
     tally = (
         f"{n['tests']} tests, {n['skipped']} skipped, {n['failures'] + n['errors']} failed; "
-        f"pytest exit {code}"
+        f"pytest exit {code}; {os.cpu_count()} cores"
     )
     ok = None if code in (0, 1) else False  # 1: tests failed; anything else: it did not run
     report(f"pytest, {what}: wall, minutes", f"{wall / 60:.3g}; {tally}", "", ok)
@@ -103,16 +105,16 @@ def tier(name: str, paths: list[str], tmp: Path, report: results.Report) -> tupl
 def perf(
     reps: int,
     report: results.Report = results.print_report,
-    tiers: tuple[str, ...] = ("quick", "full"),
+    parts: tuple[str, ...] = PARTS,
     paths: tuple[str, ...] = (),
-    build: bool = True,
 ) -> None:
-    """The tiers asked for, then the MDE package's build (``reps`` compile units of baseline)."""
+    """The parts asked for: the tiers, then the MDE package's build (``reps`` compile units
+    of baseline)."""
     import bench_ros
 
     with tempfile.TemporaryDirectory(prefix="bench-suite-") as tmp_s:
         tmp = Path(tmp_s)
-        took = {name: tier(name, list(paths), tmp, report) for name in tiers}
+        took = {name: tier(name, list(paths), tmp, report) for name in TIERS if name in parts}
         if "quick" in took and "full" in took:
             q, f = took["quick"], took["full"]
             report(
@@ -121,7 +123,7 @@ def perf(
                 "",
                 None,
             )
-        if not build:
+        if "build" not in parts:
             return
         why = bench_ros.missing()
         if why:

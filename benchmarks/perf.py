@@ -432,8 +432,8 @@ def _bench(name: str) -> Any:
     return importlib.import_module(name)
 
 
-#: The ``suite`` target's choices (``--suite-tiers``, ``--suite-tests``)
-SUITE: dict[str, Any] = {"tiers": ("quick", "full"), "paths": ()}
+#: The ``suite`` target's choices (``--suite``, ``--suite-tests``)
+SUITE: dict[str, Any] = {}
 
 TARGETS: dict[str, Callable[[int], None]] = {
     "headless": headless,
@@ -475,11 +475,12 @@ def main() -> None:
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--only", nargs="*", choices=list(TARGETS), default=list(TARGETS))
     ap.add_argument(
-        "--suite-tiers",
+        "--suite",
         nargs="*",
-        choices=["quick", "full"],
-        default=["quick", "full"],
-        help="the test suite's tiers the suite target runs (default both)",
+        choices=["quick", "full", "build"],
+        default=["quick", "full", "build"],
+        help="what the suite target measures: the quick tier, the full suite, the MDE "
+        "package's build (default all three)",
     )
     ap.add_argument(
         "--suite-tests",
@@ -494,7 +495,7 @@ def main() -> None:
         help="write the figures to benchmarks/results/perf.json and regenerate the docs' tables",
     )
     args = ap.parse_args()
-    SUITE.update(tiers=tuple(args.suite_tiers), paths=tuple(args.suite_tests))
+    SUITE.update(parts=tuple(args.suite), paths=tuple(args.suite_tests))
     global RECORDER, TEE
     if args.save:
         RECORDER = results.Recorder(args.reps)
