@@ -1,0 +1,96 @@
+"""The benchmarks that need more than the package write rows too, and the suite's figures.
+
+Every figure the manual shows comes from ``benchmarks/results/perf.json``: a row without an aim
+is shown as INFO (not a MISS), a figure that cannot be measured here (IR-SIM, ROS, PSY-TaLiRo
+missing) is a SKIP row that says why, and the test suite's duration and memory are read from
+the pytest run itself (its JUnit XML, the kernel's accounting of its processes).
+"""
+
+from __future__ import annotations
+
+import sys
+import textwrap
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import bench_suite  # noqa: E402  (benchmarks/bench_suite.py)
+import results  # noqa: E402  (benchmarks/results.py)
+
+
+def _rows(calls: list[tuple[Any, ...]]) -> list[dict[str, Any]]:
+    """The rows a sitting would write for these ``report`` calls."""
+    recorder = results.Recorder(reps=1)
+    recorder.start("t")
+    for name, measured, aim, ok, *skipped in calls:
+        recorder.add(name, measured, aim, ok, *skipped)
+    return [r.__dict__ for r in recorder.rows]
+
+
+def test_a_figure_without_an_aim_is_info_and_one_not_measured_says_why() -> None:
+    info, skip, miss = _rows(
+        [
+            ("bag size / trace.csv size", "1.42; bag 5.3 MiB", "", None),
+            ("IR-SIM ratio", "not measured: IR-SIM is not installed here", "", None, True),
+            ("frame, ms", "20.5 (min 19, max 22)", "<= 16.7", False),
+        ]
+    )
+    assert (info["verdict"], info["value"], info["detail"]) == ("INFO", 1.42, "bag 5.3 MiB")
+    assert (skip["verdict"], skip["value"]) == ("SKIP", None)
+    assert "not installed" in skip["detail"]
+    assert (miss["verdict"], miss["spread"]) == ("MISS", [19.0, 22.0])
+    table = results.render(["t"], [info, skip, miss])
+    assert "| SKIP |" in table
+    assert "IR-SIM is not installed here" in table
+    assert "| INFO |" in table
+
+
+def test_irsim_missing_gives_skip_rows_not_a_crash(monkeypatch: Any) -> None:
+    import bench_irsim
+
+    monkeypatch.setattr(bench_irsim.importlib.util, "find_spec", lambda name: None)
+    calls: list[tuple[Any, ...]] = []
+    bench_irsim.perf(1, lambda *a, **k: calls.append((*a, k.get("skipped", False))))
+    assert len(calls) == 2  # 10 Hz and 100 Hz
+    assert all(c[-1] and "pip install ir-sim" in c[1] for c in calls)
+
+
+def test_peak_memory_and_cpu_are_the_measured_commands() -> None:
+    """The launcher reports the child's own peak and exit code, not the benchmark's pages."""
+    code = "import time; x = bytearray(120 * 2**20); x[::4096] = b'1' * len(x[::4096]); exit(3)"
+    wall, cpu, rss, status = bench_suite.measure([sys.executable, "-c", code])
+    assert status == 3
+    assert rss >= 120
+    assert 0 < cpu <= wall * 2 + 1  # two cores at most, and some slack for the clock's grain
+    _, _, small, _ = bench_suite.measure([sys.executable, "-c", "pass"])
+    assert small < 100  # a bare interpreter: the benchmark process's memory is not counted
+
+
+def test_a_tier_reports_its_counts_from_the_run(tmp_path: Path) -> None:
+    tests = tmp_path / "test_sample.py"
+    tests.write_text(
+        textwrap.dedent(
+            """
+            import pytest
+
+            def test_a(): pass
+            def test_b(): assert False
+            @pytest.mark.skip(reason="x")
+            def test_c(): pass
+            @pytest.mark.ros
+            def test_d(): pass
+            """
+        )
+    )
+    calls: list[tuple[Any, ...]] = []
+    bench_suite.tier("quick", [str(tests)], tmp_path, lambda *a, **k: calls.append(a))
+    wall, cpu, rss = calls
+    assert "the quick tier (only " in wall[0]
+    # the quick tier deselects the ros test: three run, one skipped, one failed
+    assert "3 tests, 1 skipped, 1 failed; pytest exit 1" in wall[1]
+    assert float(wall[1].split(";")[0]) > 0
+    assert wall[3] is None  # failed tests still give the time: no aim, not a MISS
+    assert "CPU of pytest and its children" in cpu[0]
+    assert "peak RSS" in rss[0]
