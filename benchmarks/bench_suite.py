@@ -15,6 +15,9 @@ less than the wall time.
 Run: ``python -m benchmarks.perf --save --only suite`` (both tiers and the build), or some
 parts: ``--suite quick build``, or a subset of the tests to check the measurement itself:
 ``--suite quick --suite-tests tests/docs/test_user_text.py`` (rows then name the subset).
+A tier already run (CI's, or the lead's after a merge) need not run again:
+``--suite-junit full=report.xml`` reads its time and counts from ``pytest --junitxml``'s
+report (its CPU and memory rows then say they were not measured).
 """
 
 from __future__ import annotations
@@ -81,20 +84,54 @@ def counts(junit: Path) -> dict[str, int]:
     return total
 
 
+def junit_time(junit: Path) -> tuple[float, str]:
+    """(seconds, start) of a JUnit XML report: pytest's own session time summed over its
+    suites, and the first suite's timestamp. Raises ``ValueError`` naming the file when it is
+    not a JUnit report."""
+    try:
+        root = ET.parse(junit).getroot()
+    except (OSError, ET.ParseError) as exc:
+        raise ValueError(f"{junit}: not a JUnit XML report ({exc})") from None
+    suites = [root] if root.tag == "testsuite" else root.findall("testsuite")
+    if not suites or any(x.get("time") is None for x in suites):
+        raise ValueError(f"{junit}: no <testsuite time=...> (not pytest's --junitxml output)")
+    try:
+        return sum(float(x.get("time", "")) for x in suites), suites[0].get("timestamp", "")
+    except ValueError:
+        raise ValueError(f"{junit}: a <testsuite> time that is not a number") from None
+
+
+def _what(name: str, paths: list[str]) -> str:
+    what = "the quick tier" if name == "quick" else "the full suite"
+    return what + (f" (only {' '.join(paths)})" if paths else "")
+
+
+def _tally(n: dict[str, int]) -> str:
+    return f"{n['tests']} tests, {n['skipped']} skipped, {n['failures'] + n['errors']} failed"
+
+
+def from_junit(name: str, junit: Path, report: results.Report) -> float:
+    """Report a tier from the JUnit XML of a run the user already made (``pytest
+    --junitxml=FILE``): its time and counts; the CPU and memory rows say they were not
+    measured. The wall seconds."""
+    seconds, start = junit_time(junit)
+    what = _what(name, [])
+    detail = f"{_tally(counts(junit))}; pytest's own time, from {junit.name} of {start}"
+    report(f"pytest, {what}: wall, minutes", f"{seconds / 60:.3g}; {detail}", "", None)
+    why = f"not measured: read from {junit.name} (a JUnit report has no CPU or memory)"
+    report(f"pytest, {what}: CPU of pytest and its children, minutes", why, "", None, skipped=True)
+    report(f"pytest, {what}: peak RSS of its largest process, MiB", why, "", None, skipped=True)
+    return seconds
+
+
 def tier(name: str, paths: list[str], tmp: Path, report: results.Report) -> tuple[float, float]:
     """Run one tier (or ``paths`` of it) and report its rows; (wall, CPU) seconds."""
     junit = tmp / f"{name}.xml"
     argv = [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *TIERS[name]]
     argv += [f"--junitxml={junit}", *paths]
     wall, cpu, rss, code = measure(argv)
-    n = counts(junit)
-    what = "the quick tier" if name == "quick" else "the full suite"
-    if paths:
-        what += f" (only {' '.join(paths)})"
-    tally = (
-        f"{n['tests']} tests, {n['skipped']} skipped, {n['failures'] + n['errors']} failed; "
-        f"pytest exit {code}; {os.cpu_count()} cores"
-    )
+    what = _what(name, paths)
+    tally = f"{_tally(counts(junit))}; pytest exit {code}; {os.cpu_count()} cores"
     ok = None if code in (0, 1) else False  # 1: tests failed; anything else: it did not run
     report(f"pytest, {what}: wall, minutes", f"{wall / 60:.3g}; {tally}", "", ok)
     report(f"pytest, {what}: CPU of pytest and its children, minutes", f"{cpu / 60:.3g}", "", ok)
@@ -107,22 +144,25 @@ def perf(
     report: results.Report = results.print_report,
     parts: tuple[str, ...] = PARTS,
     paths: tuple[str, ...] = (),
+    junits: dict[str, Path] | None = None,
 ) -> None:
-    """The parts asked for: the tiers, then the MDE package's build (``reps`` compile units
-    of baseline)."""
+    """The parts asked for: the tiers (each run here, or read from the JUnit XML given for
+    it in ``junits``), then the MDE package's build (``reps`` compile units of baseline)."""
     import bench_ros
 
+    junits = junits or {}
     with tempfile.TemporaryDirectory(prefix="bench-suite-") as tmp_s:
         tmp = Path(tmp_s)
-        took = {name: tier(name, list(paths), tmp, report) for name in TIERS if name in parts}
+        took: dict[str, tuple[float, float | None]] = {}
+        for name in TIERS:
+            if name in junits:
+                took[name] = (from_junit(name, junits[name], report), None)
+            elif name in parts:
+                took[name] = tier(name, list(paths), tmp, report)
         if "quick" in took and "full" in took:
-            q, f = took["quick"], took["full"]
-            report(
-                "pytest, the full suite / the quick tier, wall",
-                f"{f[0] / q[0]:.3g}; CPU {f[1] / q[1]:.3g}x",
-                "",
-                None,
-            )
+            (qw, qc), (fw, fc) = took["quick"], took["full"]
+            cpu = f"; CPU {fc / qc:.3g}x" if qc and fc else ""
+            report("pytest, the full suite / the quick tier, wall", f"{fw / qw:.3g}{cpu}", "", None)
         if "build" not in parts:
             return
         why = bench_ros.missing()

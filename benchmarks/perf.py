@@ -464,6 +464,22 @@ TARGETS: dict[str, Callable[[int], None]] = {
 }
 
 
+def _junits(ap: argparse.ArgumentParser, args: argparse.Namespace) -> dict[str, Path]:
+    """``--suite-junit quick=FILE full=FILE`` checked before anything is measured (a bad one
+    is one line and exit 2)."""
+    junits: dict[str, Path] = {}
+    for item in args.suite_junit:
+        tier, sep, file = item.partition("=")
+        if not sep or tier not in ("quick", "full") or not file:
+            ap.error(f"--suite-junit {item}: expected quick=FILE or full=FILE")
+        try:
+            _bench("bench_suite").junit_time(Path(file))
+        except ValueError as exc:
+            ap.error(f"--suite-junit {item}: {exc}")
+        junits[tier] = Path(file)
+    return junits
+
+
 #: The most repetitions of the targets that take minutes each (the memory's hour-long runs,
 #: ROS launches, the whole test suite): ``--reps`` above it is cut to it
 REPS_CAP = {"memory": 3, "ros": 2, "ros2": 3, "suite": 1}
@@ -483,6 +499,14 @@ def main() -> None:
         "package's build (default all three)",
     )
     ap.add_argument(
+        "--suite-junit",
+        nargs="*",
+        default=[],
+        metavar="TIER=FILE",
+        help="take a tier's time and counts from a JUnit XML report of a run already made "
+        "(pytest --junitxml=FILE) instead of running it: quick=FILE, full=FILE",
+    )
+    ap.add_argument(
         "--suite-tests",
         nargs="*",
         default=[],
@@ -495,7 +519,7 @@ def main() -> None:
         help="write the figures to benchmarks/results/perf.json and regenerate the docs' tables",
     )
     args = ap.parse_args()
-    SUITE.update(parts=tuple(args.suite), paths=tuple(args.suite_tests))
+    SUITE.update(parts=tuple(args.suite), paths=tuple(args.suite_tests), junits=_junits(ap, args))
     global RECORDER, TEE
     if args.save:
         RECORDER = results.Recorder(args.reps)

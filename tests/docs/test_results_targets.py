@@ -13,6 +13,8 @@ import textwrap
 from pathlib import Path
 from typing import Any
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
@@ -94,3 +96,34 @@ def test_a_tier_reports_its_counts_from_the_run(tmp_path: Path) -> None:
     assert wall[3] is None  # failed tests still give the time: no aim, not a MISS
     assert "CPU of pytest and its children" in cpu[0]
     assert "peak RSS" in rss[0]
+
+
+def test_a_tier_already_run_is_read_from_its_junit_report(tmp_path: Path) -> None:
+    """``--suite-junit full=FILE``: the time and counts of the user's run, and rows saying the
+    CPU and memory were not measured (a figure is never made up where nothing measured it)."""
+    report_xml = tmp_path / "full.xml"
+    report_xml.write_text(
+        '<testsuites><testsuite name="pytest" tests="10" failures="1" errors="0" '
+        'skipped="2" time="90.0" timestamp="2026-11-28T12:00:00"/></testsuites>'
+    )
+    rows = []
+    took = bench_suite.from_junit(
+        "full", report_xml, lambda *a, **k: rows.append((*a, k.get("skipped", False)))
+    )
+    assert took == 90.0
+    wall, cpu, rss = rows
+    assert wall[1].startswith("1.5; 10 tests, 2 skipped, 1 failed")
+    assert not wall[-1]
+    assert cpu[-1]
+    assert rss[-1]
+    assert "not measured" in cpu[1]
+
+
+def test_a_file_that_is_no_junit_report_is_named(tmp_path: Path) -> None:
+    path = tmp_path / "report.xml"
+    for text in ("<x/>", "not xml", '<testsuite time="soon"/>'):
+        path.write_text(text)
+        with pytest.raises(ValueError, match=r"report\.xml"):
+            bench_suite.junit_time(path)
+    with pytest.raises(ValueError, match=r"missing\.xml"):
+        bench_suite.junit_time(tmp_path / "missing.xml")
