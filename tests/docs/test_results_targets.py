@@ -127,3 +127,23 @@ def test_a_file_that_is_no_junit_report_is_named(tmp_path: Path) -> None:
             bench_suite.junit_time(path)
     with pytest.raises(ValueError, match=r"missing\.xml"):
         bench_suite.junit_time(tmp_path / "missing.xml")
+
+
+def test_the_bag_target_measures_rows_a_table_can_show() -> None:
+    """The cheapest of the new targets, run end to end on a short scenario: each figure is a
+    number the results file can hold (a rotten benchmark fails here, not in the lead's
+    sitting)."""
+    import bench_bag
+
+    calls: list[tuple[Any, ...]] = []
+    bench_bag.perf(1, lambda *a, **k: calls.append(a), duration=5.0)
+    rows = _rows(calls)
+    assert [r["figure"].split(",")[0].split(" (")[0] for r in rows] == [
+        "run with --bag CPU / without",
+        "bag: CPU a message",
+        "bag size / trace.csv size",
+    ]
+    assert all(r["value"] is not None for r in rows)
+    assert rows[0]["value"] > 0  # a ratio of CPU times
+    assert rows[2]["value"] > 0  # a ratio of file sizes
+    assert rows[0]["ratio_to"].startswith("without")
