@@ -223,10 +223,10 @@ def main() -> None:
     parser.add_argument("--tools", default="amsa-phys,dual-annealing,uniform-random")
     args = parser.parse_args()
     load0 = os.getloadavg()
-    results: dict[str, Any] = {"budget": args.budget, "load_before": load0, "problems": {}}
+    found: dict[str, Any] = {"budget": args.budget, "load_before": load0, "problems": {}}
     for name in args.problems.split(","):
         p = PROBLEMS[name]
-        results["problems"][name] = {}
+        found["problems"][name] = {}
         for tool in args.tools.split(","):
             trials = []
             for seed in range(1, args.trials + 1):
@@ -235,7 +235,7 @@ def main() -> None:
                 else:
                     trials.append(psy_trial(p, args.budget, seed, tool))
             row = table(trials)
-            results["problems"][name][tool] = row
+            found["problems"][name][tool] = row
             mean = row["mean_simulations"]
             print(
                 f"{name:14} {tool:15} falsified {row['falsified']:2}/{row['trials']}"
@@ -243,10 +243,10 @@ def main() -> None:
                 f"  CPU/trial {row['mean_cpu_s']:6.2f} s  load {os.getloadavg()[0]:.1f}",
                 flush=True,
             )
-            Path(args.out).write_text(json.dumps(results, indent=1))
-    results["load_after"] = os.getloadavg()
-    results["wall_s"] = time.perf_counter()
-    Path(args.out).write_text(json.dumps(results, indent=1))
+            Path(args.out).write_text(json.dumps(found, indent=1))
+    found["load_after"] = os.getloadavg()
+    found["wall_s"] = time.perf_counter()
+    Path(args.out).write_text(json.dumps(found, indent=1))
 
 
 if __name__ == "__main__":
