@@ -530,15 +530,50 @@ def main() -> None:
         f"median of {args.reps} (min, max)",
         flush=True,
     )
-    for name in args.only:
-        reps = max(1, min(args.reps, REPS_CAP.get(name, args.reps)))
+    failed = []
+    try:
+        for name in args.only:
+            if not _measure(name, max(1, min(args.reps, REPS_CAP.get(name, args.reps)))):
+                failed.append(name)
+    except KeyboardInterrupt:
+        print("interrupted: the targets measured so far are kept", file=sys.stderr)
+        sys.exit(130)
+    finally:
         if RECORDER is not None:
-            RECORDER.start(name)
-            RECORDER.reps = reps
-        TARGETS[name](reps)
+            results.write_pages()
+    if failed:
+        sys.exit(f"the benchmark of {', '.join(failed)} stopped (its row says how)")
+
+
+def _measure(name: str, reps: int) -> bool:
+    """Measure one target; with ``--save`` its rows go to the file at once, so a sitting of
+    hours keeps every target finished before a failure or a Ctrl-C. A target whose benchmark
+    raises gets one MISS row saying so (its old rows would describe other code) and the
+    sitting goes on; a Ctrl-C drops the interrupted target's partial rows."""
     if RECORDER is not None:
-        RECORDER.save()
-        results.write_pages()
+        RECORDER.start(name)
+        RECORDER.reps = reps
+    try:
+        TARGETS[name](reps)
+    except KeyboardInterrupt:
+        if RECORDER is not None:
+            RECORDER.rows = [r for r in RECORDER.rows if r.target != name]
+        raise
+    except Exception as exc:  # one target's failure must not lose the others
+        import traceback
+
+        traceback.print_exc()
+        why = f"{type(exc).__name__}: {exc}".splitlines()[0][:300]
+        figure = f"{name}: the benchmark stopped"
+        with results.quiet(TEE):
+            print(f"MISS  {figure} ({why})", flush=True)
+        if RECORDER is not None:  # no number read from the message: it is not a figure
+            RECORDER.add_row(figure, None, None, why, "", False)
+        return False
+    finally:
+        if RECORDER is not None:
+            RECORDER.save()
+    return True
 
 
 if __name__ == "__main__":

@@ -147,3 +147,36 @@ def test_the_bag_target_measures_rows_a_table_can_show() -> None:
     assert rows[0]["value"] > 0  # a ratio of CPU times
     assert rows[2]["value"] > 0  # a ratio of file sizes
     assert rows[0]["ratio_to"].startswith("without")
+
+
+def test_a_benchmark_that_raises_is_a_row_and_the_others_are_kept(monkeypatch: Any) -> None:
+    """A sitting of hours: each target's rows are saved as it ends, and a benchmark that raises
+    is one MISS row saying why (no number read from its message), the sitting going on."""
+    import perf
+
+    recorder = results.Recorder(reps=1)
+    saved: list[list[str]] = []
+    monkeypatch.setattr(
+        recorder, "save", lambda *a: saved.append([r.target for r in recorder.rows])
+    )
+    monkeypatch.setattr(perf, "RECORDER", recorder)
+
+    def boom(reps: int) -> None:
+        raise RuntimeError("catkin_make failed: 2 errors")
+
+    def fine(reps: int) -> None:
+        perf.report("a figure", "1.5 (min 1, max 2)", "<= 2", True)
+
+    monkeypatch.setitem(perf.TARGETS, "boom", boom)
+    monkeypatch.setitem(perf.TARGETS, "fine", fine)
+    assert perf._measure("boom", 1) is False
+    assert perf._measure("fine", 1) is True
+    failed, ok = recorder.rows
+    assert (failed.figure, failed.value, failed.verdict) == (
+        "boom: the benchmark stopped",
+        None,
+        "MISS",
+    )
+    assert failed.detail == "RuntimeError: catkin_make failed: 2 errors"
+    assert (ok.target, ok.value, ok.verdict) == ("fine", 1.5, "PASS")
+    assert saved == [["boom"], ["boom", "fine"]]
