@@ -21,14 +21,17 @@ Problems (the issue's three):
 * ``fig5``: ``scenarios/paper_fig5_kv01.yaml`` cut to 120 s, the paper's Fig. 5 box
   motorCoef 40-100 x cruisePower 3-12 x lostDataGPS 0-60, rms_error below 4.8.
 
-PSY-TaLiRo is a benchmark-only dependency: ``pip install psy-taliro``.
+PSY-TaLiRo is a benchmark-only dependency: ``pip install psy-taliro`` (without it, its rows
+say so).
 
     python benchmarks/bench_falsify_peers.py [--trials 10] [--budget 150] [--out FILE.json]
+    python -m benchmarks.perf --only falsify_peers   # --reps trials, into the results file
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import resource
@@ -43,6 +46,9 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import amsa_phys as ap  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import results  # noqa: E402
 
 Cost = Callable[[dict[str, Any]], float]
 
@@ -162,6 +168,52 @@ def table(trials: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
+#: The tools compared, as the results table names them
+TOOLS = {
+    "amsa-phys": "amsa-phys (ap.falsify)",
+    "dual-annealing": "PSY-TaLiRo dual annealing",
+    "uniform-random": "PSY-TaLiRo uniform random",
+}
+
+
+def perf(reps: int, report: results.Report = results.print_report, budget: int = 150) -> None:
+    """Per problem and tool: the falsification rate over ``reps`` trials, the simulations to
+    the first violation, and the CPU a trial against amsa-phys's in the same sitting."""
+    have_psy = importlib.util.find_spec("staliro") is not None
+    first = next(iter(PROBLEMS.values()))
+    amsa_trial(first, 12, 1)  # warm: the first search imports the optimizer and the engine
+    for name, p in PROBLEMS.items():
+        mine = 0.0
+        for tool, label in TOOLS.items():
+            figure = f"falsify vs PSY-TaLiRo, {name}, budget {budget}: {label}, falsification rate"
+            if tool != "amsa-phys" and not have_psy:
+                why = "not measured: PSY-TaLiRo is not installed here (pip install psy-taliro)"
+                report(figure, why, "", None, skipped=True)
+                continue
+            trials = [
+                amsa_trial(p, budget, seed)
+                if tool == "amsa-phys"
+                else psy_trial(p, budget, seed, tool)
+                for seed in range(1, reps + 1)
+            ]
+            row = table(trials)
+            mine = mine or row["mean_cpu_s"]
+            sims = (
+                "none falsified"
+                if row["mean_simulations"] is None
+                else f"mean (median) simulations to the first violation "
+                f"{row['mean_simulations']:.1f} ({row['median_simulations']:g})"
+            )
+            vs = f" ({row['mean_cpu_s'] / mine:.3g}x amsa-phys's)" if tool != "amsa-phys" else ""
+            report(
+                figure,
+                f"{row['rate']:.3g}; {row['falsified']}/{row['trials']} trials; {sims}; "
+                f"CPU a trial {row['mean_cpu_s']:.1f} s{vs}",
+                "",
+                None,
+            )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--trials", type=int, default=10)
@@ -171,10 +223,10 @@ def main() -> None:
     parser.add_argument("--tools", default="amsa-phys,dual-annealing,uniform-random")
     args = parser.parse_args()
     load0 = os.getloadavg()
-    results: dict[str, Any] = {"budget": args.budget, "load_before": load0, "problems": {}}
+    found: dict[str, Any] = {"budget": args.budget, "load_before": load0, "problems": {}}
     for name in args.problems.split(","):
         p = PROBLEMS[name]
-        results["problems"][name] = {}
+        found["problems"][name] = {}
         for tool in args.tools.split(","):
             trials = []
             for seed in range(1, args.trials + 1):
@@ -183,7 +235,7 @@ def main() -> None:
                 else:
                     trials.append(psy_trial(p, args.budget, seed, tool))
             row = table(trials)
-            results["problems"][name][tool] = row
+            found["problems"][name][tool] = row
             mean = row["mean_simulations"]
             print(
                 f"{name:14} {tool:15} falsified {row['falsified']:2}/{row['trials']}"
@@ -191,10 +243,10 @@ def main() -> None:
                 f"  CPU/trial {row['mean_cpu_s']:6.2f} s  load {os.getloadavg()[0]:.1f}",
                 flush=True,
             )
-            Path(args.out).write_text(json.dumps(results, indent=1))
-    results["load_after"] = os.getloadavg()
-    results["wall_s"] = time.perf_counter()
-    Path(args.out).write_text(json.dumps(results, indent=1))
+            Path(args.out).write_text(json.dumps(found, indent=1))
+    found["load_after"] = os.getloadavg()
+    found["wall_s"] = time.perf_counter()
+    Path(args.out).write_text(json.dumps(found, indent=1))
 
 
 if __name__ == "__main__":

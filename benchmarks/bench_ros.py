@@ -1,21 +1,27 @@
-"""The exported ROS package against ``amsa-phys run`` (issue 26 item 5): speed and memory.
+"""The exported ROS 1 package against ``amsa-phys run``: speed, build and memory.
 
 * scenario1 (500 s) in lockstep: the simulator's own run time (``simulated 500 s in X s``, its
   loop, without roscore and process start-up) against the in-process run's loop
-  (``metrics.json`` ``wall_time_s``), launch to done (the difference is start-up and exit),
-  and the CPU seconds of every process of the launch (on a shared machine the run time
-  follows the load; the CPU does much less); with a process per C++ Leaf asked in waves,
-  with every C++ Leaf in the container asked in one message a wave and each instant's
-  answers awaited (``pipeline:=false``), and pipelined (the default: many instants a
-  message, each answer checked against the in-process template), alternated with the
-  in-process run, in one sitting;
+  (``metrics.json`` ``wall_time_s``) measured just before it, launch to done (the difference
+  is start-up and exit), and the CPU seconds of every process of the launch against the
+  in-process run's (on a shared machine the run time follows the load; the CPU does much
+  less); with a process per C++ Leaf asked in waves, with every C++ Leaf in the container
+  asked in one message a wave and each instant's answers awaited (``pipeline:=false``), and
+  pipelined (the default: many instants a message, each answer checked against the
+  in-process template), alternated with the in-process run, in one sitting;
+* lockstep's floor: the smallest world with scenario1's structure, one wait an instant;
+* the build: ``catkin_make`` of the exported scenario1 package, its CPU (compilers included)
+  against one roscpp compile unit compiled alone (``g++`` of a file including roscpp's and
+  nodelet's headers: what every C++ Leaf's unit costs before its own code);
 * the platoon world's launch: the peak of the summed resident memory of every process the
   launch started (sampled from ``/proc`` every 0.2 s), and its run time.
 
-Needs ROS 1 (roslaunch, catkin_make), ``unshare -n`` and root, as tests/ros/test_ros.py does.
-Compare ratios only: the machine is shared. Targets (issue 26): lockstep within 3x the
-in-process loop; the platoon's launch under 1 GB.
-Run: ``python benchmarks/bench_ros.py [--duration 500] [--platoon-duration 20]``.
+Needs ROS 1 (roslaunch, catkin_make), ``unshare -n`` and root, as tests/ros/test_ros.py does;
+through ``perf.py`` a row says so where they are missing. Compare ratios only: the machine is
+shared. Targets: pipelined lockstep within 3x the in-process loop; the platoon's launch under
+1 GiB.
+Run: ``python benchmarks/bench_ros.py [--duration 500] [--platoon-duration 20]`` or through
+``python -m benchmarks.perf --only ros``.
 """
 
 from __future__ import annotations
@@ -26,8 +32,10 @@ import io
 import json
 import os
 import re
+import resource
 import shutil
 import signal
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -39,6 +47,10 @@ from pathlib import Path
 from amsa_phys.cli.main import main
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import results  # noqa: E402
+
 SCENARIO1 = ROOT / "scenarios" / "scenario1.yaml"
 PLATOON = ROOT / "worlds" / "platoon.yaml"
 #: scenario1's lockstep protocols compared: (label, launch arguments)
@@ -49,6 +61,69 @@ PROTOCOLS = (
 )
 #: CPU seconds of the last :func:`launch`'s processes
 LAST_CPU_S = 0.0
+#: (wall s, CPU s of catkin_make and the compilers) of the last :func:`build`
+LAST_BUILD = (0.0, 0.0)
+#: One roscpp compile unit: what each C++ Leaf's unit costs before its own code
+UNIT_CPP = """\
+#include <nodelet/nodelet.h>
+#include <ros/ros.h>
+#include <std_msgs/Float64.h>
+int main() { return 0; }
+"""
+
+
+#: How the package's CMake compiles a unit (its flags; no build type, so no optimisation)
+COMPILE = ["g++", "-std=c++14", "-ffp-contract=off"]
+
+
+def _children_cpu() -> float:
+    """CPU seconds (user + system) of this process's finished children and theirs."""
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
+
+
+def missing() -> str:
+    """Why this machine cannot run the exported package ("" when it can)."""
+    absent = [t for t in ("roslaunch", "catkin_make", "unshare", "g++") if not shutil.which(t)]
+    if absent:
+        return f"not measured: {', '.join(absent)} not installed (ROS 1 Noetic)"
+    if os.geteuid() != 0:
+        return "not measured: needs root for unshare -n (a private network)"
+    return ""
+
+
+def unit_cpu(tmp: Path) -> float:
+    """CPU seconds of compiling :data:`UNIT_CPP` alone, as the package's CMake compiles."""
+    src = tmp / "unit.cpp"
+    src.write_text(UNIT_CPP)
+    before = _children_cpu()
+    subprocess.run(
+        [*COMPILE, "-c", str(src), "-o", str(tmp / "unit.o")],
+        check=True,
+        capture_output=True,
+    )
+    return _children_cpu() - before
+
+
+def _med(xs: list[float]) -> str:
+    return f"{statistics.median(xs):.4g} (min {min(xs):.4g}, max {max(xs):.4g})"
+
+
+def build_cost(scenario: Path, root: Path, reps: int, report: results.Report, name: str) -> str:
+    """Export and build ``scenario`` in ``root/ws_build``, reporting the build's CPU against a
+    roscpp compile unit's and its wall time; the workspace's package name."""
+    pkg = build(scenario, root / "ws_build")
+    wall, cpu = LAST_BUILD
+    units = [unit_cpu(root) for _ in range(max(1, reps))]
+    ratio = [cpu / u for u in units]
+    report(
+        f"catkin_make of the exported {name}: CPU / one roscpp compile unit",
+        f"{_med(ratio)}; build {cpu:.1f} s CPU, {wall:.1f} s wall; "
+        f"unit {statistics.median(units):.2f} s CPU",
+        "",
+        None,
+    )
+    return pkg
 
 
 def _env(token: str, ws: Path) -> dict[str, str]:
@@ -94,12 +169,15 @@ def build(scenario: Path, ws: Path, *extra: str) -> str:
         assert main(["export", "ros", str(scenario), "-o", str(ws / "src" / "pkg"), *extra]) == 0
     pkg = re.search(r"<name>(\w+)</name>", (ws / "src" / "pkg" / "package.xml").read_text())
     assert pkg is not None
+    global LAST_BUILD
+    cpu0, t0 = _children_cpu(), time.perf_counter()
     done = subprocess.run(
         ["catkin_make", "-C", str(ws), "-DPYTHON_EXECUTABLE=/usr/bin/python3"],
         capture_output=True,
         text=True,
         env={**{k: v for k, v in os.environ.items() if k != "PYTHONPATH"}, "PWD": str(ws)},
     )
+    LAST_BUILD = (time.perf_counter() - t0, _children_cpu() - cpu0)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
     (ws / "launch.sh").write_text(
         "set -e\nip link set lo up\n"
@@ -181,13 +259,14 @@ components:
 """
 
 
-def floor(root: Path, duration: str, repeat: int) -> None:
+def floor(root: Path, duration: str, repeat: int, report: results.Report) -> None:
     """Lockstep's floor on this machine (:data:`FLOOR_WORLD`), against its in-process loop."""
     (root / "floor_world.yaml").write_text(FLOOR_WORLD)
     scenario = root / "floor.yaml"
     scenario.write_text(f"name: floor\nworld: floor_world.yaml\nduration: {duration}\nseed: 1\n")
     ws = root / "ws_floor"
     build(scenario, ws)
+    beyond = []
     for _ in range(repeat):
         ref = root / "floor_ref"
         with contextlib.redirect_stdout(io.StringIO()):
@@ -204,11 +283,82 @@ def floor(root: Path, duration: str, repeat: int) -> None:
             "force:=true",
             "pipeline:=false",
         )
-        instants = 4 * float(duration)
-        print(
-            f"floor (one wait an instant, 4 Hz) {duration} s: in-process loop {loop:.3f} s, "
-            f"lockstep {run:.3f} s: {(run - loop) / instants * 1e6:.0f} us an instant beyond "
-            f"the loop; scenario1's floor {instants:.0f} instants x that"
+        beyond.append((run - loop) / (4 * float(duration)) * 1e6)
+    report(
+        "ROS 1 lockstep floor (one wait an instant): µs an instant beyond the loop",
+        _med(beyond),
+        "",
+        None,
+    )
+
+
+def perf(
+    reps: int,
+    report: results.Report = results.print_report,
+    duration: str = "500",
+    platoon_duration: str = "20",
+) -> None:
+    """Every figure of this file, each against its baseline of the same sitting."""
+    why = missing()
+    if why:
+        for name in ("lockstep pipelined / in-process loop", "catkin_make", "platoon memory"):
+            report(f"ROS 1 {name}", why, "", None, skipped=True)
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(tmp)
+        build_cost(SCENARIO1, root, reps, report, "scenario1 package")
+        _lockstep(root, root / "ws_build", duration, reps, report)
+        floor(root, duration, reps, report)
+        ws = root / "ws2"
+        build(PLATOON, ws, "--duration", platoon_duration)
+        walls, rss_mib = [], []
+        for _ in range(reps):
+            wall, _run, rss, _ = launch(ws, "platoon.launch", f"out:={ws / 'out'}", "plots:=false")
+            walls.append(wall)
+            rss_mib.append(rss / 1024)
+        ok = statistics.median(rss_mib) < 1024
+        report(
+            f"ROS 1 platoon ({platoon_duration} s) launch: peak memory of its processes, MiB",
+            f"{_med(rss_mib)}; launch to done {statistics.median(walls):.1f} s",
+            "< 1024",
+            ok,
+        )
+
+
+def _lockstep(root: Path, ws: Path, duration: str, reps: int, report: results.Report) -> None:
+    """scenario1's three lockstep protocols, each rep alternated with the in-process run."""
+    ref = root / "ref"
+    argv = ["run", str(SCENARIO1), "--headless", "-q", "--no-plot", "--out", str(ref)]
+    argv += ["--duration", duration, "--force"]
+    ratios: dict[str, list[float]] = {label: [] for label, _ in PROTOCOLS}
+    walls: dict[str, list[float]] = {label: [] for label, _ in PROTOCOLS}
+    cpus: dict[str, list[float]] = {label: [] for label, _ in PROTOCOLS}
+    same = True
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main(argv) == 0  # warm: the first run imports the run command's modules
+    for _ in range(reps):
+        for label, extra in PROTOCOLS:
+            cpu0 = time.process_time()
+            with contextlib.redirect_stdout(io.StringIO()):
+                assert main(argv) == 0
+            ref_cpu = time.process_time() - cpu0
+            loop = json.loads((ref / "metrics.json").read_text())["wall_time_s"]
+            args = (f"out:={ws / 'out'}", "plots:=false", f"duration:={duration}", "force:=true")
+            wall, run, _rss, _ = launch(ws, "scenario1.launch", *args, *extra)
+            same &= (ws / "out" / "trace.csv").read_bytes() == (ref / "trace.csv").read_bytes()
+            ratios[label].append(run / loop)
+            walls[label].append(wall)
+            cpus[label].append(LAST_CPU_S / ref_cpu)
+    for label, _ in PROTOCOLS:
+        pipelined = label.endswith("(default)")
+        ok = statistics.median(ratios[label]) <= 3 and same if pipelined else None
+        report(
+            f"ROS 1 lockstep scenario1 {duration} s, {label} / in-process loop",
+            f"{_med(ratios[label])}; launch to done {statistics.median(walls[label]):.1f} s; "
+            f"CPU of the launch / in-process {statistics.median(cpus[label]):.3g}; "
+            f"traces byte-identical {same}",
+            "<= 3" if pipelined else "",
+            ok,
         )
 
 
@@ -219,55 +369,10 @@ def main_bench() -> None:
     parser.add_argument("--platoon-duration", default="20", help="the platoon's seconds")
     parser.add_argument("--repeat", type=int, default=2, help="launches of each protocol")
     args = parser.parse_args()
-    missing = [t for t in ("roslaunch", "catkin_make", "unshare") if shutil.which(t) is None]
-    if missing or os.geteuid() != 0:
-        sys.exit(f"needs ROS 1, unshare and root (missing: {missing or 'root'})")
-    with tempfile.TemporaryDirectory() as tmp:
-        root = Path(tmp)
-        ref = root / "ref"
-        with contextlib.redirect_stdout(io.StringIO()):
-            argv = ["run", str(SCENARIO1), "--headless", "-q", "--no-plot", "--out", str(ref)]
-            assert main([*argv, "--duration", args.duration]) == 0
-        loop = json.loads((ref / "metrics.json").read_text())["wall_time_s"]
-        ws = root / "ws1"
-        build(SCENARIO1, ws)
-        cpu0 = time.process_time()
-        with contextlib.redirect_stdout(io.StringIO()):
-            assert main([*argv, "--duration", args.duration, "--out", str(root / "ref2")]) == 0
-        ref_cpu = time.process_time() - cpu0
-        print(f"scenario1 {args.duration} s, in-process loop        {loop:.3f} s")
-        print(f"scenario1 in-process: CPU of the whole run         {ref_cpu:.2f} s")
-        # the protocols, alternated with the in-process loop, --repeat times each (the
-        # machine is shared): each ratio is against the loop measured just before it
-        for _ in range(args.repeat):
-            for label, extra in PROTOCOLS:
-                with contextlib.redirect_stdout(io.StringIO()):
-                    assert main([*argv, "--duration", args.duration, "--force"]) == 0
-                loop = json.loads((ref / "metrics.json").read_text())["wall_time_s"]
-                wall, run, rss, _ = launch(
-                    ws,
-                    "scenario1.launch",
-                    f"out:={ws / 'out'}",
-                    "plots:=false",
-                    f"duration:={args.duration}",
-                    "force:=true",
-                    *extra,
-                )
-                same = (ws / "out" / "trace.csv").read_bytes() == (ref / "trace.csv").read_bytes()
-                print(
-                    f"scenario1 lockstep, {label:34}: run {run:.3f} s ({run / loop:.1f}x the "
-                    f"loop's {loop:.3f} s), "
-                    f"launch to done {wall:.1f} s (start-up and exit {wall - run:.1f} s), "
-                    f"CPU of the launch {LAST_CPU_S:.1f} s, peak memory {rss / 1024:.0f} MiB, "
-                    f"trace byte-identical {same}"
-                )
-        floor(root, args.duration, args.repeat)
-        ws = root / "ws2"
-        build(PLATOON, ws, "--duration", args.platoon_duration)
-        wall, run, rss, _ = launch(ws, "platoon.launch", f"out:={ws / 'out'}", "plots:=false")
-        print(f"platoon {args.platoon_duration} s lockstep: simulator's run         {run:.3f} s")
-        print(f"platoon lockstep: launch to done                   {wall:.1f} s")
-        print(f"platoon lockstep: peak memory of the launch        {rss / 1024:.0f} MiB")
+    why = missing()
+    if why:
+        sys.exit(why)
+    perf(args.repeat, results.print_report, args.duration, args.platoon_duration)
 
 
 if __name__ == "__main__":

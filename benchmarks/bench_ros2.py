@@ -8,7 +8,9 @@ run, alternated round by round in one sitting; and ``ros2 lockstep`` of the expo
 before each round: compare ratios only, the machine is shared.
 
 Needs ``.venv-ros2`` (``pip install -e '.[ros2]'``), ``unshare -n`` and root, as
-``tests/ros2`` do. Run: ``python benchmarks/bench_ros2.py [--rounds 3] [--out FILE]``.
+``tests/ros2`` do; through ``perf.py`` a row says so where they are missing.
+Run: ``python benchmarks/bench_ros2.py [--rounds 3]`` or through
+``python -m benchmarks.perf --only ros2`` (which writes the figures to the results file).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -24,6 +27,10 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import results  # noqa: E402
+
 PY = ROOT / ".venv-ros2" / "bin" / "python"
 SCENARIO = ROOT / "scenarios" / "scenario1.yaml"
 NODE = ROOT / "tests" / "ros2" / "follower_node.py"
@@ -70,14 +77,31 @@ def lockstep(tmp: Path, pkg: Path) -> float:
     return _loop_s(out)
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "bench_ros2.json"))
-    args = ap.parse_args()
+def missing() -> str:
+    """Why this machine cannot run ROS 2 nodes here ("" when it can)."""
     if not PY.exists():
-        sys.exit(f"{PY} is missing: python3 -m venv .venv-ros2; pip install -e '.[ros2]'")
-    rows = []
+        return f"not measured: {PY.relative_to(ROOT)} is missing (pip install -e '.[ros2]' there)"
+    if shutil.which("unshare") is None or os.geteuid() != 0:
+        return "not measured: needs unshare and root (a private network)"
+    return ""
+
+
+def _med(xs: list[float]) -> str:
+    return f"{statistics.median(xs):.4g} (min {min(xs):.4g}, max {max(xs):.4g})"
+
+
+def perf(reps: int, report: results.Report = results.print_report) -> None:
+    """A node in the loop and the exported package over the in-process run, round by round."""
+    names = (
+        "ROS 2 node in the loop (run --ros2) / in-process loop",
+        "ros2 lockstep of the exported package / in-process loop",
+    )
+    why = missing()
+    if why:
+        for name in names:
+            report(name, why, "", None, skipped=True)
+        return
+    node, lock, base = [], [], []
     with tempfile.TemporaryDirectory(prefix="bench-ros2-") as tmp_s:
         tmp = Path(tmp_s)
         pkg = tmp / "pkg"
@@ -87,40 +111,24 @@ def main() -> None:
             check=True,
             capture_output=True,
         )
-        for i in range(args.rounds):
-            load = os.getloadavg()[0]
+        for _ in range(reps):
             a = in_process(tmp)
-            b = with_node(tmp)
-            c = lockstep(tmp, pkg)
-            rows.append(
-                {
-                    "round": i,
-                    "load1": load,
-                    "in_process_s": a,
-                    "ros2_node_s": b,
-                    "ros2_lockstep_s": c,
-                }
-            )
-            print(
-                f"round {i}: load {load:.1f}; in process {a:.2f} s, one ROS 2 node "
-                f"{b:.2f} s ({b / a:.1f}x), exported package {c:.2f} s ({c / a:.1f}x)",
-                flush=True,
-            )
-    med = {k: statistics.median(r[k] for r in rows) for k in rows[0] if k.endswith("_s")}
-    result = {
-        "scenario": "scenario1 (500 s)",
-        "cpus": os.cpu_count(),
-        "rounds": rows,
-        "median_s": med,
-        "ratio_node": med["ros2_node_s"] / med["in_process_s"],
-        "ratio_lockstep": med["ros2_lockstep_s"] / med["in_process_s"],
-    }
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(json.dumps(result, indent=2) + "\n")
-    print(
-        f"median: one node {result['ratio_node']:.1f}x, exported package "
-        f"{result['ratio_lockstep']:.1f}x the in-process loop; written to {args.out}"
-    )
+            base.append(a)
+            node.append(with_node(tmp) / a)
+            lock.append(lockstep(tmp, pkg) / a)
+    loop = f"in-process loop {statistics.median(base):.3f} s"
+    report(names[0], f"{_med(node)}; {loop}", "", None)
+    report(names[1], f"{_med(lock)}; {loop}", "", None)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args()
+    why = missing()
+    if why:
+        sys.exit(why)
+    perf(args.rounds)
 
 
 if __name__ == "__main__":

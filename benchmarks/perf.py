@@ -30,6 +30,13 @@ Targets:
 * speed for learning and search (``bench_speed.py``): the single env against CartPole-v1 and
   LunarLander-v3, the vector env at 1 to 1,000 envs against ``SyncVectorEnv``, ``ap.run``
   against the compiled step alone, the whole process against ``python -c pass``.
+* benchmarks that need more than this package, each saying so in its rows where what it needs
+  is missing: the exported ROS 1 package (``bench_ros.py``: lockstep pipelined within 3x the
+  in-process loop, the build, the platoon's launch under 1 GiB), ROS 2 (``bench_ros2.py``),
+  IR-SIM (``bench_irsim.py``), the falsification search (``bench_falsify.py``) and PSY-TaLiRo
+  beside it (``bench_falsify_peers.py``); and ``--bag`` (``bench_bag.py``), the window's
+  frame (``bench_view.py``), and the test suite's duration and memory with the MDE package's
+  build (``bench_suite.py``).
 """
 
 from __future__ import annotations
@@ -73,21 +80,19 @@ def med(xs: list[float]) -> str:
     return f"{statistics.median(xs):.4g} (min {min(xs):.4g}, max {max(xs):.4g})"
 
 
-def verdict(ok: bool) -> str:
-    return "PASS" if ok else "MISS"
-
-
 #: The sitting's rows when ``--save`` is given (``report`` adds each line to it).
 RECORDER: results.Recorder | None = None
 #: Standard output while ``--save`` records (the PASS/MISS lines other benchmarks print).
 TEE: results.Tee | None = None
 
 
-def report(name: str, measured: str, target: str, ok: bool) -> None:
+def report(name: str, measured: str, target: str, ok: bool | None, skipped: bool = False) -> None:
+    """Print a figure's line and, with ``--save``, record it (``ok`` None: no aim; ``skipped``:
+    not measurable here, ``measured`` saying why)."""
     with results.quiet(TEE):
-        print(f"{verdict(ok)}  {name:34s} {measured}   target {target}", flush=True)
+        results.print_report(name, measured, target, ok, skipped)
     if RECORDER is not None:
-        RECORDER.add(name, measured, target, ok)
+        RECORDER.add(name, measured, target, ok, skipped)
 
 
 # -- headless run ----------------------------------------------------------------------------
@@ -423,6 +428,17 @@ def batched(reps: int) -> None:
     bench_batch.targets()
 
 
+def _bench(name: str) -> Any:
+    """A benchmark module imported when its target runs (ROS's, IR-SIM's, PSY-TaLiRo's
+    benchmarks import what the others never need)."""
+    import importlib
+
+    return importlib.import_module(name)
+
+
+#: The ``suite`` target's choices (``--suite``, ``--suite-tests``)
+SUITE: dict[str, Any] = {}
+
 TARGETS: dict[str, Callable[[int], None]] = {
     "headless": headless,
     "process": process,
@@ -441,6 +457,16 @@ TARGETS: dict[str, Callable[[int], None]] = {
     "engine": lambda reps: [bench_engine.TARGETS[n](reps) for n in bench_engine.TARGETS],
     # the speed table: each row against its baseline, load taken per row (bench_speed.py)
     "speed": lambda reps: bench_speed.run_all(reps, report, _mark_row("speed")),
+    # the exported ROS 1 package: lockstep, its floor, the build, the platoon's memory
+    "ros": lambda reps: _bench("bench_ros").perf(reps, report),
+    "ros2": lambda reps: _bench("bench_ros2").perf(reps, report),
+    "irsim": lambda reps: _bench("bench_irsim").perf(reps, report),
+    "bag": lambda reps: _bench("bench_bag").perf(reps, report),
+    "view": lambda reps: _bench("bench_view").perf(reps, report),
+    "falsify": lambda reps: _bench("bench_falsify").perf(reps, report),
+    "falsify_peers": lambda reps: _bench("bench_falsify_peers").perf(reps, report),
+    # the test suite's tiers (once each) and the exported MDE package's build
+    "suite": lambda reps: _bench("bench_suite").perf(reps, report, **SUITE),
 }
 
 
@@ -454,17 +480,62 @@ def _mark_row(target: str) -> Callable[[], None]:
     return mark
 
 
+def _junits(ap: argparse.ArgumentParser, args: argparse.Namespace) -> dict[str, Path]:
+    """``--suite-junit quick=FILE full=FILE`` checked before anything is measured (a bad one
+    is one line and exit 2)."""
+    junits: dict[str, Path] = {}
+    for item in args.suite_junit:
+        tier, sep, file = item.partition("=")
+        if not sep or tier not in ("quick", "full") or not file:
+            ap.error(f"--suite-junit {item}: expected quick=FILE or full=FILE")
+        try:
+            _bench("bench_suite").junit_time(Path(file))
+        except ValueError as exc:
+            ap.error(f"--suite-junit {item}: {exc}")
+        junits[tier] = Path(file)
+    return junits
+
+
+#: The most repetitions of the targets that take minutes each (the memory's hour-long runs,
+#: ROS launches, the whole test suite): ``--reps`` above it is cut to it
+REPS_CAP = {"memory": 3, "ros": 2, "ros2": 3, "suite": 1}
+
+
 def main() -> None:
     """Measure every target (or ``--only`` some) and print PASS/MISS lines."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--only", nargs="*", choices=list(TARGETS), default=list(TARGETS))
     ap.add_argument(
+        "--suite",
+        nargs="*",
+        choices=["quick", "full", "build"],
+        default=["quick", "full", "build"],
+        help="what the suite target measures: the quick tier, the full suite, the MDE "
+        "package's build (default all three)",
+    )
+    ap.add_argument(
+        "--suite-junit",
+        nargs="*",
+        default=[],
+        metavar="TIER=FILE",
+        help="take a tier's time and counts from a JUnit XML report of a run already made "
+        "(pytest --junitxml=FILE) instead of running it: quick=FILE, full=FILE",
+    )
+    ap.add_argument(
+        "--suite-tests",
+        nargs="*",
+        default=[],
+        metavar="PATH",
+        help="run only these tests in each tier (to check the suite target itself)",
+    )
+    ap.add_argument(
         "--save",
         action="store_true",
         help="write the figures to benchmarks/results/perf.json and regenerate the docs' tables",
     )
     args = ap.parse_args()
+    SUITE.update(parts=tuple(args.suite), paths=tuple(args.suite_tests), junits=_junits(ap, args))
     global RECORDER, TEE
     if args.save:
         RECORDER = results.Recorder(args.reps)
@@ -475,13 +546,50 @@ def main() -> None:
         f"median of {args.reps} (min, max)",
         flush=True,
     )
-    for name in args.only:
+    failed = []
+    try:
+        for name in args.only:
+            if not _measure(name, max(1, min(args.reps, REPS_CAP.get(name, args.reps)))):
+                failed.append(name)
+    except KeyboardInterrupt:
+        print("interrupted: the targets measured so far are kept", file=sys.stderr)
+        sys.exit(130)
+    finally:
         if RECORDER is not None:
-            RECORDER.start(name)
-        TARGETS[name](args.reps if name != "memory" else max(1, min(args.reps, 3)))
+            results.write_pages()
+    if failed:
+        sys.exit(f"the benchmark of {', '.join(failed)} stopped (its row says how)")
+
+
+def _measure(name: str, reps: int) -> bool:
+    """Measure one target; with ``--save`` its rows go to the file at once, so a sitting of
+    hours keeps every target finished before a failure or a Ctrl-C. A target whose benchmark
+    raises gets one MISS row saying so (its old rows would describe other code) and the
+    sitting goes on; a Ctrl-C drops the interrupted target's partial rows."""
     if RECORDER is not None:
-        RECORDER.save()
-        results.write_pages()
+        RECORDER.start(name)
+        RECORDER.reps = reps
+    try:
+        TARGETS[name](reps)
+    except KeyboardInterrupt:
+        if RECORDER is not None:
+            RECORDER.rows = [r for r in RECORDER.rows if r.target != name]
+        raise
+    except Exception as exc:  # one target's failure must not lose the others
+        import traceback
+
+        traceback.print_exc()
+        why = f"{type(exc).__name__}: {exc}".splitlines()[0][:300]
+        figure = f"{name}: the benchmark stopped"
+        with results.quiet(TEE):
+            print(f"MISS  {figure} ({why})", flush=True)
+        if RECORDER is not None:  # no number read from the message: it is not a figure
+            RECORDER.add_row(figure, None, None, why, "", False)
+        return False
+    finally:
+        if RECORDER is not None:
+            RECORDER.save()
+    return True
 
 
 if __name__ == "__main__":

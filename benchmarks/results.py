@@ -25,6 +25,7 @@ import os
 import re
 import subprocess
 import sys
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -39,6 +40,7 @@ BLOCK = re.compile(r"(<!-- results: ([\w ,-]+?) -->\n)(.*?)(<!-- /results -->)",
 _MED = re.compile(r"^\s*(-?[\d.e+-]+) \(min (-?[\d.e+-]+), max (-?[\d.e+-]+)\)(.*)$", re.DOTALL)
 _MED_ANYWHERE = re.compile(r"(-?[\d.]+(?:e[+-]?\d+)?) \(min (-?[\d.e+-]+), max (-?[\d.e+-]+)\)")
 _AIM = re.compile(r"(?:target |\()([<>]=? ?[\d.,]+ ?[a-zA-Z]*)")
+_LEAD = re.compile(r"^\s*(-?\d[\d,]*(?:\.\d+)?(?:e[+-]?\d+)?)(?:;|$)(.*)$", re.DOTALL)
 _NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e[+-]?\d+)?")
 
 
@@ -53,12 +55,34 @@ class Row:
     ratio_to: str  #: the baseline of a ratio measured in the same sitting ("" for none)
     detail: str  #: the rest of the printed line (baselines' own figures)
     target_text: str  #: the aim, e.g. "<= 15"
-    verdict: str  #: PASS or MISS
+    verdict: str  #: PASS or MISS; INFO without an aim; SKIP when it could not be measured
     reps: int
     load: list[float]  #: the 1-minute load average before and after the target ran
     date: str  #: UTC, ISO 8601
     commit: str  #: ``git rev-parse --short HEAD`` (``-dirty`` when the tree was modified)
     extra: dict[str, Any] = field(default_factory=dict)
+
+
+#: What a benchmark calls for each figure: ``report(name, measured, aim, ok, skipped=False)``
+#: (``perf.report`` prints the line and records it).
+Report = Callable[..., None]
+
+
+def verdict(ok: bool | None, skipped: bool = False) -> str:
+    """PASS or MISS against the aim; INFO for a figure without one; SKIP when not measured."""
+    if skipped:
+        return "SKIP"
+    if ok is None:
+        return "INFO"
+    return "PASS" if ok else "MISS"
+
+
+def print_report(
+    name: str, measured: str, aim: str, ok: bool | None, skipped: bool = False
+) -> None:
+    """``perf.report``'s line, for a benchmark run on its own (nothing recorded)."""
+    aim = f"   target {aim}" if aim else ""
+    print(f"{verdict(ok, skipped):4s}  {name:34s} {measured}{aim}", flush=True)
 
 
 def commit() -> str:
@@ -86,6 +110,9 @@ def parse_measured(measured: str) -> tuple[float | None, list[float] | None, str
     m = _MED.match(measured)
     if m:
         return float(m[1]), [float(m[2]), float(m[3])], m[4].strip(" ;")
+    lead = _LEAD.match(measured)  # "1.42; bag 5.3 MiB": one value, then what it adds
+    if lead:
+        return float(lead[1].replace(",", "")), None, lead[2].strip(" ;")
     first = _NUMBER.search(measured)
     return (float(first[0]) if first else None), None, measured.strip()
 
@@ -116,8 +143,17 @@ class Recorder:
         self.target = target
         self.load_before = os.getloadavg()[0]
 
-    def add(self, figure: str, measured: str, aim: str, ok: bool) -> None:
-        """A line of ``perf.report``: name, measured text, aim and verdict apart."""
+    def add(
+        self, figure: str, measured: str, aim: str, ok: bool | None, skipped: bool = False
+    ) -> None:
+        """A line of ``perf.report``: name, measured text, aim and verdict apart.
+
+        ``ok`` None is a figure shown without an aim (INFO); ``skipped`` a figure that could
+        not be measured here, ``measured`` saying why (SKIP: the row keeps the reason, so a
+        table says what is missing instead of dropping it)."""
+        if skipped:
+            self.add_row(figure, None, None, measured.strip(), aim, None, skipped=True)
+            return
         value, spread, detail = parse_measured(measured)
         self.add_row(figure, value, spread, detail, aim, ok)
 
@@ -140,7 +176,8 @@ class Recorder:
         spread: list[float] | None,
         detail: str,
         aim: str,
-        ok: bool,
+        ok: bool | None,
+        skipped: bool = False,
     ) -> None:
         self.rows.append(
             Row(
@@ -151,7 +188,7 @@ class Recorder:
                 ratio_to=ratio_baseline(figure),
                 detail=detail,
                 target_text=aim,
-                verdict="PASS" if ok else "MISS",
+                verdict=verdict(ok, skipped),
                 reps=self.reps,
                 load=[round(self.load_before, 2), round(os.getloadavg()[0], 2)],
                 date=datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
