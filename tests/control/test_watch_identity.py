@@ -17,28 +17,11 @@ from amsa_phys.model.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[2]
 
-USER_MODULE = '''
-from amsa_phys.model.template import Template
-from amsa_phys.sensors.gps import GPS as Shipped
-
-
-class GPS(Template):
-    """A user's own receiver that happens to share the built-in's name, ports, parameters."""
-
-    kind = Shipped.kind
-    inputs = Shipped.inputs
-    outputs = Shipped.outputs
-    params = Shipped.params
-
-
-class BiasedGPS(Shipped):
-    """A subclass of the built-in."""
-'''
+USER_TEMPLATES = ROOT / "tests" / "fixtures" / "usertemplates"  # usergps.py
 
 
 def _watched(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, template: str) -> dict[str, str]:
-    (tmp_path / "userwatch.py").write_text(USER_MODULE)
-    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.syspath_prepend(str(USER_TEMPLATES))
     world = (ROOT / "worlds" / "mde_adaptive.yaml").read_text()
     old = "  LeaderGPS:\n    template: GPS\n"
     assert old in world
@@ -56,7 +39,7 @@ def _watched(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, template: str) -> 
 def test_the_shipped_gps_and_a_subclass_are_watched(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    for template in ("GPS", "userwatch:BiasedGPS"):
+    for template in ("GPS", "usergps:BiasedGPS"):
         watched = _watched(tmp_path, monkeypatch, template)
         assert watched["LeaderGPSMonitor.lossRate"] == "LeaderGPS.lostDataGPS", template
 
@@ -64,7 +47,7 @@ def test_the_shipped_gps_and_a_subclass_are_watched(
 def test_a_template_that_only_shares_the_name_is_not(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    watched = _watched(tmp_path, monkeypatch, "userwatch:GPS")
+    watched = _watched(tmp_path, monkeypatch, "usergps:GPS")
     # the nearest shipped GPS instead (the follower's), never the look-alike
     assert watched["LeaderGPSMonitor.lossRate"] == "FollowerGPS.lostDataGPS"
     assert watched["MotorMonitor.delivered"] == "MyNormalizePower.motorCoef"  # others still

@@ -22,19 +22,7 @@ from amsa_phys.view.draw import BACKGROUND, Renderer
 from amsa_phys.view.pg import pygame
 from amsa_phys.view.scene import Scene
 
-WORLD = """\
-name: mudTrack
-components:
-  Mud:
-    template: frictionZone
-    freq: 1
-    params: {friction: 0.8, rollingResistance: 0.02, polygon: [[5, -3], [15, -3], [15, 3], [5, 3]]}
-  Ctl: {template: ConstantPower, freq: 10, params: {left: 100, right: 100}}
-  Norm: {template: NormalizePower, freq: 10,
-         inputs: {powerL: Ctl.LeftPower, powerR: Ctl.RightPower}}
-  Rover: {template: controlledRobot, freq: 10,
-          inputs: {powerL: Norm.normalizedPowerL, powerR: Norm.normalizedPowerR}}
-"""
+WORLD = (Path(__file__).resolve().parents[1] / "fixtures" / "mud_track_world.yaml").read_text()
 SCENARIO = """\
 world: w.yaml
 duration: 12

@@ -21,37 +21,12 @@ from amsa_phys.sensors.gps import GPS
 
 ROOT = Path(__file__).resolve().parents[2]
 
-USER_MODULE = '''
-from amsa_phys.model.template import Template
-from amsa_phys.sensors.gps import GPS as Shipped
-
-
-class GPS(Template):
-    """A user's own receiver that happens to share the built-in's name and ports."""
-
-    kind = Shipped.kind
-    inputs = Shipped.inputs
-    outputs = Shipped.outputs
-    params = Shipped.params
-
-    def do_step(self, t, inp):
-        return {"gpsPosX": inp["posX"] + 1.0, "gpsPosY": inp["posY"] + 1.0}
-
-
-class BiasedGPS(Shipped):
-    """A subclass of the built-in that steps otherwise."""
-
-    def do_step(self, t, inp):
-        out = dict(super().do_step(t, inp))
-        out["gpsPosX"] += 1.0
-        return out
-'''
+USER_TEMPLATES = ROOT / "tests" / "fixtures" / "usertemplates"  # usergps.py
 
 
 def _scenario(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, template: str) -> Path:
     """scenario1 with FollowerGPS made of ``template`` (a user module on sys.path)."""
-    (tmp_path / "usergps.py").write_text(USER_MODULE)
-    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.syspath_prepend(str(USER_TEMPLATES))
     world = (ROOT / "worlds" / "mde_challenge.yaml").read_text()
     head, sep, tail = world.partition("  FollowerGPS:\n    template: GPS\n")
     assert sep
