@@ -36,10 +36,16 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     parser.addini("cpu_budget_s", "CPU seconds an unmarked test may spend", default=str(BUDGET_S))
 
 
+@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """A test using a launch fixture is a ROS test."""
+    """A test using a launch fixture is a ROS test. First: ``-m`` deselects in the same hook
+    (pytest's mark plugin), and a marker added after it ran would keep ROS launches in the
+    quick tier."""
     for item in items:
-        if ROS_FIXTURES & set(getattr(item, "fixturenames", ())) and "ros" not in item.keywords:
+        # not ``"ros" in item.keywords``: a test under tests/ros/ has that keyword (its folder)
+        # and so was never marked
+        needs_ros = ROS_FIXTURES & set(getattr(item, "fixturenames", ()))
+        if needs_ros and item.get_closest_marker("ros") is None:
             item.add_marker(pytest.mark.ros)
 
 
