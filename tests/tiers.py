@@ -36,11 +36,8 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     parser.addini("cpu_budget_s", "CPU seconds an unmarked test may spend", default=str(BUDGET_S))
 
 
-@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """A test using a launch fixture is a ROS test. First: ``-m`` deselects in the same hook
-    (pytest's mark plugin), and a marker added after it ran would keep ROS launches in the
-    quick tier."""
+    """A test using a launch fixture is a ROS test."""
     for item in items:
         # not ``"ros" in item.keywords``: a test under tests/ros/ has that keyword (its folder)
         # and so was never marked
