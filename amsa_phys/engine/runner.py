@@ -314,7 +314,7 @@ class Simulation(ReadAPI, FaceReads, LiveChanges):
             self._advance(until_tick)
         if interrupt.requested():
             raise KeyboardInterrupt
-        if self.finished:
+        if self._cursor > self._end:  # ``finished`` without its property call (a gym step's)
             self.plugs.run_ended()
 
     def _advance(self, until_tick: int) -> None:
