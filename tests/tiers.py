@@ -39,7 +39,10 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """A test using a launch fixture is a ROS test."""
     for item in items:
-        if ROS_FIXTURES & set(getattr(item, "fixturenames", ())) and "ros" not in item.keywords:
+        # not ``"ros" in item.keywords``: a test under tests/ros/ has that keyword (its folder)
+        # and so was never marked
+        needs_ros = ROS_FIXTURES & set(getattr(item, "fixturenames", ()))
+        if needs_ros and item.get_closest_marker("ros") is None:
             item.add_marker(pytest.mark.ros)
 
 

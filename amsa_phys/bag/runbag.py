@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from .._version import __version__
-from ..engine.runner import Simulation
+from ..engine.face import SimDriver, SimView
 from ..model.rosnames import EVENTS
 from ..model.scenario import Scenario, traced_columns
 from ..stdmsgs import (
@@ -116,7 +116,7 @@ class BagRecorder:
         self.sources = find_sources(scenario.world)
         self.columns = traced_columns(scenario)
         self.writer: BagWriter | None = None
-        self.sim: Simulation | None = None
+        self.sim: SimView | None = None
         self._streams: list[_Stream] = []
         self._timeline = _timeline_events(scenario)
         self._next_point = 0
@@ -124,7 +124,7 @@ class BagRecorder:
         self._ready = False
 
     # -- hooking into a run --------------------------------------------------------------
-    def simulation(self, scenario: Scenario, trace: Any) -> Simulation:
+    def simulation(self, scenario: Scenario, trace: Any) -> SimDriver:
         """A :data:`~amsa_phys.runs.single.SimulationFactory`: the engine's Simulation with
         this recorder attached."""
         from ..runs.single import default_simulation  # a ros2: scenario's Leaves too
@@ -133,7 +133,7 @@ class BagRecorder:
         self.attach(sim)
         return sim
 
-    def attach(self, sim: Simulation) -> None:
+    def attach(self, sim: SimView) -> None:
         """Open the bag and listen to ``sim``'s trace instants."""
         self.sim = sim
         sc = self.scenario

@@ -19,6 +19,7 @@ from ..model.scenario import Change
 from . import schedule
 from .adapt import MAX_SWITCH_EVENTS
 from .context import Event
+from .plugs import Plugs
 from .tasks import COMPONENT_ERRORS, in_run
 
 
@@ -39,6 +40,7 @@ class LiveChanges:
     _cycle: int
     _cursor: int
     now: Fraction
+    plugs: Plugs
 
     def initialize(self) -> None:  # pragma: no cover - Simulation's
         raise NotImplementedError
@@ -100,14 +102,16 @@ class LiveChanges:
     def _apply_adapt(self) -> None:
         """Apply the ``adapt:`` rule due now, like a timeline change at this instant."""
         assert self._adapt is not None
-        firing = self._adapt.due(self.now, self.values)
-        if firing is None:
+        fired = self.plugs.rule_due(self._adapt, self.now, self.values)
+        if fired is None:
             return
-        for change in firing.rule.changes:
+        rule, detail = fired
+        for change in rule.changes:
+            self.plugs.rule_change(change)
             self.apply_change(change)
-        self.values[RULE_COLUMN] = float(firing.rule.number)
+        self.values[RULE_COLUMN] = float(rule.number)
         if self._adapt.switches <= MAX_SWITCH_EVENTS:  # later ones are counted, not kept
-            self.record_event("adapt", firing.detail())
+            self.record_event("adapt", detail)
 
     def _param_value(self, leaf: str, param: str) -> Any:
         """The value of ``leaf.param`` in force now."""

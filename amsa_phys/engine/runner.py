@@ -42,9 +42,11 @@ from .build import build_components, make_task, plan_groups
 from .clock import TickGrid
 from .context import Context, Event, Hook, RunResult
 from .delivery import Deliveries
+from .facereads import FaceReads
 from .instants import InstantSource, TimelineSource
 from .livechanges import LiveChanges
 from .log import RunLog
+from .plugs import Plugs
 from .signals import RequirementWatch
 from .store import BufferStore, ReadAPI
 from .tasks import COMPONENT_ERRORS, Steppers, Task, in_run
@@ -57,7 +59,7 @@ Wrap = Callable[[str, Template], Template]
 __all__ = ["COMPONENT_ERRORS", "Context", "Event", "RunResult", "Simulation", "Task", "Wrap"]
 
 
-class Simulation(ReadAPI, LiveChanges):
+class Simulation(ReadAPI, FaceReads, LiveChanges):
     """One run of a scenario (or of a bare world, for tests).
 
     Read from outside with :meth:`read`, :meth:`read_many`, :meth:`column` and
@@ -71,6 +73,7 @@ class Simulation(ReadAPI, LiveChanges):
     components must each be called (a ROS node per Leaf) or a test's reference run; a
     ``batch.Grouping`` says how to group instead. ``context(sim, path)`` makes what each
     component's ``initialize`` receives (a batch of runs gives each run its own).
+    ``plugs``: what a runtime changes at an instant (``plugs.py``); outsiders see ``face.py``.
     """
 
     def __init__(
@@ -90,8 +93,10 @@ class Simulation(ReadAPI, LiveChanges):
         grouping: bool | batch.Grouping = True,
         context: Callable[[Simulation, str, int], Context] = Context,
         runs: Sequence[Scenario] = (),
+        plugs: Plugs | None = None,
     ) -> None:
         self.world = world
+        self.plugs = plugs if plugs is not None else Plugs()
         self.seed = seed
         self.duration = Fraction(timeline.duration if timeline is not None else duration)
         #: ``runs``: a batch of runs of ``world``'s structure (``multirun.py``) stepped
@@ -309,6 +314,8 @@ class Simulation(ReadAPI, LiveChanges):
             self._advance(until_tick)
         if interrupt.requested():
             raise KeyboardInterrupt
+        if self._cursor > self._end:  # ``finished`` without its property call (a gym step's)
+            self.plugs.run_ended()
 
     def _advance(self, until_tick: int) -> None:
         """:meth:`advance` without the interrupt check.
@@ -442,14 +449,14 @@ class Simulation(ReadAPI, LiveChanges):
                     for at, phase, changes in source.due(tick):
                         if phase is not None:
                             self.phase_index = phase
-                        self._now_override = self.grid.time(at)
+                        self._now_override = when = self.grid.time(at)
                         run = getattr(source, "run", 0)
                         try:
                             for change in changes:
                                 if run:
                                     self._change(change, run)
-                                else:  # the single run's (a subclass may judge it first)
-                                    self.apply_change(change)
+                                else:  # the single run's (a runtime may judge it first)
+                                    self.apply_change(self.plugs.timeline_change(change, when))
                         finally:
                             self._now_override = None
             self._next_source_tick = min(s.next_tick() for s in self._sources)

@@ -214,8 +214,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         self._memory = TraceMemory(list(scenario.world.buffers)) if self.record_trace else None
         trace = self._memory.write if self._memory is not None else None
         self._episode = Episode(scenario, self.path, trace)
-        store = self._episode.sim.store
-        self._data, self._signal_at = store.data, store.at(self._signal)
+        sim = self._episode.sim
+        self._data, self._signal_at = sim.data, sim.at(self._signal)
         self._collisions = 0
         self._seen_events = 0
         if self.render_mode == "rgb_array":

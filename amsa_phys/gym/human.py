@@ -9,7 +9,7 @@ closing it ends nothing but the drawing (the agent's loop owns the episode).
 
 from __future__ import annotations
 
-from ..engine.runner import Simulation
+from ..engine.face import SimView
 from ..model.scenario import Quality
 from ..view.pg import pygame
 from ..view.window import open_display
@@ -20,7 +20,7 @@ class HumanView(FrameSource):
     """A FrameSource that also shows each frame in a window."""
 
     def __init__(
-        self, sim: Simulation, quality: Quality | None, size: tuple[int, int], fps: float
+        self, sim: SimView, quality: Quality | None, size: tuple[int, int], fps: float
     ) -> None:
         super().__init__(sim, quality, size)
         open_display()  # RuntimeError (no display) is reported by the env as it is

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..engine.runner import Simulation
+from ..engine.face import SimView
 from ..model.scenario import Quality
 from ..templatemarks import StandIn, marked
 from ..view.camera import Camera
@@ -18,7 +18,7 @@ from ..view.scene import Scene
 from ..view.video import new_surface
 
 
-def replaced_components(sim: Simulation) -> list[str]:
+def replaced_components(sim: SimView) -> list[str]:
     """The components the agent stands in for: their parameters (a replaced controller's
     ``Kv=0.35``) act on nothing, so the HUD must not list them as if they did."""
     return [path for path, _, _ in marked(sim.world.leaves, StandIn)]
@@ -27,7 +27,7 @@ def replaced_components(sim: Simulation) -> list[str]:
 class FrameSource:
     """Samples a simulation's history at every agent step and draws it on request."""
 
-    def __init__(self, sim: Simulation, quality: Quality | None, size: tuple[int, int]) -> None:
+    def __init__(self, sim: SimView, quality: Quality | None, size: tuple[int, int]) -> None:
         self.sim = sim
         self.scene = Scene(sim, quality, replaced=replaced_components(sim))
         self.camera = Camera(size)

@@ -51,7 +51,7 @@ from ..palette import (
 from ..tracemarks import lossy_in_run, lost_fix_rows
 from .distance import cut_note, read_trace
 from .save import save_png
-from .zones import draw_zones, zones_of_run
+from .zones import draw_zones
 
 #: a run is drawn in the lateral-offset view when its paths stay this close to one line
 STRAIGHT_RATIO = 0.05
@@ -189,7 +189,7 @@ def plot_trajectory(
     FigureCanvasAgg(fig)
     ax = fig.subplots()
     draw_static_world(ax, physics, view)
-    zones = world["zones"] if "zones" in world else zones_of_run(trace.parent / "scenario.yaml")
+    zones = world.get("zones") or []  # from the run's timeline (runs/plotjob.plot_context)
     draw_zones(ax, zones, view)  # terrain, from the run (its timeline changes the labels)
     grouped = len(rovers) > GROUP_ABOVE
     ranks = rover_ranks(world.get("rovers") or rovers, rovers)  # the world's order, not the trace's

@@ -1,30 +1,30 @@
-"""Terrain zones on the trajectory plot, read from a run's resolved ``scenario.yaml``.
+"""Terrain zones on the trajectory plot: each zone's polygon and ground, and the timeline's
+changes to it in its label.
 
 A zone is a component whose template declares a :class:`~amsa_phys.templatemarks.Zone` mark
-(the built-in ``frictionZone``, ``physics/zones.py``, or a user's own); the resolved scenario
-holds its polygon and values at t = 0, and the timeline its changes, so the plot can say
-"Mud: μ 0.8, from 60 s μ 0.3" without the run's objects. Drawn under the paths, in the
-colours the window uses.
+(the built-in ``frictionZone``, ``physics/zones.py``, or a user's own). The caller gives the
+zones' parameters (the world's), their marks and the run's
+:class:`~amsa_phys.model.timeline.Timeline` (the one the run ran, or
+``runs.rundata.timeline_of`` a run directory's, read as data): the plot says "Mud: μ 0.8,
+from 60 s μ 0.3" without the run's objects and without reading a file itself. Drawn under
+the paths, in the colours the window uses.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from pathlib import Path
+from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import yaml
 
-from ..model.template import BUILTINS, resolve_template
+from ..model.timeline import Timeline
 from ..physics.terrain import zone_colours
-from ..templatemarks import Zone, marks_of
+from ..templatemarks import Zone
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
-
-_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
 @dataclass(frozen=True)
@@ -38,87 +38,48 @@ class ZoneShape:
     label: str
 
 
-def zones_of_run(scenario_yaml: Path) -> list[ZoneShape]:
-    """The zones of a run directory's ``scenario.yaml`` (none if it has none), read without
-    its world: the zones the built-in templates it names declare (a template that is not
-    built in is never imported to ask)."""
-    try:
-        data = yaml.load(scenario_yaml.read_text(), Loader=_LOADER)  # a safe loader (C or Python)
-    except (OSError, yaml.YAMLError):
-        return []
-    return zones_of_resolved(data, builtin_zones(data))
-
-
-def builtin_zones(data: Any) -> dict[str, Zone]:
-    """Path -> the zone mark of every leaf of a resolved scenario whose built-in template
-    declares one."""
-    out: dict[str, Zone] = {}
-    for path, spec in _leaves(data).items():
-        ref = spec.get("template")
-        if isinstance(ref, str) and ref in BUILTINS:
-            for mark in marks_of(resolve_template(ref), Zone):
-                out[path] = mark
-    return out
-
-
-def zones_of_resolved(data: Any, declared: Mapping[str, Zone]) -> list[ZoneShape]:
-    """The zones of a resolved scenario (the data ``scenario.yaml`` holds); ``declared``:
-    path -> the zone mark its template declares (``plot_context`` reads them from the world).
+def zones_of(
+    params: Mapping[str, Mapping[str, Any]], declared: Mapping[str, Zone], timeline: Timeline
+) -> list[ZoneShape]:
+    """The zones of a run: ``declared`` maps each zone's path to its template's mark,
+    ``params`` each Leaf's parameters as its world gives them; the timeline's values at t = 0
+    are taken over them, and its later changes to a zone's ground go in its label.
 
     Matplotlib-free, so a run's process can hand the zones to its plotting child with the
     job instead of the child reading ``scenario.yaml`` (which is then still being written).
     """
-    leaves = {p: spec.get("params") or {} for p, spec in _leaves(data).items() if p in declared}
-    if not leaves or not isinstance(data, Mapping):
-        return []
+    values = {path: dict(params.get(path) or {}) for path in declared}
+    for change in timeline.initial:
+        if change.leaf in values:
+            values[change.leaf][change.param] = change.value
     changes: dict[str, list[str]] = {}
-    for entry in data.get("timeline") or []:
+    for point in timeline.points():
         said: dict[str, list[str]] = {}
-        for key, value in (entry.get("set") or {}).items():
-            path, _, param = str(key).rpartition(".")
-            mark = declared.get(path)
-            if path in leaves and mark and param in (mark.friction, mark.rolling_resistance):
-                word = "μ" if param == mark.friction else "Crr"
-                said.setdefault(path, []).append(f"{word} {value}")
+        for change in point.changes:
+            mark = declared.get(change.leaf)
+            if mark is not None and change.param in (mark.friction, mark.rolling_resistance):
+                word = "μ" if change.param == mark.friction else "Crr"
+                said.setdefault(change.leaf, []).append(f"{word} {change.value}")
         for path, words in said.items():
-            text = f"from {_at(entry.get('at'))} s " + ", ".join(words)
+            text = f"from {_at(point.at)} s " + ", ".join(words)
             changes.setdefault(path, []).append(text)
     out = []
-    for path, params in leaves.items():
-        mark = declared[path]
-        mu = float(params.get(mark.friction, 0.3))
-        crr = float(params.get(mark.rolling_resistance, 0.1))
+    for path, mark in declared.items():
+        given = values[path]
+        mu = float(given.get(mark.friction, 0.3))
+        crr = float(given.get(mark.rolling_resistance, 0.1))
         label = "; ".join([f"{path}: μ {mu:g}, Crr {crr:g}", *changes.get(path, [])])
-        pts = tuple((float(x), float(y)) for x, y in params.get(mark.polygon) or ())
+        pts = tuple((float(x), float(y)) for x, y in given.get(mark.polygon) or ())
         if len(pts) >= 3:
             out.append(ZoneShape(path, pts, mu, crr, label))
     return out
 
 
-def _leaves(data: Any) -> dict[str, Mapping[str, Any]]:
-    """Path -> spec of every leaf of a resolved scenario's world (none if it has none)."""
-    if not isinstance(data, Mapping) or not isinstance(data.get("world"), Mapping):
-        return {}
-    out: dict[str, Mapping[str, Any]] = {}
-    _collect(data["world"].get("components") or {}, "", out)
-    return out
-
-
-def _collect(components: Mapping[str, Any], prefix: str, out: dict[str, Any]) -> None:
-    for name, spec in components.items():
-        if not isinstance(spec, Mapping):
-            continue
-        if "components" in spec:
-            _collect(spec["components"], f"{prefix}{name}.", out)
-        else:
-            out[prefix + name] = spec
-
-
-def _at(value: Any) -> str:
-    try:
-        return f"{float(value):g}"
-    except (TypeError, ValueError):
-        return str(value)  # an exact fraction such as "7/3"
+def _at(at: Any) -> str:
+    """An instant as the label says it: ``60``, ``15.25``; an exact fraction that no short
+    decimal writes (``7/3``) as the fraction."""
+    text = f"{float(at):g}"
+    return text if Fraction(text) == at else str(at)
 
 
 def draw_zones(
@@ -131,7 +92,7 @@ def draw_zones(
     ``view`` maps world metres to plot coordinates (the trajectory plot's lateral-offset
     frame), so a zone stays under the paths that cross it in any view.
     """
-    from matplotlib.patches import Polygon  # here: zones_of_resolved runs without matplotlib
+    from matplotlib.patches import Polygon  # here: zones_of runs without matplotlib
 
     for z in zones:
         pts = np.asarray(z.polygon, dtype=float)

@@ -15,6 +15,7 @@ from typing import Any
 
 from .._version import __version__
 from ..errors import ConfigError
+from ..model.template import Template, resolve_template
 from ..model.world import LeafSpec
 from . import names
 from .graph import RosGraph
@@ -23,9 +24,14 @@ from .quote import Code, cmake_arg, cpp_string, fill, yaml_comment, yaml_dump
 FILES = Path(__file__).parent / "files"
 
 
-def cpp_bodies() -> dict[str, str]:
-    """Templates with a C++ body (``files/cpp/NAME.inc``), by template name."""
-    return {p.stem: p.read_text() for p in sorted((FILES / "cpp").glob("*.inc"))}
+def cpp_bodies() -> dict[type[Template], str]:
+    """The shipped templates with a C++ body (``files/cpp/NAME.inc``), by class.
+
+    A body is the C++ twin of one class's step, so it is keyed by that class, never by a
+    name: a user's own template that happens to be called ``GPS``, or a subclass of the
+    shipped GPS (which may step otherwise), has no body and runs its own Python step.
+    """
+    return {resolve_template(p.stem): p.read_text() for p in sorted((FILES / "cpp").glob("*.inc"))}
 
 
 def _names(text: str) -> list[str]:
@@ -38,7 +44,7 @@ def has_cpp(leaf: LeafSpec, bodies: dict[str, str]) -> bool:
     linked (the body indexes ``in[]`` by the template's ports; an optional port left
     unlinked, as an IMU without the pose, would shift them: such a Leaf stays in Python)."""
     ports = [p.name for p in leaf.template.inputs]
-    return leaf.template.name() in bodies and all(p in leaf.inputs for p in ports)
+    return leaf.template in bodies and all(p in leaf.inputs for p in ports)
 
 
 def check_cpp_ports(leaf: LeafSpec, body: str) -> None:
@@ -111,12 +117,17 @@ def _param_specs(leaf: LeafSpec) -> list[str]:
 
 
 def cpp_leaf(
-    graph: RosGraph, tname: str, paths: list[str], pkg: str, source: str, bodies: dict[str, str]
+    graph: RosGraph,
+    tname: str,
+    paths: list[str],
+    pkg: str,
+    source: str,
+    bodies: dict[type[Template], str],
 ) -> str:
     """``src/leaves/TEMPLATE.cpp``: the template's nodelet class, compiled once for all of
     its Leaves (``paths``); each Leaf's wiring is a parameter (:func:`wiring`)."""
     leaf = graph.leaf(paths[0])
-    body = bodies[tname].split("\n", 1)[1].rstrip()
+    body = bodies[leaf.template].split("\n", 1)[1].rstrip()
     sep = ",\n                        "
     return fill(
         (FILES / "cpp_leaf.cpp.in").read_text(),

@@ -138,7 +138,7 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
     bodies = cpp_bodies()
     cpp = [p for p in graph.remote if has_cpp(world.leaves[p], bodies)]
     for path in cpp:
-        check_cpp_ports(world.leaves[path], bodies[world.leaves[path].template.name()])
+        check_cpp_ports(world.leaves[path], bodies[world.leaves[path].template])
     source = ", ".join(Path(s).name for s in sources)
     files: dict[str, str] = {}
     executable: set[str] = set()

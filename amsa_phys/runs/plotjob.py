@@ -51,6 +51,7 @@ from ..palette import rover_names
 from ..templatemarks import Zone as ZoneMark
 from ..templatemarks import marked
 from ..tracemarks import gps_links
+from .rundata import timeline_of
 
 #: How long the parent waits for the child's plots before drawing them itself.
 TIMEOUT_S = 60.0
@@ -107,10 +108,11 @@ def plot_context(world: WorldSpec, resolved: Any = None) -> dict[str, Any]:
     context["rovers"] = rover_names(list(world.buffers))
     context["gps"] = [vars(link) for link in links]
     if resolved is not None:  # the run's resolved scenario: its zones go with the job
-        from ..plots.zones import zones_of_resolved  # matplotlib-free
+        from ..plots.zones import zones_of  # matplotlib-free
 
         declared = {path: mark for path, _, mark in marked(world.leaves, ZoneMark)}
-        context["zones"] = zones_of_resolved(resolved, declared)
+        params = {path: world.leaves[path].params for path in declared}
+        context["zones"] = zones_of(params, declared, timeline_of(resolved))
     return context
 
 

@@ -14,12 +14,13 @@ from fractions import Fraction
 from typing import Any
 
 from .._version import __version__
+from ..engine.face import SimView
 
 #: force models whose whole step (or, for a batch's columns, whose force pass) is the C one
 COMPILED_MODELS = ("CompiledFewRovers", "CompiledFleet", "ColumnForces")
 
 
-def provenance(sim: Any) -> dict[str, Any]:
+def provenance(sim: SimView) -> dict[str, Any]:
     """``{"amsa_phys_version": ..., "physics": {...} or None}`` for ``sim``'s run.
 
     ``physics`` is None for a world without a physics world (no rover). Otherwise:
@@ -29,7 +30,7 @@ def provenance(sim: Any) -> dict[str, Any]:
     sub-steps only while the fastest rover is faster than this (so none tunnels through a
     thin wall; null when nothing in the world is thin enough to need it).
     """
-    physics = sim.shared.get("physics") if hasattr(sim, "shared") else None
+    physics = sim.service("physics")
     return {"amsa_phys_version": __version__, "physics": _physics(physics)}
 
 

@@ -17,6 +17,7 @@ API::
 
     run = read_run(rundir)            # metrics judged, trace path, world (or None), notes
     world = read_world(scenario_yaml, trace_columns)   # the world alone
+    timeline = timeline_of(run.resolved)  # its Timeline (values as written)
     kept_runs(sweepdir)               # a sweep's kept run directories, for read_run
 
 Warnings go to ``warn`` (default: one line on stderr, terminal-safe) and are kept in
@@ -35,7 +36,9 @@ from typing import Any
 
 from ..errors import ConfigError, one_line
 from ..model import schema
+from ..model.changes import Change
 from ..model.template import BUILTINS, Kind, Template, resolve_template
+from ..model.timeline import Phase, Step, Timeline
 from ..model.worldspec import DEFAULT_FREQ_HZ, PHYSICS_DEFAULTS
 from ..model.yamlio import YamlDoc, load_yaml
 
@@ -159,6 +162,57 @@ def read_run(
             raise doc.error((), "not a resolved scenario: expected a mapping")
         world = world_of(doc, trace_header(trace), note)
     return RunDir(rundir, metrics, trace, resolved, world, notes)
+
+
+def timeline_of(resolved: Any) -> Timeline:
+    """The :class:`~amsa_phys.model.timeline.Timeline` a resolved ``scenario.yaml`` holds,
+    read as data: ``set:`` as phase 0, each ``timeline:`` entry a phase or a step inside one
+    (``new_phase: false``), every value as written (no template is asked to judge it, so
+    nothing is imported). An entry that is not well formed (a hand edit of a shared run
+    directory) is left out rather than refused: readers draw what they can. Without a
+    readable ``duration`` the run is taken to end at its last change.
+    """
+    data = resolved if isinstance(resolved, dict) else {}
+    phases = [Phase(Fraction(0), _changes(data.get("set")))]
+    for i, entry in enumerate(data.get("timeline") or []):
+        at = _instant(entry.get("at")) if isinstance(entry, dict) else None
+        if at is None or at <= 0:
+            continue
+        changes, label = _changes(entry.get("set")), str(entry.get("label") or "")
+        if entry.get("new_phase", True) is False:
+            step = Step(at, changes, label, entry=i)
+            phases[-1] = Phase(
+                phases[-1].at,
+                phases[-1].changes,
+                phases[-1].label,
+                [*phases[-1].within, step],
+                phases[-1].entry,
+            )
+        else:
+            phases.append(Phase(at, changes, label, entry=i))
+    last = max([p.at for p in phases] + [s.at for p in phases for s in p.within])
+    duration = _instant(data.get("duration"))
+    return Timeline.of(phases, duration if duration is not None and duration > last else last)
+
+
+def _instant(value: Any) -> Fraction | None:
+    """``at:`` or ``duration:`` as an exact number (``"61/4"`` too); None if it is none."""
+    try:
+        return Fraction(str(value)) if isinstance(value, int | float | str) else None
+    except (ValueError, ZeroDivisionError):
+        return None
+
+
+def _changes(said: Any) -> list[Change]:
+    """``{Leaf.param: value}`` as changes, values as written."""
+    if not isinstance(said, dict):
+        return []
+    out = []
+    for key, value in said.items():
+        leaf, _, param = str(key).rpartition(".")
+        if leaf and param:
+            out.append(Change(leaf, param, value))
+    return out
 
 
 def read_world(path: Path, trace_columns: Sequence[str] = (), warn: Warn | None = None) -> RunWorld:

@@ -20,6 +20,7 @@ import yaml
 
 from ..atomic import write_atomic
 from ..engine import interrupt
+from ..engine.face import SimDriver
 from ..engine.runner import Simulation
 from ..engine.tracefile import TraceWriter
 from ..errors import Interrupted, OutputError, RunFault, one_line
@@ -47,7 +48,7 @@ class RunOutcome:
 
     out_dir: Path
     metrics: dict[str, Any]
-    simulation: Simulation
+    simulation: SimDriver
 
 
 def run_scenario(
@@ -91,7 +92,7 @@ def run_scenario(
 
 
 TraceFn = Callable[[float, list[float]], None]
-SimulationFactory = Callable[[Scenario, TraceFn], Simulation]
+SimulationFactory = Callable[[Scenario, TraceFn], SimDriver]
 
 
 #: Who builds the Simulation of a scenario with ``ros2:`` Leaves: the ROS 2 target, a layer
@@ -100,7 +101,7 @@ SimulationFactory = Callable[[Scenario, TraceFn], Simulation]
 ROS2_SIMULATION = "amsa_phys.ros.ros2.bridge:ExternalSimulation"
 
 
-def default_simulation(scenario: Scenario, trace: TraceFn) -> Simulation:
+def default_simulation(scenario: Scenario, trace: TraceFn) -> SimDriver:
     """The engine's Simulation of ``scenario``; with ``ros2:`` Leaves, the ROS 2 bridge's."""
     if scenario.ros2:  # Leaves stepped by a user's ROS 2 nodes: rclpy only then
         module, _, name = ROS2_SIMULATION.partition(":")
@@ -178,7 +179,7 @@ class Ended:
     """
 
     scenario: Scenario
-    simulation: Simulation
+    simulation: SimDriver
     metrics: dict[str, Any]
     resolved: dict[str, Any]
     error: BaseException | None
@@ -239,8 +240,7 @@ def execute(
         status, error = "interrupted", exc
     wall = time.perf_counter() - t0
     external = getattr(sim, "external_report", None)  # a ROS 2 run: each node's answers
-    if external is not None:
-        sim.close()  # type: ignore[attr-defined]  # leave the ROS 2 graph
+    sim.close()  # a ROS 2 run leaves its graph
     # Each output is written even if another could not be (a full disk): metrics.json
     # above all. The first failure is raised once the run's own error, if any, is.
     unwritten: list[OutputError] = []
@@ -340,10 +340,10 @@ def _cut_note(metrics: dict[str, Any], dropped: list[Expectation]) -> str:
 
 
 #: Runs a window session; returns the wall-clock seconds it was paused (None: never).
-WindowDriver = Callable[[Simulation, Scenario, "Recorder | None"], "float | None"]
+WindowDriver = Callable[[SimDriver, Scenario, "Recorder | None"], "float | None"]
 
 
-def _open_window(sim: Simulation, scenario: Scenario, recorder: Recorder | None) -> float:
+def _open_window(sim: SimDriver, scenario: Scenario, recorder: Recorder | None) -> float:
     from ..view.window import Window
 
     return Window(
@@ -378,7 +378,7 @@ def _finish_video(recorder: Recorder | None, error: BaseException | None) -> dic
 
 
 def _advance_with_progress(
-    sim: Simulation, scenario: Scenario, progress: bool | None, sinks: list[FrameSink]
+    sim: SimDriver, scenario: Scenario, progress: bool | None, sinks: list[FrameSink]
 ) -> None:
     """Advance in one-second chunks, updating a progress bar on a terminal."""
     total = float(scenario.duration)

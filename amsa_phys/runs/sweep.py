@@ -374,8 +374,7 @@ def run_job(job: Job) -> dict[str, Any]:
                 status = f"fault: {exc}"
                 row["error"] = str(exc)
             finally:
-                if scenario.ros2:
-                    sim.close()  # type: ignore[attr-defined]
+                sim.close()  # a ros2: run leaves its graph
             metrics = compute_metrics(scenario, sim, sim.result(), 1.0, status)
     except (AmsaError, ValueError) as exc:
         row["error"] = str(exc)

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from fractions import Fraction
 from typing import Protocol
 
-from ..engine.runner import Simulation
+from ..engine.face import SimDriver, SimView
 
 
 class FrameSink(Protocol):
@@ -20,12 +20,12 @@ class FrameSink(Protocol):
         """Take the picture of the simulation's current state."""
 
 
-def last_tick_at(sim: Simulation, t: Fraction) -> int:
+def last_tick_at(sim: SimView, t: Fraction) -> int:
     """The last instant at or before ``t`` on the simulation's grid."""
     return math.floor(t / sim.grid.tick)
 
 
-def advance(sim: Simulation, until_tick: int, sinks: Sequence[FrameSink] = ()) -> None:
+def advance(sim: SimDriver, until_tick: int, sinks: Sequence[FrameSink] = ()) -> None:
     """``sim.advance(until_tick)``, stopping at every frame time on the way to capture it.
 
     Frame *k* shows the world after every instant *at or before* its time has run: the

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from ..engine.runner import Simulation
+from ..engine.face import SimView
 from ..model.params import Param
 from ..model.scenario import Change
 from ..valuetext import value_text
@@ -45,7 +45,7 @@ class Row:
 class ParamPanel:
     """Selection, pending value and feedback of the parameter panel."""
 
-    def __init__(self, sim: Simulation) -> None:
+    def __init__(self, sim: SimView) -> None:
         self.sim = sim
         self.rows = [
             Row(path, p, p.name in comp.fixed_once_running)

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
 
-from ..engine.runner import Simulation
+from ..engine.face import SimView
 from ..model.geometry import Obstacle, static_obstacles
 from ..model.scenario import Quality
 from ..palette import rover_names
@@ -127,7 +127,7 @@ class Frame:
 
 
 def describe_phase(
-    sim: Simulation,
+    sim: SimView,
     planned: Sequence[Fraction] | None = None,
     replaced: Sequence[str] = (),
 ) -> str:
@@ -182,7 +182,7 @@ def phase_line(index: int, count: int, label: str, start_s: float, sets: Sequenc
     return f"{text}: {joined}" if joined else text
 
 
-def adapt_text(sim: Simulation) -> str:
+def adapt_text(sim: SimView) -> str:
     """`` | adapt at 327.3 s: rule 3 (worn motors): Kv=0.35``: the last ``adapt:`` switch
     (events are few: the scan from the end stops at the first one found)."""
     for event in reversed(sim.events):
@@ -217,7 +217,7 @@ class Scene:
 
     def __init__(
         self,
-        sim: Simulation,
+        sim: SimView,
         quality: Quality | None = None,
         planned: Sequence[Fraction] | None = None,
         replaced: Sequence[str] = (),
@@ -269,7 +269,7 @@ class Scene:
         return len(read & rovers) >= 2
 
     def _physics(self) -> Any:
-        return self.sim.shared.get("physics")
+        return self.sim.service("physics")
 
     def zones(self) -> list[ZoneView]:
         """The world's friction zones with their current values (empty without physics)."""

@@ -17,7 +17,7 @@ from fractions import Fraction
 from pathlib import Path
 
 from ..atomic import write_atomic
-from ..engine.runner import Simulation
+from ..engine.face import SimView
 from ..model.scenario import Quality
 from .camera import Camera
 from .draw import Renderer
@@ -52,7 +52,7 @@ class Recorder:
 
     def __init__(
         self,
-        sim: Simulation,
+        sim: SimView,
         options: RecordOptions,
         quality: Quality | None = None,
         planned: Sequence[Fraction] | None = None,
@@ -111,7 +111,7 @@ class Snapshot:
 
     def __init__(
         self,
-        sim: Simulation,
+        sim: SimView,
         options: SnapshotOptions,
         quality: Quality | None = None,
         planned: Sequence[Fraction] | None = None,

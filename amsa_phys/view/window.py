@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from fractions import Fraction
 
 from ..engine import interrupt
-from ..engine.runner import Simulation
+from ..engine.face import SimDriver
 from ..model.scenario import Quality
 from ..valuetext import value_text
 from .camera import Camera
@@ -98,7 +98,7 @@ class Window:
 
     def __init__(
         self,
-        sim: Simulation,
+        sim: SimDriver,
         quality: Quality | None,
         *,
         title: str = "amsa-phys",

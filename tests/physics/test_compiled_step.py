@@ -33,6 +33,21 @@ from amsa_phys.runs.single import run_scenario
 
 ROOT = Path(__file__).resolve().parents[2]
 SHIPPED = sorted((ROOT / "scenarios").glob("*.yaml"))
+#: shipped scenarios whose compiled-versus-pure trace is compared in the full suite only (the
+#: longest, and two of the four Kv steps of Fig. 5): the quick tier keeps one of each kind (a
+#: follower, a Kv step, the obstacle course's contacts, sensed and GPS-denied runs), and the
+#: fleet and every regime of the wheel model are compared by the tests below and above
+FULL_SUITE_ONLY = {
+    "paper_fig5_kv005",
+    "paper_fig5_kv015",
+    "long_mission",
+    "adaptive",
+    "adaptive_sweep",
+    "adaptive_sweep_gps",
+    "paper_fig6_urban",
+    "paper_fig5_kv035",
+    "platoon",
+}
 
 built = pytest.mark.skipif(
     extension() is None, reason="the compiled step was not built (no C compiler at install)"
@@ -87,7 +102,13 @@ def test_every_regime_of_the_wheel_model_is_bit_identical(cls: str) -> None:
 
 
 @built
-@pytest.mark.parametrize("scenario", SHIPPED, ids=[p.stem for p in SHIPPED])
+@pytest.mark.parametrize(
+    "scenario",
+    [
+        pytest.param(p, id=p.stem, marks=[pytest.mark.slow] if p.stem in FULL_SUITE_ONLY else [])
+        for p in SHIPPED
+    ],
+)
 def test_compiled_and_pure_steps_write_the_same_trace(
     scenario: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -80,6 +80,7 @@ def test_a_long_low_friction_manoeuvre_converges_with_order_one(tmp_path: Path, 
         assert c["error"] < 0.05, c
 
 
+@pytest.mark.slow  # the property is the quick tier's (above); this shows its check can fail
 def test_mutation_without_solving_the_gripping_wheel_again_it_does_not_converge(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -14,25 +14,15 @@ from amsa_phys.errors import ConfigError
 from amsa_phys.model.scenario import load_scenario
 from amsa_phys.model.world import load_world
 from amsa_phys.physics.terrain import zone_colours
-from amsa_phys.plots.zones import zones_of_run
+from amsa_phys.plots.zones import zones_of
+from amsa_phys.runs.rundata import read_run, timeline_of
+from amsa_phys.templatemarks import Zone, marked
 from amsa_phys.view.camera import Camera
 from amsa_phys.view.draw import BACKGROUND, Renderer
 from amsa_phys.view.pg import pygame
 from amsa_phys.view.scene import Scene
 
-WORLD = """\
-name: mudTrack
-components:
-  Mud:
-    template: frictionZone
-    freq: 1
-    params: {friction: 0.8, rollingResistance: 0.02, polygon: [[5, -3], [15, -3], [15, 3], [5, 3]]}
-  Ctl: {template: ConstantPower, freq: 10, params: {left: 100, right: 100}}
-  Norm: {template: NormalizePower, freq: 10,
-         inputs: {powerL: Ctl.LeftPower, powerR: Ctl.RightPower}}
-  Rover: {template: controlledRobot, freq: 10,
-          inputs: {powerL: Norm.normalizedPowerL, powerR: Norm.normalizedPowerR}}
-"""
+WORLD = (Path(__file__).resolve().parents[1] / "fixtures" / "mud_track_world.yaml").read_text()
 SCENARIO = """\
 world: w.yaml
 duration: 12
@@ -71,7 +61,11 @@ def test_the_picture_shows_the_zone_as_it_is_now(scenario: Path) -> None:
 def test_the_trajectory_plot_draws_and_names_the_zone(scenario: Path, tmp_path: Path) -> None:
     out = tmp_path / "run"
     assert main(["run", str(scenario), "--headless", "-q", "--out", str(out)]) == 0
-    (zone,) = zones_of_run(out / "scenario.yaml")
+    run = read_run(out)
+    assert run.world is not None
+    declared = {path: mark for path, _, mark in marked(run.world.leaves, Zone)}
+    params = {path: run.world.leaves[path].params for path in declared}
+    (zone,) = zones_of(params, declared, timeline_of(run.resolved))
     assert zone.name == "Mud"
     assert zone.polygon == ((5.0, -3.0), (15.0, -3.0), (15.0, 3.0), (5.0, 3.0))
     assert zone.label == "Mud: μ 0.8, Crr 0.02; from 2 s μ 0.1, Crr 0.3"

@@ -24,6 +24,9 @@ import pytest
 
 from amsa_phys.control.avoider import ReactiveAvoider
 
+#: compiles C++ with g++: the build tier, not the quick one
+pytestmark = pytest.mark.build
+
 FILES = Path(__file__).resolve().parents[2] / "amsa_phys" / "ros" / "files"
 PARAMS = [p.name for p in ReactiveAvoider.params]
 STEPS = 4

@@ -28,6 +28,9 @@ from amsa_phys.control.estimators.leader import LeaderMonitor
 from amsa_phys.control.estimators.motor import MotorMonitor
 from amsa_phys.model.template import Template
 
+#: compiles C++ with g++: the build tier, not the quick one
+pytestmark = pytest.mark.build
+
 FILES = Path(__file__).resolve().parents[2] / "amsa_phys" / "ros" / "files"
 TEMPLATES: tuple[type[Template], ...] = (MotorMonitor, LeaderMonitor, GPSLossMonitor)
 HARNESS = """#include <algorithm>

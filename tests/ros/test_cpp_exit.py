@@ -21,6 +21,9 @@ from pathlib import Path
 
 import pytest
 
+#: compiles C++ with g++: the build tier, not the quick one
+pytestmark = pytest.mark.build
+
 HEADER = Path(__file__).resolve().parents[2] / "amsa_phys" / "ros" / "files" / "amsa_exit.h"
 
 PLUGIN = """#include "amsa_exit.h"

@@ -19,6 +19,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+#: compiles C++ with g++: the build tier, not the quick one
+pytestmark = pytest.mark.build
+
 HEADER = Path(__file__).resolve().parents[2] / "amsa_phys" / "ros" / "files" / "amsa_pymath.h"
 HARNESS = """#include <cstdio>
 #include "amsa_pymath.h"

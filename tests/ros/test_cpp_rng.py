@@ -26,6 +26,9 @@ import ziggurat_tables
 
 from amsa_phys.engine.rng import component_rng
 
+#: compiles C++ with g++: the build tier, not the quick one
+pytestmark = pytest.mark.build
+
 FILES = Path(__file__).resolve().parents[2] / "amsa_phys" / "ros" / "files"
 HARNESS = r"""#include <cstdio>
 #include <cstdlib>

@@ -23,10 +23,10 @@ ROOT = Path(__file__).resolve().parents[2]
 SCENARIO = ROOT / "tests" / "fixtures" / "ros_nodes.yaml"
 
 
-@pytest.mark.parametrize("name", sorted(cpp_bodies()))
+@pytest.mark.parametrize("name", sorted(t.name() for t in cpp_bodies()))
 def test_every_body_names_its_templates_ports(name: str) -> None:
     template = resolve_template(name)
-    m = re.match(r"// ports: in=(\S*) out=(\S*)", cpp_bodies()[name])
+    m = re.match(r"// ports: in=(\S*) out=(\S*)", cpp_bodies()[template])
     assert m is not None
     assert [n for n in m.group(1).split(",") if n] == [p.name for p in template.inputs]
     assert m.group(2).split(",") == [p.name for p in template.outputs]

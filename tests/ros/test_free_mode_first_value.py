@@ -3,7 +3,7 @@
 Until the node's first message the simulator's buffer holds the port's initial value (0.0):
 counted as samples, a follower starting 8 m behind reported ``min_distance`` 0.000 and an rms
 error inflated by the seconds of zeros. The simulator takes no quality sample until the
-signal's first message (``RunLog.quality_waits``, cleared by ``RosSimulation._pace``).
+signal's first message (``Simulation.hold_quality``, released by ``RosSimulation.pace``).
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ def test_the_signal_is_awaited_only_when_a_node_publishes_it() -> None:
 
 
 class _Link:
-    """The part of ``simulator.Link`` that ``_pace`` uses: a rospy thread fills ``fresh``
+    """The part of ``simulator.Link`` that ``pace`` uses: a rospy thread fills ``fresh``
     under ``cond``; ``take`` hands it to the engine."""
 
     def __init__(self, store: dict[str, float]) -> None:
@@ -66,14 +66,17 @@ def test_pacing_clears_the_wait_at_the_signals_first_message() -> None:
     store = {SIGNAL: 0.0}
     log = RunLog([SIGNAL], None, SIGNAL)
     log.quality_waits = True
-    sim = SimpleNamespace(link=_Link(store), awaited=SIGNAL, log=log, now=Fraction(0))
-    RosSimulation._pace(sim)  # type: ignore[arg-type]
+    engine = SimpleNamespace(
+        now=Fraction(0), hold_quality=lambda w: setattr(log, "quality_waits", w)
+    )
+    sim = SimpleNamespace(link=_Link(store), awaited=SIGNAL, sim=engine)
+    RosSimulation.pace(sim)  # type: ignore[arg-type]
     log.record(0.0, store)
     sim.link.fresh["MyFollowerController.LeftPower"] = 3.0  # another topic: still waiting
-    RosSimulation._pace(sim)  # type: ignore[arg-type]
+    RosSimulation.pace(sim)  # type: ignore[arg-type]
     log.record(0.5, store)
     sim.link.fresh[SIGNAL] = 8.0  # the monitor node's first message
-    RosSimulation._pace(sim)  # type: ignore[arg-type]
+    RosSimulation.pace(sim)  # type: ignore[arg-type]
     log.record(1.8, store)
     assert log.samples()[0].tolist() == [1.8]
     assert log.samples()[1].tolist() == [8.0]
@@ -91,11 +94,11 @@ def test_metrics_from_the_first_measurement_match_the_in_process_run() -> None:
 
     def first_message() -> None:
         if waited.now >= Fraction(9, 5):
-            waited.log.quality_waits = False
+            waited.hold_quality(False)
 
     waited.add_hook(Fraction(20), first_message, "first message")  # as RosSimulation does
     waited.initialize()
-    waited.log.quality_waits = True
+    waited.hold_quality(True)
     waited.run()
     t_all, s_all = full.result().samples_t, full.result().samples_s
     t, s = waited.result().samples_t, waited.result().samples_s

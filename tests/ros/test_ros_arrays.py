@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import ros_launch
+from fakerobot import script
 from ros_launch import Launch, build_workspace, ros_missing
 from rosbags.highlevel import AnyReader
 
@@ -97,71 +98,36 @@ def test_lockstep_reproduces_the_obstacle_course_with_cpp_and_python_avoider(
 #: lidar over the full circle (its own ray casts, ``inf`` where nothing echoes, as drivers
 #: publish), GPS fixes on the package's documented WGS 84 origin, the compass as Imu
 #: orientation; it obeys the JointState efforts (% of full power, 5.5 m/s at 100 %).
-ROBOT = """#!/usr/bin/python3
-import json, math, sys
-import rospy
-from sensor_msgs.msg import Imu, JointState, LaserScan, NavSatFix, NavSatStatus
+ROBOT = script(
+    "/Rover/wheel_cmd",
+    "from sensor_msgs.msg import LaserScan",
+    """
+    POST, R, GOAL = (44.0, 0.3), 1.0, (50.0, 0.0)
+    BEAMS, FAR = 360, 12.0
 
-LAT0, LON0 = 43.5616, 1.4683
-A, F = 6378137.0, 1 / 298.257223563
-E2 = F * (2 - F)
-S2 = math.sin(math.radians(LAT0)) ** 2
-M = A * (1 - E2) / (1 - E2 * S2) ** 1.5
-N = A / math.sqrt(1 - E2 * S2) * math.cos(math.radians(LAT0))
-POST, R, GOAL = (44.0, 0.3), 1.0, (50.0, 0.0)
-BEAMS, FAR = 360, 12.0
+    def ray(x, y, a):
+        dx, dy = math.cos(a), math.sin(a)
+        px, py = x - POST[0], y - POST[1]
+        b = dx * px + dy * py
+        disc = b * b - (px * px + py * py - R * R)
+        if disc < 0:
+            return math.inf
+        t = -b - math.sqrt(disc)
+        return t if 0 < t <= FAR else math.inf
 
-def ray(x, y, a):
-    dx, dy = math.cos(a), math.sin(a)
-    px, py = x - POST[0], y - POST[1]
-    b = dx * px + dy * py
-    disc = b * b - (px * px + py * py - R * R)
-    if disc < 0:
-        return math.inf
-    t = -b - math.sqrt(disc)
-    return t if 0 < t <= FAR else math.inf
-
-rospy.init_node("test_robot")
-effort = [0.0, 0.0]
-commands = [0]
-def on_cmd(msg):
-    effort[:] = [msg.effort[msg.name.index("left_wheel_joint")],
-                 msg.effort[msg.name.index("right_wheel_joint")]]
-    commands[0] += 1
-rospy.Subscriber("/Rover/wheel_cmd", JointState, on_cmd)
-gps = rospy.Publisher("/Rover/Gps/fix", NavSatFix, queue_size=10)
-compass = rospy.Publisher("/Rover/Heading/heading", Imu, queue_size=10)
-lidar = rospy.Publisher("/Rover/Scanner/scan", LaserScan, queue_size=10)
-x, y, th = 38.0, 0.0, 0.0
-END, DT = float(sys.argv[1]), 0.05
-rate = rospy.Rate(1 / DT)
-clearance, t0, k = math.inf, None, 0
-while not rospy.is_shutdown():
-    try:
-        rate.sleep()
-    except rospy.ROSInterruptException:
-        break
-    now = rospy.Time.now()
-    t = now.to_sec()
-    t0 = t if t0 is None else t0
-    vL, vR = (5.5 * max(-100.0, min(100.0, e)) / 100 for e in effort)
-    v, w = (vL + vR) / 2, (vR - vL) / 0.5
-    x += v * math.cos(th) * DT
-    y += v * math.sin(th) * DT
-    th += w * DT
+    gps = rospy.Publisher("/Rover/Gps/fix", NavSatFix, queue_size=10)
+    compass = rospy.Publisher("/Rover/Heading/heading", Imu, queue_size=10)
+    lidar = rospy.Publisher("/Rover/Scanner/scan", LaserScan, queue_size=10)
+    x, y, th = 38.0, 0.0, 0.0
+    clearance, k = math.inf, 0
+    """,
+    """
     clearance = min(clearance, math.hypot(x - POST[0], y - POST[1]) - R)
     k += 1
     if k % 2:
         continue  # sensors at 10 Hz
-    fix = NavSatFix()
-    fix.header.stamp, fix.header.frame_id = now, "Rover/base_link"
-    fix.status.status, fix.status.service = NavSatStatus.STATUS_FIX, NavSatStatus.SERVICE_GPS
-    fix.latitude, fix.longitude = LAT0 + math.degrees(y / M), LON0 + math.degrees(x / N)
-    gps.publish(fix)
-    imu = Imu()
-    imu.header.stamp, imu.header.frame_id = now, "Rover/base_link"
-    imu.orientation.z, imu.orientation.w = math.sin(th / 2), math.cos(th / 2)
-    compass.publish(imu)
+    fix(gps, x, y, now, "Rover/base_link", covariance=False)
+    heading(compass, th, now, "Rover/base_link")
     scan = LaserScan()
     scan.header.stamp, scan.header.frame_id = now, "Rover/base_link"
     scan.angle_min, scan.angle_increment = -math.pi, 2 * math.pi / BEAMS
@@ -171,9 +137,9 @@ while not rospy.is_shutdown():
     lidar.publish(scan)
     if t - t0 >= END or math.hypot(x - GOAL[0], y - GOAL[1]) < 0.6:
         break
-with open(sys.argv[2], "w") as f:
-    json.dump({"x": x, "y": y, "clearance": clearance, "commands": commands[0], "t": t - t0}, f)
-"""
+    """,
+    '{"x": x, "y": y, "clearance": clearance, "commands": commands[0], "t": t - t0}',
+)
 
 
 def test_sim_false_the_pilot_steers_a_robot_round_a_post_by_its_own_laserscan(

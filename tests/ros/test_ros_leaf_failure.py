@@ -41,19 +41,8 @@ pytestmark = [
     pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing())),
 ]
 launcher = ros_launch.launcher  # the fixture
-
-
-@pytest.fixture(scope="module")
-def workspace(ros_short_workspace: Path) -> Path:
-    """The session's build of ros_short (tests/ros/conftest.py), edited only through
-    ``package_edit``."""
-    return ros_short_workspace
-
-
-@pytest.fixture(scope="module")
-def checked(ros_short_checked: Path) -> Path:
-    """Runs ``rosrun PKG run_lockstep`` on the session's build (tests/ros/conftest.py)."""
-    return ros_short_checked
+# ros_short_workspace, ros_short_checked: the session's build of ros_short and its
+# run_lockstep (tests/ros/conftest.py), edited only through ``package_edit``
 
 
 def _first_death(text: str) -> tuple[str, str]:
@@ -77,8 +66,8 @@ def _no_crash(text: str) -> None:
 
 @pytest.mark.parametrize("container", ["true", "false"])
 def test_a_bad_parameter_fails_the_leaf_process_and_run_lockstep(
-    workspace: Path,
-    checked: Path,
+    ros_short_workspace: Path,
+    ros_short_checked: Path,
     launcher: Callable[..., Launch],
     container: str,
     tmp_path: Path,
@@ -87,13 +76,13 @@ def test_a_bad_parameter_fails_the_leaf_process_and_run_lockstep(
     process (the container, or its own ``nodelet standalone``) exits 2, the launch ends,
     and ``rosrun PKG run_lockstep`` exits 2. ``timeout:=600``: a launch that waited for
     some timeout instead would be killed by the test's watchdog (120 s) and fail."""
-    params = workspace / "src" / PKG / "config" / "ros_short_params.yaml"
+    params = ros_short_workspace / "src" / PKG / "config" / "ros_short_params.yaml"
     original = params.read_text()
     assert original.count("  Kv: 0.1\n") == 1
     with package_edit(params, original.replace("  Kv: 0.1\n", "  Kv: -5.0\n")):
         out = tmp_path / f"bad-{container}"
         launch = launcher(
-            checked,
+            ros_short_checked,
             "ros_short.launch",
             f"out:={out}",
             "plots:=false",
@@ -123,12 +112,12 @@ def test_a_bad_parameter_fails_the_leaf_process_and_run_lockstep(
 
 @pytest.mark.parametrize("container", ["true", "false"])
 def test_a_leaf_failing_on_its_start_up_thread_fails_its_process(
-    workspace: Path, launcher: Callable[..., Launch], container: str
+    ros_short_workspace: Path, launcher: Callable[..., Launch], container: str
 ) -> None:
     """No simulator in the launch file: each C++ Leaf loads, then gives up on its start-up
     thread after 2 × ``timeout`` waiting for its readers. The first to give up ends its
     process with exit code 2 (the container's main used to return 0 then) and the launch."""
-    launch_dir = workspace / "src" / PKG / "launch"
+    launch_dir = ros_short_workspace / "src" / PKG / "launch"
     original = (launch_dir / "ros_short.launch").read_text()
     nosim = re.sub(r'  <node [^>]*type="amsa_simulator.py".*?</node>\n', "", original, flags=re.S)
     nosim = re.sub(r'  <node [^>]*type="amsa_scenario.py"[^>]*/>\n', "", nosim)
@@ -136,7 +125,7 @@ def test_a_leaf_failing_on_its_start_up_thread_fails_its_process(
     assert "amsa_scenario.py" not in nosim
     name = f"ros_short_nosim_{container}.launch"
     with package_edit(launch_dir / name, nosim):
-        launch = launcher(workspace, name, "timeout:=0.5", f"cpp_container:={container}")
+        launch = launcher(ros_short_workspace, name, "timeout:=0.5", f"cpp_container:={container}")
         text = launch.finish()
     assert launch.proc.returncode == 0  # roslaunch's own: 0 whatever its nodes did
     gave_up = re.findall(r"error: /(\w+): gave up after \d+\.\d s waiting for the readers of", text)

@@ -71,7 +71,7 @@ def test_the_fixture_runs_every_cpp_template_as_a_cpp_node(workspace: Path) -> N
     # the scout's ReactiveAvoider reads its lidar (an array port, inline in pipelined
     # requests); test_ros_arrays.py runs the obstacle course too (not pipelined: its IMU is
     # a Python node)
-    assert ran == set(bodies)
+    assert ran == {t.name() for t in bodies}
     # one nodelet class per template, compiled once into the package's library, and the
     # container that loads every C++ Leaf of the package into one process
     assert (workspace / "devel" / "lib" / f"lib{PKG}_leaves.so").is_file()

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import pytest
 import ros_launch
+from fakerobot import script
 from ros_launch import build_workspace, ros_missing
 
 ROOT = Path(__file__).resolve().parent.parent.parent
@@ -50,68 +51,23 @@ launcher = ros_launch.launcher  # the fixture
 #: The robot: a leader 15 m ahead driving straight at 0.2 m/s, a follower obeying its wheel
 #: efforts (% of full power, 5.5 m/s at 100 %, the rover's free speed) on a 0.5 m track.
 #: GPS fixes on the WGS 84 plane at the package's documented origin (43.5616 N, 1.4683 E).
-ROBOT = """#!/usr/bin/python3
-import json, math, sys
-import rospy
-from nav_msgs.msg import Odometry
-from sensor_msgs.msg import Imu, JointState, NavSatFix, NavSatStatus
-
-LAT0, LON0 = 43.5616, 1.4683
-A, F = 6378137.0, 1 / 298.257223563
-E2 = F * (2 - F)
-S2 = math.sin(math.radians(LAT0)) ** 2
-M = A * (1 - E2) / (1 - E2 * S2) ** 1.5              # metres per radian of latitude
-N = A / math.sqrt(1 - E2 * S2) * math.cos(math.radians(LAT0))  # ... of longitude
-
-def fix(pub, x, y, stamp, frame):
-    msg = NavSatFix()
-    msg.header.stamp, msg.header.frame_id = stamp, frame
-    msg.status.status, msg.status.service = NavSatStatus.STATUS_FIX, NavSatStatus.SERVICE_GPS
-    msg.latitude = LAT0 + math.degrees(y / M)
-    msg.longitude = LON0 + math.degrees(x / N)
-    msg.position_covariance = [1e-4, 0, 0, 0, 1e-4, 0, 0, 0, 0]
-    msg.position_covariance_type = NavSatFix.COVARIANCE_TYPE_DIAGONAL_KNOWN
-    pub.publish(msg)
-
-rospy.init_node("test_robot")
-effort = [0.0, 0.0]
-commands = [0]
-def on_cmd(msg):
-    effort[:] = [msg.effort[msg.name.index("left_wheel_joint")],
-                 msg.effort[msg.name.index("right_wheel_joint")]]
-    commands[0] += 1
-rospy.Subscriber("/Follower/wheel_cmd", JointState, on_cmd)
-lead_fix = rospy.Publisher("/Leader/LeaderGPS/fix", NavSatFix, queue_size=10)
-own_fix = rospy.Publisher("/Follower/FollowerGPS/fix", NavSatFix, queue_size=10)
-compass = rospy.Publisher("/Follower/FollowerCompass/heading", Imu, queue_size=10)
-odom = rospy.Publisher("/Follower/odom", Odometry, queue_size=10)
-xl, yl, vl = 15.0, 0.0, 0.2
-x = y = th = 0.0
-END, DT = float(sys.argv[1]), 0.05
-rate = rospy.Rate(1 / DT)   # simulated time: the boundary node's /clock
-log = []
-t0 = None
-while not rospy.is_shutdown():
-    try:
-        rate.sleep()
-    except rospy.ROSInterruptException:
-        break
-    now = rospy.Time.now()
-    t = now.to_sec()
-    if t0 is None:
-        t0 = t
-    vL, vR = (5.5 * max(-100.0, min(100.0, e)) / 100 for e in effort)
-    v, w = (vL + vR) / 2, (vR - vL) / 0.5
-    x += v * math.cos(th) * DT
-    y += v * math.sin(th) * DT
-    th += w * DT
+ROBOT = script(
+    "/Follower/wheel_cmd",
+    "from nav_msgs.msg import Odometry",
+    """
+    lead_fix = rospy.Publisher("/Leader/LeaderGPS/fix", NavSatFix, queue_size=10)
+    own_fix = rospy.Publisher("/Follower/FollowerGPS/fix", NavSatFix, queue_size=10)
+    compass = rospy.Publisher("/Follower/FollowerCompass/heading", Imu, queue_size=10)
+    odom = rospy.Publisher("/Follower/odom", Odometry, queue_size=10)
+    xl, yl, vl = 15.0, 0.0, 0.2
+    x = y = th = 0.0
+    log = []
+    """,
+    """
     xl += vl * DT
     fix(lead_fix, xl, yl, now, "Leader/base_link")
     fix(own_fix, x, y, now, "Follower/base_link")
-    imu = Imu()
-    imu.header.stamp, imu.header.frame_id = now, "Follower/base_link"
-    imu.orientation.z, imu.orientation.w = math.sin(th / 2), math.cos(th / 2)
-    compass.publish(imu)
+    heading(compass, th, now, "Follower/base_link")
     o = Odometry()
     o.header.stamp, o.header.frame_id, o.child_frame_id = now, "map", "Follower/base_link"
     o.pose.pose.position.x, o.pose.pose.position.y = x, y
@@ -121,9 +77,9 @@ while not rospy.is_shutdown():
     log.append([t, math.hypot(xl - x, yl - y), x, y])
     if t - t0 >= END:
         break
-with open(sys.argv[2], "w") as f:
-    json.dump({"log": log, "commands": commands[0]}, f)
-"""
+    """,
+    '{"log": log, "commands": commands[0]}',
+)
 
 
 def test_the_exported_controller_drives_a_robot_of_the_tests_own(

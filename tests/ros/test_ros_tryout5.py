@@ -31,29 +31,20 @@ pytestmark = [
     pytest.mark.skipif(ros_missing() is not None, reason=str(ros_missing())),
 ]
 launcher = ros_launch.launcher  # the fixture
-
-
-@pytest.fixture(scope="module")
-def workspace(ros_short_workspace: Path) -> Path:
-    """The session's build of ros_short (tests/ros/conftest.py), edited only through
-    ``package_edit``."""
-    return ros_short_workspace
-
-
-@pytest.fixture(scope="module")
-def checked(ros_short_checked: Path) -> Path:
-    """Runs ``rosrun PKG run_lockstep`` on the session's build (tests/ros/conftest.py)."""
-    return ros_short_checked
+# ros_short_workspace, ros_short_checked: the session's build of ros_short and its
+# run_lockstep (tests/ros/conftest.py), edited only through ``package_edit``
 
 
 def test_ctrl_c_in_a_pipelined_run_is_130_with_the_outputs_kept(
-    checked: Path, launcher: Callable[..., Launch], tmp_path: Path
+    ros_short_checked: Path, launcher: Callable[..., Launch], tmp_path: Path
 ) -> None:
     """Ctrl-C (SIGINT to the process group, as a terminal sends it) once the scenario node
     has applied its first change: the run is pipelined, the script exits 130 and says so,
     the run directory says ``interrupted``, and no process of the launch is left."""
     out = tmp_path / "interrupted"
-    launch = launcher(checked, "ros_short.launch", f"out:={out}", "plots:=false", "duration:=36000")
+    launch = launcher(
+        ros_short_checked, "ros_short.launch", f"out:={out}", "plots:=false", "duration:=36000"
+    )
     lines = launch.lines
     assert launch.read_until("running ros_short (lockstep, pipelined)"), "".join(lines)[-3000:]
     assert launch.read_until("phase 1 at t=10 s"), "".join(lines)[-3000:]
@@ -66,19 +57,22 @@ def test_ctrl_c_in_a_pipelined_run_is_130_with_the_outputs_kept(
 
 
 def test_a_node_unlike_its_template_is_2_and_the_fault_names_the_way_out(
-    workspace: Path, checked: Path, launcher: Callable[..., Launch], tmp_path: Path
+    ros_short_workspace: Path,
+    ros_short_checked: Path,
+    launcher: Callable[..., Launch],
+    tmp_path: Path,
 ) -> None:
     """The launch file's ``/amsa/seed`` edited by hand: a C++ sensor draws other noise than
     the model's template, the pipelined run stops at that step and the script exits 2 with
     the fault in one line: the Leaf, its node, both values and ``pipeline:=false``."""
-    launch_dir = workspace / "src" / PKG / "launch"
+    launch_dir = ros_short_workspace / "src" / PKG / "launch"
     original = (launch_dir / "ros_short.launch").read_text()
     seed = re.search(r'<param name="seed" type="str" value="(\d+)"/>', original)
     assert seed is not None, original[:2000]
     reseeded = seed.group(0).replace(f'"{seed.group(1)}"', f'"{int(seed.group(1)) + 1}"')
     with package_edit(launch_dir / "reseeded.launch", original.replace(seed.group(0), reseeded)):
         out = tmp_path / "reseeded"
-        launch = launcher(checked, "reseeded.launch", f"out:={out}", "plots:=false")
+        launch = launcher(ros_short_checked, "reseeded.launch", f"out:={out}", "plots:=false")
         text = launch.finish()
     assert launch.proc.returncode == 2, text[-3000:]
     assert "running ros_short (lockstep, pipelined)" in text

@@ -155,6 +155,11 @@ def rows(out: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(fh))
 
 
+@pytest.mark.parametrize(
+    "step_path",
+    ["compiled", pytest.param("pure", marks=pytest.mark.slow)],  # the same property, 8x dearer
+    indirect=True,
+)
 def test_a_batched_sweep_is_byte_identical_across_j_and_batch_sizes(
     tmp_path: Path, step_path: Any
 ) -> None:
@@ -268,6 +273,7 @@ def test_a_batch_whose_worker_dies_costs_the_killing_run_only(
     ]
 
 
+@pytest.mark.slow  # the local pool's twin stays quick: test_a_batch_whose_worker_dies_...
 def test_on_dask_a_batch_that_kills_its_workers_costs_the_killing_run_only(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -330,6 +336,7 @@ def test_a_lost_dask_batch_is_sent_again_one_run_per_task(
 
 
 @pytest.mark.skipif(extension() is None, reason="the compiled step is not built here")
+@pytest.mark.slow  # batched rows equal runs made alone: test_batched_rows_equal_the_runs_made_alone
 def test_the_shipped_context_sweep_gives_the_same_results_batched_or_one_run_per_process(
     tmp_path: Path,
 ) -> None:

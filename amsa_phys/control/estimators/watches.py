@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 
+from ...model.template import Template, TemplateNotFound, resolve_template
 from ...model.world import WorldSpec
 from . import Estimates
 
@@ -57,17 +58,31 @@ def watches(world: WorldSpec) -> list[Watch]:
     return out
 
 
+def _classes(names: tuple[str, ...]) -> tuple[type[Template], ...]:
+    """The templates an estimator names, as classes: a Leaf counts when its template is one
+    of them or a subclass (which keeps the parameter and its meaning), never when it merely
+    shares a name (a user's own ``GPS`` is another receiver)."""
+    out = []
+    for name in names:
+        try:
+            out.append(resolve_template(name))
+        except TemplateNotFound:  # a plugin's template that is not installed: none to watch
+            continue
+    return tuple(out)
+
+
 def _nearest(
     start: str, near: dict[str, set[str]], world: WorldSpec, names: tuple[str, ...]
 ) -> str | None:
     """The closest Leaf of one of the templates ``names`` (ties: world order)."""
+    kinds = _classes(names)
     order = {p: i for i, p in enumerate(world.leaves)}
     seen = {start}
     frontier = deque([(start, 0)])
     found: list[tuple[int, int, str]] = []
     while frontier:
         path, hops = frontier.popleft()
-        if hops and world.leaves[path].template.name() in names:
+        if hops and issubclass(world.leaves[path].template, kinds):
             found.append((hops, order[path], path))
         if hops == MAX_HOPS:
             continue

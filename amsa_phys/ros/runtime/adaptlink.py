@@ -12,8 +12,9 @@ held to ``amsa-phys run``: same firings, same instants, byte-identical trace.
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from ...engine.face import SimView
 from ...errors import RunFault
 from .. import names
 from .adapt import NODE
@@ -41,7 +42,7 @@ def attach(link: Link) -> None:
     link.expected_ready.add(NODE)
 
 
-def due(link: Link, sim: Any, t: Fraction) -> tuple[int, str] | None:
+def due(link: Link, sim: SimView, t: Fraction) -> tuple[int, str] | None:
     """The rule the adapt node fires at ``t`` (its number and the event's text), or None."""
     signals = sorted(link.graph.adapt_signals)
     counts = " ".join(str(link.published[s] - sim.in_flight(s)) for s in signals)

@@ -12,9 +12,9 @@ from __future__ import annotations
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
-from ...engine.adapt import MAX_SWITCH_EVENTS
+from ...engine.plugs import Plugs
 from ...engine.runner import Simulation
-from ...model.adaptrules import RULE_COLUMN
+from ...model.adaptrules import Rule
 from ...model.scenario import Change, Scenario
 from .. import names
 from . import adaptlink, rosio
@@ -32,34 +32,36 @@ def awaited_signal(scenario: Scenario, remote: list[str]) -> str | None:
 
 
 if TYPE_CHECKING:  # the simulator node imports this module
+    from collections.abc import Mapping
+
+    from ...engine.adapt import AdaptRules
     from .simulator import Link
 
 
-class RosSimulation(Simulation):
-    """The engine with remote Leaves, parameters from the server, ``/clock`` published."""
+class RosSimulation(Plugs):
+    """The engine (:attr:`sim`) with remote Leaves, parameters from the server, ``/clock``
+    published: the plugs the engine calls at its instants, and the free-mode hooks."""
 
     def __init__(self, scenario: Scenario, trace: Any, link: Link) -> None:
-        super().__init__(
-            scenario.world,
-            # adapt: rules fire here, at the engine's exact instants (both modes); a change is
-            # put on the parameter server before the Leaf is told (apply_change)
-            **Simulation.scenario_kwargs(scenario),
+        self.link = link
+        #: the engine, driven by ``runs.single.run_scenario`` as any run's: adapt: rules fire
+        #: here, at its exact instants (both modes; a change is put on the parameter server
+        #: before the Leaf is told: rule_change), the STL requirements sampled as in process
+        self.sim = Simulation.from_scenario(
+            scenario,
             trace=trace,
             # remote Leaves and publishing local ones stand in for the world's (standins.py)
-            wrap=stand_ins(link, lambda: self.now),
+            wrap=stand_ins(link, lambda: self.sim.now),
             # every Leaf is called on its own: a node per Leaf, a topic per output
             grouping=False,
+            plugs=self,
         )
-        # the STL requirements sampled as in process, so metrics.json judges them the same
-        self.watch_requirements(scenario)
-        self.link = link
-        link.attach(self)
+        sim = self.sim
+        link.attach(sim)
         graph = link.graph
-        #: the adapt rules' changes (the very objects the engine applies when one fires)
-        self.rule_changes = {id(c) for rule in scenario.adapt for c in rule.changes}
         #: the timeline's changes, each with the number of its point (1-based): the scenario
         #: node announces how many points it has applied, a phase's start or a step inside one
-        points = enumerate(self.timeline.points(), start=1)
+        points = enumerate(sim.timeline.points(), start=1)
         self.point_of = {id(c): k for k, point in points for c in point.changes}
         # the parameter cache's values of every Leaf, as last seen (free mode: a change of the
         # cache is an edit, recorded as an event whether the Leaf steps here or in its node;
@@ -69,27 +71,52 @@ class RosSimulation(Simulation):
             for path in scenario.world.leaves
             for p in graph.leaf(path).template.params
         }
-        self.live: list[Change] = []  # live edits queued, not yet applied
         #: free mode: the quality signal a node publishes, until its first message (its
         #: port's initial value before that is no measurement: no quality sample is taken)
         self.awaited = awaited_signal(scenario, graph.remote) if not link.lockstep else None
-        self.log.quality_waits = self.awaited is not None
+        sim.hold_quality(self.awaited is not None)
         if not link.lockstep:
             rate = (
                 Fraction(str(scenario.world.physics["rate"])) if graph.local else scenario.log_rate
             )
-            self.add_hook(rate, self._pace, "ros clock")
-            self.add_hook(scenario.log_rate, self._live_params, "ros parameters")
+            sim.add_hook(rate, self.pace, "ros clock")
+            sim.add_hook(scenario.log_rate, self.live_params, "ros parameters")
 
-    def advance(self, until_tick: int) -> None:
-        """The engine's; at the run's end, pipelined lockstep's last answers checked."""
-        super().advance(until_tick)
-        if self.link.pipeline is not None and self.finished:
+    # -- the engine's plugs (engine/plugs.py) --------------------------------------------
+    def run_ended(self) -> None:
+        """Pipelined lockstep: the last answers checked."""
+        if self.link.pipeline is not None:
             self.link.pipeline.drain()
 
-    def _pace(self) -> None:
+    def timeline_change(self, change: Change, at: Fraction) -> Change:
+        """A timeline change, with the value the scenario node put on the parameter server."""
+        value = self.link.point_value(self.point_of[id(change)], at, change)
+        return Change(change.leaf, change.param, value)
+
+    def rule_change(self, change: Change) -> None:
+        """An ``adapt:`` rule fired: its value on the parameter server before the Leaf is
+        told, so a node reading the server sees what runs."""
+        rosio.set_param(self.link.rospy, change.leaf, change.param, change.value)
+
+    def rule_due(
+        self, rules: AdaptRules, now: Fraction, values: Mapping[str, float]
+    ) -> tuple[Rule, str] | None:
+        """``rules:=node``: the adapt node says which rule fires now; applied as the engine
+        applies its own firing (``adaptlink.py``). Otherwise the engine's own rules."""
+        if not self.link.cfg.rules_node:
+            return super().rule_due(rules, now, values)
+        fired = adaptlink.due(self.link, self.sim, now)
+        if fired is None:
+            return None
+        number, detail = fired
+        # counted as the engine's own firings are (metrics.json's adapt_switches)
+        rules.switches += 1
+        return next(r for r in rules.rules if r.number == number), detail
+
+    # -- free mode's hooks -----------------------------------------------------------------
+    def pace(self) -> None:
         """Free mode: hold to the wall clock, then take what the nodes published meanwhile."""
-        self.link.pace(self.now)
+        self.link.pace(self.sim.now)
         awaited = self.awaited
         arrived = False
         if awaited is not None:
@@ -97,44 +124,10 @@ class RosSimulation(Simulation):
                 arrived = awaited in self.link.fresh
         self.link.take()
         if arrived:
-            self.log.quality_waits = False
+            self.sim.hold_quality(False)
             self.awaited = None
 
-    def apply_change(self, change: Change) -> None:
-        """A timeline change, with the value the scenario node put on the parameter server."""
-        if id(change) in self.rule_changes:  # an adapt: rule fired at this instant
-            rosio.set_param(self.link.rospy, change.leaf, change.param, change.value)
-            super().apply_change(change)
-            return
-        for i, queued in enumerate(self.live):
-            if queued is change:  # a live edit (free mode), already judged
-                del self.live[i]
-                super().apply_change(change)
-                return
-        value = self.link.point_value(self.point_of[id(change)], self.now, change)
-        super().apply_change(Change(change.leaf, change.param, value))
-
-    def _apply_adapt(self) -> None:
-        """``rules:=node``: the adapt node says which rule fires now; applied as the engine
-        applies its own firing (``adaptlink.py``). Otherwise the engine's own rules."""
-        if not self.link.cfg.rules_node:
-            super()._apply_adapt()
-            return
-        fired = adaptlink.due(self.link, self, self.now)
-        if fired is None:
-            return
-        number, detail = fired
-        assert self._adapt is not None
-        rule = next(r for r in self._adapt.rules if r.number == number)
-        for change in rule.changes:
-            self.apply_change(change)
-        self.values[RULE_COLUMN] = float(number)
-        # counted and capped as the engine's own firings are (metrics.json's adapt_switches)
-        self._adapt.switches += 1
-        if self._adapt.switches <= MAX_SWITCH_EVENTS:
-            self.record_event("adapt", detail)
-
-    def _live_params(self) -> None:
+    def live_params(self) -> None:
         """Free mode: a ``rosparam set`` lands at the next instant, recorded.
 
         Judged like the window's live changes (type, range, rules between parameters;
@@ -144,6 +137,7 @@ class RosSimulation(Simulation):
         next step (judged the same way there), this process records it.
         """
         rospy = self.link.rospy
+        components = self.sim.components
         for (path, name), seen in self.seen.items():
             try:
                 raw = rospy.get_param_cached(names.param(path, name))
@@ -157,16 +151,15 @@ class RosSimulation(Simulation):
                 if name in leaf.template.fixed_once_running:
                     raise ValueError("is read only when the run starts")
                 value = leaf.template.param(name).coerce(raw)
-                leaf.template.check_params({**vars(self.components[path].p), name: value})
+                leaf.template.check_params({**vars(components[path].p), name: value})
             except ValueError as exc:
-                old = rosio.ros_value(getattr(self.components[path].p, name))
+                old = rosio.ros_value(getattr(components[path].p, name))
                 rospy.logerr(f"{names.param(path, name)}: {exc}; keeping {old!r}")
                 rospy.set_param(names.param(path, name), old)  # the server shows what runs
                 self.seen[(path, name)] = old
                 continue
-            if value == getattr(self.components[path].p, name):
+            if value == getattr(components[path].p, name):
                 continue  # the scenario node's own change, applied at its instant already
             change = Change(path, name, value)
-            self.live.append(change)
-            at = self.apply_live(change)
+            at = self.sim.apply_live(change)
             print(f"{names.SIMULATOR}: live change {change.key}={value} at t={float(at):g} s")

@@ -65,7 +65,7 @@ def main() -> None:
                 out_dir,
                 plot=bool(rospy.get_param("~plots", True)),
                 progress=False,
-                simulation=lambda sc, trace: RosSimulation(sc, trace, link),
+                simulation=lambda sc, trace: RosSimulation(sc, trace, link).sim,
             )
         if not link.drain_boundary(ready_timeout):
             print(

@@ -23,7 +23,7 @@ from fractions import Fraction
 from typing import Any
 
 from ...engine import interrupt
-from ...engine.runner import Simulation
+from ...engine.face import SimDriver
 from ...errors import RunFault
 from ...model.scenario import Change
 from .. import names
@@ -64,7 +64,7 @@ class Link:
         #: free mode: the outputs nodes published since the loop last took them (buffer ->
         #: latest value); the loop's own thread writes them into the engine (:meth:`take`)
         self.fresh: dict[str, Any] = {}
-        self.sim: Simulation | None = None
+        self.sim: SimDriver | None = None
         self.published = dict.fromkeys(self.graph.data(), 0)
         #: array ports (a lidar's ranges): one std_msgs/Float64MultiArray topic each
         self.Array = array_msg() if world.arrays else None
@@ -219,7 +219,7 @@ class Link:
     def _up(self, path: str, subscribers: dict[str, int]) -> bool:
         return readiness.topics_up(self.graph, self.data_subs, path, subscribers)
 
-    def attach(self, sim: Simulation) -> None:
+    def attach(self, sim: SimDriver) -> None:
         """The simulation whose values free mode updates and whose events remote Leaves add."""
         self.sim = sim
 
