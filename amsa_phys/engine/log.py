@@ -39,6 +39,8 @@ class RunLog:
         self.columns = list(columns)
         self.named = named
         self._trace = trace
+        #: whether a trace writer takes the rows
+        self.has_trace = trace is not None
         self._quality = None if quality is None else at(quality)
         # quality samples as packed doubles: a 1-hour run logs 72,000 of each, 1 MiB as
         # arrays instead of ~5 MiB of float objects in lists
