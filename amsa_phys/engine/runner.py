@@ -71,12 +71,7 @@ class Simulation(ReadAPI, LiveChanges):
     components must each be called (a ROS node per Leaf) or a test's reference run; a
     ``batch.Grouping`` says how to group instead. ``context(sim, path)`` makes what each
     component's ``initialize`` receives (a batch of runs gives each run its own).
-
-    ``keep_log=False`` is for a caller that reads nothing the log gives (a Gymnasium
-    episode without a trace or a picture): unless a trace writer or a log listener (STL
-    requirements add one) is there when the run starts, no instant is due for the log, so
-    no row is recorded, no quality sample taken, and the physics steps between two
-    components' instants are one batch. Everything else is the same run, bit for bit.
+    ``keep_log=False``: no log instants unless a trace or listener is there (``gym/episode.py``).
     """
 
     def __init__(
@@ -268,13 +263,11 @@ class Simulation(ReadAPI, LiveChanges):
             )
         ]
         self._log_period = g.ticks(1 / self.log_rate)
-        #: whether the log's instants are in the schedule (``keep_log``)
         self.keeps_log = bool(self._keep_log or self.log.listeners or self.log.has_trace)
+        log_at = self._log_period if self.keeps_log else None
         hooks = [(g.ticks(1 / r), fn) for r, fn, _ in self._hooks]
         try:
-            self._cycle, cycle = schedule.instants(
-                self._tasks, self._log_period if self.keeps_log else None, hooks
-            )
+            self._cycle, cycle = schedule.instants(self._tasks, log_at, hooks)
         except schedule.TooManyEvents as exc:
             raise RunFault(
                 "scheduler",
@@ -486,7 +479,7 @@ class Simulation(ReadAPI, LiveChanges):
         simulated instant, the very samples ``metrics.json`` is computed from, whatever the
         frame rate or speed-up (at x256 a frame spans seconds of simulated time).
         """
-        if hasattr(self, "_table") and not self.keeps_log:
+        if not getattr(self, "keeps_log", True):
             raise RuntimeError("this run keeps no log (keep_log=False): add listeners before it")
         self.log.listeners.append(fn)
 

@@ -214,9 +214,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         self._memory = TraceMemory(list(scenario.world.buffers)) if self.record_trace else None
         trace = self._memory.write if self._memory is not None else None
         # a picture samples the log (``view/scene.py``); the agent's own step reads the store
-        self._episode = Episode(
-            scenario, self.path, trace, keep_log=self.render_mode is not None
-        )
+        self._episode = Episode(scenario, self.path, trace, keep_log=self.render_mode is not None)
         store = self._episode.sim.store
         self._data, self._signal_at = store.data, store.at(self._signal)
         self._collisions = 0
