@@ -39,7 +39,7 @@ from ..model.world import WorldSpec
 from . import batch, interrupt, schedule
 from .adapt import AdaptRules
 from .build import build_components, make_task, plan_groups
-from .clock import TickGrid
+from .clock import TickGrid, exact
 from .context import Context, Event, Hook, RunResult
 from .delivery import Deliveries
 from .instants import InstantSource, TimelineSource
@@ -239,8 +239,8 @@ class Simulation(ReadAPI, LiveChanges):
             return now
         if not hasattr(self, "grid"):
             return Fraction(0)
-        # Fraction(n, d) directly: ``grid.tick * tick`` costs three times as much
-        now = Fraction(self._tick * self._tick_num, self._tick_den)
+        # exact(n, d): ``grid.tick * tick`` costs three times as much, Fraction(n, d) twice
+        now = exact(self._tick * self._tick_num, self._tick_den)
         self._now_cache = (self._tick, now)
         return now
 
@@ -388,7 +388,7 @@ class Simulation(ReadAPI, LiveChanges):
                             if adapt is not None:
                                 self._apply_adapt()
                             # the ``now`` property's Fraction, built here without its checks
-                            now = Fraction(tick * num, den)
+                            now = exact(tick * num, den)
                             self._now_cache = (tick, now)
                             try:
                                 for run, task in tasks:
