@@ -1,0 +1,101 @@
+"""The compiled write of published outputs (``engine/_publish.c``) leaves the store exactly as
+the scalar step's Python loop does, and every fault the same, whatever a component returns."""
+
+from __future__ import annotations
+
+import importlib.util
+from array import array
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+import pytest
+
+from amsa_phys.engine import publish
+from amsa_phys.engine.tasks import Steppers, Task
+from amsa_phys.errors import RunFault
+
+NOW = Fraction(7, 4)
+BUILT = importlib.util.find_spec("amsa_phys.engine._publish") is not None
+
+OUTPUTS: list[Any] = [
+    {"u": 1.5, "v": -2.25},
+    {"v": 0.1},  # one of two
+    {},
+    {"u": 3},  # an int: the Python loop converts it
+    {"u": True},
+    {"u": np.float64(2.5), "v": 1.0},
+    {"u": 1.0, "v": 7},  # a float written, then one the C call declines
+    {"u": 1.0, "v": float("nan")},  # a float written, then a refused one
+    {"u": float("-inf")},
+    {"u": 1.0, "nope": 2.0},
+    {"u": "fast"},
+    {"u": 10**400},
+    [("u", 1.0)],
+    None,
+    (1.0,),
+]
+
+
+class Comp:
+    def __init__(self, out: Any) -> None:
+        self.out = out
+
+    def do_step(self, t: Fraction, inp: dict[str, Any]) -> Any:
+        return self.out
+
+
+def stepped(out: Any, pure: bool, monkeypatch: pytest.MonkeyPatch) -> tuple[list[float], str]:
+    """The store after one scalar step that published ``out``, and its fault (if any)."""
+    if pure:
+        monkeypatch.setenv(publish.PURE_ENV, "1")
+    else:
+        monkeypatch.delenv(publish.PURE_ENV, raising=False)
+    values = array("d", [0.5, -1.0, 9.0, 4.0])
+    task = Task("C", Comp(out), 1, [("x", "S.x")], {"u": "C.u", "v": "C.v"})  # type: ignore[arg-type]
+    task.bind({"S.x": 0, "C.u": 2, "C.v": 3}.__getitem__)
+    step = Steppers(values, lambda *_: None, lambda p: f"{p} (T)").for_task(task)
+    try:
+        step(task, NOW)
+    except RunFault as exc:
+        return values.tolist(), str(exc)
+    return values.tolist(), ""
+
+
+@pytest.mark.parametrize("out", OUTPUTS, ids=lambda o: repr(o)[:30])
+def test_the_compiled_write_and_the_python_loop_agree(
+    out: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    assert stepped(out, False, monkeypatch) == stepped(out, True, monkeypatch)
+
+
+def test_good_floats_land_at_their_positions(monkeypatch: pytest.MonkeyPatch) -> None:
+    values, fault = stepped({"u": 1.5, "v": -2.25}, False, monkeypatch)
+    assert fault == ""
+    assert values == [0.5, -1.0, 1.5, -2.25]
+
+
+@pytest.mark.skipif(not BUILT, reason="the extension was not built (no C compiler)")
+def test_the_extension_writes_what_it_accepts_and_declines_the_rest(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.delenv(publish.PURE_ENV, raising=False)
+    fast = publish.compiled()
+    assert fast is not None
+    store = array("d", [0.0] * 4)
+    assert fast({"a": 1.5, "b": -0.0}, {"a": 3, "b": 0}, store)
+    assert store.tolist() == [-0.0, 0.0, 0.0, 1.5]
+    declined = [
+        ({"a": 1}, {"a": 0}, store),
+        ({"a": float("nan")}, {"a": 0}, store),
+        ({"a": 1.0}, {"b": 0}, store),
+        ({"a": 1.0}, {"a": 4}, store),  # past the end
+        ({"a": 1.0}, {"a": -1}, store),
+        ({"a": 1.0}, {"a": 0}, [0.0]),  # not an array of doubles
+        ({"a": 1.0}, {"a": 0}, array("f", [0.0])),
+        ([("a", 1.0)], {"a": 0}, store),
+    ]
+    for args in declined:
+        assert not fast(*args), args
+    monkeypatch.setenv(publish.PURE_ENV, "1")
+    assert publish.compiled() is None
