@@ -1,10 +1,11 @@
-"""The compiled write of a component's published floats into the store, when it was built.
+"""The compiled read and write between a component and the store, when they were built.
 
 ``_publish.c`` (an optional extension, ``setup.py``) does what the scalar step's Python
-loop does for the usual output — a dict of finite floats for known ports — in one C call,
-and declines everything else, which the Python loop then judges (``tasks.py``): the same
+loops do, in one C call each: ``gather`` builds a component's dict of inputs from the
+store, ``publish`` writes the usual output — a dict of finite floats for known ports — and
+declines everything else, which the Python loop then judges (``tasks.py``): the same
 values written, the same faults raised, only sooner. ``AMSA_PHYS_PURE=1`` (the switch of
-the pure physics step too) or a build without a C compiler runs the Python loop alone.
+the pure physics step too) or a build without a C compiler runs the Python loops alone.
 """
 
 from __future__ import annotations
@@ -17,15 +18,27 @@ from typing import Any
 PURE_ENV = "AMSA_PHYS_PURE"
 
 Publish = Callable[[dict[str, Any], dict[str, Any], Any], bool]
+Gather = Callable[[tuple[str, ...], tuple[int, ...], Any, dict[Any, float] | None], dict]
 
 
 def compiled() -> Publish | None:
     """``publish(out, targets, values)`` from the extension, or None (not built, or the
     pure path asked for)."""
+    module = _extension()
+    return None if module is None else module.publish  # type: ignore[no-any-return]
+
+
+def gather() -> Gather | None:
+    """``gather(ports, positions, values, own)`` from the extension, or None."""
+    module = _extension()
+    return None if module is None else module.gather  # type: ignore[no-any-return]
+
+
+def _extension() -> Any:
     if os.environ.get(PURE_ENV, "").strip() not in ("", "0"):
         return None
     try:
-        from ._publish import publish
-    except ImportError:  # no C compiler at install time: the Python loop runs
+        from . import _publish
+    except ImportError:  # no C compiler at install time: the Python loops run
         return None
-    return publish  # type: ignore[no-any-return]
+    return _publish

@@ -192,7 +192,7 @@ class Steppers:
         """How ``task`` steps: the lean scalar path, array ports, or through its delay line."""
         if task.arrays_in or task.arrays_out:
             return self.step_arrays
-        return self.scalar(task) if task.delay is None else self.step_delayed
+        return self.scalar(task) if task.delay is None else self.delayed(task)
 
     def scalar(self, task: Task) -> Callable[[Task, Fraction], None]:
         """:meth:`step` for ``task`` alone, what the loop calls in its place: the task's
@@ -203,8 +203,10 @@ class Steppers:
         values, who, path, comp = self.values, self.who, task.path, task.comp
         reads, targets = task.reads, task.writes
         n = len(reads)
-        # the compiled write (``publish.py``) where the store is an array of doubles
+        # the compiled read and write (``publish.py``) where the store is an array of doubles
         fast = publish.compiled() if isinstance(values, array) else None
+        take = publish.gather() if isinstance(values, array) and n > 2 else None
+        ports, ats = tuple(p for p, _ in reads), tuple(a for _, a in reads)
         (p0, a0), (p1, a1) = [*reads, ("", 0), ("", 0)][:2]
 
         def step(_task: Task, now: Fraction) -> None:
@@ -214,6 +216,8 @@ class Steppers:
                 inp = {p0: values[a0]}
             elif n == 0:
                 inp = {}
+            elif take is not None:
+                inp = take(ports, ats, values, None)
             else:
                 inp = {port: values[at] for port, at in reads}
             try:
@@ -285,12 +289,29 @@ class Steppers:
         except OUTPUT_ERRORS:
             raise bad_output(self.who(task.path), now, targets, out) from None
 
+    def delayed(self, task: Task) -> Callable[[Task, Fraction], None]:
+        """:meth:`step_delayed` for ``task`` alone, its inputs gathered in one C call where
+        the extension was built (``publish.py``)."""
+        take = publish.gather() if isinstance(self.values, array) else None
+        if take is None:
+            return self.step_delayed
+        ports, ats = tuple(p for p, _ in task.reads), tuple(a for _, a in task.reads)
+        values, own, then = self.values, task.own, self._delayed
+
+        def step(_task: Task, now: Fraction) -> None:
+            then(task, now, take(ports, ats, values, own))
+
+        return step
+
     def step_delayed(self, task: Task, now: Fraction) -> None:
         """:meth:`step` for a Leaf with latency or jitter: its outputs go into its delay
         line instead of the buffers (it reads its own outputs back at once)."""
         values = self.values
         own = task.own
-        inp = {port: own.get(at, values[at]) for port, at in task.reads}
+        self._delayed(task, now, {port: own.get(at, values[at]) for port, at in task.reads})
+
+    def _delayed(self, task: Task, now: Fraction, inp: dict[str, Any]) -> None:
+        """:meth:`step_delayed` once its inputs ``inp`` are read."""
         try:
             out = task.comp.do_step(now, inp)
         except RunFault:
@@ -307,7 +328,7 @@ class Steppers:
             return
         writes: dict[Any, float] = {}
         checked_writes(task, out, writes, now, self.who)
-        own.update(writes)
+        task.own.update(writes)
         assert task.delay is not None
         self.send(task.delay, list(writes.items()))
 

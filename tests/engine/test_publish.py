@@ -99,3 +99,55 @@ def test_the_extension_writes_what_it_accepts_and_declines_the_rest(
         assert not fast(*args), args
     monkeypatch.setenv(publish.PURE_ENV, "1")
     assert publish.compiled() is None
+
+
+@pytest.mark.skipif(not BUILT, reason="the extension was not built (no C compiler)")
+def test_gather_builds_the_dict_the_comprehension_builds(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv(publish.PURE_ENV, raising=False)
+    take = publish.gather()
+    assert take is not None
+    rng = np.random.default_rng(5)
+    store = array("d", [*rng.normal(size=50).tolist(), float("nan"), -0.0, float("inf")])
+    for _ in range(200):
+        k = int(rng.integers(0, 8))
+        ats = tuple(int(a) for a in rng.integers(0, len(store), k))
+        ports = tuple(f"p{i}" for i in range(k))
+        own = {int(a): float(rng.normal()) for a in rng.integers(0, len(store), 3)}
+        for mine in (None, own):
+            got = take(ports, ats, store, mine)
+            want = {p: (mine or {}).get(a, store[a]) for p, a in zip(ports, ats, strict=True)}
+            assert list(got.items()).__repr__() == list(want.items()).__repr__()
+    with pytest.raises(IndexError):
+        take(("a",), (len(store),), store, None)
+
+
+class Echo:
+    """Publishes its inputs, each doubled, as its two outputs."""
+
+    def do_step(self, t: Fraction, inp: dict[str, Any]) -> dict[str, float]:
+        return {"u": 2 * inp["a"] + inp["b"], "v": inp["c"] - inp["d"]}
+
+
+@pytest.mark.parametrize("delayed", [False, True])
+def test_a_step_reads_the_same_inputs_on_both_paths(
+    delayed: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def run(pure: bool) -> tuple[list[float], list[Any]]:
+        if pure:
+            monkeypatch.setenv(publish.PURE_ENV, "1")
+        else:
+            monkeypatch.delenv(publish.PURE_ENV, raising=False)
+        values = array("d", [0.25, -1.5, 3.0, 7.0, 0.0, 0.0])
+        sent: list[Any] = []
+        reads = [("a", "S.a"), ("b", "S.b"), ("c", "S.c"), ("d", "C.u")]
+        task = Task("C", Echo(), 1, reads, {"u": "C.u", "v": "C.v"})  # type: ignore[arg-type]
+        task.bind({"S.a": 0, "S.b": 1, "S.c": 2, "S.d": 3, "C.u": 4, "C.v": 5}.__getitem__)
+        if delayed:
+            task.delay = object()  # type: ignore[assignment]  # only handed to ``send``
+        step = Steppers(values, lambda _l, w: sent.append(w), str).for_task(task)
+        for k in range(4):  # a delayed Leaf reads its own last output back (own)
+            step(task, NOW + k)
+            values[0] += 1.0
+        return values.tolist(), sent
+
+    assert run(False) == run(True)
