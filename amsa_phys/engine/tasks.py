@@ -187,6 +187,11 @@ class Steppers:
         self.col = col
         self.send = send
         self.who = who
+        #: the compiled read and write (``publish.py``), looked up once: where the store is
+        #: an array of doubles and the extension was built (and not switched off)
+        packed = isinstance(values, array)
+        self._publish = publish.compiled() if packed else None
+        self._gather = publish.gather() if packed else None
 
     def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:
         """How ``task`` steps: the lean scalar path, array ports, or through its delay line."""
@@ -203,9 +208,8 @@ class Steppers:
         values, who, path, comp = self.values, self.who, task.path, task.comp
         reads, targets = task.reads, task.writes
         n = len(reads)
-        # the compiled read and write (``publish.py``) where the store is an array of doubles
-        fast = publish.compiled() if isinstance(values, array) else None
-        take = publish.gather() if isinstance(values, array) and n > 2 else None
+        fast = self._publish
+        take = self._gather if n > 2 else None
         ports, ats = tuple(p for p, _ in reads), tuple(a for _, a in reads)
         (p0, a0), (p1, a1) = [*reads, ("", 0), ("", 0)][:2]
 
@@ -292,7 +296,7 @@ class Steppers:
     def delayed(self, task: Task) -> Callable[[Task, Fraction], None]:
         """:meth:`step_delayed` for ``task`` alone, its inputs gathered in one C call where
         the extension was built (``publish.py``)."""
-        take = publish.gather() if isinstance(self.values, array) else None
+        take = self._gather
         if take is None:
             return self.step_delayed
         ports, ats = tuple(p for p, _ in task.reads), tuple(a for _, a in task.reads)
