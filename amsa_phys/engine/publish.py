@@ -4,7 +4,10 @@
 loops do, in one C call each: ``gather`` builds a component's dict of inputs from the
 store, ``publish`` writes the usual output — a dict of finite floats for known ports — and
 declines everything else, which the Python loop then judges (``tasks.py``): the same
-values written, the same faults raised, only sooner. ``AMSA_PHYS_PURE=1`` (the switch of
+values written, the same faults raised, only sooner. ``Scalar`` is the scalar step itself
+(gather, ``do_step``, publish) as a C callable, so a component's step has no Python frame
+of the engine's around it; what ``do_step`` raises and what ``publish`` declines go back to
+Python functions that raise the Python step's faults. ``AMSA_PHYS_PURE=1`` (the switch of
 the pure physics step too) or a build without a C compiler runs the Python loops alone.
 """
 
@@ -32,6 +35,13 @@ def gather() -> Gather | None:
     """``gather(ports, positions, values, own)`` from the extension, or None."""
     module = _extension()
     return None if module is None else module.gather  # type: ignore[no-any-return]
+
+
+def scalar() -> Any:
+    """The ``Scalar`` step type from the extension (a component's whole step in C, its
+    faults and declined outputs handed back to Python), or None."""
+    module = _extension()
+    return None if module is None else module.Scalar
 
 
 def _extension() -> Any:

@@ -192,6 +192,7 @@ class Steppers:
         packed = isinstance(values, array)
         self._publish = publish.compiled() if packed else None
         self._gather = publish.gather() if packed else None
+        self._scalar = publish.scalar() if packed else None
 
     def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:
         """How ``task`` steps: the lean scalar path, array ports, or through its delay line."""
@@ -212,6 +213,10 @@ class Steppers:
         take = self._gather if n > 2 else None
         ports, ats = tuple(p for p, _ in reads), tuple(a for _, a in reads)
         (p0, a0), (p1, a1) = [*reads, ("", 0), ("", 0)][:2]
+        if self._scalar is not None and type(targets) is dict:
+            # the whole step in C (``publish.py``); the same verdicts through these two
+            failed, judge = self._judges(task)
+            return self._scalar(comp, ports, ats, values, targets, failed, judge)  # type: ignore[no-any-return]
 
         def step(_task: Task, now: Fraction) -> None:
             if n == 2:
@@ -251,6 +256,40 @@ class Steppers:
                 raise bad_output(who(path), now, targets, out) from None
 
         return step
+
+    def _judges(self, task: Task) -> tuple[Callable[..., None], Callable[..., None]]:
+        """What the compiled step (``publish.Scalar``) hands back to Python: ``failed(exc,
+        now)`` raises the fault :meth:`scalar`'s step raises for what ``do_step`` raised,
+        ``judge(out, now)`` judges and writes an output the C write declined, as it does."""
+        values, who, path, targets = self.values, self.who, task.path, task.writes
+
+        def failed(exc: BaseException, now: Fraction) -> None:
+            try:
+                raise exc
+            except RunFault:
+                raise
+            except KeyboardInterrupt as err:  # the user's Ctrl-C, or the component's own
+                if interrupt.users_interrupt():
+                    raise
+                raise own_interrupt(who(path), now) from err
+            except COMPONENT_ERRORS as err:
+                raise RunFault(who(path), now, f"do_step raised {err!r}") from err
+
+        def judge(out: Any, now: Fraction) -> None:
+            if not out:
+                if out.__class__ is not dict and not isinstance(out, Mapping):
+                    raise bad_output(who(path), now, targets, out)
+                return
+            try:
+                for key, value in out.items():
+                    number = value if value.__class__ is float else as_number(value)
+                    if number - number != 0.0:  # inf or nan
+                        raise ValueError
+                    values[targets[key]] = number
+            except OUTPUT_ERRORS:
+                raise bad_output(who(path), now, targets, out) from None
+
+        return failed, judge
 
     def _call(self, task: Task, now: Fraction, inp: dict[str, Any]) -> Any:
         try:

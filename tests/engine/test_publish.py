@@ -151,3 +151,72 @@ def test_a_step_reads_the_same_inputs_on_both_paths(
         return values.tolist(), sent
 
     assert run(False) == run(True)
+
+
+class Stop(BaseException):
+    """Not a component's fault (as the gym episode's own stop): passes through."""
+
+
+class Raises:
+    def __init__(self, exc: BaseException) -> None:
+        self.exc = exc
+
+    def do_step(self, t: Fraction, inp: dict[str, Any]) -> Any:
+        raise self.exc
+
+
+RAISED = [
+    ValueError("bad"),
+    ZeroDivisionError(),
+    SystemExit(3),
+    KeyboardInterrupt(),  # raised by the component itself: no Ctrl-C was noted
+    RunFault("C (T)", NOW, "its own fault"),
+    Stop(),
+]
+
+
+@pytest.mark.parametrize("exc", RAISED, ids=lambda e: type(e).__name__)
+def test_what_do_step_raises_becomes_the_same_fault_on_both_paths(
+    exc: BaseException, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from amsa_phys.engine import interrupt
+
+    monkeypatch.setattr(interrupt, "users_interrupt", lambda: False)
+
+    def raised(pure: bool) -> tuple[type, str, type | None]:
+        if pure:
+            monkeypatch.setenv(publish.PURE_ENV, "1")
+        else:
+            monkeypatch.delenv(publish.PURE_ENV, raising=False)
+        values = array("d", [0.5, 0.0, 0.0])
+        task = Task("C", Raises(exc), 1, [("x", "S.x")], {"u": "C.u"})  # type: ignore[arg-type]
+        task.bind({"S.x": 0, "C.u": 1}.__getitem__)
+        step = Steppers(values, lambda *_: None, lambda p: f"{p} (T)").for_task(task)
+        try:
+            step(task, NOW)
+        except BaseException as caught:  # every kind, compared below
+            cause = caught.__cause__
+            return type(caught), str(caught), None if cause is None else type(cause)
+        raise AssertionError("nothing raised")
+
+    compiled, pure = raised(False), raised(True)
+    assert compiled == pure
+    if isinstance(exc, Stop | RunFault):
+        assert compiled[0] is type(exc)  # passed through as it is
+    else:
+        assert compiled[0] is RunFault
+        assert compiled[2] is type(exc)
+
+
+def test_the_compiled_step_is_the_one_the_engine_runs(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv(publish.PURE_ENV, raising=False)
+    values = array("d", [0.5, 0.0, 0.0, 0.0])
+    task = Task("C", Comp({"u": 1.0}), 1, [("x", "S.x")], {"u": "C.u"})  # type: ignore[arg-type]
+    task.bind({"S.x": 0, "C.u": 2}.__getitem__)
+    step = Steppers(values, lambda *_: None, str).for_task(task)
+    kind = publish.scalar()
+    if kind is None:
+        pytest.skip("the extension was not built (no C compiler)")
+    assert type(step) is kind
+    monkeypatch.setenv(publish.PURE_ENV, "1")
+    assert type(Steppers(values, lambda *_: None, str).for_task(task)) is not kind
