@@ -193,12 +193,20 @@ class Steppers:
         self._publish = publish.compiled() if packed else None
         self._gather = publish.gather() if packed else None
         self._scalar = publish.scalar() if packed else None
+        self._made: dict[int, tuple[Task, Callable[[Task, Fraction], None]]] = {}
 
     def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:
-        """How ``task`` steps: the lean scalar path, array ports, or through its delay line."""
+        """How ``task`` steps: the lean scalar path, array ports, or through its delay line.
+        Made once per task, however many instants of the cycle it runs at."""
+        made = self._made.get(id(task))
+        if made is not None and made[0] is task:
+            return made[1]
         if task.arrays_in or task.arrays_out:
-            return self.step_arrays
-        return self.scalar(task) if task.delay is None else self.delayed(task)
+            step = self.step_arrays
+        else:
+            step = self.scalar(task) if task.delay is None else self.delayed(task)
+        self._made[id(task)] = (task, step)
+        return step
 
     def scalar(self, task: Task) -> Callable[[Task, Fraction], None]:
         """:meth:`step` for ``task`` alone, what the loop calls in its place: the task's
