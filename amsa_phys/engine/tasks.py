@@ -187,10 +187,8 @@ class Steppers:
         self.col = col
         self.send = send
         self.who = who
-        #: the compiled read and write (``publish.py``), looked up once: where the store is
-        #: an array of doubles and the extension was built (and not switched off)
+        #: the compiled steps (``publish.py``) where the store is an array of doubles
         packed = isinstance(values, array)
-        self._publish = publish.compiled() if packed else None
         self._gather = publish.gather() if packed else None
         self._scalar = publish.scalar() if packed else None
         self._made: dict[int, tuple[Task, Callable[[Task, Fraction], None]]] = {}
@@ -209,22 +207,17 @@ class Steppers:
         return step
 
     def scalar(self, task: Task) -> Callable[[Task, Fraction], None]:
-        """:meth:`step` for ``task`` alone, what the loop calls in its place: the task's
-        positions are bound once, and up to two inputs are read into a dict display (a
-        comprehension is a function call of its own on CPython 3.11). ~0.2 us less a
-        component step, a tenth of a sensor's (issue 29). The same verdicts as :meth:`step`
-        (``tests/engine/test_tasks.py`` holds every path to them)."""
+        """:meth:`step` for ``task`` alone, what the loop calls in its place: in C where
+        built (``publish.Scalar``), else positions bound once and up to two inputs read into
+        a dict display (a comprehension is a call of its own on CPython 3.11). The same
+        verdicts as :meth:`step` (``tests/engine/test_tasks.py``, ``test_publish.py``)."""
         values, who, path, comp = self.values, self.who, task.path, task.comp
         reads, targets = task.reads, task.writes
         n = len(reads)
-        fast = self._publish
-        take = self._gather if n > 2 else None
-        ports, ats = tuple(p for p, _ in reads), tuple(a for _, a in reads)
-        (p0, a0), (p1, a1) = [*reads, ("", 0), ("", 0)][:2]
         if self._scalar is not None and type(targets) is dict:
-            # the whole step in C (``publish.py``); the same verdicts through these two
-            failed, judge = self._judges(task)
-            return self._scalar(comp, ports, ats, values, targets, failed, judge)  # type: ignore[no-any-return]
+            ports, ats = tuple(p for p, _ in reads), tuple(a for _, a in reads)
+            return self._scalar(comp, ports, ats, values, targets, *self._judges(task))  # type: ignore[no-any-return]
+        (p0, a0), (p1, a1) = [*reads, ("", 0), ("", 0)][:2]
 
         def step(_task: Task, now: Fraction) -> None:
             if n == 2:
@@ -233,8 +226,6 @@ class Steppers:
                 inp = {p0: values[a0]}
             elif n == 0:
                 inp = {}
-            elif take is not None:
-                inp = take(ports, ats, values, None)
             else:
                 inp = {port: values[at] for port, at in reads}
             try:
@@ -247,8 +238,6 @@ class Steppers:
                 raise own_interrupt(who(path), now) from exc
             except COMPONENT_ERRORS as exc:  # inlined :meth:`_call`, as in :meth:`step`
                 raise RunFault(who(path), now, f"do_step raised {exc!r}") from exc
-            if fast is not None and fast(out, targets, values):
-                return  # every output a finite float for a known port, written
             if not out:
                 if out.__class__ is not dict and not isinstance(out, Mapping):
                     raise bad_output(who(path), now, targets, out)
@@ -266,9 +255,8 @@ class Steppers:
         return step
 
     def _judges(self, task: Task) -> tuple[Callable[..., None], Callable[..., None]]:
-        """What the compiled step (``publish.Scalar``) hands back to Python: ``failed(exc,
-        now)`` raises the fault :meth:`scalar`'s step raises for what ``do_step`` raised,
-        ``judge(out, now)`` judges and writes an output the C write declined, as it does."""
+        """``publish.Scalar``'s way back: ``failed(exc, now)`` raises :meth:`scalar`'s fault
+        for what ``do_step`` raised, ``judge(out, now)`` judges an output C declined."""
         values, who, path, targets = self.values, self.who, task.path, task.writes
 
         def failed(exc: BaseException, now: Fraction) -> None:
@@ -341,8 +329,7 @@ class Steppers:
             raise bad_output(self.who(task.path), now, targets, out) from None
 
     def delayed(self, task: Task) -> Callable[[Task, Fraction], None]:
-        """:meth:`step_delayed` for ``task`` alone, its inputs gathered in one C call where
-        the extension was built (``publish.py``)."""
+        """:meth:`step_delayed` for ``task``, its inputs gathered in C (``publish.py``)."""
         take = self._gather
         if take is None:
             return self.step_delayed
