@@ -1,4 +1,5 @@
-"""The optional compiled physics step (``amsa_phys/physics/_step.c``); the rest is pyproject.toml.
+"""The optional compiled physics step (``amsa_phys/physics/_step.c``) and the engine's compiled
+write of published outputs (``amsa_phys/engine/_publish.c``); the rest is pyproject.toml.
 
 ``optional=True``: where there is no C compiler (or no Python headers) the build of the
 extension fails quietly and the install goes on; ``amsa_phys.physics.compiled`` then finds no
@@ -17,6 +18,8 @@ setup(
             extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"],
             libraries=["m"],
             optional=True,
-        )
+        ),
+        # the engine's write of a component's outputs into the store (engine/publish.py)
+        Extension("amsa_phys.engine._publish", ["amsa_phys/engine/_publish.c"], optional=True),
     ]
 )

@@ -235,6 +235,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:
         _silence_stdout()
         return EXIT_BROKEN_PIPE
+    finally:
+        if argv is None:  # the program itself: its modules' bytecode for the next one
+            from .. import bytecode
+
+            bytecode.warm()
 
 
 def _deaf_to_more_signals() -> None:

@@ -32,17 +32,18 @@ from typing import Any
 
 from ..errors import RunFault
 from ..model.adaptrules import RULE_COLUMN, Rule
-from ..model.scenario import Change, Phase, Scenario, traced_columns
+from ..model.scenario import Change, Phase, Scenario
 from ..model.template import Template
 from ..model.timeline import Timeline
 from ..model.world import WorldSpec
 from . import batch, interrupt, schedule
 from .adapt import AdaptRules
 from .build import build_components, make_task, plan_groups
-from .clock import TickGrid
+from .clock import TickGrid, exact
 from .context import Context, Event, Hook, RunResult
 from .delivery import Deliveries
 from .facereads import FaceReads
+from .fromscenario import FromScenario
 from .instants import InstantSource, TimelineSource
 from .livechanges import LiveChanges
 from .log import RunLog
@@ -59,7 +60,7 @@ Wrap = Callable[[str, Template], Template]
 __all__ = ["COMPONENT_ERRORS", "Context", "Event", "RunResult", "Simulation", "Task", "Wrap"]
 
 
-class Simulation(ReadAPI, FaceReads, LiveChanges):
+class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
     """One run of a scenario (or of a bare world, for tests).
 
     Read from outside with :meth:`read`, :meth:`read_many`, :meth:`column` and
@@ -74,6 +75,7 @@ class Simulation(ReadAPI, FaceReads, LiveChanges):
     ``batch.Grouping`` says how to group instead. ``context(sim, path)`` makes what each
     component's ``initialize`` receives (a batch of runs gives each run its own).
     ``plugs``: what a runtime changes at an instant (``plugs.py``); outsiders see ``face.py``.
+    ``keep_log=False``: no log instants unless a trace or listener is there (``gym/episode.py``).
     """
 
     def __init__(
@@ -94,6 +96,7 @@ class Simulation(ReadAPI, FaceReads, LiveChanges):
         context: Callable[[Simulation, str, int], Context] = Context,
         runs: Sequence[Scenario] = (),
         plugs: Plugs | None = None,
+        keep_log: bool = True,
     ) -> None:
         self.world = world
         self.plugs = plugs if plugs is not None else Plugs()
@@ -122,6 +125,7 @@ class Simulation(ReadAPI, FaceReads, LiveChanges):
         self.log = RunLog(
             self.columns, trace, quality_signal, self.store.at, self.values, self.store.col
         )
+        self._keep_log = keep_log
         self._hooks: list[tuple[Fraction, Hook, str]] = []
         #: hooks that take a run of their instants in one call (:meth:`batch_hook`)
         self._many: dict[Hook, Callable[[int, Callable[[int], None]], int]] = {}
@@ -157,31 +161,6 @@ class Simulation(ReadAPI, FaceReads, LiveChanges):
         #: the STL requirements judged after the run (:meth:`watch_requirements`)
         self.watch: RequirementWatch | None = None
         self._build()
-
-    @classmethod
-    def from_scenario(cls, scenario: Scenario, **kw: Any) -> Simulation:
-        """A Simulation configured by a loaded scenario (sampling what its STL requirements
-        read, so :meth:`result` judges them)."""
-        sim = cls(scenario.world, **cls.scenario_kwargs(scenario), **kw)
-        sim.watch_requirements(scenario)
-        return sim
-
-    def watch_requirements(self, scenario: Scenario) -> None:
-        """Sample what ``scenario``'s STL requirements read; :meth:`result` judges them."""
-        self.watch = RequirementWatch.of(scenario, self)
-
-    @staticmethod
-    def scenario_kwargs(scenario: Scenario) -> dict[str, Any]:
-        """What a scenario says to the constructor besides its world: the one mapping from a
-        scenario to a Simulation (``from_scenario``; the ROS simulator's ``RosSimulation``)."""
-        return {
-            "seed": scenario.seed,
-            "timeline": scenario.timeline,
-            "log_rate": scenario.log_rate,
-            "quality_signal": scenario.quality.signal if scenario.quality else None,
-            "columns": traced_columns(scenario),
-            "adapt": scenario.adapt,
-        }
 
     # -- construction -------------------------------------------------------------------
     def _build(self) -> None:
@@ -241,8 +220,8 @@ class Simulation(ReadAPI, FaceReads, LiveChanges):
             return now
         if not hasattr(self, "grid"):
             return Fraction(0)
-        # Fraction(n, d) directly: ``grid.tick * tick`` costs three times as much
-        now = Fraction(self._tick * self._tick_num, self._tick_den)
+        # exact(n, d): ``grid.tick * tick`` costs three times as much, Fraction(n, d) twice
+        now = exact(self._tick * self._tick_num, self._tick_den)
         self._now_cache = (self._tick, now)
         return now
 
@@ -265,9 +244,11 @@ class Simulation(ReadAPI, FaceReads, LiveChanges):
             )
         ]
         self._log_period = g.ticks(1 / self.log_rate)
+        self.keeps_log = bool(self._keep_log or self.log.listeners or self.log.has_trace)
+        log_at = self._log_period if self.keeps_log else None
         hooks = [(g.ticks(1 / r), fn) for r, fn, _ in self._hooks]
         try:
-            self._cycle, cycle = schedule.instants(self._tasks, self._log_period, hooks)
+            self._cycle, cycle = schedule.instants(self._tasks, log_at, hooks)
         except schedule.TooManyEvents as exc:
             raise RunFault(
                 "scheduler",
@@ -390,7 +371,7 @@ class Simulation(ReadAPI, FaceReads, LiveChanges):
                             if adapt is not None:
                                 self._apply_adapt()
                             # the ``now`` property's Fraction, built here without its checks
-                            now = Fraction(tick * num, den)
+                            now = exact(tick * num, den)
                             self._now_cache = (tick, now)
                             try:
                                 for run, task in tasks:
@@ -481,6 +462,8 @@ class Simulation(ReadAPI, FaceReads, LiveChanges):
         simulated instant, the very samples ``metrics.json`` is computed from, whatever the
         frame rate or speed-up (at x256 a frame spans seconds of simulated time).
         """
+        if not getattr(self, "keeps_log", True):
+            raise RuntimeError("this run keeps no log (keep_log=False): add listeners before it")
         self.log.listeners.append(fn)
 
     def result(self) -> RunResult:

@@ -43,9 +43,11 @@ class Instant:
     hooks: list[Hook] = field(default_factory=list)
 
 
-def cycle_of(task_periods: Sequence[int], log_period: int, hook_periods: Sequence[int]) -> int:
+def cycle_of(
+    task_periods: Sequence[int], log_period: int | None, hook_periods: Sequence[int]
+) -> int:
     """The hyperperiod of every period, in ticks (TooManyEvents if it holds too many)."""
-    periods = [*task_periods, log_period, *hook_periods]
+    periods = [*task_periods, *([log_period] if log_period else []), *hook_periods]
     cycle = hyperperiod(periods)
     count = sum(cycle // p for p in periods)
     if count > MAX_EVENTS_PER_CYCLE:
@@ -55,20 +57,22 @@ def cycle_of(task_periods: Sequence[int], log_period: int, hook_periods: Sequenc
 
 def instants(
     tasks: Sequence[Any],
-    log_period: int,
+    log_period: int | None,
     hooks: Sequence[tuple[int, Hook]],
 ) -> tuple[int, list[Instant]]:
     """The cycle's length and its instants in offset order.
 
     ``tasks`` have ``period`` and ``phase`` (ticks), in execution order; ``hooks`` are
     ``(period, fn)`` in the order they were added. Only offsets where something is due appear.
+    ``log_period`` None: a run that keeps no log (no instant is due for the log alone, so
+    the physics steps between two components' instants are one run).
     """
     cycle = cycle_of([t.period for t in tasks], log_period, [p for p, _ in hooks])
     table: dict[int, Instant] = {}
     for task in tasks:
         for off in range(task.phase, cycle, task.period):
             table.setdefault(off, Instant(off)).tasks.append(task)
-    for off in range(0, cycle, log_period):
+    for off in range(0, cycle, log_period) if log_period else ():
         table.setdefault(off, Instant(off)).log = True
     for period, fn in hooks:
         for off in range(0, cycle, period):

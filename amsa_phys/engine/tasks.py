@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import RunFault
 from ..model.params import short_repr
 from ..model.template import Template
-from . import batch, interrupt
+from . import batch, interrupt, publish
 from .timing import DelayLine
 
 #: What a component's code may raise that is its fault, not the engine's: any exception,
@@ -187,22 +187,36 @@ class Steppers:
         self.col = col
         self.send = send
         self.who = who
+        #: the compiled steps (``publish.py``) where the store is an array of doubles
+        packed = isinstance(values, array)
+        self._gather = publish.gather() if packed else None
+        self._scalar = publish.scalar() if packed else None
+        self._made: dict[int, tuple[Task, Callable[[Task, Fraction], None]]] = {}
 
     def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:
-        """How ``task`` steps: the lean scalar path, array ports, or through its delay line."""
+        """How ``task`` steps: the lean scalar path, array ports, or through its delay line.
+        Made once per task, however many instants of the cycle it runs at."""
+        made = self._made.get(id(task))
+        if made is not None and made[0] is task:
+            return made[1]
         if task.arrays_in or task.arrays_out:
-            return self.step_arrays
-        return self.scalar(task) if task.delay is None else self.step_delayed
+            step = self.step_arrays
+        else:
+            step = self.scalar(task) if task.delay is None else self.delayed(task)
+        self._made[id(task)] = (task, step)
+        return step
 
     def scalar(self, task: Task) -> Callable[[Task, Fraction], None]:
-        """:meth:`step` for ``task`` alone, what the loop calls in its place: the task's
-        positions are bound once, and up to two inputs are read into a dict display (a
-        comprehension is a function call of its own on CPython 3.11). ~0.2 us less a
-        component step, a tenth of a sensor's (issue 29). The same verdicts as :meth:`step`
-        (``tests/engine/test_tasks.py`` holds every path to them)."""
+        """:meth:`step` for ``task`` alone, what the loop calls in its place: in C where
+        built (``publish.Scalar``), else positions bound once and up to two inputs read into
+        a dict display (a comprehension is a call of its own on CPython 3.11). The same
+        verdicts as :meth:`step` (``tests/engine/test_tasks.py``, ``test_publish.py``)."""
         values, who, path, comp = self.values, self.who, task.path, task.comp
         reads, targets = task.reads, task.writes
         n = len(reads)
+        if self._scalar is not None and type(targets) is dict:
+            ports, ats = tuple(p for p, _ in reads), tuple(a for _, a in reads)
+            return self._scalar(comp, ports, ats, values, targets, *self._judges(task))  # type: ignore[no-any-return]
         (p0, a0), (p1, a1) = [*reads, ("", 0), ("", 0)][:2]
 
         def step(_task: Task, now: Fraction) -> None:
@@ -239,6 +253,39 @@ class Steppers:
                 raise bad_output(who(path), now, targets, out) from None
 
         return step
+
+    def _judges(self, task: Task) -> tuple[Callable[..., None], Callable[..., None]]:
+        """``publish.Scalar``'s way back: ``failed(exc, now)`` raises :meth:`scalar`'s fault
+        for what ``do_step`` raised, ``judge(out, now)`` judges an output C declined."""
+        values, who, path, targets = self.values, self.who, task.path, task.writes
+
+        def failed(exc: BaseException, now: Fraction) -> None:
+            try:
+                raise exc
+            except RunFault:
+                raise
+            except KeyboardInterrupt as err:  # the user's Ctrl-C, or the component's own
+                if interrupt.users_interrupt():
+                    raise
+                raise own_interrupt(who(path), now) from err
+            except COMPONENT_ERRORS as err:
+                raise RunFault(who(path), now, f"do_step raised {err!r}") from err
+
+        def judge(out: Any, now: Fraction) -> None:
+            if not out:
+                if out.__class__ is not dict and not isinstance(out, Mapping):
+                    raise bad_output(who(path), now, targets, out)
+                return
+            try:
+                for key, value in out.items():
+                    number = value if value.__class__ is float else as_number(value)
+                    if number - number != 0.0:  # inf or nan
+                        raise ValueError
+                    values[targets[key]] = number
+            except OUTPUT_ERRORS:
+                raise bad_output(who(path), now, targets, out) from None
+
+        return failed, judge
 
     def _call(self, task: Task, now: Fraction, inp: dict[str, Any]) -> Any:
         try:
@@ -281,12 +328,28 @@ class Steppers:
         except OUTPUT_ERRORS:
             raise bad_output(self.who(task.path), now, targets, out) from None
 
+    def delayed(self, task: Task) -> Callable[[Task, Fraction], None]:
+        """:meth:`step_delayed` for ``task``, its inputs gathered in C (``publish.py``)."""
+        take = self._gather
+        if take is None:
+            return self.step_delayed
+        ports, ats = tuple(p for p, _ in task.reads), tuple(a for _, a in task.reads)
+        values, own, then = self.values, task.own, self._delayed
+
+        def step(_task: Task, now: Fraction) -> None:
+            then(task, now, take(ports, ats, values, own))
+
+        return step
+
     def step_delayed(self, task: Task, now: Fraction) -> None:
         """:meth:`step` for a Leaf with latency or jitter: its outputs go into its delay
         line instead of the buffers (it reads its own outputs back at once)."""
         values = self.values
         own = task.own
-        inp = {port: own.get(at, values[at]) for port, at in task.reads}
+        self._delayed(task, now, {port: own.get(at, values[at]) for port, at in task.reads})
+
+    def _delayed(self, task: Task, now: Fraction, inp: dict[str, Any]) -> None:
+        """:meth:`step_delayed` once its inputs ``inp`` are read."""
         try:
             out = task.comp.do_step(now, inp)
         except RunFault:
@@ -303,7 +366,7 @@ class Steppers:
             return
         writes: dict[Any, float] = {}
         checked_writes(task, out, writes, now, self.who)
-        own.update(writes)
+        task.own.update(writes)
         assert task.delay is not None
         self.send(task.delay, list(writes.items()))
 

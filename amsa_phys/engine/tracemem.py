@@ -9,7 +9,7 @@ streams to, so the saved ``trace.csv`` is byte-identical to ``amsa-phys run --he
 from __future__ import annotations
 
 from array import array
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +25,10 @@ class TraceMemory:
         self.width = len(self.columns) + 1
         self._flat = array("d")
         self._closed = False
+        #: set by the engine's log when it hands rows a block at a time (``log.py``'s
+        #: ``RowBlock.flush``): called before any read, so the rows still in the block are
+        #: here (reads come from the thread that runs the simulation)
+        self.pending: Callable[[], None] | None = None
 
     def write(self, t_s: float, values: Sequence[float] | np.ndarray) -> None:
         """Append one row (the engine's trace callback): floats, or a float64 array, which
@@ -40,17 +44,32 @@ class TraceMemory:
     #: tells the engine's log (``log.py``) to hand :meth:`write` rows as float64 arrays
     write.packed_rows = True  # type: ignore[attr-defined]
 
+    def write_block(self, times: np.ndarray, rows: np.ndarray) -> None:
+        """Append ``len(times)`` rows at once: ``rows`` is ``(n, columns)`` float64, what
+        ``n`` calls of :meth:`write` would append."""
+        block = np.empty((len(times), self.width), dtype=np.float64)
+        block[:, 0] = times
+        block[:, 1:] = rows
+        self._flat.frombytes(block.tobytes())
+
+    def _drain(self) -> None:
+        if self.pending is not None:
+            self.pending()
+
     def close(self) -> None:
         """No more rows: the arrays handed out from now on are views, not copies."""
+        self._drain()
         self._closed = True
 
     @property
     def rows(self) -> int:
         """Rows recorded so far."""
+        self._drain()
         return len(self._flat) // self.width
 
     def matrix(self) -> np.ndarray:
         """The rows as a read-only ``(rows, 1 + columns)`` float64 array (``t`` first)."""
+        self._drain()
         # a view while rows may still come would pin the array: ``extend`` then fails
         data = np.frombuffer(self._flat, dtype=np.float64) if self._closed else np.array(self._flat)
         data = data.reshape(-1, self.width)

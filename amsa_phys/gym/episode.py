@@ -75,6 +75,10 @@ class Episode:
     instant: :attr:`t` is its time and :attr:`inputs` what the component reads there; or
     the run has ended (:attr:`done`). A fault in the run is raised by the call that meets it.
     The episode belongs to the thread that made it: a greenlet switches only within one.
+
+    The run keeps a log only for ``trace`` or with ``keep_log`` (a picture samples it): the
+    agent reads the store, never the log, and without the log's instants the physics steps
+    between the components' instants go in one batch (``Simulation``'s ``keep_log``).
     """
 
     def __init__(
@@ -82,13 +86,17 @@ class Episode:
         scenario: Scenario,
         path: str,
         trace: Callable[[float, list[float]], None] | None = None,
+        *,
+        keep_log: bool = False,
     ) -> None:
         world = scenario.world
         self.path = path
         leaf = world.leaves[path]
         agent = dataclasses.replace(leaf, template=stand_in(leaf.template, self._exchange))
         world = dataclasses.replace(world, leaves={**world.leaves, path: agent})
-        self.sim = Simulation.from_scenario(dataclasses.replace(scenario, world=world), trace=trace)
+        self.sim = Simulation.from_scenario(
+            dataclasses.replace(scenario, world=world), trace=trace, keep_log=keep_log
+        )
         self.end = self.sim.duration
         self._end_num, self._end_den = self.end.numerator, self.end.denominator
         self.t = Fraction(0)

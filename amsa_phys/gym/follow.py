@@ -213,7 +213,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         self.close()
         self._memory = TraceMemory(list(scenario.world.buffers)) if self.record_trace else None
         trace = self._memory.write if self._memory is not None else None
-        self._episode = Episode(scenario, self.path, trace)
+        # a picture samples the log (``view/scene.py``); the agent's own step reads the store
+        self._episode = Episode(scenario, self.path, trace, keep_log=self.render_mode is not None)
         sim = self._episode.sim
         self._data, self._signal_at = sim.data, sim.at(self._signal)
         self._collisions = 0
