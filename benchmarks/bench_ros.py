@@ -312,8 +312,9 @@ def perf(
         ws = root / "ws2"
         build(PLATOON, ws, "--duration", platoon_duration)
         walls, rss_mib = [], []
-        for _ in range(reps):
-            wall, _run, rss, _ = launch(ws, "platoon.launch", f"out:={ws / 'out'}", "plots:=false")
+        for rep in range(reps):  # a run directory each: out:= refuses one that is not empty
+            out = ws / f"out{rep}"
+            wall, _run, rss, _ = launch(ws, "platoon.launch", f"out:={out}", "plots:=false")
             walls.append(wall)
             rss_mib.append(rss / 1024)
         ok = statistics.median(rss_mib) < 1024
