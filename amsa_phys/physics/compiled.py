@@ -55,6 +55,8 @@ def check_layout(ext: Any) -> tuple[str, ...]:
         problems.append(f"ground rows {ext.GROUND_ROWS} != fleet.GROUND_ROWS {GROUND_ROWS}")
     if not hasattr(ext, "Columns"):  # older builds: no batch step, Stepper takes 7 functions
         problems.append("no Columns (the batch's step)")
+    if not getattr(ext, "SECOND_ORDER", 0):  # older builds: Chipmunk's first-order pose update
+        problems.append("no second-order pose update (bodyio.trapezoid)")
     if problems:
         raise ImportError(
             "amsa_phys.physics._step was built from another version of _step.c ("
@@ -75,10 +77,9 @@ _FUNCTIONS = (
     "cpBodySetForce",
     "cpBodySetTorque",
     "cpSpaceStep",
+    "cpBodySetPosition",
+    "cpBodySetAngle",
 )
-#: Read after each step when Chipmunk's rotation of a body is ``math.cos``/``math.sin`` of
-#: its angle (:func:`_rotation_is_libms`): the C step then skips computing them again.
-_ROTATION = "cpBodyGetRotation"
 
 
 def status() -> tuple[bool, str]:
@@ -98,38 +99,16 @@ _cached: tuple[int, ...] | bool | None = False
 
 
 def _functions() -> tuple[int, ...] | None:
-    """Addresses of :data:`_FUNCTIONS` in pymunk's own Chipmunk, or None if not reachable;
-    with :data:`_ROTATION`'s after them when :func:`_rotation_is_libms`."""
+    """Addresses of :data:`_FUNCTIONS` in pymunk's own Chipmunk, or None if not reachable."""
     global _cached
     if _cached is False:
         try:
             from pymunk._chipmunk import ffi, lib
 
-            names = _FUNCTIONS + ((_ROTATION,) if _rotation_is_libms() else ())
-            _cached = tuple(int(ffi.cast("uintptr_t", ffi.addressof(lib, n))) for n in names)
+            _cached = tuple(int(ffi.cast("uintptr_t", ffi.addressof(lib, n))) for n in _FUNCTIONS)
         except Exception:  # an older/newer pymunk layout: stay pure
             _cached = None
     return _cached  # type: ignore[return-value]
-
-
-def _rotation_is_libms(samples: int = 200) -> bool:
-    """Whether Chipmunk's rotation of a body equals ``math.cos`` and ``math.sin`` of its
-    angle (the functions the C step calls) on angles of every size and sign: true where
-    pymunk's Chipmunk calls the same libm (checked once a process, ~0.2 ms); elsewhere the C
-    step computes them itself."""
-    import math
-
-    import pymunk
-    from pymunk._chipmunk import lib
-
-    body = pymunk.Body(1.0, 1.0)
-    for i in range(samples):
-        angle = math.ldexp(math.sin(7.0 * i + 1.0), i % 40 - 20)  # |angle| 1e-6 .. 1e6
-        body.angle = angle
-        r = lib.cpBodyGetRotation(body._body)
-        if r.x != math.cos(angle) or r.y != math.sin(angle):
-            return False
-    return True
 
 
 def _address(handle: Any) -> int:
@@ -163,8 +142,11 @@ def _step_with(io: BodyIO, stepper: Any, dt: float, top2: float, sub_speed: floa
     if space._bodies_to_check:  # new bodies (the first step): let pymunk validate them
         stepper.apply()
         n = substeps(top2, sub_speed)
+        h = dt / n
         for _ in range(n):
-            space.step(dt / n)
+            stepper.before()
+            space.step(h)
+            stepper.after(h)  # the trapezoid, as the C step's own steps (bodyio.trapezoid)
         return int(stepper.read_check())
     return _locked_step(space, stepper.advance)
 

@@ -76,7 +76,7 @@ class Folded(NamedTuple):
     kx: float  # tyre longitudinal stiffness times speed: N / c_x (N)
     ky: float  # lateral: N / c_y (N)
     half_track: float
-    turn_k: float  # dt^2 / I: heading change per N m
+    turn_k: float  # dt^2 / (2 I): heading change per N m (the trapezoid, bodyio.trapezoid)
     dt_i: float  # dt / I
     dt_m: float  # dt / m
     m_dt: float  # m / dt
@@ -110,7 +110,7 @@ def fold(rover: DiffDriveRover, dt: float) -> Folded:
         kx=kx,
         ky=w.load_n / w.slip_lat,
         half_track=rover.half_track,
-        turn_k=dt * dt / rover.moment,
+        turn_k=0.5 * dt * dt / rover.moment,
         dt_i=dt / rover.moment,
         dt_m=dt / rover.mass,
         m_dt=rover.mass / dt,
@@ -253,8 +253,13 @@ def rover_step(
     if sloped:  # the solves see the velocity gravity gives the body within the step
         vx = vx + gax * dt
         vy = vy + gay * dt
-    co = cos(angle)
-    si = sin(angle)
+    # the body's frame half a step on (its heading turned by half the step at the rate it
+    # starts with): the tyres slip in a frame that turns w dt within the step, and seen from
+    # the frame it starts in their slip is a first-order angle behind (a 20 s skid on mu 0.1
+    # ended 0.059 rad and, with 600 N motors, 0.63 m off at 100 Hz; 0.013 rad and 4 cm now)
+    ahead = angle + 0.5 * w * dt
+    co = cos(ahead)
+    si = sin(ahead)
     v_fwd = vx * co + vy * si
     wh = w * h
     ixl, iyl, rl, ixr, iyr, rr, ts, _, _ = gnd
@@ -338,7 +343,7 @@ def rover_step(
     if not (-tl <= kphl * wn <= tl and -tr <= kphr * wn <= tr):
         scrub = patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i)
     torque += scrub
-    # predicted heading change over this step (semi-implicit Euler, as pymunk does)
+    # predicted heading change over this step (the trapezoid: (w + w1) dt / 2, bodyio.trapezoid)
     turn = w * dt + torque * turn_k
     end = angle + turn
     mid = angle + 0.5 * turn
