@@ -13,6 +13,7 @@ from ..engine import noise as nz
 from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
+from .clock import stamped
 
 _TWO_PI = 2 * math.pi
 
@@ -180,3 +181,7 @@ class Compass(Template):
         q = nz.quantise_many(value, p.precision)
         value = np.where(p.precision > 0, (q + math.pi) % _TWO_PI - math.pi, value)
         return {"compassHeading": value}, ~lost
+
+
+#: Compass with the sensor's own clock: an output ``stamp`` (``sensors/clock.py``)
+StampedCompass = stamped(Compass)
