@@ -253,13 +253,8 @@ def rover_step(
     if sloped:  # the solves see the velocity gravity gives the body within the step
         vx = vx + gax * dt
         vy = vy + gay * dt
-    # the body's frame half a step on (its heading turned by half the step at the rate it
-    # starts with): the tyres slip in a frame that turns w dt within the step, and seen from
-    # the frame it starts in their slip is a first-order angle behind (a 20 s skid on mu 0.1
-    # ended 0.059 rad and, with 600 N motors, 0.63 m off at 100 Hz; 0.013 rad and 4 cm now)
-    ahead = angle + 0.5 * w * dt
-    co = cos(ahead)
-    si = sin(ahead)
+    co = cos(angle)
+    si = sin(angle)
     v_fwd = vx * co + vy * si
     wh = w * h
     ixl, iyl, rl, ixr, iyr, rr, ts, _, _ = gnd

@@ -15,7 +15,6 @@ sliding tyre's rim solve instead.
 
 from __future__ import annotations
 
-import itertools
 from pathlib import Path
 from typing import Any
 
@@ -138,22 +137,19 @@ def skid_errors(tmp_path: Path, geometry: dict[str, float] = ON_AXLE) -> list[fl
 SKID_RATES = [100, 200, 400, 800]
 
 
-def converges(errs: list[float], at_100_hz: float) -> None:
-    """The skid's errors shrink as the rate rises, 800 Hz's within half of 100 Hz's, and 100
-    Hz's within ``at_100_hz``. Not a slope: with the second-order pose update (and the frame
-    half a step on) the 100 Hz error halved while 200-800 Hz sit on a plateau of ~0.5 cm
-    (where the skid's events fall in a step, the same before the change), which flattens a
-    four-rate slope to ~0.4 though every rate is as close as before or closer."""
-    assert all(b <= a for a, b in itertools.pairwise(errs)), errs
-    assert errs[-1] <= 0.5 * errs[0], errs
-    assert errs[0] < at_100_hz, errs
+def within(errs: list[float], bound: float) -> None:
+    """Every rate from 100 to 800 Hz within ``bound`` of the 3,200 Hz run. Not a slope: with
+    the second-order pose update the 100 Hz error fell from 2.5 to 0.69 cm and every rate now
+    sits on a plateau of 0.4-0.7 cm (where the skid's events fall in a step, the same before
+    the change), which no four-rate slope describes."""
+    assert max(errs) < bound, errs
 
 
-def test_a_skid_pose_converges_with_the_rate(tmp_path: Path) -> None:
-    # measured against 3,200 Hz: 1.15, 0.71, 0.60, 0.46 cm (before the second-order pose
-    # update and the frame half a step on: 2.5 cm at 100 Hz, four-rate order 0.87; the old
-    # saturated scheme on today's model: 0.66 m, order -0.02: it does not converge)
-    converges(skid_errors(tmp_path), 0.015)
+def test_a_skid_pose_is_rate_independent_to_a_centimetre(tmp_path: Path) -> None:
+    # measured against 3,200 Hz: 0.69, 0.40, 0.47, 0.41 cm (with Chipmunk's first-order pose
+    # update: 2.5, 1.1, 0.68, 0.55 cm; the old saturated scheme on today's model: 0.66 m, order
+    # -0.02: it does not converge)
+    within(skid_errors(tmp_path), 0.01)
 
 
 def test_mutation_skid_check_fails_with_the_old_saturated_scheme(
@@ -161,14 +157,14 @@ def test_mutation_skid_check_fails_with_the_old_saturated_scheme(
 ) -> None:
     mutate(monkeypatch)
     with pytest.raises(AssertionError):
-        converges(skid_errors(tmp_path), 0.015)
+        within(skid_errors(tmp_path), 0.01)
 
 
-def test_a_skid_pose_converges_with_the_rate_with_load_transfer(tmp_path: Path) -> None:
+def test_a_skid_pose_is_rate_independent_with_load_transfer(tmp_path: Path) -> None:
     # the default base (caster 30 cm behind, centre of mass 20 cm high): the braking skid moves
-    # load onto the drive axle, capped at the traction it allows each step (measured 1.1 cm
-    # at 100 Hz, 0.43 at 800; before: 2.7 cm, order 1.15; the old scheme: 0.68 m)
-    converges(skid_errors(tmp_path, {}), 0.015)
+    # load onto the drive axle, capped at the traction it allows each step (measured 0.62,
+    # 0.32, 0.43, 0.39 cm; before the trapezoid 2.7 cm at 100 Hz; the old scheme: 0.68 m)
+    within(skid_errors(tmp_path, {}), 0.01)
 
 
 # -- spin-up peak slip ----------------------------------------------------------------------------
