@@ -17,8 +17,8 @@ import numpy as np
 
 from ..engine import noise as nz
 from ..model.params import Param
+from ..model.sensorclock import SensorClock, clock_params
 from ..model.template import Kind, Port, Template
-from ..sensors.clock import SensorClock, clock_params
 from .lidar import cast_rays
 from .space import physics_of
 from .terrain import POLYGON, Zone, check_polygon
@@ -113,7 +113,7 @@ class GNSS(Template):
         self.mp_start = mp.standard_normal(2).tolist()
         self.mp_rng = mp
         self.loss_rng = loss
-        self.clock = SensorClock(jit)  # the one clock model of every sensor (sensors/clock.py)
+        self.clock = SensorClock(jit)  # the one clock model of every sensor (model/sensorclock.py)
         self.mp = [0.0, 0.0]
         self.t_prev: float | None = None
         self.lost = 0  # samples without a fix so far (losses and outages)

@@ -17,8 +17,8 @@ import pymunk
 
 from ..engine import noise as nz
 from ..model.params import Param
+from ..model.sensorclock import stamped
 from ..model.template import Kind, Port, Template
-from ..sensors.clock import stamped
 from ..templatemarks import Scan
 from .space import physics_of
 
@@ -212,5 +212,5 @@ def cast_rays(
     return out
 
 
-#: Lidar with the sensor's own clock: an output ``stamp`` (``sensors/clock.py``)
+#: Lidar with the sensor's own clock: an output ``stamp`` (``model/sensorclock.py``)
 StampedLidar = stamped(Lidar)

@@ -12,8 +12,8 @@ import numpy as np
 from ..engine import noise as nz
 from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
+from ..model.sensorclock import stamped
 from ..model.template import Kind, Port, Template
-from .clock import stamped
 
 _TWO_PI = 2 * math.pi
 
@@ -183,5 +183,5 @@ class Compass(Template):
         return {"compassHeading": value}, ~lost
 
 
-#: Compass with the sensor's own clock: an output ``stamp`` (``sensors/clock.py``)
+#: Compass with the sensor's own clock: an output ``stamp`` (``model/sensorclock.py``)
 StampedCompass = stamped(Compass)

@@ -9,8 +9,8 @@ from typing import Any
 
 from ..engine import noise as nz
 from ..model.params import Param
+from ..model.sensorclock import stamped
 from ..model.template import Kind, Port, Template
-from .clock import stamped
 
 
 class _Optional(Port):
@@ -131,5 +131,5 @@ def _body_velocity(
     return (dx * c + dy * s) / (period * k), (-dx * s + dy * c) / (period * k)
 
 
-#: IMU with the sensor's own clock: an output ``stamp`` (``sensors/clock.py``)
+#: IMU with the sensor's own clock: an output ``stamp`` (``model/sensorclock.py``)
 StampedIMU = stamped(IMU)

@@ -9,8 +9,8 @@ from typing import Any
 
 from ..engine import noise as nz
 from ..model.params import Param
+from ..model.sensorclock import stamped
 from ..model.template import Kind, Port, Template
-from .clock import stamped
 
 
 class WheelOdometry(Template):
@@ -105,5 +105,5 @@ class WheelOdometry(Template):
         self.heading += dth
 
 
-#: WheelOdometry with the sensor's own clock: an output ``stamp`` (``sensors/clock.py``)
+#: WheelOdometry with the sensor's own clock: an output ``stamp`` (``model/sensorclock.py``)
 StampedWheelOdometry = stamped(WheelOdometry)

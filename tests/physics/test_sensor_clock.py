@@ -1,4 +1,4 @@
-"""Every sensor's clock (``sensors/clock.py``): the stamped twins of IMU, odometry, compass and
+"""Every sensor's clock (``model/sensorclock.py``): the stamped twins of IMU, odometry, compass and
 lidar publish their sensor's very samples plus a stamp, and the stamps follow the closed forms
 (a constant offset shifts them by exactly it, a drift by exactly ppm·t, the jitter's spread).
 GNSS has the same clock (``test_gnss.py`` holds its stamps); its code is this one."""
@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from rig import drive
 
+from amsa_phys.model import sensorclock as clock
 from amsa_phys.model.template import resolve_template
-from amsa_phys.sensors import clock
 
 FREQ = 20
 #: the four sensors, each with noise and losses on (so "the same samples" means something),

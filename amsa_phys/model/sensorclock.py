@@ -1,5 +1,8 @@
 """A sensor's own clock: the time stamp it puts on a sample, and the templates that publish it.
 
+In the model layer because both sensor packages use it (``sensors/`` and ``physics/``, whose
+GNSS and lidar read the world's geometry) and neither may import the other.
+
 One clock model for every sensor. A real sensor stamps a sample with its own clock, which
 is off from the robot's by a constant offset, drifts from it at some parts per million
 since they were last synchronised (here at t = 0), and is read with some jitter (the
@@ -23,8 +26,8 @@ from collections.abc import Mapping
 from fractions import Fraction
 from typing import Any, ClassVar
 
-from ..model.params import Param
-from ..model.template import Port, Template
+from .params import Param
+from .template import Port, Template
 
 #: the clock's parameters (their names, in the order :func:`clock_params` gives them)
 CLOCK_NAMES = ("clockOffset", "syncDrift", "stampJitter")
@@ -149,7 +152,7 @@ def stamped(base: type[Template]) -> type[Template]:
     Twin.__doc__ = (
         f"{first}, stamped by the sensor's own clock (offset, drift, jitter).\n\n"
         f"``{base.name()}`` with an output ``stamp``: the sample's true time + ``clockOffset`` "
-        "+ ``syncDrift``·1e-6·t + ``stampJitter``·N(0,1) (``sensors/clock.py``). Everything "
+        "+ ``syncDrift``·1e-6·t + ``stampJitter``·N(0,1) (``model/sensorclock.py``). Everything "
         f"else is ``{base.name()}``'s, sample for sample.\n\n" + (base.__doc__ or "")
     )
     return Twin
