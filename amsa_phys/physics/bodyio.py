@@ -108,6 +108,53 @@ def locked_step(space: pymunk.Space, step: Callable[[], Any]) -> Any:
     return result
 
 
+def velocities(bodies: list[pymunk.Body]) -> list[tuple[float, float, float]]:
+    """Each body's ``vx, vy, w`` before a Chipmunk step (:func:`trapezoid`'s other end)."""
+    if _lib is not None:  # Chipmunk's own getters: ~4x cheaper than the properties
+        out = []
+        for b in bodies:
+            h = b._body
+            v = _lib.cpBodyGetVelocity(h)
+            out.append((v.x, v.y, _lib.cpBodyGetAngularVelocity(h)))
+        return out
+    return [(b.velocity.x, b.velocity.y, b.angular_velocity) for b in bodies]
+
+
+def trapezoid(
+    bodies: list[pymunk.Body], before: list[tuple[float, float, float]], half: float
+) -> None:
+    """Make the Chipmunk step just taken second order in the pose: ``p += (v1 - v0) h / 2``.
+
+    Chipmunk moves a body by the velocity it had at the start of the step
+    (``cpBodyUpdatePosition`` runs before ``cpBodyUpdateVelocity``), so under an acceleration
+    ``a`` the pose lags by ``a t dt / 2``, a first-order error (a 3 s spin-up from rest on
+    μ 0.1: 0.032 rad of heading at 100 Hz). Moving each body on by half the step's change of
+    velocity (``half`` is ``h / 2``) makes the step the trapezoid ``p += (v0 + v1) h / 2``.
+    Velocities are untouched, so no energy is added; a contact impulse's change of velocity
+    moves the body by half of it times ``h``, as the trapezoid would. ``_step.c``'s
+    ``second_order`` is the compiled step's copy: the same operations in the same order
+    (and the same Chipmunk setters, which the properties call too).
+    """
+    lib = _lib
+    if lib is not None:
+        for b, (vx0, vy0, w0) in zip(bodies, before, strict=True):
+            h = b._body
+            p = lib.cpBodyGetPosition(h)
+            v = lib.cpBodyGetVelocity(h)
+            a = lib.cpBodyGetAngle(h)
+            w = lib.cpBodyGetAngularVelocity(h)
+            lib.cpBodySetPosition(h, (p.x + (v.x - vx0) * half, p.y + (v.y - vy0) * half))
+            lib.cpBodySetAngle(h, a + (w - w0) * half)
+        return
+    for b, (vx0, vy0, w0) in zip(bodies, before, strict=True):
+        p = b.position
+        v = b.velocity
+        a = b.angle
+        w = b.angular_velocity
+        b.position = (p.x + (v.x - vx0) * half, p.y + (v.y - vy0) * half)
+        b.angle = a + (w - w0) * half
+
+
 class BodyIO:
     """Batch state reads and force writes for every body of one Space.
 
@@ -117,6 +164,8 @@ class BodyIO:
 
     def __init__(self, space: pymunk.Space, bodies: list[pymunk.Body], direct: bool = True) -> None:
         self.space = space
+        #: the bodies whose pose :func:`trapezoid` corrects after each Chipmunk step
+        self.bodies = list(bodies)
         ids_buf = pb.Buffer()
         pb.get_space_bodies(space, pb.BodyFields.BODY_ID, ids_buf)
         ids = np.frombuffer(memoryview(ids_buf.int_buf()).cast("P"), dtype=np.uintp)
@@ -197,12 +246,16 @@ class BodyIO:
         If a callback ever queued work during the step, it is refused loudly rather than lost.
         """
         space = self.space
+        bodies = self.bodies
         h = dt / substeps
+        half = 0.5 * h
         for _ in range(substeps):
+            before = velocities(bodies)
             if not self.direct or space._bodies_to_check:  # new bodies: pymunk validates them
                 space.step(h)
             else:
                 locked_step(space, lambda: self._space_step(self._handle, h))
+            trapezoid(bodies, before, half)
 
     def write(self) -> None:
         """Send :attr:`forces` to every body (forces of non-rover bodies stay zero)."""

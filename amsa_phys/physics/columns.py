@@ -15,9 +15,10 @@ pymunk's broadphase quadratic). What is shared is the arithmetic:
   rover takes one at two steps in three); the C pass takes each rover's branch alone;
 * every rover is integrated here, in numpy, with Chipmunk's own update for a body without
   contacts (``cpBodyUpdatePosition`` then ``cpBodyUpdateVelocity``: ``p += v dt; a += w dt;
-  v += (g + f / m) dt; w += t / I dt``, the same operations in the same order, so the same
-  floats: given the same forces, a body ends each step where its Space would put it, bit
-  for bit; ``tests/physics/test_columns.py``).
+  v += (g + f / m) dt; w += t / I dt``, then ``bodyio.trapezoid``'s second-order pose
+  correction, the same operations in the same order, so the same floats: given the same
+  forces, a body ends each step where its Space would put it, bit for bit;
+  ``tests/physics/test_columns.py``).
 
 With the compiled forces the integration, the contact screening below and the safety check
 run in the same C call as the forces (``_step.Columns``, ``ColumnForces.columns``): the
@@ -103,6 +104,12 @@ class _ColumnIO:
         s[:, 3] += (0.0 + f[:, 0] * self.m_inv) * dt
         s[:, 4] += (0.0 + f[:, 1] * self.m_inv) * dt
         s[:, 5] += f[:, 2] * self.i_inv * dt
+        # bodyio.trapezoid: p = p + (v1 - v0) * (dt / 2), a = a + (w1 - w0) * (dt / 2)
+        half = 0.5 * dt
+        b = self.before
+        s[:, 0] += (s[:, 3] - b[:, 3]) * half
+        s[:, 1] += (s[:, 4] - b[:, 4]) * half
+        s[:, 2] += (s[:, 5] - b[:, 5]) * half
         if self.on_step is not None:
             self.on_step(dt)
 

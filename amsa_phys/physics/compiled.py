@@ -55,6 +55,8 @@ def check_layout(ext: Any) -> tuple[str, ...]:
         problems.append(f"ground rows {ext.GROUND_ROWS} != fleet.GROUND_ROWS {GROUND_ROWS}")
     if not hasattr(ext, "Columns"):  # older builds: no batch step, Stepper takes 7 functions
         problems.append("no Columns (the batch's step)")
+    if not getattr(ext, "SECOND_ORDER", 0):  # older builds: Chipmunk's first-order pose update
+        problems.append("no second-order pose update (bodyio.trapezoid)")
     if problems:
         raise ImportError(
             "amsa_phys.physics._step was built from another version of _step.c ("
@@ -75,6 +77,8 @@ _FUNCTIONS = (
     "cpBodySetForce",
     "cpBodySetTorque",
     "cpSpaceStep",
+    "cpBodySetPosition",
+    "cpBodySetAngle",
 )
 #: Read after each step when Chipmunk's rotation of a body is ``math.cos``/``math.sin`` of
 #: its angle (:func:`_rotation_is_libms`): the C step then skips computing them again.
@@ -163,8 +167,11 @@ def _step_with(io: BodyIO, stepper: Any, dt: float, top2: float, sub_speed: floa
     if space._bodies_to_check:  # new bodies (the first step): let pymunk validate them
         stepper.apply()
         n = substeps(top2, sub_speed)
+        h = dt / n
         for _ in range(n):
-            space.step(dt / n)
+            stepper.before()
+            space.step(h)
+            stepper.after(h)  # the trapezoid, as the C step's own steps (bodyio.trapezoid)
         return int(stepper.read_check())
     return _locked_step(space, stepper.advance)
 

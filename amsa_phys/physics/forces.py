@@ -76,7 +76,7 @@ class Folded(NamedTuple):
     kx: float  # tyre longitudinal stiffness times speed: N / c_x (N)
     ky: float  # lateral: N / c_y (N)
     half_track: float
-    turn_k: float  # dt^2 / I: heading change per N m
+    turn_k: float  # dt^2 / (2 I): heading change per N m (the trapezoid, bodyio.trapezoid)
     dt_i: float  # dt / I
     dt_m: float  # dt / m
     m_dt: float  # m / dt
@@ -110,7 +110,7 @@ def fold(rover: DiffDriveRover, dt: float) -> Folded:
         kx=kx,
         ky=w.load_n / w.slip_lat,
         half_track=rover.half_track,
-        turn_k=dt * dt / rover.moment,
+        turn_k=0.5 * dt * dt / rover.moment,
         dt_i=dt / rover.moment,
         dt_m=dt / rover.mass,
         m_dt=rover.mass / dt,
@@ -338,7 +338,7 @@ def rover_step(
     if not (-tl <= kphl * wn <= tl and -tr <= kphr * wn <= tr):
         scrub = patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i)
     torque += scrub
-    # predicted heading change over this step (semi-implicit Euler, as pymunk does)
+    # predicted heading change over this step (the trapezoid: (w + w1) dt / 2, bodyio.trapezoid)
     turn = w * dt + torque * turn_k
     end = angle + turn
     mid = angle + 0.5 * turn

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..engine import noise as nz
 from ..model.params import Param
+from ..model.sensorclock import SensorClock, clock_params
 from ..model.template import Kind, Port, Template
 from .lidar import cast_rays
 from .space import physics_of
@@ -90,19 +91,7 @@ class GNSS(Template):
         Param("deniedXMax", "float", "east edge of the no-fix rectangle", 0.0, -1e6, 1e6, "m"),
         Param("deniedYMin", "float", "south edge of the no-fix rectangle", 0.0, -1e6, 1e6, "m"),
         Param("deniedYMax", "float", "north edge of the no-fix rectangle", 0.0, -1e6, 1e6, "m"),
-        Param("clockOffset", "float", "constant offset of the fix stamps", 0.0, -1e3, 1e3, "s"),
-        Param(
-            "syncDrift",
-            "float",
-            "drift of the receiver clock from the robot's",
-            0.0,
-            -1e5,
-            1e5,
-            "ppm",
-        ),
-        Param(
-            "stampJitter", "float", "standard deviation of the stamp jitter", 0.0, 0.0, 10.0, "s"
-        ),
+        *clock_params("fix", "receiver"),
     )
 
     @classmethod
@@ -124,7 +113,7 @@ class GNSS(Template):
         self.mp_start = mp.standard_normal(2).tolist()
         self.mp_rng = mp
         self.loss_rng = loss
-        self.jit_rng = jit
+        self.clock = SensorClock(jit)  # the one clock model of every sensor (model/sensorclock.py)
         self.mp = [0.0, 0.0]
         self.t_prev: float | None = None
         self.lost = 0  # samples without a fix so far (losses and outages)
@@ -153,7 +142,7 @@ class GNSS(Template):
         ey = self.noise.draw_white()
         gx, gy = self.mp_rng.standard_normal(2).tolist()
         u_loss = float(self.loss_rng.random())
-        jitter = float(self.jit_rng.standard_normal())
+        jitter = self.clock.draw()
         if self.t_prev is None:
             self.mp = list(self.mp_start)
         else:
@@ -171,7 +160,7 @@ class GNSS(Template):
         if p.precision > 0:
             x = nz.quantise(x, p.precision)
             y = nz.quantise(y, p.precision)
-        stamp = now + p.clockOffset + p.syncDrift * 1e-6 * now + p.stampJitter * jitter
+        stamp = SensorClock.at(now, p, jitter)
         denied = (
             visible <= 0
             or visible < p.minSky

@@ -17,6 +17,7 @@ import pymunk
 
 from ..engine import noise as nz
 from ..model.params import Param
+from ..model.sensorclock import stamped
 from ..model.template import Kind, Port, Template
 from ..templatemarks import Scan
 from .space import physics_of
@@ -209,3 +210,7 @@ def cast_rays(
         if best < 1.0:
             out[i] = best * reach
     return out
+
+
+#: Lidar with the sensor's own clock: an output ``stamp`` (``model/sensorclock.py``)
+StampedLidar = stamped(Lidar)

@@ -65,8 +65,9 @@ def reference_forces(
     caps = (wm.scrub_limit(mul), wm.scrub_limit(mur))
     scrub = _scrub(w, torque, (sphi / vl, sphi / vr), caps, dt / body.moment)
     torque += scrub
-    # lateral grip at the end-of-step heading, applied along the mid-step normal
-    turn = (w + torque / body.moment * dt) * dt
+    # lateral grip at the end-of-step heading, applied along the mid-step normal; the step
+    # turns the body by the trapezoid of its yaw rates (bodyio.trapezoid)
+    turn = (w + 0.5 * torque / body.moment * dt) * dt
     end, mid = a + turn, a + 0.5 * turn
     fx = fxl + fxr
     px = vx + fx * math.cos(mid) / rover.mass * dt

@@ -12,6 +12,7 @@ import numpy as np
 from ..engine import noise as nz
 from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
+from ..model.sensorclock import stamped
 from ..model.template import Kind, Port, Template
 
 _TWO_PI = 2 * math.pi
@@ -180,3 +181,7 @@ class Compass(Template):
         q = nz.quantise_many(value, p.precision)
         value = np.where(p.precision > 0, (q + math.pi) % _TWO_PI - math.pi, value)
         return {"compassHeading": value}, ~lost
+
+
+#: Compass with the sensor's own clock: an output ``stamp`` (``model/sensorclock.py``)
+StampedCompass = stamped(Compass)

@@ -9,6 +9,7 @@ from typing import Any
 
 from ..engine import noise as nz
 from ..model.params import Param
+from ..model.sensorclock import stamped
 from ..model.template import Kind, Port, Template
 
 
@@ -128,3 +129,7 @@ def _body_velocity(
     mid = a0 + half
     c, s = math.cos(mid), math.sin(mid)
     return (dx * c + dy * s) / (period * k), (-dx * s + dy * c) / (period * k)
+
+
+#: IMU with the sensor's own clock: an output ``stamp`` (``model/sensorclock.py``)
+StampedIMU = stamped(IMU)

@@ -9,6 +9,7 @@ from typing import Any
 
 from ..engine import noise as nz
 from ..model.params import Param
+from ..model.sensorclock import stamped
 from ..model.template import Kind, Port, Template
 
 
@@ -102,3 +103,7 @@ class WheelOdometry(Template):
         self.x += chord * math.cos(mid)
         self.y += chord * math.sin(mid)
         self.heading += dth
+
+
+#: WheelOdometry with the sensor's own clock: an output ``stamp`` (``model/sensorclock.py``)
+StampedWheelOdometry = stamped(WheelOdometry)

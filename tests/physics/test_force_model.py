@@ -128,5 +128,9 @@ def test_the_c_layout_is_checked_at_import() -> None:
         with pytest.raises(ImportError, match="rebuild"):
             compiled.check_layout(types.SimpleNamespace(**{**good, **change}))
     with pytest.raises(ImportError, match="no Columns"):  # a build from before the batch step
-        compiled.check_layout(types.SimpleNamespace(**good))
-    assert compiled.check_layout(types.SimpleNamespace(**good, Columns=ext.Columns))  # type: ignore[union-attr]
+        compiled.check_layout(types.SimpleNamespace(**good, SECOND_ORDER=1))
+    with pytest.raises(ImportError, match="second-order"):  # before the trapezoid
+        compiled.check_layout(types.SimpleNamespace(**good, Columns=ext.Columns))  # type: ignore[union-attr]
+    assert compiled.check_layout(
+        types.SimpleNamespace(**good, Columns=ext.Columns, SECOND_ORDER=1)  # type: ignore[union-attr]
+    )

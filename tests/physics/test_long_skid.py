@@ -3,15 +3,18 @@
 On μ 0.1: 4 s straight at full power, 6 s spinning at -100/100 (the rover still sliding
 forward), 5 s at 60/100, 5 s at -100/-30. The final pose at 100-800 Hz against 6,400 Hz must
 shrink with order >= 0.9 (a least-squares slope over four rates), and the default rover's
-position at 100 Hz must be within 5 cm. Two fixes made it: a wheel that grips beside a sliding
-one is solved again with its hub moved by the sliding tyre's force (the gripping solve had
-given it the other's force of ~1/dt), and the scrub is solved again with the torque the tyres
-then give. Before: order 0.60 in position and 0.54 in heading, 7.5 cm and 0.136 rad at 100 Hz.
+pose at 100 Hz must be within 5 cm and 0.062 rad. What made it: a wheel that grips beside a
+sliding one is solved again with its hub moved by the sliding tyre's force, the scrub is solved
+again with the torque the tyres then give (before: order 0.60 in position and 0.54 in heading,
+7.5 cm and 0.136 rad at 100 Hz), and the pose update is the trapezoid (``bodyio.trapezoid``:
+Chipmunk moved the body by the step's starting velocity; 4.8 cm and 0.066 rad before it, 3.6 cm
+and 0.059 rad after).
 
-The heading is not held within 0.01 rad: pymunk's semi-implicit Euler turns the body by the
-step's end yaw rate, a first-order error of α t dt / 2 under a yaw acceleration α (0.032 rad
-after a 3 s spin-up from rest at 100 Hz on its own), so 0.066 rad at 100 Hz is the
-integrator's; its order is held instead.
+Not met: 0.01 rad. Most of the rest comes from the tyres' slip being taken in the body's frame
+at the step's start while the rover spins at up to 6 rad/s (0.06 rad a step): taken half a
+step on it is 0.013 rad, but the same change puts every steady drift 0.3-0.5 % off the law
+(``test_drift_law.py``), since there the velocity turns with the body; doing both right needs
+the mid-step velocity too (docs/physics.md).
 """
 
 from __future__ import annotations
@@ -23,18 +26,27 @@ import numpy as np
 import pytest
 from rig import ON_AXLE, drive
 
-from amsa_phys.physics import forces, sliding
+from amsa_phys.physics import bodyio, forces, sliding
 
 RATES = [100, 200, 400, 800]
-#: the rovers whose convergence is held (mass, tyres, geometry); measured position orders
-#: 1.08, 1.02, 1.03, 1.08, 1.06. Not held (reported): a 100 kg rover (order 0.82) and a
-#: 600 N-stall one (order 1.08 but 0.64 m at 100 Hz, heading order 0.72).
+#: the rovers whose order is held (mass, tyres, geometry); measured position orders 1.09,
+#: 1.05, 1.04, 1.10, 1.07, heading orders 1.05, 1.07, 1.03, 1.10, 1.02
 FAMILY = {
     "default": {},
     "light": {"mass": 10.0},
     "stiff": {"slipComplianceLongitudinal": 1e-4, "slipComplianceLateral": 1e-4},
     "soft": {"slipComplianceLongitudinal": 1.0, "slipComplianceLateral": 1.0},
     "on-axle": ON_AXLE,
+}
+#: rovers held more loosely. The heavy one (100 kg) gets closer at every rate but not with a
+#: clean order (a stick or slip event moving from one step to the next leaves a plateau):
+#: 11.5, 7.2, 3.8, 2.2 cm and 0.094, 0.052, 0.027, 0.018 rad at 100-800 Hz (12.5 cm and 0.104
+#: rad before the trapezoid). The 600 N one converges with order 1.07 in position but is
+#: 0.63 m off at 100 Hz, and its heading (0.105, 0.008, 0.004, 0.016 rad) does not converge
+#: monotonically: not held.
+ROUGH = {
+    "heavy": {"mass": 100.0},
+    "600 N": {"stallForce": 600.0, "freeSpeed": 6.0, "maxWheelTorque": 40.0},
 }
 
 
@@ -56,8 +68,9 @@ def pose(tmp_path: Path, rate: int, robot: dict[str, Any]) -> np.ndarray:
     return np.array([tr["Rover.posX"][-1], tr["Rover.posY"][-1], tr["Rover.heading"][-1]])
 
 
-def convergence(tmp_path: Path, robot: dict[str, Any]) -> dict[str, float]:
-    """Orders (position, heading) over 100-800 Hz against 6,400 Hz, and the errors at 100 Hz."""
+def convergence(tmp_path: Path, robot: dict[str, Any]) -> dict[str, Any]:
+    """Orders (position, heading) over 100-800 Hz against 6,400 Hz, the errors at 100 Hz and
+    at every rate."""
     ref = pose(tmp_path / "ref", 6400, robot)
     runs = [pose(tmp_path / str(r), r, robot) for r in RATES]
     pos = [float(np.hypot(*(p[:2] - ref[:2]))) for p in runs]
@@ -68,6 +81,8 @@ def convergence(tmp_path: Path, robot: dict[str, Any]) -> dict[str, float]:
         "heading_order": float(np.polyfit(x, np.log(ang), 1)[0]),
         "error": pos[0],
         "heading_error": ang[0],
+        "errors": pos,
+        "heading_errors": ang,
     }
 
 
@@ -76,8 +91,32 @@ def test_a_long_low_friction_manoeuvre_converges_with_order_one(tmp_path: Path, 
     c = convergence(tmp_path, FAMILY[name])
     assert c["order"] >= 0.9, c
     assert c["heading_order"] >= 0.9, c
-    if name == "default":  # measured 4.84 cm and 0.066 rad
+    if name == "default":  # measured 3.64 cm and 0.0586 rad
         assert c["error"] < 0.05, c
+        assert c["heading_error"] < 0.062, c
+
+
+def test_a_heavy_rover_gets_closer_with_the_rate(tmp_path: Path) -> None:
+    c = convergence(tmp_path, ROUGH["heavy"])
+    assert c["error"] < 0.12, c  # 100 Hz
+    assert c["heading_error"] < 0.1, c
+    assert c["errors"][-1] < c["errors"][0] / 4, c  # 800 Hz: an order of at least 2/3
+    assert c["heading_errors"][-1] < c["heading_errors"][0] / 4, c
+
+
+def test_a_strong_rovers_position_converges_with_order_one(tmp_path: Path) -> None:
+    c = convergence(tmp_path, ROUGH["600 N"])
+    assert c["order"] >= 0.9, c
+
+
+def test_mutation_with_chipmunks_first_order_pose_update_the_heading_is_off(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # the body moved by the step's starting velocity (no trapezoid): measured 0.0673 rad
+    monkeypatch.setattr(bodyio, "trapezoid", lambda *args: None)
+    monkeypatch.setenv("AMSA_PHYS_PURE", "1")
+    c = convergence(tmp_path, {})
+    assert c["heading_error"] > 0.062, c
 
 
 @pytest.mark.slow  # the property is the quick tier's (above); this shows its check can fail

