@@ -1,7 +1,7 @@
 """The test suite's duration and memory, and the build of the exported MDE package.
 
 What a contributor waits for, measured the way the README states it: the quick tier
-(``pytest -m "not (ros or ros2 or build or docs or slow)"``) and the full suite (``pytest``,
+(``pytest -n auto -m "not (ros or ros2 or build or docs or slow)"``) and the full suite (``pytest``,
 what CI runs), each in a child process: its wall time, the CPU of pytest and everything it
 started (compilers, ROS launches), the peak resident memory of the largest of those processes,
 and the counts from the run's JUnit XML (a run with failures still gives its time; the row
@@ -37,7 +37,7 @@ import results
 ROOT = Path(__file__).resolve().parent.parent
 #: The tiers as the README names them: the arguments each adds to ``pytest``
 TIERS = {
-    "quick": ["-m", "not (ros or ros2 or build or docs or slow)"],
+    "quick": ["-n", "auto", "-m", "not (ros or ros2 or build or docs or slow)"],
     "full": [],
 }
 #: What the suite target measures: the tiers and the MDE package's build
