@@ -114,7 +114,7 @@ def fused_loop(duration: float, trace: bool = True) -> float:
         writer = TraceWriter(Path(tmp) / "trace.csv", list(sc.world.buffers))
         sim = Simulation.from_scenario(sc, trace=writer.write)
         sim.initialize()
-        values = sim.values
+        values = sim.store.data  # the store's array: tasks and the log's row index it by position
         row = sim.log.row
         write = writer.write if trace else (lambda t, v: None)
         (hook,) = [fn for _, fn, _ in sim._hooks]
@@ -123,7 +123,7 @@ def fused_loop(duration: float, trace: bool = True) -> float:
         due: list[list] = [[] for _ in range(cycle)]
         for task in sim._tasks:
             for off in range(0, cycle, task.period):
-                due[off].append((task.comp.do_step, task.inputs, task.targets))
+                due[off].append((task.comp.do_step, task.reads, task.writes))
         end = int(duration * den / num)
         t0 = time.perf_counter()
         for tick in range(end):
