@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import yaml
+from sweepfiles import two_context_sweep
 
 from amsa_phys.adapt.validate import Row, loses
 from amsa_phys.cli.main import main
@@ -19,27 +19,10 @@ WORLD = str(ROOT / "worlds" / "mde_adaptive.yaml")
 
 
 def _lying_sweep(tmp_path: Path) -> tuple[Path, Path]:
-    scenario = {
-        "world": WORLD,
-        "duration": 200,
-        "quality": {"signal": "MyDistanceMonitor.distanceFollowerToLeader", "reference": 15},
-        "sweep": {
-            "contexts": {
-                "healthy": {"MyNormalizePower.motorCoef": 100},
-                "worn": {"MyNormalizePower.motorCoef": 50},
-            }
-        },
-    }
-    path = tmp_path / "sweep.yaml"
-    path.write_text(yaml.safe_dump(scenario))
-    rows = ["run,context,MyFollowerController.Kv,seed_index,seed,error,rms_error"]
-    table = {("healthy", 0.2): 0.5, ("healthy", 0.8): 0.3, ("worn", 0.2): 0.5, ("worn", 0.8): 0.6}
-    for i, ((ctx, kv), value) in enumerate(table.items()):
-        rows.append(f"{i},{ctx},{kv},0,1,,{value}")
-    sweep = tmp_path / "sweepdir"
-    sweep.mkdir()
-    sweep.joinpath("results.csv").write_text("\n".join(rows) + "\n")
-    return path, sweep
+    return two_context_sweep(
+        tmp_path,
+        {("healthy", 0.2): 0.5, ("healthy", 0.8): 0.3, ("worn", 0.2): 0.5, ("worn", 0.8): 0.6},
+    )
 
 
 def test_rules_that_lose_on_held_out_sequences_exit_1(tmp_path, capsys) -> None:

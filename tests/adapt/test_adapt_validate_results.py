@@ -11,7 +11,7 @@ import json
 import statistics
 from pathlib import Path
 
-import yaml
+from sweepfiles import two_context_sweep
 
 from amsa_phys.adapt.validate import markdown
 from amsa_phys.cli.main import main
@@ -22,28 +22,10 @@ WORLD = str(ROOT / "worlds" / "mde_adaptive.yaml")
 
 def _sweep(tmp_path: Path) -> tuple[Path, Path]:
     """A two-context sweep whose table says Kv 0.35 is best on worn motors."""
-    scenario = {
-        "world": WORLD,
-        "duration": 200,
-        "quality": {"signal": "MyDistanceMonitor.distanceFollowerToLeader", "reference": 15},
-        "sweep": {
-            "contexts": {
-                "healthy": {"MyNormalizePower.motorCoef": 100},
-                "worn": {"MyNormalizePower.motorCoef": 50},
-            }
-        },
-    }
-    path = tmp_path / "sweep.yaml"
-    path.write_text(yaml.safe_dump(scenario))
-    rows = ["run,context,MyFollowerController.Kv,seed_index,seed,error,rms_error"]
-    table = {("healthy", 0.2): 0.5, ("healthy", 0.35): 0.9, ("worn", 0.2): 0.9}
-    table[("worn", 0.35)] = 0.5
-    for i, ((ctx, kv), value) in enumerate(table.items()):
-        rows.append(f"{i},{ctx},{kv},0,1,,{value}")
-    sweep = tmp_path / "sweepdir"
-    sweep.mkdir()
-    sweep.joinpath("results.csv").write_text("\n".join(rows) + "\n")
-    return path, sweep
+    return two_context_sweep(
+        tmp_path,
+        {("healthy", 0.2): 0.5, ("healthy", 0.35): 0.9, ("worn", 0.2): 0.9, ("worn", 0.35): 0.5},
+    )
 
 
 def test_results_hold_every_seed_and_render_the_printed_table(tmp_path, capsys) -> None:
