@@ -67,13 +67,45 @@ def leftovers(token: str) -> list[int]:
     return found
 
 
+def in_private_network(
+    script: Path, extra_env: dict[str, str], log: Path | None = None, cwd: Path | None = None
+) -> tuple[int, list[int]]:
+    """Run the bash ``script`` in ``unshare -n`` with ``extra_env``, a ROS_DOMAIN_ID and a
+    token of its own; its output to ``log`` (a file, not a pipe: a straggler holding it cannot
+    hang us) or inherited. Returns its exit code (-1: killed at ``WALL_LIMIT_S``) and the
+    processes it left behind, which are killed (a straggler fails the test, and is not left
+    running after it)."""
+    token = uuid.uuid4().hex
+    env = {
+        **os.environ,
+        **extra_env,
+        "AMSA_ROS2_TEST": token,
+        "ROS_DOMAIN_ID": str(random.randint(1, 100)),
+    }
+    env.pop("VIRTUAL_ENV", None)
+    argv = ["unshare", "-n", "bash", str(script)]
+    try:
+        with log.open("w") if log is not None else contextlib.nullcontext() as out:
+            err = subprocess.STDOUT if out is not None else None
+            proc = subprocess.run(
+                argv, env=env, cwd=cwd, stdout=out, stderr=err, timeout=WALL_LIMIT_S
+            )
+        rc = proc.returncode
+    except subprocess.TimeoutExpired:
+        rc = -1
+    left = leftovers(token)
+    for pid in left:
+        with contextlib.suppress(OSError):
+            os.kill(pid, 9)
+    return rc, left
+
+
 def run_with_nodes(
     tmp: Path, amsa_args: list[str], nodes: list[list[str]], domains: list[int] | None = None
 ) -> Outcome:
     """Start each node (``nodes``: argument lists of ``follower_node.py``; ``domains``: each
     one's ROS_DOMAIN_ID after the test's own, default 0), then ``amsa-phys AMSA_ARGS`` with
     the ROS 2 venv's python; stop the nodes; report."""
-    token = uuid.uuid4().hex
     out, err, log = tmp / "amsa.out", tmp / "amsa.err", tmp / "node.log"
     lines = ["set -u", "ip link set lo up", "pids=()"]
     for i, args in enumerate(nodes):
@@ -88,26 +120,8 @@ def run_with_nodes(
     lines.append("exit $rc")
     script = tmp / "run.sh"
     script.write_text("\n".join(lines) + "\n")
-    env = {
-        **os.environ,
-        "AMSA_ROS2_TEST": token,
-        "ROS_DOMAIN_ID": str(random.randint(1, 100)),
-        "SDL_VIDEODRIVER": "dummy",
-        "MPLBACKEND": "Agg",
-        "PYTHONUNBUFFERED": "1",
-    }
-    env.pop("VIRTUAL_ENV", None)
-    try:
-        proc = subprocess.run(
-            ["unshare", "-n", "bash", str(script)], env=env, cwd=tmp, timeout=WALL_LIMIT_S
-        )
-        rc = proc.returncode
-    except subprocess.TimeoutExpired:
-        rc = -1
-    left = leftovers(token)
-    for pid in left:  # a straggler fails the test, and is not left running after it
-        with contextlib.suppress(OSError):
-            os.kill(pid, 9)
+    extra = {"SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg", "PYTHONUNBUFFERED": "1"}
+    rc, left = in_private_network(script, extra, cwd=tmp)
     return Outcome(
         rc,
         out.read_text() if out.exists() else "",

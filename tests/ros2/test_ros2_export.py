@@ -10,18 +10,14 @@ is generated and parsed here, not run. Everything ROS 2 runs with ``.venv-ros2``
 from __future__ import annotations
 
 import ast
-import contextlib
-import os
-import random
 import subprocess
 import sys
-import uuid
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
 import yaml
-from ros2net import PY, ROOT, WALL_LIMIT_S, leftovers, ros2_missing
+from ros2net import PY, ROOT, in_private_network, ros2_missing
 
 pytestmark = pytest.mark.ros2
 MISSING = ros2_missing()
@@ -44,30 +40,11 @@ def amsa(*args: str) -> subprocess.CompletedProcess[str]:
 
 def in_netns(tmp: Path, body: str) -> tuple[int, str, list[int]]:
     """``body`` (bash, ``$PY`` the ROS 2 python) in a private network; rc, output, leftovers."""
-    token = uuid.uuid4().hex
     script = tmp / "netns.sh"
     script.write_text(f"ip link set lo up\nPY={PY}\n{body}\n")
-    env = {
-        **os.environ,
-        **ENV,
-        "AMSA_ROS2_TEST": token,
-        "ROS_DOMAIN_ID": str(random.randint(1, 100)),
-    }
-    env.pop("VIRTUAL_ENV", None)
-    log = tmp / "netns.log"  # a file, not a pipe: a straggler holding it cannot hang us
-    with log.open("w") as f:
-        proc = subprocess.run(
-            ["unshare", "-n", "bash", str(script)],
-            env=env,
-            stdout=f,
-            stderr=subprocess.STDOUT,
-            timeout=WALL_LIMIT_S,
-        )
-    left = leftovers(token)
-    for pid in left:  # a straggler fails the test, and is not left running after it
-        with contextlib.suppress(OSError):
-            os.kill(pid, 9)
-    return proc.returncode, log.read_text(), left
+    log = tmp / "netns.log"
+    rc, left = in_private_network(script, ENV, log)
+    return rc, log.read_text(), left
 
 
 @pytest.mark.parametrize("name", ["scenario1", "adaptive"])

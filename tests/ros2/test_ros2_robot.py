@@ -14,7 +14,6 @@ the boundary's documented one line and never reach a data topic. Everything runs
 from __future__ import annotations
 
 import ast
-import contextlib
 import json
 import math
 import os
@@ -24,7 +23,7 @@ import uuid
 from pathlib import Path
 
 import pytest
-from ros2net import PY, ROOT, WALL_LIMIT_S, leftovers, ros2_missing
+from ros2net import PY, ROOT, WALL_LIMIT_S, in_private_network, leftovers, ros2_missing
 
 pytestmark = pytest.mark.ros2
 MISSING = ros2_missing()
@@ -82,7 +81,6 @@ def on_robot(
     """``amsa-phys ros2 robot PKG`` and the fake robot in a private network; the robot's end
     stops amsa-phys (SIGTERM). Returns amsa-phys's exit status, its output, the log of
     everything, and the processes left behind."""
-    token = uuid.uuid4().hex
     amsa_log, log = tmp / "amsa.log", tmp / "all.log"
     script = tmp / "robot.sh"
     script.write_text(
@@ -91,25 +89,7 @@ def on_robot(
         f"{PY} {robot} {' '.join(robot_args)}\n"
         "kill -TERM $AMSA; wait $AMSA; echo AMSA_RC=$?\n"
     )
-    env = {
-        **os.environ,
-        **ENV,
-        "AMSA_ROS2_TEST": token,
-        "ROS_DOMAIN_ID": str(random.randint(1, 100)),
-    }
-    env.pop("VIRTUAL_ENV", None)
-    with log.open("w") as f:
-        subprocess.run(
-            ["unshare", "-n", "bash", str(script)],
-            env=env,
-            stdout=f,
-            stderr=subprocess.STDOUT,
-            timeout=WALL_LIMIT_S,
-        )
-    left = leftovers(token)
-    for pid in left:  # a straggler fails the test, and is not left running after it
-        with contextlib.suppress(OSError):
-            os.kill(pid, 9)
+    _, left = in_private_network(script, ENV, log)
     text = log.read_text()
     rc_lines = [x for x in text.splitlines() if x.startswith("AMSA_RC=")]
     rc = int(rc_lines[-1].partition("=")[2]) if rc_lines else -1
