@@ -27,6 +27,7 @@ run leaf by leaf to ~1e-12, not bit for bit (the tests hold it to that).
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -242,8 +243,15 @@ def ident(task: Any) -> tuple[int, str]:
 
 
 def first_bad(arr: np.ndarray, published: np.ndarray | None) -> int | None:
-    """Index of the first published member whose value is not finite, or None."""
-    if published is None and np.isfinite(arr).all():  # the usual case, in two calls
+    """Index of the first published member whose value is not finite, or None.
+
+    Every output of every group at every instant passes here (a vector env of the default
+    scenario: ~35 a vector step), so the usual case is one call, not two: the dot product
+    of the values with themselves is finite only if every value is (NaN and infinity carry
+    through, and a sum of squares is never NaN otherwise). Finite values large enough to
+    overflow the sum (|x| > ~1e154) take the exact path below and are found good there.
+    """
+    if published is None and math.isfinite(arr.dot(arr)):  # the usual case, one call
         return None
     bad = ~np.isfinite(arr)
     if published is not None:
