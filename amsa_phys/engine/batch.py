@@ -46,25 +46,30 @@ _COPY = re.compile(r"^(.*?)(\d+)$")
 class ParamArrays:
     """The members' parameter values as float arrays (``p.Kv``), built on first use.
 
-    The engine calls :meth:`invalidate` after a timeline or live change to any member.
+    A built array is kept as an attribute of the instance, so that the next ``p.Kv`` is
+    an ordinary attribute read and never reaches :meth:`__getattr__` (a vector env of the
+    default scenario reads ~60 parameters a vector step). The engine calls
+    :meth:`invalidate` after a timeline or live change to any member.
     """
 
     def __init__(self, comps: Sequence[Any]) -> None:
         self._comps = comps
-        self._cache: dict[str, np.ndarray] = {}
+        self._built: list[str] = []
 
     def __getattr__(self, name: str) -> np.ndarray:
-        cache = self.__dict__["_cache"]
-        try:
-            return cache[name]
-        except KeyError:
-            arr = np.array([getattr(c.p, name) for c in self.__dict__["_comps"]], dtype=float)
-            cache[name] = arr
-            return arr
+        if name.startswith("__") or name in ParamArrays.__dict__:
+            raise AttributeError(name)  # copy/pickle probes; never shadow a method
+        arr = np.array([getattr(c.p, name) for c in self.__dict__["_comps"]], dtype=float)
+        self.__dict__[name] = arr
+        self.__dict__["_built"].append(name)
+        return arr
 
     def invalidate(self) -> None:
         """Forget the arrays (a member's parameter changed)."""
-        self._cache.clear()
+        d = self.__dict__
+        for name in d["_built"]:
+            d.pop(name, None)
+        d["_built"].clear()
 
 
 class Group:
