@@ -36,6 +36,8 @@ from typing import Any
 
 import numpy as np
 
+from . import noise
+
 #: Smallest group stepped as arrays: below it numpy's fixed cost per call outweighs the
 #: per-component Python it saves.
 MIN_GROUP = 32
@@ -245,6 +247,43 @@ def _breaks(
 def ident(task: Any) -> tuple[int, str]:
     """What tells tasks apart: (run, path); the runs of a batch share their paths."""
     return (task.run, task.path)
+
+
+def derived(
+    state: dict[str, Any], key: str, args: tuple[Any, ...], make: Callable[..., Any]
+) -> Any:
+    """``make(*args)``, remembered in a group's ``state`` under ``key`` while ``args`` are the
+    very same objects (``is``).
+
+    Why: a template's ``step_many`` recomputes what depends on its parameters alone (a
+    sensor's turn-on bias, whether every copy quantises) at every step, a few numpy calls
+    each. Parameter arrays (:class:`ParamArrays`) are the same objects until a member's
+    parameter changes, when they are built anew: so identity says when to recompute.
+    """
+    hit = state.get(key)
+    if hit is not None:
+        old = hit[0]
+        if len(old) == len(args) and all(a is b for a, b in zip(old, args, strict=True)):
+            return hit[1]
+    value = make(*args)
+    state[key] = (args, value)
+    return value
+
+
+def all_positive(values: np.ndarray) -> bool:
+    """Whether every copy's ``values`` is above 0 (a sensor: every copy quantises, so
+    ``noise.quantise_many`` is its plain arithmetic; for :func:`derived`)."""
+    return bool((values > 0).all())
+
+
+def gauss_markov(state: dict[str, Any], sigma: Any, tau: Any, dt: float) -> Any:
+    """``noise.gauss_markov_many(sigma, tau, dt)``, remembered in a group's ``state`` while
+    the parameter arrays are the same objects and the period the same (as :func:`derived`;
+    a sensor asks at every step with the same three)."""
+    hit = state.get("_gauss_markov")
+    if hit is None or hit[0] is not sigma or hit[1] is not tau or hit[2] != dt:
+        hit = state["_gauss_markov"] = (sigma, tau, dt, noise.gauss_markov_many(sigma, tau, dt))
+    return hit[3]
 
 
 def first_bad(arr: np.ndarray, published: np.ndarray | None) -> int | None:
