@@ -10,6 +10,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..engine import noise as nz
+from ..engine.batch import all_positive, derived, gauss_markov
 from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
 from ..model.sensorclock import stamped
@@ -167,7 +168,7 @@ class Compass(Template):
         if state["t_prev"] is None:
             state["b"] = np.where(tau > 0, sigma * np.sqrt(tau / 2), 0.0) * state["gm_start"]
         else:
-            phi, q = nz.gauss_markov_many(sigma, tau, now - state["t_prev"])
+            phi, q = gauss_markov(state, sigma, tau, now - state["t_prev"])
             state["b"] = phi * state["b"] + q * g
         state["t_prev"] = now
         lost = u * 100.0 < p.lostData
@@ -175,11 +176,20 @@ class Compass(Template):
             comps[k].lost += 1
         h = inp["heading"]
         value = h + p.mean + state["b"] + p.stddev * w
-        value += state["on_sign"] * (p.bias_mean + p.bias_stddev * state["on_z"])
+        # what depends on the parameters alone, computed again only when they change
+        # (``batch.derived``): the same arithmetic, so the same floats
+        sign, z = state["on_sign"], state["on_z"]
+        value += derived(
+            state, "turn_on", (p.bias_mean, p.bias_stddev), lambda m, s: sign * (m + s * z)
+        )
         value += deviation(h, p.deviationB, p.deviationC, p.deviationD, p.deviationE)
         value = (value + math.pi) % _TWO_PI - math.pi
-        q = nz.quantise_many(value, p.precision)
-        value = np.where(p.precision > 0, (q + math.pi) % _TWO_PI - math.pi, value)
+        precision = p.precision
+        if derived(state, "all_quantise", (precision,), all_positive):
+            q = np.floor(value / precision + 0.5) * precision  # quantise_many's arithmetic
+            return {"compassHeading": (q + math.pi) % _TWO_PI - math.pi}, ~lost
+        q = nz.quantise_many(value, precision)
+        value = np.where(precision > 0, (q + math.pi) % _TWO_PI - math.pi, value)
         return {"compassHeading": value}, ~lost
 
 

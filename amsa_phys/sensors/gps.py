@@ -10,6 +10,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..engine import noise as nz
+from ..engine.batch import all_positive, derived, gauss_markov
 from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
@@ -179,33 +180,50 @@ class GPS(Template):
             state["bx"], state["by"] = s0 * state["gm_start"][0], s0 * state["gm_start"][1]
             state["bad"] = u_burst * 100.0 < p.burstLoss
         else:
-            phi, q = nz.gauss_markov_many(sigma, tau, now - state["t_prev"])
+            phi, q = gauss_markov(state, sigma, tau, now - state["t_prev"])
             state["bx"] = phi * state["bx"] + q * gx
             state["by"] = phi * state["by"] + q * gy
         state["t_prev"] = now
+        # what depends on the parameters alone, computed again only when they change
+        # (``batch.derived``): the same arithmetic, so the same floats
         z, sign = state["on_z"], state["on_sign"]
-        on_x = sign[0] * (p.bias_mean + p.bias_stddev * z[0])
-        on_y = sign[1] * (p.bias_mean + p.bias_stddev * z[1])
+        on_x, on_y = derived(
+            state,
+            "turn_on",
+            (p.bias_mean, p.bias_stddev),
+            lambda m, s: (sign[0] * (m + s * z[0]), sign[1] * (m + s * z[1])),
+        )
         x = inp["posX"] + p.mean + on_x + state["bx"] + p.stddev * ex
         y = inp["posY"] + p.mean + on_y + state["by"] + p.stddev * ey
-        x = nz.quantise_many(x, p.precision)
-        y = nz.quantise_many(y, p.precision)
+        precision = p.precision
+        if derived(state, "all_quantise", (precision,), all_positive):
+            x = np.floor(x / precision + 0.5) * precision  # quantise_many's arithmetic
+            y = np.floor(y / precision + 0.5) * precision
+        else:
+            x = nz.quantise_many(x, precision)
+            y = nz.quantise_many(y, precision)
         if not first:
-            pi = p.burstLoss / 100.0
-            leave = 1.0 / p.burstLength
-            enter = leave * pi / (1.0 - pi)
+            enter, leave = derived(state, "burst_chance", (p.burstLoss, p.burstLength), _burst_many)
             bad = state["bad"]
             state["bad"] = np.where(bad, u_burst >= leave, u_burst < enter)
         lost = state["bad"] | (u_loss * 100.0 < p.lostDataGPS)
         published = ~lost
         latency = p.latency
-        if latency.any() or state["history"]:
+        if derived(state, "any_latency", (latency,), np.any) or state["history"]:
             x, y, ready = _delay_many(state["history"], now, x, y, latency)
             published &= ready
             lost &= ready
         for k in np.flatnonzero(lost).tolist():
             comps[k].lost += 1
         return {"gpsPosX": x, "gpsPosY": y}, published
+
+
+def _burst_many(burst_loss: np.ndarray, length: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each copy's ``(enter, leave)`` per-sample probabilities (``noise.burst_chance``'s
+    arithmetic on arrays)."""
+    pi = burst_loss / 100.0
+    leave = 1.0 / length
+    return leave * pi / (1.0 - pi), leave
 
 
 def _delay_many(
