@@ -60,9 +60,11 @@ def log_period(t: np.ndarray, path: Path) -> Fraction:
 def run(args: argparse.Namespace) -> int:
     """Print the formula's robustness at t = 0 on the run; exit 0 if it holds, 1 if not."""
     from ..model.suggest import did_you_mean
+    from ..runs.rundata import refuse_sweep_dir
     from ..stl.requirement import TIME, Requirement, check_formula, judge
     from ..stl.syntax import FormulaError, parse
 
+    refuse_sweep_dir(Path(args.rundir), "monitor")
     path = Path(args.rundir) / "trace.csv"
     if not path.is_file():
         raise ConfigError("no trace.csv: not a run directory", file=Path(args.rundir))

@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError, one_line
-from ..runs.rundata import read_run
+from ..runs.rundata import read_run, refuse_sweep_dir
 
 RUN_FILES = ("trace.csv", "metrics.json", "scenario.yaml")
 
@@ -39,14 +39,7 @@ def load_run(rundir: Path) -> Any:
         raise ConfigError(
             "no such directory" if not rundir.exists() else "not a directory", file=rundir
         )
-    if (rundir / "results.csv").is_file() and not (rundir / "trace.csv").exists():
-        kept = sorted(p.name for p in (rundir / "runs").glob("*") if (p / "trace.csv").is_file())
-        hint = (
-            f" (kept runs: {rundir / 'runs' / kept[0]} ...)"
-            if kept
-            else (" (it kept no run: sweep again with --keep-runs)")
-        )
-        raise ConfigError(f"a sweep directory: view one of its kept runs{hint}", file=rundir)
+    refuse_sweep_dir(rundir, "view")
     run = read_run(rundir)  # data only: nothing the run directory names is imported
     columns, data = read_trace(run.trace)
     if len(data) == 0:
