@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -57,10 +58,36 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def untraced_note(scene: Any, rundir: Path) -> str | None:
+    """The line saying which of the world's rovers the window cannot draw, or None.
+
+    A run made with ``--trace-columns`` (or ``trace_columns:``) may keep no rover's
+    ``posX``/``posY``: the window then shows an empty world while the HUD and the plot pane
+    replay the run, and without a word a user takes it for a broken replay."""
+    from ..palette import rover_names
+
+    missing = [r for r in rover_names(list(scene.world.buffers)) if r not in scene.rover_names]
+    if not missing:
+        return None
+    names = ", ".join(missing)
+    if not scene.rover_names:
+        what = "no rover is"
+    else:
+        what = f"{names} {'is' if len(missing) == 1 else 'are'} not"
+    return (
+        f"note: {rundir / 'trace.csv'}: no posX, posY columns for {names} (the run traced "
+        f"only some buffers: trace_columns), so {what} drawn; the HUD and the plot pane (g) "
+        "replay the columns it has"
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     """Replay the run until the window is closed."""
     size = _size(args.size)
     scene = load_run(Path(args.rundir))
+    note = untraced_note(scene, Path(args.rundir))
+    if note is not None:
+        print(one_line(note), file=sys.stderr)
     from ..view.player import Player
     from ..view.window import open_display
 
