@@ -64,8 +64,14 @@ def run(args: argparse.Namespace) -> int:
     from ..stl.requirement import TIME, Requirement, check_formula, judge
     from ..stl.syntax import FormulaError, parse
 
-    refuse_sweep_dir(Path(args.rundir), "monitor")
-    path = Path(args.rundir) / "trace.csv"
+    rundir = Path(args.rundir)
+    if rundir.is_file():  # the trace itself, or the run's scenario.yaml: name the directory
+        raise ConfigError(
+            f"not a directory: give the run directory ({rundir.parent}), whose trace.csv is read",
+            file=rundir,
+        )
+    refuse_sweep_dir(rundir, "monitor")
+    path = rundir / "trace.csv"
     if not path.is_file():
         raise ConfigError("no trace.csv: not a run directory", file=Path(args.rundir))
     try:

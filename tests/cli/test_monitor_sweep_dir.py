@@ -1,6 +1,5 @@
-"""``amsa-phys monitor`` given a sweep's directory says which directory to give instead, as
-``view`` does: a sweep and its runs sit side by side, and "not a run directory" teaches
-nothing."""
+"""``amsa-phys monitor`` given a sweep's directory, or a file, says which directory to give
+instead, as ``view`` does: "not a run directory" teaches nothing."""
 
 from __future__ import annotations
 
@@ -38,3 +37,17 @@ def test_a_sweep_directory_names_a_kept_run_or_how_to_keep_one(
         assert main(["monitor", str(sweep / "runs" / "run-00000"), "always(a >= 0)"]) == 0
     else:
         assert "sweep again with --keep-runs" in err
+
+
+def test_a_file_given_for_the_run_directory_names_its_directory(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "trace.csv").write_text("t,a\n0,1\n0.5,2\n")
+    capsys.readouterr()
+    assert main(["monitor", str(tmp_path / "trace.csv"), "always(a >= 0)"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        f"error: {tmp_path / 'trace.csv'}: not a directory: give the run directory "
+        f"({tmp_path}), whose trace.csv is read"
+    )
+    assert main(["monitor", str(tmp_path), "always(a >= 0)"]) == 0
