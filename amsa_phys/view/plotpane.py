@@ -245,7 +245,7 @@ def draw_side_panes(
     area: pygame.Rect,
 ) -> tuple[pygame.Rect | None, pygame.Rect | None]:
     """The plot pane (bottom right), the signal list and the help (right, or left when it
-    would reach the pane), under the HUD.
+    would reach the pane or the signal list is open at the right), under the HUD.
 
     Returns the boxes drawn at the right and at the left (None where nothing is): the
     camera frames the rovers beside them, so the key list never hides the leader.
@@ -263,6 +263,9 @@ def draw_side_panes(
             colours.append(INK)
         margin, width = beside_pane(screen, pane, top, len(lines), line_px)
         box = renderer.panel(screen, lines, colours, (margin, top), align_right=True, width=width)
+        if show_help:  # the list holds the right: the help goes at the left, both readable
+            ink = [INK] * len(help_lines)
+            return box, renderer.panel(screen, help_lines, ink, (10, top), align_right=False)
         return box, None
     if show_help:
         ink = [INK] * len(help_lines)
