@@ -295,7 +295,11 @@ def beside_pane(
 ) -> tuple[int, int | None]:
     """(right margin, width) of a box of ``n_lines`` drawn at the right from ``top``: 10 px
     and the frame's width, or left of the plot pane, in the room left of it, when the box
-    would reach down to the pane (the help or the list drawn over the pane hid both)."""
+    would reach down to the pane (the help or the list drawn over the pane hid both); over
+    the pane when the room left of it is under a third of the window (320x240: 50 px)."""
     if pane is None or top + n_lines * line_px + 12 < pane.top:
         return 10, None
-    return screen.get_width() - pane.left + 10, pane.left - 20
+    room = pane.left - 20
+    if room < screen.get_width() // 3:  # a small window: a column that narrow wraps every
+        return 10, None  # word onto its own line, so the box goes over the pane instead
+    return screen.get_width() - pane.left + 10, room
