@@ -325,7 +325,13 @@ class Window:
             state = "running"
         lines = [f"{state}  x{self.speed:g}", f"camera {self.camera.label()}  h: help"]
         if self.recorder is not None:
-            lines.append(f"recording {self.recorder.options.path.name}")
+            name = self.recorder.options.path.name
+            if self.finished:  # every frame is in; the file gets its name once the window closes
+                lines.append(f"video {name}: saved when closed")
+            elif self.paused:  # frames follow simulated time: none while it stands still
+                lines.append(f"recording {name} (paused: no frames)")
+            else:
+                lines.append(f"recording {name}")
         return lines
 
     def draw(self) -> None:
