@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from fractions import Fraction
 from pathlib import Path
 
@@ -30,20 +31,15 @@ def add_args(p: argparse.ArgumentParser) -> None:
 
 def read_trace(path: Path, wanted: set[str]) -> tuple[list[str], np.ndarray, dict[str, np.ndarray]]:
     """The header, the ``t`` column and the ``wanted`` columns of ``trace.csv`` (only those
-    are kept in memory). One line naming the file if it is not a trace."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            header = fh.readline().rstrip("\r\n").split(",")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"cannot read the trace: {exc}", file=path) from None
-    if not header or header[0] != "t":
-        raise ConfigError("not a trace.csv: its first column is not t", file=path, line=1)
-    names = [c for c in header if c in wanted or c == "t"]
-    cols = [header.index(c) for c in names]
-    try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, usecols=cols, ndmin=2, dtype=float)
-    except ValueError as exc:
-        raise ConfigError(f"not a trace.csv: {one_line(str(exc))}", file=path) from None
+    are kept in memory), every row. Read through the reader ``plot`` and ``view`` use, so a
+    file that is not a whole trace (a row wider or narrower than the header, a cell that is
+    not a number, ``t`` going back) is refused the same way: one line naming the file and
+    its line, never judged as if it were a run's."""
+    from ..engine.traceread import read_header, read_rows
+
+    header = read_header(path)
+    # every row: a formula's windows count samples, so none may be skipped
+    names, data, _stride = read_rows(path, frozenset(wanted), max_cells=sys.maxsize)
     out = {c: data[:, k] for k, c in enumerate(names)}
     return header, out["t"], out
 
@@ -64,10 +60,18 @@ def log_period(t: np.ndarray, path: Path) -> Fraction:
 def run(args: argparse.Namespace) -> int:
     """Print the formula's robustness at t = 0 on the run; exit 0 if it holds, 1 if not."""
     from ..model.suggest import did_you_mean
+    from ..runs.rundata import refuse_sweep_dir
     from ..stl.requirement import TIME, Requirement, check_formula, judge
     from ..stl.syntax import FormulaError, parse
 
-    path = Path(args.rundir) / "trace.csv"
+    rundir = Path(args.rundir)
+    if rundir.is_file():  # the trace itself, or the run's scenario.yaml: name the directory
+        raise ConfigError(
+            f"not a directory: give the run directory ({rundir.parent}), whose trace.csv is read",
+            file=rundir,
+        )
+    refuse_sweep_dir(rundir, "monitor")
+    path = rundir / "trace.csv"
     if not path.is_file():
         raise ConfigError("no trace.csv: not a run directory", file=Path(args.rundir))
     try:

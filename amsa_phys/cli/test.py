@@ -16,13 +16,16 @@ from ..runs.rundir import check_output
 from ..runs.suite import ScenarioResult, find_scenarios, run_dir_names, run_scenario_job
 from .options import add_jobs, add_ros2
 
+#: What ``test`` searches without a path (a project's own scenarios, as in this repository).
+DEFAULT_FOLDER = "scenarios"
+
 
 def add_args(p: argparse.ArgumentParser) -> None:
     """Arguments of ``amsa-phys test``."""
     p.add_argument(
         "paths",
         nargs="*",
-        default=["scenarios"],
+        default=[],
         help="scenario files or folders (default: scenarios)",
     )
     p.add_argument("--junit", metavar="FILE", help="also write JUnit XML")
@@ -34,7 +37,15 @@ def add_args(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Exit 0 if every check passes, 1 if any fails or errors."""
     skipped: list[Path] = []
-    files = find_scenarios(args.paths, skipped)
+    if not args.paths and not Path(DEFAULT_FOLDER).is_dir():
+        # the default, not a name the user typed: say where it was looked for and what to give
+        raise ConfigError(
+            "no scenarios folder in the current directory (the default): give scenario files "
+            "or folders, e.g. amsa-phys test my_scenarios/",
+            file=Path(DEFAULT_FOLDER).resolve(),
+        )
+    paths = args.paths or [DEFAULT_FOLDER]
+    files = find_scenarios(paths, skipped)
     if skipped:
         print(
             f"skipped {plural(len(skipped), 'resolved scenario')} in run directories "
@@ -45,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
         if not f.exists():
             raise ConfigError("file not found", file=f)
     if not files:
-        raise ConfigError("no scenario with an expect: section found", key=" ".join(args.paths))
+        raise ConfigError("no scenario with an expect: section found", key=" ".join(paths))
     if args.jobs < 1:
         raise ConfigError("must be at least 1", key="--jobs")
     if args.junit:  # before the suite runs, not after (its folder is made, as pytest does)

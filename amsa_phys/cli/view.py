@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError, one_line
-from ..runs.rundata import read_run
+from ..runs.rundata import read_run, refuse_sweep_dir
 
 RUN_FILES = ("trace.csv", "metrics.json", "scenario.yaml")
 
@@ -39,14 +40,7 @@ def load_run(rundir: Path) -> Any:
         raise ConfigError(
             "no such directory" if not rundir.exists() else "not a directory", file=rundir
         )
-    if (rundir / "results.csv").is_file() and not (rundir / "trace.csv").exists():
-        kept = sorted(p.name for p in (rundir / "runs").glob("*") if (p / "trace.csv").is_file())
-        hint = (
-            f" (kept runs: {rundir / 'runs' / kept[0]} ...)"
-            if kept
-            else (" (it kept no run: sweep again with --keep-runs)")
-        )
-        raise ConfigError(f"a sweep directory: view one of its kept runs{hint}", file=rundir)
+    refuse_sweep_dir(rundir, "view")
     run = read_run(rundir)  # data only: nothing the run directory names is imported
     columns, data = read_trace(run.trace)
     if len(data) == 0:
@@ -64,10 +58,36 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def untraced_note(scene: Any, rundir: Path) -> str | None:
+    """The line saying which of the world's rovers the window cannot draw, or None.
+
+    A run made with ``--trace-columns`` (or ``trace_columns:``) may keep no rover's
+    ``posX``/``posY``: the window then shows an empty world while the HUD and the plot pane
+    replay the run, and without a word a user takes it for a broken replay."""
+    from ..palette import rover_names
+
+    missing = [r for r in rover_names(list(scene.world.buffers)) if r not in scene.rover_names]
+    if not missing:
+        return None
+    names = ", ".join(missing)
+    if not scene.rover_names:
+        what = "no rover is"
+    else:
+        what = f"{names} {'is' if len(missing) == 1 else 'are'} not"
+    return (
+        f"note: {rundir / 'trace.csv'}: no posX, posY columns for {names} (the run traced "
+        f"only some buffers: trace_columns), so {what} drawn; the HUD and the plot pane (g) "
+        "replay the columns it has"
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     """Replay the run until the window is closed."""
     size = _size(args.size)
     scene = load_run(Path(args.rundir))
+    note = untraced_note(scene, Path(args.rundir))
+    if note is not None:
+        print(one_line(note), file=sys.stderr)
     from ..view.player import Player
     from ..view.window import open_display
 

@@ -126,6 +126,22 @@ class RunDir:
     notes: list[str] = field(default_factory=list)
 
 
+def refuse_sweep_dir(rundir: Path, verb: str) -> None:
+    """Refuse a sweep's directory where one run is wanted, naming a kept run to give instead.
+
+    A sweep directory and a run directory sit side by side under ``runs/``; a user who gives
+    the one for the other should learn what to give, not that the directory "is not a run".
+    """
+    if (rundir / "results.csv").is_file() and not (rundir / "trace.csv").exists():
+        kept = sorted(p.name for p in (rundir / "runs").glob("*") if (p / "trace.csv").is_file())
+        hint = (
+            f" (kept runs: {rundir / 'runs' / kept[0]} ...)"
+            if kept
+            else " (it kept no run: sweep again with --keep-runs)"
+        )
+        raise ConfigError(f"a sweep directory: {verb} one of its kept runs{hint}", file=rundir)
+
+
 def read_run(
     rundir: Path,
     *,

@@ -245,7 +245,7 @@ def draw_side_panes(
     area: pygame.Rect,
 ) -> tuple[pygame.Rect | None, pygame.Rect | None]:
     """The plot pane (bottom right), the signal list and the help (right, or left when it
-    would reach the pane), under the HUD.
+    would reach the pane or the signal list is open at the right), under the HUD.
 
     Returns the boxes drawn at the right and at the left (None where nothing is): the
     camera frames the rovers beside them, so the key list never hides the leader.
@@ -263,6 +263,9 @@ def draw_side_panes(
             colours.append(INK)
         margin, width = beside_pane(screen, pane, top, len(lines), line_px)
         box = renderer.panel(screen, lines, colours, (margin, top), align_right=True, width=width)
+        if show_help:  # the list holds the right: the help goes at the left, both readable
+            ink = [INK] * len(help_lines)
+            return box, renderer.panel(screen, help_lines, ink, (10, top), align_right=False)
         return box, None
     if show_help:
         ink = [INK] * len(help_lines)
@@ -292,7 +295,11 @@ def beside_pane(
 ) -> tuple[int, int | None]:
     """(right margin, width) of a box of ``n_lines`` drawn at the right from ``top``: 10 px
     and the frame's width, or left of the plot pane, in the room left of it, when the box
-    would reach down to the pane (the help or the list drawn over the pane hid both)."""
+    would reach down to the pane (the help or the list drawn over the pane hid both); over
+    the pane when the room left of it is under a third of the window (320x240: 50 px)."""
     if pane is None or top + n_lines * line_px + 12 < pane.top:
         return 10, None
-    return screen.get_width() - pane.left + 10, pane.left - 20
+    room = pane.left - 20
+    if room < screen.get_width() // 3:  # a small window: a column that narrow wraps every
+        return 10, None  # word onto its own line, so the box goes over the pane instead
+    return screen.get_width() - pane.left + 10, room

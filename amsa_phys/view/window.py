@@ -325,7 +325,13 @@ class Window:
             state = "running"
         lines = [f"{state}  x{self.speed:g}", f"camera {self.camera.label()}  h: help"]
         if self.recorder is not None:
-            lines.append(f"recording {self.recorder.options.path.name}")
+            name = self.recorder.options.path.name
+            if self.finished:  # every frame is in; the file gets its name once the window closes
+                lines.append(f"video {name}: saved when closed")
+            elif self.paused:  # frames follow simulated time: none while it stands still
+                lines.append(f"recording {name} (paused: no frames)")
+            else:
+                lines.append(f"recording {name}")
         return lines
 
     def draw(self) -> None:
@@ -377,10 +383,13 @@ class Window:
         listed, _ = draw_side_panes(
             self.screen, self.renderer, self.picker, self.series.series, False, [], area
         )
-        if self.show_help and listed is None:  # after the pane, never under it
+        if self.show_help:  # after the pane, never under it
             y = fitting(len(HELP))
             ink = [INK] * len(HELP)
-            if reaches_pane(pane_rect(area, self.picker), y, len(HELP), line_px):
+            # at the left when the right holds the signal list or the help would reach the pane
+            if listed is not None or reaches_pane(
+                pane_rect(area, self.picker), y, len(HELP), line_px
+            ):
                 if not self.panel.visible:  # at the left, clear of the pane
                     box = self.renderer.panel(self.screen, HELP, ink, (10, y), align_right=False)
                     self.camera.left = box.right

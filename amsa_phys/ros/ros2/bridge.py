@@ -160,16 +160,12 @@ class Bridge:
     # -- parameters -----------------------------------------------------------------------
     def set_params(self, leaf: Wiring, values: Mapping[str, Any]) -> None:
         """Set the node's parameters through its service; a refusal is the run's fault."""
-        from rclpy.parameter import Parameter
-
         if not values:
             return
         from rcl_interfaces.srv import SetParameters
 
         req = SetParameters.Request()
-        req.parameters = [
-            Parameter(k, value=_param_value(v)).to_parameter_msg() for k, v in values.items()
-        ]
+        req.parameters = [_parameter(k, v).to_parameter_msg() for k, v in values.items()]
         future = self.clients[leaf.path].call_async(req)
         self.executor.spin_until_future_complete(future, timeout_sec=self.timeout_s)
         if not future.done():
@@ -325,6 +321,18 @@ def _param_value(value: Any) -> Any:
                 flat.append(float(v))
         return flat
     return value
+
+
+def _parameter(name: str, value: Any) -> Any:
+    """The rclpy ``Parameter`` a node is given: a list is always a double array, as
+    ``describe --ros2`` says (rclpy infers a list's type from its items, and an empty one,
+    a leader without waypoints, became a byte array the node's declared type refused)."""
+    from rclpy.parameter import Parameter
+
+    flat = _param_value(value)
+    if isinstance(flat, list):
+        return Parameter(name, Parameter.Type.DOUBLE_ARRAY, flat)
+    return Parameter(name, value=flat)
 
 
 class ExternalLeaf:

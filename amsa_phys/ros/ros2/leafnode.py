@@ -69,6 +69,21 @@ def _descriptor(param: Param) -> Any:
     return desc
 
 
+def declare(node: Any, param: Param, value: Any) -> None:
+    """Declare ``param`` on ``node`` with ``value``, typed as ``describe --ros2`` lists it.
+
+    Points are a double array even when empty (a leader without waypoints): rclpy infers a
+    list's type from its items and takes an empty one for a byte array, which then refused
+    the double array amsa-phys sets (``run --ros2``, ``ros2 lockstep``)."""
+    if param.type != "points":
+        node.declare_parameter(param.name, value, _descriptor(param))
+        return
+    from rclpy.parameter import Parameter
+
+    node.declare_parameter(param.name, Parameter.Type.DOUBLE_ARRAY, _descriptor(param))
+    node.set_parameters([Parameter(param.name, Parameter.Type.DOUBLE_ARRAY, value)])
+
+
 def main(path: str, scenario_file: str) -> None:
     """Run the node of Leaf ``path`` of the package's scenario until shut down.
 
@@ -116,7 +131,7 @@ def main(path: str, scenario_file: str) -> None:
             self.templ = {p.name: p for p in leaf.template.params}
             for name, p in self.templ.items():
                 if name in values:
-                    self.declare_parameter(name, _ros_value(values[name]), _descriptor(p))
+                    declare(self, p, _ros_value(values[name]))
             self.add_on_set_parameters_callback(self._amsa_judge)
             self.inp: dict[str, Any] = {p.name: p.initial for p in leaf.template.inputs}
             self.last_out: dict[str, Any] = {}
