@@ -1,7 +1,8 @@
 """Judging ``ros2:`` / ``--ros2``: which Leaves a user's ROS 2 nodes step.
 
-Names only, no ROS: the loader refuses a bad list in one line (file, line, key) before
-anything starts. What each external Leaf's topics are is ``ros/external.py``'s.
+No ROS: the loader refuses a bad list in one line (file, line, key) before anything starts.
+Besides the names, the Leaves named are initialized once (``ros.graph.classify``) to refuse
+one that shares the physics world: a node cannot step a body. What each external Leaf's topics are is ``ros/external.py``'s.
 """
 
 from __future__ import annotations
@@ -55,6 +56,14 @@ def problem(world: WorldSpec, paths: Sequence[str]) -> str | None:
                     f"{path}.{port} reads {buffer}, an output of {source}, also external: "
                     "wire the two nodes to each other in ROS, or keep one of them in amsa-phys"
                 )
+    from ..ros.graph import classify  # initializes the Leaves named, and only those
+
+    bodies = classify(world, 0, paths)
+    if bodies:
+        return (
+            f"{bodies[0]} shares the simulator's physics world (a body, a ray-cast sensor), "
+            "so it stays in amsa-phys: a ROS 2 node can step a Leaf that only exchanges Data"
+        )
     return None
 
 

@@ -53,10 +53,14 @@ class NodeContext:
         self.events.append((kind, detail))
 
 
-def classify(world: WorldSpec, seed: int = 0) -> list[str]:
-    """The Leaves that must run inside the simulator node, in world order."""
+def classify(world: WorldSpec, seed: int = 0, paths: Iterable[str] | None = None) -> list[str]:
+    """The Leaves (of ``paths``, default all) that must run inside the simulator node, in
+    world order."""
+    wanted = None if paths is None else set(paths)
     local = []
     for path, leaf in world.leaves.items():
+        if wanted is not None and path not in wanted:
+            continue
         comp = leaf.template(path, dict(leaf.params))
         try:
             comp.initialize(NodeContext(seed, path, world))

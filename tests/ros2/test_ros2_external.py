@@ -42,6 +42,9 @@ def test_the_scenario_key_names_leaves_stepped_by_nodes(tmp_path: Path) -> None:
         (["MyFollowerControler"], "did you mean MyFollowerController"),
         ("MyFollowerController,,Leader", "an empty Leaf name"),
         (["MyFollowerController", "MyDistanceMonitor"], "also external"),
+        # a body stays where the physics is: a node stepping it would leave it parked
+        (["Leader"], "Leader shares the simulator's physics world"),
+        (["MyFollowerController", "Follower"], "Follower shares the simulator's physics world"),
     ],
 )
 def test_a_bad_ros2_key_is_one_line_naming_file_line_and_key(
