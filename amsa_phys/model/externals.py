@@ -2,7 +2,8 @@
 
 No ROS: the loader refuses a bad list in one line (file, line, key) before anything starts.
 Besides the names, the Leaves named are initialized once (``ros.graph.classify``) to refuse
-one that shares the physics world: a node cannot step a body. What each external Leaf's topics are is ``ros/external.py``'s.
+one that shares the physics world: a node cannot step a body. What each external Leaf's
+topics are is ``ros/external.py``'s.
 """
 
 from __future__ import annotations
