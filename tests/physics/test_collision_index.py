@@ -23,7 +23,10 @@ from amsa_phys.physics import space
 
 ROOT = Path(__file__).resolve().parents[2]
 #: Largest difference in any position (m), heading (rad) or speed after the pile-up below.
-CONTACT_BOUND_M = 5e-3
+#: Since the gripping solve sees the scrub's yaw (``forces.GRIP_PASSES``) the pile-up
+#: amplifies a last-bit difference faster: 0.6 mm at 50 s, 4.6 mm at 55 s, 34 mm at 60 s
+#: (before: 0.4 mm at 55 s, 1.2 mm at 60 s).
+CONTACT_BOUND_M = 5e-2
 
 
 def pile_up(tmp: Path, duration: float) -> Path:
