@@ -130,7 +130,7 @@ def turns(report: Callable[..., None]) -> None:
             if rate == 100:
                 radius = s["speed"] / s["yawRate"]
                 report(
-                    f"turn {left:g}/{right:g} %, radius vs closed form {closed:.3f} m",
+                    f"turn {left:g}/{right:g} %, radius (closed form: {closed:.3f} m)",
                     f"{radius:.3f} m, {100.0 * (radius / closed - 1.0):.1f} % wider",
                     "",
                     None,
@@ -138,7 +138,8 @@ def turns(report: Callable[..., None]) -> None:
 
 
 def perf(reps: int, report: Callable[..., Any]) -> None:
-    """The ``fidelity`` target (deterministic: one repetition whatever ``reps``)."""
+    """The ``fidelity`` target. Deterministic (the same figures every time), so one run
+    whatever ``reps``: the table's reps column is the sitting's, not repetitions here."""
     long_skid(report)
     drifts(report)
     turns(report)
