@@ -130,19 +130,21 @@ def steady_state(f: Callable[[np.ndarray], np.ndarray], x0: list[float]) -> np.n
     raise AssertionError(f"no steady state: residual {np.abs(f(x)).max():.3g}")
 
 
-def simulated(tmp_path: Path, case: tuple[float, float, float, float]) -> dict[str, float]:
-    """Speed, yaw rate and rim speeds after 8 s at 100 Hz (settled within ~3 s), and the
-    slowest rim over the last second."""
+def simulated(
+    tmp_path: Path, case: tuple[float, float, float, float], duration: float = 8.0
+) -> dict[str, float]:
+    """Speed, yaw rate and rim speeds after ``duration`` at 100 Hz (the family settles within
+    ~3 s; the drifts on mu 0.3 need ~20 s), and the slowest rim over the last second."""
     mass, c, stall, mu = case
     tmp_path.mkdir(parents=True, exist_ok=True)
     tr, _ = drive(
         tmp_path,
         *POWER,
-        8,
+        duration,
         robot=robot(mass, c, stall),
         physics={"rate": 100, "ground": {"friction": mu, "rolling_resistance": CRR}},
     )
-    last = tr["t"] >= 7.0
+    last = tr["t"] >= duration - 1.0
     rims = np.abs(np.concatenate([tr["Rover.wheelSpeedL"][last], tr["Rover.wheelSpeedR"][last]]))
     return {
         "u": float(tr["Rover.speed"][-1]),
@@ -153,10 +155,12 @@ def simulated(tmp_path: Path, case: tuple[float, float, float, float]) -> dict[s
     }
 
 
-def law_error(tmp_path: Path, case: tuple[float, float, float, float]) -> tuple[float, dict]:
+def law_error(
+    tmp_path: Path, case: tuple[float, float, float, float], duration: float = 8.0
+) -> tuple[float, dict]:
     """Largest relative difference of speed and yaw rate, simulation against the law."""
     mass, c, stall, mu = case
-    sim = simulated(tmp_path, case)
+    sim = simulated(tmp_path, case, duration)
     x = steady_state(
         law(robot(mass, c, stall), mu), [sim["u"], 0.1, sim["w"], sim["ul"], sim["ur"]]
     )
@@ -178,6 +182,26 @@ def test_a_steady_drift_or_turn_matches_the_documented_law_at_100_hz(
 
 
 TURNS = [case for case in FAMILY if case[2] < 200.0]
+#: 600 N drifts on mu 0.3: a slow sideways mode, settled only after ~20 s (at 8 s they were
+#: 0.5-4.8 % off, which read as a rate-independent error of the step)
+SLOW_DRIFTS = [(10.0, 1e-4, 600.0, 0.3), (30.0, 1e-4, 600.0, 0.3), (100.0, 1e-4, 600.0, 0.3)]
+
+
+@pytest.mark.parametrize("case", SLOW_DRIFTS, ids=lambda c: "m{}-c{}-F{}-mu{}".format(*c))
+def test_a_slowly_settling_drift_on_mu_0_3_matches_the_law(
+    tmp_path: Path, case: tuple[float, float, float, float]
+) -> None:
+    # measured after 20 s: 0.145 %, 0.041 %, 0.004 % (after 8 s: 4.8 %, 1.1 %, 0.47 %)
+    err, info = law_error(tmp_path, case, 20.0)
+    assert err < 0.01, info
+    assert info["sim"]["slowest_rim"] > 0.05, info
+
+
+def test_the_slow_drift_check_fails_on_a_drift_not_yet_settled(tmp_path: Path) -> None:
+    # the same check 12 s earlier, mid-transient: measured 4.8 % (what once read as a step
+    # error independent of the rate)
+    err, info = law_error(tmp_path, SLOW_DRIFTS[0], 8.0)
+    assert err > 0.01, info
 
 
 @pytest.mark.parametrize("case", TURNS, ids=lambda c: "m{}-c{}-F{}-mu{}".format(*c))
