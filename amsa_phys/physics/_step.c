@@ -256,7 +256,7 @@ typedef struct {
 
 static double slide_tyre_x(const Slide *w, double up, double *scale)
 {
-    double fx = w->kx * (up - w->v) * w->ivs;
+    double fx = w->kx * (0.5 * (w->u + up) - w->v) * w->ivs;
     double qx = fx * w->ix;
     double qq = qx * qx + w->qy * w->qy;
     *scale = qq > 1.0 ? 1.0 / sqrt(qq) : 1.0;

@@ -38,9 +38,12 @@ def slide(
     slip: a steady drift's yaw rate moved by 12 % between 100 and 1,600 Hz (issue 31).
     Here the tyre law itself, ``F = (N kappa / c_x, -N tan(alpha) / c_y) / max(1, |q|)``
     with ``q`` the two forces over their grips (the friction ellipse), is solved with the
-    rim's next speed: ``M_w (u+ - u) / dt = F_m(u+) - R sign(u+) - F_x(u+)`` (backward Euler;
-    the motor on its curve or at its current limit, the rim stuck at zero if its resistance
-    holds it). The left side rises with ``u+`` and the right side falls, so the root is
+    rim's next speed: ``M_w (u+ - u) / dt = F_m(u+) - R sign(u+) - F_x((u + u+) / 2)``
+    (backward Euler for the motor, on its curve or at its current limit, the rim stuck at zero
+    if its resistance holds it; the tyre's slip at the rim's mid-step speed, the speed the
+    body feels over the step: with the end-of-step speed a spinning-up or spinning-down rim on
+    ice pushed the body by a whole step's change of slip too early, 0.008 rad of a long
+    manoeuvre's heading at 100 Hz). The left side rises with ``u+`` and the right side falls, so the root is
     unique; bisection finds it, the same operations in C and Python. The lateral slip
     ``side * ivs`` (sideways velocity over the slip speed) is the step's start value: the
     body is ~30 times the rim's mass, so its lateral slip moves slowly; the lateral force is
@@ -54,7 +57,7 @@ def slide(
 
     def tyre_x(up: float) -> tuple[float, float]:
         """The tyre's longitudinal force and the ellipse's scale at rim speed ``up``."""
-        fx = kx * (up - v) * ivs
+        fx = kx * (0.5 * (u + up) - v) * ivs
         qx = fx * ix
         qq = qx * qx + qy * qy
         scale = 1.0 / math.sqrt(qq) if qq > 1.0 else 1.0
