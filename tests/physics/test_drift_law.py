@@ -172,7 +172,7 @@ def law_error(
 def test_a_steady_drift_or_turn_matches_the_documented_law_at_100_hz(
     tmp_path: Path, case: tuple[float, float, float, float]
 ) -> None:
-    # target 1 %; measured 0.008-0.019 % for the 600 N drifts but the heavy soft-tyred one
+    # target 1 %; measured 0.009-0.020 % for the 600 N drifts but the heavy soft-tyred one
     # (0.39 %: its outer tyre grips, a first-order step error), 0.000-0.025 % for the 120 N
     # turns (0.56-0.89 % before the gripping solve saw the scrub's yaw: forces.GRIP_PASSES)
     err, info = law_error(tmp_path, case)
