@@ -43,14 +43,14 @@ def slide(
     if its resistance holds it; the tyre's slip at the rim's mid-step speed, the speed the
     body feels over the step: with the end-of-step speed a spinning-up or spinning-down rim on
     ice pushed the body by a whole step's change of slip too early, 0.008 rad of a long
-    manoeuvre's heading at 100 Hz). The left side rises with ``u+`` and the right side falls, so the root is
-    unique; bisection finds it, the same operations in C and Python. The lateral slip
-    ``side * ivs`` (sideways velocity over the slip speed) is the step's start value: the
-    body is ~30 times the rim's mass, so its lateral slip moves slowly; the lateral force is
-    capped by ``fy_cap``, the gripping solve's (which cancels the sideways velocity within
-    the step), so that a slide ending within the step does not overshoot into the other
-    side. ``tyre`` is ``(N / c_x, N / c_y, 1 / grip_x, 1 / grip_y)``; ``ivs`` is ``1 /
-    max(|v|, v_min)``.
+    manoeuvre's heading at 100 Hz). The left side rises with ``u+`` and the right side falls,
+    so the root is unique; bisection finds it, the same operations in C and Python. The hub
+    speed ``v`` and the lateral slip ``side * ivs`` (sideways velocity over the slip speed)
+    are the body's, held through the step (it is ~30 times the rim's mass): the caller passes
+    them half a step on (:func:`mid_step`). The lateral force is capped by ``fy_cap``, the
+    force that cancels the sideways velocity within the step, so that a slide ending within
+    the step does not overshoot into the other side. ``tyre`` is ``(N / c_x, N / c_y,
+    1 / grip_x, 1 / grip_y)``; ``ivs`` is ``1 / max(|v|, v_min)``.
     """
     kx, ky, ix, iy = tyre
     qy = -ky * side * ivs * iy
