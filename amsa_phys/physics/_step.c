@@ -256,7 +256,7 @@ typedef struct {
 
 static double slide_tyre_x(const Slide *w, double up, double *scale)
 {
-    double fx = w->kx * (up - w->v) * w->ivs;
+    double fx = w->kx * (0.5 * (w->u + up) - w->v) * w->ivs;
     double qx = fx * w->ix;
     double qq = qx * qx + w->qy * w->qy;
     *scale = qq > 1.0 ? 1.0 / sqrt(qq) : 1.0;
@@ -338,6 +338,89 @@ static double patch_scrub(double w, double torque, double kl, double kr, double 
     return s1 + s2;
 }
 
+/* ---- sliding.slide_pair and sliding.mid_step ------------------------------------------ */
+typedef struct {
+    double ul, vl, f0l, rl, ivl, ixl, iyl, ur, vr, f0r, rr, ivr, ixr, iyr, kx, ky, ky_dt_m,
+        cancel;
+    const StepConstants *s;
+} SlideIn;
+
+/* grip: the gripping solve's (F_xL, F_yL, u_L+, F_xR, F_yR, u_R+); hub: the sliding tyres'
+ * (v_L, 1/s_L, v_R, 1/s_R, v_side); out as grip */
+static void slide_pair(const SlideIn *in, int sat_l, int sat_r, const double grip[6],
+                       const double hub[5], double out[6])
+{
+    const StepConstants sc = *in->s;
+    const double ul = in->ul, vl = in->vl, f0l = in->f0l, rl = in->rl, ivl = in->ivl;
+    const double ixl = in->ixl, iyl = in->iyl, ur = in->ur, vr = in->vr, f0r = in->f0r;
+    const double rr = in->rr, ivr = in->ivr, ixr = in->ixr, iyr = in->iyr, kx = in->kx;
+    const double ky = in->ky, ky_dt_m = in->ky_dt_m, cancel = in->cancel;
+    const double ml = hub[0], jl = hub[1], mr = hub[2], jr = hub[3], side0 = hub[4];
+    double fxl = grip[0], fyl = grip[1], upl = grip[2], fxr = grip[3], fyr = grip[4],
+           upr = grip[5];
+    double t1, t2, t3, t4;
+        if (sat_l)
+            slide(ul, ml, f0l, rl, jl, kx, ky, ixl, iyl, side0, cancel, &sc, &fxl, &fyl, &upl);
+        if (sat_r)
+            slide(ur, mr, f0r, rr, jr, kx, ky, ixr, iyr, side0, cancel, &sc, &fxr, &fyr, &upr);
+        if (sat_l && !sat_r)
+            rim_and_tyre(ur, vr + sc.e2 * fxl, f0r, rr, kx * ivr, &sc, &fxr, &upr);
+        else if (sat_r && !sat_l)
+            rim_and_tyre(ul, vl + sc.e2 * fxr, f0l, rl, kx * ivl, &sc, &fxl, &upl);
+        if (!sat_r) {
+            double kg = ky_dt_m * ivr;
+            fyr = (cancel - fyl) * kg / (1.0 + kg);
+            t3 = fxr * ixr;
+            t4 = fyr * iyr;
+            if (t3 * t3 + t4 * t4 > 1.0) {
+                sat_r = 1;
+                slide(ur, mr, f0r, rr, jr, kx, ky, ixr, iyr, side0, cancel, &sc, &fxr, &fyr,
+                      &upr);
+            }
+        } else if (!sat_l) {
+            double kg = ky_dt_m * ivl;
+            fyl = (cancel - fyr) * kg / (1.0 + kg);
+            t1 = fxl * ixl;
+            t2 = fyl * iyl;
+            if (t1 * t1 + t2 * t2 > 1.0) {
+                sat_l = 1;
+                slide(ul, ml, f0l, rl, jl, kx, ky, ixl, iyl, side0, cancel, &sc, &fxl, &fyl,
+                      &upl);
+            }
+        }
+        if (sat_l && sat_r) {
+            double fsum = fyl + fyr;
+            if (fsum * cancel > 0.0 && fabs(fsum) > fabs(cancel)) {
+                double q = cancel / fsum;
+                fyl = fyl * q;
+                fyr = fyr * q;
+            }
+        }
+    out[0] = fxl, out[1] = fyl, out[2] = upl, out[3] = fxr, out[4] = fyr, out[5] = upr;
+}
+
+static void mid_step(double vx, double vy, double w, double angle, double qx, double qy,
+                     double torque, double dt, double dt_m, double dt_i, double turn_k, double h,
+                     double hub[5])
+{
+    double hv = 0.5 * dt_m;
+    double mx = vx + qx * hv;
+    double my = vy + qy * hv;
+    double wm = w + 0.5 * torque * dt_i;
+    double th = angle + 0.5 * w * dt + 0.25 * torque * turn_k;
+    double c = cos(th);
+    double s = sin(th);
+    double mf = mx * c + my * s;
+    double ml = mf - wm * h;
+    double mr = mf + wm * h;
+    const double vmin = SLIP_SPEED_MIN;
+    hub[0] = ml;
+    hub[1] = ml > vmin ? 1.0 / ml : (ml < -vmin ? -1.0 / ml : 1.0 / vmin);
+    hub[2] = mr;
+    hub[3] = mr > vmin ? 1.0 / mr : (mr < -vmin ? -1.0 / mr : 1.0 / vmin);
+    hub[4] = my * c - mx * s;
+}
+
 /* ---- forces.rover_step, one rover ------------------------------------------------------ */
 static inline int same_bits(double a, double b)
 {
@@ -400,73 +483,85 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
             rr = rr + brake;
     }
     double fxl, fxr, upl, upr;
-    double pu[2] = {ul, ur}, pv[2] = {vl, vr}, pf0[2] = {f0l, f0r}, pres[2] = {rl, rr};
+    double pu[2] = {ul, ur}, pv[2], pf0[2] = {f0l, f0r}, pres[2] = {rl, rr};
     double pk[2] = {kl, kr}, pair[4];
     int rigid = 0;
-    if (ul == 0.0 && ur == 0.0) {
-        if (sloped) { /* held rigidly on a slope (forces.rover_step says why) */
-            double det = e * e - e2 * e2;
-            fxl = (e2 * vr - e * vl) / det;
-            fxr = (e2 * vl - e * vr) / det;
-        } else {
-            double gl = 1.0 + kl * e;
-            double gr = 1.0 + kr * e;
-            double cl = kl * e2;
-            double cr = kr * e2;
-            double bl = -kl * vl;
-            double br = -kr * vr;
-            double det = gl * gr - cl * cr;
-            fxl = (bl * gr - cl * br) / det;
-            fxr = (br * gl - cr * bl) / det;
-        }
-        double nl = ((-fmax <= f0l && f0l <= fmax) ? f0l : (f0l > 0 ? fmax : -fmax)) - fxl;
-        double nr = ((-fmax <= f0r && f0r <= fmax) ? f0r : (f0r > 0 ? fmax : -fmax)) - fxr;
-        if (-rl <= nl && nl <= rl && -rr <= nr && nr <= rr) {
-            upl = upr = 0.0;
-            rigid = sloped;
-        } else {
-            wheel_pair(pu, pv, pf0, pres, pk, &sc, pair);
-            fxl = pair[0], upl = pair[1], fxr = pair[2], upr = pair[3];
-        }
-    } else {
-        double al = (mw * ul + f0l - (ul > 0.0 ? rl : (ul < 0.0 ? -rl : 0.0))) * bb;
-        double ar = (mw * ur + f0r - (ur > 0.0 ? rr : (ur < 0.0 ? -rr : 0.0))) * bb;
-        double gl = 1.0 + kl * bbe;
-        double gr = 1.0 + kr * bbe;
-        double cl = kl * e2;
-        double cr = kr * e2;
-        double bl = kl * (al - vl);
-        double br = kr * (ar - vr);
-        double det = gl * gr - cl * cr;
-        fxl = (bl * gr - cl * br) / det;
-        fxr = (br * gl - cr * bl) / det;
-        upl = al - bb * fxl;
-        upr = ar - bb * fxr;
-        double fml = f0l - c * upl;
-        double fmr = f0r - c * upr;
-        if (!(upl * ul > 0.0 && upr * ur > 0.0 && -fmax <= fml && fml <= fmax && -fmax <= fmr &&
-              fmr <= fmax)) {
-            wheel_pair(pu, pv, pf0, pres, pk, &sc, pair);
-            fxl = pair[0], upl = pair[1], fxr = pair[2], upr = pair[3];
-        }
-    }
     /* scrub: each patch capped at its Coulomb torque (scrub.patch_scrub) */
     double isum = ivl + ivr;
-    double torque = (fxr - fxl) * h;
     double kphl = sphi * ivl;
     double kphr = sphi * ivr;
     double kphi = sphi * isum;
-    double base = w + torque * dt_i;
-    double den = 1.0 + kphi * dt_i;
-    double scrub = -kphi * base / den;
-    double wn = base / den;
     double ysum = iyl + iyr; /* > 0 for any real ground (GRIP_FLOOR_N) */
     double tl = ysum > 0.0 ? ts * iyr / ysum : 0.5 * ts;
     double tr = ts - tl;
-    double ql = kphl * wn, qr = kphr * wn;
-    if (!(-tl <= ql && ql <= tl && -tr <= qr && qr <= tr))
-        scrub = patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i);
-    torque += scrub;
+    double torque = 0.0, scrub = 0.0;
+    const double vl0 = vl, vr0 = vr;
+    /* the gripping solve twice: the second time with the hubs moved by the yaw the first
+     * one's scrub gives them within the step (forces.rover_step says why) */
+    for (int pass = 0; pass < 2; pass++) {
+        vl = vl0 - scrub * dt_i * h;
+        vr = vr0 + scrub * dt_i * h;
+        pv[0] = vl;
+        pv[1] = vr;
+        rigid = 0;
+        if (ul == 0.0 && ur == 0.0) {
+            if (sloped) { /* held rigidly on a slope (forces.rover_step says why) */
+                double det = e * e - e2 * e2;
+                fxl = (e2 * vr - e * vl) / det;
+                fxr = (e2 * vl - e * vr) / det;
+            } else {
+                double gl = 1.0 + kl * e;
+                double gr = 1.0 + kr * e;
+                double cl = kl * e2;
+                double cr = kr * e2;
+                double bl = -kl * vl;
+                double br = -kr * vr;
+                double det = gl * gr - cl * cr;
+                fxl = (bl * gr - cl * br) / det;
+                fxr = (br * gl - cr * bl) / det;
+            }
+            double nl = ((-fmax <= f0l && f0l <= fmax) ? f0l : (f0l > 0 ? fmax : -fmax)) - fxl;
+            double nr = ((-fmax <= f0r && f0r <= fmax) ? f0r : (f0r > 0 ? fmax : -fmax)) - fxr;
+            if (-rl <= nl && nl <= rl && -rr <= nr && nr <= rr) {
+                upl = upr = 0.0;
+                rigid = sloped;
+            } else {
+                wheel_pair(pu, pv, pf0, pres, pk, &sc, pair);
+                fxl = pair[0], upl = pair[1], fxr = pair[2], upr = pair[3];
+            }
+        } else {
+            double al = (mw * ul + f0l - (ul > 0.0 ? rl : (ul < 0.0 ? -rl : 0.0))) * bb;
+            double ar = (mw * ur + f0r - (ur > 0.0 ? rr : (ur < 0.0 ? -rr : 0.0))) * bb;
+            double gl = 1.0 + kl * bbe;
+            double gr = 1.0 + kr * bbe;
+            double cl = kl * e2;
+            double cr = kr * e2;
+            double bl = kl * (al - vl);
+            double br = kr * (ar - vr);
+            double det = gl * gr - cl * cr;
+            fxl = (bl * gr - cl * br) / det;
+            fxr = (br * gl - cr * bl) / det;
+            upl = al - bb * fxl;
+            upr = ar - bb * fxr;
+            double fml = f0l - c * upl;
+            double fmr = f0r - c * upr;
+            if (!(upl * ul > 0.0 && upr * ur > 0.0 && -fmax <= fml && fml <= fmax && -fmax <= fmr &&
+                  fmr <= fmax)) {
+                wheel_pair(pu, pv, pf0, pres, pk, &sc, pair);
+                fxl = pair[0], upl = pair[1], fxr = pair[2], upr = pair[3];
+            }
+        }
+
+        torque = (fxr - fxl) * h;
+        double base = w + torque * dt_i;
+        double den = 1.0 + kphi * dt_i;
+        scrub = -kphi * base / den;
+        double wn = base / den;
+        double ql = kphl * wn, qr = kphr * wn;
+        if (!(-tl <= ql && ql <= tl && -tr <= qr && qr <= tr))
+            scrub = patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i);
+        torque += scrub;
+    }
     /* predicted heading change */
     double turn = w * dt + torque * turn_k;
     double end = angle + turn;
@@ -529,48 +624,26 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     if (sat_l || sat_r) { /* forces.rover_step says why each part */
         double side0 = vy * co - vx * si;
         double cancel = neg_m_dt * side / cos(0.5 * turn);
-        const double ky = p[P_KY];
-        if (sat_l)
-            slide(ul, vl, f0l, rl, ivl, kx, ky, ixl, iyl, side0, cancel, &sc, &fxl, &fyl, &upl);
-        if (sat_r)
-            slide(ur, vr, f0r, rr, ivr, kx, ky, ixr, iyr, side0, cancel, &sc, &fxr, &fyr, &upr);
-        if (sat_l && !sat_r)
-            rim_and_tyre(ur, vr + sc.e2 * fxl, f0r, rr, kx * ivr, &sc, &fxr, &upr);
-        else if (sat_r && !sat_l)
-            rim_and_tyre(ul, vl + sc.e2 * fxr, f0l, rl, kx * ivl, &sc, &fxl, &upl);
-        if (!sat_r) {
-            double kg = ky_dt_m * ivr;
-            fyr = (cancel - fyl) * kg / (1.0 + kg);
-            t3 = fxr * ixr;
-            t4 = fyr * iyr;
-            if (t3 * t3 + t4 * t4 > 1.0) {
-                sat_r = 1;
-                slide(ur, vr, f0r, rr, ivr, kx, ky, ixr, iyr, side0, cancel, &sc, &fxr, &fyr,
-                      &upr);
-            }
-        } else if (!sat_l) {
-            double kg = ky_dt_m * ivl;
-            fyl = (cancel - fyr) * kg / (1.0 + kg);
-            t1 = fxl * ixl;
-            t2 = fyl * iyl;
-            if (t1 * t1 + t2 * t2 > 1.0) {
-                sat_l = 1;
-                slide(ul, vl, f0l, rl, ivl, kx, ky, ixl, iyl, side0, cancel, &sc, &fxl, &fyl,
-                      &upl);
-            }
-        }
-        if (sat_l && sat_r) {
-            double fsum = fyl + fyr;
-            if (fsum * cancel > 0.0 && fabs(fsum) > fabs(cancel)) {
-                double q = cancel / fsum;
-                fyl = fyl * q;
-                fyr = fyr * q;
-            }
-        }
+        const SlideIn in = {ul, vl, f0l, rl, ivl, ixl, iyl, ur, vr, f0r, rr, ivr, ixr, iyr,
+                            kx, p[P_KY], ky_dt_m, cancel, &sc};
+        const double grip[6] = {fxl, fyl, upl, fxr, fyr, upr};
+        double o[6];
+        /* the predictor: the tyre law at the step's start */
+        const double start[5] = {vl, ivl, vr, ivr, side0};
+        slide_pair(&in, sat_l, sat_r, grip, start, o);
+        fx = o[0] + o[3];
+        torque = (o[3] - o[0]) * h;
+        torque += patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i);
+        f_lat = o[1] + o[4];
+        /* the sliding tyres' slip at the half step (sliding.mid_step) */
+        double hub[5];
+        mid_step(vx, vy, w, angle, fx * cm - f_lat * sm, fx * sm + f_lat * cm, torque, dt, dt_m,
+                 dt_i, turn_k, h, hub);
+        slide_pair(&in, sat_l, sat_r, grip, hub, o);
+        fxl = o[0], fyl = o[1], upl = o[2], fxr = o[3], fyr = o[4], upr = o[5];
         fx = fxl + fxr;
         torque = (fxr - fxl) * h;
-        scrub = patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i);
-        torque += scrub;
+        torque += patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i);
         f_lat = fyl + fyr;
     }
     double fwx = fx * cm - f_lat * sm;

@@ -25,7 +25,7 @@ class FewRovers:
     """The force model over plain floats for rovers at body ``rows`` of a batch state.
 
     Constants are folded per rover once; each step reads the rovers' state in one batch call,
-    computes forces (~90 float operations and seven trig calls a rover on the usual path),
+    computes forces (~130 float operations and seven trig calls a rover on the usual path),
     writes them in one batch call and advances the rims (``rims``: left and right rim speed of
     rover ``k`` at ``2k``, ``2k + 1``).
     """

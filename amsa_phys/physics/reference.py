@@ -15,7 +15,7 @@ import math
 
 from .forces import GRIP_FLOOR_N, LOAD_FLOOR
 from .rover import DiffDriveRover
-from .sliding import slide
+from .sliding import mid_step, slide
 from .wheel import (
     TORSION,
     WheelModel,
@@ -57,14 +57,20 @@ def reference_forces(
     rl += wm.brake_force_n if wm.command(rover.power_l) == 0.0 else 0.0
     rr += wm.brake_force_n if wm.command(rover.power_r) == 0.0 else 0.0
     ul, ur = rims
-    fxl, upl, fxr, upr = wheel_pair((ul, ur), (vl, vr), (f0l, f0r), (rl, rr), (kx / sl, kx / sr), s)
-    vl, vr = sl, sr
-    # scrub
-    torque = (fxr - fxl) * rover.half_track
     sphi = TORSION * wm.patch_radius_m**2 * kx
     caps = (wm.scrub_limit(mul), wm.scrub_limit(mur))
-    scrub = _scrub(w, torque, (sphi / vl, sphi / vr), caps, dt / body.moment)
+    # the gripping solve, then again with the hubs moved by the yaw the scrub gives them
+    # within the step (the scrub: the patches' turn-slip moment, implicit in the yaw rate)
+    scrub = 0.0
+    hub = (vl, vr)
+    for _ in (0, 1):
+        dv = scrub * dt / body.moment * rover.half_track
+        hub = (vl - dv, vr + dv)
+        fxl, upl, fxr, upr = wheel_pair((ul, ur), hub, (f0l, f0r), (rl, rr), (kx / sl, kx / sr), s)
+        torque = (fxr - fxl) * rover.half_track
+        scrub = _scrub(w, torque, (sphi / sl, sphi / sr), caps, dt / body.moment)
     torque += scrub
+    vl, vr = sl, sr
     # lateral grip at the end-of-step heading, applied along the mid-step normal; the step
     # turns the body by the trapezoid of its yaw rates (bodyio.trapezoid)
     turn = (w + 0.5 * torque / body.moment * dt) * dt
@@ -88,42 +94,49 @@ def reference_forces(
     ) ** 2 > 1
     if sat:  # a sliding tyre: the tyre law solved with its rim (sliding.slide)
         side0 = vy * math.cos(a) - vx * math.sin(a)
-        ky1 = wm.load_n / wm.slip_lat
-        hub = (v_fwd - w * rover.half_track, v_fwd + w * rover.half_track)
         # no tyre, nor both together, pushes past the force that cancels the sideways
         # velocity within the step
         cancel = -rover.mass / dt * side / math.cos(0.5 * turn)
-        out = [(fxl, fyl, upl), (fxr, fyr, upr)]
-        slid = [
-            (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1,
-            (fxr * inv[2]) ** 2 + (fyr * inv[3]) ** 2 > 1,
-        ]
-        args = [(ul, hub[0], f0l, rl, 1 / sl), (ur, hub[1], f0r, rr, 1 / sr)]
-        for i in (0, 1):
-            if slid[i]:
-                tyre = (kx, ky1, inv[2 * i], inv[2 * i + 1])
-                out[i] = slide(*args[i], tyre, side0, cancel, s)
-        if slid[0] != slid[1]:  # the gripping wheel again, its hub moved by the sliding force
-            i = 0 if slid[1] else 1
-            u_i, hub_i, f0_i, r_i, iv_i = args[i]
-            fx_i, up_i = rim_and_tyre(u_i, hub_i + s.e2 * out[1 - i][0], f0_i, r_i, kx * iv_i, s)
-            out[i] = (fx_i, out[i][1], up_i)
-        for i in (0, 1):  # a gripping tyre takes, implicitly, what the sliding one leaves
-            if slid[1 - i] and not slid[i]:
-                kg = ky1 / (sl, sr)[i] * dt / rover.mass
-                fy = (cancel - out[1 - i][1]) * kg / (1 + kg)
-                out[i] = (out[i][0], fy, out[i][2])
-                if (out[i][0] * inv[2 * i]) ** 2 + (fy * inv[2 * i + 1]) ** 2 > 1:
-                    slid[i] = True
-                    tyre = (kx, ky1, inv[2 * i], inv[2 * i + 1])
-                    out[i] = slide(*args[i], tyre, side0, cancel, s)
-        (fxl, fyl, upl), (fxr, fyr, upr) = out
-        if all(slid) and (fyl + fyr) * cancel > 0 and abs(fyl + fyr) > abs(cancel):
-            fyl, fyr = fyl * cancel / (fyl + fyr), fyr * cancel / (fyl + fyr)
+        grip = (fxl, fyl, upl, fxr, fyr, upr)
+        # the tyre law at the step's start predicts the forces; the sliding tyres' slip is
+        # then taken half a step on (sliding.mid_step) and the tyres solved again
+        fxl, fyl, upl, fxr, fyr, upr, torque = _slide_both(
+            rover,
+            dt,
+            (ul, ur),
+            hub,
+            (f0l, f0r),
+            (rl, rr),
+            (sl, sr),
+            inv,
+            grip,
+            side0,
+            cancel,
+            (w, sphi, caps),
+            None,
+        )
+        f_lat = fyl + fyr
         fx = fxl + fxr
-        # the scrub again, with the torque the tyres now give
-        torque = (fxr - fxl) * rover.half_track
-        torque += _scrub(w, torque, (sphi / vl, sphi / vr), caps, dt / body.moment)
+        qx = fx * math.cos(mid) - f_lat * math.sin(mid)
+        qy = fx * math.sin(mid) + f_lat * math.cos(mid)
+        k = (dt, dt / rover.mass, dt / body.moment, dt * dt / (2 * body.moment), rover.half_track)
+        at_mid = mid_step((vx, vy, w, a), (qx, qy, torque), k)
+        fxl, fyl, upl, fxr, fyr, upr, torque = _slide_both(
+            rover,
+            dt,
+            (ul, ur),
+            hub,
+            (f0l, f0r),
+            (rl, rr),
+            (sl, sr),
+            inv,
+            grip,
+            side0,
+            cancel,
+            (w, sphi, caps),
+            at_mid,
+        )
+        fx = fxl + fxr
         f_lat = fyl + fyr
     return (
         fx * math.cos(mid) - f_lat * math.sin(mid),
@@ -132,6 +145,75 @@ def reference_forces(
         upl,
         upr,
     )
+
+
+def _slide_both(
+    rover: DiffDriveRover,
+    dt: float,
+    rims: tuple[float, float],
+    hub: tuple[float, float],
+    f0: tuple[float, float],
+    res: tuple[float, float],
+    slip: tuple[float, float],
+    inv: list[float],
+    grip: tuple[float, float, float, float, float, float],
+    side0: float,
+    cancel: float,
+    yaw: tuple[float, float, tuple[float, float]],
+    at_mid: tuple[float, float, float, float, float] | None,
+) -> tuple[float, float, float, float, float, float, float]:
+    """Both wheels when a tyre slides (``sliding.slide_pair``, written plainly):
+    ``(F_xL, F_yL, u_L+, F_xR, F_yR, u_R+, torque)``, the torque with the scrub solved again.
+    ``at_mid``: the sliding tyres' hub speeds, slip speeds and sideways velocity
+    (``sliding.mid_step``), or None for the step's start."""
+    wm = rover.wheel
+    s = step_constants(wm, dt, rover.mass, rover.body.moment, rover.half_track)
+    kx = wm.load_n / wm.slip_long
+    ky1 = wm.load_n / wm.slip_lat
+    ul, ur = rims
+    f0l, f0r = f0
+    rl, rr = res
+    sl, sr = slip
+    w, sphi, caps = yaw
+    fxl, fyl, upl, fxr, fyr, upr = grip
+    if at_mid is None:
+        at_mid = (hub[0], 1 / sl, hub[1], 1 / sr, side0)
+    out = [(fxl, fyl, upl), (fxr, fyr, upr)]
+    slid = [
+        (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1,
+        (fxr * inv[2]) ** 2 + (fyr * inv[3]) ** 2 > 1,
+    ]
+    args = [(ul, hub[0], f0l, rl, 1 / sl), (ur, hub[1], f0r, rr, 1 / sr)]
+    sliding_args = [
+        (ul, at_mid[0], f0l, rl, at_mid[1]),
+        (ur, at_mid[2], f0r, rr, at_mid[3]),
+    ]
+    side_mid = at_mid[4]
+    for i in (0, 1):
+        if slid[i]:
+            tyre = (kx, ky1, inv[2 * i], inv[2 * i + 1])
+            out[i] = slide(*sliding_args[i], tyre, side_mid, cancel, s)
+    if slid[0] != slid[1]:  # the gripping wheel again, its hub moved by the sliding force
+        i = 0 if slid[1] else 1
+        u_i, hub_i, f0_i, r_i, iv_i = args[i]
+        fx_i, up_i = rim_and_tyre(u_i, hub_i + s.e2 * out[1 - i][0], f0_i, r_i, kx * iv_i, s)
+        out[i] = (fx_i, out[i][1], up_i)
+    for i in (0, 1):  # a gripping tyre takes, implicitly, what the sliding one leaves
+        if slid[1 - i] and not slid[i]:
+            kg = ky1 / (sl, sr)[i] * dt / rover.mass
+            fy = (cancel - out[1 - i][1]) * kg / (1 + kg)
+            out[i] = (out[i][0], fy, out[i][2])
+            if (out[i][0] * inv[2 * i]) ** 2 + (fy * inv[2 * i + 1]) ** 2 > 1:
+                slid[i] = True
+                tyre = (kx, ky1, inv[2 * i], inv[2 * i + 1])
+                out[i] = slide(*sliding_args[i], tyre, side_mid, cancel, s)
+    (fxl, fyl, upl), (fxr, fyr, upr) = out
+    if all(slid) and (fyl + fyr) * cancel > 0 and abs(fyl + fyr) > abs(cancel):
+        fyl, fyr = fyl * cancel / (fyl + fyr), fyr * cancel / (fyl + fyr)
+    # the scrub again, with the torque the tyres now give
+    torque = (fxr - fxl) * rover.half_track
+    torque += _scrub(w, torque, (sphi / sl, sphi / sr), caps, dt / rover.body.moment)
+    return fxl, fyl, upl, fxr, fyr, upr, torque
 
 
 def load_factor(wm: WheelModel, force: float, grip: float) -> float:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-from .wheel import StepConstants, rim_and_tyre
+from .wheel import SLIP_SPEED_MIN, StepConstants, rim_and_tyre
 
 #: Bisection steps of :func:`slide`'s rim solve at most (a double's bracket is exhausted
 #: sooner unless the root is within ~1e-30 of zero; the loop also stops there).
@@ -38,23 +38,26 @@ def slide(
     slip: a steady drift's yaw rate moved by 12 % between 100 and 1,600 Hz (issue 31).
     Here the tyre law itself, ``F = (N kappa / c_x, -N tan(alpha) / c_y) / max(1, |q|)``
     with ``q`` the two forces over their grips (the friction ellipse), is solved with the
-    rim's next speed: ``M_w (u+ - u) / dt = F_m(u+) - R sign(u+) - F_x(u+)`` (backward Euler;
-    the motor on its curve or at its current limit, the rim stuck at zero if its resistance
-    holds it). The left side rises with ``u+`` and the right side falls, so the root is
-    unique; bisection finds it, the same operations in C and Python. The lateral slip
-    ``side * ivs`` (sideways velocity over the slip speed) is the step's start value: the
-    body is ~30 times the rim's mass, so its lateral slip moves slowly; the lateral force is
-    capped by ``fy_cap``, the gripping solve's (which cancels the sideways velocity within
-    the step), so that a slide ending within the step does not overshoot into the other
-    side. ``tyre`` is ``(N / c_x, N / c_y, 1 / grip_x, 1 / grip_y)``; ``ivs`` is ``1 /
-    max(|v|, v_min)``.
+    rim's next speed: ``M_w (u+ - u) / dt = F_m(u+) - R sign(u+) - F_x((u + u+) / 2)``
+    (backward Euler for the motor, on its curve or at its current limit, the rim stuck at zero
+    if its resistance holds it; the tyre's slip at the rim's mid-step speed, the speed the
+    body feels over the step: with the end-of-step speed a spinning-up or spinning-down rim on
+    ice pushed the body by a whole step's change of slip too early, 0.008 rad of a long
+    manoeuvre's heading at 100 Hz). The left side rises with ``u+`` and the right side falls,
+    so the root is unique; bisection finds it, the same operations in C and Python. The hub
+    speed ``v`` and the lateral slip ``side * ivs`` (sideways velocity over the slip speed)
+    are the body's, held through the step (it is ~30 times the rim's mass): the caller passes
+    them half a step on (:func:`mid_step`). The lateral force is capped by ``fy_cap``, the
+    force that cancels the sideways velocity within the step, so that a slide ending within
+    the step does not overshoot into the other side. ``tyre`` is ``(N / c_x, N / c_y,
+    1 / grip_x, 1 / grip_y)``; ``ivs`` is ``1 / max(|v|, v_min)``.
     """
     kx, ky, ix, iy = tyre
     qy = -ky * side * ivs * iy
 
     def tyre_x(up: float) -> tuple[float, float]:
         """The tyre's longitudinal force and the ellipse's scale at rim speed ``up``."""
-        fx = kx * (up - v) * ivs
+        fx = kx * (0.5 * (u + up) - v) * ivs
         qx = fx * ix
         qq = qx * qx + qy * qy
         scale = 1.0 / math.sqrt(qq) if qq > 1.0 else 1.0
@@ -95,6 +98,46 @@ def slide(
     return fx, fy, up
 
 
+def mid_step(
+    body: tuple[float, float, float, float],
+    force: tuple[float, float, float],
+    k: tuple[float, float, float, float, float],
+) -> tuple[float, float, float, float, float]:
+    """The sliding tyres' slip half a step on: ``(v_L, 1/s_L, v_R, 1/s_R, v_side)``.
+
+    A sliding tyre's force is explicit in the body's velocity (the body is ~30 times the rim's
+    mass), so taking its slip from the step's start is forward Euler: a rover spinning at
+    6 rad/s on ice turns 0.06 rad a step under a velocity that does not turn with it, and a
+    long low-friction manoeuvre's heading came 0.059 rad off at 100 Hz. Taken in the frame
+    half a step on *alone* it was 0.013 rad, but every steady drift moved 0.3-0.5 % off the
+    tyre law, because there the tyres' forces turn the velocity with the body. So the body
+    is moved on by half of what the step's predicted forces give it, velocity and yaw rate
+    alike (the midpoint rule): in a steady drift the slip is the law's again (to 0.01 %),
+    and the spin's frame turns under its velocity.
+
+    ``body``: ``(v_x, v_y, w, heading)`` at the step's start (world frame); ``force``: the
+    predictor's ``(F_x, F_y, torque)`` (world frame, scrub included); ``k``: ``(dt, dt/m,
+    dt/I, dt^2/(2 I), track/2)``. ``1/s`` is ``1 / max(|v|, v_min)``.
+    """
+    vx, vy, w, angle = body
+    qx, qy, torque = force
+    dt, dt_m, dt_i, turn_k, h = k
+    hv = 0.5 * dt_m
+    mx = vx + qx * hv
+    my = vy + qy * hv
+    wm = w + 0.5 * torque * dt_i
+    th = angle + 0.5 * w * dt + 0.25 * torque * turn_k
+    c = math.cos(th)
+    s = math.sin(th)
+    mf = mx * c + my * s
+    ml = mf - wm * h
+    mr = mf + wm * h
+    vmin = SLIP_SPEED_MIN
+    jl = 1.0 / ml if ml > vmin else (-1.0 / ml if ml < -vmin else 1.0 / vmin)
+    jr = 1.0 / mr if mr > vmin else (-1.0 / mr if mr < -vmin else 1.0 / vmin)
+    return ml, jl, mr, jr, my * c - mx * s
+
+
 def slide_pair(
     sat: tuple[bool, bool],
     left: tuple[float, ...],
@@ -103,6 +146,7 @@ def slide_pair(
     side: float,
     cancel: float,
     s: StepConstants,
+    mid: tuple[float, float, float, float, float] | None = None,
 ) -> tuple[float, float, float, float, float, float]:
     """Both wheels when at least one tyre slides: ``(F_xL, F_yL, u_L+, F_xR, F_yR, u_R+)``.
 
@@ -122,16 +166,20 @@ def slide_pair(
 
     ``left``/``right``: ``(u, v, f0, res, ivs, 1/grip_x, 1/grip_y, F_x, F_y, u+)``, the last
     three the gripping solve's; ``tyre``: ``(N / c_x, N / c_y, N dt / (c_y m))``; ``side`` the
-    sideways velocity at the step's start (the sliding tyres' lateral slip).
+    sideways velocity at the step's start; ``mid`` (:func:`mid_step`) the sliding tyres' hub
+    speeds, slip speeds and sideways velocity when they are not the step's start values (a
+    gripping wheel's solve is implicit from the start: it keeps ``v`` and ``ivs``).
     """
     kx, ky, ky_dt_m = tyre
     sat_l, sat_r = sat
     ul, vl, f0l, rl, ivl, ixl, iyl, fxl, fyl, upl = left
     ur, vr, f0r, rr, ivr, ixr, iyr, fxr, fyr, upr = right
+    # the sliding tyres' slip: the hubs' speeds, their slip speeds and the sideways velocity
+    ml, jl, mr, jr, ms = mid if mid is not None else (vl, ivl, vr, ivr, side)
     if sat_l:
-        fxl, fyl, upl = slide(ul, vl, f0l, rl, ivl, (kx, ky, ixl, iyl), side, cancel, s)
+        fxl, fyl, upl = slide(ul, ml, f0l, rl, jl, (kx, ky, ixl, iyl), ms, cancel, s)
     if sat_r:
-        fxr, fyr, upr = slide(ur, vr, f0r, rr, ivr, (kx, ky, ixr, iyr), side, cancel, s)
+        fxr, fyr, upr = slide(ur, mr, f0r, rr, jr, (kx, ky, ixr, iyr), ms, cancel, s)
     # a gripping wheel again, its hub moved by the sliding one's force (the joint solve had
     # the other's gripping force, ~1/dt, which made this one's an O(1) error)
     if sat_l and not sat_r:
@@ -145,7 +193,7 @@ def slide_pair(
         t4 = fyr * iyr
         if t3 * t3 + t4 * t4 > 1.0:
             sat_r = True
-            fxr, fyr, upr = slide(ur, vr, f0r, rr, ivr, (kx, ky, ixr, iyr), side, cancel, s)
+            fxr, fyr, upr = slide(ur, mr, f0r, rr, jr, (kx, ky, ixr, iyr), ms, cancel, s)
     elif not sat_l:
         kg = ky_dt_m * ivl
         fyl = (cancel - fyr) * kg / (1.0 + kg)
@@ -153,7 +201,7 @@ def slide_pair(
         t2 = fyl * iyl
         if t1 * t1 + t2 * t2 > 1.0:
             sat_l = True
-            fxl, fyl, upl = slide(ul, vl, f0l, rl, ivl, (kx, ky, ixl, iyl), side, cancel, s)
+            fxl, fyl, upl = slide(ul, ml, f0l, rl, jl, (kx, ky, ixl, iyl), ms, cancel, s)
     if sat_l and sat_r:  # both sliding: together not past the cancelling force either
         f_lat = fyl + fyr
         if f_lat * cancel > 0.0 and abs(f_lat) > abs(cancel):

@@ -64,7 +64,7 @@ def error(r: dict[str, float]) -> float:
 
 
 def test_the_accelerometer_reads_the_specific_force_in_a_steady_skid(tmp_path: Path) -> None:
-    # measured: 2.7964 / -7.3104 m/s² against 2.7960 / -7.3093 (error 0.0012 m/s²)
+    # measured: 2.8169 / -7.3091 m/s² against 2.8166 / -7.3079 (error 0.0013 m/s²)
     r = skid_imu(tmp_path, {}, POSED)
     assert abs(r["true_x"]) > 2.0  # a real skid: -w v_y is several m/s² forward
     assert error(r) < 0.02 * np.hypot(r["true_x"], r["true_y"])
