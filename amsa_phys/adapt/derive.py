@@ -53,6 +53,11 @@ MARGIN = 0.5
 MIN_GAIN = 0.05
 #: Share of the distance between two levels left to no rule on each side of the midpoint.
 GAP = 0.1
+#: A safe point at most this much worse than a cell's lowest safe mean counts as level with
+#: it, and the one nearest the robust point among those is the cell's best.
+NEAR = 0.0
+#: A cell leaves the robust point only for a point at least this much better there.
+CELL_GAIN = 0.0
 #: Seconds an estimator must stay unsure before the robust point is set (None: the rules'
 #: hold). A longer wait keeps a switch that blinds an estimator for a while (a high gain on
 #: very worn motors makes the loop reverse now and then) but leaves a wrong one in force
@@ -116,6 +121,8 @@ def derive(
     robust: dict[str, Any] | None = None,
     fallback_hold: float | None = FALLBACK_HOLD,
     fallback_dwell: float | None = FALLBACK_DWELL,
+    near: float = NEAR,
+    cell_gain: float = CELL_GAIN,
 ) -> Derivation:
     """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
     is the fixed choice to fall back on (default: the sweep's least worst-case point)."""
@@ -165,11 +172,15 @@ def derive(
     for key, cell in cells.items():
         by_point = table.stats[key]
         cell.runs = sum(s.count + s.failed for s in by_point.values())
-        best = _safe_best(table, key, margin)
+        best = _safe_best(table, key, margin, robust, near)
         if (
             robust is not None
             and robust in by_point
-            and (best is None or by_point[robust].mean <= by_point[best].mean)
+            and (
+                best is None
+                or by_point[best].mean > (1.0 - cell_gain) * by_point[robust].mean
+                or by_point[robust].mean <= by_point[best].mean
+            )
         ):
             best = robust  # never a choice worse than the fallback
         if best is None:
@@ -269,13 +280,34 @@ def _safe(table: SweepTable, cell: tuple[Any, ...], point: tuple[Any, ...], marg
     return True
 
 
-def _safe_best(table: SweepTable, cell: tuple[Any, ...], margin: float) -> tuple[Any, ...] | None:
-    """The cell's lowest-mean safe point (None if none is safe)."""
+def _safe_best(
+    table: SweepTable,
+    cell: tuple[Any, ...],
+    margin: float,
+    robust: tuple[Any, ...] | None = None,
+    near: float = 0.0,
+) -> tuple[Any, ...] | None:
+    """The cell's lowest-mean safe point (None if none is safe); of the safe points within
+    ``near`` of it, the fewest grid steps from ``robust``."""
     by_point = table.stats[cell]
     ranked = sorted(
         (p for p, s in by_point.items() if s.stable), key=lambda p: (by_point[p].mean, p)
     )
-    return next((p for p in ranked if _safe(table, cell, p, margin)), None)
+    safe = [p for p in ranked if _safe(table, cell, p, margin)]
+    if not safe or robust is None or near <= 0:
+        return safe[0] if safe else None
+    level = [p for p in safe if by_point[p].mean <= (1.0 + near) * by_point[safe[0]].mean]
+    return min(level, key=lambda p: (_steps(table, p, robust), by_point[p].mean, p))
+
+
+def _steps(table: SweepTable, a: tuple[Any, ...], b: tuple[Any, ...]) -> int:
+    """Grid steps between two points (summed over the tuned axes)."""
+    out = 0
+    for i in range(len(a)):
+        values = sorted({p[i] for by in table.stats.values() for p in by})
+        if a[i] in values and b[i] in values:
+            out += abs(values.index(a[i]) - values.index(b[i]))
+    return out
 
 
 def _robust(table: SweepTable, margin: float) -> tuple[Any, ...] | None:
