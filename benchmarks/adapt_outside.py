@@ -27,7 +27,7 @@ SWEEP = ROOT / "scenarios" / "adaptive_sweep.yaml"
 RULES = "rules/adaptive_rules.yaml"
 SEEDS = (1, 2, 3)
 ROBUST = 0.2
-GRID = (0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.45, 0.6, 0.8)
+GRID = (0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.6, 0.7, 0.8)
 #: Leader.cruisePower 4 drives at 0.06 m/s, 7 at the MDE speed (0.22 m/s), 12 at 0.5 m/s
 SEQUENCES: dict[str, tuple[dict[str, Any], list[dict[str, Any]]]] = {
     "slow straight leader (0.06 m/s); at 250 s a fast random one (0.5 m/s) and motors at 70 %": (
