@@ -11,7 +11,10 @@ contexts; ``robust=`` gives tune's answer instead); it is what the robot runs wh
 estimators are unsure. Each cell's **safe best** is its lowest seed-mean point whose grid neighbours
 (one step along each tuned axis) all finished and are at most ``margin`` worse: a gain one
 step below instability is never chosen, since the estimate that picks it is never exact
-(the robust point instead, when no safe point beats it there).
+(the robust point instead, when no safe point beats it there). Two more cautions, for
+the same reason: of the safe points within ``near`` of the lowest, the one fewest grid steps
+from the robust point is the best, and a cell keeps the robust point unless its best beats
+it there by ``cell_gain`` (a switch costs a transient and a detection delay).
 The **oracle** is each cell's safe best, switched at the true instants; when its mean over
 the cells gains less than ``min_gain`` over the robust point's mean, there is nothing for
 adaptation to win and no rules are written (:attr:`Derivation.refused`).
@@ -91,9 +94,8 @@ class Cell:
     score: float = float("nan")
     runs: int = 0
     levels: dict[str, float] = field(default_factory=dict)
-    #: the lowest mean, when the margin kept it from being the cell's best
+    #: the lowest mean, when it is not the cell's best (``why`` says why not)
     unsafe: tuple[dict[str, Any], float] | None = None
-    #: why the lowest mean is not the cell's best
     why: str = ""
     robust_score: float = float("nan")
 
@@ -185,9 +187,6 @@ def derive(
         cell.runs = sum(s.count + s.failed for s in by_point.values())
         safest = _safe_best(table, key, margin)
         best = _safe_best(table, key, margin, robust, near)
-        why = "a neighbour is unstable or far worse"
-        if best is not None and best != safest:
-            why = f"level within {100 * near:g} % and nearer the robust point"
         if (
             robust is not None
             and robust in by_point
@@ -197,19 +196,20 @@ def derive(
                 or by_point[robust].mean <= by_point[best].mean
             )
         ):
-            if best is not None and by_point[robust].mean > by_point[best].mean:
-                why = f"less than {100 * cell_gain:g} % better than the robust point"
-            best = robust  # never a choice worse than the fallback
+            best = robust  # never a choice worse than the fallback, nor one barely better
         if best is None:
             continue
         cell.best = dict(zip(table.tuned, best, strict=True))
         cell.score = by_point[best].mean
         lowest = _lowest(by_point)
         if lowest is not None and lowest != best:
-            if _safe_best(table, key, margin) != lowest:
-                why = "a neighbour is unstable or far worse"
             cell.unsafe = (dict(zip(table.tuned, lowest, strict=True)), by_point[lowest].mean)
-            cell.why = why
+            if lowest != safest:
+                cell.why = "a neighbour is unstable or far worse"
+            elif best == robust:
+                cell.why = f"less than {100 * cell_gain:g} % better than the robust point"
+            else:
+                cell.why = f"level within {100 * near:g} % and nearer the robust point"
         if robust is not None and robust in by_point:
             cell.robust_score = by_point[robust].mean
     derivation = Derivation(metric, table.tuned, list(cells.values()), [], [], found)

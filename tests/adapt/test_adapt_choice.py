@@ -49,3 +49,17 @@ def test_of_gains_level_with_the_best_the_one_nearest_the_robust_gain(tmp_path: 
     assert _best(tmp_path, TABLE, near=0.05)["worn"] == 0.3
     # 1 % apart is level within 5 %, not within 0.5 %
     assert _best(tmp_path / "tight", TABLE, near=0.005)["worn"] == 0.4
+
+
+def test_the_table_says_why_the_lowest_mean_was_not_chosen(tmp_path: Path) -> None:
+    scenario, sweep = two_context_sweep(tmp_path, TABLE)
+    found = derive(sweep / "results.csv", load_scenario(scenario), margin=float("inf"))
+    why = {c.name: (c.unsafe, c.why) for c in found.cells}
+    assert why["healthy"] == (
+        ({"MyFollowerController.Kv": 0.15}, 0.92),
+        "less than 15 % better than the robust point",
+    )
+    assert why["worn"] == (
+        ({"MyFollowerController.Kv": 0.4}, 1.0),
+        "level within 5 % and nearer the robust point",
+    )
