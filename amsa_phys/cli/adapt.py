@@ -238,7 +238,7 @@ def _check_validate_args(args: argparse.Namespace) -> None:
 
 def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -> int:
     """Run the held-out sequences, print the table; 1 if the rules lose to the robust one."""
-    from ..adapt.validate import HEADER, loses, results, validate
+    from ..adapt.validate import HEADER, loses, results, short_of_oracle, validate
 
     contexts = dict(scenario.data.get("sweep", {}).get("contexts", {}))
     if not contexts:
@@ -272,6 +272,14 @@ def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -
         }
         doc = results(rows, found, settings)
         write_atomic(Path(args.results), json.dumps(doc, indent=1) + "\n")
+    worth, short = short_of_oracle(rows)
+    if worth:
+        print(
+            one_line(
+                f"where the oracle gains 10 % or more ({len(worth)} of {len(rows)} sequences), "
+                f"the rules do on {len(worth) - len(short)}"
+            )
+        )
     lost = loses(rows, args.tolerance)
     if lost:
         print(
