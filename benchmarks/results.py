@@ -252,18 +252,60 @@ def _num(x: float) -> str:
 
 
 #: Blocks rendered from a results file of their own by the code that wrote it (not perf.json):
-#: ``amsa-phys adapt --validate --results FILE`` writes the held-out validation's table.
-OWN_TABLES = {"adapt-validate": ROOT / "scenarios" / "rules" / "adaptive_rules.validate.json"}
+#: ``amsa-phys adapt --validate --results FILE`` writes the held-out validation's table;
+#: ``benchmarks/adapt_demo.py`` and ``adapt_outside.py`` write a table of their own (a
+#: ``columns`` file: the cells as they print them).
+ADAPT = ROOT / "scenarios" / "rules"
+OWN_TABLES = {
+    "adapt-validate": ADAPT / "adaptive_rules.validate.json",
+    "adapt-demo": ROOT / "benchmarks" / "results" / "adapt_demo.json",
+    "adapt-outside": ROOT / "benchmarks" / "results" / "adapt_outside.json",
+}
 
 
 def _own_table(target: str) -> str:
     """The table of a block in :data:`OWN_TABLES`, rendered as its writer renders it."""
-    from amsa_phys.adapt.validate import markdown
-
     path = OWN_TABLES[target]
     if not path.exists():
         return f"*Not measured yet: no {path.relative_to(ROOT)}.*\n"
-    return markdown(json.loads(path.read_text()))
+    doc = json.loads(path.read_text())
+    if "columns" in doc:
+        return table_markdown(doc)
+    from amsa_phys.adapt.validate import markdown
+
+    return markdown(doc)
+
+
+def table_markdown(doc: dict[str, Any]) -> str:
+    """A ``columns`` results file as Markdown: its rows, then its caption, sitting and command."""
+    lines = [
+        "| " + " | ".join(doc["columns"]) + " |",
+        "| " + " | ".join("---" for _ in doc["columns"]) + " |",
+    ]
+    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in doc["rows"]]
+    load_ = "–".join(f"{x:g}" for x in doc["load"])
+    lines += [
+        "",
+        f"*{doc['caption']} (load {load_}, {doc['date'][:10]}). Regenerate: `{doc['command']}`.*",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def table_doc(
+    columns: list[str], rows: list[list[Any]], caption: str, command: str, **extra: Any
+) -> dict[str, Any]:
+    """A ``columns`` results file (what :func:`table_markdown` renders), with its sitting:
+    the machine's load and the date (the figures do not depend on them when the runs are
+    deterministic; they say when the table was made)."""
+    return {
+        "columns": columns,
+        "rows": rows,
+        "caption": caption,
+        "command": command,
+        "load": [round(x, 2) for x in os.getloadavg()],
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        **extra,
+    }
 
 
 def render(targets: list[str], rows: list[dict[str, Any]] | None = None) -> str:

@@ -11,7 +11,10 @@ contexts; ``robust=`` gives tune's answer instead); it is what the robot runs wh
 estimators are unsure. Each cell's **safe best** is its lowest seed-mean point whose grid neighbours
 (one step along each tuned axis) all finished and are at most ``margin`` worse: a gain one
 step below instability is never chosen, since the estimate that picks it is never exact
-(the robust point instead, when no safe point beats it there).
+(the robust point instead, when no safe point beats it there). Two more cautions, for
+the same reason: of the safe points within ``near`` of the lowest, the one fewest grid steps
+from the robust point is the best, and a cell keeps the robust point unless its best beats
+it there by ``cell_gain`` (a switch costs a transient and a detection delay).
 The **oracle** is each cell's safe best, switched at the true instants; when its mean over
 the cells gains less than ``min_gain`` over the robust point's mean, there is nothing for
 adaptation to win and no rules are written (:attr:`Derivation.refused`).
@@ -53,6 +56,20 @@ MARGIN = 0.5
 MIN_GAIN = 0.05
 #: Share of the distance between two levels left to no rule on each side of the midpoint.
 GAP = 0.1
+#: A safe point at most this much worse than a cell's lowest safe mean counts as level with
+#: it, and the one nearest the robust point among those is the cell's best. A held-out level
+#: between two cells sits between their best gains, and the estimate that places it is never
+#: exact: of two gains level in the cell, the one nearer the robust gain is the safer guess
+#: (on the shipped box: Kv 0.3 rather than 0.35 for worn motors, 0.6 rather than 0.7 for very
+#: worn ones, each 0.4-0.5 % worse in its cell, the next point 10-13 % worse).
+NEAR = 0.05
+#: A cell leaves the robust point only for a point at least this much better there. Every
+#: switch costs a transient and a detection delay, and a gain that wins little in its cell
+#: loses more where the estimate misplaces the context: on the shipped box the nominal
+#: cell's Kv 0.15 (9.5 % better there) and the tired random leader's 0.3 (8 %) lost 2-10 %
+#: to the robust gain on held-out sequences of motors at 74-92 %; the cells adaptation is
+#: for gain 27-63 %.
+CELL_GAIN = 0.15
 #: Seconds an estimator must stay unsure before the robust point is set (None: the rules'
 #: hold). A longer wait keeps a switch that blinds an estimator for a while (a high gain on
 #: very worn motors makes the loop reverse now and then) but leaves a wrong one in force
@@ -77,8 +94,9 @@ class Cell:
     score: float = float("nan")
     runs: int = 0
     levels: dict[str, float] = field(default_factory=dict)
-    #: the lowest mean, when the margin kept it from being the cell's best
+    #: the lowest mean, when it is not the cell's best (``why`` says why not)
     unsafe: tuple[dict[str, Any], float] | None = None
+    why: str = ""
     robust_score: float = float("nan")
 
 
@@ -116,6 +134,8 @@ def derive(
     robust: dict[str, Any] | None = None,
     fallback_hold: float | None = FALLBACK_HOLD,
     fallback_dwell: float | None = FALLBACK_DWELL,
+    near: float = NEAR,
+    cell_gain: float = CELL_GAIN,
 ) -> Derivation:
     """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
     is the fixed choice to fall back on (default: the sweep's least worst-case point)."""
@@ -165,13 +185,18 @@ def derive(
     for key, cell in cells.items():
         by_point = table.stats[key]
         cell.runs = sum(s.count + s.failed for s in by_point.values())
-        best = _safe_best(table, key, margin)
+        safest = _safe_best(table, key, margin)
+        best = _safe_best(table, key, margin, robust, near)
         if (
             robust is not None
             and robust in by_point
-            and (best is None or by_point[robust].mean <= by_point[best].mean)
+            and (
+                best is None
+                or by_point[best].mean > (1.0 - cell_gain) * by_point[robust].mean
+                or by_point[robust].mean <= by_point[best].mean
+            )
         ):
-            best = robust  # never a choice worse than the fallback
+            best = robust  # never a choice worse than the fallback, nor one barely better
         if best is None:
             continue
         cell.best = dict(zip(table.tuned, best, strict=True))
@@ -179,6 +204,12 @@ def derive(
         lowest = _lowest(by_point)
         if lowest is not None and lowest != best:
             cell.unsafe = (dict(zip(table.tuned, lowest, strict=True)), by_point[lowest].mean)
+            if lowest != safest:
+                cell.why = "a neighbour is unstable or far worse"
+            elif best == robust:
+                cell.why = f"less than {100 * cell_gain:g} % better than the robust point"
+            else:
+                cell.why = f"level within {100 * near:g} % and nearer the robust point"
         if robust is not None and robust in by_point:
             cell.robust_score = by_point[robust].mean
     derivation = Derivation(metric, table.tuned, list(cells.values()), [], [], found)
@@ -269,13 +300,34 @@ def _safe(table: SweepTable, cell: tuple[Any, ...], point: tuple[Any, ...], marg
     return True
 
 
-def _safe_best(table: SweepTable, cell: tuple[Any, ...], margin: float) -> tuple[Any, ...] | None:
-    """The cell's lowest-mean safe point (None if none is safe)."""
+def _safe_best(
+    table: SweepTable,
+    cell: tuple[Any, ...],
+    margin: float,
+    robust: tuple[Any, ...] | None = None,
+    near: float = 0.0,
+) -> tuple[Any, ...] | None:
+    """The cell's lowest-mean safe point (None if none is safe); of the safe points within
+    ``near`` of it, the fewest grid steps from ``robust``."""
     by_point = table.stats[cell]
     ranked = sorted(
         (p for p, s in by_point.items() if s.stable), key=lambda p: (by_point[p].mean, p)
     )
-    return next((p for p in ranked if _safe(table, cell, p, margin)), None)
+    safe = [p for p in ranked if _safe(table, cell, p, margin)]
+    if not safe or robust is None or near <= 0:
+        return safe[0] if safe else None
+    level = [p for p in safe if by_point[p].mean <= (1.0 + near) * by_point[safe[0]].mean]
+    return min(level, key=lambda p: (_steps(table, p, robust), by_point[p].mean, p))
+
+
+def _steps(table: SweepTable, a: tuple[Any, ...], b: tuple[Any, ...]) -> int:
+    """Grid steps between two points (summed over the tuned axes)."""
+    out = 0
+    for i in range(len(a)):
+        values = sorted({p[i] for by in table.stats.values() for p in by})
+        if a[i] in values and b[i] in values:
+            out += abs(values.index(a[i]) - values.index(b[i]))
+    return out
 
 
 def _robust(table: SweepTable, margin: float) -> tuple[Any, ...] | None:

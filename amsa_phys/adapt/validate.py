@@ -117,6 +117,18 @@ def loses(rows: list[Row], tolerance: float) -> list[Row]:
     return [r for r in rows if r.change > tolerance]
 
 
+def short_of_oracle(rows: list[Row], gain: float = 0.1) -> tuple[list[Row], list[Row]]:
+    """(sequences where the oracle gains at least ``gain`` over the robust choice, those of
+    them where the rules do not): where adaptation is worth having, how often the rules
+    deliver it (a rule set that never loses may still never switch)."""
+    worth = [
+        r
+        for r in rows
+        if math.isfinite(r.robust) and r.robust > 0 and r.oracle <= (1.0 - gain) * r.robust
+    ]
+    return worth, [r for r in worth if not r.adaptive <= (1.0 - gain) * r.robust]
+
+
 def results(rows: list[Row], found: Derivation, settings: dict[str, Any]) -> dict[str, Any]:
     """The scored rules as a results file: what ``--results`` writes and the docs render.
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import yaml
 
-from ..adapt.derive import MARGIN, MIN_GAIN, Derivation, derive
+from ..adapt.derive import CELL_GAIN, MARGIN, MIN_GAIN, NEAR, Derivation, derive
 from ..adapt.sweepdir import read_sweep_scenario
 from ..atomic import write_atomic
 from ..errors import ConfigError, one_line
@@ -66,6 +66,23 @@ def add_args(p: argparse.ArgumentParser) -> None:
         metavar="M",
         help="a chosen point's grid neighbours may be at most M worse (default 0.5: 50 %%; "
         "inf: no margin)",
+    )
+    p.add_argument(
+        "--near",
+        type=float,
+        default=NEAR,
+        metavar="T",
+        help="safe points at most T worse than a cell's lowest count as level with it, and "
+        "the one fewest grid steps from the robust choice is the cell's best (default "
+        f"{NEAR:g}: {100 * NEAR:g} %%)",
+    )
+    p.add_argument(
+        "--cell-gain",
+        type=float,
+        default=CELL_GAIN,
+        metavar="G",
+        help="a cell keeps the robust choice unless its best is at least G better there "
+        f"(default {CELL_GAIN:g}: {100 * CELL_GAIN:g} %%)",
     )
     p.add_argument(
         "--min-gain",
@@ -141,6 +158,10 @@ def run(args: argparse.Namespace) -> int:
         )
     if not args.margin >= 0:
         raise ConfigError(f"must be >= 0 (or inf), got {args.margin}", key="--margin")
+    if not (0 <= args.near < 1):
+        raise ConfigError(f"must be in [0, 1), got {args.near}", key="--near")
+    if not (0 <= args.cell_gain < 1):
+        raise ConfigError(f"must be in [0, 1), got {args.cell_gain}", key="--cell-gain")
     if not (0 <= args.min_gain < 1):
         raise ConfigError(f"must be in [0, 1), got {args.min_gain}", key="--min-gain")
     if args.validate:
@@ -164,6 +185,8 @@ def run(args: argparse.Namespace) -> int:
         robust,
         args.fallback_hold,
         args.fallback_dwell,
+        args.near,
+        args.cell_gain,
     )
     for line in table(found):
         print(one_line(line))
@@ -215,7 +238,7 @@ def _check_validate_args(args: argparse.Namespace) -> None:
 
 def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -> int:
     """Run the held-out sequences, print the table; 1 if the rules lose to the robust one."""
-    from ..adapt.validate import HEADER, loses, results, validate
+    from ..adapt.validate import HEADER, loses, results, short_of_oracle, validate
 
     contexts = dict(scenario.data.get("sweep", {}).get("contexts", {}))
     if not contexts:
@@ -249,6 +272,14 @@ def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -
         }
         doc = results(rows, found, settings)
         write_atomic(Path(args.results), json.dumps(doc, indent=1) + "\n")
+    worth, short = short_of_oracle(rows)
+    if worth:
+        print(
+            one_line(
+                f"where the oracle gains 10 % or more ({len(worth)} of {len(rows)} sequences), "
+                f"the rules do on {len(worth) - len(short)}"
+            )
+        )
     lost = loses(rows, args.tolerance)
     if lost:
         print(
@@ -280,6 +311,12 @@ def _command(args: argparse.Namespace) -> str:
             words += [flag, f"{value:g}"]
     if args.fallback_dwell is not None:
         words += ["--fallback-dwell", f"{args.fallback_dwell:g}"]
+    for flag, value, default in (
+        ("--near", args.near, NEAR),
+        ("--cell-gain", args.cell_gain, CELL_GAIN),
+    ):
+        if value != default:
+            words += [flag, f"{value:g}"]
     words += ["--results", args.results]
     return shlex.join(one_line(w) for w in words)
 
@@ -296,7 +333,7 @@ def table(found: Derivation) -> list[str]:
         if c.unsafe is not None:
             lowest = ", ".join(f"{v}" for v in c.unsafe[0].values())
             at = _shown(found, c.unsafe[1])
-            note = f" (not {lowest} at {at:.4g}: a neighbour is unstable or far worse)"
+            note = f" (not {lowest} at {at:.4g}: {c.why})"
         score, robust = _shown(found, c.score), _shown(found, c.robust_score)
         lines.append(f"{c.name} | {levels} | {best} | {score:.4g} | {robust:.4g}{note}")
     if found.robust:
