@@ -465,6 +465,8 @@ TARGETS: dict[str, Callable[[int], None]] = {
     "view": lambda reps: _bench("bench_view").perf(reps, report),
     "falsify": lambda reps: _bench("bench_falsify").perf(reps, report),
     "falsify_peers": lambda reps: _bench("bench_falsify_peers").perf(reps, report),
+    # where the time goes: each part's share of the single env's and ap.run's CPU (INFO)
+    "profile": lambda reps: _bench("profile_loop").perf(reps, report),
     # the test suite's tiers (once each) and the exported MDE package's build
     "suite": lambda reps: _bench("bench_suite").perf(reps, report, **SUITE),
 }
