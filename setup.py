@@ -19,14 +19,7 @@ setup(
             libraries=["m"],
             optional=True,
         ),
-        # the engine's write of a component's outputs into the store (engine/publish.py);
-        # it computes a robot's pose too: rounded as CPython rounds, as the C step
-        Extension(
-            "amsa_phys.engine._publish",
-            ["amsa_phys/engine/_publish.c"],
-            extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"],
-            libraries=["m"],
-            optional=True,
-        ),
+        # the engine's write of a component's outputs into the store (engine/publish.py)
+        Extension("amsa_phys.engine._publish", ["amsa_phys/engine/_publish.c"], optional=True),
     ]
 )

@@ -29,7 +29,6 @@
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #include <structmember.h>
-#include <math.h>
 
 /* 1: every item of ``out`` written; 0: declined (the Python loop judges) */
 static int publish_into(PyObject *out, PyObject *targets, PyObject *values) {
@@ -412,102 +411,10 @@ static PyTypeObject DrawnType = {
     .tp_getset = Drawn_getset,
 };
 
-/* pose(kinematics, rims) -> dict or None: a robot's published pose (``physics/robots.py``,
- * ``Robot._pose``) from its rover's two readers, ``kinematics()`` -> x, y, angle, vx, vy, w
- * and ``rims()`` -> left, right: the same dict, the same floats. ``heading`` is
- * ``(angle + pi) % (2 pi) - pi`` with Python's float ``%`` (fmod, then the divisor's sign),
- * ``speed`` is ``vx cos(angle) + vy sin(angle)`` with libm's cos and sin, as ``math``'s, and
- * no contraction into fused multiply-adds (``setup.py``: -ffp-contract=off). None when
- * a reader gives anything but six (two) floats, or the angle is not finite: the Python pose
- * then runs, and raises what it raises. Why: the pose is built at every step of every robot. */
-static PyObject *pose_keys[7];
-
-static double py_fmod(double vx, double wx) { /* float.__mod__, for a finite divisor */
-    double mod = fmod(vx, wx);
-    if (mod) {
-        if ((wx < 0) != (mod < 0)) {
-            mod += wx;
-        }
-    } else {
-        mod = copysign(0.0, wx);
-    }
-    return mod;
-}
-
-static PyObject *pose(PyObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    (void)self;
-    if (nargs != 2) {
-        PyErr_SetString(PyExc_TypeError, "pose(kinematics, rims)");
-        return NULL;
-    }
-    PyObject *kin = PyObject_CallNoArgs(args[0]);
-    if (kin == NULL) {
-        return NULL;
-    }
-    PyObject *rims = PyObject_CallNoArgs(args[1]);
-    if (rims == NULL) {
-        Py_DECREF(kin);
-        return NULL;
-    }
-    PyObject *result = NULL;
-    PyObject *items[8];
-    int ok = (PyList_CheckExact(kin) && PyList_GET_SIZE(kin) == 6) ||
-             (PyTuple_CheckExact(kin) && PyTuple_GET_SIZE(kin) == 6);
-    ok = ok && ((PyTuple_CheckExact(rims) && PyTuple_GET_SIZE(rims) == 2) ||
-                (PyList_CheckExact(rims) && PyList_GET_SIZE(rims) == 2));
-    if (ok) {
-        for (int i = 0; i < 6; i++) {
-            items[i] = PyList_CheckExact(kin) ? PyList_GET_ITEM(kin, i) : PyTuple_GET_ITEM(kin, i);
-            ok = ok && PyFloat_CheckExact(items[i]);
-        }
-        for (int i = 0; i < 2; i++) {
-            items[6 + i] =
-                PyTuple_CheckExact(rims) ? PyTuple_GET_ITEM(rims, i) : PyList_GET_ITEM(rims, i);
-            ok = ok && PyFloat_CheckExact(items[6 + i]);
-        }
-    }
-    /* a non-finite angle: math.cos raises for an infinite one, C does not */
-    if (!ok || !isfinite(PyFloat_AS_DOUBLE(items[2]))) {
-        Py_DECREF(kin);
-        Py_DECREF(rims);
-        Py_RETURN_NONE;
-    }
-    double a = PyFloat_AS_DOUBLE(items[2]);
-    double vx = PyFloat_AS_DOUBLE(items[3]), vy = PyFloat_AS_DOUBLE(items[4]);
-    const double pi = 3.141592653589793, two_pi = 2 * 3.141592653589793;
-    double heading = py_fmod(a + pi, two_pi) - pi;
-    double c = cos(a), s = sin(a);
-    double along = vx * c;
-    double across = vy * s;
-    PyObject *h = PyFloat_FromDouble(heading);
-    PyObject *v = PyFloat_FromDouble(along + across);
-    PyObject *out = PyDict_New();
-    if (h != NULL && v != NULL && out != NULL) {
-        PyObject *values[7] = {items[0], items[1], h, v, items[5], items[6], items[7]};
-        int bad = 0;
-        for (int i = 0; i < 7 && !bad; i++) {
-            bad = PyDict_SetItem(out, pose_keys[i], values[i]) < 0;
-        }
-        if (!bad) {
-            result = out;
-            out = NULL;
-        }
-    }
-    Py_XDECREF(out);
-    Py_XDECREF(h);
-    Py_XDECREF(v);
-    Py_DECREF(kin);
-    Py_DECREF(rims);
-    return result;
-}
-
 static PyMethodDef methods[] = {
     {"gather", (PyCFunction)(void (*)(void))gather, METH_FASTCALL,
      "gather(ports, positions, values, own) -> dict: a component's inputs from the store "
      "(own[at] first where own has it)."},
-    {"pose", (PyCFunction)(void (*)(void))pose, METH_FASTCALL,
-     "pose(kinematics, rims) -> dict or None: a robot's pose outputs from its rover's readers "
-     "(None: not six and two floats; the Python pose runs)."},
     {"publish", (PyCFunction)(void (*)(void))publish, METH_FASTCALL,
      "publish(out, targets, values) -> bool: write a component's float outputs into the "
      "store; False: let the Python loop judge them."},
@@ -528,14 +435,6 @@ PyMODINIT_FUNC PyInit__publish(void) {
     tolist_name = PyUnicode_InternFromString("tolist");
     if (do_step_name == NULL || tolist_name == NULL) {
         return NULL;
-    }
-    const char *names[7] = {"posX",    "posY",        "heading",    "speed",
-                            "yawRate", "wheelSpeedL", "wheelSpeedR"};
-    for (int i = 0; i < 7; i++) {
-        pose_keys[i] = PyUnicode_InternFromString(names[i]);
-        if (pose_keys[i] == NULL) {
-            return NULL;
-        }
     }
     PyObject *m = PyModule_Create(&module);
     if (m == NULL) {

@@ -8,9 +8,8 @@ values written, the same faults raised, only sooner. ``Scalar`` is the scalar st
 (gather, ``do_step``, publish) as a C callable, so a component's step has no Python frame
 of the engine's around it; what ``do_step`` raises and what ``publish`` declines go back to
 Python functions that raise the Python step's faults. ``Drawn`` is ``engine/rng.py``'s
-block-drawn random stream as a C callable, ``pose`` a robot's pose outputs
-(``physics/robots.py``). ``AMSA_PHYS_PURE=1`` (the switch of the pure physics step too) or a
-build without a C compiler runs the Python loops alone.
+block-drawn random stream as a C callable. ``AMSA_PHYS_PURE=1`` (the switch of the pure
+physics step too) or a build without a C compiler runs the Python loops alone.
 """
 
 from __future__ import annotations
@@ -50,13 +49,6 @@ def drawn() -> Any:
     """The compiled ``Drawn`` (``engine/rng.py``'s, in C), or None."""
     module = _extension()
     return None if module is None else module.Drawn
-
-
-def pose() -> Any:
-    """``pose(kinematics, rims)``: a robot's pose outputs in C (``physics/robots.py``), or
-    None."""
-    module = _extension()
-    return None if module is None else module.pose
 
 
 def _extension() -> Any:

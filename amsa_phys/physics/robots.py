@@ -15,7 +15,6 @@ from typing import Any
 
 import numpy as np
 
-from ..engine import publish
 from ..model.template import Kind, Port, Template
 from .power import POWER_NAMES, POWER_PARAMS, PowerSupply, power_on
 from .rover import DiffDriveRover
@@ -64,13 +63,9 @@ class Robot(Template):
         """Refuse a geometry statics cannot stand on (``check_geometry``)."""
         check_geometry(values)
 
-    #: the compiled pose (``engine/_publish.c``'s ``pose``), or None: the Python one
-    _c_pose: Any = None
-
     def initialize(self, ctx: Any) -> None:
         self.physics = physics_of(ctx)
         self.rover = self.physics.add_rover(self.path, self.p)
-        self._c_pose = publish.pose()
 
     def on_param_change(self, name: str, value: Any) -> None:
         if name in WHEEL_PARAMS:
@@ -83,11 +78,6 @@ class Robot(Template):
         # rover.kinematics() and rover.wheel_speeds() without their frames: the readers
         # the physics world attached (the C step's own), called straight
         source, rims = rover._source, rover._rims
-        c_pose = self._c_pose
-        if c_pose is not None and source is not None and rims is not None:
-            out = c_pose(source, rims)  # this very dict, in C (None: not plain floats)
-            if out is not None:
-                return out  # type: ignore[no-any-return]
         x, y, a, vx, vy, w = source() if source is not None else rover.kinematics()
         left, right = rims() if rims is not None else (0.0, 0.0)
         return {
