@@ -240,7 +240,16 @@ class FreeRobot(Robot):
             return cruise * self.speed_factor, cruise * self.speed_factor
         if b == 5:
             return self._waypoints(cruise)
-        return self._steer(cruise * self.speed_factor, self.target_heading)
+        # self._steer(cruise * self.speed_factor, self.target_heading), inlined: behaviour 4
+        # steers at every step; the rover's state read through the C step's own reader
+        rover = self.rover
+        source = rover._source
+        angle = (source() if source is not None else rover.kinematics())[2]
+        err = (self.target_heading - angle + _PI) % _TWO_PI - _PI
+        diff = p.steerGain * err
+        cos = _cos(err)
+        forward = cruise * self.speed_factor * (cos if cos > 0.0 else 0.0)
+        return forward - diff, forward + diff
 
     def _circle(self, cruise: float, radius: float) -> tuple[float, float]:
         """Wheel powers for a circle of ``radius`` at the cruise speed, from the rover's own
