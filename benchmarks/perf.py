@@ -467,6 +467,8 @@ TARGETS: dict[str, Callable[[int], None]] = {
     "falsify_peers": lambda reps: _bench("bench_falsify_peers").perf(reps, report),
     # the physics page's fidelity figures: skid convergence, drifts vs the tyre law, turns
     "fidelity": lambda reps: _bench("bench_fidelity").perf(reps, report),
+    # where the time goes: each part's share of the single env's and ap.run's CPU (INFO)
+    "profile": lambda reps: _bench("profile_loop").perf(reps, report),
     # the test suite's tiers (once each) and the exported MDE package's build
     "suite": lambda reps: _bench("bench_suite").perf(reps, report, **SUITE),
 }

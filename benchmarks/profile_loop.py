@@ -31,6 +31,10 @@ read them as near the cost, the parts as the cost. The timer fires at the kernel
 best (often every 4 ms): the loops are long enough for a thousand samples or more. The
 shares are of the samples in the measured loop; the CPU time beside them is that share of
 the loop's measured CPU time per step (or per run).
+
+``python -m benchmarks.perf --save --only profile`` profiles both targets ``--reps`` times and
+writes each part's share to ``benchmarks/results/perf.json``; the manual's "Where the time
+goes" table is generated from there (:func:`perf`).
 """
 
 from __future__ import annotations
@@ -39,9 +43,11 @@ import argparse
 import collections
 import os
 import signal
+import statistics
 import sys
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
 
@@ -153,34 +159,104 @@ def run_loop(runs: int) -> tuple[Callable[[], None], str, int]:
     return loop, "run", runs
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("target", choices=["gym", "run"])
-    parser.add_argument("--count", type=int, help="env steps (gym, 40000) or runs (run, 20)")
-    parser.add_argument("--interval", type=float, default=0.5, help="ms of CPU between samples")
-    parser.add_argument("--top", type=int, default=15, help="hottest lines listed")
-    args = parser.parse_args(argv)
+#: what each target measures by default, and its unit of CPU time
+COUNTS = {"gym": 100_000, "run": 40}
+SCALE = {"gym": ("env step", "µs", 1e6), "run": ("run", "ms", 1e3)}
+#: the parts in the order a table lists them
+PARTS = (
+    "physics step (C)",
+    "components",
+    "engine loop",
+    "log and trace",
+    "gym env",
+    "gymnasium",
+    "reset and build",
+    "other",
+)
+
+
+@dataclass
+class Profile:
+    """One profiled loop: CPU per unit (in its scale) and the samples by part and line."""
+
+    target: str
+    count: int
+    per: float
+    parts: collections.Counter[str]
+    lines: collections.Counter[str]
+
+    @property
+    def total(self) -> int:
+        return sum(self.parts.values()) or 1
+
+    def share(self, part: str) -> float:
+        """``part``'s share of the samples, in percent."""
+        return 100 * self.parts[part] / self.total
+
+
+def profile(target: str, count: int | None = None, interval_ms: float = 0.5) -> Profile:
+    """Profile ``target`` (``gym`` or ``run``) over ``count`` env steps or runs."""
     import amsa_phys
 
     global PACKAGE
     PACKAGE = str(Path(amsa_phys.__file__).resolve().parent) + os.sep
-    make = gym_loop if args.target == "gym" else run_loop
-    count = args.count or (100_000 if args.target == "gym" else 40)
-    loop, unit, n = make(count)
-    sampler = Sampler(args.interval / 1000)
+    make = gym_loop if target == "gym" else run_loop
+    loop, _unit, n = make(count or COUNTS[target])
+    sampler = Sampler(interval_ms / 1000)
     cpu = time.process_time()
     with sampler:
         loop()
     cpu = time.process_time() - cpu
-    total = sum(sampler.parts.values()) or 1
-    per = cpu / n * (1e6 if args.target == "gym" else 1e3)
-    scale = "us" if args.target == "gym" else "ms"
-    print(f"{args.target}: {n} x {unit}, {per:.1f} {scale} CPU per {unit}, {total} samples")
+    return Profile(target, n, cpu / n * SCALE[target][2], sampler.parts, sampler.lines)
+
+
+def perf(reps: int, report: Callable[[str, str, str, bool | None], None]) -> None:
+    """The ``profile`` target of ``benchmarks/perf.py``: each part's share of the CPU of the
+    single env's step and of ``amsa_phys.run``'s loop, median over ``reps`` profiles, with
+    that share of the CPU time per env step (per run) beside it. Figures without an aim
+    (INFO): where the time goes, for the docs' "Where the time goes"."""
+    for target in ("gym", "run"):
+        unit, scale, _ = SCALE[target]
+        runs = [profile(target, COUNTS[target] // 2) for _ in range(reps)]
+        per = [r.per for r in runs]
+        report(f"{target}: CPU per {unit}, {scale}", _med(per), "", None)
+        mid = statistics.median(per)
+        for part in PARTS:
+            shares = [r.share(part) for r in runs]
+            if not any(shares):
+                continue
+            cost = mid * statistics.median(shares) / 100
+            report(
+                f"{target}: {part}, % of CPU",
+                f"{_med(shares)}; {cost:.3g} {scale} per {unit}",
+                "",
+                None,
+            )
+
+
+def _med(xs: list[float]) -> str:
+    """``median (min a, max b)``, as ``perf.med`` (``results.py`` parses it)."""
+    return f"{statistics.median(xs):.4g} (min {min(xs):.4g}, max {max(xs):.4g})"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("target", choices=["gym", "run"])
+    parser.add_argument("--count", type=int, help="env steps (gym, 100000) or runs (run, 40)")
+    parser.add_argument("--interval", type=float, default=0.5, help="ms of CPU between samples")
+    parser.add_argument("--top", type=int, default=15, help="hottest lines listed")
+    args = parser.parse_args(argv)
+    prof = profile(args.target, args.count, args.interval)
+    unit, scale, _ = SCALE[args.target]
+    per, total = prof.per, prof.total
+    print(
+        f"{args.target}: {prof.count} x {unit}, {per:.1f} {scale} CPU per {unit}, {total} samples"
+    )
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
-    for part, k in sampler.parts.most_common():
+    for part, k in prof.parts.most_common():
         print(f"  {100 * k / total:5.1f} %  {per * k / total:8.2f} {scale}  {part}")
     print(f"hottest lines ({args.top}):")
-    for line, k in sampler.lines.most_common(args.top):
+    for line, k in prof.lines.most_common(args.top):
         print(f"  {100 * k / total:5.1f} %  {line}")
     return 0
 

@@ -113,7 +113,10 @@ class FollowerController(Template):
             # no distance measured yet (or the rovers touch): command nothing
             return {"LeftPower": 0.0, "RightPower": 0.0, "leaderSpeed": self.v_leader}
         xl, yl = inp["xLeader"], inp["yLeader"]
-        self._update_speed(float(t), xl, yl)
+        # float(t) without ``Fraction.__float__``'s calls (numerator / denominator, as it does)
+        self._update_speed(
+            t._numerator / t._denominator if t.__class__ is Fraction else float(t), xl, yl
+        )
         dx = xl - inp["xFollower"]
         dy = yl - inp["yFollower"]
         alpha = math.atan2(dy, dx) - inp["headingFollower"]

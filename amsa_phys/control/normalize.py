@@ -53,11 +53,17 @@ class NormalizePower(Template):
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
         """The paper's doStep: clamp, then scale."""
-        lo, hi = self.p.powerMin, self.p.powerMax
-        k = self.p.motorCoef * 0.01
+        p = self.p
+        lo, hi = p.powerMin, p.powerMax
+        k = p.motorCoef * 0.01
+        # min(hi, max(lo, v)) as comparisons (the builtins' calls were most of the step):
+        # max(lo, v) is v only if v > lo, min(hi, m) is m only if m < hi; NaN gives lo
+        left, right = inp["powerL"], inp["powerR"]
+        left = left if left > lo else lo
+        right = right if right > lo else lo
         return {
-            "normalizedPowerL": min(hi, max(lo, inp["powerL"])) * k,
-            "normalizedPowerR": min(hi, max(lo, inp["powerR"])) * k,
+            "normalizedPowerL": (left if left < hi else hi) * k,
+            "normalizedPowerR": (right if right < hi else hi) * k,
         }
 
     @classmethod

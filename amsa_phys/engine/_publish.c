@@ -28,6 +28,7 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <structmember.h>
 
 /* 1: every item of ``out`` written; 0: declined (the Python loop judges) */
 static int publish_into(PyObject *out, PyObject *targets, PyObject *values) {
@@ -279,6 +280,137 @@ static PyTypeObject ScalarType = {
     .tp_call = (ternaryfunc)Scalar_call,
 };
 
+/* Drawn(draw, block=64): the next number of one random stream at each call, drawn from numpy
+ * ``block`` at a time: ``engine/rng.py``'s ``Drawn`` (its docstring says why), as a C
+ * callable. Same numbers, same order: the block is ``draw(block).tolist()`` and each call
+ * hands out its next float object. A sensor draws a handful a step; a Python ``__call__``
+ * cost ~0.15 us of each, this a fraction of that. */
+typedef struct {
+    PyObject_HEAD
+    PyObject *draw;  /* the stream's method, e.g. a Generator's standard_normal */
+    PyObject *block; /* the block size, as passed */
+    PyObject *buf;   /* the current block as a list of floats, or NULL before the first */
+    Py_ssize_t pos;  /* the next number's index in buf */
+} Drawn;
+
+static PyObject *tolist_name = NULL;
+
+static int Drawn_init(Drawn *self, PyObject *args, PyObject *kw) {
+    static char *names[] = {"draw", "block", NULL};
+    PyObject *draw, *block = NULL;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|O!:Drawn", names, &draw, &PyLong_Type,
+                                     &block)) {
+        return -1;
+    }
+    if (block == NULL) {
+        block = PyLong_FromLong(64);
+        if (block == NULL) {
+            return -1;
+        }
+    } else {
+        Py_INCREF(block);
+    }
+    Py_ssize_t n = PyLong_AsSsize_t(block);
+    if (n < 1) {
+        Py_DECREF(block);
+        if (!PyErr_Occurred()) {
+            PyErr_SetString(PyExc_ValueError, "Drawn: block must be at least 1");
+        }
+        return -1;
+    }
+    Py_INCREF(draw);
+    Py_XSETREF(self->draw, draw);
+    Py_XSETREF(self->block, block);
+    Py_CLEAR(self->buf);
+    self->pos = 0;
+    return 0;
+}
+
+static int Drawn_traverse(Drawn *self, visitproc visit, void *arg) {
+    Py_VISIT(self->draw);
+    Py_VISIT(self->block);
+    Py_VISIT(self->buf);
+    return 0;
+}
+
+static int Drawn_clear(Drawn *self) {
+    Py_CLEAR(self->draw);
+    Py_CLEAR(self->block);
+    Py_CLEAR(self->buf);
+    return 0;
+}
+
+static void Drawn_dealloc(Drawn *self) {
+    PyObject_GC_UnTrack(self);
+    Drawn_clear(self);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static PyObject *Drawn_call(Drawn *self, PyObject *args, PyObject *kw) {
+    if ((kw != NULL && PyDict_GET_SIZE(kw)) || PyTuple_GET_SIZE(args) != 0) {
+        PyErr_SetString(PyExc_TypeError, "Drawn() takes no arguments");
+        return NULL;
+    }
+    if (self->draw == NULL) {
+        PyErr_SetString(PyExc_TypeError, "Drawn not initialised");
+        return NULL;
+    }
+    if (self->buf == NULL || self->pos >= PyList_GET_SIZE(self->buf)) {
+        PyObject *arr = PyObject_CallOneArg(self->draw, self->block);
+        if (arr == NULL) {
+            return NULL;
+        }
+        PyObject *list = PyObject_CallMethodNoArgs(arr, tolist_name);
+        Py_DECREF(arr);
+        if (list == NULL) {
+            return NULL;
+        }
+        if (!PyList_CheckExact(list) || PyList_GET_SIZE(list) == 0) {
+            Py_DECREF(list);
+            PyErr_SetString(PyExc_ValueError, "Drawn: the draw gave no numbers");
+            return NULL;
+        }
+        Py_XSETREF(self->buf, list);
+        self->pos = 0;
+    }
+    PyObject *value = PyList_GET_ITEM(self->buf, self->pos);
+    self->pos++;
+    Py_INCREF(value);
+    return value;
+}
+
+static PyObject *Drawn_fresh(Drawn *self, void *closure) {
+    (void)closure;
+    return PyBool_FromLong(self->buf == NULL);
+}
+
+static PyMemberDef Drawn_members[] = {
+    {"_draw", T_OBJECT, offsetof(Drawn, draw), READONLY, "the stream's draw(n)"},
+    {"_block", T_OBJECT, offsetof(Drawn, block), READONLY, "numbers drawn at a time"},
+    {NULL, 0, 0, 0, NULL},
+};
+
+static PyGetSetDef Drawn_getset[] = {
+    {"fresh", (getter)Drawn_fresh, NULL,
+     "Whether nothing was drawn yet (a group may then take the stream over).", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
+static PyTypeObject DrawnType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "amsa_phys.engine._publish.Drawn",
+    .tp_basicsize = sizeof(Drawn),
+    .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_HAVE_GC,
+    .tp_doc = "Drawn(draw, block=64)() -> the stream's next number (engine/rng.py).",
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)Drawn_init,
+    .tp_dealloc = (destructor)Drawn_dealloc,
+    .tp_traverse = (traverseproc)Drawn_traverse,
+    .tp_clear = (inquiry)Drawn_clear,
+    .tp_call = (ternaryfunc)Drawn_call,
+    .tp_members = Drawn_members,
+    .tp_getset = Drawn_getset,
+};
+
 static PyMethodDef methods[] = {
     {"gather", (PyCFunction)(void (*)(void))gather, METH_FASTCALL,
      "gather(ports, positions, values, own) -> dict: a component's inputs from the store "
@@ -296,11 +428,12 @@ static struct PyModuleDef module = {
 };
 
 PyMODINIT_FUNC PyInit__publish(void) {
-    if (PyType_Ready(&ScalarType) < 0) {
+    if (PyType_Ready(&ScalarType) < 0 || PyType_Ready(&DrawnType) < 0) {
         return NULL;
     }
     do_step_name = PyUnicode_InternFromString("do_step");
-    if (do_step_name == NULL) {
+    tolist_name = PyUnicode_InternFromString("tolist");
+    if (do_step_name == NULL || tolist_name == NULL) {
         return NULL;
     }
     PyObject *m = PyModule_Create(&module);
@@ -310,6 +443,12 @@ PyMODINIT_FUNC PyInit__publish(void) {
     Py_INCREF(&ScalarType);
     if (PyModule_AddObject(m, "Scalar", (PyObject *)&ScalarType) < 0) {
         Py_DECREF(&ScalarType);
+        Py_DECREF(m);
+        return NULL;
+    }
+    Py_INCREF(&DrawnType);
+    if (PyModule_AddObject(m, "Drawn", (PyObject *)&DrawnType) < 0) {
+        Py_DECREF(&DrawnType);
         Py_DECREF(m);
         return NULL;
     }

@@ -43,8 +43,17 @@ class Context:
         self.path = path
         #: the run of a batch the component belongs to (``multirun.py``); 0 alone
         self.run = run
-        self.rng = component_rng(sim.seed, path)
         self.world = sim.world
+
+    def __getattr__(self, name: str) -> Any:
+        """``rng``, made at its first use: the stream depends on the seed and the path
+        alone, so it is the same whenever it is made, and a component that draws nothing
+        (a robot, a monitor, an actuator) costs no Generator (a Gymnasium reset makes every
+        component's context again)."""
+        if name == "rng":
+            self.rng = rng = component_rng(self._sim.seed, self.path)
+            return rng
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     def shared(self, name: str, factory: Callable[[Simulation], Any]) -> Any:
         """The run's shared service ``name``, created by ``factory(sim)`` the first time."""

@@ -7,8 +7,9 @@ declines everything else, which the Python loop then judges (``tasks.py``): the 
 values written, the same faults raised, only sooner. ``Scalar`` is the scalar step itself
 (gather, ``do_step``, publish) as a C callable, so a component's step has no Python frame
 of the engine's around it; what ``do_step`` raises and what ``publish`` declines go back to
-Python functions that raise the Python step's faults. ``AMSA_PHYS_PURE=1`` (the switch of
-the pure physics step too) or a build without a C compiler runs the Python loops alone.
+Python functions that raise the Python step's faults. ``Drawn`` is ``engine/rng.py``'s
+block-drawn random stream as a C callable. ``AMSA_PHYS_PURE=1`` (the switch of the pure
+physics step too) or a build without a C compiler runs the Python loops alone.
 """
 
 from __future__ import annotations
@@ -42,6 +43,12 @@ def scalar() -> Any:
     faults and declined outputs handed back to Python), or None."""
     module = _extension()
     return None if module is None else module.Scalar
+
+
+def drawn() -> Any:
+    """The compiled ``Drawn`` (``engine/rng.py``'s, in C), or None."""
+    module = _extension()
+    return None if module is None else module.Drawn
 
 
 def _extension() -> Any:

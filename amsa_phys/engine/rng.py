@@ -13,6 +13,8 @@ from typing import Any
 
 import numpy as np
 
+from . import publish
+
 
 def component_rng(seed: int, path: str) -> np.random.Generator:
     """The Generator for ``path`` under scenario ``seed``."""
@@ -41,6 +43,14 @@ class Drawn:
     the stream alone, so it is the same whatever else the component does between draws.
     ``draw(n)`` returns the next ``n`` numbers, e.g. ``rng.standard_normal``.
     """
+
+    def __new__(cls, draw: Callable[[int], np.ndarray], block: int = 64) -> Any:
+        """The compiled ``Drawn`` where built (``_publish.c``: the same numbers, a call a
+        fraction of this class's ``__call__``), this class on the pure path."""
+        fast = publish.drawn() if cls is Drawn else None
+        if fast is not None:
+            return fast(draw, block)
+        return super().__new__(cls)
 
     def __init__(self, draw: Callable[[int], np.ndarray], block: int = 64) -> None:
         self._draw = draw

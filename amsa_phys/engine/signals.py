@@ -3,7 +3,7 @@
 A requirement reads a few signals (``Component.output``) of every logged instant; the trace
 file has them too, but a sweep or a falsification writes no trace, and the batched engine's
 runs share one store. This listener copies the named buffers of every run out of the store
-at each logged instant (one fancy-indexed copy, as the quality samples are taken), so a
+at each logged instant (one fancy-indexed copy, appended to one flat array of doubles), so a
 requirement is judged the same way whatever the executor.
 """
 
@@ -25,26 +25,33 @@ class SignalSampler:
         self.runs = runs
         self._where = np.array([at(n, r) for n in self.names for r in range(runs)], dtype=np.intp)
         self._t = array("d")
-        self._rows: list[np.ndarray] = []
+        #: every sample, flat: ``len(names) * runs`` doubles per logged instant. A numpy
+        #: array per instant cost ~100 bytes of object header for a few doubles of data,
+        #: and was what grew with a run's length (a 1-hour run's peak memory)
+        self._flat = array("d")
 
     def listener(self, col: np.ndarray) -> Callable[[float, Any], None]:
         """The log listener reading ``col`` (the store's array)."""
+        take = col.take
         where = self._where
-        rows = self._rows
+        extend = self._flat.frombytes
         times = self._t
 
         def sample(t_s: float, _values: Any) -> None:
-            rows.append(col[where])  # fancy indexing copies
+            extend(take(where).tobytes())  # the same doubles, appended as they are
             times.append(t_s)
 
         return sample
 
     def table(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """The logged instants and each signal as a ``(samples, runs)`` array."""
-        n = min(len(self._t), len(self._rows))  # equal even if Ctrl-C fell between appends
+        width = len(self._where)
+        n = len(self._t)
+        if width:  # equal even if Ctrl-C fell between the two appends
+            n = min(n, len(self._flat) // width)
         t = np.array(self._t[:n], dtype=np.float64)
         shape = (n, len(self.names), self.runs)
-        data = np.array(self._rows[:n], dtype=np.float64).reshape(shape)
+        data = np.array(self._flat[: n * width], dtype=np.float64).reshape(shape)
         return t, {name: data[:, k, :] for k, name in enumerate(self.names)}
 
 

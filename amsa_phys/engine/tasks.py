@@ -15,11 +15,13 @@ the delivery heap), a Leaf with array ports, and a group of like copies stepped 
   loop inlined, because the call alone cost ~2 % of a headless run (CPU time, measured);
   it uses the same exception set and message, and ``tests/engine/test_tasks.py`` holds the
   two to the same verdict on every kind of bad output.
+
+The exception sets and the fault messages live in ``verdicts.py`` (re-exported here); a
+delayed Leaf's packed step in ``delayedstep.py``.
 """
 
 from __future__ import annotations
 
-import math
 from array import array
 from collections.abc import Callable, Mapping, MutableMapping
 from dataclasses import dataclass, field
@@ -32,17 +34,16 @@ from ..errors import RunFault
 from ..model.params import short_repr
 from ..model.template import Template
 from . import batch, interrupt, publish
+from .delayedstep import packed_delayed
 from .timing import DelayLine
-
-#: What a component's code may raise that is its fault, not the engine's: any exception,
-#: and ``sys.exit()`` (SystemExit), which would otherwise end the whole program with its
-#: code and no message. KeyboardInterrupt is the user's and stays one.
-COMPONENT_ERRORS = (Exception, SystemExit)
-
-#: What judging a published output may raise: not a mapping (AttributeError: no ``items``),
-#: an unknown port (KeyError), not a number (TypeError, ValueError), too large for a float
-#: (OverflowError), or not finite (ValueError, raised here).
-OUTPUT_ERRORS = (KeyError, TypeError, ValueError, OverflowError, AttributeError)
+from .verdicts import (
+    COMPONENT_ERRORS,
+    OUTPUT_ERRORS,
+    as_number,
+    bad_output,
+    in_run,
+    own_interrupt,
+)
 
 
 @dataclass
@@ -111,49 +112,6 @@ def checked_writes(
             into[targets[key]] = number
     except OUTPUT_ERRORS:
         raise bad_output(who(task.path), now, targets, out) from None
-
-
-def as_number(value: Any) -> float:
-    """An output's value as a float: a number (bool and numpy's too), never text (``float``
-    alone would take ``"10"`` and ``b"nan"``: the documented contract is a mapping of numbers)."""
-    if isinstance(value, str | bytes | bytearray):
-        raise TypeError("text is not a number")
-    return float(value)
-
-
-def own_interrupt(who: str, now: Fraction) -> RunFault:
-    """The fault for a KeyboardInterrupt a component raised itself. One out of a step is the
-    user's only if :mod:`.interrupt` noted a Ctrl-C or SIGTERM (or nobody defers them, so it
-    cannot tell); otherwise it is the component's, a fault like any exception it raises."""
-    return RunFault(who, now, "raised KeyboardInterrupt() itself (not a Ctrl-C: a fault)")
-
-
-def in_run(fault: RunFault, run: int | None) -> RunFault:
-    """``fault`` marked as run ``run``'s, unless already marked: a batch (``multirun.py``)
-    makes that run alone, which says what went wrong; unmarked, no one run is to blame."""
-    if getattr(fault, "run", None) is None:
-        fault.run = run  # type: ignore[attr-defined]
-    return fault
-
-
-def bad_output(who: str, now: Fraction, targets: Mapping[str, Any], out: Any) -> RunFault:
-    """The fault for the first output :func:`checked_writes` refused (a slow path)."""
-    if not isinstance(out, Mapping):
-        return RunFault(
-            who, now, f"do_step must return a mapping of outputs, got {short_repr(out)}"
-        )
-    for key, value in out.items():
-        if key not in targets:
-            return RunFault(who, now, f"published unknown output {short_repr(key)}")
-        try:
-            number = as_number(value)
-        except OverflowError:
-            return RunFault(who, now, f"output {key} is too large for a float")
-        except (TypeError, ValueError):
-            return RunFault(who, now, f"output {key} is not a number: {short_repr(value)}")
-        if not math.isfinite(number):
-            return RunFault(who, now, f"output {key} is {number}")
-    return RunFault(who, now, f"published invalid outputs {dict(out)!r}")
 
 
 def _is_mask(published: Any, n: int) -> bool:
@@ -329,17 +287,13 @@ class Steppers:
             raise bad_output(self.who(task.path), now, targets, out) from None
 
     def delayed(self, task: Task) -> Callable[[Task, Fraction], None]:
-        """:meth:`step_delayed` for ``task``, its inputs gathered in C (``publish.py``)."""
+        """:meth:`step_delayed` for ``task``, its inputs gathered in C (``publish.py``), in
+        one frame (``delayedstep.py``)."""
         take = self._gather
         if take is None:
             return self.step_delayed
         ports, ats = tuple(p for p, _ in task.reads), tuple(a for _, a in task.reads)
-        values, own, then = self.values, task.own, self._delayed
-
-        def step(_task: Task, now: Fraction) -> None:
-            then(task, now, take(ports, ats, values, own))
-
-        return step
+        return packed_delayed(self, task, take, ports, ats)
 
     def step_delayed(self, task: Task, now: Fraction) -> None:
         """:meth:`step` for a Leaf with latency or jitter: its outputs go into its delay

@@ -75,8 +75,11 @@ class Robot(Template):
 
     def _pose(self) -> dict[str, float]:
         rover = self.rover
-        x, y, a, vx, vy, w = rover.kinematics()
-        left, right = rover.wheel_speeds()
+        # rover.kinematics() and rover.wheel_speeds() without their frames: the readers
+        # the physics world attached (the C step's own), called straight
+        source, rims = rover._source, rover._rims
+        x, y, a, vx, vy, w = source() if source is not None else rover.kinematics()
+        left, right = rims() if rims is not None else (0.0, 0.0)
         return {
             "posX": x,
             "posY": y,
