@@ -149,6 +149,9 @@ def _motor(rng: np.random.Generator) -> Case:
         params.update(maxSpeed=5.5, frictionPower=2.9, timeConstant=10.0, minPower=3.0)
     params["edge"] = float(rng.uniform(0.01, 8.0)) if rng.random() < 0.5 else 4.0
     params["maxShare"] = float(rng.choice([1.15, 1.0, rng.uniform(1.0, 3.0)]))
+    # the held estimate's decaying confidence, and how much cancelling out ends it
+    params["validHold"] = float(rng.choice([0.0, 20.0, rng.uniform(0.5, 60.0)]))
+    params["holdReverse"] = float(rng.choice([1.0, 0.4, rng.uniform(0.0, 1.0)]))
     times = _times(rng, params["window"] + rng.uniform(5, 60))
     # commands about a level, sometimes reversing or too small; speed from a delivered share
     level = float(rng.choice([rng.uniform(5, 40), rng.uniform(0, 4)]))
@@ -157,9 +160,12 @@ def _motor(rng: np.random.Generator) -> Case:
     speed = max(0.0, delivered * (level - params["frictionPower"]) * params["maxSpeed"] / 100)
     fixes = _track(rng, times, speed, float(rng.choice([0.0, 0.015, 0.02])))
     stops = rng.random() < 0.2  # now and then a command of exactly zero: not forward
+    late = rng.random() < 0.4  # forward first, reversing once the window is full (the hold)
     inputs = []
     for t, (x, y) in zip(times, fixes, strict=True):
         wave = swing * np.sin(0.3 * float(t))
+        if late and float(t) < params["window"]:
+            wave = 0.0
         left = level + wave + rng.normal(0, 1.0)
         right = level + wave + rng.normal(0, 1.0)
         if stops and rng.random() < 0.02:

@@ -45,6 +45,18 @@ class MotorMonitor(Template):
     ``maxShare`` is physically impossible (motors deliver at most what is commanded), so it
     is invalid too. While invalid, ``delivered`` holds the last valid estimate; a valid one
     between 1 and ``maxShare`` (noise about healthy motors) is published as 1.
+
+    A window that cancels out is not evidence against the last valid estimate: a follower
+    whose leader stops backs off for a few seconds whatever its motors, and a right gain
+    does so as often as a wrong one. With ``validHold`` > 0 the confidence in the held
+    estimate decays, from 1 to 0 over ``validHold`` seconds since the last valid window,
+    instead of dropping to 0 at once (a rule waiting for ``valid`` below 0.5 fires half the
+    hold later). A loop that oscillates for good never yields a valid window again, so its
+    confidence still runs out; 0 (the default) drops it at once. How much cancels out tells
+    the two apart sooner, though not cleanly: in the held-out runs of docs/adaptation.md a
+    right gain backing off after its leader stops cancelled up to 0.37 of a 30 s window's
+    command, a wrong one oscillating 0.15 to 1. A window where more than ``holdReverse``
+    cancels out ends the hold at once (the confidence is 0 until the next valid window).
     """
 
     batchable = True  # each run's copy steps alone in a batch (no step_many needed)
@@ -129,6 +141,24 @@ class MotorMonitor(Template):
             10.0,
             "",
         ),
+        Param(
+            "validHold",
+            "float",
+            "time over which the confidence in the last valid estimate decays to 0",
+            0.0,
+            0.0,
+            600.0,
+            "s",
+        ),
+        Param(
+            "holdReverse",
+            "float",
+            "cancelling-out share of the window's command that ends validHold at once (1: never)",
+            1.0,
+            0.0,
+            1.0,
+            "",
+        ),
     )
     estimates = (Estimates("delivered", "motorCoef", ("NormalizePower",), scale=0.01),)
 
@@ -139,6 +169,7 @@ class MotorMonitor(Template):
         self.fix: tuple[float, float, float] | None = None
         self.estimate = 1.0
         self.valid = 0.0
+        self.valid_at: float | None = None  # when the last valid window ended
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
         """The paper's doStep: add the command and (every ``spacing`` s) the path, estimate."""
@@ -170,6 +201,11 @@ class MotorMonitor(Template):
                 if share <= p.maxShare:
                     self.estimate = min(share, 1.0)
                     self.valid = 1.0
+                    self.valid_at = now
+            if p.holdReverse < 1.0 and command < (1.0 - p.holdReverse) * magnitude:
+                self.valid_at = None  # oscillating: the held estimate is not to be trusted
+            if self.valid == 0.0 and self.valid_at is not None and p.validHold > 0:
+                self.valid = max(0.0, 1.0 - (now - self.valid_at) / p.validHold)
         return {"delivered": self.estimate, "valid": self.valid}
 
     def _edge_speed(self, end: int) -> float:
