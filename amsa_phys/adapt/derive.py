@@ -48,7 +48,8 @@ from typing import Any
 from ..control.estimators.watches import Watch, watches
 from ..errors import ConfigError
 from ..model.scenario import Scenario
-from .table import SweepTable, read_table
+from .grid import lowest, robust_point, safe_best
+from .table import read_table
 
 #: Default safety margin: a best point's grid neighbours may be at most this much worse.
 MARGIN = 0.5
@@ -168,7 +169,7 @@ def derive(
             name.append(str(v) if a == "context" else f"{a}={v}")
         cells[key] = Cell(", ".join(name), ctx)
     given = robust
-    robust = _robust(table, margin)
+    robust = robust_point(table, margin)
     if given is not None:
         if sorted(given) != sorted(table.tuned):
             raise ConfigError(
@@ -185,8 +186,8 @@ def derive(
     for key, cell in cells.items():
         by_point = table.stats[key]
         cell.runs = sum(s.count + s.failed for s in by_point.values())
-        safest = _safe_best(table, key, margin)
-        best = _safe_best(table, key, margin, robust, near)
+        safest = safe_best(table, key, margin)
+        best = safe_best(table, key, margin, robust, near)
         if (
             robust is not None
             and robust in by_point
@@ -201,10 +202,10 @@ def derive(
             continue
         cell.best = dict(zip(table.tuned, best, strict=True))
         cell.score = by_point[best].mean
-        lowest = _lowest(by_point)
-        if lowest is not None and lowest != best:
-            cell.unsafe = (dict(zip(table.tuned, lowest, strict=True)), by_point[lowest].mean)
-            if lowest != safest:
+        low = lowest(by_point)
+        if low is not None and low != best:
+            cell.unsafe = (dict(zip(table.tuned, low, strict=True)), by_point[low].mean)
+            if low != safest:
                 cell.why = "a neighbour is unstable or far worse"
             elif best == robust:
                 cell.why = f"less than {100 * cell_gain:g} % better than the robust point"
@@ -265,85 +266,6 @@ def _why(unplaced: Sequence[str], name: str) -> str:
 
 def _show(values: dict[str, Any]) -> str:
     return ", ".join(f"{k}={v}" for k, v in values.items())
-
-
-def _lowest(by_point: dict[tuple[Any, ...], Any]) -> tuple[Any, ...] | None:
-    """The point with the lowest seed mean among those every run of which finished."""
-    stable = [p for p, s in by_point.items() if s.stable]
-    return min(stable, key=lambda p: (by_point[p].mean, p)) if stable else None
-
-
-def _neighbours(table: SweepTable, point: tuple[Any, ...]) -> list[tuple[Any, ...]]:
-    """The grid points one step from ``point`` along each tuned axis (in any cell)."""
-    values = [sorted({p[i] for by in table.stats.values() for p in by}) for i in range(len(point))]
-    out = []
-    for i, v in enumerate(point):
-        j = values[i].index(v)
-        for k in (j - 1, j + 1):
-            if 0 <= k < len(values[i]):
-                out.append((*point[:i], values[i][k], *point[i + 1 :]))
-    return out
-
-
-def _safe(table: SweepTable, cell: tuple[Any, ...], point: tuple[Any, ...], margin: float) -> bool:
-    """``point`` finished in ``cell`` and its neighbours did, none more than ``margin`` worse."""
-    by_point = table.stats[cell]
-    here = by_point.get(point)
-    if here is None or not here.stable:
-        return False
-    for other in _neighbours(table, point):
-        near = by_point.get(other)
-        if near is None:
-            continue  # not swept in this cell: nothing known against it
-        if not near.stable or near.mean > (1.0 + margin) * here.mean:
-            return False
-    return True
-
-
-def _safe_best(
-    table: SweepTable,
-    cell: tuple[Any, ...],
-    margin: float,
-    robust: tuple[Any, ...] | None = None,
-    near: float = 0.0,
-) -> tuple[Any, ...] | None:
-    """The cell's lowest-mean safe point (None if none is safe); of the safe points within
-    ``near`` of it, the fewest grid steps from ``robust``."""
-    by_point = table.stats[cell]
-    ranked = sorted(
-        (p for p, s in by_point.items() if s.stable), key=lambda p: (by_point[p].mean, p)
-    )
-    safe = [p for p in ranked if _safe(table, cell, p, margin)]
-    if not safe or robust is None or near <= 0:
-        return safe[0] if safe else None
-    level = [p for p in safe if by_point[p].mean <= (1.0 + near) * by_point[safe[0]].mean]
-    return min(level, key=lambda p: (_steps(table, p, robust), by_point[p].mean, p))
-
-
-def _steps(table: SweepTable, a: tuple[Any, ...], b: tuple[Any, ...]) -> int:
-    """Grid steps between two points (summed over the tuned axes)."""
-    out = 0
-    for i in range(len(a)):
-        values = sorted({p[i] for by in table.stats.values() for p in by})
-        if a[i] in values and b[i] in values:
-            out += abs(values.index(a[i]) - values.index(b[i]))
-    return out
-
-
-def _robust(table: SweepTable, margin: float) -> tuple[Any, ...] | None:
-    """The point with the least worst-case seed mean over the cells (safe ones first)."""
-    cells = list(table.stats)
-    common = set.intersection(*(set(table.stats[c]) for c in cells)) if cells else set()
-    everywhere = [p for p in common if all(table.stats[c][p].stable for c in cells)]
-    if not everywhere:
-        return None
-
-    def worst(p: tuple[Any, ...]) -> tuple[float, float, tuple[Any, ...]]:
-        means = [table.stats[c][p].mean for c in cells]
-        return (max(means), statistics.fmean(means), p)
-
-    safe = [p for p in everywhere if all(_safe(table, c, p, margin) for c in cells)]
-    return min(safe or everywhere, key=worst)
 
 
 def _fallbacks(

@@ -1,7 +1,7 @@
 """Judging ``ros2:`` / ``--ros2``: which Leaves a user's ROS 2 nodes step.
 
 No ROS: the loader refuses a bad list in one line (file, line, key) before anything starts.
-Besides the names, the Leaves named are initialized once (``ros.graph.classify``) to refuse
+Besides the names, the Leaves named are initialized once (``placement.classify``) to refuse
 one that shares the physics world: a node cannot step a body. What each external Leaf's
 topics are is ``ros/external.py``'s.
 """
@@ -10,7 +10,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import numpy as np
+
 from ..errors import ConfigError
+from .placement import AloneContext, classify
 from .rosnames import BASE, RESERVED
 from .suggest import did_you_mean
 from .world import WorldSpec
@@ -57,9 +60,9 @@ def problem(world: WorldSpec, paths: Sequence[str]) -> str | None:
                     f"{path}.{port} reads {buffer}, an output of {source}, also external: "
                     "wire the two nodes to each other in ROS, or keep one of them in amsa-phys"
                 )
-    from ..ros.graph import classify  # initializes the Leaves named, and only those
-
-    bodies = classify(world, 0, paths)
+    bodies = classify(
+        world, lambda path: AloneContext(path, world, np.random.default_rng(0)), paths
+    )
     if bodies:
         return (
             f"{bodies[0]} shares the simulator's physics world (a body, a ray-cast sensor), "

@@ -16,61 +16,27 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any
 
 from ..engine.rng import component_rng
 from ..errors import ConfigError
+from ..model import placement
+from ..model.placement import AloneContext
 from ..model.world import LeafSpec, WorldSpec
 from . import names
 
 
-class NeedsSimulator(Exception):
-    """A Leaf asked for the simulator's shared services while initializing."""
-
-
-class NodeContext:
-    """What a Leaf's ``initialize`` gets in its own node: its random stream, no shared world.
-
-    ``events`` collects what the Leaf records (sent to the simulator with its next answer).
-    """
+class NodeContext(AloneContext):
+    """What a Leaf's ``initialize`` gets in its own node: the run's random stream for its
+    path, no shared world; ``events`` are sent to the simulator with its next answer."""
 
     def __init__(self, seed: int, path: str, world: WorldSpec) -> None:
-        self.path = path
-        self.rng = component_rng(seed, path)
-        self.world = world
-        self.events: list[tuple[str, str]] = []
-
-    def shared(self, name: str, factory: Any) -> Any:
-        """Shared services live in the simulator node."""
-        raise NeedsSimulator(name)
-
-    def add_hook(self, rate_hz: Any, fn: Any, name: str) -> None:
-        """Engine hooks live in the simulator node."""
-        raise NeedsSimulator(name)
-
-    def record_event(self, kind: str, detail: str) -> None:
-        """Kept until the next answer to the simulator, which records it at that instant."""
-        self.events.append((kind, detail))
+        super().__init__(path, world, component_rng(seed, path))
 
 
 def classify(world: WorldSpec, seed: int = 0, paths: Iterable[str] | None = None) -> list[str]:
     """The Leaves (of ``paths``, default all) that must run inside the simulator node, in
-    world order."""
-    wanted = None if paths is None else set(paths)
-    local = []
-    for path, leaf in world.leaves.items():
-        if wanted is not None and path not in wanted:
-            continue
-        comp = leaf.template(path, dict(leaf.params))
-        try:
-            comp.initialize(NodeContext(seed, path, world))
-        except NeedsSimulator:
-            local.append(path)
-        except Exception as exc:  # a template's own failure, reported as for a run
-            raise ConfigError(
-                f"initialize failed: {exc!r}", key=f"component {path} ({leaf.template.name()})"
-            ) from None
-    return local
+    world order (:func:`amsa_phys.model.placement.classify` with the nodes' own context)."""
+    return placement.classify(world, lambda path: NodeContext(seed, path, world), paths)
 
 
 @dataclass
