@@ -587,9 +587,10 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double t3 = fxr * ixr;
     double t4 = fyr * iyr;
     double room = d < 1.0 ? (1.0 - d) * (1.0 - d) : 0.0;
+    double ax = 0.0, gxl = 0.0, gyl = 0.0, gxr = 0.0, gyr = 0.0;
     if (xfer != 0.0 && (t1 * t1 + t2 * t2 > room || t3 * t3 + t4 * t4 > room)) {
         double cs = sloped ? sqrt(1.0 - (gax * gax + gay * gay) * p[P_INV_G2]) : 1.0;
-        double ax = xfer / cs;
+        ax = xfer / cs;
         double aa = ax > 0.0 ? ax : -ax;
         double gsum = 1.0 / ixl + 1.0 / ixr;
         double lim;
@@ -609,6 +610,10 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
         else if (k < LOAD_FLOOR)
             k = LOAD_FLOOR;
         double ik = 1.0 / k;
+        gxl = ixl;
+        gyl = iyl;
+        gxr = ixr;
+        gyr = iyr;
         ixl = ixl * ik;
         iyl = iyl * ik;
         ixr = ixr * ik;
@@ -624,8 +629,8 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     if (sat_l || sat_r) { /* forces.rover_step says why each part */
         double side0 = vy * co - vx * si;
         double cancel = neg_m_dt * side / cos(0.5 * turn);
-        const SlideIn in = {ul, vl, f0l, rl, ivl, ixl, iyl, ur, vr, f0r, rr, ivr, ixr, iyr,
-                            kx, p[P_KY], ky_dt_m, cancel, &sc};
+        SlideIn in = {ul, vl, f0l, rl, ivl, ixl, iyl, ur, vr, f0r, rr, ivr, ixr, iyr,
+                      kx, p[P_KY], ky_dt_m, cancel, &sc};
         const double grip[6] = {fxl, fyl, upl, fxr, fyr, upr};
         double o[6];
         /* the predictor: the tyre law at the step's start */
@@ -635,6 +640,18 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
         torque = (o[3] - o[0]) * h;
         torque += patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i);
         f_lat = o[1] + o[4];
+        if (ax != 0.0) { /* the load the sliding tyres' own drive force leaves */
+            double k = 1.0 - ax * fx;
+            if (k > p[P_KMAX])
+                k = p[P_KMAX];
+            else if (k < LOAD_FLOOR)
+                k = LOAD_FLOOR;
+            double ik = 1.0 / k;
+            in.ixl = gxl * ik;
+            in.iyl = gyl * ik;
+            in.ixr = gxr * ik;
+            in.iyr = gyr * ik;
+        }
         /* the sliding tyres' slip at the half step (sliding.mid_step) */
         double hub[5];
         mid_step(vx, vy, w, angle, fx * cm - f_lat * sm, fx * sm + f_lat * cm, torque, dt, dt_m,

@@ -63,6 +63,9 @@ LOAD_FLOOR = 1e-9
 #: The gripping solve runs twice a step, the second time with the hubs moved by the yaw the
 #: first one's scrub gives them (``rover_step``); the tests run a mutant with one pass.
 GRIP_PASSES = (0, 1)
+#: Whether a sliding tyre's load is the one its own drive force leaves (``rover_step``); the
+#: tests run a mutant with the gripping solve's load.
+SLIDING_LOAD = True
 
 
 class Folded(NamedTuple):
@@ -384,6 +387,7 @@ def rover_step(
     t3 = fxr * ixr
     t4 = fyr * iyr
     room = (1.0 - d) * (1.0 - d) if d < 1.0 else 0.0
+    ax = 0.0
     if xfer != 0.0 and (t1 * t1 + t2 * t2 > room or t3 * t3 + t4 * t4 > room):
         # load transfer: the drive force at the ground, below the centre of mass, moves load
         # between the drive wheels and the caster, k = N'/N = 1 - z F / (2 L N cos); the
@@ -410,6 +414,10 @@ def rover_step(
         elif k < LOAD_FLOOR:
             k = LOAD_FLOOR
         ik = 1.0 / k
+        gxl = ixl
+        gyl = iyl
+        gxr = ixr
+        gyr = iyr
         ixl = ixl * ik
         iyl = iyl * ik
         ixr = ixr * ik
@@ -439,6 +447,18 @@ def rover_step(
         torque = (fxr - fxl) * h
         torque += patch_scrub(w, torque, kphl, kphr, kphi, tl, tr, ts, dt_i)
         f_lat = fyl + fyr
+        if ax != 0.0 and SLIDING_LOAD:
+            # the load the sliding tyres' own drive force leaves the drive wheels: the
+            # gripping solve's is the force that would cancel the slip within the step
+            # (~1/dt, capped at the traction), not the one the ground gives (reference.py)
+            k = 1.0 - ax * fx
+            if k > kmax:
+                k = kmax
+            elif k < LOAD_FLOOR:
+                k = LOAD_FLOOR
+            ik = 1.0 / k
+            left = (ul, vl, f0l, rl, ivl, gxl * ik, gyl * ik, *left[7:])
+            right = (ur, vr, f0r, rr, ivr, gxr * ik, gyr * ik, *right[7:])
         # the sliding tyres' slip at the half step (sliding.mid_step): the body's velocity
         # and yaw rate moved on by half of what the predictor's forces give them, in the
         # frame of the heading half a step on; a rover spinning on ice turns under a

@@ -87,8 +87,9 @@ def reference_forces(
     # friction ellipses, on the load the drive force leaves the drive wheels
     gl, gr = wm.grip(mul), wm.grip(mur)
     inv = [1 / max(g, GRIP_FLOOR_N) for g in (*gl, *gr)]
+    raw = inv
     k = load_factor(wm, fxl + fxr, 1 / inv[0] + 1 / inv[2])
-    inv = [i / k for i in inv]
+    inv = [i / k for i in raw]
     sat = (fxl * inv[0]) ** 2 + (fyl * inv[1]) ** 2 > 1 or (fxr * inv[2]) ** 2 + (
         fyr * inv[3]
     ) ** 2 > 1
@@ -117,6 +118,11 @@ def reference_forces(
         )
         f_lat = fyl + fyr
         fx = fxl + fxr
+        # the load the sliding tyres' own drive force leaves the drive wheels
+        a_load = wm.com_height_m / (2 * wm.wheelbase_m * wm.load_n)
+        if a_load != 0:
+            k = max(LOAD_FLOOR, min(wm.half_weight_n / wm.load_n, 1 - a_load * fx))
+            inv = [i / k for i in raw]
         qx = fx * math.cos(mid) - f_lat * math.sin(mid)
         qy = fx * math.sin(mid) + f_lat * math.cos(mid)
         k = (dt, dt / rover.mass, dt / body.moment, dt * dt / (2 * body.moment), rover.half_track)

@@ -3,18 +3,21 @@
 On mu 0.1: 4 s straight at full power, 6 s spinning at -100/100 (the rover still sliding
 forward), 5 s at 60/100, 5 s at -100/-30. The final pose at 100-800 Hz against 6,400 Hz must
 shrink with order >= 0.9 (a least-squares slope over four rates), and the default rover's
-pose at 100 Hz must be within 1.2 cm and 0.025 rad. What made it: a wheel that grips beside a
+pose at 100 Hz must be within 0.8 cm and 0.0125 rad. What made it: a wheel that grips beside a
 sliding one is solved again with its hub moved by the sliding tyre's force, the scrub is solved
 again with the torque the tyres then give (before: order 0.60 in position and 0.54 in heading,
 7.5 cm and 0.136 rad at 100 Hz); the pose update is the trapezoid (``bodyio.trapezoid``: 4.8 cm
 and 0.066 rad before it, 3.6 cm and 0.059 rad after); the sliding tyres' slip is taken half a
 step on (``sliding.mid_step``), the gripping solve is run again with the hubs moved by the
 yaw the scrub gives them (``forces.GRIP_PASSES``; 1.6 cm and 0.029 rad) and a sliding tyre's
-slip is taken at its rim's mid-step speed (``sliding.slide``): 0.92 cm and 0.021 rad.
+slip is taken at its rim's mid-step speed (``sliding.slide``): 0.92 cm and 0.021 rad; a
+sliding tyre's load is the one its own drive force leaves (``forces.SLIDING_LOAD``; before,
+the gripping solve's, whose drive force is the one that would cancel the slip within the
+step): 0.66 cm and 0.0112 rad, and a 100 kg rover's plateau (8.9 cm, 0.056 rad) is gone.
 
-Not met: 0.01 rad. The rest is built while the yaw rate changes with both tyres sliding (the
-spin-up to 6 rad/s and the two turns after it); the steady spin itself is exact
-(docs/physics.md).
+Not met: 0.01 rad (0.0112). The rest is built while the yaw rate changes with both tyres
+sliding, where the moment hardly depends on the yaw rate, so a yaw-rate error made at a
+change of command or of grip is never taken back (docs/physics.md).
 """
 
 from __future__ import annotations
@@ -30,23 +33,20 @@ from rig import ON_AXLE, drive
 from amsa_phys.physics import bodyio, forces, sliding
 
 RATES = [100, 200, 400, 800]
-#: the rovers whose order is held (mass, tyres, geometry); measured position orders 1.19,
-#: 1.40, 1.01, 1.21, 1.37, heading orders 0.98, 1.08, 0.93, 1.01, 0.94
+#: the rovers whose order is held (mass, tyres, geometry); measured position orders 1.09,
+#: 1.40, 0.94, 1.10, 1.37, 1.19, heading orders 1.22, 1.11, 0.97, 1.06, 0.94, 1.02
 FAMILY = {
     "default": {},
     "light": {"mass": 10.0},
     "stiff": {"slipComplianceLongitudinal": 1e-4, "slipComplianceLateral": 1e-4},
     "soft": {"slipComplianceLongitudinal": 1.0, "slipComplianceLateral": 1.0},
     "on-axle": ON_AXLE,
-}
-#: rovers held more loosely. The heavy one (100 kg) gets closer at every rate but not with a
-#: clean order (a stick or slip event moving from one step to the next leaves a plateau):
-#: 8.9, 5.8, 3.2, 1.8 cm and 0.056, 0.032, 0.018, 0.013 rad at 100-800 Hz (11.5 cm and 0.094
-#: rad before the half-step slip). The 600 N one converges with order 1.52 in position and is
-#: 3.8 cm off at 100 Hz (0.63 m before the half-step slip), but its heading (0.114, 0.021,
-#: 0.042, 0.003 rad) does not converge monotonically: not held.
-ROUGH = {
     "heavy": {"mass": 100.0},
+}
+#: a rover held more loosely: the 600 N one converges with order 1.51 in position and is
+#: 4.3 cm off at 100 Hz (0.63 m before the half-step slip), but its heading (0.145, 0.046,
+#: 0.055, 0.0001 rad at 100-800 Hz) does not converge monotonically: not held.
+ROUGH = {
     "600 N": {"stallForce": 600.0, "freeSpeed": 6.0, "maxWheelTorque": 40.0},
 }
 
@@ -100,29 +100,25 @@ def test_a_long_low_friction_manoeuvre_converges_with_order_one(tmp_path: Path, 
     c = convergence(tmp_path, FAMILY[name])
     assert c["order"] >= 0.9, c
     assert c["heading_order"] >= 0.9, c
-    if name == "default":  # measured 0.92 cm and 0.0212 rad
-        assert c["error"] < 0.012, c
-        assert c["heading_error"] < 0.025, c
-
-
-def test_a_heavy_rover_gets_closer_with_the_rate(tmp_path: Path) -> None:
-    c = convergence(tmp_path, ROUGH["heavy"])
-    assert c["error"] < 0.1, c  # 100 Hz: measured 8.9 cm and 0.056 rad
-    assert c["heading_error"] < 0.07, c
-    assert c["errors"][-1] < c["errors"][0] / 4, c  # 800 Hz: an order of at least 2/3
-    assert c["heading_errors"][-1] < c["heading_errors"][0] / 4, c
+    if name == "default":  # measured 0.66 cm and 0.0112 rad
+        assert c["error"] < 0.008, c
+        assert c["heading_error"] < 0.0125, c
+    if name == "heavy":  # measured 0.29 cm and 0.0032 rad (8.9 cm and 0.056 rad with the
+        # gripping solve's load for a sliding tyre: a plateau, orders 0.77 and 0.73)
+        assert c["error"] < 0.01, c
+        assert c["heading_error"] < 0.01, c
 
 
 def test_a_strong_rovers_position_converges_with_order_one(tmp_path: Path) -> None:
     c = convergence(tmp_path, ROUGH["600 N"])
     assert c["order"] >= 0.9, c
-    assert c["error"] < 0.05, c  # 100 Hz: measured 3.8 cm (0.63 m with the start's slip)
+    assert c["error"] < 0.05, c  # 100 Hz: measured 4.3 cm (0.63 m with the start's slip)
 
 
 def test_mutation_with_the_sliding_slip_at_the_steps_start_the_heading_is_off(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    # the sliding tyres' slip as the step starts (no half step): measured 0.0414 rad
+    # the sliding tyres' slip as the step starts (no half step): measured 0.0314 rad
     def at_start(body, force, k):  # type: ignore[no-untyped-def]
         vx, vy, w, angle = body
         return sliding.mid_step((vx, vy, w, angle), (0.0, 0.0, 0.0), (0.0, *k[1:]))
@@ -132,13 +128,23 @@ def test_mutation_with_the_sliding_slip_at_the_steps_start_the_heading_is_off(
     assert off > 0.025, off
 
 
+def test_mutation_with_the_gripping_solves_load_for_a_sliding_tyre_the_heading_is_off(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # the sliding tyres on the load the gripping solve's drive force leaves: measured 0.36 rad
+    # (the manoeuvre itself moves: a heavy rover's plateau was this)
+    monkeypatch.setattr(forces, "SLIDING_LOAD", False)
+    off = mutant_off(tmp_path, monkeypatch)
+    assert off > 0.0125, off
+
+
 def test_mutation_without_the_scrubs_yaw_in_the_gripping_solve_the_heading_is_off(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    # the gripping solve once, its hubs not moved by the scrub: measured 0.0306 rad
+    # the gripping solve once, its hubs not moved by the scrub: measured 0.0204 rad
     monkeypatch.setattr(forces, "GRIP_PASSES", (0,))
     off = mutant_off(tmp_path, monkeypatch)
-    assert off > 0.025, off
+    assert off > 0.0125, off
 
 
 def end_speed_slide(u, v, f0, res, ivs, tyre, side, fy_cap, s):  # type: ignore[no-untyped-def]
@@ -176,19 +182,19 @@ def end_speed_slide(u, v, f0, res, ivs, tyre, side, fy_cap, s):  # type: ignore[
 def test_mutation_with_the_slip_at_the_rims_end_speed_the_heading_is_off(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    # a sliding tyre's slip at its rim's end-of-step speed: measured 0.0293 rad
+    # a sliding tyre's slip at its rim's end-of-step speed: measured 0.0215 rad
     monkeypatch.setattr(sliding, "slide", end_speed_slide)
     off = mutant_off(tmp_path, monkeypatch)
-    assert off > 0.025, off
+    assert off > 0.0125, off
 
 
 def test_mutation_with_chipmunks_first_order_pose_update_the_heading_is_off(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    # the body moved by the step's starting velocity (no trapezoid): measured 0.0302 rad
+    # the body moved by the step's starting velocity (no trapezoid): measured 0.0206 rad
     monkeypatch.setattr(bodyio, "trapezoid", lambda *args: None)
     off = mutant_off(tmp_path, monkeypatch)
-    assert off > 0.025, off
+    assert off > 0.0125, off
 
 
 @pytest.mark.slow  # the property is the quick tier's (above); this shows its check can fail
