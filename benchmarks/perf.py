@@ -593,6 +593,9 @@ def _measure(name: str, reps: int) -> bool:
     finally:
         if RECORDER is not None:
             RECORDER.save()
+            # the pages follow the file at once: a later target (the suite's tiers run the
+            # tests that hold the pages to the file) must find the tree consistent
+            results.write_pages()
     return True
 
 
