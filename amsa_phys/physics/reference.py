@@ -99,23 +99,16 @@ def reference_forces(
         # velocity within the step
         cancel = -rover.mass / dt * side / math.cos(0.5 * turn)
         grip = (fxl, fyl, upl, fxr, fyr, upr)
+        rims = ((ul, ur), hub, (f0l, f0r), (rl, rr), (sl, sr))
+
+        def slide(
+            inv: list[float], at: tuple[float, float, float, float, float] | None
+        ) -> tuple[float, float, float, float, float, float, float]:
+            return _slide_both(rover, dt, *rims, inv, grip, side0, cancel, (w, sphi, caps), at)
+
         # the tyre law at the step's start predicts the forces; the sliding tyres' slip is
         # then taken half a step on (sliding.mid_step) and the tyres solved again
-        fxl, fyl, upl, fxr, fyr, upr, torque = _slide_both(
-            rover,
-            dt,
-            (ul, ur),
-            hub,
-            (f0l, f0r),
-            (rl, rr),
-            (sl, sr),
-            inv,
-            grip,
-            side0,
-            cancel,
-            (w, sphi, caps),
-            None,
-        )
+        fxl, fyl, upl, fxr, fyr, upr, torque = slide(inv, None)
         f_lat = fyl + fyr
         fx = fxl + fxr
         # the load the sliding tyres' own drive force leaves the drive wheels
@@ -127,21 +120,7 @@ def reference_forces(
         qy = fx * math.sin(mid) + f_lat * math.cos(mid)
         k = (dt, dt / rover.mass, dt / body.moment, dt * dt / (2 * body.moment), rover.half_track)
         at_mid = mid_step((vx, vy, w, a), (qx, qy, torque), k)
-        fxl, fyl, upl, fxr, fyr, upr, torque = _slide_both(
-            rover,
-            dt,
-            (ul, ur),
-            hub,
-            (f0l, f0r),
-            (rl, rr),
-            (sl, sr),
-            inv,
-            grip,
-            side0,
-            cancel,
-            (w, sphi, caps),
-            at_mid,
-        )
+        fxl, fyl, upl, fxr, fyr, upr, torque = slide(inv, at_mid)
         fx = fxl + fxr
         f_lat = fyl + fyr
     return (
