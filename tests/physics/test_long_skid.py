@@ -115,36 +115,10 @@ def test_a_strong_rovers_position_converges_with_order_one(tmp_path: Path) -> No
     assert c["error"] < 0.05, c  # 100 Hz: measured 4.3 cm (0.63 m with the start's slip)
 
 
-def test_mutation_with_the_sliding_slip_at_the_steps_start_the_heading_is_off(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    # the sliding tyres' slip as the step starts (no half step): measured 0.0314 rad
-    def at_start(body, force, k):  # type: ignore[no-untyped-def]
-        vx, vy, w, angle = body
-        return sliding.mid_step((vx, vy, w, angle), (0.0, 0.0, 0.0), (0.0, *k[1:]))
-
-    monkeypatch.setattr(forces, "mid_step", at_start)
-    off = mutant_off(tmp_path, monkeypatch)
-    assert off > 0.025, off
-
-
-def test_mutation_with_the_gripping_solves_load_for_a_sliding_tyre_the_heading_is_off(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    # the sliding tyres on the load the gripping solve's drive force leaves: measured 0.36 rad
-    # (the manoeuvre itself moves: a heavy rover's plateau was this)
-    monkeypatch.setattr(forces, "SLIDING_LOAD", False)
-    off = mutant_off(tmp_path, monkeypatch)
-    assert off > 0.0125, off
-
-
-def test_mutation_without_the_scrubs_yaw_in_the_gripping_solve_the_heading_is_off(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    # the gripping solve once, its hubs not moved by the scrub: measured 0.0204 rad
-    monkeypatch.setattr(forces, "GRIP_PASSES", (0,))
-    off = mutant_off(tmp_path, monkeypatch)
-    assert off > 0.0125, off
+def at_start(body, force, k):  # type: ignore[no-untyped-def]
+    """The mutant of ``sliding.mid_step``: the sliding tyres' slip as the step starts."""
+    vx, vy, w, angle = body
+    return sliding.mid_step((vx, vy, w, angle), (0.0, 0.0, 0.0), (0.0, *k[1:]))
 
 
 def end_speed_slide(u, v, f0, res, ivs, tyre, side, fy_cap, s):  # type: ignore[no-untyped-def]
@@ -179,22 +153,26 @@ def end_speed_slide(u, v, f0, res, ivs, tyre, side, fy_cap, s):  # type: ignore[
     return fx, (fy_cap if abs(fy_cap) < abs(fy) else fy), up
 
 
-def test_mutation_with_the_slip_at_the_rims_end_speed_the_heading_is_off(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    # a sliding tyre's slip at its rim's end-of-step speed: measured 0.0215 rad
-    monkeypatch.setattr(sliding, "slide", end_speed_slide)
-    off = mutant_off(tmp_path, monkeypatch)
-    assert off > 0.0125, off
+#: (module, name, mutant, the least heading error it must leave at 100 Hz); measured:
+#: slip at the step's start 0.0314 rad, the gripping solve's load 0.36 rad (a heavy rover's
+#: plateau was this), one gripping pass 0.0204, the rim's end speed 0.0215, no trapezoid 0.0206
+MUTANTS = {
+    "slip at the step's start": (forces, "mid_step", at_start, 0.025),
+    "the gripping solve's load for a sliding tyre": (forces, "SLIDING_LOAD", False, 0.0125),
+    "no scrub yaw in the gripping solve": (forces, "GRIP_PASSES", (0,), 0.0125),
+    "slip at the rim's end-of-step speed": (sliding, "slide", end_speed_slide, 0.0125),
+    "Chipmunk's first-order pose update": (bodyio, "trapezoid", lambda *args: None, 0.0125),
+}
 
 
-def test_mutation_with_chipmunks_first_order_pose_update_the_heading_is_off(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+@pytest.mark.parametrize("mutant", list(MUTANTS))
+def test_each_mutant_of_the_step_puts_the_heading_off(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, mutant: str
 ) -> None:
-    # the body moved by the step's starting velocity (no trapezoid): measured 0.0206 rad
-    monkeypatch.setattr(bodyio, "trapezoid", lambda *args: None)
+    module, name, value, least = MUTANTS[mutant]
+    monkeypatch.setattr(module, name, value)
     off = mutant_off(tmp_path, monkeypatch)
-    assert off > 0.0125, off
+    assert off > least, off
 
 
 @pytest.mark.slow  # the property is the quick tier's (above); this shows its check can fail
