@@ -10,9 +10,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from sweepfiles import two_context_sweep
+
 from amsa_phys.adapt.derive import derive
 from amsa_phys.model.scenario import load_scenario
-from tests.sweepfiles import two_context_sweep
 
 
 def _best(tmp_path: Path, table: dict[tuple[str, float], float], **kw: float) -> dict[str, float]:
