@@ -145,25 +145,24 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
         inputs=tuple(input_files(scenario)),
         warnings=tuple(timeline_overlaps(swept, scenario, Fraction(str(end)))),
     )
-    if seeds > 1:
-        warn_same_seeds(plan, scenario)
+    if seeds > 1 and (same := same_seeds_warning(plan, scenario)):
+        plan.warnings += (same,)
     return plan
 
 
-def warn_same_seeds(plan: SweepPlan, scenario: Any) -> None:
-    """One line on stderr if, at some grid points, nothing random runs: their seeds are copies."""
+def same_seeds_warning(plan: SweepPlan, scenario: Any) -> str | None:
+    """A warning if, at some grid points, nothing random runs: their seeds are copies."""
     same = deterministic_points(plan, scenario)
     if not same:
-        return
+        return None
     total = 1
     for a in plan.axes:
         total *= len(a.values)
     example = ", ".join(f"{k}={v}" for k, v in same[0])
-    print(
-        f"warning: nothing random at {len(same)} of {total} grid points (e.g. {example}: no "
+    return (
+        f"nothing random at {len(same)} of {total} grid points (e.g. {example}: no "
         f"sensor noise or loss, no random leader), so their {plan.seeds} seeds give identical "
-        "runs",
-        file=sys.stderr,
+        "runs"
     )
 
 
@@ -173,8 +172,6 @@ def run(args: argparse.Namespace) -> int:
     if args.jobs is None:
         args.jobs = os.cpu_count() or 1
     plan = build_plan(args)
-    for warning in plan.warnings:
-        print(f"warning: {warning}", file=sys.stderr)
     if args.executor == "dask" and not args.scheduler:
         raise ConfigError("the Dask executor needs --scheduler ADDR", key="--executor")
     if args.jobs < 1:
@@ -188,6 +185,9 @@ def run(args: argparse.Namespace) -> int:
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-sweep")
     prepare_run_dir(out, args.force, inputs=plan.inputs)
+    # warned only once the sweep will run: a refused --out or option is the one line printed
+    for warning in plan.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
     from ..adapt.sweepdir import write_sweep_scenario  # what `adapt SWEEPDIR` reads back
 
     write_sweep_scenario(
