@@ -250,7 +250,7 @@ static void wheel_pair(const double u[2], const double v[2], const double f0[2],
 #define SLIDE_ITERATIONS 100
 
 typedef struct {
-    double u, v, f0, ivs, kx, ix, qy;
+    double u, v, f0, res, ivs, kx, ix, qy;
     const StepConstants *s;
 } Slide;
 
@@ -271,6 +271,8 @@ static double slide_excess(const Slide *w, double up, double fr)
         fm = s->f_max;
     else if (fm < -s->f_max)
         fm = -s->f_max;
+    if (up * w->u < 0.0) /* through zero within the step: the resistance's mean over the path */
+        fr = w->res * (fabs(up) - fabs(w->u)) / (up - w->u);
     double scale;
     double fx = slide_tyre_x(w, up, &scale);
     return s->mw * (up - w->u) - fm + fr + fx;
@@ -280,16 +282,27 @@ static void slide(double u, double v, double f0, double res, double ivs, double 
                   double ix, double iy, double side, double fy_cap, const StepConstants *s,
                   double *fx_out, double *fy_out, double *up_out)
 {
-    Slide w = {u, v, f0, ivs, kx, ix, -ky * side * ivs * iy, s};
+    Slide w = {u, v, f0, res, ivs, kx, ix, -ky * side * ivs * iy, s};
     double scale;
     double up;
-    double need = s->mw * u + limited(f0, s) - slide_tyre_x(&w, 0.0, &scale);
-    if (-res <= need && need <= res) {
-        up = 0.0;
+    double rest = limited(f0, s) - slide_tyre_x(&w, 0.0, &scale);
+    double need = s->mw * u + rest;
+    /* the side the rim ends on: it keeps its direction, or stops within the step */
+    double side_up;
+    if (u > 0.0)
+        side_up = need > res ? 1.0 : -1.0;
+    else if (u < 0.0)
+        side_up = need < -res ? -1.0 : 1.0;
+    else
+        side_up = need > res ? 1.0 : (need < -res ? -1.0 : 0.0);
+    if (side_up * u <= 0.0 && -res <= rest && rest <= res) {
+        up = 0.0; /* at rest, or stopped within the step, and the resistance holds it */
     } else {
         double reach = (s->f_max + 1.0 / ix) / s->mw;
+        if (side_up * u < 0.0) /* through zero: the mean resistance lets it go R further */
+            reach = reach + res / s->mw;
         double lo, hi, fr;
-        if (need > 0) {
+        if (side_up > 0.0) {
             lo = 0.0, hi = u + reach, fr = res;
         } else {
             lo = u - reach, hi = 0.0, fr = -res;

@@ -43,8 +43,17 @@ def slide(
     if its resistance holds it; the tyre's slip at the rim's mid-step speed, the speed the
     body feels over the step: with the end-of-step speed a spinning-up or spinning-down rim on
     ice pushed the body by a whole step's change of slip too early, 0.008 rad of a long
-    manoeuvre's heading at 100 Hz). The left side rises with ``u+`` and the right side falls,
-    so the root is unique; bisection finds it, the same operations in C and Python. The hub
+    manoeuvre's heading at 100 Hz). A rim that passes through zero within the step meets its
+    Coulomb resistance ``R sign(u)`` on both sides of zero, so the resistance is its mean over
+    the rim's straight path from ``u`` to ``u+``, ``R (|u+| - |u|) / (u+ - u)``; and the rim
+    stops there only if the resistance holds it *at rest* (``|F_m(0) - F_x(0)| <= R``). Before,
+    the end speed's sign held for the whole step, and a rim whose backward Euler step ended
+    within ``R dt / M_w`` of zero was held there even when the motor drove it on through: at
+    each reversal the rim lost up to ``2 R dt`` of momentum, which the body kept as a yaw-rate
+    offset while both tyres slid (0.005 rad of the long manoeuvre's heading at 100 Hz, and
+    an order below one). The left side rises with ``u+`` (the mean resistance does too) and
+    the right side falls, so the root is unique; bisection finds it, the same operations in C
+    and Python. The hub
     speed ``v`` and the lateral slip ``side * ivs`` (sideways velocity over the slip speed)
     are the body's, held through the step (it is ~30 times the rim's mass): the caller passes
     them half a step on (:func:`mid_step`). The lateral force is capped by ``fy_cap``, the
@@ -70,15 +79,28 @@ def slide(
             fm = s.f_max
         elif fm < -s.f_max:
             fm = -s.f_max
+        if up * u < 0.0:  # through zero within the step: the resistance's mean over the path
+            fr = res * (abs(up) - abs(u)) / (up - u)
         return s.mw * (up - u) - fm + fr + tyre_x(up)[0]
 
     f0_lim = f0 if -s.f_max <= f0 <= s.f_max else (s.f_max if f0 > 0 else -s.f_max)
-    need = s.mw * u + f0_lim - tyre_x(0.0)[0]
-    if -res <= need <= res:
-        up = 0.0
+    rest = f0_lim - tyre_x(0.0)[0]  # what moves the rim at rest, besides its resistance
+    need = s.mw * u + rest
+    # the side the rim ends on: it keeps its direction, or stops within the step (at rest:
+    # whichever side the forces overcome the resistance on, none if it holds)
+    if u > 0.0:
+        side_up = 1 if need > res else -1
+    elif u < 0.0:
+        side_up = -1 if need < -res else 1
+    else:
+        side_up = 1 if need > res else (-1 if need < -res else 0)
+    if side_up * u <= 0.0 and -res <= rest <= res:
+        up = 0.0  # at rest, or stopped within the step, and the resistance holds it
     else:
         reach = (s.f_max + 1.0 / ix) / s.mw  # |F_m| <= f_max and |F_x| <= grip
-        if need > 0:
+        if side_up * u < 0.0:  # through zero: the mean resistance lets it go up to R further
+            reach = reach + res / s.mw
+        if side_up > 0:
             lo, hi, fr = 0.0, u + reach, res
         else:
             lo, hi, fr = u - reach, 0.0, -res
