@@ -278,9 +278,9 @@ static double slide_excess(const Slide *w, double up, double fr)
     return s->mw * (up - w->u) - fm + fr + fx;
 }
 
-static void slide(double u, double v, double f0, double res, double ivs, double kx, double ky,
-                  double ix, double iy, double side, double fy_cap, const StepConstants *s,
-                  double *fx_out, double *fy_out, double *up_out)
+static void slide_once(double u, double v, double f0, double res, double ivs, double kx,
+                       double ky, double ix, double iy, double side, double fy_cap,
+                       const StepConstants *s, double *fx_out, double *fy_out, double *up_out)
 {
     Slide w = {u, v, f0, res, ivs, kx, ix, -ky * side * ivs * iy, s};
     double scale;
@@ -322,6 +322,36 @@ static void slide(double u, double v, double f0, double res, double ivs, double 
     double fy = -ky * side * ivs * scale;
     if (fabs(fy_cap) < fabs(fy))
         fy = fy_cap;
+    *fx_out = fx;
+    *fy_out = fy;
+    *up_out = up;
+}
+
+#define SPLIT_MIN 0.02
+
+/* sliding.slide: one solve, split where the rim passes its hub's speed within the step */
+static void slide(double u, double v, double f0, double res, double ivs, double kx, double ky,
+                  double ix, double iy, double side, double fy_cap, const StepConstants *s,
+                  double *fx_out, double *fy_out, double *up_out)
+{
+    double fx, fy, up;
+    slide_once(u, v, f0, res, ivs, kx, ky, ix, iy, side, fy_cap, s, &fx, &fy, &up);
+    double a = u - v;
+    double b = up - v;
+    if (a * b < 0.0) {
+        double tau = a / (a - b);
+        if (SPLIT_MIN < tau && tau < 1.0 - SPLIT_MIN) {
+            StepConstants s1 = *s;
+            StepConstants s2 = *s;
+            s1.mw = s->mw / tau;
+            s2.mw = s->mw / (1.0 - tau);
+            double fx1, fy1, u1, fx2, fy2;
+            slide_once(u, v, f0, res, ivs, kx, ky, ix, iy, side, fy_cap, &s1, &fx1, &fy1, &u1);
+            slide_once(u1, v, f0, res, ivs, kx, ky, ix, iy, side, fy_cap, &s2, &fx2, &fy2, &up);
+            fx = tau * fx1 + (1.0 - tau) * fx2;
+            fy = tau * fy1 + (1.0 - tau) * fy2;
+        }
+    }
     *fx_out = fx;
     *fy_out = fy;
     *up_out = up;

@@ -1,19 +1,22 @@
-"""A sliding tyre's rim that reverses within a step: its Coulomb resistance on both sides of zero.
+"""A sliding tyre's rim that reverses, or passes its hub's speed, within a step.
 
 The rim's resistance ``R sign(u)`` flips where the rim passes through zero. Taken with the end
 speed's sign for the whole step (as it was), a rim reversing under its motor lost up to
 ``2 R dt`` of momentum at each reversal, and a backward Euler step ending within ``R dt / M_w``
 of zero held the rim there even when the motor drove it on: the body kept that as a yaw-rate
 offset while both tyres slid on ice (the long manoeuvre's heading, ``test_long_skid.py``).
-Here the rim is checked against the closed form of its own equation,
+Likewise the tyre's force flips where the rim passes its hub's speed, and one solve over the
+step gave the whole step one side's force (a strong rover's heading did not converge). Here
+the rim is checked against the closed form of its own equation,
 ``M_w du/dt = F_m - R sign(u) - F_x``, with a constant motor force (no back-EMF) and a tyre
-sliding at a constant force (slip far from zero): two straight pieces, before and after zero.
+sliding at a constant force: two straight pieces, before and after zero (or the hub's speed).
 """
 
 from __future__ import annotations
 
 import pytest
 
+from amsa_phys.physics import sliding
 from amsa_phys.physics.sliding import slide
 from amsa_phys.physics.wheel import StepConstants
 
@@ -57,3 +60,25 @@ def test_a_rim_that_keeps_its_direction_meets_its_resistance_throughout() -> Non
     u = 1.0
     motor = -20.0
     assert step(u, motor) == pytest.approx(u + (motor + GRIP - RES) / RIM * DT, rel=1e-12)
+
+
+def test_a_rim_passing_its_hubs_speed_within_a_step_gets_each_sides_force_for_its_time() -> None:
+    # the motor brakes the rim from 1.3 m/s through its hub's 1.0 m/s: the tyre pushes the
+    # ground forward (+GRIP) until then and backward after; the rim stays above zero
+    hub, u, motor = 1.0, 1.3, -40.0
+    before = (motor - RES - GRIP) / RIM  # the rim's deceleration while it runs ahead
+    after = (motor - RES + GRIP) / RIM
+    t = (hub - u) / before  # when it passes the hub (0.53 of the step)
+    exact_u = hub + after * (DT - t)
+    exact_fx = GRIP * (2.0 * t / DT - 1.0)
+    fx, _, up = slide(u, hub, motor, RES, 1.0 / hub, TYRE, 0.0, 1e9, CONST)
+    # one solve gives the step +GRIP (12 N against 0.63 N); the split, measured, to 1e-9
+    assert fx == pytest.approx(exact_fx, abs=1e-6)
+    assert up == pytest.approx(exact_u, abs=1e-6)
+
+
+def test_the_split_solves_each_side_as_one_solve_would() -> None:
+    # no crossing: the split changes nothing, bit for bit
+    hub, u, motor = 1.0, 2.0, -40.0
+    once = sliding.slide_once(u, hub, motor, RES, 1.0 / hub, TYRE, 0.0, 1e9, CONST)
+    assert slide(u, hub, motor, RES, 1.0 / hub, TYRE, 0.0, 1e9, CONST) == once
