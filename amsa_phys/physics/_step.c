@@ -250,7 +250,7 @@ static void wheel_pair(const double u[2], const double v[2], const double f0[2],
 #define SLIDE_ITERATIONS 100
 
 typedef struct {
-    double u, v, f0, ivs, kx, ix, qy;
+    double u, v, f0, res, ivs, kx, ix, qy;
     const StepConstants *s;
 } Slide;
 
@@ -271,25 +271,38 @@ static double slide_excess(const Slide *w, double up, double fr)
         fm = s->f_max;
     else if (fm < -s->f_max)
         fm = -s->f_max;
+    if (up * w->u < 0.0) /* through zero within the step: the resistance's mean over the path */
+        fr = w->res * (fabs(up) - fabs(w->u)) / (up - w->u);
     double scale;
     double fx = slide_tyre_x(w, up, &scale);
     return s->mw * (up - w->u) - fm + fr + fx;
 }
 
-static void slide(double u, double v, double f0, double res, double ivs, double kx, double ky,
-                  double ix, double iy, double side, double fy_cap, const StepConstants *s,
-                  double *fx_out, double *fy_out, double *up_out)
+static void slide_once(double u, double v, double f0, double res, double ivs, double kx,
+                       double ky, double ix, double iy, double side, double fy_cap,
+                       const StepConstants *s, double *fx_out, double *fy_out, double *up_out)
 {
-    Slide w = {u, v, f0, ivs, kx, ix, -ky * side * ivs * iy, s};
+    Slide w = {u, v, f0, res, ivs, kx, ix, -ky * side * ivs * iy, s};
     double scale;
     double up;
-    double need = s->mw * u + limited(f0, s) - slide_tyre_x(&w, 0.0, &scale);
-    if (-res <= need && need <= res) {
-        up = 0.0;
+    double rest = limited(f0, s) - slide_tyre_x(&w, 0.0, &scale);
+    double need = s->mw * u + rest;
+    /* the side the rim ends on: it keeps its direction, or stops within the step */
+    double side_up;
+    if (u > 0.0)
+        side_up = need > res ? 1.0 : -1.0;
+    else if (u < 0.0)
+        side_up = need < -res ? -1.0 : 1.0;
+    else
+        side_up = need > res ? 1.0 : (need < -res ? -1.0 : 0.0);
+    if (side_up * u <= 0.0 && -res <= rest && rest <= res) {
+        up = 0.0; /* at rest, or stopped within the step, and the resistance holds it */
     } else {
         double reach = (s->f_max + 1.0 / ix) / s->mw;
+        if (side_up * u < 0.0) /* through zero: the mean resistance lets it go R further */
+            reach = reach + res / s->mw;
         double lo, hi, fr;
-        if (need > 0) {
+        if (side_up > 0.0) {
             lo = 0.0, hi = u + reach, fr = res;
         } else {
             lo = u - reach, hi = 0.0, fr = -res;
@@ -309,6 +322,36 @@ static void slide(double u, double v, double f0, double res, double ivs, double 
     double fy = -ky * side * ivs * scale;
     if (fabs(fy_cap) < fabs(fy))
         fy = fy_cap;
+    *fx_out = fx;
+    *fy_out = fy;
+    *up_out = up;
+}
+
+#define SPLIT_MIN 0.02
+
+/* sliding.slide: one solve, split where the rim passes its hub's speed within the step */
+static void slide(double u, double v, double f0, double res, double ivs, double kx, double ky,
+                  double ix, double iy, double side, double fy_cap, const StepConstants *s,
+                  double *fx_out, double *fy_out, double *up_out)
+{
+    double fx, fy, up;
+    slide_once(u, v, f0, res, ivs, kx, ky, ix, iy, side, fy_cap, s, &fx, &fy, &up);
+    double a = u - v;
+    double b = up - v;
+    if (a * b < 0.0) {
+        double tau = a / (a - b);
+        if (SPLIT_MIN < tau && tau < 1.0 - SPLIT_MIN) {
+            StepConstants s1 = *s;
+            StepConstants s2 = *s;
+            s1.mw = s->mw / tau;
+            s2.mw = s->mw / (1.0 - tau);
+            double fx1, fy1, u1, fx2, fy2;
+            slide_once(u, v, f0, res, ivs, kx, ky, ix, iy, side, fy_cap, &s1, &fx1, &fy1, &u1);
+            slide_once(u1, v, f0, res, ivs, kx, ky, ix, iy, side, fy_cap, &s2, &fx2, &fy2, &up);
+            fx = tau * fx1 + (1.0 - tau) * fx2;
+            fy = tau * fy1 + (1.0 - tau) * fy2;
+        }
+    }
     *fx_out = fx;
     *fy_out = fy;
     *up_out = up;
