@@ -1168,7 +1168,7 @@ typedef struct {
     const double *m_inv, *i_inv, *radius, *sub, *boxes;
     const int64_t *run, *pa, *pb;
     uint8_t *touched;
-    double *reach; /* scratch: each rover's reach this step */
+    double *reach; /* scratch: each rover's reach this step, then its bound */
     Py_ssize_t n_pairs, n_boxes, n_runs;
     double reach_m, max2, extent;
 } Columns;
@@ -1179,33 +1179,68 @@ static inline double np_maximum(double a, double b)
     return (a >= b || a != a) ? a : b;
 }
 
+/* The screening's libm calls, mostly skipped: hypot(x, y) lies between max(|x|, |y|) and
+ * |x| + |y|, so a rover whose |vx| + |vy| is below its limit is not fast, and a pair (or a
+ * rover and a box) farther apart in x or in y than an upper bound of their reaches is not
+ * near, without a hypot. SCREEN_SLACK, relative, is far above the few roundings between
+ * the bounds and the exact values; every case within it, and NaN and infinity (which fail
+ * the bounds' comparisons), takes the exact test below, the numpy path's: the same runs are
+ * marked. Why: two hypot calls a rover and step were ~10 % of a batch's column step. */
+#define SCREEN_SLACK 1e-9
+
+/* Rover k's reach this step, as ColumnPhysics._near computes it: radius + reach_m +
+ * 2 dt hypot(vx, vy); computed once a step, when a test needs it (c->reach[k] < 0: not
+ * yet; a NaN reach stays NaN). */
+static double screen_reach(Columns *c, Py_ssize_t k)
+{
+    if (c->reach[k] < 0.0) {
+        const double *r = c->st.state + 6 * k;
+        c->reach[k] = c->radius[k] + c->reach_m + 2.0 * c->st.dt * hypot(r[3], r[4]);
+    }
+    return c->reach[k];
+}
+
 static void Columns_screen(Columns *c)
 {
     const Stepper *st = &c->st;
     const double *s = st->state;
     const double dt = st->dt;
+    double *hi = c->reach + st->n; /* each rover's reach bound, |vx| + |vy| for the speed */
     for (Py_ssize_t k = 0; k < st->n; k++) {
         const double *r = s + 6 * k;
+        const double sum = fabs(r[3]) + fabs(r[4]);
+        c->reach[k] = -1.0;
+        hi[k] = (c->radius[k] + c->reach_m + 2.0 * dt * sum) * (1.0 + SCREEN_SLACK);
+        if (sum < 0.99 * c->sub[k] * (1.0 - SCREEN_SLACK))
+            continue; /* slower than hypot's test could find fast */
         double speed = hypot(r[3], r[4]);
         c->reach[k] = c->radius[k] + c->reach_m + 2.0 * dt * speed;
         if (speed > 0.99 * c->sub[k])
             c->touched[c->run[k]] = 1;
     }
     for (Py_ssize_t p = 0; p < c->n_pairs; p++) {
-        const double *a = s + 6 * c->pa[p], *b = s + 6 * c->pb[p];
-        double gap = hypot(a[0] - b[0], a[1] - b[1]);
-        if (gap < c->reach[c->pa[p]] + c->reach[c->pb[p]])
-            c->touched[c->run[c->pa[p]]] = 1;
+        const Py_ssize_t ia = c->pa[p], ib = c->pb[p];
+        const double *a = s + 6 * ia, *b = s + 6 * ib;
+        const double dx = a[0] - b[0], dy = a[1] - b[1];
+        const double bound = (hi[ia] + hi[ib]) * (1.0 + SCREEN_SLACK);
+        if (fabs(dx) > bound || fabs(dy) > bound)
+            continue; /* farther apart than both reaches: hypot(dx, dy) >= max(|dx|, |dy|) */
+        double gap = hypot(dx, dy);
+        if (gap < screen_reach(c, ia) + screen_reach(c, ib))
+            c->touched[c->run[ia]] = 1;
     }
     if (c->n_boxes == 0)
         return;
     for (Py_ssize_t k = 0; k < st->n; k++) {
         const double x = s[6 * k], y = s[6 * k + 1];
+        const double bound = hi[k] * (1.0 + SCREEN_SLACK);
         for (Py_ssize_t j = 0; j < c->n_boxes; j++) {
             const double *b = c->boxes + 4 * j; /* left, bottom, right, top */
             double dx = np_maximum(np_maximum(b[0] - x, 0.0), x - b[2]);
             double dy = np_maximum(np_maximum(b[1] - y, 0.0), y - b[3]);
-            if (hypot(dx, dy) < c->reach[k]) {
+            if (dx > bound || dy > bound)
+                continue;
+            if (hypot(dx, dy) < screen_reach(c, k)) {
                 c->touched[c->run[k]] = 1;
                 break;
             }
@@ -1328,7 +1363,7 @@ static int Columns_init(Columns *c, PyObject *args, PyObject *kwds)
             PyErr_SetString(PyExc_ValueError, "pairs: a rover index out of range");
             return -1;
         }
-    c->reach = PyMem_Malloc((n ? n : 1) * sizeof(double));
+    c->reach = PyMem_Malloc((n ? 2 * n : 1) * sizeof(double));
     if (c->reach == NULL) {
         PyErr_NoMemory();
         return -1;
