@@ -304,8 +304,11 @@ def first_bad(arr: np.ndarray, published: np.ndarray | None) -> int | None:
     of the values with themselves is finite only if every value is (NaN and infinity carry
     through, and a sum of squares is never NaN otherwise). Finite values large enough to
     overflow the sum (|x| > ~1e154) take the exact path below and are found good there.
+    With a ``published`` mask the same call clears the usual case too (every value finite,
+    so every published one): the mask is applied only when some value is not finite (a
+    lost GPS fix's row may hold anything).
     """
-    if published is None and math.isfinite(arr.dot(arr)):  # the usual case, one call
+    if math.isfinite(arr.dot(arr)):  # the usual case, one call
         return None
     bad = ~np.isfinite(arr)
     if published is not None:
