@@ -270,13 +270,14 @@ def derived(
     each. Parameter arrays (:class:`ParamArrays`) are the same objects until a member's
     parameter changes, when they are built anew: so identity says when to recompute.
     """
+    ids = tuple(map(id, args))
     hit = state.get(key)
-    if hit is not None:
-        old = hit[0]
-        if len(old) == len(args) and all(a is b for a, b in zip(old, args, strict=True)):
-            return hit[1]
+    # equal ids are the same objects: the entry holds the old ones, so none of their ids
+    # can have been given to another object meanwhile
+    if hit is not None and hit[0] == ids:
+        return hit[1]
     value = make(*args)
-    state[key] = (args, value)
+    state[key] = (ids, value, args)
     return value
 
 
