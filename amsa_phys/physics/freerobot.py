@@ -17,6 +17,7 @@ import numpy as np
 from ..engine.batch import derived
 from ..model.params import Param
 from ..model.template import Kind
+from .columns import _compiled_step
 from .robots import POSE_OUTPUTS, ControlledRobot, Robot
 from .roverparams import ROVER_PARAMS
 from .scrub import scrub_moment
@@ -192,6 +193,8 @@ class FreeRobot(Robot):
                 "heading": np.array([c.target_heading for c in comps], dtype=np.float64),
                 "factor": np.array([c.speed_factor for c in comps], dtype=np.float64),
                 "soonest": min(c.next_change for c in comps),
+                # the steering below in one C call (``_step.steer_random``) where built
+                "steer": getattr(_compiled_step(), "steer_random", None),
             }
         comps = mine["comps"]
         if t >= mine["soonest"]:  # some copies draw: each as alone, from its own generator
@@ -204,6 +207,19 @@ class FreeRobot(Robot):
             mine["soonest"] = min(c.next_change for c in comps)
         angle = comps[0].physics.kinematics_array(mine["index"])[:, 2]
         cruise, gain = derived(state, "_steering", (p.cruisePower, p.steerGain, rows), _rows_of)
+        steer = mine["steer"]
+        if steer is not None:  # the same operations as below, in C
+            left, right = np.empty(len(comps)), np.empty(len(comps))
+            steer(
+                mine["heading"],
+                np.ascontiguousarray(angle),
+                cruise,
+                mine["factor"],
+                gain,
+                left,
+                right,
+            )
+            return left, right
         power = cruise * mine["factor"]
         err = (mine["heading"] - angle + math.pi) % (2 * math.pi) - math.pi  # wrap_angle
         diff = gain * err
@@ -308,5 +324,10 @@ def _behaviours(behavior: np.ndarray) -> tuple[list[int], np.ndarray | None] | N
 
 
 def _rows_of(cruise: np.ndarray, gain: np.ndarray, rows: np.ndarray) -> tuple[Any, Any]:
-    """The random copies' cruise power and steering gain (kept as :func:`_behaviours`)."""
-    return np.asarray(cruise)[rows], np.asarray(gain)[rows]
+    """The random copies' cruise power and steering gain (kept as :func:`_behaviours`), as
+    contiguous float64 arrays (what the C steering reads)."""
+    f64 = np.float64
+    return (
+        np.ascontiguousarray(np.asarray(cruise)[rows], dtype=f64),
+        np.ascontiguousarray(np.asarray(gain)[rows], dtype=f64),
+    )
