@@ -1678,6 +1678,74 @@ done:
     return result;
 }
 
+/* ---- robot_poses: a robot group's pose outputs (physics/robots.py) ----------------------
+ * Why: ControlledRobot.step_many gathered them in ~12 numpy calls (two gathers, the heading's
+ * wrap, the speed's cos and sin), three or four groups a vector env's step. Rover index[j]'s
+ * row of the (N, 6) state and its two rims of the (2, N) rims go to column j of the (7, m)
+ * out: x, y, (angle + pi) % (2 pi) - pi (the floor modulo, as Python's and numpy's), vx cos(a)
+ * + vy sin(a) (libm's, what a run alone computes with math.cos and math.sin), w, left rim,
+ * right rim. */
+static PyObject *robot_poses(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    PyObject *objs[4];
+    if (!PyArg_ParseTuple(args, "OOOO", &objs[0], &objs[1], &objs[2], &objs[3]))
+        return NULL;
+    static const char *names[4] = {"state", "rims", "index", "out"};
+    Py_buffer views[4];
+    int held = 0;
+    PyObject *result = NULL;
+    for (; held < 4; held++) {
+        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (held == 3 ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[held], &views[held], flags) < 0)
+            goto done;
+        const char *f = views[held].format ? views[held].format : "B";
+        if (*f == '<' || *f == '=' || *f == '@')
+            f++;
+        int ok = views[held].itemsize == 8 &&
+                 (held == 2 ? (strchr("qlQL", *f) != NULL && f[1] == 0) : strcmp(f, "d") == 0);
+        if (!ok) {
+            PyErr_Format(PyExc_ValueError, "%s: %s items expected", names[held],
+                         held == 2 ? "int64" : "float64");
+            held++;
+            goto done;
+        }
+    }
+    const Py_ssize_t big_n = views[0].len / (6 * 8), m = views[2].len / 8;
+    if (views[0].len != big_n * 6 * 8 || views[1].len != 2 * big_n * 8 ||
+        views[3].len != 7 * m * 8) {
+        PyErr_SetString(PyExc_ValueError, "robot_poses: state (N, 6), rims (2, N), out (7, "
+                                          "len(index)) expected");
+        goto done;
+    }
+    const double *state = views[0].buf, *rims = views[1].buf;
+    const int64_t *index = views[2].buf;
+    double *out = views[3].buf;
+    for (Py_ssize_t j = 0; j < m; j++)
+        if (index[j] < 0 || index[j] >= big_n) {
+            PyErr_SetString(PyExc_IndexError, "robot_poses: a rover index out of range");
+            goto done;
+        }
+    const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+    for (Py_ssize_t j = 0; j < m; j++) {
+        const Py_ssize_t k = (Py_ssize_t)index[j];
+        const double *r = state + 6 * k;
+        const double a = r[2];
+        out[j] = r[0];
+        out[m + j] = r[1];
+        out[2 * m + j] = floor_mod(a + pi, two_pi) - pi;
+        out[3 * m + j] = r[3] * cos(a) + r[4] * sin(a);
+        out[4 * m + j] = r[5];
+        out[5 * m + j] = rims[k];
+        out[6 * m + j] = rims[big_n + k];
+    }
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    for (int i = 0; i < held; i++)
+        PyBuffer_Release(&views[i]);
+    return result;
+}
+
 static PyMethodDef module_methods[] = {
     {"column_forces", column_forces, METH_VARARGS,
      "column_forces(plan, drives, rims, ground, state, forces, dt): every rover's force and "
@@ -1691,6 +1759,9 @@ static PyMethodDef module_methods[] = {
     {"steer_random", steer_random, METH_VARARGS,
      "steer_random(heading, angle, cruise, factor, gain, left, right): a random leader "
      "group's wheel powers (physics/freerobot.py), into left and right."},
+    {"robot_poses", robot_poses, METH_VARARGS,
+     "robot_poses(state, rims, index, out): a robot group's pose outputs (x, y, heading, "
+     "speed, yaw rate, rims) of the rovers at index into the (7, m) out."},
     {NULL, NULL, 0, NULL},
 };
 
