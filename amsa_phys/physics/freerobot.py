@@ -177,7 +177,9 @@ class FreeRobot(Robot):
         alone); between draws the steering law is arithmetic over the copies. ``math.cos``
         stays scalar: numpy may compute ``cos`` with its own SIMD code, which can differ from
         libm's (what a single run uses) in the last bit; subtraction, product, ``%`` (the
-        same fmod-based rule as Python's) and comparisons are IEEE-exact in both.
+        same fmod-based rule as Python's) and comparisons are IEEE-exact in both. Where the
+        extension is built the steering is one C call with the same operations and libm's
+        ``cos`` (``_step.steer_random``); the numpy code is the pure path.
         """
         mine = state.get("random")
         if mine is not None and mine["at"] is not rows and mine["rows"] == rows.tobytes():
