@@ -1248,13 +1248,14 @@ static void Columns_screen(Columns *c)
     }
 }
 
-static PyObject *Columns_advance(Columns *c, PyObject *Py_UNUSED(ignored))
+/* The step after the screening: every rover's forces, its integration and the check;
+ * whether every rover passed. */
+static int Columns_move(Columns *c)
 {
     Stepper *st = &c->st;
     const double dt = st->dt;
     const double half = 0.5 * dt;
     double *s = st->state;
-    Columns_screen(c);
     int ok = 1;
     for (Py_ssize_t k = 0; k < st->n; k++) {
         double *f = c->forces + 3 * k;
@@ -1274,7 +1275,13 @@ static PyObject *Columns_advance(Columns *c, PyObject *Py_UNUSED(ignored))
         if (!(v2 <= c->max2 && fabs(r[0]) <= c->extent && fabs(r[1]) <= c->extent))
             ok = 0;
     }
-    return PyBool_FromLong(ok);
+    return ok;
+}
+
+static PyObject *Columns_advance(Columns *c, PyObject *Py_UNUSED(ignored))
+{
+    Columns_screen(c);
+    return PyBool_FromLong(Columns_move(c));
 }
 
 static void Columns_dealloc(Columns *c)
@@ -1388,9 +1395,10 @@ static int Columns_init(Columns *c, PyObject *args, PyObject *kwds)
  * Python call per step (the hook, the model, the screening's bookkeeping) cost ~60 us each
  * whatever the batch's size, more than the arithmetic of a small batch. The engine hands a
  * run of physics-only instants to one call (Simulation.batch_hook); this takes them here.
- * Each step IS Columns_advance (called, not copied: whatever that step does, these do), and
- * with ``freeze`` the rows of every rover whose run is marked touched (this step's
- * screening included) are then put back where they were before the step, as
+ * Each step is Columns_advance's two parts (called, not copied: whatever that step does,
+ * these do), and with ``freeze`` the rows of every rover whose run is marked touched (this
+ * step's screening included) are then put back where they were before the step (only
+ * those rows are kept aside, and only once some run is marked), as
  * gym/veccolumns.py's EpisodeColumns puts them back in numpy (their forces and rims are
  * computed as there). Stops after the first step whose check fails (a frozen row may fail
  * it before it is put back: the caller looks for the violation in the rows as they are):
@@ -1403,22 +1411,26 @@ static PyObject *Columns_advance_many(Columns *c, PyObject *args)
         return NULL;
     const Py_ssize_t n = c->st.n;
     double *s = c->st.state;
-    double *before = NULL;
-    if (freeze && n > 0 && (before = PyMem_Malloc(6 * n * sizeof(double))) == NULL)
-        return PyErr_NoMemory();
+    double *before = NULL; /* the frozen rows before the step (allocated when first needed) */
     Py_ssize_t done = 0;
     int ok = 1;
     while (done < count && ok) {
+        Columns_screen(c);
+        /* the rows to hold: those of runs marked, this step's screening included (the
+         * screening reads the state, never writes it: these are the rows before the step) */
+        int held = 0;
         if (freeze)
-            memcpy(before, s, 6 * n * sizeof(double));
-        PyObject *passed = Columns_advance(c, NULL);
-        if (passed == NULL) {
-            PyMem_Free(before);
-            return NULL;
+            for (Py_ssize_t r = 0; r < c->n_runs && !held; r++)
+                held = c->touched[r] != 0;
+        if (held) {
+            if (before == NULL && (before = PyMem_Malloc(6 * n * sizeof(double))) == NULL)
+                return PyErr_NoMemory();
+            for (Py_ssize_t k = 0; k < n; k++)
+                if (c->touched[c->run[k]])
+                    memcpy(before + 6 * k, s + 6 * k, 6 * sizeof(double));
         }
-        ok = passed == Py_True;
-        Py_DECREF(passed);
-        if (freeze)
+        ok = Columns_move(c);
+        if (held)
             for (Py_ssize_t k = 0; k < n; k++)
                 if (c->touched[c->run[k]])
                     memcpy(s + 6 * k, before + 6 * k, 6 * sizeof(double));
