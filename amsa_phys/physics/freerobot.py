@@ -17,7 +17,6 @@ import numpy as np
 from ..engine.batch import derived
 from ..model.params import Param
 from ..model.template import Kind
-from .columns import _compiled_step
 from .robots import POSE_OUTPUTS, ControlledRobot, Robot
 from .roverparams import ROVER_PARAMS
 from .scrub import scrub_moment
@@ -196,7 +195,7 @@ class FreeRobot(Robot):
                 "factor": np.array([c.speed_factor for c in comps], dtype=np.float64),
                 "soonest": min(c.next_change for c in comps),
                 # the steering below in one C call (``_step.steer_random``) where built
-                "steer": getattr(_compiled_step(), "steer_random", None),
+                "steer": _steer_random(),
             }
         comps = mine["comps"]
         if t >= mine["soonest"]:  # some copies draw: each as alone, from its own generator
@@ -333,3 +332,10 @@ def _rows_of(cruise: np.ndarray, gain: np.ndarray, rows: np.ndarray) -> tuple[An
         np.ascontiguousarray(np.asarray(cruise)[rows], dtype=f64),
         np.ascontiguousarray(np.asarray(gain)[rows], dtype=f64),
     )
+
+
+def _steer_random() -> Any:
+    """``_step.steer_random`` where the extension is in use, else None (numpy's path)."""
+    from . import compiled
+
+    return getattr(compiled._step, "steer_random", None) if compiled.columns_compiled() else None
