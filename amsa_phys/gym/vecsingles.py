@@ -1,8 +1,8 @@
 """A small vector env's episodes: each env a single env, stepped in turn, no batch at all.
 
 Why: a batched simulation (``gym/vecepisode.py``) pays a fixed price per vector step, the
-numpy calls of every component group whatever the number of runs (~0.6 ms on 2 shared
-cores), against ~80 µs an env-step for the single env on the compiled few-rover step. Below
+numpy calls of every component group whatever the number of runs (~0.35 ms on 2 shared
+cores), against ~50 µs an env-step for the single env on the compiled few-rover step. Below
 :data:`SINGLES_BELOW` envs the batch would be slower than Gymnasium's own ``SyncVectorEnv``
 over the single env; the vector env then holds that many :class:`FollowEnv` and steps them
 one after the other, gathering their results into arrays (what ``SyncVectorEnv`` does,
@@ -21,11 +21,12 @@ import numpy as np
 from .follow import FollowEnv
 
 #: Fewer envs than this step as single envs; this many or more as one batch. Measured on
-#: 2 shared cores (random actions, CPU time, each path against SyncVectorEnv in the same
-#: sitting): at 8 envs both paths ~1.04x SyncVectorEnv, at 10 the batch 1.26x and the
-#: single envs 1.14x, at 12 the batch 1.5x (``benchmarks/bench_speed.py``). A faster
-#: single env moves the crossing up: re-measure both paths before changing it.
-SINGLES_BELOW = 10
+#: 2 shared cores (random actions, CPU time, both paths in the same sitting, medians of 3):
+#: batch / single envs 0.78 at 6 envs, 0.91 at 7, 1.08 at 8, 1.14 at 9, 1.16 at 10
+#: (``FollowVecEnv(n, stepping=...)`` timed as ``benchmarks/bench_speed.py`` times it).
+#: A faster single env moves the crossing up, a cheaper batch step down:
+#: re-measure both paths before changing it.
+SINGLES_BELOW = 8
 
 
 class Singles:

@@ -1211,7 +1211,7 @@ typedef struct {
     const double *m_inv, *i_inv, *radius, *sub, *boxes;
     const int64_t *run, *pa, *pb;
     uint8_t *touched;
-    double *reach; /* scratch: each rover's reach this step */
+    double *reach; /* scratch: each rover's reach this step, then its bound */
     Py_ssize_t n_pairs, n_boxes, n_runs;
     double reach_m, max2, extent;
 } Columns;
@@ -1222,33 +1222,68 @@ static inline double np_maximum(double a, double b)
     return (a >= b || a != a) ? a : b;
 }
 
+/* The screening's libm calls, mostly skipped: hypot(x, y) lies between max(|x|, |y|) and
+ * |x| + |y|, so a rover whose |vx| + |vy| is below its limit is not fast, and a pair (or a
+ * rover and a box) farther apart in x or in y than an upper bound of their reaches is not
+ * near, without a hypot. SCREEN_SLACK, relative, is far above the few roundings between
+ * the bounds and the exact values; every case within it, and NaN and infinity (which fail
+ * the bounds' comparisons), takes the exact test below, the numpy path's: the same runs are
+ * marked. Why: two hypot calls a rover and step were ~10 % of a batch's column step. */
+#define SCREEN_SLACK 1e-9
+
+/* Rover k's reach this step, as ColumnPhysics._near computes it: radius + reach_m +
+ * 2 dt hypot(vx, vy); computed once a step, when a test needs it (c->reach[k] < 0: not
+ * yet; a NaN reach stays NaN). */
+static double screen_reach(Columns *c, Py_ssize_t k)
+{
+    if (c->reach[k] < 0.0) {
+        const double *r = c->st.state + 6 * k;
+        c->reach[k] = c->radius[k] + c->reach_m + 2.0 * c->st.dt * hypot(r[3], r[4]);
+    }
+    return c->reach[k];
+}
+
 static void Columns_screen(Columns *c)
 {
     const Stepper *st = &c->st;
     const double *s = st->state;
     const double dt = st->dt;
+    double *hi = c->reach + st->n; /* each rover's reach bound, |vx| + |vy| for the speed */
     for (Py_ssize_t k = 0; k < st->n; k++) {
         const double *r = s + 6 * k;
+        const double sum = fabs(r[3]) + fabs(r[4]);
+        c->reach[k] = -1.0;
+        hi[k] = (c->radius[k] + c->reach_m + 2.0 * dt * sum) * (1.0 + SCREEN_SLACK);
+        if (sum < 0.99 * c->sub[k] * (1.0 - SCREEN_SLACK))
+            continue; /* slower than hypot's test could find fast */
         double speed = hypot(r[3], r[4]);
         c->reach[k] = c->radius[k] + c->reach_m + 2.0 * dt * speed;
         if (speed > 0.99 * c->sub[k])
             c->touched[c->run[k]] = 1;
     }
     for (Py_ssize_t p = 0; p < c->n_pairs; p++) {
-        const double *a = s + 6 * c->pa[p], *b = s + 6 * c->pb[p];
-        double gap = hypot(a[0] - b[0], a[1] - b[1]);
-        if (gap < c->reach[c->pa[p]] + c->reach[c->pb[p]])
-            c->touched[c->run[c->pa[p]]] = 1;
+        const Py_ssize_t ia = c->pa[p], ib = c->pb[p];
+        const double *a = s + 6 * ia, *b = s + 6 * ib;
+        const double dx = a[0] - b[0], dy = a[1] - b[1];
+        const double bound = (hi[ia] + hi[ib]) * (1.0 + SCREEN_SLACK);
+        if (fabs(dx) > bound || fabs(dy) > bound)
+            continue; /* farther apart than both reaches: hypot(dx, dy) >= max(|dx|, |dy|) */
+        double gap = hypot(dx, dy);
+        if (gap < screen_reach(c, ia) + screen_reach(c, ib))
+            c->touched[c->run[ia]] = 1;
     }
     if (c->n_boxes == 0)
         return;
     for (Py_ssize_t k = 0; k < st->n; k++) {
         const double x = s[6 * k], y = s[6 * k + 1];
+        const double bound = hi[k] * (1.0 + SCREEN_SLACK);
         for (Py_ssize_t j = 0; j < c->n_boxes; j++) {
             const double *b = c->boxes + 4 * j; /* left, bottom, right, top */
             double dx = np_maximum(np_maximum(b[0] - x, 0.0), x - b[2]);
             double dy = np_maximum(np_maximum(b[1] - y, 0.0), y - b[3]);
-            if (hypot(dx, dy) < c->reach[k]) {
+            if (dx > bound || dy > bound)
+                continue;
+            if (hypot(dx, dy) < screen_reach(c, k)) {
                 c->touched[c->run[k]] = 1;
                 break;
             }
@@ -1256,13 +1291,14 @@ static void Columns_screen(Columns *c)
     }
 }
 
-static PyObject *Columns_advance(Columns *c, PyObject *Py_UNUSED(ignored))
+/* The step after the screening: every rover's forces, its integration and the check;
+ * whether every rover passed. */
+static int Columns_move(Columns *c)
 {
     Stepper *st = &c->st;
     const double dt = st->dt;
     const double half = 0.5 * dt;
     double *s = st->state;
-    Columns_screen(c);
     int ok = 1;
     for (Py_ssize_t k = 0; k < st->n; k++) {
         double *f = c->forces + 3 * k;
@@ -1282,7 +1318,13 @@ static PyObject *Columns_advance(Columns *c, PyObject *Py_UNUSED(ignored))
         if (!(v2 <= c->max2 && fabs(r[0]) <= c->extent && fabs(r[1]) <= c->extent))
             ok = 0;
     }
-    return PyBool_FromLong(ok);
+    return ok;
+}
+
+static PyObject *Columns_advance(Columns *c, PyObject *Py_UNUSED(ignored))
+{
+    Columns_screen(c);
+    return PyBool_FromLong(Columns_move(c));
 }
 
 static void Columns_dealloc(Columns *c)
@@ -1371,7 +1413,7 @@ static int Columns_init(Columns *c, PyObject *args, PyObject *kwds)
             PyErr_SetString(PyExc_ValueError, "pairs: a rover index out of range");
             return -1;
         }
-    c->reach = PyMem_Malloc((n ? n : 1) * sizeof(double));
+    c->reach = PyMem_Malloc((n ? 2 * n : 1) * sizeof(double));
     if (c->reach == NULL) {
         PyErr_NoMemory();
         return -1;
@@ -1396,9 +1438,10 @@ static int Columns_init(Columns *c, PyObject *args, PyObject *kwds)
  * Python call per step (the hook, the model, the screening's bookkeeping) cost ~60 us each
  * whatever the batch's size, more than the arithmetic of a small batch. The engine hands a
  * run of physics-only instants to one call (Simulation.batch_hook); this takes them here.
- * Each step IS Columns_advance (called, not copied: whatever that step does, these do), and
- * with ``freeze`` the rows of every rover whose run is marked touched (this step's
- * screening included) are then put back where they were before the step, as
+ * Each step is Columns_advance's two parts (called, not copied: whatever that step does,
+ * these do), and with ``freeze`` the rows of every rover whose run is marked touched (this
+ * step's screening included) are then put back where they were before the step (only
+ * those rows are kept aside, and only once some run is marked), as
  * gym/veccolumns.py's EpisodeColumns puts them back in numpy (their forces and rims are
  * computed as there). Stops after the first step whose check fails (a frozen row may fail
  * it before it is put back: the caller looks for the violation in the rows as they are):
@@ -1411,22 +1454,26 @@ static PyObject *Columns_advance_many(Columns *c, PyObject *args)
         return NULL;
     const Py_ssize_t n = c->st.n;
     double *s = c->st.state;
-    double *before = NULL;
-    if (freeze && n > 0 && (before = PyMem_Malloc(6 * n * sizeof(double))) == NULL)
-        return PyErr_NoMemory();
+    double *before = NULL; /* the frozen rows before the step (allocated when first needed) */
     Py_ssize_t done = 0;
     int ok = 1;
     while (done < count && ok) {
+        Columns_screen(c);
+        /* the rows to hold: those of runs marked, this step's screening included (the
+         * screening reads the state, never writes it: these are the rows before the step) */
+        int held = 0;
         if (freeze)
-            memcpy(before, s, 6 * n * sizeof(double));
-        PyObject *passed = Columns_advance(c, NULL);
-        if (passed == NULL) {
-            PyMem_Free(before);
-            return NULL;
+            for (Py_ssize_t r = 0; r < c->n_runs && !held; r++)
+                held = c->touched[r] != 0;
+        if (held) {
+            if (before == NULL && (before = PyMem_Malloc(6 * n * sizeof(double))) == NULL)
+                return PyErr_NoMemory();
+            for (Py_ssize_t k = 0; k < n; k++)
+                if (c->touched[c->run[k]])
+                    memcpy(before + 6 * k, s + 6 * k, 6 * sizeof(double));
         }
-        ok = passed == Py_True;
-        Py_DECREF(passed);
-        if (freeze)
+        ok = Columns_move(c);
+        if (held)
             for (Py_ssize_t k = 0; k < n; k++)
                 if (c->touched[c->run[k]])
                     memcpy(s + 6 * k, before + 6 * k, 6 * sizeof(double));
@@ -1620,6 +1667,140 @@ done:
     return result;
 }
 
+/* ---- steer_random: a random leader group's steering (physics/freerobot.py) ---------------
+ * Why: FreeRobot._random_many did it in ~12 numpy calls and one Python math.cos call a copy
+ * (its biggest part at 1,000 envs, most of the group's fixed cost at 16). The same operations
+ * in the same order: power = cruise * factor; err = (heading - angle + pi) % (2 pi) - pi with
+ * the floor-modulo of Python and numpy (fmod, then the divisor added when the signs differ,
+ * +-0 given the divisor's sign); diff = gain * err; forward = power * (cos(err) if
+ * cos(err) > 0 else 0, NaN giving 0); left = forward - diff, right = forward + diff. */
+static double floor_mod(double a, double b)
+{
+    double mod = fmod(a, b);
+    if (mod != 0.0) {
+        if ((b < 0) != (mod < 0))
+            mod += b;
+    } else {
+        mod = copysign(0.0, b);
+    }
+    return mod;
+}
+
+static PyObject *steer_random(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    PyObject *objs[7];
+    if (!PyArg_ParseTuple(args, "OOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4],
+                          &objs[5], &objs[6]))
+        return NULL;
+    static const char *names[7] = {"heading", "angle", "cruise", "factor", "gain", "left",
+                                   "right"};
+    Py_buffer views[7];
+    int held = 0;
+    PyObject *result = NULL;
+    for (; held < 7; held++) {
+        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (held >= 5 ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[held], &views[held], flags) < 0)
+            goto done;
+        const char *f = views[held].format ? views[held].format : "B";
+        if (*f == '<' || *f == '=' || *f == '@')
+            f++;
+        if (views[held].itemsize != 8 || strcmp(f, "d") != 0 || views[held].len != views[0].len) {
+            PyErr_Format(PyExc_ValueError, "%s: as many float64 items as heading expected",
+                         names[held]);
+            held++;
+            goto done;
+        }
+    }
+    const Py_ssize_t n = views[0].len / 8;
+    const double *heading = views[0].buf, *angle = views[1].buf, *cruise = views[2].buf;
+    const double *factor = views[3].buf, *gain = views[4].buf;
+    double *left = views[5].buf, *right = views[6].buf;
+    const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        const double power = cruise[k] * factor[k];
+        const double err = floor_mod(heading[k] - angle[k] + pi, two_pi) - pi;
+        const double diff = gain[k] * err;
+        const double c = cos(err);
+        const double forward = power * (c > 0.0 ? c : 0.0);
+        left[k] = forward - diff;
+        right[k] = forward + diff;
+    }
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    for (int i = 0; i < held; i++)
+        PyBuffer_Release(&views[i]);
+    return result;
+}
+
+/* ---- robot_poses: a robot group's pose outputs (physics/robots.py) ----------------------
+ * Why: ControlledRobot.step_many gathered them in ~12 numpy calls (two gathers, the heading's
+ * wrap, the speed's cos and sin), three or four groups a vector env's step. Rover index[j]'s
+ * row of the (N, 6) state and its two rims of the (2, N) rims go to column j of the (7, m)
+ * out: x, y, (angle + pi) % (2 pi) - pi (the floor modulo, as Python's and numpy's), vx cos(a)
+ * + vy sin(a) (libm's, what a run alone computes with math.cos and math.sin), w, left rim,
+ * right rim. */
+static PyObject *robot_poses(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    PyObject *objs[4];
+    if (!PyArg_ParseTuple(args, "OOOO", &objs[0], &objs[1], &objs[2], &objs[3]))
+        return NULL;
+    static const char *names[4] = {"state", "rims", "index", "out"};
+    Py_buffer views[4];
+    int held = 0;
+    PyObject *result = NULL;
+    for (; held < 4; held++) {
+        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (held == 3 ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[held], &views[held], flags) < 0)
+            goto done;
+        const char *f = views[held].format ? views[held].format : "B";
+        if (*f == '<' || *f == '=' || *f == '@')
+            f++;
+        int ok = views[held].itemsize == 8 &&
+                 (held == 2 ? (strchr("qlQL", *f) != NULL && f[1] == 0) : strcmp(f, "d") == 0);
+        if (!ok) {
+            PyErr_Format(PyExc_ValueError, "%s: %s items expected", names[held],
+                         held == 2 ? "int64" : "float64");
+            held++;
+            goto done;
+        }
+    }
+    const Py_ssize_t big_n = views[0].len / (6 * 8), m = views[2].len / 8;
+    if (views[0].len != big_n * 6 * 8 || views[1].len != 2 * big_n * 8 ||
+        views[3].len != 7 * m * 8) {
+        PyErr_SetString(PyExc_ValueError, "robot_poses: state (N, 6), rims (2, N), out (7, "
+                                          "len(index)) expected");
+        goto done;
+    }
+    const double *state = views[0].buf, *rims = views[1].buf;
+    const int64_t *index = views[2].buf;
+    double *out = views[3].buf;
+    for (Py_ssize_t j = 0; j < m; j++)
+        if (index[j] < 0 || index[j] >= big_n) {
+            PyErr_SetString(PyExc_IndexError, "robot_poses: a rover index out of range");
+            goto done;
+        }
+    const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+    for (Py_ssize_t j = 0; j < m; j++) {
+        const Py_ssize_t k = (Py_ssize_t)index[j];
+        const double *r = state + 6 * k;
+        const double a = r[2];
+        out[j] = r[0];
+        out[m + j] = r[1];
+        out[2 * m + j] = floor_mod(a + pi, two_pi) - pi;
+        out[3 * m + j] = r[3] * cos(a) + r[4] * sin(a);
+        out[4 * m + j] = r[5];
+        out[5 * m + j] = rims[k];
+        out[6 * m + j] = rims[big_n + k];
+    }
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    for (int i = 0; i < held; i++)
+        PyBuffer_Release(&views[i]);
+    return result;
+}
+
 static PyMethodDef module_methods[] = {
     {"column_forces", column_forces, METH_VARARGS,
      "column_forces(plan, drives, rims, ground, state, forces, dt): every rover's force and "
@@ -1630,6 +1811,12 @@ static PyMethodDef module_methods[] = {
     {"column_powers", column_powers, METH_VARARGS,
      "column_powers(left, right, index, band, drives): power commands (NaN -100, clipped to "
      "+-100, 0 in the deadband) into the (2, n) drives of the rovers at index."},
+    {"steer_random", steer_random, METH_VARARGS,
+     "steer_random(heading, angle, cruise, factor, gain, left, right): a random leader "
+     "group's wheel powers (physics/freerobot.py), into left and right."},
+    {"robot_poses", robot_poses, METH_VARARGS,
+     "robot_poses(state, rims, index, out): a robot group's pose outputs (x, y, heading, "
+     "speed, yaw rate, rims) of the rovers at index into the (7, m) out."},
     {NULL, NULL, 0, NULL},
 };
 

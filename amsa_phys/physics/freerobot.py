@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ..engine.batch import derived
 from ..model.params import Param
 from ..model.template import Kind
 from .robots import POSE_OUTPUTS, ControlledRobot, Robot
@@ -133,20 +134,23 @@ class FreeRobot(Robot):
     ) -> tuple[Mapping[str, Any], None]:
         """``do_step`` for many copies at once (a batched sweep's leaders): each copy's
         behaviour as alone, the powers and poses as arrays (``ControlledRobot.step_many``)."""
-        behavior = p.behavior
-        straight = behavior == 1  # behaviour 1 is the cruise power on both wheels
-        if straight.all():
+        plan = derived(state, "_behaviours", (p.behavior,), _behaviours)
+        if plan is None:  # every copy cruises straight (behaviour 1)
             left = right = p.cruisePower
         else:
-            left = np.array(p.cruisePower, dtype=np.float64)
-            right = left.copy()
-            random = behavior == 4
-            for i in np.flatnonzero(~straight & ~random).tolist():  # circles, waypoints, ...
-                left[i], right[i] = comps[i]._behaviour(t)
-            if random.any():
-                rows = np.flatnonzero(random)
-                sl, sr = cls._random_many(comps, t, p, rows, state)
-                left[rows], right[rows] = sl, sr
+            others, rows = plan
+            if len(others) == 0 and rows is not None and len(rows) == len(comps):
+                # every copy random: its powers are the steering's arrays themselves (what
+                # filling copies of the cruise power row by row would give)
+                left, right = cls._random_many(comps, t, p, rows, state)
+            else:
+                left = np.array(p.cruisePower, dtype=np.float64)
+                right = left.copy()
+                for i in others:  # circles, waypoints, ...
+                    left[i], right[i] = comps[i]._behaviour(t)
+                if rows is not None:
+                    sl, sr = cls._random_many(comps, t, p, rows, state)
+                    left[rows], right[rows] = sl, sr
         return ControlledRobot.step_many(
             comps,  # type: ignore[arg-type]
             t,
@@ -172,19 +176,26 @@ class FreeRobot(Robot):
         alone); between draws the steering law is arithmetic over the copies. ``math.cos``
         stays scalar: numpy may compute ``cos`` with its own SIMD code, which can differ from
         libm's (what a single run uses) in the last bit; subtraction, product, ``%`` (the
-        same fmod-based rule as Python's) and comparisons are IEEE-exact in both.
+        same fmod-based rule as Python's) and comparisons are IEEE-exact in both. Where the
+        extension is built the steering is one C call with the same operations and libm's
+        ``cos`` (``_step.steer_random``); the numpy code is the pure path.
         """
         mine = state.get("random")
-        if mine is None or mine["rows"] != rows.tobytes():  # first step, or behaviours changed
+        if mine is not None and mine["at"] is not rows and mine["rows"] == rows.tobytes():
+            mine["at"] = rows  # the same copies in a new array: behaviours changed elsewhere
+        if mine is None or mine["at"] is not rows:  # first step, or behaviours changed
             comps = [every[i] for i in rows.tolist()]
             physics = comps[0].physics
             mine = state["random"] = {
                 "rows": rows.tobytes(),
+                "at": rows,
                 "comps": comps,
                 "index": physics.index_of([c.rover for c in comps]),
                 "heading": np.array([c.target_heading for c in comps], dtype=np.float64),
                 "factor": np.array([c.speed_factor for c in comps], dtype=np.float64),
                 "soonest": min(c.next_change for c in comps),
+                # the steering below in one C call (``_step.steer_random``) where built
+                "steer": _steer_random(),
             }
         comps = mine["comps"]
         if t >= mine["soonest"]:  # some copies draw: each as alone, from its own generator
@@ -196,9 +207,23 @@ class FreeRobot(Robot):
                     factor[k] = c.speed_factor
             mine["soonest"] = min(c.next_change for c in comps)
         angle = comps[0].physics.kinematics_array(mine["index"])[:, 2]
-        power = np.asarray(p.cruisePower)[rows] * mine["factor"]
+        cruise, gain = derived(state, "_steering", (p.cruisePower, p.steerGain, rows), _rows_of)
+        steer = mine["steer"]
+        if steer is not None:  # the same operations as below, in C
+            left, right = np.empty(len(comps)), np.empty(len(comps))
+            steer(
+                mine["heading"],
+                np.ascontiguousarray(angle),
+                cruise,
+                mine["factor"],
+                gain,
+                left,
+                right,
+            )
+            return left, right
+        power = cruise * mine["factor"]
         err = (mine["heading"] - angle + math.pi) % (2 * math.pi) - math.pi  # wrap_angle
-        diff = np.asarray(p.steerGain)[rows] * err
+        diff = gain * err
         cos = np.fromiter(map(math.cos, err.tolist()), dtype=np.float64, count=len(comps))
         forward = power * np.where(cos > 0.0, cos, 0.0)  # max(0.0, cos): NaN gives 0.0
         return forward - diff, forward + diff
@@ -283,3 +308,34 @@ class FreeRobot(Robot):
                 return self._steer(cruise, math.atan2(wy - y, wx - x))
             self.waypoint += 1
         return 0.0, 0.0
+
+
+def _behaviours(behavior: np.ndarray) -> tuple[list[int], np.ndarray | None] | None:
+    """What a group's ``step_many`` does with each copy, from the ``behavior`` array: None
+    when all cruise straight (behaviour 1); else the copies stepped one by one (circles,
+    waypoints, ...) and those that steer at random (behaviour 4, None if none). Kept while
+    the parameter array is the same object (``engine.batch.derived``): a few numpy calls a
+    step fewer."""
+    straight = behavior == 1
+    if straight.all():
+        return None
+    random = behavior == 4
+    rows = np.flatnonzero(random) if random.any() else None
+    return np.flatnonzero(~straight & ~random).tolist(), rows
+
+
+def _rows_of(cruise: np.ndarray, gain: np.ndarray, rows: np.ndarray) -> tuple[Any, Any]:
+    """The random copies' cruise power and steering gain (kept as :func:`_behaviours`), as
+    contiguous float64 arrays (what the C steering reads)."""
+    f64 = np.float64
+    return (
+        np.ascontiguousarray(np.asarray(cruise)[rows], dtype=f64),
+        np.ascontiguousarray(np.asarray(gain)[rows], dtype=f64),
+    )
+
+
+def _steer_random() -> Any:
+    """``_step.steer_random`` where the extension is in use, else None (numpy's path)."""
+    from . import compiled
+
+    return getattr(compiled._step, "steer_random", None) if compiled.columns_compiled() else None

@@ -171,6 +171,13 @@ class ControlledRobot(Robot):
         if "rovers" not in state:
             state["rovers"] = [c.rover for c in comps]
         physics.set_powers(state["rovers"], state["index"], inp["powerL"], inp["powerR"])
+        if "poses" not in state:
+            state["poses"] = _robot_poses()
+        arrays = _pose_arrays(physics) if state["poses"] is not None else None
+        if arrays is not None:  # the same outputs in one C call (``_step.robot_poses``)
+            out = np.empty((len(POSE_OUTPUTS), len(comps)))
+            state["poses"](*arrays, state["index"], out)
+            return dict(zip(POSE_NAMES, out, strict=True)), None
         x, y, a, vx, vy, w = physics.kinematics_array(state["index"]).T
         left, right = physics.rim_array(state["index"]).T
         return {
@@ -182,3 +189,26 @@ class ControlledRobot(Robot):
             "wheelSpeedL": left,
             "wheelSpeedR": right,
         }, None
+
+
+#: :data:`POSE_OUTPUTS`' names, in order (the rows of ``_step.robot_poses``' output)
+POSE_NAMES = tuple(port.name for port in POSE_OUTPUTS)
+
+
+def _robot_poses() -> Any:
+    """``_step.robot_poses`` where the extension is in use, else None (numpy's path)."""
+    from . import compiled
+
+    return getattr(compiled._step, "robot_poses", None) if compiled.columns_compiled() else None
+
+
+def _pose_arrays(physics: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """The (N, 6) state and (2, N) rims arrays a robot group's indices point into, when its
+    rovers are arrays (a batch's columns, a large fleet: a ``fleet.Fleet``); else None."""
+    from .fleet import Fleet
+
+    group = physics.group
+    model = group._model if group is not None else physics._model
+    if not isinstance(model, Fleet):
+        return None
+    return model.state, model.rims

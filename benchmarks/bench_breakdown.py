@@ -1,0 +1,150 @@
+"""Where a batch's CPU goes: the rovers' column physics, each component group, the rest.
+
+The vector env (``FollowVecEnv``, random actions) at each size in ``--vector``, per vector
+step, and a batched sweep (``--sweep``: ``--runs`` runs of 60 s, 25 Kv values, as
+``bench_engine.py`` plans them, in this process), per run. Every group's ``step_many`` and
+every call of the column physics is timed (CPU); "the rest" is the engine's loop, the
+agent's side of the vector env (actions, rewards, observations) and, in a sweep, each
+run's set-up and metrics. The physics line is the floor no work on the rest can pass: the
+ceiling it gives is the rate with everything else free.
+
+Run: ``python benchmarks/bench_breakdown.py [--vector 2 16 64 1000] [--sweep scenario1
+scenario2] [--runs 1000]``. Prints a table; measures nothing against a baseline (the
+ratios are ``bench_speed.py``'s and ``bench_engine.py``'s).
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import sys
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+
+PHYSICS = "(column physics)"
+
+
+@contextmanager
+def timers() -> Iterator[tuple[collections.Counter, collections.Counter]]:
+    """CPU seconds and calls per group template (and :data:`PHYSICS`), summed while open.
+    Patches the classes, so only simulations built inside see the timers."""
+    from amsa_phys.engine.tasks import Steppers
+    from amsa_phys.physics.columns import ColumnPhysics
+
+    cpu: collections.Counter = collections.Counter()
+    calls: collections.Counter = collections.Counter()
+    clock = time.process_time
+
+    def timed(name: Callable[[Any], str], fn: Callable[..., Any]) -> Callable[..., Any]:
+        def wrapper(self: Any, *args: Any) -> Any:
+            t0 = clock()
+            try:
+                return fn(self, *args)
+            finally:
+                key = name(args)
+                cpu[key] += clock() - t0
+                calls[key] += 1
+
+        return wrapper
+
+    saved = Steppers.step_group, ColumnPhysics.step, ColumnPhysics.step_many
+    Steppers.step_group = timed(lambda a: a[0].template.__name__, saved[0])  # type: ignore[method-assign]
+    ColumnPhysics.step = timed(lambda a: PHYSICS, saved[1])  # type: ignore[method-assign]
+    ColumnPhysics.step_many = timed(lambda a: PHYSICS, saved[2])  # type: ignore[method-assign]
+    try:
+        yield cpu, calls
+    finally:
+        Steppers.step_group, ColumnPhysics.step, ColumnPhysics.step_many = saved  # type: ignore[method-assign]
+
+
+def table(
+    total: float, per: float, unit: str, cpu: collections.Counter, calls: dict, each: str
+) -> None:
+    """``cpu`` (seconds over ``per`` vector steps or runs) as one line per part, with its
+    ``calls`` (counted ``each``)."""
+    scale, digits = (1e6, 1) if unit == "us" else (1e3, 3)
+    for name, sec in cpu.most_common():
+        print(
+            f"  {name:24s} {sec / per * scale:9.{digits}f} {unit} ({sec / total:4.0%}), "
+            f"{calls[name]:,.1f} calls {each}"
+        )
+    rest = total - sum(cpu.values())
+    print(f"  {'the rest':24s} {rest / per * scale:9.{digits}f} {unit} ({rest / total:4.0%})")
+
+
+def vector(n: int, steps: int) -> None:
+    """The vector env at ``n`` envs (batched), ``steps`` vector steps after a warm-up."""
+    from amsa_phys.gym.vector import FollowVecEnv
+
+    actions = np.random.default_rng(n).uniform(-1, 1, (steps + 3, n, 2))
+    with timers() as (cpu, calls):
+        env = FollowVecEnv(n, stepping="batch")
+        env.reset(seed=0)
+        for a in actions[:3]:  # the columns and groups start at the first steps
+            env.step(a)
+        cpu.clear()
+        calls.clear()
+        t0 = time.process_time()
+        for a in actions[3:]:
+            env.step(a)
+        total = time.process_time() - t0
+        env.close()
+    physics = cpu[PHYSICS]
+    ceiling = f"; the physics alone would allow {steps * n / physics:,.0f}" if physics else ""
+    print(
+        f"vector env, {n} envs: {total / steps * 1e6:,.0f} us a vector step, "
+        f"{steps * n / total:,.0f} env-steps/s{ceiling}"
+    )
+    table(total, steps, "us", cpu, {k: v / steps for k, v in calls.items()}, "a vector step")
+
+
+def sweep(scenario: str, runs: int) -> None:
+    """A batched sweep of ``runs`` runs of ``scenario`` in this process, as two workers'
+    batches would be cut."""
+    sys.path.insert(0, str(ROOT))
+    from amsa_phys.runs.batched import iter_batched, plan_units
+    from amsa_phys.runs.sweep import Axis, SweepPlan, iter_local
+    from benchmarks.bench_engine import KV, SCENARIOS
+
+    plan = SweepPlan(
+        SCENARIOS[scenario],
+        [Axis("MyFollowerController.Kv", KV)],
+        seeds=max(1, runs // len(KV)),
+        base_seed=1,
+        duration=60.0,
+    )
+    jobs = plan.jobs()
+    with timers() as (cpu, calls):
+        t0 = time.process_time()
+        units, _ = plan_units(jobs, 2)
+        rows = list(iter_batched(units, 1, iter_local))
+        total = time.process_time() - t0
+    n = len(rows)
+    print(
+        f"batched sweep, {scenario}, {n} runs in {len(units)} batches: "
+        f"{total / n * 1e3:.2f} ms CPU a run"
+    )
+    table(total, n, "ms", cpu, {k: v / len(units) for k, v in calls.items()}, "a batch")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--vector", type=int, nargs="*", default=[2, 16, 64, 1000])
+    ap.add_argument("--sweep", nargs="*", default=["scenario1", "scenario2"])
+    ap.add_argument("--runs", type=int, default=1000)
+    args = ap.parse_args()
+    for n in args.vector:
+        vector(n, max(20, min(480, 20_000 // n)))
+    for scenario in args.sweep:
+        sweep(scenario, args.runs)
+
+
+if __name__ == "__main__":
+    main()
