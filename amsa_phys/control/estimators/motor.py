@@ -57,6 +57,20 @@ class MotorMonitor(Template):
     right gain backing off after its leader stops cancelled up to 0.37 of a 30 s window's
     command, a wrong one oscillating 0.15 to 1. A window where more than ``holdReverse``
     cancels out ends the hold at once (the confidence is 0 until the next valid window).
+
+    With ``forwardPower`` > 0 the window is judged over its forward seconds only: a path
+    segment counts when every command in it is at least ``forwardPower`` % and has been
+    for ``settle`` s (a rover that was reversing is still moving backward when the command
+    turns forward, and the path counts that as forward), the command is taken as the
+    actuator delivers it (each wheel within ``powerMax``: a saturated loop's 150 % moves
+    the rover as 100 % does), and the power that went into changing speed is taken per
+    run of counted segments. A window with less than ``minForward`` of its time counted is
+    unsure, unless its mean command magnitude is below ``quietPower`` % (a follower
+    waiting for a stopped leader says nothing about its motors: the last estimate and
+    confidence stand). ``maxReverse`` does not apply then. Off by default: measured on
+    held-out sequences (docs/adaptation.md), it makes a right gain that backs off after a
+    leader's stop sure and keeps an oscillating wrong one unsure, but it also leaves a
+    very worn motor's high gain unsure more often, and no setting was better everywhere.
     """
 
     batchable = True  # each run's copy steps alone in a batch (no step_many needed)
