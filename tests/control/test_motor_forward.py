@@ -92,3 +92,17 @@ def test_a_command_beyond_the_actuators_limit_counts_as_the_limit() -> None:
     assert abs(_at(out, 140)["delivered"] - SHARE) < 0.03
     unclamped = _run({**FORWARD, "maxShare": 10.0, "powerMax": 1000.0}, lambda t: 150.0)
     assert _at(unclamped, 140)["delivered"] < 0.4  # 150 % read as commanded: a third short
+
+
+def test_whole_window_judges_a_window_with_too_few_forward_seconds() -> None:
+    """A high gain on worn motors reverses briefly and often: every reversal costs the
+    settling time, too few seconds count, but little of the command cancels out."""
+
+    def flicker(t: float) -> float:
+        return -4.0 if t >= 60 and int(t) % 7 == 0 else 20.0
+
+    alone = _run(FORWARD, flicker)
+    whole = _run({**FORWARD, "wholeWindow": 1.0}, flicker)
+    assert _at(alone, 140)["valid"] == 0.0
+    assert _at(whole, 140)["valid"] == 1.0
+    assert abs(_at(whole, 140)["delivered"] - SHARE) < 0.05

@@ -157,6 +157,7 @@ def _motor(rng: np.random.Generator) -> Case:
     params["settle"] = float(rng.choice([5.0, 0.0, rng.uniform(0.0, 15.0)]))
     params["quietPower"] = float(rng.choice([0.0, 15.0, rng.uniform(0.0, 60.0)]))
     params["minForward"] = float(rng.choice([0.5, rng.uniform(0.0, 1.0)]))
+    params["wholeWindow"] = float(rng.choice([0.0, 1.0]))
     params["powerMax"] = float(rng.choice([100.0, rng.uniform(5.0, 120.0)]))
     times = _times(rng, params["window"] + rng.uniform(5, 60))
     # commands about a level, sometimes reversing or too small; speed from a delivered share

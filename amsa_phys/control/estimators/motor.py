@@ -67,7 +67,10 @@ class MotorMonitor(Template):
     run of counted segments. A window with less than ``minForward`` of its time counted is
     unsure, unless its mean command magnitude is below ``quietPower`` % (a follower
     waiting for a stopped leader says nothing about its motors: the last estimate and
-    confidence stand). ``maxReverse`` does not apply then. Off by default: measured on
+    confidence stand), or, with ``wholeWindow`` 1, judged as a whole as without
+    ``forwardPower`` (a right high gain reversing briefly and often leaves too few seconds
+    after its settling, yet little of its command cancels out). ``maxReverse`` applies
+    only to a window judged whole. Off by default: measured on
     held-out sequences (docs/adaptation.md), it makes a right gain that backs off after a
     leader's stop sure and keeps an oscillating wrong one unsure, but it also leaves a
     very worn motor's high gain unsure more often, and no setting was better everywhere.
@@ -202,6 +205,15 @@ class MotorMonitor(Template):
             "%",
         ),
         Param(
+            "wholeWindow",
+            "float",
+            "1: a window with too few forward seconds is judged whole (with forwardPower)",
+            0.0,
+            0.0,
+            1.0,
+            "",
+        ),
+        Param(
             "minForward",
             "float",
             "least share of the window that must count for an estimate (with forwardPower)",
@@ -272,30 +284,35 @@ class MotorMonitor(Template):
             if self.power.covered_s() >= p.window - 1e-9 and self.path.covered_s() > 0:
                 self._forward_estimate(now)
         elif self.power.covered_s() >= p.window - 1e-9 and self.path.covered_s() > 0:
-            steps = self.path.items
-            span = steps[-1][0] - steps[0][0]
-            # the first segment ends at steps[0]: it lies before the span, leave it out
-            length = sum(d for _, d in steps) - steps[0][1]
-            speed = length / span
-            # power also went into changing speed: tau * (v_last - v_first) / span on top of
-            # the speed's own share (first-order rover: P ~ v + tau dv/dt)
-            speed += p.timeConstant * (self._edge_speed(-1) - self._edge_speed(0)) / span
-            command = sum(v for _, v in self.power.items) / len(self.power)
-            magnitude = sum(abs(v) for _, v in self.power.items) / len(self.power)
-            # forward enough: at most maxReverse of the command cancels out (0: none reversed)
-            forward = command >= (1.0 - p.maxReverse) * magnitude
-            self.valid = 0.0
-            if command >= p.minPower and forward:
-                share = (p.frictionPower + 100.0 * speed / p.maxSpeed) / command
-                if share <= p.maxShare:
-                    self.estimate = min(share, 1.0)
-                    self.valid = 1.0
-                    self.valid_at = now
-            if p.holdReverse < 1.0 and command < (1.0 - p.holdReverse) * magnitude:
-                self.valid_at = None  # oscillating: the held estimate is not to be trusted
-            if self.valid == 0.0 and self.valid_at is not None and p.validHold > 0:
-                self.valid = max(0.0, 1.0 - (now - self.valid_at) / p.validHold)
+            self._window_estimate(now)
         return {"delivered": self.estimate, "valid": self.valid}
+
+    def _window_estimate(self, now: float) -> None:
+        """The share over the whole window (the default; see the class docstring)."""
+        p = self.p
+        steps = self.path.items
+        span = steps[-1][0] - steps[0][0]
+        # the first segment ends at steps[0]: it lies before the span, leave it out
+        length = sum(d for _, d in steps) - steps[0][1]
+        speed = length / span
+        # power also went into changing speed: tau * (v_last - v_first) / span on top of
+        # the speed's own share (first-order rover: P ~ v + tau dv/dt)
+        speed += p.timeConstant * (self._edge_speed(-1) - self._edge_speed(0)) / span
+        command = sum(v for _, v in self.power.items) / len(self.power)
+        magnitude = sum(abs(v) for _, v in self.power.items) / len(self.power)
+        # forward enough: at most maxReverse of the command cancels out (0: none reversed)
+        forward = command >= (1.0 - p.maxReverse) * magnitude
+        self.valid = 0.0
+        if command >= p.minPower and forward:
+            share = (p.frictionPower + 100.0 * speed / p.maxSpeed) / command
+            if share <= p.maxShare:
+                self.estimate = min(share, 1.0)
+                self.valid = 1.0
+                self.valid_at = now
+        if p.holdReverse < 1.0 and command < (1.0 - p.holdReverse) * magnitude:
+            self.valid_at = None  # oscillating: the held estimate is not to be trusted
+        if self.valid == 0.0 and self.valid_at is not None and p.validHold > 0:
+            self.valid = max(0.0, 1.0 - (now - self.valid_at) / p.validHold)
 
     def _forward_estimate(self, now: float) -> None:
         """The share over the window's forward seconds only (``forwardPower`` > 0).
@@ -327,6 +344,9 @@ class MotorMonitor(Template):
         enough = count > 0 and seconds >= p.minForward * p.window - 1e-9
         if not enough and magnitude < p.quietPower:
             return  # a quiet window (a leader stopped, the follower waiting): nothing new
+        if not enough and p.wholeWindow > 0:
+            self._window_estimate(now)  # too few forward seconds: judged as a whole
+            return
         self.valid = 0.0
         if enough:
             mean = command / count
