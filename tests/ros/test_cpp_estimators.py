@@ -152,10 +152,18 @@ def _motor(rng: np.random.Generator) -> Case:
     # the held estimate's decaying confidence, and how much cancelling out ends it
     params["validHold"] = float(rng.choice([0.0, 20.0, rng.uniform(0.5, 60.0)]))
     params["holdReverse"] = float(rng.choice([1.0, 0.4, rng.uniform(0.0, 1.0)]))
+    # the estimate over forward seconds only: off, the world's, or anything in range
+    params["forwardPower"] = float(rng.choice([0.0, 3.0, 3.0, rng.uniform(0.0, 20.0)]))
+    params["settle"] = float(rng.choice([5.0, 0.0, rng.uniform(0.0, 15.0)]))
+    params["quietPower"] = float(rng.choice([0.0, 15.0, rng.uniform(0.0, 60.0)]))
+    params["minForward"] = float(rng.choice([0.5, rng.uniform(0.0, 1.0)]))
+    params["wholeWindow"] = float(rng.choice([0.0, 1.0]))
+    params["powerMax"] = float(rng.choice([100.0, rng.uniform(5.0, 120.0)]))
     times = _times(rng, params["window"] + rng.uniform(5, 60))
     # commands about a level, sometimes reversing or too small; speed from a delivered share
     level = float(rng.choice([rng.uniform(5, 40), rng.uniform(0, 4)]))
-    swing = float(rng.choice([0.0, rng.uniform(0, 10), rng.uniform(10, 50)]))
+    # a swing beyond 100 % saturates the actuator (an oscillating loop)
+    swing = float(rng.choice([0.0, rng.uniform(0, 10), rng.uniform(10, 50), rng.uniform(80, 150)]))
     delivered = float(rng.choice([1.0, rng.uniform(0.4, 1.0), rng.uniform(1.0, 1.5)]))
     speed = max(0.0, delivered * (level - params["frictionPower"]) * params["maxSpeed"] / 100)
     fixes = _track(rng, times, speed, float(rng.choice([0.0, 0.015, 0.02])))

@@ -57,6 +57,23 @@ class MotorMonitor(Template):
     right gain backing off after its leader stops cancelled up to 0.37 of a 30 s window's
     command, a wrong one oscillating 0.15 to 1. A window where more than ``holdReverse``
     cancels out ends the hold at once (the confidence is 0 until the next valid window).
+
+    With ``forwardPower`` > 0 the window is judged over its forward seconds only: a path
+    segment counts when every command in it is at least ``forwardPower`` % and has been
+    for ``settle`` s (a rover that was reversing is still moving backward when the command
+    turns forward, and the path counts that as forward), the command is taken as the
+    actuator delivers it (each wheel within ``powerMax``: a saturated loop's 150 % moves
+    the rover as 100 % does), and the power that went into changing speed is taken per
+    run of counted segments. A window with less than ``minForward`` of its time counted is
+    unsure, unless its mean command magnitude is below ``quietPower`` % (a follower
+    waiting for a stopped leader says nothing about its motors: the last estimate and
+    confidence stand), or, with ``wholeWindow`` 1, judged as a whole as without
+    ``forwardPower`` (a right high gain reversing briefly and often leaves too few seconds
+    after its settling, yet little of its command cancels out). ``maxReverse`` applies
+    only to a window judged whole. Off by default: measured on
+    held-out sequences (docs/adaptation.md), it makes a right gain that backs off after a
+    leader's stop sure and keeps an oscillating wrong one unsure, but it also leaves a
+    very worn motor's high gain unsure more often, and no setting was better everywhere.
     """
 
     batchable = True  # each run's copy steps alone in a batch (no step_many needed)
@@ -151,6 +168,61 @@ class MotorMonitor(Template):
             "s",
         ),
         Param(
+            "forwardPower",
+            "float",
+            "least command for a second to count in the estimate (0: every second counts)",
+            0.0,
+            0.0,
+            100.0,
+            "%",
+        ),
+        Param(
+            "powerMax",
+            "float",
+            "the actuator's limit on each wheel's command (with forwardPower)",
+            100.0,
+            0.01,
+            1000.0,
+            "%",
+        ),
+        Param(
+            "settle",
+            "float",
+            "time the command must have been forward before a second counts (with forwardPower)",
+            5.0,
+            0.0,
+            600.0,
+            "s",
+        ),
+        Param(
+            "quietPower",
+            "float",
+            "mean command magnitude below which a window without enough forward time keeps "
+            "the last estimate and confidence (with forwardPower)",
+            0.0,
+            0.0,
+            100.0,
+            "%",
+        ),
+        Param(
+            "wholeWindow",
+            "float",
+            "1: a window with too few forward seconds is judged whole (with forwardPower)",
+            0.0,
+            0.0,
+            1.0,
+            "",
+        ),
+        Param(
+            "minForward",
+            "float",
+            "least share of the window that must count for an estimate (with forwardPower)",
+            0.5,
+            0.0,
+            1.0,
+            "",
+        ),
+        Param(
             "holdReverse",
             "float",
             "cancelling-out share of the window's command that ends validHold at once (1: never)",
@@ -167,6 +239,11 @@ class MotorMonitor(Template):
         self.power: Window[float] = Window(self.p.window)
         self.path: Window[float] = Window(self.p.window)
         self.fix: tuple[float, float, float] | None = None
+        #: each path segment as (duration, length, command sum, command count, counts), where
+        #: it counts when its every command was forward and had been for ``settle`` s
+        self.segments: Window[tuple[float, float, float, int, bool]] = Window(self.p.window)
+        self.seg_sum, self.seg_count, self.seg_low = 0.0, 0, math.inf
+        self.forward_since: float | None = None  # the start of the forward run, if any
         self.estimate = 1.0
         self.valid = 0.0
         self.valid_at: float | None = None  # when the last valid window ended
@@ -180,33 +257,126 @@ class MotorMonitor(Template):
         if self.fix is None:
             self.fix = (now, x, y)
         elif now - self.fix[0] >= p.spacing - 1e-9:
-            self.path.add(now, math.hypot(x - self.fix[1], y - self.fix[2]))
+            step = math.hypot(x - self.fix[1], y - self.fix[2])
+            self.path.add(now, step)
+            # the segment's commands are those from its first fix up to (not with) this one
+            counts = (
+                self.seg_count > 0
+                and self.seg_low >= p.forwardPower
+                and self.forward_since is not None
+                and self.fix[0] - self.forward_since >= p.settle - 1e-9
+            )
+            segment = (now - self.fix[0], step, self.seg_sum, self.seg_count, counts)
+            self.segments.add(now, segment)
+            self.seg_sum, self.seg_count, self.seg_low = 0.0, 0, math.inf
             self.fix = (now, x, y)
-        if self.power.covered_s() >= p.window - 1e-9 and self.path.covered_s() > 0:
-            steps = self.path.items
-            span = steps[-1][0] - steps[0][0]
-            # the first segment ends at steps[0]: it lies before the span, leave it out
-            length = sum(d for _, d in steps) - steps[0][1]
-            speed = length / span
-            # power also went into changing speed: tau * (v_last - v_first) / span on top of
-            # the speed's own share (first-order rover: P ~ v + tau dv/dt)
-            speed += p.timeConstant * (self._edge_speed(-1) - self._edge_speed(0)) / span
-            command = sum(v for _, v in self.power.items) / len(self.power)
-            magnitude = sum(abs(v) for _, v in self.power.items) / len(self.power)
-            # forward enough: at most maxReverse of the command cancels out (0: none reversed)
-            forward = command >= (1.0 - p.maxReverse) * magnitude
-            self.valid = 0.0
-            if command >= p.minPower and forward:
-                share = (p.frictionPower + 100.0 * speed / p.maxSpeed) / command
-                if share <= p.maxShare:
-                    self.estimate = min(share, 1.0)
-                    self.valid = 1.0
-                    self.valid_at = now
-            if p.holdReverse < 1.0 and command < (1.0 - p.holdReverse) * magnitude:
-                self.valid_at = None  # oscillating: the held estimate is not to be trusted
-            if self.valid == 0.0 and self.valid_at is not None and p.validHold > 0:
-                self.valid = max(0.0, 1.0 - (now - self.valid_at) / p.validHold)
+        # what reaches the motors: each wheel's command within the actuator's limit
+        hi = p.powerMax
+        power = 0.5 * (min(hi, max(-hi, inp["powerL"])) + min(hi, max(-hi, inp["powerR"])))
+        if power < p.forwardPower:
+            self.forward_since = None
+        elif self.forward_since is None:
+            self.forward_since = now
+        self.seg_sum += power
+        self.seg_count += 1
+        self.seg_low = min(self.seg_low, power)
+        if p.forwardPower > 0:
+            if self.power.covered_s() >= p.window - 1e-9 and self.path.covered_s() > 0:
+                self._forward_estimate(now)
+        elif self.power.covered_s() >= p.window - 1e-9 and self.path.covered_s() > 0:
+            self._window_estimate(now)
         return {"delivered": self.estimate, "valid": self.valid}
+
+    def _window_estimate(self, now: float) -> None:
+        """The share over the whole window (the default; see the class docstring)."""
+        p = self.p
+        steps = self.path.items
+        span = steps[-1][0] - steps[0][0]
+        # the first segment ends at steps[0]: it lies before the span, leave it out
+        length = sum(d for _, d in steps) - steps[0][1]
+        speed = length / span
+        # power also went into changing speed: tau * (v_last - v_first) / span on top of
+        # the speed's own share (first-order rover: P ~ v + tau dv/dt)
+        speed += p.timeConstant * (self._edge_speed(-1) - self._edge_speed(0)) / span
+        command = sum(v for _, v in self.power.items) / len(self.power)
+        magnitude = sum(abs(v) for _, v in self.power.items) / len(self.power)
+        # forward enough: at most maxReverse of the command cancels out (0: none reversed)
+        forward = command >= (1.0 - p.maxReverse) * magnitude
+        self.valid = 0.0
+        if command >= p.minPower and forward:
+            share = (p.frictionPower + 100.0 * speed / p.maxSpeed) / command
+            if share <= p.maxShare:
+                self.estimate = min(share, 1.0)
+                self.valid = 1.0
+                self.valid_at = now
+        if p.holdReverse < 1.0 and command < (1.0 - p.holdReverse) * magnitude:
+            self.valid_at = None  # oscillating: the held estimate is not to be trusted
+        if self.valid == 0.0 and self.valid_at is not None and p.validHold > 0:
+            self.valid = max(0.0, 1.0 - (now - self.valid_at) / p.validHold)
+
+    def _forward_estimate(self, now: float) -> None:
+        """The share over the window's forward seconds only (``forwardPower`` > 0).
+
+        A segment counts when every command in it is at least ``forwardPower``: a leader's
+        stop (the follower backing off, or idling at the reference distance) is left out of
+        both the command and the path, so it neither corrupts the estimate nor makes it
+        unsure, and an oscillating loop's forward strokes still show the motors' share. The
+        power that went into changing speed is taken per forward stretch (a run of counted
+        segments), since the speed jumps across the gaps between them.
+        """
+        p = self.p
+        seconds = length = command = change = 0.0
+        count = 0
+        stretch: list[tuple[float, float]] = []
+        steps = list(self.segments.items)[1:]  # the first began before the window
+        for _, (span, step, total, n, counts) in steps:
+            if counts:
+                stretch.append((span, step))
+                seconds += span
+                length += step
+                command += total
+                count += n
+            else:
+                change += self._stretch_change(stretch)
+                stretch = []
+        change += self._stretch_change(stretch)
+        magnitude = sum(abs(v) for _, v in self.power.items) / len(self.power)
+        enough = count > 0 and seconds >= p.minForward * p.window - 1e-9
+        if not enough and magnitude < p.quietPower:
+            return  # a quiet window (a leader stopped, the follower waiting): nothing new
+        if not enough and p.wholeWindow > 0:
+            self._window_estimate(now)  # too few forward seconds: judged as a whole
+            return
+        self.valid = 0.0
+        if enough:
+            mean = command / count
+            speed = (length + p.timeConstant * change) / seconds
+            share = (p.frictionPower + 100.0 * speed / p.maxSpeed) / mean
+            if mean >= p.minPower and share <= p.maxShare:
+                self.estimate = min(share, 1.0)
+                self.valid = 1.0
+                self.valid_at = now
+        mean_all = sum(v for _, v in self.power.items) / len(self.power)
+        if p.holdReverse < 1.0 and mean_all < (1.0 - p.holdReverse) * magnitude:
+            self.valid_at = None
+        if self.valid == 0.0 and self.valid_at is not None and p.validHold > 0:
+            self.valid = max(0.0, 1.0 - (now - self.valid_at) / p.validHold)
+
+    def _stretch_change(self, stretch: list[tuple[float, float]]) -> float:
+        """Speed over a stretch's last ``edge`` s less over its first (0 if it is empty)."""
+        if not stretch:
+            return 0.0
+
+        def edge(segments: list[tuple[float, float]]) -> float:
+            time = way = 0.0
+            for span, step in segments:
+                if time >= self.p.edge - 1e-9:
+                    break
+                time += span
+                way += step
+            return way / time
+
+        return edge(stretch[::-1]) - edge(stretch)
 
     def _edge_speed(self, end: int) -> float:
         """Mean speed over the first (``end`` 0) or last (-1) ``edge`` s of the window."""
