@@ -411,6 +411,226 @@ static PyTypeObject DrawnType = {
     .tp_getset = Drawn_getset,
 };
 
+/* Kernel(code, comp, ins, outs, values, fallback): a component whose do_step is plain
+ * arithmetic on its inputs (and parameters), stepped without a Python call: ``step(task,
+ * now)`` as the table calls it. ``ins`` and ``outs`` are the store positions of its inputs
+ * and outputs in port order (``engine/kernels.py`` binds them); ``code`` says which body:
+ *
+ *   0  DistanceMonitor: math.hypot(in0 - in2, in1 - in3) (``control/monitor.py``), the
+ *      hypot called as math.hypot itself, so its bits are CPython's whatever the version;
+ *   1  NormalizePower: min(hi, max(lo, v)) * (motorCoef * 0.01) for each of two inputs,
+ *      written as the Python comparisons (a NaN gives lo), its parameters read from
+ *      ``comp.p`` at every call (the timeline changes them between steps).
+ *
+ * Anything the body cannot take as the Python step would (a parameter not a float, or an
+ * int for motorCoef; an output not finite) goes to ``fallback(task, now)``, the component's
+ * ordinary step, which computes the same outputs from the same store (the bodies keep no
+ * state) and publishes or raises exactly as without this type. */
+typedef struct {
+    PyObject_HEAD
+    int code;
+    PyObject *comp, *ins, *outs, *values, *fallback;
+} Kernel;
+
+static PyObject *hypot_fn = NULL;
+static PyObject *p_name = NULL, *lo_name = NULL, *hi_name = NULL, *coef_name = NULL;
+
+static int Kernel_init(Kernel *self, PyObject *args, PyObject *kw) {
+    int code;
+    PyObject *comp, *ins, *outs, *values, *fallback;
+    if (kw != NULL && PyDict_GET_SIZE(kw)) {
+        PyErr_SetString(PyExc_TypeError, "Kernel takes no keywords");
+        return -1;
+    }
+    if (!PyArg_ParseTuple(args, "iOO!O!OO", &code, &comp, &PyTuple_Type, &ins, &PyTuple_Type,
+                          &outs, &values, &fallback)) {
+        return -1;
+    }
+    Py_ssize_t want_in = code == 0 ? 4 : 2, want_out = code == 0 ? 1 : 2;
+    if (code < 0 || code > 1 || PyTuple_GET_SIZE(ins) != want_in ||
+        PyTuple_GET_SIZE(outs) != want_out) {
+        PyErr_SetString(PyExc_ValueError, "Kernel: unknown body, or wrong port counts");
+        return -1;
+    }
+    for (Py_ssize_t k = 0; k < want_in + want_out; k++) {
+        PyObject *at = k < want_in ? PyTuple_GET_ITEM(ins, k) : PyTuple_GET_ITEM(outs, k - want_in);
+        if (!PyLong_CheckExact(at)) {
+            PyErr_SetString(PyExc_TypeError, "Kernel: positions must be ints");
+            return -1;
+        }
+    }
+    self->code = code;
+    PyObject **slots[] = {&self->comp, &self->ins, &self->outs, &self->values, &self->fallback};
+    PyObject *given[] = {comp, ins, outs, values, fallback};
+    for (int k = 0; k < 5; k++) {
+        Py_INCREF(given[k]);
+        Py_XSETREF(*slots[k], given[k]);
+    }
+    return 0;
+}
+
+static int Kernel_traverse(Kernel *self, visitproc visit, void *arg) {
+    Py_VISIT(self->comp);
+    Py_VISIT(self->ins);
+    Py_VISIT(self->outs);
+    Py_VISIT(self->values);
+    Py_VISIT(self->fallback);
+    return 0;
+}
+
+static int Kernel_clear(Kernel *self) {
+    Py_CLEAR(self->comp);
+    Py_CLEAR(self->ins);
+    Py_CLEAR(self->outs);
+    Py_CLEAR(self->values);
+    Py_CLEAR(self->fallback);
+    return 0;
+}
+
+static void Kernel_dealloc(Kernel *self) {
+    PyObject_GC_UnTrack(self);
+    Kernel_clear(self);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+/* The store position ``k`` of the tuple ``at``, checked against the store's length. */
+static int position(PyObject *at, Py_ssize_t k, Py_ssize_t n, Py_ssize_t *out) {
+    Py_ssize_t i = PyLong_AsSsize_t(PyTuple_GET_ITEM(at, k));
+    if (i == -1 && PyErr_Occurred()) {
+        return -1;
+    }
+    if (i < 0 || i >= n) {
+        PyErr_SetString(PyExc_IndexError, "Kernel: position out of range");
+        return -1;
+    }
+    *out = i;
+    return 0;
+}
+
+/* A parameter of ``p`` as a double, when it is a float exactly (ints too with
+ * ``int_ok``): 1; 0 when it is something else (the Python step then judges); -1 on error. */
+static int float_param(PyObject *p, PyObject *name, int int_ok, double *out) {
+    PyObject *v = PyObject_GetAttr(p, name);
+    if (v == NULL) {
+        PyErr_Clear(); /* the Python step raises its own fault for a missing parameter */
+        return 0;
+    }
+    int ok = 1;
+    if (PyFloat_CheckExact(v)) {
+        *out = PyFloat_AS_DOUBLE(v);
+    } else if (int_ok && PyLong_CheckExact(v)) {
+        *out = PyLong_AsDouble(v); /* int * float in Python converts the same way */
+        if (*out == -1.0 && PyErr_Occurred()) {
+            PyErr_Clear();
+            ok = 0;
+        }
+    } else {
+        ok = 0;
+    }
+    Py_DECREF(v);
+    return ok;
+}
+
+static PyObject *Kernel_call(Kernel *self, PyObject *args, PyObject *kw) {
+    if (kw != NULL || !PyTuple_Check(args) || PyTuple_GET_SIZE(args) != 2) {
+        PyErr_SetString(PyExc_TypeError, "step(task, now)");
+        return NULL;
+    }
+    if (self->comp == NULL) {
+        PyErr_SetString(PyExc_TypeError, "Kernel not initialised");
+        return NULL;
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(self->values, &view, PyBUF_WRITABLE | PyBUF_FORMAT) < 0) {
+        return NULL;
+    }
+    if (view.itemsize != sizeof(double) || view.format == NULL || view.format[0] != 'd' ||
+        view.format[1] != '\0') {
+        PyBuffer_Release(&view);
+        PyErr_SetString(PyExc_TypeError, "Kernel: the store must be an array of doubles");
+        return NULL;
+    }
+    double *data = (double *)view.buf;
+    Py_ssize_t n = view.len / (Py_ssize_t)sizeof(double);
+    Py_ssize_t at[6];
+    Py_ssize_t n_in = PyTuple_GET_SIZE(self->ins), n_out = PyTuple_GET_SIZE(self->outs);
+    for (Py_ssize_t k = 0; k < n_in; k++) {
+        if (position(self->ins, k, n, &at[k]) < 0) {
+            goto fail;
+        }
+    }
+    for (Py_ssize_t k = 0; k < n_out; k++) {
+        if (position(self->outs, k, n, &at[n_in + k]) < 0) {
+            goto fail;
+        }
+    }
+    double result[2];
+    int taken = 0; /* 1: the body computed every output, finite */
+    if (self->code == 0) {
+        PyObject *dx = PyFloat_FromDouble(data[at[0]] - data[at[2]]);
+        PyObject *dy = dx == NULL ? NULL : PyFloat_FromDouble(data[at[1]] - data[at[3]]);
+        PyObject *h = NULL;
+        if (dy != NULL) {
+            PyObject *pair[2] = {dx, dy};
+            h = PyObject_Vectorcall(hypot_fn, pair, 2, NULL);
+        }
+        Py_XDECREF(dx);
+        Py_XDECREF(dy);
+        if (h == NULL) {
+            goto fail;
+        }
+        result[0] = PyFloat_AsDouble(h);
+        Py_DECREF(h);
+        taken = result[0] - result[0] == 0.0;
+    } else {
+        PyObject *p = PyObject_GetAttr(self->comp, p_name);
+        if (p == NULL) {
+            goto fail;
+        }
+        double lo, hi, coef;
+        int got = float_param(p, lo_name, 0, &lo);
+        got = got == 1 ? float_param(p, hi_name, 0, &hi) : got;
+        got = got == 1 ? float_param(p, coef_name, 1, &coef) : got;
+        Py_DECREF(p);
+        if (got == 1) {
+            double k = coef * 0.01;
+            for (int j = 0; j < 2; j++) {
+                double v = data[at[j]];
+                v = v > lo ? v : lo;
+                result[j] = (v < hi ? v : hi) * k;
+            }
+            taken = result[0] - result[0] == 0.0 && result[1] - result[1] == 0.0;
+        }
+    }
+    if (taken) {
+        for (Py_ssize_t k = 0; k < n_out; k++) {
+            data[at[n_in + k]] = result[k];
+        }
+    }
+    PyBuffer_Release(&view);
+    if (taken) {
+        Py_RETURN_NONE;
+    }
+    return PyObject_CallFunctionObjArgs(self->fallback, PyTuple_GET_ITEM(args, 0),
+                                        PyTuple_GET_ITEM(args, 1), NULL);
+fail:
+    PyBuffer_Release(&view);
+    return NULL;
+}
+
+static PyTypeObject KernelType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "amsa_phys.engine._publish.Kernel",
+    .tp_basicsize = sizeof(Kernel),
+    .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_HAVE_GC,
+    .tp_doc = "A component's arithmetic body, step(task, now), in C (see _publish.c).",
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)Kernel_init,
+    .tp_dealloc = (destructor)Kernel_dealloc,
+    .tp_traverse = (traverseproc)Kernel_traverse,
+    .tp_clear = (inquiry)Kernel_clear,
+    .tp_call = (ternaryfunc)Kernel_call,
+};
+
 static PyMethodDef methods[] = {
     {"gather", (PyCFunction)(void (*)(void))gather, METH_FASTCALL,
      "gather(ports, positions, values, own) -> dict: a component's inputs from the store "
@@ -428,7 +648,22 @@ static struct PyModuleDef module = {
 };
 
 PyMODINIT_FUNC PyInit__publish(void) {
-    if (PyType_Ready(&ScalarType) < 0 || PyType_Ready(&DrawnType) < 0) {
+    if (PyType_Ready(&ScalarType) < 0 || PyType_Ready(&DrawnType) < 0 ||
+        PyType_Ready(&KernelType) < 0) {
+        return NULL;
+    }
+    PyObject *math = PyImport_ImportModule("math");
+    if (math == NULL) {
+        return NULL;
+    }
+    hypot_fn = PyObject_GetAttrString(math, "hypot");
+    Py_DECREF(math);
+    p_name = PyUnicode_InternFromString("p");
+    lo_name = PyUnicode_InternFromString("powerMin");
+    hi_name = PyUnicode_InternFromString("powerMax");
+    coef_name = PyUnicode_InternFromString("motorCoef");
+    if (hypot_fn == NULL || p_name == NULL || lo_name == NULL || hi_name == NULL ||
+        coef_name == NULL) {
         return NULL;
     }
     do_step_name = PyUnicode_InternFromString("do_step");
@@ -449,6 +684,12 @@ PyMODINIT_FUNC PyInit__publish(void) {
     Py_INCREF(&DrawnType);
     if (PyModule_AddObject(m, "Drawn", (PyObject *)&DrawnType) < 0) {
         Py_DECREF(&DrawnType);
+        Py_DECREF(m);
+        return NULL;
+    }
+    Py_INCREF(&KernelType);
+    if (PyModule_AddObject(m, "Kernel", (PyObject *)&KernelType) < 0) {
+        Py_DECREF(&KernelType);
         Py_DECREF(m);
         return NULL;
     }

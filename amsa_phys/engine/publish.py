@@ -45,6 +45,13 @@ def scalar() -> Any:
     return None if module is None else module.Scalar
 
 
+def kernel() -> Any:
+    """The ``Kernel`` step type from the extension (an arithmetic component's whole step in
+    C, ``kernels.py``), or None."""
+    module = _extension()
+    return getattr(module, "Kernel", None) if module is not None else None
+
+
 def drawn() -> Any:
     """The compiled ``Drawn`` (``engine/rng.py``'s, in C), or None."""
     module = _extension()

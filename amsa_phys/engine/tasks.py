@@ -33,7 +33,7 @@ import numpy as np
 from ..errors import RunFault
 from ..model.params import short_repr
 from ..model.template import Template
-from . import batch, interrupt, publish
+from . import batch, interrupt, kernels, publish
 from .delayedstep import packed_delayed
 from .timing import DelayLine
 from .verdicts import (
@@ -159,8 +159,12 @@ class Steppers:
             return made[1]
         if task.arrays_in or task.arrays_out:
             step = self.step_arrays
+        elif task.delay is not None:
+            step = self.delayed(task)
         else:
-            step = self.scalar(task) if task.delay is None else self.delayed(task)
+            step = self.scalar(task)
+            if self._scalar is not None:  # packed and compiled: an arithmetic body in C
+                step = kernels.kernel(task, self.values, step) or step
         self._made[id(task)] = (task, step)
         return step
 

@@ -1,0 +1,81 @@
+"""Components whose step is plain arithmetic, run as compiled bodies (``_publish.Kernel``).
+
+A distance monitor or a power normaliser computes a number or two from its inputs: through
+the ordinary scalar step that is a dict of inputs, a Python frame, a dict of outputs and
+their judging, ~1 µs for a few floating-point operations. Where the extension is built, the
+store is packed and the component is exactly such a template — its class's own ``do_step``,
+not a subclass's or an instance's replacement — ``Kernel`` reads the store, computes the
+same operations in the same order and writes the results, in one C call. What it cannot
+take as the Python step would (a parameter of another type, an output that is not finite)
+it hands to the component's ordinary step, which publishes or raises exactly as before, so
+a run is the same bit for bit and fault for fault either way (``tests/engine/test_kernels.py``).
+``AMSA_PHYS_PURE=1`` (``publish.py``) runs every component through Python.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from fractions import Fraction
+from typing import TYPE_CHECKING, Any
+
+from . import publish
+
+if TYPE_CHECKING:
+    from .tasks import Task
+
+#: the bodies ``_publish.Kernel`` knows: (module, class) -> (code, input ports, output ports)
+BODIES: dict[tuple[str, str], tuple[int, tuple[str, ...], tuple[str, ...]]] = {
+    ("amsa_phys.control.monitor", "DistanceMonitor"): (
+        0,
+        ("xLeader", "yLeader", "xFollower", "yFollower"),
+        ("distanceFollowerToLeader",),
+    ),
+    ("amsa_phys.control.normalize", "NormalizePower"): (
+        1,
+        ("powerL", "powerR"),
+        ("normalizedPowerL", "normalizedPowerR"),
+    ),
+}
+
+
+def body_of(comp: Any) -> tuple[int, tuple[str, ...], tuple[str, ...]] | None:
+    """The compiled body of ``comp``'s step, or None: only an instance of a listed class
+    itself (a subclass may change what its step does) whose ``do_step`` is the class's own."""
+    cls = type(comp)
+    key = (cls.__module__, cls.__qualname__)
+    body = BODIES.get(key)
+    if body is None or "do_step" in getattr(comp, "__dict__", {}):
+        return None
+    # the class's do_step as written in its module (a test or a plugin may have replaced it)
+    fn = cls.__dict__.get("do_step")
+    if (getattr(fn, "__module__", None), getattr(fn, "__qualname__", None)) != (
+        key[0],
+        f"{key[1]}.do_step",
+    ):
+        return None
+    return body
+
+
+def kernel(task: Task, values: Any, fallback: Callable[[Task, Fraction], None]) -> Any:
+    """``task``'s step as a compiled body (see the module docstring), or None: the
+    extension not built, the pure path asked for, or no body for this component."""
+    make = publish.kernel()
+    body = body_of(task.comp)
+    if make is None or body is None:
+        return None
+    code, ins, outs = body
+    reads = dict(task.reads)
+    writes = task.writes
+    # every input connected and every output bound to a position: else the Python step
+    if set(reads) != set(ins) or any(type(reads[p]) is not int or reads[p] < 0 for p in ins):
+        return None
+    if set(writes) != set(outs) or any(type(writes[p]) is not int for p in outs):
+        return None
+    return make(
+        code,
+        task.comp,
+        tuple(reads[p] for p in ins),
+        tuple(writes[p] for p in outs),
+        values,
+        fallback,
+    )

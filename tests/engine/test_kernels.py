@@ -1,0 +1,206 @@
+"""Arithmetic components stepped as compiled bodies (``engine/kernels.py``) give the runs,
+the episodes and the faults of their Python steps, bit for bit."""
+
+from __future__ import annotations
+
+import importlib.util
+from array import array
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import amsa_phys as ap
+from amsa_phys.control.monitor import DistanceMonitor
+from amsa_phys.control.normalize import NormalizePower
+from amsa_phys.engine import kernels
+from amsa_phys.engine.tasks import Steppers, Task
+from amsa_phys.errors import RunFault
+from amsa_phys.gym import FollowEnv
+
+ROOT = Path(__file__).resolve().parents[2]
+BUILT = importlib.util.find_spec("amsa_phys.engine._publish") is not None
+needs_c = pytest.mark.skipif(not BUILT, reason="the extension was not built (no C compiler)")
+NOW = Fraction(5, 4)
+
+#: scenario2 whose actuator's parameters change mid-run (the body reads them at each step):
+#: worn motors from 20 s, a narrower range from 40 s, an int coefficient back at 60 s
+CHANGING: dict[str, Any] = {
+    "name": "kernels",
+    "world": str(ROOT / "worlds" / "mde_challenge.yaml"),
+    "duration": 80,
+    "seed": 3,
+    "set": {"Leader.behavior": 4, "LeaderGPS.lostDataGPS": 10},
+    "timeline": [
+        {"at": 20, "set": {"MyNormalizePower.motorCoef": 60}},
+        {"at": 40, "set": {"MyNormalizePower.powerMax": 7.5, "MyNormalizePower.powerMin": -3.0}},
+        {"at": 60, "set": {"MyNormalizePower.motorCoef": 85}},
+    ],
+}
+
+
+def _without_bodies(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(kernels, "BODIES", {})
+
+
+def _trace(source: Any) -> bytes:
+    return ap.run(source).trace.tobytes()
+
+
+@needs_c
+def test_the_follow_world_steps_its_monitor_and_actuator_in_c() -> None:
+    """Else the comparisons below would compare the Python step with itself."""
+    env = FollowEnv()
+    env.reset(seed=0)
+    steps = {t.path: type(run).__name__ for e in env._episode.sim._plan for run, t in e[1]}
+    env.close()
+    assert steps["MyDistanceMonitor"] == "Kernel"
+    assert steps["MyNormalizePower"] == "Kernel"
+    assert steps["FollowerGPS"] != "Kernel"
+
+
+@pytest.mark.parametrize(
+    "source",
+    [
+        str(ROOT / "scenarios" / "scenario1.yaml"),
+        str(ROOT / "scenarios" / "paper_fig6.yaml"),
+        CHANGING,
+    ],
+    ids=["scenario1", "paper_fig6", "parameters-change"],
+)
+def test_runs_are_byte_identical_with_and_without_the_bodies(
+    source: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    compiled = _trace(source)
+    _without_bodies(monkeypatch)
+    assert _trace(source) == compiled
+
+
+def _episode(actions: np.ndarray) -> bytes:
+    env = FollowEnv(duration=30)
+    obs, _ = env.reset(seed=11)
+    rows = [obs]
+    rewards = []
+    for a in actions:
+        obs, reward, _, truncated, info = env.step(a)
+        rows.append(obs)
+        rewards.append([reward, info["signal"]])
+        if truncated:
+            break
+    env.close()
+    return np.concatenate([np.ravel(rows), np.ravel(rewards)]).tobytes()
+
+
+def test_episodes_are_byte_identical_with_and_without_the_bodies(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    actions = np.random.default_rng(4).uniform(-1.2, 1.2, (130, 2))  # past the end, clamped
+    compiled = _episode(actions)
+    _without_bodies(monkeypatch)
+    assert _episode(actions) == compiled
+
+
+# -- one step, against the Python step, on what a run rarely meets -------------------------
+def _stepped(comp: Any, inputs: list[float], body: bool) -> tuple[list[float], str, str]:
+    """The store after one step of ``comp`` (inputs first, then its outputs), its fault,
+    and how it stepped."""
+    ins = [p.name for p in comp.inputs]
+    outs = [p.name for p in comp.outputs]
+    n = len(ins)
+    values = array("d", [*inputs, -7.0, -7.0][: n + len(outs)])
+    task = Task("C", comp, 1, [(p, f"S.{p}") for p in ins], {p: f"C.{p}" for p in outs})
+    where = {f"S.{p}": i for i, p in enumerate(ins)} | {f"C.{p}": n + i for i, p in enumerate(outs)}
+    task.bind(where.__getitem__)
+    steppers = Steppers(values, lambda *_: None, lambda p: f"{p} (T)")
+    if not body:
+        steppers._scalar = None  # the packed store's other compiled step stays out too
+    step = steppers.for_task(task)
+    try:
+        step(task, NOW)
+    except RunFault as exc:
+        return values.tolist(), str(exc), type(step).__name__
+    return values.tolist(), "", type(step).__name__
+
+
+INF, NAN = float("inf"), float("nan")
+MONITOR_INPUTS = [
+    [3.0, 4.0, 0.0, 0.0],
+    [1e308, -1e308, -1e308, 1e308],  # an infinite distance: a fault
+    [NAN, 0.0, 0.0, 0.0],
+    [INF, 0.0, INF, 0.0],  # inf - inf
+    [5e-324, 0.0, 0.0, 0.0],
+    [0.1, 0.2, 0.3, 0.4],
+]
+
+
+@needs_c
+@pytest.mark.parametrize("inputs", MONITOR_INPUTS, ids=repr)
+def test_the_monitor_body_publishes_and_faults_as_its_python_step(inputs: list[float]) -> None:
+    got = _stepped(DistanceMonitor("M", {}), inputs, True)
+    want = _stepped(DistanceMonitor("M", {}), inputs, False)
+    assert got[2] == "Kernel"
+    assert np.array(got[0]).tobytes() == np.array(want[0]).tobytes()
+    assert got[1] == want[1]
+
+
+def _normaliser(**params: Any) -> NormalizePower:
+    comp = NormalizePower("N", {})
+    comp.p.__dict__.update(params)
+    return comp
+
+
+POWERS = [[150.0, -150.0], [12.5, -0.3], [NAN, INF], [-INF, 99.99]]
+PARAMS: list[dict[str, Any]] = [
+    {},
+    {"motorCoef": 60},
+    {"motorCoef": 37.5},  # a float coefficient
+    {"powerMin": -3.0, "powerMax": 7.5, "motorCoef": 7},
+    {"powerMin": -5, "powerMax": 5},  # ints: the Python step compares them itself
+    {"motorCoef": True},
+    {"motorCoef": "60"},  # not a number: the Python step's fault
+    {"powerMax": INF, "motorCoef": 100},  # an infinite output: its fault
+]
+
+
+@needs_c
+@pytest.mark.parametrize("params", PARAMS, ids=repr)
+@pytest.mark.parametrize("powers", POWERS, ids=repr)
+def test_the_actuator_body_publishes_and_faults_as_its_python_step(
+    powers: list[float], params: dict[str, Any]
+) -> None:
+    got = _stepped(_normaliser(**params), powers, True)
+    want = _stepped(_normaliser(**params), powers, False)
+    assert got[2] == "Kernel"
+    assert np.array(got[0]).tobytes() == np.array(want[0]).tobytes()
+    assert got[1] == want[1]
+
+
+def test_a_replaced_step_is_called_not_the_body(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A class's do_step replaced (a test's, a plugin's), or an instance's own: that is
+    what runs."""
+    monkeypatch.setattr(
+        DistanceMonitor, "do_step", lambda self, t, inp: {"distanceFollowerToLeader": 1.25}
+    )
+    values, fault, how = _stepped(DistanceMonitor("M", {}), [3.0, 4.0, 0.0, 0.0], True)
+    assert (values[-1], fault, how) == (1.25, "", "Scalar" if BUILT else "function")
+    monkeypatch.undo()
+    comp = _normaliser()
+    comp.do_step = lambda t, inp: {"normalizedPowerL": 2.0}  # type: ignore[method-assign]
+    values, fault, how = _stepped(comp, [10.0, 10.0], True)
+    assert values[2:] == [2.0, -7.0]
+    assert how != "Kernel"
+
+
+class Louder(NormalizePower):
+    """A subclass: its step may differ (here it does), so it never runs as the body."""
+
+    def do_step(self, t: Fraction, inp: Any) -> Any:
+        return {"normalizedPowerL": 1.0, "normalizedPowerR": 1.0}
+
+
+def test_a_subclass_is_stepped_as_written() -> None:
+    values, _, how = _stepped(Louder("N", {}), [50.0, 50.0], True)
+    assert values[2:] == [1.0, 1.0]
+    assert how != "Kernel"
