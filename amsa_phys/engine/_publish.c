@@ -30,6 +30,8 @@
 #include <Python.h>
 #include <structmember.h>
 
+#include <math.h>
+
 /* 1: every item of ``out`` written; 0: declined (the Python loop judges) */
 static int publish_into(PyObject *out, PyObject *targets, PyObject *values) {
     if (!PyDict_CheckExact(out) || !PyDict_CheckExact(targets)) {
@@ -420,7 +422,16 @@ static PyTypeObject DrawnType = {
  *      hypot called as math.hypot itself, so its bits are CPython's whatever the version;
  *   1  NormalizePower: min(hi, max(lo, v)) * (motorCoef * 0.01) for each of two inputs,
  *      written as the Python comparisons (a NaN gives lo), its parameters read from
- *      ``comp.p`` at every call (the timeline changes them between steps).
+ *      ``comp.p`` at every call (the timeline changes them between steps);
+ *   2  controlledRobot: ``comp.rover.set_power(in0, in1)`` called (Python: the driver's
+ *      state is the rover's), then the pose ``Robot._pose`` publishes, from the physics
+ *      step's own readers (``rover._source``, ``rover._rims``), without its dict;
+ *   3  freeRobot: the same after ``comp._behaviour(now)`` chose the powers.
+ *
+ * The robots' bodies call Python (the behaviour, the driver) before they publish: what
+ * those raise goes to ``failed(exc, now)`` and a pose they cannot write as floats (not
+ * finite, or a reader that gives something else) to ``judge(out, now)`` with the dict
+ * ``_pose`` returns, both the scalar step's own (``Scalar``), so the faults are its faults.
  *
  * Anything the body cannot take as the Python step would (a parameter not a float, or an
  * int for motorCoef; an output not finite) goes to ``fallback(task, now)``, the component's
@@ -429,26 +440,36 @@ static PyTypeObject DrawnType = {
 typedef struct {
     PyObject_HEAD
     int code;
-    PyObject *comp, *ins, *outs, *values, *fallback;
+    PyObject *comp, *ins, *outs, *values, *fallback, *failed, *judge;
 } Kernel;
 
 static PyObject *hypot_fn = NULL;
 static PyObject *p_name = NULL, *lo_name = NULL, *hi_name = NULL, *coef_name = NULL;
+static PyObject *supply_name = NULL, *rover_name = NULL, *source_name = NULL,
+                *rims_name = NULL, *set_power_name = NULL, *behaviour_name = NULL,
+                *pose_name = NULL;
+
+/* The number of inputs and outputs of each body. */
+static const Py_ssize_t kernel_ins[] = {4, 2, 2, 0};
+static const Py_ssize_t kernel_outs[] = {1, 2, 7, 7};
 
 static int Kernel_init(Kernel *self, PyObject *args, PyObject *kw) {
     int code;
-    PyObject *comp, *ins, *outs, *values, *fallback;
+    PyObject *comp, *ins, *outs, *values, *fallback, *failed, *judge;
     if (kw != NULL && PyDict_GET_SIZE(kw)) {
         PyErr_SetString(PyExc_TypeError, "Kernel takes no keywords");
         return -1;
     }
-    if (!PyArg_ParseTuple(args, "iOO!O!OO", &code, &comp, &PyTuple_Type, &ins, &PyTuple_Type,
-                          &outs, &values, &fallback)) {
+    if (!PyArg_ParseTuple(args, "iOO!O!OOOO", &code, &comp, &PyTuple_Type, &ins, &PyTuple_Type,
+                          &outs, &values, &fallback, &failed, &judge)) {
         return -1;
     }
-    Py_ssize_t want_in = code == 0 ? 4 : 2, want_out = code == 0 ? 1 : 2;
-    if (code < 0 || code > 1 || PyTuple_GET_SIZE(ins) != want_in ||
-        PyTuple_GET_SIZE(outs) != want_out) {
+    if (code < 0 || code > 3) {
+        PyErr_SetString(PyExc_ValueError, "Kernel: unknown body");
+        return -1;
+    }
+    Py_ssize_t want_in = kernel_ins[code], want_out = kernel_outs[code];
+    if (PyTuple_GET_SIZE(ins) != want_in || PyTuple_GET_SIZE(outs) != want_out) {
         PyErr_SetString(PyExc_ValueError, "Kernel: unknown body, or wrong port counts");
         return -1;
     }
@@ -460,9 +481,10 @@ static int Kernel_init(Kernel *self, PyObject *args, PyObject *kw) {
         }
     }
     self->code = code;
-    PyObject **slots[] = {&self->comp, &self->ins, &self->outs, &self->values, &self->fallback};
-    PyObject *given[] = {comp, ins, outs, values, fallback};
-    for (int k = 0; k < 5; k++) {
+    PyObject **slots[] = {&self->comp,     &self->ins,    &self->outs, &self->values,
+                          &self->fallback, &self->failed, &self->judge};
+    PyObject *given[] = {comp, ins, outs, values, fallback, failed, judge};
+    for (int k = 0; k < 7; k++) {
         Py_INCREF(given[k]);
         Py_XSETREF(*slots[k], given[k]);
     }
@@ -475,6 +497,8 @@ static int Kernel_traverse(Kernel *self, visitproc visit, void *arg) {
     Py_VISIT(self->outs);
     Py_VISIT(self->values);
     Py_VISIT(self->fallback);
+    Py_VISIT(self->failed);
+    Py_VISIT(self->judge);
     return 0;
 }
 
@@ -484,6 +508,8 @@ static int Kernel_clear(Kernel *self) {
     Py_CLEAR(self->outs);
     Py_CLEAR(self->values);
     Py_CLEAR(self->fallback);
+    Py_CLEAR(self->failed);
+    Py_CLEAR(self->judge);
     return 0;
 }
 
@@ -531,6 +557,203 @@ static int float_param(PyObject *p, PyObject *name, int int_ok, double *out) {
     return ok;
 }
 
+/* What do_step raised, handed to ``failed(exc, now)`` (which raises the scalar step's fault
+ * for it): the Scalar step's way, NULL always. */
+static PyObject *hand_fault(PyObject *failed, PyObject *now) {
+    PyObject *type, *value, *tb;
+    PyErr_Fetch(&type, &value, &tb);
+    PyErr_NormalizeException(&type, &value, &tb);
+    if (tb != NULL && value != NULL) {
+        PyException_SetTraceback(value, tb);
+    }
+    PyObject *res = PyObject_CallFunctionObjArgs(failed, value ? value : Py_None, now, NULL);
+    Py_XDECREF(type);
+    Py_XDECREF(value);
+    Py_XDECREF(tb);
+    if (res != NULL) {
+        Py_DECREF(res);
+        PyErr_SetString(PyExc_SystemError, "Kernel: failed() returned");
+    }
+    return NULL;
+}
+
+/* Python's float ``x % y`` (Objects/floatobject.c float_rem), for y != 0. */
+static double py_mod(double x, double y) {
+    double mod = fmod(x, y);
+    if (mod) {
+        if ((y < 0) != (mod < 0)) {
+            mod += y;
+        }
+    } else {
+        mod = copysign(0.0, y);
+    }
+    return mod;
+}
+
+/* ``n`` exact floats of the sequence ``seq`` into ``out``: 1, or 0 for anything else. */
+static int floats_of(PyObject *seq, Py_ssize_t n, double *out) {
+    if (!PyTuple_CheckExact(seq) && !PyList_CheckExact(seq)) {
+        return 0;
+    }
+    if (PySequence_Fast_GET_SIZE(seq) != n) {
+        return 0;
+    }
+    PyObject **items = PySequence_Fast_ITEMS(seq);
+    for (Py_ssize_t k = 0; k < n; k++) {
+        if (!PyFloat_CheckExact(items[k])) {
+            return 0;
+        }
+        out[k] = PyFloat_AS_DOUBLE(items[k]);
+    }
+    return 1;
+}
+
+/* The robots' bodies (codes 2 and 3; see Kernel's comment). */
+static PyObject *robot_step(Kernel *self, PyObject *task, PyObject *now) {
+    PyObject *comp = self->comp;
+    PyObject *rover = NULL, *source = NULL, *rims = NULL, *powers = NULL, *res = NULL;
+    if (self->code == 2) { /* a supply (battery, windings): the Python step */
+        PyObject *supply = PyObject_GetAttr(comp, supply_name);
+        if (supply == NULL) {
+            return NULL;
+        }
+        int ideal = supply == Py_None;
+        Py_DECREF(supply);
+        if (!ideal) {
+            return PyObject_CallFunctionObjArgs(self->fallback, task, now, NULL);
+        }
+    }
+    rover = PyObject_GetAttr(comp, rover_name);
+    if (rover == NULL) {
+        return hand_fault(self->failed, now);
+    }
+    source = PyObject_GetAttr(rover, source_name);
+    rims = source == NULL ? NULL : PyObject_GetAttr(rover, rims_name);
+    if (rims == NULL) {
+        goto done;
+    }
+    if (source == Py_None) { /* no physics step's reader: the Python step */
+        res = PyObject_CallFunctionObjArgs(self->fallback, task, now, NULL);
+        goto done;
+    }
+    PyObject *left, *right;
+    if (self->code == 2) {
+        Py_buffer view;
+        if (PyObject_GetBuffer(self->values, &view, PyBUF_FORMAT) < 0) {
+            goto done;
+        }
+        const double *data = (const double *)view.buf;
+        Py_ssize_t n = view.len / (Py_ssize_t)sizeof(double), at[2];
+        int bad = view.itemsize != sizeof(double) || view.format == NULL ||
+                  view.format[0] != 'd' || view.format[1] != '\0';
+        for (Py_ssize_t k = 0; k < 2 && !bad; k++) {
+            bad = position(self->ins, k, n, &at[k]) < 0;
+        }
+        if (bad) {
+            PyBuffer_Release(&view);
+            if (!PyErr_Occurred()) {
+                PyErr_SetString(PyExc_TypeError, "Kernel: the store must be an array of doubles");
+            }
+            goto done;
+        }
+        powers = Py_BuildValue("(dd)", data[at[0]], data[at[1]]);
+        PyBuffer_Release(&view);
+        if (powers == NULL) {
+            goto done;
+        }
+    } else {
+        powers = PyObject_CallMethodObjArgs(comp, behaviour_name, now, NULL);
+        if (powers == NULL) {
+            res = hand_fault(self->failed, now);
+            goto done;
+        }
+        if (!PyTuple_CheckExact(powers) || PyTuple_GET_SIZE(powers) != 2) {
+            PyErr_SetString(PyExc_SystemError, "Kernel: _behaviour gave no pair");
+            goto done;
+        }
+    }
+    left = PyTuple_GET_ITEM(powers, 0);
+    right = PyTuple_GET_ITEM(powers, 1);
+    PyObject *set = PyObject_CallMethodObjArgs(rover, set_power_name, left, right, NULL);
+    if (set == NULL) {
+        res = hand_fault(self->failed, now);
+        goto done;
+    }
+    Py_DECREF(set);
+    /* Robot._pose: x, y, a, vx, vy, w from the state reader, the rims' speeds */
+    double kin[6], rim[2] = {0.0, 0.0};
+    PyObject *state = PyObject_CallNoArgs(source);
+    if (state == NULL) {
+        res = hand_fault(self->failed, now);
+        goto done;
+    }
+    int plain = floats_of(state, 6, kin);
+    Py_DECREF(state);
+    if (plain && rims != Py_None) {
+        PyObject *r = PyObject_CallNoArgs(rims);
+        if (r == NULL) {
+            res = hand_fault(self->failed, now);
+            goto done;
+        }
+        plain = floats_of(r, 2, rim);
+        Py_DECREF(r);
+    }
+    double out[7];
+    if (plain) {
+        const double pi = 3.141592653589793, two_pi = 2 * 3.141592653589793;
+        double a = kin[2];
+        out[0] = kin[0];
+        out[1] = kin[1];
+        out[2] = py_mod(a + pi, two_pi) - pi;
+        double along = kin[3] * cos(a);
+        double across = kin[4] * sin(a);
+        out[3] = along + across;
+        out[4] = kin[5];
+        out[5] = rim[0];
+        out[6] = rim[1];
+        for (int k = 0; k < 7 && plain; k++) {
+            plain = out[k] - out[k] == 0.0;
+        }
+    }
+    if (!plain) { /* the pose as _pose gives it, judged by the Python loop */
+        PyObject *pose = PyObject_CallMethodNoArgs(comp, pose_name);
+        if (pose == NULL) {
+            res = hand_fault(self->failed, now);
+            goto done;
+        }
+        res = PyObject_CallFunctionObjArgs(self->judge, pose, now, NULL);
+        Py_DECREF(pose);
+        goto done;
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(self->values, &view, PyBUF_WRITABLE | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    double *data = (double *)view.buf;
+    Py_ssize_t n = view.len / (Py_ssize_t)sizeof(double), at[7];
+    int bad = view.itemsize != sizeof(double) || view.format == NULL || view.format[0] != 'd' ||
+              view.format[1] != '\0';
+    for (Py_ssize_t k = 0; k < 7 && !bad; k++) {
+        bad = position(self->outs, k, n, &at[k]) < 0;
+    }
+    if (!bad) {
+        for (int k = 0; k < 7; k++) {
+            data[at[k]] = out[k];
+        }
+        Py_INCREF(Py_None);
+        res = Py_None;
+    } else if (!PyErr_Occurred()) {
+        PyErr_SetString(PyExc_TypeError, "Kernel: the store must be an array of doubles");
+    }
+    PyBuffer_Release(&view);
+done:
+    Py_XDECREF(rover);
+    Py_XDECREF(source);
+    Py_XDECREF(rims);
+    Py_XDECREF(powers);
+    return res;
+}
+
 static PyObject *Kernel_call(Kernel *self, PyObject *args, PyObject *kw) {
     if (kw != NULL || !PyTuple_Check(args) || PyTuple_GET_SIZE(args) != 2) {
         PyErr_SetString(PyExc_TypeError, "step(task, now)");
@@ -539,6 +762,9 @@ static PyObject *Kernel_call(Kernel *self, PyObject *args, PyObject *kw) {
     if (self->comp == NULL) {
         PyErr_SetString(PyExc_TypeError, "Kernel not initialised");
         return NULL;
+    }
+    if (self->code >= 2) {
+        return robot_step(self, PyTuple_GET_ITEM(args, 0), PyTuple_GET_ITEM(args, 1));
     }
     Py_buffer view;
     if (PyObject_GetBuffer(self->values, &view, PyBUF_WRITABLE | PyBUF_FORMAT) < 0) {
@@ -662,6 +888,17 @@ PyMODINIT_FUNC PyInit__publish(void) {
     lo_name = PyUnicode_InternFromString("powerMin");
     hi_name = PyUnicode_InternFromString("powerMax");
     coef_name = PyUnicode_InternFromString("motorCoef");
+    supply_name = PyUnicode_InternFromString("supply");
+    rover_name = PyUnicode_InternFromString("rover");
+    source_name = PyUnicode_InternFromString("_source");
+    rims_name = PyUnicode_InternFromString("_rims");
+    set_power_name = PyUnicode_InternFromString("set_power");
+    behaviour_name = PyUnicode_InternFromString("_behaviour");
+    pose_name = PyUnicode_InternFromString("_pose");
+    if (supply_name == NULL || rover_name == NULL || source_name == NULL || rims_name == NULL ||
+        set_power_name == NULL || behaviour_name == NULL || pose_name == NULL) {
+        return NULL;
+    }
     if (hypot_fn == NULL || p_name == NULL || lo_name == NULL || hi_name == NULL ||
         coef_name == NULL) {
         return NULL;

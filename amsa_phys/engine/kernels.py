@@ -23,6 +23,9 @@ from . import publish
 if TYPE_CHECKING:
     from .tasks import Task
 
+#: what both robots publish, in ``Robot._pose``'s order
+POSE = ("posX", "posY", "heading", "speed", "yawRate", "wheelSpeedL", "wheelSpeedR")
+
 #: the bodies ``_publish.Kernel`` knows: (module, class) -> (code, input ports, output ports)
 BODIES: dict[tuple[str, str], tuple[int, tuple[str, ...], tuple[str, ...]]] = {
     ("amsa_phys.control.monitor", "DistanceMonitor"): (
@@ -35,7 +38,15 @@ BODIES: dict[tuple[str, str], tuple[int, tuple[str, ...], tuple[str, ...]]] = {
         ("powerL", "powerR"),
         ("normalizedPowerL", "normalizedPowerR"),
     ),
+    ("amsa_phys.physics.robots", "ControlledRobot"): (2, ("powerL", "powerR"), POSE),
+    ("amsa_phys.physics.freerobot", "FreeRobot"): (3, (), POSE),
 }
+
+#: methods a body computes itself, besides ``do_step``: each must still be the one written
+#: in its module (the body calls the others, ``set_power`` and ``_behaviour``, by name)
+COMPUTED = {2: ("_pose",), 3: ("_pose",)}
+#: where those methods are written
+WRITTEN = {"_pose": ("amsa_phys.physics.robots", "Robot._pose")}
 
 
 def body_of(comp: Any) -> tuple[int, tuple[str, ...], tuple[str, ...]] | None:
@@ -48,17 +59,33 @@ def body_of(comp: Any) -> tuple[int, tuple[str, ...], tuple[str, ...]] | None:
         return None
     # the class's do_step as written in its module (a test or a plugin may have replaced it)
     fn = cls.__dict__.get("do_step")
-    if (getattr(fn, "__module__", None), getattr(fn, "__qualname__", None)) != (
-        key[0],
-        f"{key[1]}.do_step",
-    ):
+    if _where(fn) != (key[0], f"{key[1]}.do_step"):
         return None
+    for name in COMPUTED.get(body[0], ()):
+        if (
+            name in getattr(comp, "__dict__", {})
+            or _where(getattr(cls, name, None)) != WRITTEN[name]
+        ):
+            return None
     return body
 
 
-def kernel(task: Task, values: Any, fallback: Callable[[Task, Fraction], None]) -> Any:
+def _where(fn: Any) -> tuple[Any, Any]:
+    """Where a function was written: its module and qualified name."""
+    return getattr(fn, "__module__", None), getattr(fn, "__qualname__", None)
+
+
+def kernel(
+    task: Task,
+    values: Any,
+    fallback: Callable[[Task, Fraction], None],
+    judges: tuple[Callable[..., None], Callable[..., None]],
+) -> Any:
     """``task``'s step as a compiled body (see the module docstring), or None: the
-    extension not built, the pure path asked for, or no body for this component."""
+    extension not built, the pure path asked for, or no body for this component.
+    ``fallback`` is the component's ordinary step; ``judges`` the scalar step's
+    ``(failed, judge)`` (``Steppers._judges``), for what a robot's body meets after it has
+    called into Python."""
     make = publish.kernel()
     body = body_of(task.comp)
     if make is None or body is None:
@@ -78,4 +105,5 @@ def kernel(task: Task, values: Any, fallback: Callable[[Task, Fraction], None]) 
         tuple(writes[p] for p in outs),
         values,
         fallback,
+        *judges,
     )

@@ -164,7 +164,7 @@ class Steppers:
         else:
             step = self.scalar(task)
             if self._scalar is not None:  # packed and compiled: an arithmetic body in C
-                step = kernels.kernel(task, self.values, step) or step
+                step = kernels.kernel(task, self.values, step, self._judges(task)) or step
         self._made[id(task)] = (task, step)
         return step
 

@@ -19,6 +19,8 @@ from amsa_phys.engine import kernels
 from amsa_phys.engine.tasks import Steppers, Task
 from amsa_phys.errors import RunFault
 from amsa_phys.gym import FollowEnv
+from amsa_phys.physics.freerobot import FreeRobot
+from amsa_phys.physics.robots import ControlledRobot
 
 ROOT = Path(__file__).resolve().parents[2]
 BUILT = importlib.util.find_spec("amsa_phys.engine._publish") is not None
@@ -41,6 +43,18 @@ CHANGING: dict[str, Any] = {
 }
 
 
+def _leader(behavior: int, **more: Any) -> dict[str, Any]:
+    """The MDE world, its leader driving by ``behavior``; a wheel parameter changes at 15 s."""
+    return {
+        "name": f"leader{behavior}",
+        "world": str(ROOT / "worlds" / "mde_challenge.yaml"),
+        "duration": 30,
+        "seed": 5,
+        "set": {"Leader.behavior": behavior, "Leader.cruisePower": 12.0, **more},
+        "timeline": [{"at": 15, "set": {"Follower.freeSpeed": 4.0, "Leader.cruisePower": 20.0}}],
+    }
+
+
 def _without_bodies(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(kernels, "BODIES", {})
 
@@ -56,8 +70,8 @@ def test_the_follow_world_steps_its_monitor_and_actuator_in_c() -> None:
     env.reset(seed=0)
     steps = {t.path: type(run).__name__ for e in env._episode.sim._plan for run, t in e[1]}
     env.close()
-    assert steps["MyDistanceMonitor"] == "Kernel"
-    assert steps["MyNormalizePower"] == "Kernel"
+    for path in ("MyDistanceMonitor", "MyNormalizePower", "Leader", "Follower"):
+        assert steps[path] == "Kernel", path
     assert steps["FollowerGPS"] != "Kernel"
 
 
@@ -67,8 +81,23 @@ def test_the_follow_world_steps_its_monitor_and_actuator_in_c() -> None:
         str(ROOT / "scenarios" / "scenario1.yaml"),
         str(ROOT / "scenarios" / "paper_fig6.yaml"),
         CHANGING,
+        str(ROOT / "scenarios" / "obstacle_course.yaml"),  # contacts: collisions
+        _leader(2, **{"Leader.circleRadius": 6.0}),
+        _leader(3),
+        _leader(5, **{"Leader.waypoints": [[30, 10], [10, 25], [0, 0]]}),
+        # a battery and windings: the follower's Python step (its supply), the leader's body
+        _leader(4, **{"Follower.batteryCapacity": 0.05, "Follower.motorThermalTau": 30.0}),
     ],
-    ids=["scenario1", "paper_fig6", "parameters-change"],
+    ids=[
+        "scenario1",
+        "paper_fig6",
+        "parameters-change",
+        "obstacles",
+        "circle",
+        "speeds",
+        "waypoints",
+        "supply",
+    ],
 )
 def test_runs_are_byte_identical_with_and_without_the_bodies(
     source: Any, monkeypatch: pytest.MonkeyPatch
@@ -109,7 +138,7 @@ def _stepped(comp: Any, inputs: list[float], body: bool) -> tuple[list[float], s
     ins = [p.name for p in comp.inputs]
     outs = [p.name for p in comp.outputs]
     n = len(ins)
-    values = array("d", [*inputs, -7.0, -7.0][: n + len(outs)])
+    values = array("d", [*inputs, *[-7.0] * len(outs)])
     task = Task("C", comp, 1, [(p, f"S.{p}") for p in ins], {p: f"C.{p}" for p in outs})
     where = {f"S.{p}": i for i, p in enumerate(ins)} | {f"C.{p}": n + i for i, p in enumerate(outs)}
     task.bind(where.__getitem__)
@@ -204,3 +233,63 @@ def test_a_subclass_is_stepped_as_written() -> None:
     values, _, how = _stepped(Louder("N", {}), [50.0, 50.0], True)
     assert values[2:] == [1.0, 1.0]
     assert how != "Kernel"
+
+
+# -- the robots' bodies, on what the physics rarely gives -----------------------------------
+class Rover:
+    """A rover's readers and driver, as the physics world attaches them, giving ``state``."""
+
+    def __init__(self, state: Any, rims: Any = (0.25, -0.5), fail: bool = False) -> None:
+        self._source = (lambda: state) if state is not None else None
+        self._rims = (lambda: rims) if rims is not None else None
+        self.fail = fail
+        self.powers: list[tuple[float, float]] = []
+
+    def set_power(self, left: float, right: float) -> None:
+        if self.fail:
+            raise RuntimeError("driver fault")
+        self.powers.append((left, right))
+
+    def kinematics(self) -> Any:  # the pure path's reader (no physics step attached)
+        return (1.0, 2.0, 3.0, 4.0, 5.0, 6.0)
+
+
+STATES = [
+    (1.5, -2.0, 0.7, 1.25, -0.5, 0.1),
+    (1.5, -2.0, -7.0, 1.25, -0.5, 0.1),  # a heading far from [-pi, pi)
+    (1.5, -2.0, 3.141592653589793, 0.0, -0.0, -0.0),
+    (1.5, float("nan"), 0.7, 1.25, -0.5, 0.1),  # a blown-up body: the fault
+    (1.5, -2.0, float("inf"), 1.25, -0.5, 0.1),
+    [1.5, -2.0, 0.7, 1.25, -0.5, 0.1],  # a list
+    np.array([1.5, -2.0, 0.7, 1.25, -0.5, 0.1]),  # numpy floats: _pose's own dict
+    (1, -2, 0, 1, 0, 0),  # ints
+    None,  # no reader attached: the Python step
+]
+
+
+def _robot(cls: type, state: Any, rims: Any = (0.25, -0.5), fail: bool = False) -> Any:
+    comp = cls("R", {"behavior": 1, "cruisePower": 7.0} if cls is FreeRobot else {})
+    comp.rover = Rover(state, rims, fail)
+    return comp
+
+
+@needs_c
+@pytest.mark.parametrize("cls", [ControlledRobot, FreeRobot], ids=lambda c: c.__name__)
+@pytest.mark.parametrize(
+    ("state", "rims", "fail"),
+    [(s, (0.25, -0.5), False) for s in STATES]
+    + [(STATES[0], None, False), (STATES[0], (0.25, float("nan")), False)]
+    + [(STATES[0], (0.25, -0.5), True)],
+    ids=repr,
+)
+def test_a_robot_body_publishes_and_faults_as_its_python_step(
+    cls: type, state: Any, rims: Any, fail: bool
+) -> None:
+    inputs = [33.0, -150.0] if cls is ControlledRobot else []
+    comps = [_robot(cls, state, rims, fail) for _ in range(2)]
+    got = _stepped(comps[0], inputs, True)
+    want = _stepped(comps[1], inputs, False)
+    assert got[2] == "Kernel"
+    assert np.array(got[0]).tobytes() == np.array(want[0]).tobytes()
+    assert got[1] == want[1]
+    assert comps[0].rover.powers == comps[1].rover.powers  # the driver commanded alike
