@@ -450,8 +450,8 @@ static PyObject *supply_name = NULL, *rover_name = NULL, *source_name = NULL,
                 *pose_name = NULL;
 
 /* The number of inputs and outputs of each body. */
-static const Py_ssize_t kernel_ins[] = {4, 2, 2, 0};
-static const Py_ssize_t kernel_outs[] = {1, 2, 7, 7};
+static const Py_ssize_t kernel_ins[] = {4, 2, 2, 0, 1, 2};
+static const Py_ssize_t kernel_outs[] = {1, 2, 7, 7, 1, 2};
 
 static int Kernel_init(Kernel *self, PyObject *args, PyObject *kw) {
     int code;
@@ -464,7 +464,7 @@ static int Kernel_init(Kernel *self, PyObject *args, PyObject *kw) {
                           &outs, &values, &fallback, &failed, &judge)) {
         return -1;
     }
-    if (code < 0 || code > 3) {
+    if (code < 0 || code > 5) {
         PyErr_SetString(PyExc_ValueError, "Kernel: unknown body");
         return -1;
     }
@@ -754,6 +754,486 @@ done:
     return res;
 }
 
+/* -- the sensors' bodies (codes 4 and 5) ------------------------------------------------ */
+
+static PyObject *floor_fn = NULL, *fraction_type = NULL;
+static PyObject *noise_name = NULL, *bias_draw_name = NULL, *loss_draw_name = NULL,
+                *burst_draw_name = NULL, *t_prev_name = NULL, *gm_name = NULL,
+                *lost_name = NULL, *numerator_name = NULL, *denominator_name = NULL,
+                *b_name = NULL, *bx_name = NULL, *by_name = NULL, *on_x_name = NULL,
+                *on_y_name = NULL, *enter_name = NULL, *leave_name = NULL, *bad_name = NULL,
+                *history_name = NULL, *turn_on_name = NULL, *sign_name = NULL, *z_name = NULL;
+
+/* The sensors' parameters by name: mean, stddev, bias_mean, bias_stddev,
+ * dynamic_bias_stddev, dynamic_bias_correlation_time, precision, lostData, latency,
+ * lostDataGPS, deviationB..E. */
+static const char *const param_texts[] = {"mean",
+                                          "stddev",
+                                          "bias_mean",
+                                          "bias_stddev",
+                                          "dynamic_bias_stddev",
+                                          "dynamic_bias_correlation_time",
+                                          "precision",
+                                          "lostData",
+                                          "latency",
+                                          "lostDataGPS",
+                                          "deviationB",
+                                          "deviationC",
+                                          "deviationD",
+                                          "deviationE"};
+#define N_PARAMS 14
+static PyObject *param_names[N_PARAMS];
+
+/* ``obj.name`` as a double when it is a float exactly (an int too with ``int_ok``, within
+ * 2**53, where Python's mixed comparisons and products give the double's answers): 1, or 0
+ * (anything else, or missing: the Python step judges). */
+static int attr_double(PyObject *obj, PyObject *name, int int_ok, double *out) {
+    PyObject *v = PyObject_GetAttr(obj, name);
+    if (v == NULL) {
+        PyErr_Clear();
+        return 0;
+    }
+    int ok = 1;
+    if (PyFloat_CheckExact(v)) {
+        *out = PyFloat_AS_DOUBLE(v);
+    } else if (int_ok && PyLong_CheckExact(v)) {
+        long long n = PyLong_AsLongLong(v);
+        if ((n == -1 && PyErr_Occurred()) || n > (1LL << 53) || n < -(1LL << 53)) {
+            PyErr_Clear();
+            ok = 0;
+        } else {
+            *out = (double)n;
+        }
+    } else {
+        ok = 0;
+    }
+    Py_DECREF(v);
+    return ok;
+}
+
+/* ``obj.name[0]`` as a double, when a list's first item is a float exactly: 1, or 0. */
+static int first_double(PyObject *obj, PyObject *name, double *out) {
+    PyObject *v = PyObject_GetAttr(obj, name);
+    if (v == NULL) {
+        PyErr_Clear();
+        return 0;
+    }
+    int ok = PyList_CheckExact(v) && PyList_GET_SIZE(v) > 0 &&
+             PyFloat_CheckExact(PyList_GET_ITEM(v, 0));
+    if (ok) {
+        *out = PyFloat_AS_DOUBLE(PyList_GET_ITEM(v, 0));
+    }
+    Py_DECREF(v);
+    return ok;
+}
+
+/* ``t`` as the sensors take it: ``t._numerator / t._denominator`` for a Fraction (int / int,
+ * correctly rounded), ``float(t)`` otherwise. NULL on error. */
+static PyObject *seconds(PyObject *t) {
+    if ((PyObject *)Py_TYPE(t) == fraction_type) {
+        PyObject *n = PyObject_GetAttr(t, numerator_name);
+        PyObject *d = n == NULL ? NULL : PyObject_GetAttr(t, denominator_name);
+        PyObject *q = d == NULL ? NULL : PyNumber_TrueDivide(n, d);
+        Py_XDECREF(n);
+        Py_XDECREF(d);
+        return q;
+    }
+    return PyNumber_Float(t);
+}
+
+/* One draw of the stream ``comp.name``, as a double (the streams give floats). */
+static int draw(PyObject *comp, PyObject *name, double *out) {
+    PyObject *fn = PyObject_GetAttr(comp, name);
+    PyObject *v = fn == NULL ? NULL : PyObject_CallNoArgs(fn);
+    Py_XDECREF(fn);
+    if (v == NULL) {
+        return -1;
+    }
+    *out = PyFloat_AsDouble(v);
+    Py_DECREF(v);
+    return *out == -1.0 && PyErr_Occurred() ? -1 : 0;
+}
+
+/* The Gauss-Markov step's ``(phi, q)`` for ``(sigma, tau, dt)``, as ``comp._gm`` remembers
+ * it (``nz.gauss_markov`` asked, and remembered, when the key changed). */
+static int gauss_markov(PyObject *comp, double sigma, double tau, double dt, double *phi,
+                        double *q) {
+    PyObject *key = Py_BuildValue("(ddd)", sigma, tau, dt);
+    if (key == NULL) {
+        return -1;
+    }
+    PyObject *gm = PyObject_GetAttr(comp, gm_name);
+    if (gm == NULL) {
+        Py_DECREF(key);
+        return -1;
+    }
+    if (!PyTuple_Check(gm) || PyTuple_GET_SIZE(gm) != 2) {
+        PyErr_SetString(PyExc_TypeError, "Kernel: _gm is not a pair");
+        goto fail;
+    }
+    int changed = PyObject_RichCompareBool(key, PyTuple_GET_ITEM(gm, 0), Py_NE);
+    if (changed < 0) {
+        goto fail;
+    }
+    if (changed) {
+        PyObject *nz = PyImport_ImportModule("amsa_phys.engine.noise");
+        PyObject *fn = nz == NULL ? NULL : PyObject_GetAttrString(nz, "gauss_markov");
+        Py_XDECREF(nz);
+        PyObject *pair = fn == NULL ? NULL : PyObject_CallObject(fn, key);
+        Py_XDECREF(fn);
+        if (pair == NULL) {
+            goto fail;
+        }
+        PyObject *fresh = PyTuple_Pack(2, key, pair);
+        Py_DECREF(pair);
+        if (fresh == NULL || PyObject_SetAttr(comp, gm_name, fresh) < 0) {
+            Py_XDECREF(fresh);
+            goto fail;
+        }
+        Py_SETREF(gm, fresh);
+    }
+    PyObject *pair = PyTuple_GET_ITEM(gm, 1);
+    if (!PyTuple_Check(pair) || PyTuple_GET_SIZE(pair) != 2) {
+        PyErr_SetString(PyExc_TypeError, "Kernel: gauss_markov gave no pair");
+        goto fail;
+    }
+    *phi = PyFloat_AsDouble(PyTuple_GET_ITEM(pair, 0));
+    *q = PyFloat_AsDouble(PyTuple_GET_ITEM(pair, 1));
+    if (PyErr_Occurred()) {
+        goto fail;
+    }
+    Py_DECREF(gm);
+    Py_DECREF(key);
+    return 0;
+fail:
+    Py_DECREF(gm);
+    Py_DECREF(key);
+    return -1;
+}
+
+static int set_double(PyObject *obj, PyObject *name, double v) {
+    PyObject *f = PyFloat_FromDouble(v);
+    if (f == NULL) {
+        return -1;
+    }
+    int rc = PyObject_SetAttr(obj, name, f);
+    Py_DECREF(f);
+    return rc;
+}
+
+/* ``comp.lost += 1`` */
+static int count_lost(PyObject *comp) {
+    PyObject *lost = PyObject_GetAttr(comp, lost_name);
+    if (lost == NULL) {
+        return -1;
+    }
+    PyObject *one = PyLong_FromLong(1);
+    PyObject *more = one == NULL ? NULL : PyNumber_InPlaceAdd(lost, one);
+    Py_XDECREF(one);
+    Py_DECREF(lost);
+    if (more == NULL) {
+        return -1;
+    }
+    int rc = PyObject_SetAttr(comp, lost_name, more);
+    Py_DECREF(more);
+    return rc;
+}
+
+/* ``math.floor(v)`` as a double; for a v it refuses (inf, nan), its exception. */
+static int py_floor(double v, double *out) {
+    if (isfinite(v)) {
+        *out = floor(v);
+        return 0;
+    }
+    PyObject *f = PyFloat_FromDouble(v);
+    PyObject *r = f == NULL ? NULL : PyObject_CallOneArg(floor_fn, f);
+    Py_XDECREF(f);
+    if (r != NULL) { /* not reached: math.floor refuses every value that is not finite */
+        Py_DECREF(r);
+        PyErr_SetString(PyExc_SystemError, "Kernel: floor took a value that is not finite");
+    }
+    return -1;
+}
+
+static PyObject *sin_fn = NULL, *cos_fn = NULL;
+
+/* ``math.sin`` or ``math.cos`` of ``x`` (``f`` and ``fn``) as a double: libm's, as math's;
+ * for an infinite x, math's own ValueError (libm gives a NaN). */
+static int py_trig(double (*f)(double), PyObject *fn, double x, double *out) {
+    if (!isinf(x)) {
+        *out = f(x);
+        return 0;
+    }
+    PyObject *v = PyFloat_FromDouble(x);
+    PyObject *r = v == NULL ? NULL : PyObject_CallOneArg(fn, v);
+    Py_XDECREF(v);
+    if (r != NULL) { /* not reached: math refuses an infinite angle */
+        Py_DECREF(r);
+        PyErr_SetString(PyExc_SystemError, "Kernel: math took an infinite angle");
+    }
+    return -1;
+}
+
+/* The store's ``k``-th input of this kernel, as a double. */
+static int input_value(Kernel *self, Py_ssize_t k, double *out) {
+    Py_buffer view;
+    if (PyObject_GetBuffer(self->values, &view, PyBUF_FORMAT) < 0) {
+        return -1;
+    }
+    Py_ssize_t n = view.len / (Py_ssize_t)sizeof(double), at;
+    int rc = -1;
+    if (view.itemsize != sizeof(double) || view.format == NULL || view.format[0] != 'd' ||
+        view.format[1] != '\0') {
+        PyErr_SetString(PyExc_TypeError, "Kernel: the store must be an array of doubles");
+    } else if (position(self->ins, k, n, &at) == 0) {
+        *out = ((const double *)view.buf)[at];
+        rc = 0;
+    }
+    PyBuffer_Release(&view);
+    return rc;
+}
+
+/* Write ``count`` outputs; or, if one is not finite, hand the dict the step would have
+ * returned (``names`` its keys) to ``judge``. */
+static PyObject *publish_values(Kernel *self, const double *out, const char *const *names,
+                                Py_ssize_t count, PyObject *now) {
+    int finite = 1;
+    for (Py_ssize_t k = 0; k < count; k++) {
+        finite = finite && out[k] - out[k] == 0.0;
+    }
+    if (!finite) {
+        PyObject *dict = PyDict_New();
+        for (Py_ssize_t k = 0; dict != NULL && k < count; k++) {
+            PyObject *v = PyFloat_FromDouble(out[k]);
+            if (v == NULL || PyDict_SetItemString(dict, names[k], v) < 0) {
+                Py_CLEAR(dict);
+            }
+            Py_XDECREF(v);
+        }
+        if (dict == NULL) {
+            return NULL;
+        }
+        PyObject *res = PyObject_CallFunctionObjArgs(self->judge, dict, now, NULL);
+        Py_DECREF(dict);
+        return res;
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(self->values, &view, PyBUF_WRITABLE | PyBUF_FORMAT) < 0) {
+        return NULL;
+    }
+    Py_ssize_t n = view.len / (Py_ssize_t)sizeof(double), at[2];
+    int bad = view.itemsize != sizeof(double) || view.format == NULL || view.format[0] != 'd' ||
+              view.format[1] != '\0';
+    for (Py_ssize_t k = 0; k < count && !bad; k++) {
+        bad = position(self->outs, k, n, &at[k]) < 0;
+    }
+    if (!bad) {
+        for (Py_ssize_t k = 0; k < count; k++) {
+            ((double *)view.buf)[at[k]] = out[k];
+        }
+    } else if (!PyErr_Occurred()) {
+        PyErr_SetString(PyExc_TypeError, "Kernel: the store must be an array of doubles");
+    }
+    PyBuffer_Release(&view);
+    if (bad) {
+        return NULL;
+    }
+    Py_RETURN_NONE;
+}
+
+/* Compass.do_step (``sensors/compass.py``), after its first step. */
+static PyObject *compass_step(Kernel *self, PyObject *task, PyObject *now_t) {
+    PyObject *comp = self->comp, *p = NULL, *turn_on = NULL, *now = NULL;
+    double t_prev = 0, b = 0, mean = 0, stddev = 0, bias_mean = 0, bias_stddev = 0, sigma = 0;
+    double tau = 0, precision = 0, lost_pct = 0, dev[4] = {0, 0, 0, 0}, sign0 = 0, z0 = 0;
+    int ok = 0;
+    p = PyObject_GetAttr(comp, p_name);
+    turn_on = p == NULL ? NULL : PyObject_GetAttr(comp, turn_on_name);
+    if (turn_on == NULL) {
+        PyErr_Clear();
+    } else {
+        ok = attr_double(comp, t_prev_name, 0, &t_prev) && attr_double(comp, b_name, 0, &b) &&
+             attr_double(p, param_names[0], 0, &mean) &&
+             attr_double(p, param_names[1], 0, &stddev) &&
+             attr_double(p, param_names[2], 0, &bias_mean) &&
+             attr_double(p, param_names[3], 0, &bias_stddev) &&
+             attr_double(p, param_names[4], 0, &sigma) &&
+             attr_double(p, param_names[5], 0,
+                         &tau) &&
+             attr_double(p, param_names[6], 0, &precision) &&
+             attr_double(p, param_names[7], 0, &lost_pct) &&
+             first_double(turn_on, sign_name, &sign0) && first_double(turn_on, z_name, &z0);
+        for (int k = 0; k < 4 && ok; k++) {
+            ok = attr_double(p, param_names[10 + k], 0, &dev[k]);
+        }
+    }
+    Py_XDECREF(p);
+    Py_XDECREF(turn_on);
+    if (!ok) { /* the first step, or anything the body does not take: the Python step */
+        if (PyErr_Occurred()) {
+            return NULL;
+        }
+        return PyObject_CallFunctionObjArgs(self->fallback, task, now_t, NULL);
+    }
+    double w, g, u, nowd, h;
+    if (draw(comp, noise_name, &w) < 0 || draw(comp, bias_draw_name, &g) < 0 ||
+        draw(comp, loss_draw_name, &u) < 0) {
+        return hand_fault(self->failed, now_t);
+    }
+    now = seconds(now_t);
+    if (now == NULL) {
+        return hand_fault(self->failed, now_t);
+    }
+    nowd = PyFloat_AsDouble(now);
+    if (sigma > 0 || b != 0.0) {
+        double phi, q;
+        if (gauss_markov(comp, sigma, tau, nowd - t_prev, &phi, &q) < 0) {
+            Py_DECREF(now);
+            return hand_fault(self->failed, now_t);
+        }
+        b = phi * b + q * g;
+        if (set_double(comp, b_name, b) < 0) {
+            Py_DECREF(now);
+            return NULL;
+        }
+    }
+    int rc = PyObject_SetAttr(comp, t_prev_name, now);
+    Py_DECREF(now);
+    if (rc < 0) {
+        return NULL;
+    }
+    if (u * 100.0 < lost_pct) {
+        if (count_lost(comp) < 0) {
+            return hand_fault(self->failed, now_t);
+        }
+        Py_RETURN_NONE; /* {}: nothing published */
+    }
+    if (input_value(self, 0, &h) < 0) {
+        return NULL;
+    }
+    const double pi = 3.141592653589793, two_pi = 2 * 3.141592653589793;
+    double value = h + mean + b + stddev * w;
+    value = value + sign0 * (bias_mean + bias_stddev * z0);
+    if (dev[0] != 0.0 || dev[1] != 0.0 || dev[2] != 0.0 || dev[3] != 0.0 || isnan(dev[0]) ||
+        isnan(dev[1]) || isnan(dev[2]) || isnan(dev[3])) {
+        double s1, c1, s2, c2;
+        if (py_trig(sin, sin_fn, h, &s1) < 0 || py_trig(cos, cos_fn, h, &c1) < 0 ||
+            py_trig(sin, sin_fn, 2 * h, &s2) < 0 || py_trig(cos, cos_fn, 2 * h, &c2) < 0) {
+            return hand_fault(self->failed, now_t);
+        }
+        double d1 = dev[0] * s1;
+        double d2 = dev[1] * c1;
+        double d3 = dev[2] * s2;
+        double d4 = dev[3] * c2;
+        value = value + (((d1 + d2) + d3) + d4);
+    }
+    value = py_mod(value + pi, two_pi) - pi;
+    if (precision > 0) {
+        double f;
+        if (py_floor(value / precision + 0.5, &f) < 0) {
+            return hand_fault(self->failed, now_t);
+        }
+        value = py_mod(f * precision + pi, two_pi) - pi;
+    }
+    static const char *const names[] = {"compassHeading"};
+    return publish_values(self, &value, names, 1, now_t);
+}
+
+/* GPS.do_step (``sensors/gps.py``), after its first step and without latency. */
+static PyObject *gps_step(Kernel *self, PyObject *task, PyObject *now_t) {
+    PyObject *comp = self->comp, *p = NULL, *now = NULL;
+    double t_prev = 0, bx = 0, by = 0, on_x = 0, on_y = 0, enter = 0, leave = 0, mean = 0;
+    double stddev = 0, sigma = 0, tau = 0, precision = 0, latency = 0, lost_pct = 0;
+    int ok = 0, bad = -1, history = -1;
+    p = PyObject_GetAttr(comp, p_name);
+    if (p == NULL) {
+        PyErr_Clear();
+    } else {
+        ok = attr_double(comp, t_prev_name, 0, &t_prev) &&
+             attr_double(comp, bx_name, 0, &bx) && attr_double(comp, by_name, 0, &by) &&
+             attr_double(comp, on_x_name, 0, &on_x) && attr_double(comp, on_y_name, 0, &on_y) &&
+             attr_double(comp, enter_name, 0, &enter) &&
+             attr_double(comp, leave_name, 0, &leave) &&
+             attr_double(p, param_names[0], 0, &mean) &&
+             attr_double(p, param_names[1], 0, &stddev) &&
+             attr_double(p, param_names[4], 0, &sigma) &&
+             attr_double(p, param_names[5], 0,
+                         &tau) &&
+             attr_double(p, param_names[6], 0, &precision) &&
+             attr_double(p, param_names[8], 0, &latency) &&
+             attr_double(p, param_names[9], 1, &lost_pct);
+        Py_DECREF(p);
+        PyObject *v = ok ? PyObject_GetAttr(comp, bad_name) : NULL;
+        if (v != NULL) {
+            bad = PyBool_Check(v) ? v == Py_True : -1;
+            Py_DECREF(v);
+        }
+        v = ok ? PyObject_GetAttr(comp, history_name) : NULL;
+        if (v != NULL) {
+            history = PyObject_IsTrue(v);
+            Py_DECREF(v);
+        }
+        PyErr_Clear();
+    }
+    if (!ok || bad < 0 || history != 0 || latency > 0 || isnan(latency)) {
+        /* the first step, a delayed fix, or anything the body does not take: Python */
+        return PyObject_CallFunctionObjArgs(self->fallback, task, now_t, NULL);
+    }
+    double ex, ey, gx, gy, u_loss, u_burst, nowd, px, py;
+    if (draw(comp, noise_name, &ex) < 0 || draw(comp, noise_name, &ey) < 0 ||
+        draw(comp, bias_draw_name, &gx) < 0 || draw(comp, bias_draw_name, &gy) < 0 ||
+        draw(comp, loss_draw_name, &u_loss) < 0 || draw(comp, burst_draw_name, &u_burst) < 0) {
+        return hand_fault(self->failed, now_t);
+    }
+    now = seconds(now_t);
+    if (now == NULL) {
+        return hand_fault(self->failed, now_t);
+    }
+    nowd = PyFloat_AsDouble(now);
+    if (sigma > 0 || bx != 0.0 || by != 0.0) {
+        double phi, q;
+        if (gauss_markov(comp, sigma, tau, nowd - t_prev, &phi, &q) < 0) {
+            Py_DECREF(now);
+            return hand_fault(self->failed, now_t);
+        }
+        bx = phi * bx + q * gx;
+        by = phi * by + q * gy;
+        if (set_double(comp, bx_name, bx) < 0 || set_double(comp, by_name, by) < 0) {
+            Py_DECREF(now);
+            return NULL;
+        }
+    }
+    int rc = PyObject_SetAttr(comp, t_prev_name, now);
+    Py_DECREF(now);
+    if (rc < 0 || input_value(self, 0, &px) < 0 || input_value(self, 1, &py) < 0) {
+        return NULL;
+    }
+    double out[2];
+    out[0] = px + mean + on_x + bx + stddev * ex;
+    out[1] = py + mean + on_y + by + stddev * ey;
+    if (precision > 0) {
+        double fx, fy;
+        if (py_floor(out[0] / precision + 0.5, &fx) < 0 ||
+            py_floor(out[1] / precision + 0.5, &fy) < 0) {
+            return hand_fault(self->failed, now_t);
+        }
+        out[0] = fx * precision;
+        out[1] = fy * precision;
+    }
+    int now_bad = bad ? u_burst >= leave : u_burst < enter;
+    if (PyObject_SetAttr(comp, bad_name, now_bad ? Py_True : Py_False) < 0) {
+        return NULL;
+    }
+    if (now_bad || u_loss * 100.0 < lost_pct) {
+        if (count_lost(comp) < 0) {
+            return hand_fault(self->failed, now_t);
+        }
+        Py_RETURN_NONE; /* {}: nothing published */
+    }
+    static const char *const names[] = {"gpsPosX", "gpsPosY"};
+    return publish_values(self, out, names, 2, now_t);
+}
+
 static PyObject *Kernel_call(Kernel *self, PyObject *args, PyObject *kw) {
     if (kw != NULL || !PyTuple_Check(args) || PyTuple_GET_SIZE(args) != 2) {
         PyErr_SetString(PyExc_TypeError, "step(task, now)");
@@ -763,8 +1243,14 @@ static PyObject *Kernel_call(Kernel *self, PyObject *args, PyObject *kw) {
         PyErr_SetString(PyExc_TypeError, "Kernel not initialised");
         return NULL;
     }
-    if (self->code >= 2) {
+    if (self->code == 2 || self->code == 3) {
         return robot_step(self, PyTuple_GET_ITEM(args, 0), PyTuple_GET_ITEM(args, 1));
+    }
+    if (self->code == 4) {
+        return compass_step(self, PyTuple_GET_ITEM(args, 0), PyTuple_GET_ITEM(args, 1));
+    }
+    if (self->code == 5) {
+        return gps_step(self, PyTuple_GET_ITEM(args, 0), PyTuple_GET_ITEM(args, 1));
     }
     Py_buffer view;
     if (PyObject_GetBuffer(self->values, &view, PyBUF_WRITABLE | PyBUF_FORMAT) < 0) {
@@ -895,6 +1381,43 @@ PyMODINIT_FUNC PyInit__publish(void) {
     set_power_name = PyUnicode_InternFromString("set_power");
     behaviour_name = PyUnicode_InternFromString("_behaviour");
     pose_name = PyUnicode_InternFromString("_pose");
+    PyObject *fractions = PyImport_ImportModule("fractions");
+    if (fractions == NULL) {
+        return NULL;
+    }
+    fraction_type = PyObject_GetAttrString(fractions, "Fraction");
+    Py_DECREF(fractions);
+    math = PyImport_ImportModule("math");
+    floor_fn = math == NULL ? NULL : PyObject_GetAttrString(math, "floor");
+    sin_fn = math == NULL ? NULL : PyObject_GetAttrString(math, "sin");
+    cos_fn = math == NULL ? NULL : PyObject_GetAttrString(math, "cos");
+    Py_XDECREF(math);
+    const char *const texts[] = {"noise",   "draw_bias", "draw_loss", "draw_burst", "t_prev",
+                                 "_gm",     "lost",      "_numerator", "_denominator", "b",
+                                 "bx",      "by",        "on_x",      "on_y",      "enter",
+                                 "leave",   "bad",       "history",   "turn_on",   "sign",
+                                 "z"};
+    PyObject **interned[] = {&noise_name,     &bias_draw_name, &loss_draw_name, &burst_draw_name,
+                             &t_prev_name,    &gm_name,        &lost_name,      &numerator_name,
+                             &denominator_name, &b_name,       &bx_name,        &by_name,
+                             &on_x_name,      &on_y_name,      &enter_name,     &leave_name,
+                             &bad_name,       &history_name,   &turn_on_name,   &sign_name,
+                             &z_name};
+    for (int k = 0; k < 21; k++) {
+        *interned[k] = PyUnicode_InternFromString(texts[k]);
+        if (*interned[k] == NULL) {
+            return NULL;
+        }
+    }
+    for (int k = 0; k < N_PARAMS; k++) {
+        param_names[k] = PyUnicode_InternFromString(param_texts[k]);
+        if (param_names[k] == NULL) {
+            return NULL;
+        }
+    }
+    if (fraction_type == NULL || floor_fn == NULL || sin_fn == NULL || cos_fn == NULL) {
+        return NULL;
+    }
     if (supply_name == NULL || rover_name == NULL || source_name == NULL || rims_name == NULL ||
         set_power_name == NULL || behaviour_name == NULL || pose_name == NULL) {
         return NULL;

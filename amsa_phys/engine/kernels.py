@@ -40,13 +40,18 @@ BODIES: dict[tuple[str, str], tuple[int, tuple[str, ...], tuple[str, ...]]] = {
     ),
     ("amsa_phys.physics.robots", "ControlledRobot"): (2, ("powerL", "powerR"), POSE),
     ("amsa_phys.physics.freerobot", "FreeRobot"): (3, (), POSE),
+    ("amsa_phys.sensors.compass", "Compass"): (4, ("heading",), ("compassHeading",)),
+    ("amsa_phys.sensors.gps", "GPS"): (5, ("posX", "posY"), ("gpsPosX", "gpsPosY")),
 }
 
 #: methods a body computes itself, besides ``do_step``: each must still be the one written
 #: in its module (the body calls the others, ``set_power`` and ``_behaviour``, by name)
-COMPUTED = {2: ("_pose",), 3: ("_pose",)}
+COMPUTED = {2: ("_pose",), 3: ("_pose",), 5: ("_delay",)}
 #: where those methods are written
-WRITTEN = {"_pose": ("amsa_phys.physics.robots", "Robot._pose")}
+WRITTEN = {
+    "_pose": ("amsa_phys.physics.robots", "Robot._pose"),
+    "_delay": ("amsa_phys.sensors.gps", "GPS._delay"),
+}
 
 
 def body_of(comp: Any) -> tuple[int, tuple[str, ...], tuple[str, ...]] | None:

@@ -21,6 +21,8 @@ from amsa_phys.errors import RunFault
 from amsa_phys.gym import FollowEnv
 from amsa_phys.physics.freerobot import FreeRobot
 from amsa_phys.physics.robots import ControlledRobot
+from amsa_phys.sensors.compass import Compass
+from amsa_phys.sensors.gps import GPS
 
 ROOT = Path(__file__).resolve().parents[2]
 BUILT = importlib.util.find_spec("amsa_phys.engine._publish") is not None
@@ -64,7 +66,7 @@ def _trace(source: Any) -> bytes:
 
 
 @needs_c
-def test_the_follow_world_steps_its_monitor_and_actuator_in_c() -> None:
+def test_the_follow_world_steps_its_components_in_c() -> None:
     """Else the comparisons below would compare the Python step with itself."""
     env = FollowEnv()
     env.reset(seed=0)
@@ -72,7 +74,9 @@ def test_the_follow_world_steps_its_monitor_and_actuator_in_c() -> None:
     env.close()
     for path in ("MyDistanceMonitor", "MyNormalizePower", "Leader", "Follower"):
         assert steps[path] == "Kernel", path
-    assert steps["FollowerGPS"] != "Kernel"
+    for path in ("LeaderGPS", "FollowerGPS", "FollowerCompass"):
+        assert steps[path] == "Kernel", path
+    assert steps["MyFollowerController"] != "Kernel"  # the agent: delayed, its own step
 
 
 @pytest.mark.parametrize(
@@ -135,6 +139,13 @@ def test_episodes_are_byte_identical_with_and_without_the_bodies(
 def _stepped(comp: Any, inputs: list[float], body: bool) -> tuple[list[float], str, str]:
     """The store after one step of ``comp`` (inputs first, then its outputs), its fault,
     and how it stepped."""
+    return _stepped_at(comp, inputs, body, NOW)
+
+
+def _stepped_at(
+    comp: Any, inputs: list[float], body: bool, now: Fraction
+) -> tuple[list[float], str, str]:
+    """:func:`_stepped` at ``now``."""
     ins = [p.name for p in comp.inputs]
     outs = [p.name for p in comp.outputs]
     n = len(ins)
@@ -147,7 +158,7 @@ def _stepped(comp: Any, inputs: list[float], body: bool) -> tuple[list[float], s
         steppers._scalar = None  # the packed store's other compiled step stays out too
     step = steppers.for_task(task)
     try:
-        step(task, NOW)
+        step(task, now)
     except RunFault as exc:
         return values.tolist(), str(exc), type(step).__name__
     return values.tolist(), "", type(step).__name__
@@ -293,3 +304,100 @@ def test_a_robot_body_publishes_and_faults_as_its_python_step(
     assert np.array(got[0]).tobytes() == np.array(want[0]).tobytes()
     assert got[1] == want[1]
     assert comps[0].rover.powers == comps[1].rover.powers  # the driver commanded alike
+
+
+# -- the sensors' bodies: a sequence of steps against the Python step's ---------------------
+SENSED: dict[str, Any] = {
+    "name": "sensors",
+    "world": str(ROOT / "worlds" / "mde_challenge.yaml"),
+    "duration": 40,
+    "seed": 9,
+    "set": {
+        "LeaderGPS.burstLoss": 20.0,
+        "LeaderGPS.burstLength": 3.0,
+        "FollowerGPS.lostDataGPS": 15,
+        "FollowerCompass.lostData": 5.0,
+        "FollowerCompass.deviationB": 0.0,
+        "FollowerCompass.deviationC": 0.0,
+        "FollowerCompass.deviationD": 0.0,
+    },
+    "timeline": [  # the Gauss-Markov factors change, then a fix arrives late, then again not
+        {"at": 10, "set": {"FollowerGPS.dynamic_bias_correlation_time": 5.0}},
+        {
+            "at": 15,
+            "set": {"FollowerCompass.dynamic_bias_stddev": 0.0, "FollowerGPS.precision": 0.0},
+        },
+        {"at": 20, "set": {"LeaderGPS.latency": 0.6, "FollowerCompass.precision": 0.0}},
+        {"at": 30, "set": {"LeaderGPS.latency": 0.0, "FollowerCompass.deviationE": 0.02}},
+    ],
+}
+
+
+def test_a_run_with_losses_bursts_latency_and_changing_noise_is_byte_identical(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    compiled = _trace(SENSED)
+    _without_bodies(monkeypatch)
+    assert _trace(SENSED) == compiled
+
+
+class Ctx:
+    def __init__(self, seed: int) -> None:
+        self.rng = np.random.default_rng(seed)
+
+
+def _sensor(cls: type, params: dict[str, Any]) -> Any:
+    comp = cls("S", params)
+    comp.initialize(Ctx(21))
+    return comp
+
+
+SENSOR_CASES: list[tuple[type, dict[str, Any]]] = [
+    (Compass, {"stddev": 0.01, "deviationB": 0.02, "lostData": 20.0, "precision": 0.0017}),
+    (Compass, {"stddev": 0.01, "dynamic_bias_stddev": 0.003, "dynamic_bias_correlation_time": 0.0}),
+    (Compass, {"stddev": 0.0, "precision": 0.0}),
+    (  # every term of the deviation and a turn-on bias, unrounded: their order shows
+        Compass,
+        {
+            "stddev": 0.01,
+            "bias_mean": 0.01,
+            "bias_stddev": 0.005,
+            "deviationB": 0.02,
+            "deviationC": -0.013,
+            "deviationD": 0.005,
+            "deviationE": 0.0031,
+            "precision": 0.0,
+        },
+    ),
+    (GPS, {"stddev": 0.015, "dynamic_bias_stddev": 0.0055, "precision": 0.01, "lostDataGPS": 30}),
+    (GPS, {"stddev": 0.5, "burstLoss": 30.0, "burstLength": 4.0, "precision": 0.0}),
+    (GPS, {"stddev": 0.1, "latency": 0.5, "precision": 0.01}),  # delayed fixes: Python's
+]
+#: the true inputs at each step: ordinary ones, then what a blown-up physics would give
+READINGS = [[1.0, 2.0], [1.5, 2.5], [-3.25, 7.0], [1e9, -1e9], [2.0, 2.0], [0.5, 0.25]] * 3 + [
+    [1.7e308, 0.0],  # twice the heading overflows; so does a fix over its precision
+    [float("inf"), 0.0],
+    [float("nan"), 1.0],
+]
+
+
+@needs_c
+@pytest.mark.parametrize(("cls", "params"), SENSOR_CASES, ids=repr)
+def test_a_sensor_body_steps_as_its_python_step(cls: type, params: dict[str, Any]) -> None:
+    """Step after step (the first is always Python's): the same fixes, losses, state and
+    faults, to the bit."""
+    body, python = _sensor(cls, params), _sensor(cls, params)
+    for k, reading in enumerate(READINGS):
+        now = Fraction(k, 4)
+        inputs = reading[: len(cls.inputs)]
+        got = _stepped_at(body, inputs, True, now)
+        want = _stepped_at(python, inputs, False, now)
+        assert k == 0 or got[2] == "Kernel"
+        assert np.array(got[0]).tobytes() == np.array(want[0]).tobytes(), k
+        assert got[1] == want[1], k
+        state = ("t_prev", "lost", "b", "bx", "by", "bad", "_gm")
+        assert [getattr(body, a, None) for a in state] == [getattr(python, a, None) for a in state]
+        if got[1]:
+            break
+    if not any(params.get(k) for k in ("lostData", "lostDataGPS", "burstLoss")):
+        assert got[1], "the last readings end the run with the Python step's fault"
