@@ -557,6 +557,61 @@ static int float_param(PyObject *p, PyObject *name, int int_ok, double *out) {
     return ok;
 }
 
+static PyObject *floor_fn = NULL, *fraction_type = NULL;
+static PyObject *noise_name = NULL, *bias_draw_name = NULL, *loss_draw_name = NULL,
+                *burst_draw_name = NULL, *t_prev_name = NULL, *gm_name = NULL,
+                *lost_name = NULL, *numerator_name = NULL, *denominator_name = NULL,
+                *b_name = NULL, *bx_name = NULL, *by_name = NULL, *on_x_name = NULL,
+                *on_y_name = NULL, *enter_name = NULL, *leave_name = NULL, *bad_name = NULL,
+                *history_name = NULL, *turn_on_name = NULL, *sign_name = NULL, *z_name = NULL;
+
+/* The sensors' parameters by name: mean, stddev, bias_mean, bias_stddev,
+ * dynamic_bias_stddev, dynamic_bias_correlation_time, precision, lostData, latency,
+ * lostDataGPS, deviationB..E. */
+static const char *const param_texts[] = {"mean",
+                                          "stddev",
+                                          "bias_mean",
+                                          "bias_stddev",
+                                          "dynamic_bias_stddev",
+                                          "dynamic_bias_correlation_time",
+                                          "precision",
+                                          "lostData",
+                                          "latency",
+                                          "lostDataGPS",
+                                          "deviationB",
+                                          "deviationC",
+                                          "deviationD",
+                                          "deviationE"};
+#define N_PARAMS 14
+static PyObject *param_names[N_PARAMS];
+
+/* ``obj.name`` as a double when it is a float exactly (an int too with ``int_ok``, within
+ * 2**53, where Python's mixed comparisons and products give the double's answers): 1, or 0
+ * (anything else, or missing: the Python step judges). */
+static int attr_double(PyObject *obj, PyObject *name, int int_ok, double *out) {
+    PyObject *v = PyObject_GetAttr(obj, name);
+    if (v == NULL) {
+        PyErr_Clear();
+        return 0;
+    }
+    int ok = 1;
+    if (PyFloat_CheckExact(v)) {
+        *out = PyFloat_AS_DOUBLE(v);
+    } else if (int_ok && PyLong_CheckExact(v)) {
+        long long n = PyLong_AsLongLong(v);
+        if ((n == -1 && PyErr_Occurred()) || n > (1LL << 53) || n < -(1LL << 53)) {
+            PyErr_Clear();
+            ok = 0;
+        } else {
+            *out = (double)n;
+        }
+    } else {
+        ok = 0;
+    }
+    Py_DECREF(v);
+    return ok;
+}
+
 /* What do_step raised, handed to ``failed(exc, now)`` (which raises the scalar step's fault
  * for it): the Scalar step's way, NULL always. */
 static PyObject *hand_fault(PyObject *failed, PyObject *now) {
@@ -606,6 +661,94 @@ static int floats_of(PyObject *seq, Py_ssize_t n, double *out) {
         out[k] = PyFloat_AS_DOUBLE(items[k]);
     }
     return 1;
+}
+
+static PyObject *behavior_name = NULL, *cruise_name = NULL, *next_change_name = NULL,
+                *target_name = NULL, *speed_factor_name = NULL, *steer_gain_name = NULL;
+static PyObject *fraction_cls = NULL;
+
+/* FreeRobot._behaviour(t) for behaviour 1 (the cruise power on both wheels) and for
+ * behaviour 4 (random) between two changes of heading (t < next_change): the pair it
+ * returns, the same floats. NULL without an error for anything else (the Python method
+ * then runs: other behaviours, a change due, parameters of other types); NULL with an
+ * error for what the method would raise. ``source`` is the rover's state reader. */
+static PyObject *steer(PyObject *comp, PyObject *t, PyObject *source) {
+    PyObject *p = PyObject_GetAttr(comp, p_name);
+    if (p == NULL) {
+        PyErr_Clear();
+        return NULL;
+    }
+    PyObject *b = PyObject_GetAttr(p, behavior_name);
+    PyObject *cruise = b == NULL ? NULL : PyObject_GetAttr(p, cruise_name);
+    PyObject *gain = cruise == NULL ? NULL : PyObject_GetAttr(p, steer_gain_name);
+    PyObject *res = NULL;
+    PyErr_Clear();
+    if (gain == NULL || !PyLong_CheckExact(b) || !PyFloat_CheckExact(cruise) ||
+        !PyFloat_CheckExact(gain)) {
+        goto out;
+    }
+    long behavior = PyLong_AsLong(b);
+    if (behavior == 1) {
+        res = PyTuple_Pack(2, cruise, cruise);
+        goto out;
+    }
+    if (behavior != 4) {
+        PyErr_Clear();
+        goto out;
+    }
+    /* t >= next_change, as the method compares two Fractions: in integers */
+    PyObject *nc = PyObject_GetAttr(comp, next_change_name);
+    if (nc == NULL) {
+        PyErr_Clear();
+        goto out;
+    }
+    int due = -1;
+    if ((PyObject *)Py_TYPE(t) == fraction_cls && (PyObject *)Py_TYPE(nc) == fraction_cls) {
+        PyObject *tn = PyObject_GetAttr(t, numerator_name);
+        PyObject *td = PyObject_GetAttr(t, denominator_name);
+        PyObject *nn = PyObject_GetAttr(nc, numerator_name);
+        PyObject *nd = PyObject_GetAttr(nc, denominator_name);
+        PyObject *lhs = tn && nd ? PyNumber_Multiply(tn, nd) : NULL;
+        PyObject *rhs = nn && td ? PyNumber_Multiply(nn, td) : NULL;
+        if (lhs != NULL && rhs != NULL) {
+            due = PyObject_RichCompareBool(lhs, rhs, Py_GE);
+        }
+        Py_XDECREF(tn);
+        Py_XDECREF(td);
+        Py_XDECREF(nn);
+        Py_XDECREF(nd);
+        Py_XDECREF(lhs);
+        Py_XDECREF(rhs);
+        PyErr_Clear();
+    }
+    Py_DECREF(nc);
+    double target, factor;
+    if (due != 0 || !attr_double(comp, target_name, 0, &target) ||
+        !attr_double(comp, speed_factor_name, 0, &factor)) {
+        goto out; /* a change due (its draws are the method's), or not plain floats */
+    }
+    PyObject *state = PyObject_CallNoArgs(source);
+    if (state == NULL) {
+        goto out; /* raised: the error goes to the step's fault */
+    }
+    double kin[6];
+    int plain = floats_of(state, 6, kin);
+    Py_DECREF(state);
+    if (!plain) {
+        goto out; /* the method reads it its own way */
+    }
+    const double pi = 3.141592653589793, two_pi = 2 * 3.141592653589793;
+    double err = py_mod(target - kin[2] + pi, two_pi) - pi;
+    double diff = PyFloat_AS_DOUBLE(gain) * err;
+    double c = cos(err); /* err is finite or NaN: math.cos raises for neither */
+    double forward = PyFloat_AS_DOUBLE(cruise) * factor * (c > 0.0 ? c : 0.0);
+    res = Py_BuildValue("(dd)", forward - diff, forward + diff);
+out:
+    Py_DECREF(p);
+    Py_XDECREF(b);
+    Py_XDECREF(cruise);
+    Py_XDECREF(gain);
+    return res;
 }
 
 /* The robots' bodies (codes 2 and 3; see Kernel's comment). */
@@ -661,6 +804,11 @@ static PyObject *robot_step(Kernel *self, PyObject *task, PyObject *now) {
         if (powers == NULL) {
             goto done;
         }
+    } else if ((powers = steer(comp, now, source)) != NULL) {
+        /* behaviour 1 or 4 between two changes: FreeRobot._behaviour's floats, here */
+    } else if (PyErr_Occurred()) {
+        res = hand_fault(self->failed, now);
+        goto done;
     } else {
         powers = PyObject_CallMethodObjArgs(comp, behaviour_name, now, NULL);
         if (powers == NULL) {
@@ -755,61 +903,6 @@ done:
 }
 
 /* -- the sensors' bodies (codes 4 and 5) ------------------------------------------------ */
-
-static PyObject *floor_fn = NULL, *fraction_type = NULL;
-static PyObject *noise_name = NULL, *bias_draw_name = NULL, *loss_draw_name = NULL,
-                *burst_draw_name = NULL, *t_prev_name = NULL, *gm_name = NULL,
-                *lost_name = NULL, *numerator_name = NULL, *denominator_name = NULL,
-                *b_name = NULL, *bx_name = NULL, *by_name = NULL, *on_x_name = NULL,
-                *on_y_name = NULL, *enter_name = NULL, *leave_name = NULL, *bad_name = NULL,
-                *history_name = NULL, *turn_on_name = NULL, *sign_name = NULL, *z_name = NULL;
-
-/* The sensors' parameters by name: mean, stddev, bias_mean, bias_stddev,
- * dynamic_bias_stddev, dynamic_bias_correlation_time, precision, lostData, latency,
- * lostDataGPS, deviationB..E. */
-static const char *const param_texts[] = {"mean",
-                                          "stddev",
-                                          "bias_mean",
-                                          "bias_stddev",
-                                          "dynamic_bias_stddev",
-                                          "dynamic_bias_correlation_time",
-                                          "precision",
-                                          "lostData",
-                                          "latency",
-                                          "lostDataGPS",
-                                          "deviationB",
-                                          "deviationC",
-                                          "deviationD",
-                                          "deviationE"};
-#define N_PARAMS 14
-static PyObject *param_names[N_PARAMS];
-
-/* ``obj.name`` as a double when it is a float exactly (an int too with ``int_ok``, within
- * 2**53, where Python's mixed comparisons and products give the double's answers): 1, or 0
- * (anything else, or missing: the Python step judges). */
-static int attr_double(PyObject *obj, PyObject *name, int int_ok, double *out) {
-    PyObject *v = PyObject_GetAttr(obj, name);
-    if (v == NULL) {
-        PyErr_Clear();
-        return 0;
-    }
-    int ok = 1;
-    if (PyFloat_CheckExact(v)) {
-        *out = PyFloat_AS_DOUBLE(v);
-    } else if (int_ok && PyLong_CheckExact(v)) {
-        long long n = PyLong_AsLongLong(v);
-        if ((n == -1 && PyErr_Occurred()) || n > (1LL << 53) || n < -(1LL << 53)) {
-            PyErr_Clear();
-            ok = 0;
-        } else {
-            *out = (double)n;
-        }
-    } else {
-        ok = 0;
-    }
-    Py_DECREF(v);
-    return ok;
-}
 
 /* ``obj.name[0]`` as a double, when a list's first item is a float exactly: 1, or 0. */
 static int first_double(PyObject *obj, PyObject *name, double *out) {
@@ -1416,6 +1509,17 @@ PyMODINIT_FUNC PyInit__publish(void) {
         }
     }
     if (fraction_type == NULL || floor_fn == NULL || sin_fn == NULL || cos_fn == NULL) {
+        return NULL;
+    }
+    behavior_name = PyUnicode_InternFromString("behavior");
+    cruise_name = PyUnicode_InternFromString("cruisePower");
+    next_change_name = PyUnicode_InternFromString("next_change");
+    target_name = PyUnicode_InternFromString("target_heading");
+    speed_factor_name = PyUnicode_InternFromString("speed_factor");
+    steer_gain_name = PyUnicode_InternFromString("steerGain");
+    fraction_cls = fraction_type;
+    if (behavior_name == NULL || cruise_name == NULL || next_change_name == NULL ||
+        target_name == NULL || speed_factor_name == NULL || steer_gain_name == NULL) {
         return NULL;
     }
     if (supply_name == NULL || rover_name == NULL || source_name == NULL || rims_name == NULL ||

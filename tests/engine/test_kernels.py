@@ -401,3 +401,28 @@ def test_a_sensor_body_steps_as_its_python_step(cls: type, params: dict[str, Any
             break
     if not any(params.get(k) for k in ("lostData", "lostDataGPS", "burstLoss")):
         assert got[1], "the last readings end the run with the Python step's fault"
+
+
+@needs_c
+@pytest.mark.parametrize("target", [0.9, -2.5, 3.0, float("nan")], ids=repr)
+@pytest.mark.parametrize("change", [Fraction(100), Fraction(1, 4)], ids=["steering", "change-due"])
+def test_a_random_leader_steers_as_its_python_step(target: float, change: Fraction) -> None:
+    """Behaviour 4 between two changes is the body's; at a change, the method's (it draws)."""
+    comps = []
+    for _ in range(2):
+        comp = FreeRobot("R", {"behavior": 4, "cruisePower": 9.0, "steerGain": 1.5})
+        comp.rover = Rover(STATES[0])
+        comp.rng = np.random.default_rng(2)
+        comp.next_change, comp.target_heading, comp.speed_factor = change, target, 0.85
+        comps.append(comp)
+    got = _stepped(comps[0], [], True)
+    want = _stepped(comps[1], [], False)
+    assert got[2] == "Kernel"
+    assert np.array(got[0]).tobytes() == np.array(want[0]).tobytes()
+    assert got[1] == want[1]
+    powers = [np.array(c.rover.powers).tobytes() for c in comps]
+    assert powers[0] == powers[1]
+    assert (comps[0].next_change, comps[0].target_heading) == (
+        comps[1].next_change,
+        comps[1].target_heading,
+    ) or np.isnan(target)
