@@ -585,11 +585,47 @@ static const char *const param_texts[] = {"mean",
 #define N_PARAMS 14
 static PyObject *param_names[N_PARAMS];
 
+/* ``o.name`` where ``o`` is an object, or its instance dict (a component's, its parameters'):
+ * the sensors' bodies read their state from the dict itself, as the attribute read would
+ * find it there (their classes define no descriptor of these names), at a fraction of the
+ * cost. A new reference, or NULL with AttributeError (or another error) set. */
+static PyObject *get_ref(PyObject *o, PyObject *name) {
+    if (!PyDict_CheckExact(o)) {
+        return PyObject_GetAttr(o, name);
+    }
+    PyObject *v = PyDict_GetItemWithError(o, name);
+    if (v == NULL) {
+        if (!PyErr_Occurred()) {
+            PyErr_SetObject(PyExc_AttributeError, name);
+        }
+        return NULL;
+    }
+    Py_INCREF(v);
+    return v;
+}
+
+/* ``o.name = v`` (``o`` an object or its instance dict, as for get_ref). */
+static int set_ref(PyObject *o, PyObject *name, PyObject *v) {
+    return PyDict_CheckExact(o) ? PyDict_SetItem(o, name, v) : PyObject_SetAttr(o, name, v);
+}
+
+/* The instance dict of ``obj`` (a new reference), or ``obj`` itself where it has none. */
+static PyObject *dict_of(PyObject *obj) {
+    PyObject *d = PyObject_GenericGetDict(obj, NULL);
+    if (d == NULL || !PyDict_CheckExact(d)) {
+        PyErr_Clear();
+        Py_XDECREF(d);
+        Py_INCREF(obj);
+        return obj;
+    }
+    return d;
+}
+
 /* ``obj.name`` as a double when it is a float exactly (an int too with ``int_ok``, within
  * 2**53, where Python's mixed comparisons and products give the double's answers): 1, or 0
  * (anything else, or missing: the Python step judges). */
 static int attr_double(PyObject *obj, PyObject *name, int int_ok, double *out) {
-    PyObject *v = PyObject_GetAttr(obj, name);
+    PyObject *v = get_ref(obj, name);
     if (v == NULL) {
         PyErr_Clear();
         return 0;
@@ -906,7 +942,7 @@ done:
 
 /* ``obj.name[0]`` as a double, when a list's first item is a float exactly: 1, or 0. */
 static int first_double(PyObject *obj, PyObject *name, double *out) {
-    PyObject *v = PyObject_GetAttr(obj, name);
+    PyObject *v = get_ref(obj, name);
     if (v == NULL) {
         PyErr_Clear();
         return 0;
@@ -936,7 +972,7 @@ static PyObject *seconds(PyObject *t) {
 
 /* One draw of the stream ``comp.name``, as a double (the streams give floats). */
 static int draw(PyObject *comp, PyObject *name, double *out) {
-    PyObject *fn = PyObject_GetAttr(comp, name);
+    PyObject *fn = get_ref(comp, name);
     PyObject *v = fn == NULL ? NULL : PyObject_CallNoArgs(fn);
     Py_XDECREF(fn);
     if (v == NULL) {
@@ -955,7 +991,7 @@ static int gauss_markov(PyObject *comp, double sigma, double tau, double dt, dou
     if (key == NULL) {
         return -1;
     }
-    PyObject *gm = PyObject_GetAttr(comp, gm_name);
+    PyObject *gm = get_ref(comp, gm_name);
     if (gm == NULL) {
         Py_DECREF(key);
         return -1;
@@ -979,7 +1015,7 @@ static int gauss_markov(PyObject *comp, double sigma, double tau, double dt, dou
         }
         PyObject *fresh = PyTuple_Pack(2, key, pair);
         Py_DECREF(pair);
-        if (fresh == NULL || PyObject_SetAttr(comp, gm_name, fresh) < 0) {
+        if (fresh == NULL || set_ref(comp, gm_name, fresh) < 0) {
             Py_XDECREF(fresh);
             goto fail;
         }
@@ -1009,14 +1045,14 @@ static int set_double(PyObject *obj, PyObject *name, double v) {
     if (f == NULL) {
         return -1;
     }
-    int rc = PyObject_SetAttr(obj, name, f);
+    int rc = set_ref(obj, name, f);
     Py_DECREF(f);
     return rc;
 }
 
 /* ``comp.lost += 1`` */
 static int count_lost(PyObject *comp) {
-    PyObject *lost = PyObject_GetAttr(comp, lost_name);
+    PyObject *lost = get_ref(comp, lost_name);
     if (lost == NULL) {
         return -1;
     }
@@ -1027,7 +1063,7 @@ static int count_lost(PyObject *comp) {
     if (more == NULL) {
         return -1;
     }
-    int rc = PyObject_SetAttr(comp, lost_name, more);
+    int rc = set_ref(comp, lost_name, more);
     Py_DECREF(more);
     return rc;
 }
@@ -1135,13 +1171,16 @@ static PyObject *publish_values(Kernel *self, const double *out, const char *con
 }
 
 /* Compass.do_step (``sensors/compass.py``), after its first step. */
-static PyObject *compass_step(Kernel *self, PyObject *task, PyObject *now_t) {
-    PyObject *comp = self->comp, *p = NULL, *turn_on = NULL, *now = NULL;
+static PyObject *compass_body(Kernel *self, PyObject *task, PyObject *now_t, PyObject *cd) {
+    PyObject *comp = cd, *p = NULL, *turn_on = NULL, *now = NULL;
     double t_prev = 0, b = 0, mean = 0, stddev = 0, bias_mean = 0, bias_stddev = 0, sigma = 0;
     double tau = 0, precision = 0, lost_pct = 0, dev[4] = {0, 0, 0, 0}, sign0 = 0, z0 = 0;
     int ok = 0;
-    p = PyObject_GetAttr(comp, p_name);
-    turn_on = p == NULL ? NULL : PyObject_GetAttr(comp, turn_on_name);
+    p = get_ref(comp, p_name);
+    if (p != NULL) {
+        Py_SETREF(p, dict_of(p));
+    }
+    turn_on = p == NULL ? NULL : get_ref(comp, turn_on_name);
     if (turn_on == NULL) {
         PyErr_Clear();
     } else {
@@ -1190,7 +1229,7 @@ static PyObject *compass_step(Kernel *self, PyObject *task, PyObject *now_t) {
             return NULL;
         }
     }
-    int rc = PyObject_SetAttr(comp, t_prev_name, now);
+    int rc = set_ref(comp, t_prev_name, now);
     Py_DECREF(now);
     if (rc < 0) {
         return NULL;
@@ -1232,13 +1271,23 @@ static PyObject *compass_step(Kernel *self, PyObject *task, PyObject *now_t) {
     return publish_values(self, &value, names, 1, now_t);
 }
 
+static PyObject *compass_step(Kernel *self, PyObject *task, PyObject *now_t) {
+    PyObject *cd = dict_of(self->comp);
+    PyObject *res = compass_body(self, task, now_t, cd);
+    Py_DECREF(cd);
+    return res;
+}
+
 /* GPS.do_step (``sensors/gps.py``), after its first step and without latency. */
-static PyObject *gps_step(Kernel *self, PyObject *task, PyObject *now_t) {
-    PyObject *comp = self->comp, *p = NULL, *now = NULL;
+static PyObject *gps_body(Kernel *self, PyObject *task, PyObject *now_t, PyObject *cd) {
+    PyObject *comp = cd, *p = NULL, *now = NULL;
     double t_prev = 0, bx = 0, by = 0, on_x = 0, on_y = 0, enter = 0, leave = 0, mean = 0;
     double stddev = 0, sigma = 0, tau = 0, precision = 0, latency = 0, lost_pct = 0;
     int ok = 0, bad = -1, history = -1;
-    p = PyObject_GetAttr(comp, p_name);
+    p = get_ref(comp, p_name);
+    if (p != NULL) {
+        Py_SETREF(p, dict_of(p));
+    }
     if (p == NULL) {
         PyErr_Clear();
     } else {
@@ -1256,12 +1305,12 @@ static PyObject *gps_step(Kernel *self, PyObject *task, PyObject *now_t) {
              attr_double(p, param_names[8], 0, &latency) &&
              attr_double(p, param_names[9], 1, &lost_pct);
         Py_DECREF(p);
-        PyObject *v = ok ? PyObject_GetAttr(comp, bad_name) : NULL;
+        PyObject *v = ok ? get_ref(comp, bad_name) : NULL;
         if (v != NULL) {
             bad = PyBool_Check(v) ? v == Py_True : -1;
             Py_DECREF(v);
         }
-        v = ok ? PyObject_GetAttr(comp, history_name) : NULL;
+        v = ok ? get_ref(comp, history_name) : NULL;
         if (v != NULL) {
             history = PyObject_IsTrue(v);
             Py_DECREF(v);
@@ -1296,7 +1345,7 @@ static PyObject *gps_step(Kernel *self, PyObject *task, PyObject *now_t) {
             return NULL;
         }
     }
-    int rc = PyObject_SetAttr(comp, t_prev_name, now);
+    int rc = set_ref(comp, t_prev_name, now);
     Py_DECREF(now);
     if (rc < 0 || input_value(self, 0, &px) < 0 || input_value(self, 1, &py) < 0) {
         return NULL;
@@ -1314,7 +1363,7 @@ static PyObject *gps_step(Kernel *self, PyObject *task, PyObject *now_t) {
         out[1] = fy * precision;
     }
     int now_bad = bad ? u_burst >= leave : u_burst < enter;
-    if (PyObject_SetAttr(comp, bad_name, now_bad ? Py_True : Py_False) < 0) {
+    if (set_ref(comp, bad_name, now_bad ? Py_True : Py_False) < 0) {
         return NULL;
     }
     if (now_bad || u_loss * 100.0 < lost_pct) {
@@ -1325,6 +1374,13 @@ static PyObject *gps_step(Kernel *self, PyObject *task, PyObject *now_t) {
     }
     static const char *const names[] = {"gpsPosX", "gpsPosY"};
     return publish_values(self, out, names, 2, now_t);
+}
+
+static PyObject *gps_step(Kernel *self, PyObject *task, PyObject *now_t) {
+    PyObject *cd = dict_of(self->comp);
+    PyObject *res = gps_body(self, task, now_t, cd);
+    Py_DECREF(cd);
+    return res;
 }
 
 static PyObject *Kernel_call(Kernel *self, PyObject *args, PyObject *kw) {
