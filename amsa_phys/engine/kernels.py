@@ -18,8 +18,6 @@ from collections.abc import Callable
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
-from . import publish
-
 if TYPE_CHECKING:
     from .tasks import Task
 
@@ -81,19 +79,19 @@ def _where(fn: Any) -> tuple[Any, Any]:
 
 
 def kernel(
+    make: Any,
     task: Task,
     values: Any,
     fallback: Callable[[Task, Fraction], None],
-    judges: tuple[Callable[..., None], Callable[..., None]],
+    judges: Callable[[Task], tuple[Callable[..., None], Callable[..., None]]],
 ) -> Any:
-    """``task``'s step as a compiled body (see the module docstring), or None: the
-    extension not built, the pure path asked for, or no body for this component.
-    ``fallback`` is the component's ordinary step; ``judges`` the scalar step's
-    ``(failed, judge)`` (``Steppers._judges``), for what a robot's body meets after it has
-    called into Python."""
-    make = publish.kernel()
+    """``task``'s step as a compiled body (see the module docstring) made by ``make``
+    (``publish.kernel()``, asked by the caller once), or None: no body for this component.
+    ``fallback`` is the component's ordinary step; ``judges(task)`` gives the scalar step's
+    ``(failed, judge)`` (``Steppers._judges``), for what a robot's or a sensor's body meets
+    after it has called into Python."""
     body = body_of(task.comp)
-    if make is None or body is None:
+    if body is None:
         return None
     code, ins, outs = body
     reads = dict(task.reads)
@@ -110,5 +108,5 @@ def kernel(
         tuple(writes[p] for p in outs),
         values,
         fallback,
-        *judges,
+        *judges(task),
     )

@@ -58,11 +58,20 @@ def drawn() -> Any:
     return None if module is None else module.Drawn
 
 
+#: the extension once imported (False: not built); the switch is read at every call, so a
+#: test or a user may set it between runs
+_module: Any = None
+
+
 def _extension() -> Any:
+    global _module
     if os.environ.get(PURE_ENV, "").strip() not in ("", "0"):
         return None
-    try:
-        from . import _publish
-    except ImportError:  # no C compiler at install time: the Python loops run
-        return None
-    return _publish
+    if _module is None:  # the import statement's machinery once, not at every ask
+        try:
+            from . import _publish
+        except ImportError:  # no C compiler at install time: the Python loops run
+            _module = False
+        else:
+            _module = _publish
+    return _module or None

@@ -149,6 +149,8 @@ class Steppers:
         packed = isinstance(values, array)
         self._gather = publish.gather() if packed else None
         self._scalar = publish.scalar() if packed else None
+        #: the compiled bodies' type (``kernels.py``), asked once per run, not per task
+        self._kernel = publish.kernel() if packed else None
         self._made: dict[int, tuple[Task, Callable[[Task, Fraction], None]]] = {}
 
     def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:
@@ -163,8 +165,8 @@ class Steppers:
             step = self.delayed(task)
         else:
             step = self.scalar(task)
-            if self._scalar is not None:  # packed and compiled: an arithmetic body in C
-                step = kernels.kernel(task, self.values, step, self._judges(task)) or step
+            if self._kernel is not None:  # packed and compiled: an arithmetic body in C
+                step = kernels.kernel(self._kernel, task, self.values, step, self._judges) or step
         self._made[id(task)] = (task, step)
         return step
 

@@ -154,8 +154,8 @@ def _stepped_at(
     where = {f"S.{p}": i for i, p in enumerate(ins)} | {f"C.{p}": n + i for i, p in enumerate(outs)}
     task.bind(where.__getitem__)
     steppers = Steppers(values, lambda *_: None, lambda p: f"{p} (T)")
-    if not body:
-        steppers._scalar = None  # the packed store's other compiled step stays out too
+    if not body:  # the Python step (the packed store's other compiled step stays out too)
+        steppers._scalar = steppers._kernel = None
     step = steppers.for_task(task)
     try:
         step(task, now)
