@@ -157,6 +157,7 @@ def _stepped_at(
     if not body:  # the Python step (the packed store's other compiled step stays out too)
         steppers._scalar = steppers._kernel = None
     step = steppers.for_task(task)
+    assert body or type(step).__name__ != "Kernel"  # else a body compared with itself
     try:
         step(task, now)
     except RunFault as exc:
