@@ -708,15 +708,16 @@ static PyObject *fraction_cls = NULL;
  * returns, the same floats. NULL without an error for anything else (the Python method
  * then runs: other behaviours, a change due, parameters of other types); NULL with an
  * error for what the method would raise. ``source`` is the rover's state reader. */
-static PyObject *steer(PyObject *comp, PyObject *t, PyObject *source) {
-    PyObject *p = PyObject_GetAttr(comp, p_name);
+static PyObject *steer_in(PyObject *comp, PyObject *t, PyObject *source) {
+    PyObject *p = get_ref(comp, p_name);
     if (p == NULL) {
         PyErr_Clear();
         return NULL;
     }
-    PyObject *b = PyObject_GetAttr(p, behavior_name);
-    PyObject *cruise = b == NULL ? NULL : PyObject_GetAttr(p, cruise_name);
-    PyObject *gain = cruise == NULL ? NULL : PyObject_GetAttr(p, steer_gain_name);
+    Py_SETREF(p, dict_of(p));
+    PyObject *b = get_ref(p, behavior_name);
+    PyObject *cruise = b == NULL ? NULL : get_ref(p, cruise_name);
+    PyObject *gain = cruise == NULL ? NULL : get_ref(p, steer_gain_name);
     PyObject *res = NULL;
     PyErr_Clear();
     if (gain == NULL || !PyLong_CheckExact(b) || !PyFloat_CheckExact(cruise) ||
@@ -733,7 +734,7 @@ static PyObject *steer(PyObject *comp, PyObject *t, PyObject *source) {
         goto out;
     }
     /* t >= next_change, as the method compares two Fractions: in integers */
-    PyObject *nc = PyObject_GetAttr(comp, next_change_name);
+    PyObject *nc = get_ref(comp, next_change_name);
     if (nc == NULL) {
         PyErr_Clear();
         goto out;
@@ -787,6 +788,14 @@ out:
     return res;
 }
 
+/* steer_in on the component's instance dict (``comp`` is the component). */
+static PyObject *steer(PyObject *comp, PyObject *t, PyObject *source) {
+    PyObject *cd = dict_of(comp);
+    PyObject *res = steer_in(cd, t, source);
+    Py_DECREF(cd);
+    return res;
+}
+
 /* The robots' bodies (codes 2 and 3; see Kernel's comment). */
 static PyObject *robot_step(Kernel *self, PyObject *task, PyObject *now) {
     PyObject *comp = self->comp;
@@ -802,7 +811,13 @@ static PyObject *robot_step(Kernel *self, PyObject *task, PyObject *now) {
             return PyObject_CallFunctionObjArgs(self->fallback, task, now, NULL);
         }
     }
-    rover = PyObject_GetAttr(comp, rover_name);
+    PyObject *cd = dict_of(comp); /* the rover: an instance attribute */
+    rover = get_ref(cd, rover_name);
+    Py_DECREF(cd);
+    if (rover == NULL) { /* the attribute read's own error, as the Python step meets it */
+        PyErr_Clear();
+        rover = PyObject_GetAttr(comp, rover_name);
+    }
     if (rover == NULL) {
         return hand_fault(self->failed, now);
     }

@@ -427,3 +427,14 @@ def test_a_random_leader_steers_as_its_python_step(target: float, change: Fracti
         comps[1].next_change,
         comps[1].target_heading,
     ) or np.isnan(target)
+
+
+@needs_c
+@pytest.mark.parametrize("cls", [ControlledRobot, FreeRobot], ids=lambda c: c.__name__)
+def test_a_robot_never_initialised_faults_as_its_python_step(cls: type) -> None:
+    inputs = [1.0, 2.0] if cls is ControlledRobot else []
+    got = _stepped(cls("R", {}), inputs, True)
+    want = _stepped(cls("R", {}), inputs, False)
+    assert got[2] == "Kernel"
+    assert got[1] == want[1]
+    assert "has no attribute" in got[1]
