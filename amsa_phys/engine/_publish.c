@@ -823,10 +823,9 @@ static PyObject *robot_step(Kernel *self, PyObject *task, PyObject *now) {
     }
     source = PyObject_GetAttr(rover, source_name);
     rims = source == NULL ? NULL : PyObject_GetAttr(rover, rims_name);
-    if (rims == NULL) {
-        goto done;
-    }
-    if (source == Py_None) { /* no physics step's reader: the Python step */
+    if (rims == NULL || source == Py_None) {
+        /* no physics step's reader (or a rover without them): the Python step */
+        PyErr_Clear();
         res = PyObject_CallFunctionObjArgs(self->fallback, task, now, NULL);
         goto done;
     }
