@@ -1,14 +1,18 @@
-"""Components whose step is plain arithmetic, run as compiled bodies (``_publish.Kernel``).
+"""The standard components' steps as compiled bodies (``_kernels.Kernel``).
 
-A distance monitor or a power normaliser computes a number or two from its inputs: through
-the ordinary scalar step that is a dict of inputs, a Python frame, a dict of outputs and
-their judging, ~1 µs for a few floating-point operations. Where the extension is built, the
-store is packed and the component is exactly such a template — its class's own ``do_step``,
-not a subclass's or an instance's replacement — ``Kernel`` reads the store, computes the
-same operations in the same order and writes the results, in one C call. What it cannot
-take as the Python step would (a parameter of another type, an output that is not finite)
-it hands to the component's ordinary step, which publishes or raises exactly as before, so
-a run is the same bit for bit and fault for fault either way (``tests/engine/test_kernels.py``).
+Through the ordinary scalar step a component's step is a dict of inputs, a Python frame, a
+dict of outputs and their judging: ~1 µs for a distance monitor's few floating-point
+operations, more for a robot's pose or a GPS fix, at every step of every run. Where the
+extension is built and the store is packed, the robots, the GPS, the compass, the distance
+monitor and the power normaliser step as C bodies instead — only the template's class
+itself (a subclass may step differently) with its own ``do_step`` (not a replaced one):
+``Kernel`` reads the store and the component's state, does the template's operations in the
+same order and writes the results. What stays Python it calls by name (the rover's driver,
+the leader's behaviour at a change, the Gauss–Markov factors when their parameters change,
+the random streams), and what it cannot take as the Python step would (its first step, a
+delayed fix, a battery model, a parameter of another type, an output that is not finite)
+goes to the component's ordinary step, which publishes or raises exactly as before. So a
+run is the same bit for bit and fault for fault either way (``tests/engine/test_kernels.py``).
 ``AMSA_PHYS_PURE=1`` (``publish.py``) runs every component through Python.
 """
 
@@ -24,7 +28,7 @@ if TYPE_CHECKING:
 #: what both robots publish, in ``Robot._pose``'s order
 POSE = ("posX", "posY", "heading", "speed", "yawRate", "wheelSpeedL", "wheelSpeedR")
 
-#: the bodies ``_publish.Kernel`` knows: (module, class) -> (code, input ports, output ports)
+#: the bodies ``_kernels.Kernel`` knows: (module, class) -> (code, input ports, output ports)
 BODIES: dict[tuple[str, str], tuple[int, tuple[str, ...], tuple[str, ...]]] = {
     ("amsa_phys.control.monitor", "DistanceMonitor"): (
         0,

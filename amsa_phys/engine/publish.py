@@ -8,12 +8,15 @@ values written, the same faults raised, only sooner. ``Scalar`` is the scalar st
 (gather, ``do_step``, publish) as a C callable, so a component's step has no Python frame
 of the engine's around it; what ``do_step`` raises and what ``publish`` declines go back to
 Python functions that raise the Python step's faults. ``Drawn`` is ``engine/rng.py``'s
-block-drawn random stream as a C callable. ``AMSA_PHYS_PURE=1`` (the switch of the pure
+block-drawn random stream as a C callable. ``_kernels.c``, a second extension, holds
+``Kernel``: the standard components' whole steps as compiled bodies (``kernels.py``).
+``AMSA_PHYS_PURE=1`` (the switch of the pure
 physics step too) or a build without a C compiler runs the Python loops alone.
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 from collections.abc import Callable
 from typing import Any
@@ -46,10 +49,10 @@ def scalar() -> Any:
 
 
 def kernel() -> Any:
-    """The ``Kernel`` step type from the extension (an arithmetic component's whole step in
-    C, ``kernels.py``), or None."""
-    module = _extension()
-    return getattr(module, "Kernel", None) if module is not None else None
+    """The ``Kernel`` step type (a standard component's whole step as a compiled body,
+    ``kernels.py``; the ``_kernels`` extension), or None (not built, or the pure path)."""
+    module = _extension("_kernels")
+    return None if module is None else module.Kernel
 
 
 def drawn() -> Any:
@@ -58,20 +61,19 @@ def drawn() -> Any:
     return None if module is None else module.Drawn
 
 
-#: the extension once imported (False: not built); the switch is read at every call, so a
+#: the extensions once imported (False: not built); the switch is read at every call, so a
 #: test or a user may set it between runs
-_module: Any = None
+_modules: dict[str, Any] = {}
 
 
-def _extension() -> Any:
-    global _module
+def _extension(name: str = "_publish") -> Any:
     if os.environ.get(PURE_ENV, "").strip() not in ("", "0"):
         return None
-    if _module is None:  # the import statement's machinery once, not at every ask
+    module = _modules.get(name)
+    if module is None:  # the import machinery once, not at every ask
         try:
-            from . import _publish
+            module = importlib.import_module(f"{__package__}.{name}")
         except ImportError:  # no C compiler at install time: the Python loops run
-            _module = False
-        else:
-            _module = _publish
-    return _module or None
+            module = False
+        _modules[name] = module
+    return module or None

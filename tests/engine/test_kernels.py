@@ -25,7 +25,7 @@ from amsa_phys.sensors.compass import Compass
 from amsa_phys.sensors.gps import GPS
 
 ROOT = Path(__file__).resolve().parents[2]
-BUILT = importlib.util.find_spec("amsa_phys.engine._publish") is not None
+BUILT = importlib.util.find_spec("amsa_phys.engine._kernels") is not None
 needs_c = pytest.mark.skipif(not BUILT, reason="the extension was not built (no C compiler)")
 NOW = Fraction(5, 4)
 
