@@ -21,5 +21,13 @@ setup(
         ),
         # the engine's write of a component's outputs into the store (engine/publish.py)
         Extension("amsa_phys.engine._publish", ["amsa_phys/engine/_publish.c"], optional=True),
+        Extension(
+            "amsa_phys.engine._kernels",
+            ["amsa_phys/engine/_kernels.c"],
+            # the components' bodies (``engine/kernels.py``) round as Python's arithmetic does
+            extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"],
+            libraries=["m"],
+            optional=True,
+        ),
     ]
 )

@@ -18,7 +18,8 @@ part                   what
 =====================  ==============================================================
 physics step (C)       ``physics/space.py``'s step: the compiled step's one C call
 components             every component's ``do_step`` (robots, sensors, controllers)
-engine loop            ``engine/``: the schedule walk, the component calls, deliveries
+engine loop            ``engine/``: the schedule walk, the component calls, deliveries, and
+                       the components stepped as compiled bodies (``engine/kernels.py``)
 log and trace          ``engine/log.py`` and the trace and signal writers
 gym env                ``gym/``: the agent's step, the episode's stack switch, observations
 gymnasium              Gymnasium's own wrappers (``gymnasium.make`` adds them)

@@ -8,12 +8,15 @@ values written, the same faults raised, only sooner. ``Scalar`` is the scalar st
 (gather, ``do_step``, publish) as a C callable, so a component's step has no Python frame
 of the engine's around it; what ``do_step`` raises and what ``publish`` declines go back to
 Python functions that raise the Python step's faults. ``Drawn`` is ``engine/rng.py``'s
-block-drawn random stream as a C callable. ``AMSA_PHYS_PURE=1`` (the switch of the pure
+block-drawn random stream as a C callable. ``_kernels.c``, a second extension, holds
+``Kernel``: the standard components' whole steps as compiled bodies (``kernels.py``).
+``AMSA_PHYS_PURE=1`` (the switch of the pure
 physics step too) or a build without a C compiler runs the Python loops alone.
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 from collections.abc import Callable
 from typing import Any
@@ -45,17 +48,32 @@ def scalar() -> Any:
     return None if module is None else module.Scalar
 
 
+def kernel() -> Any:
+    """The ``Kernel`` step type (a standard component's whole step as a compiled body,
+    ``kernels.py``; the ``_kernels`` extension), or None (not built, or the pure path)."""
+    module = _extension("_kernels")
+    return None if module is None else module.Kernel
+
+
 def drawn() -> Any:
     """The compiled ``Drawn`` (``engine/rng.py``'s, in C), or None."""
     module = _extension()
     return None if module is None else module.Drawn
 
 
-def _extension() -> Any:
+#: the extensions once imported (False: not built); the switch is read at every call, so a
+#: test or a user may set it between runs
+_modules: dict[str, Any] = {}
+
+
+def _extension(name: str = "_publish") -> Any:
     if os.environ.get(PURE_ENV, "").strip() not in ("", "0"):
         return None
-    try:
-        from . import _publish
-    except ImportError:  # no C compiler at install time: the Python loops run
-        return None
-    return _publish
+    module = _modules.get(name)
+    if module is None:  # the import machinery once, not at every ask
+        try:
+            module = importlib.import_module(f"{__package__}.{name}")
+        except ImportError:  # no C compiler at install time: the Python loops run
+            module = False
+        _modules[name] = module
+    return module or None

@@ -33,7 +33,7 @@ import numpy as np
 from ..errors import RunFault
 from ..model.params import short_repr
 from ..model.template import Template
-from . import batch, interrupt, publish
+from . import batch, interrupt, kernels, publish
 from .delayedstep import packed_delayed
 from .timing import DelayLine
 from .verdicts import (
@@ -149,6 +149,8 @@ class Steppers:
         packed = isinstance(values, array)
         self._gather = publish.gather() if packed else None
         self._scalar = publish.scalar() if packed else None
+        #: the compiled bodies' type (``kernels.py``), asked once per run, not per task
+        self._kernel = publish.kernel() if packed else None
         self._made: dict[int, tuple[Task, Callable[[Task, Fraction], None]]] = {}
 
     def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:
@@ -159,8 +161,12 @@ class Steppers:
             return made[1]
         if task.arrays_in or task.arrays_out:
             step = self.step_arrays
+        elif task.delay is not None:
+            step = self.delayed(task)
         else:
-            step = self.scalar(task) if task.delay is None else self.delayed(task)
+            step = self.scalar(task)
+            if self._kernel is not None:  # packed and compiled: an arithmetic body in C
+                step = kernels.kernel(self._kernel, task, self.values, step, self._judges) or step
         self._made[id(task)] = (task, step)
         return step
 

@@ -1,0 +1,1201 @@
+/* The standard components' steps as compiled bodies: ``Kernel``, chosen by
+ * ``engine/kernels.py`` (which component, which body, and why the runs stay the same bit
+ * for bit). The scalar step's other compiled pieces (``Scalar``, ``gather``, ``publish``,
+ * ``Drawn``) are ``_publish.c``'s; a body hands what it does not take to them, through the
+ * Python callables it is given.
+ *
+ * Built with -ffp-contract=off (``setup.py``): every product and sum rounds once, as Python's
+ * float arithmetic does, so no fused multiply-add changes a last bit.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <math.h>
+
+/* Kernel(code, comp, ins, outs, values, fallback): a component whose do_step is plain
+ * arithmetic on its inputs (and parameters), stepped without a Python call: ``step(task,
+ * now)`` as the table calls it. ``ins`` and ``outs`` are the store positions of its inputs
+ * and outputs in port order (``engine/kernels.py`` binds them); ``code`` says which body:
+ *
+ *   0  DistanceMonitor: math.hypot(in0 - in2, in1 - in3) (``control/monitor.py``), the
+ *      hypot called as math.hypot itself, so its bits are CPython's whatever the version;
+ *   1  NormalizePower: min(hi, max(lo, v)) * (motorCoef * 0.01) for each of two inputs,
+ *      written as the Python comparisons (a NaN gives lo), its parameters read from
+ *      ``comp.p`` at every call (the timeline changes them between steps);
+ *   2  controlledRobot: ``comp.rover.set_power(in0, in1)`` called (Python: the driver's
+ *      state is the rover's), then the pose ``Robot._pose`` publishes, from the physics
+ *      step's own readers (``rover._source``, ``rover._rims``), without its dict;
+ *   3  freeRobot: the same after ``comp._behaviour(now)`` chose the powers.
+ *
+ * The robots' bodies call Python (the behaviour, the driver) before they publish: what
+ * those raise goes to ``failed(exc, now)`` and a pose they cannot write as floats (not
+ * finite, or a reader that gives something else) to ``judge(out, now)`` with the dict
+ * ``_pose`` returns, both the scalar step's own (``Scalar``), so the faults are its faults.
+ *
+ * Anything the body cannot take as the Python step would (a parameter not a float, or an
+ * int for motorCoef; an output not finite) goes to ``fallback(task, now)``, the component's
+ * ordinary step, which computes the same outputs from the same store (the bodies keep no
+ * state) and publishes or raises exactly as without this type. */
+typedef struct {
+    PyObject_HEAD
+    int code;
+    PyObject *comp, *ins, *outs, *values, *fallback, *failed, *judge;
+} Kernel;
+
+static PyObject *hypot_fn = NULL;
+static PyObject *p_name = NULL, *lo_name = NULL, *hi_name = NULL, *coef_name = NULL;
+static PyObject *supply_name = NULL, *rover_name = NULL, *source_name = NULL,
+                *rims_name = NULL, *set_power_name = NULL, *behaviour_name = NULL,
+                *pose_name = NULL;
+
+/* The number of inputs and outputs of each body. */
+static const Py_ssize_t kernel_ins[] = {4, 2, 2, 0, 1, 2};
+static const Py_ssize_t kernel_outs[] = {1, 2, 7, 7, 1, 2};
+
+static int Kernel_init(Kernel *self, PyObject *args, PyObject *kw) {
+    int code;
+    PyObject *comp, *ins, *outs, *values, *fallback, *failed, *judge;
+    if (kw != NULL && PyDict_GET_SIZE(kw)) {
+        PyErr_SetString(PyExc_TypeError, "Kernel takes no keywords");
+        return -1;
+    }
+    if (!PyArg_ParseTuple(args, "iOO!O!OOOO", &code, &comp, &PyTuple_Type, &ins, &PyTuple_Type,
+                          &outs, &values, &fallback, &failed, &judge)) {
+        return -1;
+    }
+    if (code < 0 || code > 5) {
+        PyErr_SetString(PyExc_ValueError, "Kernel: unknown body");
+        return -1;
+    }
+    Py_ssize_t want_in = kernel_ins[code], want_out = kernel_outs[code];
+    if (PyTuple_GET_SIZE(ins) != want_in || PyTuple_GET_SIZE(outs) != want_out) {
+        PyErr_SetString(PyExc_ValueError, "Kernel: unknown body, or wrong port counts");
+        return -1;
+    }
+    for (Py_ssize_t k = 0; k < want_in + want_out; k++) {
+        PyObject *at = k < want_in ? PyTuple_GET_ITEM(ins, k) : PyTuple_GET_ITEM(outs, k - want_in);
+        if (!PyLong_CheckExact(at)) {
+            PyErr_SetString(PyExc_TypeError, "Kernel: positions must be ints");
+            return -1;
+        }
+    }
+    self->code = code;
+    PyObject **slots[] = {&self->comp,     &self->ins,    &self->outs, &self->values,
+                          &self->fallback, &self->failed, &self->judge};
+    PyObject *given[] = {comp, ins, outs, values, fallback, failed, judge};
+    for (int k = 0; k < 7; k++) {
+        Py_INCREF(given[k]);
+        Py_XSETREF(*slots[k], given[k]);
+    }
+    return 0;
+}
+
+static int Kernel_traverse(Kernel *self, visitproc visit, void *arg) {
+    Py_VISIT(self->comp);
+    Py_VISIT(self->ins);
+    Py_VISIT(self->outs);
+    Py_VISIT(self->values);
+    Py_VISIT(self->fallback);
+    Py_VISIT(self->failed);
+    Py_VISIT(self->judge);
+    return 0;
+}
+
+static int Kernel_clear(Kernel *self) {
+    Py_CLEAR(self->comp);
+    Py_CLEAR(self->ins);
+    Py_CLEAR(self->outs);
+    Py_CLEAR(self->values);
+    Py_CLEAR(self->fallback);
+    Py_CLEAR(self->failed);
+    Py_CLEAR(self->judge);
+    return 0;
+}
+
+static void Kernel_dealloc(Kernel *self) {
+    PyObject_GC_UnTrack(self);
+    Kernel_clear(self);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+/* The store position ``k`` of the tuple ``at``, checked against the store's length. */
+static int position(PyObject *at, Py_ssize_t k, Py_ssize_t n, Py_ssize_t *out) {
+    Py_ssize_t i = PyLong_AsSsize_t(PyTuple_GET_ITEM(at, k));
+    if (i == -1 && PyErr_Occurred()) {
+        return -1;
+    }
+    if (i < 0 || i >= n) {
+        PyErr_SetString(PyExc_IndexError, "Kernel: position out of range");
+        return -1;
+    }
+    *out = i;
+    return 0;
+}
+
+/* A parameter of ``p`` as a double, when it is a float exactly (ints too with
+ * ``int_ok``): 1; 0 when it is something else (the Python step then judges); -1 on error. */
+static int float_param(PyObject *p, PyObject *name, int int_ok, double *out) {
+    PyObject *v = PyObject_GetAttr(p, name);
+    if (v == NULL) {
+        PyErr_Clear(); /* the Python step raises its own fault for a missing parameter */
+        return 0;
+    }
+    int ok = 1;
+    if (PyFloat_CheckExact(v)) {
+        *out = PyFloat_AS_DOUBLE(v);
+    } else if (int_ok && PyLong_CheckExact(v)) {
+        *out = PyLong_AsDouble(v); /* int * float in Python converts the same way */
+        if (*out == -1.0 && PyErr_Occurred()) {
+            PyErr_Clear();
+            ok = 0;
+        }
+    } else {
+        ok = 0;
+    }
+    Py_DECREF(v);
+    return ok;
+}
+
+static PyObject *floor_fn = NULL, *fraction_type = NULL;
+static PyObject *noise_name = NULL, *bias_draw_name = NULL, *loss_draw_name = NULL,
+                *burst_draw_name = NULL, *t_prev_name = NULL, *gm_name = NULL,
+                *lost_name = NULL, *numerator_name = NULL, *denominator_name = NULL,
+                *b_name = NULL, *bx_name = NULL, *by_name = NULL, *on_x_name = NULL,
+                *on_y_name = NULL, *enter_name = NULL, *leave_name = NULL, *bad_name = NULL,
+                *history_name = NULL, *turn_on_name = NULL, *sign_name = NULL, *z_name = NULL;
+
+/* The sensors' parameters by name: mean, stddev, bias_mean, bias_stddev,
+ * dynamic_bias_stddev, dynamic_bias_correlation_time, precision, lostData, latency,
+ * lostDataGPS, deviationB..E. */
+static const char *const param_texts[] = {"mean",
+                                          "stddev",
+                                          "bias_mean",
+                                          "bias_stddev",
+                                          "dynamic_bias_stddev",
+                                          "dynamic_bias_correlation_time",
+                                          "precision",
+                                          "lostData",
+                                          "latency",
+                                          "lostDataGPS",
+                                          "deviationB",
+                                          "deviationC",
+                                          "deviationD",
+                                          "deviationE"};
+#define N_PARAMS 14
+static PyObject *param_names[N_PARAMS];
+
+/* ``o.name`` where ``o`` is an object, or its instance dict (a component's, its parameters'):
+ * the sensors' bodies read their state from the dict itself, as the attribute read would
+ * find it there (their classes define no descriptor of these names), at a fraction of the
+ * cost. A new reference, or NULL with AttributeError (or another error) set. */
+static PyObject *get_ref(PyObject *o, PyObject *name) {
+    if (!PyDict_CheckExact(o)) {
+        return PyObject_GetAttr(o, name);
+    }
+    PyObject *v = PyDict_GetItemWithError(o, name);
+    if (v == NULL) {
+        if (!PyErr_Occurred()) {
+            PyErr_SetObject(PyExc_AttributeError, name);
+        }
+        return NULL;
+    }
+    Py_INCREF(v);
+    return v;
+}
+
+/* ``o.name = v`` (``o`` an object or its instance dict, as for get_ref). */
+static int set_ref(PyObject *o, PyObject *name, PyObject *v) {
+    return PyDict_CheckExact(o) ? PyDict_SetItem(o, name, v) : PyObject_SetAttr(o, name, v);
+}
+
+/* The instance dict of ``obj`` (a new reference), or ``obj`` itself where it has none. */
+static PyObject *dict_of(PyObject *obj) {
+    PyObject *d = PyObject_GenericGetDict(obj, NULL);
+    if (d == NULL || !PyDict_CheckExact(d)) {
+        PyErr_Clear();
+        Py_XDECREF(d);
+        Py_INCREF(obj);
+        return obj;
+    }
+    return d;
+}
+
+/* ``obj.name`` as a double when it is a float exactly (an int too with ``int_ok``, within
+ * 2**53, where Python's mixed comparisons and products give the double's answers): 1, or 0
+ * (anything else, or missing: the Python step judges). */
+static int attr_double(PyObject *obj, PyObject *name, int int_ok, double *out) {
+    PyObject *v = get_ref(obj, name);
+    if (v == NULL) {
+        PyErr_Clear();
+        return 0;
+    }
+    int ok = 1;
+    if (PyFloat_CheckExact(v)) {
+        *out = PyFloat_AS_DOUBLE(v);
+    } else if (int_ok && PyLong_CheckExact(v)) {
+        long long n = PyLong_AsLongLong(v);
+        if ((n == -1 && PyErr_Occurred()) || n > (1LL << 53) || n < -(1LL << 53)) {
+            PyErr_Clear();
+            ok = 0;
+        } else {
+            *out = (double)n;
+        }
+    } else {
+        ok = 0;
+    }
+    Py_DECREF(v);
+    return ok;
+}
+
+/* What do_step raised, handed to ``failed(exc, now)`` (which raises the scalar step's fault
+ * for it): the Scalar step's way, NULL always. */
+static PyObject *hand_fault(PyObject *failed, PyObject *now) {
+    PyObject *type, *value, *tb;
+    PyErr_Fetch(&type, &value, &tb);
+    PyErr_NormalizeException(&type, &value, &tb);
+    if (tb != NULL && value != NULL) {
+        PyException_SetTraceback(value, tb);
+    }
+    PyObject *res = PyObject_CallFunctionObjArgs(failed, value ? value : Py_None, now, NULL);
+    Py_XDECREF(type);
+    Py_XDECREF(value);
+    Py_XDECREF(tb);
+    if (res != NULL) {
+        Py_DECREF(res);
+        PyErr_SetString(PyExc_SystemError, "Kernel: failed() returned");
+    }
+    return NULL;
+}
+
+/* Python's float ``x % y`` (Objects/floatobject.c float_rem), for y != 0. */
+static double py_mod(double x, double y) {
+    double mod = fmod(x, y);
+    if (mod) {
+        if ((y < 0) != (mod < 0)) {
+            mod += y;
+        }
+    } else {
+        mod = copysign(0.0, y);
+    }
+    return mod;
+}
+
+/* ``n`` exact floats of the sequence ``seq`` into ``out``: 1, or 0 for anything else. */
+static int floats_of(PyObject *seq, Py_ssize_t n, double *out) {
+    if (!PyTuple_CheckExact(seq) && !PyList_CheckExact(seq)) {
+        return 0;
+    }
+    if (PySequence_Fast_GET_SIZE(seq) != n) {
+        return 0;
+    }
+    PyObject **items = PySequence_Fast_ITEMS(seq);
+    for (Py_ssize_t k = 0; k < n; k++) {
+        if (!PyFloat_CheckExact(items[k])) {
+            return 0;
+        }
+        out[k] = PyFloat_AS_DOUBLE(items[k]);
+    }
+    return 1;
+}
+
+static PyObject *behavior_name = NULL, *cruise_name = NULL, *next_change_name = NULL,
+                *target_name = NULL, *speed_factor_name = NULL, *steer_gain_name = NULL;
+static PyObject *fraction_cls = NULL;
+
+/* FreeRobot._behaviour(t) for behaviour 1 (the cruise power on both wheels) and for
+ * behaviour 4 (random) between two changes of heading (t < next_change): the pair it
+ * returns, the same floats. NULL without an error for anything else (the Python method
+ * then runs: other behaviours, a change due, parameters of other types); NULL with an
+ * error for what the method would raise. ``source`` is the rover's state reader. */
+static PyObject *steer_in(PyObject *comp, PyObject *t, PyObject *source) {
+    PyObject *p = get_ref(comp, p_name);
+    if (p == NULL) {
+        PyErr_Clear();
+        return NULL;
+    }
+    Py_SETREF(p, dict_of(p));
+    PyObject *b = get_ref(p, behavior_name);
+    PyObject *cruise = b == NULL ? NULL : get_ref(p, cruise_name);
+    PyObject *gain = cruise == NULL ? NULL : get_ref(p, steer_gain_name);
+    PyObject *res = NULL;
+    PyErr_Clear();
+    if (gain == NULL || !PyLong_CheckExact(b) || !PyFloat_CheckExact(cruise) ||
+        !PyFloat_CheckExact(gain)) {
+        goto out;
+    }
+    long behavior = PyLong_AsLong(b);
+    if (behavior == 1) {
+        res = PyTuple_Pack(2, cruise, cruise);
+        goto out;
+    }
+    if (behavior != 4) {
+        PyErr_Clear();
+        goto out;
+    }
+    /* t >= next_change, as the method compares two Fractions: in integers */
+    PyObject *nc = get_ref(comp, next_change_name);
+    if (nc == NULL) {
+        PyErr_Clear();
+        goto out;
+    }
+    int due = -1;
+    if ((PyObject *)Py_TYPE(t) == fraction_cls && (PyObject *)Py_TYPE(nc) == fraction_cls) {
+        PyObject *tn = PyObject_GetAttr(t, numerator_name);
+        PyObject *td = PyObject_GetAttr(t, denominator_name);
+        PyObject *nn = PyObject_GetAttr(nc, numerator_name);
+        PyObject *nd = PyObject_GetAttr(nc, denominator_name);
+        PyObject *lhs = tn && nd ? PyNumber_Multiply(tn, nd) : NULL;
+        PyObject *rhs = nn && td ? PyNumber_Multiply(nn, td) : NULL;
+        if (lhs != NULL && rhs != NULL) {
+            due = PyObject_RichCompareBool(lhs, rhs, Py_GE);
+        }
+        Py_XDECREF(tn);
+        Py_XDECREF(td);
+        Py_XDECREF(nn);
+        Py_XDECREF(nd);
+        Py_XDECREF(lhs);
+        Py_XDECREF(rhs);
+        PyErr_Clear();
+    }
+    Py_DECREF(nc);
+    double target, factor;
+    if (due != 0 || !attr_double(comp, target_name, 0, &target) ||
+        !attr_double(comp, speed_factor_name, 0, &factor)) {
+        goto out; /* a change due (its draws are the method's), or not plain floats */
+    }
+    PyObject *state = PyObject_CallNoArgs(source);
+    if (state == NULL) {
+        goto out; /* raised: the error goes to the step's fault */
+    }
+    double kin[6];
+    int plain = floats_of(state, 6, kin);
+    Py_DECREF(state);
+    if (!plain) {
+        goto out; /* the method reads it its own way */
+    }
+    const double pi = 3.141592653589793, two_pi = 2 * 3.141592653589793;
+    double err = py_mod(target - kin[2] + pi, two_pi) - pi;
+    double diff = PyFloat_AS_DOUBLE(gain) * err;
+    double c = cos(err); /* err is finite or NaN: math.cos raises for neither */
+    double forward = PyFloat_AS_DOUBLE(cruise) * factor * (c > 0.0 ? c : 0.0);
+    res = Py_BuildValue("(dd)", forward - diff, forward + diff);
+out:
+    Py_DECREF(p);
+    Py_XDECREF(b);
+    Py_XDECREF(cruise);
+    Py_XDECREF(gain);
+    return res;
+}
+
+/* steer_in on the component's instance dict (``comp`` is the component). */
+static PyObject *steer(PyObject *comp, PyObject *t, PyObject *source) {
+    PyObject *cd = dict_of(comp);
+    PyObject *res = steer_in(cd, t, source);
+    Py_DECREF(cd);
+    return res;
+}
+
+/* The robots' bodies (codes 2 and 3; see Kernel's comment). */
+static PyObject *robot_step(Kernel *self, PyObject *task, PyObject *now) {
+    PyObject *comp = self->comp;
+    PyObject *rover = NULL, *source = NULL, *rims = NULL, *powers = NULL, *res = NULL;
+    if (self->code == 2) { /* a supply (battery, windings): the Python step */
+        PyObject *supply = PyObject_GetAttr(comp, supply_name);
+        if (supply == NULL) {
+            return NULL;
+        }
+        int ideal = supply == Py_None;
+        Py_DECREF(supply);
+        if (!ideal) {
+            return PyObject_CallFunctionObjArgs(self->fallback, task, now, NULL);
+        }
+    }
+    PyObject *cd = dict_of(comp); /* the rover: an instance attribute */
+    rover = get_ref(cd, rover_name);
+    Py_DECREF(cd);
+    if (rover == NULL) { /* the attribute read's own error, as the Python step meets it */
+        PyErr_Clear();
+        rover = PyObject_GetAttr(comp, rover_name);
+    }
+    if (rover == NULL) {
+        return hand_fault(self->failed, now);
+    }
+    source = PyObject_GetAttr(rover, source_name);
+    rims = source == NULL ? NULL : PyObject_GetAttr(rover, rims_name);
+    if (rims == NULL || source == Py_None) {
+        /* no physics step's reader (or a rover without them): the Python step */
+        PyErr_Clear();
+        res = PyObject_CallFunctionObjArgs(self->fallback, task, now, NULL);
+        goto done;
+    }
+    PyObject *left, *right;
+    if (self->code == 2) {
+        Py_buffer view;
+        if (PyObject_GetBuffer(self->values, &view, PyBUF_FORMAT) < 0) {
+            goto done;
+        }
+        const double *data = (const double *)view.buf;
+        Py_ssize_t n = view.len / (Py_ssize_t)sizeof(double), at[2];
+        int bad = view.itemsize != sizeof(double) || view.format == NULL ||
+                  view.format[0] != 'd' || view.format[1] != '\0';
+        for (Py_ssize_t k = 0; k < 2 && !bad; k++) {
+            bad = position(self->ins, k, n, &at[k]) < 0;
+        }
+        if (bad) {
+            PyBuffer_Release(&view);
+            if (!PyErr_Occurred()) {
+                PyErr_SetString(PyExc_TypeError, "Kernel: the store must be an array of doubles");
+            }
+            goto done;
+        }
+        powers = Py_BuildValue("(dd)", data[at[0]], data[at[1]]);
+        PyBuffer_Release(&view);
+        if (powers == NULL) {
+            goto done;
+        }
+    } else if ((powers = steer(comp, now, source)) != NULL) {
+        /* behaviour 1 or 4 between two changes: FreeRobot._behaviour's floats, here */
+    } else if (PyErr_Occurred()) {
+        res = hand_fault(self->failed, now);
+        goto done;
+    } else {
+        powers = PyObject_CallMethodObjArgs(comp, behaviour_name, now, NULL);
+        if (powers == NULL) {
+            res = hand_fault(self->failed, now);
+            goto done;
+        }
+        if (!PyTuple_CheckExact(powers) || PyTuple_GET_SIZE(powers) != 2) {
+            PyErr_SetString(PyExc_SystemError, "Kernel: _behaviour gave no pair");
+            goto done;
+        }
+    }
+    left = PyTuple_GET_ITEM(powers, 0);
+    right = PyTuple_GET_ITEM(powers, 1);
+    PyObject *set = PyObject_CallMethodObjArgs(rover, set_power_name, left, right, NULL);
+    if (set == NULL) {
+        res = hand_fault(self->failed, now);
+        goto done;
+    }
+    Py_DECREF(set);
+    /* Robot._pose: x, y, a, vx, vy, w from the state reader, the rims' speeds */
+    double kin[6], rim[2] = {0.0, 0.0};
+    PyObject *state = PyObject_CallNoArgs(source);
+    if (state == NULL) {
+        res = hand_fault(self->failed, now);
+        goto done;
+    }
+    int plain = floats_of(state, 6, kin);
+    Py_DECREF(state);
+    if (plain && rims != Py_None) {
+        PyObject *r = PyObject_CallNoArgs(rims);
+        if (r == NULL) {
+            res = hand_fault(self->failed, now);
+            goto done;
+        }
+        plain = floats_of(r, 2, rim);
+        Py_DECREF(r);
+    }
+    double out[7];
+    if (plain) {
+        const double pi = 3.141592653589793, two_pi = 2 * 3.141592653589793;
+        double a = kin[2];
+        out[0] = kin[0];
+        out[1] = kin[1];
+        out[2] = py_mod(a + pi, two_pi) - pi;
+        double along = kin[3] * cos(a);
+        double across = kin[4] * sin(a);
+        out[3] = along + across;
+        out[4] = kin[5];
+        out[5] = rim[0];
+        out[6] = rim[1];
+        for (int k = 0; k < 7 && plain; k++) {
+            plain = out[k] - out[k] == 0.0;
+        }
+    }
+    if (!plain) { /* the pose as _pose gives it, judged by the Python loop */
+        PyObject *pose = PyObject_CallMethodNoArgs(comp, pose_name);
+        if (pose == NULL) {
+            res = hand_fault(self->failed, now);
+            goto done;
+        }
+        res = PyObject_CallFunctionObjArgs(self->judge, pose, now, NULL);
+        Py_DECREF(pose);
+        goto done;
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(self->values, &view, PyBUF_WRITABLE | PyBUF_FORMAT) < 0) {
+        goto done;
+    }
+    double *data = (double *)view.buf;
+    Py_ssize_t n = view.len / (Py_ssize_t)sizeof(double), at[7];
+    int bad = view.itemsize != sizeof(double) || view.format == NULL || view.format[0] != 'd' ||
+              view.format[1] != '\0';
+    for (Py_ssize_t k = 0; k < 7 && !bad; k++) {
+        bad = position(self->outs, k, n, &at[k]) < 0;
+    }
+    if (!bad) {
+        for (int k = 0; k < 7; k++) {
+            data[at[k]] = out[k];
+        }
+        Py_INCREF(Py_None);
+        res = Py_None;
+    } else if (!PyErr_Occurred()) {
+        PyErr_SetString(PyExc_TypeError, "Kernel: the store must be an array of doubles");
+    }
+    PyBuffer_Release(&view);
+done:
+    Py_XDECREF(rover);
+    Py_XDECREF(source);
+    Py_XDECREF(rims);
+    Py_XDECREF(powers);
+    return res;
+}
+
+/* -- the sensors' bodies (codes 4 and 5) ------------------------------------------------ */
+
+/* ``obj.name[0]`` as a double, when a list's first item is a float exactly: 1, or 0. */
+static int first_double(PyObject *obj, PyObject *name, double *out) {
+    PyObject *v = get_ref(obj, name);
+    if (v == NULL) {
+        PyErr_Clear();
+        return 0;
+    }
+    int ok = PyList_CheckExact(v) && PyList_GET_SIZE(v) > 0 &&
+             PyFloat_CheckExact(PyList_GET_ITEM(v, 0));
+    if (ok) {
+        *out = PyFloat_AS_DOUBLE(PyList_GET_ITEM(v, 0));
+    }
+    Py_DECREF(v);
+    return ok;
+}
+
+/* ``t`` as the sensors take it: ``t._numerator / t._denominator`` for a Fraction (int / int,
+ * correctly rounded), ``float(t)`` otherwise. NULL on error. */
+static PyObject *seconds(PyObject *t) {
+    if ((PyObject *)Py_TYPE(t) == fraction_type) {
+        PyObject *n = PyObject_GetAttr(t, numerator_name);
+        PyObject *d = n == NULL ? NULL : PyObject_GetAttr(t, denominator_name);
+        PyObject *q = d == NULL ? NULL : PyNumber_TrueDivide(n, d);
+        Py_XDECREF(n);
+        Py_XDECREF(d);
+        return q;
+    }
+    return PyNumber_Float(t);
+}
+
+/* One draw of the stream ``comp.name``, as a double (the streams give floats). */
+static int draw(PyObject *comp, PyObject *name, double *out) {
+    PyObject *fn = get_ref(comp, name);
+    PyObject *v = fn == NULL ? NULL : PyObject_CallNoArgs(fn);
+    Py_XDECREF(fn);
+    if (v == NULL) {
+        return -1;
+    }
+    *out = PyFloat_AsDouble(v);
+    Py_DECREF(v);
+    return *out == -1.0 && PyErr_Occurred() ? -1 : 0;
+}
+
+/* The Gauss-Markov step's ``(phi, q)`` for ``(sigma, tau, dt)``, as ``comp._gm`` remembers
+ * it (``nz.gauss_markov`` asked, and remembered, when the key changed). */
+static int gauss_markov(PyObject *comp, double sigma, double tau, double dt, double *phi,
+                        double *q) {
+    PyObject *key = Py_BuildValue("(ddd)", sigma, tau, dt);
+    if (key == NULL) {
+        return -1;
+    }
+    PyObject *gm = get_ref(comp, gm_name);
+    if (gm == NULL) {
+        Py_DECREF(key);
+        return -1;
+    }
+    if (!PyTuple_Check(gm) || PyTuple_GET_SIZE(gm) != 2) {
+        PyErr_SetString(PyExc_TypeError, "Kernel: _gm is not a pair");
+        goto fail;
+    }
+    int changed = PyObject_RichCompareBool(key, PyTuple_GET_ITEM(gm, 0), Py_NE);
+    if (changed < 0) {
+        goto fail;
+    }
+    if (changed) {
+        PyObject *nz = PyImport_ImportModule("amsa_phys.engine.noise");
+        PyObject *fn = nz == NULL ? NULL : PyObject_GetAttrString(nz, "gauss_markov");
+        Py_XDECREF(nz);
+        PyObject *pair = fn == NULL ? NULL : PyObject_CallObject(fn, key);
+        Py_XDECREF(fn);
+        if (pair == NULL) {
+            goto fail;
+        }
+        PyObject *fresh = PyTuple_Pack(2, key, pair);
+        Py_DECREF(pair);
+        if (fresh == NULL || set_ref(comp, gm_name, fresh) < 0) {
+            Py_XDECREF(fresh);
+            goto fail;
+        }
+        Py_SETREF(gm, fresh);
+    }
+    PyObject *pair = PyTuple_GET_ITEM(gm, 1);
+    if (!PyTuple_Check(pair) || PyTuple_GET_SIZE(pair) != 2) {
+        PyErr_SetString(PyExc_TypeError, "Kernel: gauss_markov gave no pair");
+        goto fail;
+    }
+    *phi = PyFloat_AsDouble(PyTuple_GET_ITEM(pair, 0));
+    *q = PyFloat_AsDouble(PyTuple_GET_ITEM(pair, 1));
+    if (PyErr_Occurred()) {
+        goto fail;
+    }
+    Py_DECREF(gm);
+    Py_DECREF(key);
+    return 0;
+fail:
+    Py_DECREF(gm);
+    Py_DECREF(key);
+    return -1;
+}
+
+static int set_double(PyObject *obj, PyObject *name, double v) {
+    PyObject *f = PyFloat_FromDouble(v);
+    if (f == NULL) {
+        return -1;
+    }
+    int rc = set_ref(obj, name, f);
+    Py_DECREF(f);
+    return rc;
+}
+
+/* ``comp.lost += 1`` */
+static int count_lost(PyObject *comp) {
+    PyObject *lost = get_ref(comp, lost_name);
+    if (lost == NULL) {
+        return -1;
+    }
+    PyObject *one = PyLong_FromLong(1);
+    PyObject *more = one == NULL ? NULL : PyNumber_InPlaceAdd(lost, one);
+    Py_XDECREF(one);
+    Py_DECREF(lost);
+    if (more == NULL) {
+        return -1;
+    }
+    int rc = set_ref(comp, lost_name, more);
+    Py_DECREF(more);
+    return rc;
+}
+
+/* ``math.floor(v)`` as a double; for a v it refuses (inf, nan), its exception. */
+static int py_floor(double v, double *out) {
+    if (isfinite(v)) {
+        *out = floor(v);
+        return 0;
+    }
+    PyObject *f = PyFloat_FromDouble(v);
+    PyObject *r = f == NULL ? NULL : PyObject_CallOneArg(floor_fn, f);
+    Py_XDECREF(f);
+    if (r != NULL) { /* not reached: math.floor refuses every value that is not finite */
+        Py_DECREF(r);
+        PyErr_SetString(PyExc_SystemError, "Kernel: floor took a value that is not finite");
+    }
+    return -1;
+}
+
+static PyObject *sin_fn = NULL, *cos_fn = NULL;
+
+/* ``math.sin`` or ``math.cos`` of ``x`` (``f`` and ``fn``) as a double: libm's, as math's;
+ * for an infinite x, math's own ValueError (libm gives a NaN). */
+static int py_trig(double (*f)(double), PyObject *fn, double x, double *out) {
+    if (!isinf(x)) {
+        *out = f(x);
+        return 0;
+    }
+    PyObject *v = PyFloat_FromDouble(x);
+    PyObject *r = v == NULL ? NULL : PyObject_CallOneArg(fn, v);
+    Py_XDECREF(v);
+    if (r != NULL) { /* not reached: math refuses an infinite angle */
+        Py_DECREF(r);
+        PyErr_SetString(PyExc_SystemError, "Kernel: math took an infinite angle");
+    }
+    return -1;
+}
+
+/* The store's ``k``-th input of this kernel, as a double. */
+static int input_value(Kernel *self, Py_ssize_t k, double *out) {
+    Py_buffer view;
+    if (PyObject_GetBuffer(self->values, &view, PyBUF_FORMAT) < 0) {
+        return -1;
+    }
+    Py_ssize_t n = view.len / (Py_ssize_t)sizeof(double), at;
+    int rc = -1;
+    if (view.itemsize != sizeof(double) || view.format == NULL || view.format[0] != 'd' ||
+        view.format[1] != '\0') {
+        PyErr_SetString(PyExc_TypeError, "Kernel: the store must be an array of doubles");
+    } else if (position(self->ins, k, n, &at) == 0) {
+        *out = ((const double *)view.buf)[at];
+        rc = 0;
+    }
+    PyBuffer_Release(&view);
+    return rc;
+}
+
+/* Write ``count`` outputs; or, if one is not finite, hand the dict the step would have
+ * returned (``names`` its keys) to ``judge``. */
+static PyObject *publish_values(Kernel *self, const double *out, const char *const *names,
+                                Py_ssize_t count, PyObject *now) {
+    int finite = 1;
+    for (Py_ssize_t k = 0; k < count; k++) {
+        finite = finite && out[k] - out[k] == 0.0;
+    }
+    if (!finite) {
+        PyObject *dict = PyDict_New();
+        for (Py_ssize_t k = 0; dict != NULL && k < count; k++) {
+            PyObject *v = PyFloat_FromDouble(out[k]);
+            if (v == NULL || PyDict_SetItemString(dict, names[k], v) < 0) {
+                Py_CLEAR(dict);
+            }
+            Py_XDECREF(v);
+        }
+        if (dict == NULL) {
+            return NULL;
+        }
+        PyObject *res = PyObject_CallFunctionObjArgs(self->judge, dict, now, NULL);
+        Py_DECREF(dict);
+        return res;
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(self->values, &view, PyBUF_WRITABLE | PyBUF_FORMAT) < 0) {
+        return NULL;
+    }
+    Py_ssize_t n = view.len / (Py_ssize_t)sizeof(double), at[2];
+    int bad = view.itemsize != sizeof(double) || view.format == NULL || view.format[0] != 'd' ||
+              view.format[1] != '\0';
+    for (Py_ssize_t k = 0; k < count && !bad; k++) {
+        bad = position(self->outs, k, n, &at[k]) < 0;
+    }
+    if (!bad) {
+        for (Py_ssize_t k = 0; k < count; k++) {
+            ((double *)view.buf)[at[k]] = out[k];
+        }
+    } else if (!PyErr_Occurred()) {
+        PyErr_SetString(PyExc_TypeError, "Kernel: the store must be an array of doubles");
+    }
+    PyBuffer_Release(&view);
+    if (bad) {
+        return NULL;
+    }
+    Py_RETURN_NONE;
+}
+
+/* Compass.do_step (``sensors/compass.py``), after its first step. */
+static PyObject *compass_body(Kernel *self, PyObject *task, PyObject *now_t, PyObject *cd) {
+    PyObject *comp = cd, *p = NULL, *turn_on = NULL, *now = NULL;
+    double t_prev = 0, b = 0, mean = 0, stddev = 0, bias_mean = 0, bias_stddev = 0, sigma = 0;
+    double tau = 0, precision = 0, lost_pct = 0, dev[4] = {0, 0, 0, 0}, sign0 = 0, z0 = 0;
+    int ok = 0;
+    p = get_ref(comp, p_name);
+    if (p != NULL) {
+        Py_SETREF(p, dict_of(p));
+    }
+    turn_on = p == NULL ? NULL : get_ref(comp, turn_on_name);
+    if (turn_on == NULL) {
+        PyErr_Clear();
+    } else {
+        ok = attr_double(comp, t_prev_name, 0, &t_prev) && attr_double(comp, b_name, 0, &b) &&
+             attr_double(p, param_names[0], 0, &mean) &&
+             attr_double(p, param_names[1], 0, &stddev) &&
+             attr_double(p, param_names[2], 0, &bias_mean) &&
+             attr_double(p, param_names[3], 0, &bias_stddev) &&
+             attr_double(p, param_names[4], 0, &sigma) &&
+             attr_double(p, param_names[5], 0,
+                         &tau) &&
+             attr_double(p, param_names[6], 0, &precision) &&
+             attr_double(p, param_names[7], 0, &lost_pct) &&
+             first_double(turn_on, sign_name, &sign0) && first_double(turn_on, z_name, &z0);
+        for (int k = 0; k < 4 && ok; k++) {
+            ok = attr_double(p, param_names[10 + k], 0, &dev[k]);
+        }
+    }
+    Py_XDECREF(p);
+    Py_XDECREF(turn_on);
+    if (!ok) { /* the first step, or anything the body does not take: the Python step */
+        if (PyErr_Occurred()) {
+            return NULL;
+        }
+        return PyObject_CallFunctionObjArgs(self->fallback, task, now_t, NULL);
+    }
+    double w, g, u, nowd, h;
+    if (draw(comp, noise_name, &w) < 0 || draw(comp, bias_draw_name, &g) < 0 ||
+        draw(comp, loss_draw_name, &u) < 0) {
+        return hand_fault(self->failed, now_t);
+    }
+    now = seconds(now_t);
+    if (now == NULL) {
+        return hand_fault(self->failed, now_t);
+    }
+    nowd = PyFloat_AsDouble(now);
+    if (sigma > 0 || b != 0.0) {
+        double phi, q;
+        if (gauss_markov(comp, sigma, tau, nowd - t_prev, &phi, &q) < 0) {
+            Py_DECREF(now);
+            return hand_fault(self->failed, now_t);
+        }
+        b = phi * b + q * g;
+        if (set_double(comp, b_name, b) < 0) {
+            Py_DECREF(now);
+            return NULL;
+        }
+    }
+    int rc = set_ref(comp, t_prev_name, now);
+    Py_DECREF(now);
+    if (rc < 0) {
+        return NULL;
+    }
+    if (u * 100.0 < lost_pct) {
+        if (count_lost(comp) < 0) {
+            return hand_fault(self->failed, now_t);
+        }
+        Py_RETURN_NONE; /* {}: nothing published */
+    }
+    if (input_value(self, 0, &h) < 0) {
+        return NULL;
+    }
+    const double pi = 3.141592653589793, two_pi = 2 * 3.141592653589793;
+    double value = h + mean + b + stddev * w;
+    value = value + sign0 * (bias_mean + bias_stddev * z0);
+    if (dev[0] != 0.0 || dev[1] != 0.0 || dev[2] != 0.0 || dev[3] != 0.0 || isnan(dev[0]) ||
+        isnan(dev[1]) || isnan(dev[2]) || isnan(dev[3])) {
+        double s1, c1, s2, c2;
+        if (py_trig(sin, sin_fn, h, &s1) < 0 || py_trig(cos, cos_fn, h, &c1) < 0 ||
+            py_trig(sin, sin_fn, 2 * h, &s2) < 0 || py_trig(cos, cos_fn, 2 * h, &c2) < 0) {
+            return hand_fault(self->failed, now_t);
+        }
+        double d1 = dev[0] * s1;
+        double d2 = dev[1] * c1;
+        double d3 = dev[2] * s2;
+        double d4 = dev[3] * c2;
+        value = value + (((d1 + d2) + d3) + d4);
+    }
+    value = py_mod(value + pi, two_pi) - pi;
+    if (precision > 0) {
+        double f;
+        if (py_floor(value / precision + 0.5, &f) < 0) {
+            return hand_fault(self->failed, now_t);
+        }
+        value = py_mod(f * precision + pi, two_pi) - pi;
+    }
+    static const char *const names[] = {"compassHeading"};
+    return publish_values(self, &value, names, 1, now_t);
+}
+
+static PyObject *compass_step(Kernel *self, PyObject *task, PyObject *now_t) {
+    PyObject *cd = dict_of(self->comp);
+    PyObject *res = compass_body(self, task, now_t, cd);
+    Py_DECREF(cd);
+    return res;
+}
+
+/* GPS.do_step (``sensors/gps.py``), after its first step and without latency. */
+static PyObject *gps_body(Kernel *self, PyObject *task, PyObject *now_t, PyObject *cd) {
+    PyObject *comp = cd, *p = NULL, *now = NULL;
+    double t_prev = 0, bx = 0, by = 0, on_x = 0, on_y = 0, enter = 0, leave = 0, mean = 0;
+    double stddev = 0, sigma = 0, tau = 0, precision = 0, latency = 0, lost_pct = 0;
+    int ok = 0, bad = -1, history = -1;
+    p = get_ref(comp, p_name);
+    if (p != NULL) {
+        Py_SETREF(p, dict_of(p));
+    }
+    if (p == NULL) {
+        PyErr_Clear();
+    } else {
+        ok = attr_double(comp, t_prev_name, 0, &t_prev) &&
+             attr_double(comp, bx_name, 0, &bx) && attr_double(comp, by_name, 0, &by) &&
+             attr_double(comp, on_x_name, 0, &on_x) && attr_double(comp, on_y_name, 0, &on_y) &&
+             attr_double(comp, enter_name, 0, &enter) &&
+             attr_double(comp, leave_name, 0, &leave) &&
+             attr_double(p, param_names[0], 0, &mean) &&
+             attr_double(p, param_names[1], 0, &stddev) &&
+             attr_double(p, param_names[4], 0, &sigma) &&
+             attr_double(p, param_names[5], 0,
+                         &tau) &&
+             attr_double(p, param_names[6], 0, &precision) &&
+             attr_double(p, param_names[8], 0, &latency) &&
+             attr_double(p, param_names[9], 1, &lost_pct);
+        Py_DECREF(p);
+        PyObject *v = ok ? get_ref(comp, bad_name) : NULL;
+        if (v != NULL) {
+            bad = PyBool_Check(v) ? v == Py_True : -1;
+            Py_DECREF(v);
+        }
+        v = ok ? get_ref(comp, history_name) : NULL;
+        if (v != NULL) {
+            history = PyObject_IsTrue(v);
+            Py_DECREF(v);
+        }
+        PyErr_Clear();
+    }
+    if (!ok || bad < 0 || history != 0 || latency > 0 || isnan(latency)) {
+        /* the first step, a delayed fix, or anything the body does not take: Python */
+        return PyObject_CallFunctionObjArgs(self->fallback, task, now_t, NULL);
+    }
+    double ex, ey, gx, gy, u_loss, u_burst, nowd, px, py;
+    if (draw(comp, noise_name, &ex) < 0 || draw(comp, noise_name, &ey) < 0 ||
+        draw(comp, bias_draw_name, &gx) < 0 || draw(comp, bias_draw_name, &gy) < 0 ||
+        draw(comp, loss_draw_name, &u_loss) < 0 || draw(comp, burst_draw_name, &u_burst) < 0) {
+        return hand_fault(self->failed, now_t);
+    }
+    now = seconds(now_t);
+    if (now == NULL) {
+        return hand_fault(self->failed, now_t);
+    }
+    nowd = PyFloat_AsDouble(now);
+    if (sigma > 0 || bx != 0.0 || by != 0.0) {
+        double phi, q;
+        if (gauss_markov(comp, sigma, tau, nowd - t_prev, &phi, &q) < 0) {
+            Py_DECREF(now);
+            return hand_fault(self->failed, now_t);
+        }
+        bx = phi * bx + q * gx;
+        by = phi * by + q * gy;
+        if (set_double(comp, bx_name, bx) < 0 || set_double(comp, by_name, by) < 0) {
+            Py_DECREF(now);
+            return NULL;
+        }
+    }
+    int rc = set_ref(comp, t_prev_name, now);
+    Py_DECREF(now);
+    if (rc < 0 || input_value(self, 0, &px) < 0 || input_value(self, 1, &py) < 0) {
+        return NULL;
+    }
+    double out[2];
+    out[0] = px + mean + on_x + bx + stddev * ex;
+    out[1] = py + mean + on_y + by + stddev * ey;
+    if (precision > 0) {
+        double fx, fy;
+        if (py_floor(out[0] / precision + 0.5, &fx) < 0 ||
+            py_floor(out[1] / precision + 0.5, &fy) < 0) {
+            return hand_fault(self->failed, now_t);
+        }
+        out[0] = fx * precision;
+        out[1] = fy * precision;
+    }
+    int now_bad = bad ? u_burst >= leave : u_burst < enter;
+    if (set_ref(comp, bad_name, now_bad ? Py_True : Py_False) < 0) {
+        return NULL;
+    }
+    if (now_bad || u_loss * 100.0 < lost_pct) {
+        if (count_lost(comp) < 0) {
+            return hand_fault(self->failed, now_t);
+        }
+        Py_RETURN_NONE; /* {}: nothing published */
+    }
+    static const char *const names[] = {"gpsPosX", "gpsPosY"};
+    return publish_values(self, out, names, 2, now_t);
+}
+
+static PyObject *gps_step(Kernel *self, PyObject *task, PyObject *now_t) {
+    PyObject *cd = dict_of(self->comp);
+    PyObject *res = gps_body(self, task, now_t, cd);
+    Py_DECREF(cd);
+    return res;
+}
+
+static PyObject *Kernel_call(Kernel *self, PyObject *args, PyObject *kw) {
+    if (kw != NULL || !PyTuple_Check(args) || PyTuple_GET_SIZE(args) != 2) {
+        PyErr_SetString(PyExc_TypeError, "step(task, now)");
+        return NULL;
+    }
+    if (self->comp == NULL) {
+        PyErr_SetString(PyExc_TypeError, "Kernel not initialised");
+        return NULL;
+    }
+    if (self->code == 2 || self->code == 3) {
+        return robot_step(self, PyTuple_GET_ITEM(args, 0), PyTuple_GET_ITEM(args, 1));
+    }
+    if (self->code == 4) {
+        return compass_step(self, PyTuple_GET_ITEM(args, 0), PyTuple_GET_ITEM(args, 1));
+    }
+    if (self->code == 5) {
+        return gps_step(self, PyTuple_GET_ITEM(args, 0), PyTuple_GET_ITEM(args, 1));
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(self->values, &view, PyBUF_WRITABLE | PyBUF_FORMAT) < 0) {
+        return NULL;
+    }
+    if (view.itemsize != sizeof(double) || view.format == NULL || view.format[0] != 'd' ||
+        view.format[1] != '\0') {
+        PyBuffer_Release(&view);
+        PyErr_SetString(PyExc_TypeError, "Kernel: the store must be an array of doubles");
+        return NULL;
+    }
+    double *data = (double *)view.buf;
+    Py_ssize_t n = view.len / (Py_ssize_t)sizeof(double);
+    Py_ssize_t at[6];
+    Py_ssize_t n_in = PyTuple_GET_SIZE(self->ins), n_out = PyTuple_GET_SIZE(self->outs);
+    for (Py_ssize_t k = 0; k < n_in; k++) {
+        if (position(self->ins, k, n, &at[k]) < 0) {
+            goto fail;
+        }
+    }
+    for (Py_ssize_t k = 0; k < n_out; k++) {
+        if (position(self->outs, k, n, &at[n_in + k]) < 0) {
+            goto fail;
+        }
+    }
+    double result[2];
+    int taken = 0; /* 1: the body computed every output, finite */
+    if (self->code == 0) {
+        PyObject *dx = PyFloat_FromDouble(data[at[0]] - data[at[2]]);
+        PyObject *dy = dx == NULL ? NULL : PyFloat_FromDouble(data[at[1]] - data[at[3]]);
+        PyObject *h = NULL;
+        if (dy != NULL) {
+            PyObject *pair[2] = {dx, dy};
+            h = PyObject_Vectorcall(hypot_fn, pair, 2, NULL);
+        }
+        Py_XDECREF(dx);
+        Py_XDECREF(dy);
+        if (h == NULL) {
+            goto fail;
+        }
+        result[0] = PyFloat_AsDouble(h);
+        Py_DECREF(h);
+        taken = result[0] - result[0] == 0.0;
+    } else {
+        PyObject *p = PyObject_GetAttr(self->comp, p_name);
+        if (p == NULL) {
+            goto fail;
+        }
+        double lo, hi, coef;
+        int got = float_param(p, lo_name, 0, &lo);
+        got = got == 1 ? float_param(p, hi_name, 0, &hi) : got;
+        got = got == 1 ? float_param(p, coef_name, 1, &coef) : got;
+        Py_DECREF(p);
+        if (got == 1) {
+            double k = coef * 0.01;
+            for (int j = 0; j < 2; j++) {
+                double v = data[at[j]];
+                v = v > lo ? v : lo;
+                result[j] = (v < hi ? v : hi) * k;
+            }
+            taken = result[0] - result[0] == 0.0 && result[1] - result[1] == 0.0;
+        }
+    }
+    if (taken) {
+        for (Py_ssize_t k = 0; k < n_out; k++) {
+            data[at[n_in + k]] = result[k];
+        }
+    }
+    PyBuffer_Release(&view);
+    if (taken) {
+        Py_RETURN_NONE;
+    }
+    return PyObject_CallFunctionObjArgs(self->fallback, PyTuple_GET_ITEM(args, 0),
+                                        PyTuple_GET_ITEM(args, 1), NULL);
+fail:
+    PyBuffer_Release(&view);
+    return NULL;
+}
+
+static PyTypeObject KernelType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "amsa_phys.engine._kernels.Kernel",
+    .tp_basicsize = sizeof(Kernel),
+    .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_HAVE_GC,
+    .tp_doc = "A component's arithmetic body, step(task, now), in C (see _kernels.c).",
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)Kernel_init,
+    .tp_dealloc = (destructor)Kernel_dealloc,
+    .tp_traverse = (traverseproc)Kernel_traverse,
+    .tp_clear = (inquiry)Kernel_clear,
+    .tp_call = (ternaryfunc)Kernel_call,
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_kernels",
+    "The standard components' steps as compiled bodies (engine/kernels.py).", -1, NULL,
+};
+
+PyMODINIT_FUNC PyInit__kernels(void) {
+    if (PyType_Ready(&KernelType) < 0) {
+        return NULL;
+    }
+    PyObject *math = PyImport_ImportModule("math");
+    if (math == NULL) {
+        return NULL;
+    }
+    hypot_fn = PyObject_GetAttrString(math, "hypot");
+    Py_DECREF(math);
+    p_name = PyUnicode_InternFromString("p");
+    lo_name = PyUnicode_InternFromString("powerMin");
+    hi_name = PyUnicode_InternFromString("powerMax");
+    coef_name = PyUnicode_InternFromString("motorCoef");
+    supply_name = PyUnicode_InternFromString("supply");
+    rover_name = PyUnicode_InternFromString("rover");
+    source_name = PyUnicode_InternFromString("_source");
+    rims_name = PyUnicode_InternFromString("_rims");
+    set_power_name = PyUnicode_InternFromString("set_power");
+    behaviour_name = PyUnicode_InternFromString("_behaviour");
+    pose_name = PyUnicode_InternFromString("_pose");
+    PyObject *fractions = PyImport_ImportModule("fractions");
+    if (fractions == NULL) {
+        return NULL;
+    }
+    fraction_type = PyObject_GetAttrString(fractions, "Fraction");
+    Py_DECREF(fractions);
+    math = PyImport_ImportModule("math");
+    floor_fn = math == NULL ? NULL : PyObject_GetAttrString(math, "floor");
+    sin_fn = math == NULL ? NULL : PyObject_GetAttrString(math, "sin");
+    cos_fn = math == NULL ? NULL : PyObject_GetAttrString(math, "cos");
+    Py_XDECREF(math);
+    const char *const texts[] = {"noise",   "draw_bias", "draw_loss", "draw_burst", "t_prev",
+                                 "_gm",     "lost",      "_numerator", "_denominator", "b",
+                                 "bx",      "by",        "on_x",      "on_y",      "enter",
+                                 "leave",   "bad",       "history",   "turn_on",   "sign",
+                                 "z"};
+    PyObject **interned[] = {&noise_name,     &bias_draw_name, &loss_draw_name, &burst_draw_name,
+                             &t_prev_name,    &gm_name,        &lost_name,      &numerator_name,
+                             &denominator_name, &b_name,       &bx_name,        &by_name,
+                             &on_x_name,      &on_y_name,      &enter_name,     &leave_name,
+                             &bad_name,       &history_name,   &turn_on_name,   &sign_name,
+                             &z_name};
+    for (int k = 0; k < 21; k++) {
+        *interned[k] = PyUnicode_InternFromString(texts[k]);
+        if (*interned[k] == NULL) {
+            return NULL;
+        }
+    }
+    for (int k = 0; k < N_PARAMS; k++) {
+        param_names[k] = PyUnicode_InternFromString(param_texts[k]);
+        if (param_names[k] == NULL) {
+            return NULL;
+        }
+    }
+    if (fraction_type == NULL || floor_fn == NULL || sin_fn == NULL || cos_fn == NULL) {
+        return NULL;
+    }
+    behavior_name = PyUnicode_InternFromString("behavior");
+    cruise_name = PyUnicode_InternFromString("cruisePower");
+    next_change_name = PyUnicode_InternFromString("next_change");
+    target_name = PyUnicode_InternFromString("target_heading");
+    speed_factor_name = PyUnicode_InternFromString("speed_factor");
+    steer_gain_name = PyUnicode_InternFromString("steerGain");
+    fraction_cls = fraction_type;
+    if (behavior_name == NULL || cruise_name == NULL || next_change_name == NULL ||
+        target_name == NULL || speed_factor_name == NULL || steer_gain_name == NULL) {
+        return NULL;
+    }
+    if (supply_name == NULL || rover_name == NULL || source_name == NULL || rims_name == NULL ||
+        set_power_name == NULL || behaviour_name == NULL || pose_name == NULL) {
+        return NULL;
+    }
+    if (hypot_fn == NULL || p_name == NULL || lo_name == NULL || hi_name == NULL ||
+        coef_name == NULL) {
+        return NULL;
+    }
+    PyObject *m = PyModule_Create(&module);
+    if (m == NULL) {
+        return NULL;
+    }
+    Py_INCREF(&KernelType);
+    if (PyModule_AddObject(m, "Kernel", (PyObject *)&KernelType) < 0) {
+        Py_DECREF(&KernelType);
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
+}
