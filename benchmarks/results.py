@@ -260,6 +260,7 @@ OWN_TABLES = {
     "adapt-validate": ADAPT / "adaptive_rules.validate.json",
     "adapt-demo": ROOT / "benchmarks" / "results" / "adapt_demo.json",
     "adapt-outside": ROOT / "benchmarks" / "results" / "adapt_outside.json",
+    "adapt-fresh": ROOT / "benchmarks" / "results" / "adapt_fresh.json",
 }
 
 
