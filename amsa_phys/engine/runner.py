@@ -36,7 +36,7 @@ from ..model.scenario import Change, Phase, Scenario
 from ..model.template import Template
 from ..model.timeline import Timeline
 from ..model.world import WorldSpec
-from . import batch, interrupt, schedule
+from . import batch, interrupt, layout, schedule
 from .adapt import AdaptRules
 from .build import build_components, make_task, plan_groups
 from .clock import TickGrid, exact
@@ -247,6 +247,31 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
         self.keeps_log = bool(self._keep_log or self.log.listeners or self.log.has_trace)
         log_at = self._log_period if self.keeps_log else None
         hooks = [(g.ticks(1 / r), fn) for r, fn, _ in self._hooks]
+        cycle = self._lay_out(log_at, hooks)
+        self._table = schedule.runs(cycle)
+        self._plan = schedule.merges(self._table, self._many)
+        self._end = g.ticks(self.duration)
+        self._sources[:0] = [TimelineSource(t, g, r) for r, t in enumerate(self.timelines)]
+        self._next_source_tick = min(s.next_tick() for s in self._sources)
+        self._next_instant_tick = min(self._next_source_tick, self.deliveries.next_due())
+
+    def _lay_out(self, log_at: int | None, hooks: list[tuple[int, Hook]]) -> list[schedule.Instant]:
+        """The cycle's instants with like components grouped (sets ``_cycle`` and
+        ``_groups_of``): laid out afresh, or by the layout kept from an earlier run of the
+        same structure (``layout.py``; a single run's, where resets repeat it)."""
+        worlds = self.worlds
+        freq = lambda t: worlds[t.run].leaves[t.path].freq  # noqa: E731
+        sig = None
+        if len(worlds) == 1:
+            key = self.grouping.key
+            sig = layout.signature(
+                self._tasks, [key(t, freq(t)) for t in self._tasks], log_at, hooks, self.grouping
+            )
+            kept = layout.kept(sig)
+            if kept is not None:
+                self._cycle = kept.cycle
+                cycle, self._groups_of = layout.rebuild(kept, self._tasks, hooks, self._steppers)
+                return cycle
         try:
             self._cycle, cycle = schedule.instants(self._tasks, log_at, hooks)
         except schedule.TooManyEvents as exc:
@@ -254,23 +279,13 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
                 "scheduler",
                 0,
                 f"the rates repeat only every "
-                f"{float(g.time(exc.cycle)):g} s ({exc.count} events); use "
+                f"{float(self.grid.time(exc.cycle)):g} s ({exc.count} events); use "
                 "commensurate frequencies",
             ) from None
-        worlds = self.worlds
-        self._groups_of = plan_groups(
-            cycle,
-            self._tasks,
-            lambda t: worlds[t.run].leaves[t.path].freq,
-            self.grouping,
-            self._steppers,
-        )
-        self._table = schedule.runs(cycle)
-        self._plan = schedule.merges(self._table, self._many)
-        self._end = g.ticks(self.duration)
-        self._sources[:0] = [TimelineSource(t, g, r) for r, t in enumerate(self.timelines)]
-        self._next_source_tick = min(s.next_tick() for s in self._sources)
-        self._next_instant_tick = min(self._next_source_tick, self.deliveries.next_due())
+        self._groups_of = plan_groups(cycle, self._tasks, freq, self.grouping, self._steppers)
+        if sig is not None:
+            layout.keep(sig, self._cycle, cycle, self._tasks, hooks)
+        return cycle
 
     # -- running --------------------------------------------------------------------------
     def run(self) -> RunResult:

@@ -1,0 +1,135 @@
+"""The cycle's layout, kept across runs of one structure: a reset pays no scheduling twice.
+
+A Gymnasium ``reset`` (``gym/follow.py``) or a falsification loop builds a new
+:class:`~amsa_phys.engine.runner.Simulation` of the same world for every episode; only the
+seed and parameter values change. Laying out the cycle (``schedule.instants``) and merging
+like components into groups (``build.plan_groups``) took ~40 % of such a build, and both
+depend only on what :func:`signature` collects: each task's path, run, period, timer phase,
+inputs and whether it is delayed, each task's group key, the log's and the hooks' periods.
+A layout records the result as positions (task ``k`` of the run's task list, hook ``k`` of its
+hook list, a group as the tuple of its members' positions); :func:`rebuild` lays the new
+run's own objects out by them, in the same order, so the table the hot loop walks is the one
+a fresh compilation gives (``tests/engine/test_layout.py`` compares them entry by entry).
+
+Only what the signature says is reused; a world whose seed draws other timer phases, or
+whose parameters change a group key, has another signature and is laid out afresh.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Hashable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from . import batch, schedule
+from .tasks import Steppers, Task
+
+#: How many layouts are kept (the oldest dropped first): one env or loop needs one
+MAX_LAYOUTS = 8
+
+#: A member of a group, as ``apply_change`` names it: (run, path)
+Member = tuple[int, str]
+#: An instant's item: a task's position, or a group as its members' positions
+Item = int | tuple[int, ...]
+
+
+@dataclass(frozen=True)
+class Layout:
+    """One structure's cycle: its length and, per instant, ``(offset, items, log, hooks)``
+    with tasks, groups and hooks by position."""
+
+    cycle: int
+    instants: tuple[tuple[int, tuple[Item, ...], bool, tuple[int, ...]], ...]
+
+
+_kept: dict[Hashable, Layout] = {}
+
+
+def signature(
+    tasks: Sequence[Task],
+    keys: Sequence[Any],
+    log_at: int | None,
+    hooks: Sequence[tuple[int, Callable[[], None]]],
+    grouping: batch.Grouping,
+) -> Hashable:
+    """Everything the layout depends on (``keys``: each task's group key, in task order)."""
+    fns = [fn for _, fn in hooks]
+    return (
+        tuple(
+            (t.path, t.run, t.period, t.phase, t.delay is not None, tuple(t.inputs)) for t in tasks
+        ),
+        tuple(keys),
+        log_at,
+        tuple(p for p, _ in hooks),
+        tuple(fns.index(fn) for fn in fns),  # which hooks are one function
+        grouping.key,
+        grouping.min_group,
+        grouping.enabled,
+    )
+
+
+def kept(sig: Hashable) -> Layout | None:
+    """The layout kept for ``sig``, if any."""
+    return _kept.get(sig)
+
+
+def keep(
+    sig: Hashable,
+    cycle: int,
+    instants: Sequence[schedule.Instant],
+    tasks: Sequence[Task],
+    hooks: Sequence[tuple[int, Callable[[], None]]],
+) -> None:
+    """Record a freshly planned cycle (its instants' tasks as ``(step, item)`` pairs)."""
+    where = {id(t): k for k, t in enumerate(tasks)}
+    fns = [fn for _, fn in hooks]
+    rows = []
+    for inst in instants:
+        items: list[Item] = []
+        for _, item in inst.tasks:
+            if isinstance(item, batch.Group):
+                items.append(tuple(where[id(m)] for m in item.tasks))
+            else:
+                items.append(where[id(item)])
+        rows.append((inst.offset, tuple(items), inst.log, tuple(fns.index(h) for h in inst.hooks)))
+    if len(_kept) >= MAX_LAYOUTS:
+        del _kept[next(iter(_kept))]
+    _kept[sig] = Layout(cycle, tuple(rows))
+
+
+def rebuild(
+    layout: Layout,
+    tasks: Sequence[Task],
+    hooks: Sequence[tuple[int, Callable[[], None]]],
+    steppers: Steppers,
+) -> tuple[list[schedule.Instant], dict[Member, list[batch.Group]]]:
+    """The cycle's instants with this run's tasks, groups and hooks, and the groups each
+    member steps in, as ``build.plan_groups`` returns them."""
+    step_group: Callable[..., None] = steppers.step_group
+    for_task = steppers.for_task
+    fns = [fn for _, fn in hooks]
+    made: dict[tuple[int, ...], batch.Group] = {}
+    groups_of: dict[Member, list[batch.Group]] = {}
+    out = []
+    for offset, items, log, hook_at in layout.instants:
+        pairs: list[tuple[Any, Any]] = []
+        for item in items:
+            if type(item) is int:
+                task = tasks[item]
+                pairs.append((for_task(task), task))
+                continue
+            group = made.get(item)  # type: ignore[arg-type]
+            if group is None:
+                group = made[item] = batch.Group([tasks[k] for k in item])  # type: ignore[union-attr]
+            pairs.append((step_group, group))
+            for member in group.tasks:
+                groups = groups_of.setdefault(batch.ident(member), [])
+                if group not in groups:
+                    groups.append(group)
+        out.append(schedule.Instant(offset, pairs, log, [fns[k] for k in hook_at]))
+    return out, groups_of
+
+
+def forget() -> None:
+    """Drop every kept layout (tests compare a fresh compilation with a kept one)."""
+    _kept.clear()
