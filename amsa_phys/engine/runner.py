@@ -60,6 +60,24 @@ Wrap = Callable[[str, Template], Template]
 __all__ = ["COMPONENT_ERRORS", "Context", "Event", "RunResult", "Simulation", "Task", "Wrap"]
 
 
+#: instants' times kept per tick grid (``_nows``): a Gymnasium env's episodes or a loop's
+#: runs meet the same instants again; bounded, ~1.5 MB a grid at most
+_NOWS_KEPT = 8192
+_GRIDS_KEPT = 4
+_nows_of: dict[tuple[int, int], dict[int, Fraction]] = {}
+
+
+def _nows(num: int, den: int) -> dict[int, Fraction]:
+    """The instants' times kept for the tick grid ``num / den`` s (tick -> exact time):
+    Fractions are immutable, so runs on one grid share them; the oldest grid goes first."""
+    nows = _nows_of.get((num, den))
+    if nows is None:
+        if len(_nows_of) >= _GRIDS_KEPT:
+            del _nows_of[next(iter(_nows_of))]
+        nows = _nows_of[(num, den)] = {}
+    return nows
+
+
 class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
     """One run of a scenario (or of a bare world, for tests).
 
@@ -331,6 +349,8 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
         num, den = self._tick_num, self._tick_den
         adapt = self._adapt  # fixed at construction
         many_of, seek = self._many, self._seek
+        nows = _nows(num, den)
+        deliver, data, col = self.deliveries.deliver, self.store.data, self.store.col
         try:
             while cursor <= until:
                 base = (cursor // cycle) * cycle
@@ -378,15 +398,25 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
                             cursor = tick
                             return
                         if tick >= self._next_instant_tick:
-                            self._apply_instant(tick)
+                            if self._next_source_tick > tick:  # deliveries alone are due
+                                nxt = deliver(tick, data, col)  # ``_apply_instant`` inlined
+                                source = self._next_source_tick
+                                self._next_instant_tick = nxt if nxt < source else source
+                            else:
+                                self._apply_instant(tick)
                         self._tick = tick
                         if self._pending_live:
                             self._apply_live()
                         if tasks:
                             if adapt is not None:
                                 self._apply_adapt()
-                            # the ``now`` property's Fraction, built here without its checks
-                            now = exact(tick * num, den)
+                            # the ``now`` property's Fraction, built here without its checks,
+                            # once per instant of the grid (an env's episodes repeat them)
+                            now = nows.get(tick)
+                            if now is None:
+                                now = exact(tick * num, den)
+                                if len(nows) < _NOWS_KEPT:
+                                    nows[tick] = now
                             self._now_cache = (tick, now)
                             try:
                                 for run, task in tasks:
