@@ -93,7 +93,7 @@ def keep(
                 items.append(where[id(item)])
         rows.append((inst.offset, tuple(items), inst.log, tuple(fns.index(h) for h in inst.hooks)))
     if len(_kept) >= MAX_LAYOUTS:
-        del _kept[next(iter(_kept))]
+        _kept.pop(next(iter(_kept), None), None)  # another thread may have dropped it
     _kept[sig] = Layout(cycle, tuple(rows))
 
 

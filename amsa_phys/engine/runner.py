@@ -73,7 +73,7 @@ def _nows(num: int, den: int) -> dict[int, Fraction]:
     nows = _nows_of.get((num, den))
     if nows is None:
         if len(_nows_of) >= _GRIDS_KEPT:
-            del _nows_of[next(iter(_nows_of))]
+            _nows_of.pop(next(iter(_nows_of), None), None)
         nows = _nows_of[(num, den)] = {}
     return nows
 

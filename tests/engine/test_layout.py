@@ -124,3 +124,13 @@ def test_phases_drawn_per_seed_are_laid_out_afresh(tmp_path: Path) -> None:
     fresh.initialize()
     assert table(first) != table(fresh)  # the seeds draw other phases
     assert table(other) == table(fresh)
+
+
+def test_the_kept_layouts_are_bounded(tmp_path: Path) -> None:
+    path = tmp_path / "w.yaml"
+    path.write_text(FREE)
+    world = load_world(path)
+    layout.forget()
+    for seed in range(3 * layout.MAX_LAYOUTS):  # most seeds draw other phases
+        Simulation(world, seed=seed, duration=Fraction(1)).initialize()
+    assert len(layout._kept) == layout.MAX_LAYOUTS
