@@ -43,6 +43,12 @@ class SignalSampler:
 
         return sample
 
+    def count(self) -> int:
+        """How many instants were sampled so far (whole ones: see :meth:`table`)."""
+        width = len(self._where)
+        n = len(self._t)
+        return min(n, len(self._flat) // width) if width else n
+
     def table(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """The logged instants and each signal as a ``(samples, runs)`` array."""
         width = len(self._where)
