@@ -55,9 +55,11 @@ class SignalSampler:
         n = len(self._t)
         if width:  # equal even if Ctrl-C fell between the two appends
             n = min(n, len(self._flat) // width)
-        t = np.array(self._t[:n], dtype=np.float64)
+        t = np.frombuffer(self._t, dtype=np.float64, count=n).copy()
         shape = (n, len(self.names), self.runs)
-        data = np.array(self._flat[: n * width], dtype=np.float64).reshape(shape)
+        # one copy out of the samples' buffer (slicing the ``array`` first made two)
+        data = np.frombuffer(self._flat, dtype=np.float64, count=n * width).copy()
+        data = data.reshape(shape)
         return t, {name: data[:, k, :] for k, name in enumerate(self.names)}
 
 
