@@ -3,10 +3,12 @@
 The vector env (``FollowVecEnv``, random actions) at each size in ``--vector``, per vector
 step, and a batched sweep (``--sweep``: ``--runs`` runs of 60 s, 25 Kv values, as
 ``bench_engine.py`` plans them, in this process), per run. Every group's ``step_many`` and
-every call of the column physics is timed (CPU); "the rest" is the engine's loop, the
-agent's side of the vector env (actions, rewards, observations) and, in a sweep, each
-run's set-up and metrics. The physics line is the floor no work on the rest can pass: the
-ceiling it gives is the rate with everything else free.
+every call of the column physics is timed (CPU), and in a sweep each batch's set-up (its
+runs' components built, then initialized and the schedule planned) and end (verdicts,
+metrics); "the rest" is the engine's loop, the agent's side of the vector env (actions,
+rewards, observations) and, in a sweep, the jobs' planning and preparation. The
+physics line is the floor no work on the rest can pass: the ceiling it gives is the rate
+with everything else free.
 
 Run: ``python benchmarks/bench_breakdown.py [--vector 2 16 64 1000] [--sweep scenario1
 scenario2] [--runs 1000]``. Prints a table; measures nothing against a baseline (the
@@ -105,9 +107,49 @@ def vector(n: int, steps: int) -> None:
     table(total, steps, "us", cpu, {k: v / steps for k, v in calls.items()}, "a vector step")
 
 
+#: A sweep's parts outside the loop, timed on their own lines: the batch's set-up and end
+SETUP = "(set-up: build)"
+INIT = "(set-up: initialize, plan)"
+END = "(end: verdicts, metrics)"
+
+
+@contextmanager
+def phases(cpu: collections.Counter, calls: collections.Counter) -> Iterator[None]:
+    """Time a batch's set-up (its runs' components built; their ``initialize`` and the
+    schedule's and groups' planning) and its end (requirements judged, each run's metrics)
+    into ``cpu`` and ``calls``, beside the loop's groups and physics."""
+    from amsa_phys.engine.multirun import MultiRun
+    from amsa_phys.engine.runner import Simulation
+    from amsa_phys.runs import batched
+
+    clock = time.process_time
+
+    def timed(key: str, fn: Callable[..., Any]) -> Callable[..., Any]:
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            t0 = clock()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                cpu[key] += clock() - t0
+                calls[key] += 1
+
+        return wrapper
+
+    saved = MultiRun.__init__, Simulation.initialize, MultiRun.outcomes, batched.compute_metrics
+    MultiRun.__init__ = timed(SETUP, saved[0])  # type: ignore[method-assign]
+    Simulation.initialize = timed(INIT, saved[1])  # type: ignore[method-assign]
+    MultiRun.outcomes = timed(END, saved[2])  # type: ignore[method-assign]
+    batched.compute_metrics = timed(END, saved[3])
+    try:
+        yield
+    finally:
+        MultiRun.__init__, Simulation.initialize, MultiRun.outcomes = saved[:3]  # type: ignore[method-assign]
+        batched.compute_metrics = saved[3]
+
+
 def sweep(scenario: str, runs: int) -> None:
     """A batched sweep of ``runs`` runs of ``scenario`` in this process, as two workers'
-    batches would be cut."""
+    batches would be cut; the batches' set-up and end on lines of their own."""
     sys.path.insert(0, str(ROOT))
     from amsa_phys.runs.batched import iter_batched, plan_units
     from amsa_phys.runs.sweep import Axis, SweepPlan, iter_local
@@ -121,7 +163,7 @@ def sweep(scenario: str, runs: int) -> None:
         duration=60.0,
     )
     jobs = plan.jobs()
-    with timers() as (cpu, calls):
+    with timers() as (cpu, calls), phases(cpu, calls):
         t0 = time.process_time()
         units, _ = plan_units(jobs, 2)
         rows = list(iter_batched(units, 1, iter_local))

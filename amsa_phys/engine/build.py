@@ -60,7 +60,7 @@ def make_task(
     task = Task(
         path,
         comp,
-        grid.ticks(1 / leaf.freq),
+        period_ticks(grid, leaf.freq),
         list(leaf.inputs.items()),
         {p.name: f"{path}.{p.name}" for p in leaf.template.outputs},
         run=run,
@@ -71,11 +71,22 @@ def make_task(
     for port in leaf.template.outputs:
         if port.array:
             task.arrays_out[port.name] = arrays[f"{path}.{port.name}"]
-    task.phase = grid.ticks(phase)
+    task.phase = grid.ticks(phase) if phase else 0
     if leaf.timing.delayed:
         task.delay = DelayLine(leaf, grid.tick, seed)
     task.bind(lambda name: store.at(name, run))
     return task
+
+
+def period_ticks(grid: TickGrid, freq: Fraction) -> int:
+    """``grid.ticks(1 / freq)`` in integers: a batch makes a task per (Leaf, run), and two
+    Fraction divisions a task were a tenth of a batch's planning. Off the grid: the same
+    ValueError as ``grid.ticks``."""
+    num = freq.denominator * grid.tick.denominator
+    den = freq.numerator * grid.tick.numerator
+    if den <= 0 or num % den:
+        return grid.ticks(1 / freq)
+    return num // den
 
 
 def plan_groups(

@@ -43,15 +43,23 @@ class SignalSampler:
 
         return sample
 
+    def count(self) -> int:
+        """How many instants were sampled so far (whole ones: see :meth:`table`)."""
+        width = len(self._where)
+        n = len(self._t)
+        return min(n, len(self._flat) // width) if width else n
+
     def table(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """The logged instants and each signal as a ``(samples, runs)`` array."""
         width = len(self._where)
         n = len(self._t)
         if width:  # equal even if Ctrl-C fell between the two appends
             n = min(n, len(self._flat) // width)
-        t = np.array(self._t[:n], dtype=np.float64)
+        t = np.frombuffer(self._t, dtype=np.float64, count=n).copy()
         shape = (n, len(self.names), self.runs)
-        data = np.array(self._flat[: n * width], dtype=np.float64).reshape(shape)
+        # one copy out of the samples' buffer (slicing the ``array`` first made two)
+        data = np.frombuffer(self._flat, dtype=np.float64, count=n * width).copy()
+        data = data.reshape(shape)
         return t, {name: data[:, k, :] for k, name in enumerate(self.names)}
 
 

@@ -1,0 +1,70 @@
+"""A batch collects its young garbage less often while it runs, and leaves the process's
+garbage-collector settings as it found them (an in-process sweep, a notebook's)."""
+
+from __future__ import annotations
+
+import gc
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from amsa_phys.runs import batched
+from amsa_phys.runs.sweep import Axis, SweepPlan
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _jobs() -> list[Any]:
+    plan = SweepPlan(
+        ROOT / "scenarios" / "scenario1.yaml",
+        [Axis("MyFollowerController.Kv", (0.05, 0.2))],
+        seeds=1,
+        base_seed=3,
+        duration=1.0,
+    )
+    return plan.jobs()
+
+
+@pytest.fixture
+def thresholds() -> Any:
+    saved = gc.get_threshold()
+    gc.set_threshold(700, 9, 8)  # a user's own, not the default's second and third
+    yield
+    gc.set_threshold(*saved)
+
+
+def test_a_batch_runs_with_fewer_young_collections_and_restores_the_settings(
+    thresholds: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    seen: list[tuple[int, int, int]] = []
+    real = batched._run_whole
+
+    def watching(sim: Any) -> None:
+        seen.append(gc.get_threshold())
+        real(sim)
+
+    monkeypatch.setattr(batched, "_run_whole", watching)
+    rows = batched.run_batch(_jobs())
+    assert [r["error"] for r in rows] == ["", ""]
+    assert seen == [(batched.YOUNG_GC, 9, 8)]
+    assert gc.get_threshold() == (700, 9, 8)
+
+
+def test_a_batch_that_raises_restores_the_settings(
+    thresholds: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def interrupted(sim: Any) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(batched, "_run_whole", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        batched.run_batch(_jobs())
+    assert gc.get_threshold() == (700, 9, 8)
+
+
+def test_a_higher_threshold_of_the_users_is_kept(thresholds: Any) -> None:
+    gc.set_threshold(10 * batched.YOUNG_GC, 9, 8)
+    with batched.fewer_collections():
+        assert gc.get_threshold() == (10 * batched.YOUNG_GC, 9, 8)
+    assert gc.get_threshold() == (10 * batched.YOUNG_GC, 9, 8)
