@@ -94,3 +94,21 @@ class TickGrid:
 def hyperperiod(periods_ticks: Iterable[int]) -> int:
     """The least common multiple of the periods: the schedule repeats after it."""
     return lcm(*periods_ticks)
+
+
+#: instants' times kept per tick grid (``kept_times``): a Gymnasium env's episodes or a loop's
+#: runs meet the same instants again; bounded, ~1.5 MB a grid at most
+NOWS_KEPT = 8192
+_GRIDS_KEPT = 4
+_nows_of: dict[tuple[int, int], dict[int, Fraction]] = {}
+
+
+def kept_times(num: int, den: int) -> dict[int, Fraction]:
+    """The instants' times kept for the tick grid ``num / den`` s (tick -> exact time):
+    Fractions are immutable, so runs on one grid share them; the oldest grid goes first."""
+    nows = _nows_of.get((num, den))
+    if nows is None:
+        if len(_nows_of) >= _GRIDS_KEPT:
+            _nows_of.pop(next(iter(_nows_of), None), None)
+        nows = _nows_of[(num, den)] = {}
+    return nows

@@ -21,7 +21,10 @@ from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from ..errors import RunFault
 from . import batch, schedule
+from .build import plan_groups
+from .clock import TickGrid
 from .tasks import Steppers, Task
 
 #: How many layouts are kept (the oldest dropped first): one env or loop needs one
@@ -133,3 +136,40 @@ def rebuild(
 def forget() -> None:
     """Drop every kept layout (tests compare a fresh compilation with a kept one)."""
     _kept.clear()
+
+
+def lay_out(
+    tasks: list[Task],
+    worlds: Sequence[Any],
+    grouping: Any,
+    steppers: Steppers,
+    grid: TickGrid,
+    log_at: int | None,
+    hooks: list[tuple[int, Any]],
+) -> tuple[int, list[schedule.Instant], dict[Any, Any]]:
+    """A run's cycle length, its instants with like components grouped, and the groups:
+    by the layout kept from an earlier run of the same structure (a single run's, where
+    resets repeat it), else laid out afresh and kept."""
+    freq = lambda t: worlds[t.run].leaves[t.path].freq  # noqa: E731
+    sig = None
+    if len(worlds) == 1:
+        key = grouping.key
+        sig = signature(tasks, [key(t, freq(t)) for t in tasks], log_at, hooks, grouping)
+        found = kept(sig)
+        if found is not None:
+            cycle, groups_of = rebuild(found, tasks, hooks, steppers)
+            return found.cycle, cycle, groups_of
+    try:
+        length, cycle = schedule.instants(tasks, log_at, hooks)
+    except schedule.TooManyEvents as exc:
+        raise RunFault(
+            "scheduler",
+            0,
+            f"the rates repeat only every "
+            f"{float(grid.time(exc.cycle)):g} s ({exc.count} events); use "
+            "commensurate frequencies",
+        ) from None
+    groups_of = plan_groups(cycle, tasks, freq, grouping, steppers)
+    if sig is not None:
+        keep(sig, length, cycle, tasks, hooks)
+    return length, cycle, groups_of

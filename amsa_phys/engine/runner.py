@@ -38,8 +38,8 @@ from ..model.timeline import Timeline
 from ..model.world import WorldSpec
 from . import batch, interrupt, layout, schedule
 from .adapt import AdaptRules
-from .build import build_components, make_task, plan_groups
-from .clock import TickGrid, exact
+from .build import build_components, make_task
+from .clock import NOWS_KEPT, TickGrid, exact, kept_times
 from .context import Context, Event, Hook, RunResult
 from .delivery import Deliveries
 from .facereads import FaceReads
@@ -58,24 +58,6 @@ from .timing import DelayLine, run_phases
 Wrap = Callable[[str, Template], Template]
 
 __all__ = ["COMPONENT_ERRORS", "Context", "Event", "RunResult", "Simulation", "Task", "Wrap"]
-
-
-#: instants' times kept per tick grid (``_nows``): a Gymnasium env's episodes or a loop's
-#: runs meet the same instants again; bounded, ~1.5 MB a grid at most
-_NOWS_KEPT = 8192
-_GRIDS_KEPT = 4
-_nows_of: dict[tuple[int, int], dict[int, Fraction]] = {}
-
-
-def _nows(num: int, den: int) -> dict[int, Fraction]:
-    """The instants' times kept for the tick grid ``num / den`` s (tick -> exact time):
-    Fractions are immutable, so runs on one grid share them; the oldest grid goes first."""
-    nows = _nows_of.get((num, den))
-    if nows is None:
-        if len(_nows_of) >= _GRIDS_KEPT:
-            _nows_of.pop(next(iter(_nows_of), None), None)
-        nows = _nows_of[(num, den)] = {}
-    return nows
 
 
 class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
@@ -275,34 +257,10 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
 
     def _lay_out(self, log_at: int | None, hooks: list[tuple[int, Hook]]) -> list[schedule.Instant]:
         """The cycle's instants with like components grouped (sets ``_cycle`` and
-        ``_groups_of``): laid out afresh, or by the layout kept from an earlier run of the
-        same structure (``layout.py``; a single run's, where resets repeat it)."""
-        worlds = self.worlds
-        freq = lambda t: worlds[t.run].leaves[t.path].freq  # noqa: E731
-        sig = None
-        if len(worlds) == 1:
-            key = self.grouping.key
-            sig = layout.signature(
-                self._tasks, [key(t, freq(t)) for t in self._tasks], log_at, hooks, self.grouping
-            )
-            kept = layout.kept(sig)
-            if kept is not None:
-                self._cycle = kept.cycle
-                cycle, self._groups_of = layout.rebuild(kept, self._tasks, hooks, self._steppers)
-                return cycle
-        try:
-            self._cycle, cycle = schedule.instants(self._tasks, log_at, hooks)
-        except schedule.TooManyEvents as exc:
-            raise RunFault(
-                "scheduler",
-                0,
-                f"the rates repeat only every "
-                f"{float(self.grid.time(exc.cycle)):g} s ({exc.count} events); use "
-                "commensurate frequencies",
-            ) from None
-        self._groups_of = plan_groups(cycle, self._tasks, freq, self.grouping, self._steppers)
-        if sig is not None:
-            layout.keep(sig, self._cycle, cycle, self._tasks, hooks)
+        ``_groups_of``): :func:`layout.lay_out`, afresh or as kept from an earlier run."""
+        self._cycle, cycle, self._groups_of = layout.lay_out(
+            self._tasks, self.worlds, self.grouping, self._steppers, self.grid, log_at, hooks
+        )
         return cycle
 
     # -- running --------------------------------------------------------------------------
@@ -349,7 +307,7 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
         num, den = self._tick_num, self._tick_den
         adapt = self._adapt  # fixed at construction
         many_of, seek = self._many, self._seek
-        nows = _nows(num, den)
+        nows = kept_times(num, den)
         deliver, data, col = self.deliveries.deliver, self.store.data, self.store.col
         try:
             while cursor <= until:
@@ -415,7 +373,7 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
                             now = nows.get(tick)
                             if now is None:
                                 now = exact(tick * num, den)
-                                if len(nows) < _NOWS_KEPT:
+                                if len(nows) < NOWS_KEPT:
                                     nows[tick] = now
                             self._now_cache = (tick, now)
                             try:
