@@ -9,7 +9,9 @@ way ``--validate`` does (robust fixed gain, rules, oracle schedule; seeds 1-3, 6
 ``--sequences`` (30) sequences drawn with another generator seed (``--draw``, 2000). It
 prints the table and the two counts ``--validate`` prints, writes
 ``benchmarks/results/adapt_fresh.json`` (``--validate``'s results format) and rewrites the
-page's ``<!-- results: adapt-fresh -->`` block from it. Deterministic: the same table at any load.
+page's ``<!-- results: adapt-fresh -->`` block from it. ``--no-save`` prints the table and
+the counts only, so another draw (the docs' third, ``--draw 3000``) can be scored without
+replacing the committed one. Deterministic: the same table at any load.
 """
 
 from __future__ import annotations
@@ -45,6 +47,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("sweepdir", type=Path, help="the sweep's output directory")
     ap.add_argument("--sequences", type=int, default=30)
     ap.add_argument("--draw", type=int, default=2000, help="the sequences' generator seed")
+    ap.add_argument(
+        "--no-save",
+        action="store_true",
+        help="print only: leave the results file and the page as they are",
+    )
     args = ap.parse_args(argv)
     scenario = load_scenario(str(SWEEP))
     found = derive(args.sweepdir / "results.csv", scenario)
@@ -72,11 +79,12 @@ def main(argv: list[str] | None = None) -> int:
         f"--draw {args.draw}",
     }
     doc = results(rows, found, settings)
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text(json.dumps(doc, indent=1) + "\n")
     print(markdown(doc))
-    for page in bench_results.write_pages():
-        print(f"rewrote {page.relative_to(ROOT)}", file=sys.stderr)
+    if not args.no_save:
+        OUT.parent.mkdir(parents=True, exist_ok=True)
+        OUT.write_text(json.dumps(doc, indent=1) + "\n")
+        for page in bench_results.write_pages():
+            print(f"rewrote {page.relative_to(ROOT)}", file=sys.stderr)
     worth, short = short_of_oracle(rows)
     print(
         f"where the oracle gains 10 % or more ({len(worth)}), the rules do on "
