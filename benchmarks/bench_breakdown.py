@@ -152,17 +152,10 @@ def sweep(scenario: str, runs: int) -> None:
     batches would be cut; the batches' set-up and end on lines of their own."""
     sys.path.insert(0, str(ROOT))
     from amsa_phys.runs.batched import iter_batched, plan_units
-    from amsa_phys.runs.sweep import Axis, SweepPlan, iter_local
-    from benchmarks.bench_engine import KV, SCENARIOS
+    from amsa_phys.runs.sweep import iter_local
+    from benchmarks.bench_engine import sweep_plan
 
-    plan = SweepPlan(
-        SCENARIOS[scenario],
-        [Axis("MyFollowerController.Kv", KV)],
-        seeds=max(1, runs // len(KV)),
-        base_seed=1,
-        duration=60.0,
-    )
-    jobs = plan.jobs()
+    jobs = sweep_plan(scenario, runs).jobs()
     with timers() as (cpu, calls), phases(cpu, calls):
         t0 = time.process_time()
         units, _ = plan_units(jobs, 2)

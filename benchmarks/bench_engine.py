@@ -27,8 +27,12 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import yaml
+
+if TYPE_CHECKING:
+    from amsa_phys.runs.sweep import SweepPlan
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = {name: ROOT / "scenarios" / f"{name}.yaml" for name in ("scenario1", "scenario2")}
@@ -45,20 +49,26 @@ def verdict(ok: bool) -> str:
 
 
 # -- batched sweeps ---------------------------------------------------------------------------
-def sweep(scenario: str, runs: int, workers: int, executor: str, limit: int) -> dict:
-    """Wall and CPU seconds of one sweep (this process and its workers), 25 Kv x seeds,
-    60 s runs."""
-    from amsa_phys.runs.batched import iter_batched, plan_units
-    from amsa_phys.runs.sweep import Axis, SweepPlan, iter_local
+def sweep_plan(scenario: str, runs: int) -> SweepPlan:
+    """The benchmarks' sweep: 25 Kv x seeds (``runs`` in all), 60 s runs of ``scenario``."""
+    from amsa_phys.runs.sweep import Axis, SweepPlan
 
-    plan = SweepPlan(
+    return SweepPlan(
         SCENARIOS[scenario],
         [Axis("MyFollowerController.Kv", KV)],
         seeds=max(1, runs // len(KV)),
         base_seed=1,
         duration=60.0,
     )
-    jobs = plan.jobs()
+
+
+def sweep(scenario: str, runs: int, workers: int, executor: str, limit: int) -> dict:
+    """Wall and CPU seconds of one sweep (this process and its workers), 25 Kv x seeds,
+    60 s runs."""
+    from amsa_phys.runs.batched import iter_batched, plan_units
+    from amsa_phys.runs.sweep import iter_local
+
+    jobs = sweep_plan(scenario, runs).jobs()
     if limit:  # spread over the grid
         jobs = jobs[:: max(1, len(jobs) // limit)][:limit]
     cpu0 = _cpu()
