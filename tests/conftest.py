@@ -59,7 +59,16 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Skip ``@pytest.mark.slow`` tests unless asked for."""
+    """Skip ``@pytest.mark.slow`` tests unless asked for; keep the ROS tests together.
+
+    Under ``pytest -n 2 --dist loadgroup`` (the full suite's command) every ROS 1 and ROS 2
+    test runs on one worker, one after another, while the other worker takes the rest: their
+    package builds (module fixtures) happen once, and two ROS graphs never compete for the
+    same two cores. Without xdist the group is ignored.
+    """
+    for item in items:
+        if item.get_closest_marker("ros") or item.get_closest_marker("ros2"):
+            item.add_marker(pytest.mark.xdist_group("ros"))
     if config.getoption("--runslow") or os.environ.get("AMSA_RUNSLOW") == "1":
         return
     skip = pytest.mark.skip(reason="slow: run with --runslow or AMSA_RUNSLOW=1")

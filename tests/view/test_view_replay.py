@@ -235,18 +235,19 @@ def test_colours_follow_the_world_not_the_trace_columns(tmp_path: Path) -> None:
 
 # -- a real window: Xvfb, xdotool and ImageMagick's import ------------------------------------
 X_TOOLS = ("Xvfb", "xdotool", "import")
-X_TIMEOUT_S = 60.0  # a deadline for a failure, never a measured time: every wait polls
+X_TIMEOUT_S = 120.0  # a deadline for a failure, never a measured time: every wait polls
 
 
-def _poll(what: str, check: Callable[[], T | None]) -> T:
-    """``check()`` until it gives a value (the event waited for), or fail at the deadline."""
+def _poll(what: str, check: Callable[[], T | None], state: Callable[[], str] = str) -> T:
+    """``check()`` until it gives a value (the event waited for), or fail at the deadline
+    saying ``state()`` (what the process under test said by then)."""
     deadline = time.monotonic() + X_TIMEOUT_S
     while time.monotonic() < deadline:
         found = check()
         if found is not None:
             return found
         time.sleep(0.1)
-    raise AssertionError(f"waited {X_TIMEOUT_S:g} s for {what}")
+    raise AssertionError(f"waited {X_TIMEOUT_S:g} s for {what}; {state()}")
 
 
 @pytest.fixture
@@ -298,7 +299,8 @@ def test_view_in_a_real_x_window_scrubs_to_an_event_and_draws_the_traced_pose(
     if not script.is_file():
         pytest.skip("the amsa-phys console script is not installed next to this Python")
     argv = [str(script), "view", str(rundir), "--size", "800x480"]
-    viewer = subprocess.Popen(argv, env=env, stderr=subprocess.PIPE, text=True)
+    with (tmp_path / "stderr.txt").open("w") as err_file:  # a file: a full pipe would block it
+        viewer = subprocess.Popen(argv, env=env, stderr=err_file, text=True)
     try:
         window = _poll(
             "the window", lambda: _x(xdisplay, "xdotool", "search", "--class", "amsa-phys") or None
@@ -426,30 +428,46 @@ def test_a_run_quit_from_a_real_window_says_in_its_plots_where_it_was_cut(
         pytest.skip("the amsa-phys console script is not installed next to this Python")
     out = tmp_path / "run"
     argv = [str(script), "run", str(SCENARIO), "--out", str(out), "-q"]
-    runner = subprocess.Popen(argv, env=env, stderr=subprocess.PIPE, text=True)
-    try:
-        window = _poll(
-            "the window", lambda: _x(xdisplay, "xdotool", "search", "--class", "amsa-phys") or None
-        ).splitlines()[0]
+    # stderr to a file, never a pipe nobody reads while the run goes on (a full pipe would
+    # freeze the run in its window), and said in full if anything goes wrong
+    err_path = tmp_path / "stderr.txt"
+    with err_path.open("w") as err_file:
+        runner = subprocess.Popen(argv, env=env, stderr=err_file, text=True)
 
+    def said() -> str:
+        return f"the run's exit {runner.poll()}, its stderr: {err_path.read_text()!r}"
+
+    def alive() -> None:
+        if runner.poll() is not None:
+            raise AssertionError(f"the run ended before q was pressed: {said()}")
+
+    try:
+
+        def found() -> str | None:
+            alive()
+            return _x(xdisplay, "xdotool", "search", "--class", "amsa-phys") or None
+
+        window = _poll("the window", found, said).splitlines()[0]
         shots = [tmp_path / "a.png", tmp_path / "b.png"]
 
         def moving() -> bool | None:  # two grabs differ: the clock and the rovers advance
-            for shot in shots:
+            alive()
+            for shot in shots:  # a grab that fails leaves no file: never compare a stale one
+                shot.unlink(missing_ok=True)
                 _x(xdisplay, "import", "-window", window, str(shot))
             if not all(shot.is_file() for shot in shots):
                 return None
             a, b = (pygame.image.tobytes(pygame.image.load(str(s)), "RGB") for s in shots)
             return True if a != b else None
 
-        _poll("the run to advance in its window", moving)
+        _poll("the run to advance in its window", moving, said)
         _x(xdisplay, "xdotool", "key", "--window", window, "q")
-        _err = runner.communicate(timeout=X_TIMEOUT_S)[1]
+        runner.wait(timeout=X_TIMEOUT_S)
     finally:
         if runner.poll() is None:
             runner.terminate()
             runner.wait(timeout=30)
-    assert runner.returncode == 0, _err
+    assert runner.returncode == 0, said()
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["status"].startswith("closed in the window at t=")
     ran = metrics["simulated"]
