@@ -1,12 +1,13 @@
 """The test suite's duration and memory, and the build of the exported MDE package.
 
-What a contributor waits for, measured the way the README states it: the quick tier
-(``pytest -n auto -m "not (ros or ros2 or build or docs or slow)"``) and the full suite (``pytest``,
-what CI runs), each in a child process: its wall time, the CPU of pytest and everything it
-started (compilers, ROS launches), the peak resident memory of the largest of those processes,
-and the counts from the run's JUnit XML (a run with failures still gives its time; the row
-says how many failed). Then ``catkin_make`` of the exported MDE package (scenario1), against
-one roscpp compile unit compiled alone in the same sitting (``bench_ros.build_cost``).
+What a contributor waits for, measured the way the README states it: the quick tier (``pytest
+-n auto -m "not (ros or ros2 or build or docs or slow)"``) and the full suite (``pytest -n 2
+--dist loadgroup``, what CI runs), each in a child process: its wall time, the CPU of pytest
+and everything it started (compilers, ROS launches), the peak resident memory of the largest of
+those processes, and the counts from the run's JUnit XML (a run with failures still gives its
+time; the row says how many failed). Then ``catkin_make`` of the exported MDE package
+(scenario1), against one roscpp compile unit compiled alone in the same sitting
+(``bench_ros.build_cost``).
 
 One repetition (the full suite takes long); the machine's load before and after is recorded
 with each row. Measure on a quiet machine, and compare the CPU figures, which the load moves
@@ -38,7 +39,7 @@ ROOT = Path(__file__).resolve().parent.parent
 #: The tiers as the README names them: the arguments each adds to ``pytest``
 TIERS = {
     "quick": ["-n", "auto", "-m", "not (ros or ros2 or build or docs or slow)"],
-    "full": [],
+    "full": ["-n", "2", "--dist", "loadgroup"],
 }
 #: What the suite target measures: the tiers and the MDE package's build
 PARTS = (*TIERS, "build")
