@@ -214,13 +214,13 @@ class FollowerController(Template):
             t_, x_, y_ = T[sel], X[sel], Y[sel]
             k = m.sum(axis=1)
             count = np.maximum(k, 1)  # rows with no fix are masked out below
-            mt = np.where(m, t_, 0.0).sum(axis=1) / count
-            mx = np.where(m, x_, 0.0).sum(axis=1) / count
-            my = np.where(m, y_, 0.0).sum(axis=1) / count
+            mt = _in_order(np.where(m, t_, 0.0)) / count
+            mx = _in_order(np.where(m, x_, 0.0)) / count
+            my = _in_order(np.where(m, y_, 0.0)) / count
             dt = np.where(m, t_ - mt[:, None], 0.0)
-            stt = (dt * dt).sum(axis=1)
-            stx = (dt * (x_ - mx[:, None])).sum(axis=1)
-            sty = (dt * (y_ - my[:, None])).sum(axis=1)
+            stt = _in_order(dt * dt)
+            stx = _in_order(dt * (x_ - mx[:, None]))
+            sty = _in_order(dt * (y_ - my[:, None]))
             ok = (k >= 2) & (stt > 0)
             safe = np.where(ok, stt, 1.0)
             v_leader[rows[ok]] = libm.hypot(stx / safe, sty / safe)[ok]
@@ -239,6 +239,18 @@ class FollowerController(Template):
             "RightPower": np.where(active, forward + turn, zero),
             "leaderSpeed": v_leader.copy(),
         }, None
+
+
+def _in_order(a: np.ndarray) -> np.ndarray:
+    """Each row's sum, added left to right as ``_update_speed`` adds its fixes.
+
+    Why not ``a.sum(axis=1)``: numpy sums a row of eight or more with eight interleaved
+    accumulators (pairwise summation), which rounds unlike the sequential loop of ``do_step``
+    and so gave a batched run a leader speed a few ulps off the run made alone (a different
+    trace, and a different command with ``Kff`` > 0). ``cumsum`` accumulates in order; the
+    masked slots add 0.0, which leaves a sum unchanged.
+    """
+    return np.cumsum(a, axis=1)[:, -1]
 
 
 def _grow(
