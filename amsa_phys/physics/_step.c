@@ -1123,6 +1123,41 @@ static PyTypeObject StepperType = {
     .tp_members = Stepper_members,
 };
 
+/* ---- the module functions' array arguments ------------------------------------------
+ * The format's first character without its byte-order prefix ("<", "=", "@"). */
+static const char *item_format(const Py_buffer *view)
+{
+    const char *f = view->format ? view->format : "B";
+    return (*f == '<' || *f == '=' || *f == '@') ? f + 1 : f;
+}
+
+/* Why one function: every module function below takes numpy arrays by the buffer protocol and
+ * must refuse a wrong one (dtype, layout) with a ValueError naming it, releasing what it took.
+ * ``kinds[i]``: 'd' a float64 array read, 'w' a float64 array written, 'i' an int64 array
+ * read. Returns how many views are held: ``count`` when all are, fewer after an error (the
+ * caller releases those ``held`` and returns NULL). */
+static int acquire_views(PyObject *const *objs, Py_buffer *views, const char *const *names,
+                         const char *kinds, int count)
+{
+    for (int held = 0; held < count; held++) {
+        const int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT |
+                          (kinds[held] == 'w' ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[held], &views[held], flags) < 0)
+            return held;
+        const char *f = item_format(&views[held]);
+        const int ints = kinds[held] == 'i';
+        const int ok = views[held].itemsize == 8 &&
+                       (ints ? (strchr("qlQL", *f) != NULL && f[1] == 0) : strcmp(f, "d") == 0);
+        if (!ok) {
+            PyErr_Format(PyExc_ValueError, "%s: %s items expected", names[held],
+                         ints ? "int64" : "float64");
+            PyBuffer_Release(&views[held]);
+            return held;
+        }
+    }
+    return count;
+}
+
 /* ---- column_forces: the force model alone, over a batch's columns (physics/columns.py) ---
  * Why: a batched sweep integrates its rovers itself (no Space to step), and the numpy fleet's
  * masks for the rare branches cost half of a batch. This is rover_forces above (the same
@@ -1137,20 +1172,11 @@ static PyObject *column_forces(PyObject *Py_UNUSED(module), PyObject *args)
                           &objs[5], &dt))
         return NULL;
     static const char *names[6] = {"plan", "drives", "rims", "ground", "state", "forces"};
-    static const int writable[6] = {0, 0, 1, 0, 0, 1};
     Py_buffer views[6];
-    int held = 0;
     PyObject *result = NULL;
-    for (; held < 6; held++) {
-        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable[held] ? PyBUF_WRITABLE : 0);
-        if (PyObject_GetBuffer(objs[held], &views[held], flags) < 0)
-            goto done;
-        if (views[held].itemsize != 8 || strcmp(views[held].format, "d") != 0) {
-            PyErr_Format(PyExc_ValueError, "%s: float64 items expected", names[held]);
-            held++;
-            goto done;
-        }
-    }
+    const int held = acquire_views(objs, views, names, "ddwddw", 6);
+    if (held < 6)
+        goto done;
     Py_ssize_t n = views[4].len / (6 * 8);
     const Py_ssize_t need[6] = {n * PLAN_WIDTH, 2 * n, 2 * n, GROUND_TERMS * n, 6 * n, 3 * n};
     for (int i = 0; i < 6; i++)
@@ -1345,9 +1371,7 @@ static void *column_buffer(Columns *c, PyObject *obj, const char *what, Py_ssize
     if (PyObject_GetBuffer(obj, view, flags) < 0)
         return NULL;
     c->n_views++;
-    const char *f = view->format ? view->format : "B";
-    if (*f == '<' || *f == '=' || *f == '@')
-        f++;
+    const char *f = item_format(view);
     int kind_ok = fmt ? strcmp(f, fmt) == 0 : (strchr("qlQL", *f) != NULL && f[1] == 0);
     if (view->itemsize != itemsize || !kind_ok || view->len != need * itemsize) {
         PyErr_Format(PyExc_ValueError, "%s: %zd items of %zd bytes (%s) expected", what, need,
@@ -1517,24 +1541,10 @@ static PyObject *column_powers(PyObject *Py_UNUSED(module), PyObject *args)
         return NULL;
     static const char *names[5] = {"left", "right", "index", "band", "drives"};
     Py_buffer views[5];
-    int held = 0;
     PyObject *result = NULL;
-    for (; held < 5; held++) {
-        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (held == 4 ? PyBUF_WRITABLE : 0);
-        if (PyObject_GetBuffer(objs[held], &views[held], flags) < 0)
-            goto done;
-        const char *f = views[held].format ? views[held].format : "B";
-        if (*f == '<' || *f == '=' || *f == '@')
-            f++;
-        int ok = views[held].itemsize == 8 &&
-                 (held == 2 ? (strchr("qlQL", *f) != NULL && f[1] == 0) : strcmp(f, "d") == 0);
-        if (!ok) {
-            PyErr_Format(PyExc_ValueError, "%s: %s items expected", names[held],
-                         held == 2 ? "int64" : "float64");
-            held++;
-            goto done;
-        }
-    }
+    const int held = acquire_views(objs, views, names, "ddidw", 5);
+    if (held < 5)
+        goto done;
     Py_ssize_t m = views[2].len / 8, n = views[3].len / 8;
     if (views[0].len != m * 8 || views[1].len != m * 8 || views[4].len != 2 * n * 8) {
         PyErr_SetString(PyExc_ValueError, "column_powers: left, right and index of one length, "
@@ -1592,26 +1602,11 @@ static PyObject *observe_rows(PyObject *Py_UNUSED(module), PyObject *args)
                           &objs[5], &range_m))
         return NULL;
     static const char *names[6] = {"rows", "own", "pairs", "rest", "scales", "out"};
-    static const int ints[6] = {0, 1, 1, 1, 0, 0};
     Py_buffer views[6];
-    int held = 0;
     PyObject *result = NULL;
-    for (; held < 6; held++) {
-        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (held == 5 ? PyBUF_WRITABLE : 0);
-        if (PyObject_GetBuffer(objs[held], &views[held], flags) < 0)
-            goto done;
-        const char *f = views[held].format ? views[held].format : "B";
-        if (*f == '<' || *f == '=' || *f == '@')
-            f++;
-        int ok = views[held].itemsize == 8 &&
-                 (ints[held] ? (strchr("qlQL", *f) != NULL && f[1] == 0) : strcmp(f, "d") == 0);
-        if (!ok) {
-            PyErr_Format(PyExc_ValueError, "%s: %s items expected", names[held],
-                         ints[held] ? "int64" : "float64");
-            held++;
-            goto done;
-        }
-    }
+    const int held = acquire_views(objs, views, names, "diiidw", 6);
+    if (held < 6)
+        goto done;
     const Py_ssize_t n_own = views[1].len / 8, n_pairs = views[2].len / 16;
     const Py_ssize_t n_rest = views[3].len / 8;
     const Py_ssize_t width = 2 * n_pairs + n_rest;
@@ -1695,22 +1690,16 @@ static PyObject *steer_random(PyObject *Py_UNUSED(module), PyObject *args)
     static const char *names[7] = {"heading", "angle", "cruise", "factor", "gain", "left",
                                    "right"};
     Py_buffer views[7];
-    int held = 0;
     PyObject *result = NULL;
-    for (; held < 7; held++) {
-        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (held >= 5 ? PyBUF_WRITABLE : 0);
-        if (PyObject_GetBuffer(objs[held], &views[held], flags) < 0)
-            goto done;
-        const char *f = views[held].format ? views[held].format : "B";
-        if (*f == '<' || *f == '=' || *f == '@')
-            f++;
-        if (views[held].itemsize != 8 || strcmp(f, "d") != 0 || views[held].len != views[0].len) {
+    const int held = acquire_views(objs, views, names, "dddddww", 7);
+    if (held < 7)
+        goto done;
+    for (int i = 1; i < 7; i++)
+        if (views[i].len != views[0].len) {
             PyErr_Format(PyExc_ValueError, "%s: as many float64 items as heading expected",
-                         names[held]);
-            held++;
+                         names[i]);
             goto done;
         }
-    }
     const Py_ssize_t n = views[0].len / 8;
     const double *heading = views[0].buf, *angle = views[1].buf, *cruise = views[2].buf;
     const double *factor = views[3].buf, *gain = views[4].buf;
@@ -1747,24 +1736,10 @@ static PyObject *robot_poses(PyObject *Py_UNUSED(module), PyObject *args)
         return NULL;
     static const char *names[4] = {"state", "rims", "index", "out"};
     Py_buffer views[4];
-    int held = 0;
     PyObject *result = NULL;
-    for (; held < 4; held++) {
-        int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (held == 3 ? PyBUF_WRITABLE : 0);
-        if (PyObject_GetBuffer(objs[held], &views[held], flags) < 0)
-            goto done;
-        const char *f = views[held].format ? views[held].format : "B";
-        if (*f == '<' || *f == '=' || *f == '@')
-            f++;
-        int ok = views[held].itemsize == 8 &&
-                 (held == 2 ? (strchr("qlQL", *f) != NULL && f[1] == 0) : strcmp(f, "d") == 0);
-        if (!ok) {
-            PyErr_Format(PyExc_ValueError, "%s: %s items expected", names[held],
-                         held == 2 ? "int64" : "float64");
-            held++;
-            goto done;
-        }
-    }
+    const int held = acquire_views(objs, views, names, "ddiw", 4);
+    if (held < 4)
+        goto done;
     const Py_ssize_t big_n = views[0].len / (6 * 8), m = views[2].len / 8;
     if (views[0].len != big_n * 6 * 8 || views[1].len != 2 * big_n * 8 ||
         views[3].len != 7 * m * 8) {

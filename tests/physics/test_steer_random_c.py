@@ -14,6 +14,9 @@ import pytest
 from amsa_phys.physics import compiled
 from amsa_phys.physics.step_path import extension
 
+#: the C function's arguments, as its errors name them
+NAMES = ("heading", "angle", "cruise", "factor", "gain", "left", "right")
+
 pytestmark = pytest.mark.skipif(
     extension() is None or not compiled.columns_compiled(),
     reason="the compiled step was not built (no C compiler at install)",
@@ -87,5 +90,5 @@ def test_the_c_steering_refuses_arrays_it_would_read_out_of_bounds() -> None:
     for k, bad in ((2, np.zeros(2)), (4, np.zeros(3, dtype=np.float32)), (6, np.zeros(4))):
         args = list(ok)
         args[k] = bad
-        with pytest.raises(ValueError, match="as many float64 items as heading"):
+        with pytest.raises(ValueError, match=f"{NAMES[k]}: .*float64 items"):
             _step.steer_random(*args)
