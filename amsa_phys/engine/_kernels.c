@@ -40,6 +40,9 @@ typedef struct {
     PyObject_HEAD
     int code;
     PyObject *comp, *ins, *outs, *values, *fallback, *failed, *judge;
+    /* the robots' driver (``driver()``): (rover class, its set_power, its update_drive) as
+     * written in ``physics/rover.py``, or NULL: ``rover.set_power`` called in Python */
+    PyObject *driver;
 } Kernel;
 
 static PyObject *hypot_fn = NULL;
@@ -47,6 +50,10 @@ static PyObject *p_name = NULL, *lo_name = NULL, *hi_name = NULL, *coef_name = N
 static PyObject *supply_name = NULL, *rover_name = NULL, *source_name = NULL,
                 *rims_name = NULL, *set_power_name = NULL, *behaviour_name = NULL,
                 *pose_name = NULL;
+static PyObject *update_drive_name = NULL, *pending_name = NULL, *dirty_name = NULL,
+                *wheel_name = NULL, *deadband_name = NULL, *slot_name = NULL,
+                *power_l_name = NULL, *power_r_name = NULL, *drive_l_name = NULL,
+                *drive_r_name = NULL;
 
 /* The number of inputs and outputs of each body. */
 static const Py_ssize_t kernel_ins[] = {4, 2, 2, 0, 1, 2};
@@ -54,13 +61,19 @@ static const Py_ssize_t kernel_outs[] = {1, 2, 7, 7, 1, 2};
 
 static int Kernel_init(Kernel *self, PyObject *args, PyObject *kw) {
     int code;
-    PyObject *comp, *ins, *outs, *values, *fallback, *failed, *judge;
+    PyObject *comp, *ins, *outs, *values, *fallback, *failed, *judge, *driver = Py_None;
     if (kw != NULL && PyDict_GET_SIZE(kw)) {
         PyErr_SetString(PyExc_TypeError, "Kernel takes no keywords");
         return -1;
     }
-    if (!PyArg_ParseTuple(args, "iOO!O!OOOO", &code, &comp, &PyTuple_Type, &ins, &PyTuple_Type,
-                          &outs, &values, &fallback, &failed, &judge)) {
+    if (!PyArg_ParseTuple(args, "iOO!O!OOOO|O", &code, &comp, &PyTuple_Type, &ins,
+                          &PyTuple_Type, &outs, &values, &fallback, &failed, &judge, &driver)) {
+        return -1;
+    }
+    if (driver != Py_None &&
+        (!PyTuple_CheckExact(driver) || PyTuple_GET_SIZE(driver) != 3 ||
+         !PyType_Check(PyTuple_GET_ITEM(driver, 0)))) {
+        PyErr_SetString(PyExc_TypeError, "Kernel: driver is (class, set_power, update_drive)");
         return -1;
     }
     if (code < 0 || code > 5) {
@@ -87,6 +100,7 @@ static int Kernel_init(Kernel *self, PyObject *args, PyObject *kw) {
         Py_INCREF(given[k]);
         Py_XSETREF(*slots[k], given[k]);
     }
+    Py_XSETREF(self->driver, driver == Py_None ? NULL : Py_NewRef(driver));
     return 0;
 }
 
@@ -98,6 +112,7 @@ static int Kernel_traverse(Kernel *self, visitproc visit, void *arg) {
     Py_VISIT(self->fallback);
     Py_VISIT(self->failed);
     Py_VISIT(self->judge);
+    Py_VISIT(self->driver);
     return 0;
 }
 
@@ -109,6 +124,7 @@ static int Kernel_clear(Kernel *self) {
     Py_CLEAR(self->fallback);
     Py_CLEAR(self->failed);
     Py_CLEAR(self->judge);
+    Py_CLEAR(self->driver);
     return 0;
 }
 
@@ -395,6 +411,125 @@ static PyObject *steer(PyObject *comp, PyObject *t, PyObject *source) {
     return res;
 }
 
+/* ``rover.set_power(left, right)`` as ``DiffDriveRover.set_power`` and ``update_drive`` do it
+ * (``physics/rover.py``), without their two frames and the slot's two item writes: 1 done,
+ * 0 not taken (nothing changed: the caller calls the Python method), -1 an error set.
+ *
+ * Taken only where the outcome is plainly those methods': the rover is the very class the
+ * kernel was given (``kernels.driver()`` checked its methods as written, and they are still
+ * the class's and not the instance's), both powers are floats exactly, no group command is
+ * pending (``_pending.dirty`` is False: else ``forget`` and ``settle`` run in Python), the
+ * deadband is a float, and the batch path's slot is None or a writable 2-D buffer of
+ * doubles. Then: each power saturated at +-100 as the chained comparison and ``_saturate``
+ * (``min(100.0, max(-100.0, p))``: a NaN gives -100), the drives 0.0 inside the open band
+ * ``-band < p < band``, the four attributes set in the instance dict and the drives written
+ * to ``slot[0][0, i]`` and ``[1, i]``. */
+static int drive(Kernel *self, PyObject *rover, PyObject *left, PyObject *right) {
+    PyObject *driver = self->driver;
+    if (driver == NULL || (PyObject *)Py_TYPE(rover) != PyTuple_GET_ITEM(driver, 0) ||
+        !PyFloat_CheckExact(left) || !PyFloat_CheckExact(right)) {
+        return 0;
+    }
+    PyObject *td = ((PyTypeObject *)PyTuple_GET_ITEM(driver, 0))->tp_dict;
+    if (PyDict_GetItemWithError(td, set_power_name) != PyTuple_GET_ITEM(driver, 1) ||
+        PyDict_GetItemWithError(td, update_drive_name) != PyTuple_GET_ITEM(driver, 2)) {
+        return PyErr_Occurred() ? -1 : 0;
+    }
+    PyObject *rd = PyObject_GenericGetDict(rover, NULL);
+    if (rd == NULL || !PyDict_CheckExact(rd)) {
+        PyErr_Clear();
+        Py_XDECREF(rd);
+        return 0;
+    }
+    int res = 0;
+    PyObject *dirty = NULL, *pl = NULL, *pr = NULL, *dl = NULL, *dr = NULL;
+    Py_buffer view;
+    int viewed = 0;
+    if (PyDict_GetItemWithError(rd, set_power_name) != NULL ||
+        PyDict_GetItemWithError(rd, update_drive_name) != NULL) {
+        goto done; /* an instance's own method */
+    }
+    PyObject *pending = PyDict_GetItemWithError(rd, pending_name);
+    PyObject *wheel = pending == NULL ? NULL : PyDict_GetItemWithError(rd, wheel_name);
+    PyObject *slot = wheel == NULL ? NULL : PyDict_GetItemWithError(rd, slot_name);
+    if (slot == NULL) {
+        goto done;
+    }
+    dirty = PyObject_GetAttr(pending, dirty_name);
+    double band;
+    if (dirty != Py_False || !attr_double(wheel, deadband_name, 0, &band)) {
+        goto done;
+    }
+    Py_ssize_t i = 0;
+    if (slot != Py_None) {
+        if (!PyTuple_CheckExact(slot) || PyTuple_GET_SIZE(slot) != 2 ||
+            !PyLong_CheckExact(PyTuple_GET_ITEM(slot, 1))) {
+            goto done;
+        }
+        i = PyLong_AsSsize_t(PyTuple_GET_ITEM(slot, 1));
+        if (PyObject_GetBuffer(PyTuple_GET_ITEM(slot, 0), &view,
+                               PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_STRIDES) < 0) {
+            goto done;
+        }
+        viewed = 1;
+        if (view.ndim != 2 || view.itemsize != sizeof(double) || view.format == NULL ||
+            view.format[0] != 'd' || view.format[1] != '\0' || view.shape[0] < 2 || i < 0 ||
+            i >= view.shape[1]) {
+            goto done;
+        }
+    }
+    double l = PyFloat_AS_DOUBLE(left), r = PyFloat_AS_DOUBLE(right);
+    /* ``p if -100.0 <= p <= 100.0 else _saturate(p)`` */
+    if (-100.0 <= l && l <= 100.0) {
+        pl = Py_NewRef(left);
+    } else {
+        double v = l > -100.0 ? l : -100.0;
+        pl = PyFloat_FromDouble(v < 100.0 ? v : 100.0);
+    }
+    if (-100.0 <= r && r <= 100.0) {
+        pr = Py_NewRef(right);
+    } else {
+        double v = r > -100.0 ? r : -100.0;
+        pr = PyFloat_FromDouble(v < 100.0 ? v : 100.0);
+    }
+    if (pl == NULL || pr == NULL) {
+        res = -1;
+        goto done;
+    }
+    double vl = PyFloat_AS_DOUBLE(pl), vr = PyFloat_AS_DOUBLE(pr);
+    /* ``p if not -band < p < band else 0.0`` */
+    dl = !(-band < vl && vl < band) ? Py_NewRef(pl) : PyFloat_FromDouble(0.0);
+    dr = !(-band < vr && vr < band) ? Py_NewRef(pr) : PyFloat_FromDouble(0.0);
+    if (dl == NULL || dr == NULL || PyDict_SetItem(rd, power_l_name, pl) < 0 ||
+        PyDict_SetItem(rd, power_r_name, pr) < 0 || PyDict_SetItem(rd, drive_l_name, dl) < 0 ||
+        PyDict_SetItem(rd, drive_r_name, dr) < 0) {
+        res = -1;
+        goto done;
+    }
+    if (viewed) {
+        char *buf = (char *)view.buf;
+        Py_ssize_t s0 = view.strides ? view.strides[0] : view.shape[1] * view.itemsize;
+        Py_ssize_t s1 = view.strides ? view.strides[1] : view.itemsize;
+        *(double *)(buf + i * s1) = PyFloat_AS_DOUBLE(dl);
+        *(double *)(buf + s0 + i * s1) = PyFloat_AS_DOUBLE(dr);
+    }
+    res = 1;
+done:
+    if (res == 0 && PyErr_Occurred()) { /* a missing attribute, a released buffer: Python's */
+        PyErr_Clear();
+    }
+    if (viewed) {
+        PyBuffer_Release(&view);
+    }
+    Py_XDECREF(dirty);
+    Py_XDECREF(pl);
+    Py_XDECREF(pr);
+    Py_XDECREF(dl);
+    Py_XDECREF(dr);
+    Py_DECREF(rd);
+    return res;
+}
+
 /* The robots' bodies (codes 2 and 3; see Kernel's comment). */
 static PyObject *robot_step(Kernel *self, PyObject *task, PyObject *now) {
     PyObject *comp = self->comp;
@@ -471,12 +606,19 @@ static PyObject *robot_step(Kernel *self, PyObject *task, PyObject *now) {
     }
     left = PyTuple_GET_ITEM(powers, 0);
     right = PyTuple_GET_ITEM(powers, 1);
-    PyObject *set = PyObject_CallMethodObjArgs(rover, set_power_name, left, right, NULL);
-    if (set == NULL) {
+    int driven = drive(self, rover, left, right);
+    if (driven < 0) {
         res = hand_fault(self->failed, now);
         goto done;
     }
-    Py_DECREF(set);
+    if (!driven) {
+        PyObject *set = PyObject_CallMethodObjArgs(rover, set_power_name, left, right, NULL);
+        if (set == NULL) {
+            res = hand_fault(self->failed, now);
+            goto done;
+        }
+        Py_DECREF(set);
+    }
     /* Robot._pose: x, y, a, vx, vy, w from the state reader, the rims' speeds */
     double kin[6], rim[2] = {0.0, 0.0};
     PyObject *state = PyObject_CallNoArgs(source);
@@ -1131,6 +1273,18 @@ PyMODINIT_FUNC PyInit__kernels(void) {
     set_power_name = PyUnicode_InternFromString("set_power");
     behaviour_name = PyUnicode_InternFromString("_behaviour");
     pose_name = PyUnicode_InternFromString("_pose");
+    const char *const drive_texts[] = {"update_drive", "_pending", "dirty",    "wheel",
+                                       "deadband_pct", "_slot",    "_power_l", "_power_r",
+                                       "_drive_l",     "_drive_r"};
+    PyObject **drive_names[] = {&update_drive_name, &pending_name, &dirty_name, &wheel_name,
+                                &deadband_name,     &slot_name,    &power_l_name,
+                                &power_r_name,      &drive_l_name, &drive_r_name};
+    for (int k = 0; k < 10; k++) {
+        *drive_names[k] = PyUnicode_InternFromString(drive_texts[k]);
+        if (*drive_names[k] == NULL) {
+            return NULL;
+        }
+    }
     PyObject *fractions = PyImport_ImportModule("fractions");
     if (fractions == NULL) {
         return NULL;
