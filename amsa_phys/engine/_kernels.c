@@ -1247,9 +1247,487 @@ static PyTypeObject KernelType = {
     .tp_call = (ternaryfunc)Kernel_call,
 };
 
+/* -- the schedule walk (``engine/walk.py``) ------------------------------------------------
+ *
+ * ``walk(sim, nums, objs, until, cursor, cycle, end, helpers)``: ``Simulation._advance``'s
+ * loop over the precomputed table, statement for statement, for a run whose ticks fit in
+ * 62 bits (``walk.py`` checks that, and keeps the Python loop otherwise). ``nums`` is an
+ * ``array('q')`` of six numbers per table entry (offset, last offset, spacing, log, the
+ * merged run's last offset or -1, its spacing) and ``objs`` a tuple of ``(tasks, hooks,
+ * batch)`` per entry; ``helpers`` are the loop's locals (``walk.py``). Every attribute the
+ * Python loop reads from ``sim`` at each use (the next instant's tick, live changes pending)
+ * is read here at each use too, and every one it writes (the clock ``_tick``, a batch's
+ * run, ``_now_cache``, ``_cursor`` at the end, whatever happens) is written alike, so a
+ * component, a hook or an instant source sees the same engine either way. Returns None. */
+
+static PyObject *w_tick = NULL, *w_run_first = NULL, *w_run_spacing = NULL, *w_now_cache = NULL,
+                *w_nit = NULL, *w_nst = NULL, *w_pending = NULL, *w_cursor = NULL,
+                *w_apply_instant = NULL, *w_apply_live = NULL, *w_apply_adapt = NULL,
+                *w_run = NULL;
+
+/* ``a < b`` for a tick ``a`` and the object ``b`` (an int tick or a float, inf: none):
+ * 1, 0, or -1 with an error set. */
+static int tick_lt(long long a, PyObject *b) {
+    if (PyLong_CheckExact(b)) {
+        int overflow = 0;
+        long long v = PyLong_AsLongLongAndOverflow(b, &overflow);
+        if (overflow) {
+            return overflow > 0;
+        }
+        if (v == -1 && PyErr_Occurred()) {
+            return -1;
+        }
+        return a < v;
+    }
+    if (PyFloat_CheckExact(b) && isinf(PyFloat_AS_DOUBLE(b))) {
+        return PyFloat_AS_DOUBLE(b) > 0;
+    }
+    PyObject *ta = PyLong_FromLongLong(a);
+    if (ta == NULL) {
+        return -1;
+    }
+    int r = PyObject_RichCompareBool(ta, b, Py_LT);
+    Py_DECREF(ta);
+    return r;
+}
+
+/* ``a < sim.name`` (see tick_lt). */
+static int tick_lt_attr(PyObject *sim, long long a, PyObject *name) {
+    PyObject *b = PyObject_GetAttr(sim, name);
+    if (b == NULL) {
+        return -1;
+    }
+    int r = tick_lt(a, b);
+    Py_DECREF(b);
+    return r;
+}
+
+/* ``sim.name = v`` for a tick. */
+static int set_tick(PyObject *sim, PyObject *name, long long v) {
+    PyObject *o = PyLong_FromLongLong(v);
+    if (o == NULL) {
+        return -1;
+    }
+    int r = PyObject_SetAttr(sim, name, o);
+    Py_DECREF(o);
+    return r;
+}
+
+/* ``bool(sim._pending_live)``: 1, 0, or -1. */
+static int live_pending(PyObject *sim) {
+    PyObject *p = PyObject_GetAttr(sim, w_pending);
+    if (p == NULL) {
+        return -1;
+    }
+    int r = PyObject_IsTrue(p);
+    Py_DECREF(p);
+    return r;
+}
+
+/* ``fn(count, seek)``'s answer as a count, or -1 with an error. */
+static long long call_many(PyObject *fn, long long count, PyObject *seek) {
+    PyObject *n = PyLong_FromLongLong(count);
+    if (n == NULL) {
+        return -1;
+    }
+    PyObject *args[2] = {n, seek};
+    PyObject *r = PyObject_Vectorcall(fn, args, 2, NULL);
+    Py_DECREF(n);
+    if (r == NULL) {
+        return -1;
+    }
+    long long done = PyLong_AsLongLong(r);
+    Py_DECREF(r);
+    if (done == -1 && PyErr_Occurred()) {
+        return -1;
+    }
+    return done;
+}
+
+/* ``sim.name(tick)`` or ``sim.name()`` (tick < 0), its result dropped: 0, or -1. */
+static int call_method(PyObject *sim, PyObject *name, long long tick) {
+    PyObject *r;
+    if (tick >= 0) {
+        PyObject *t = PyLong_FromLongLong(tick);
+        if (t == NULL) {
+            return -1;
+        }
+        r = PyObject_CallMethodOneArg(sim, name, t);
+        Py_DECREF(t);
+    } else {
+        r = PyObject_CallMethodNoArgs(sim, name);
+    }
+    if (r == NULL) {
+        return -1;
+    }
+    Py_DECREF(r);
+    return 0;
+}
+
+/* Each hook of the tuple ``hooks`` called once: 0, or -1. */
+static int call_hooks(PyObject *hooks) {
+    for (Py_ssize_t h = 0; h < PyTuple_GET_SIZE(hooks); h++) {
+        PyObject *r = PyObject_CallNoArgs(PyTuple_GET_ITEM(hooks, h));
+        if (r == NULL) {
+            return -1;
+        }
+        Py_DECREF(r);
+    }
+    return 0;
+}
+
+#define W_CHECK(x)                                                                               \
+    do {                                                                                         \
+        if ((x) < 0) {                                                                           \
+            goto finish;                                                                         \
+        }                                                                                        \
+    } while (0)
+
+static PyObject *walk(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 8 || !PyTuple_CheckExact(args[2]) || !PyTuple_CheckExact(args[7]) ||
+        PyTuple_GET_SIZE(args[7]) != 14) {
+        PyErr_SetString(PyExc_TypeError,
+                        "walk(sim, nums, objs, until, cursor, cycle, end, helpers)");
+        return NULL;
+    }
+    PyObject *sim = args[0], *objs = args[2], *helpers = args[7];
+    long long until = PyLong_AsLongLong(args[3]), cursor = PyLong_AsLongLong(args[4]);
+    long long cycle = PyLong_AsLongLong(args[5]), end = PyLong_AsLongLong(args[6]);
+    if (PyErr_Occurred()) {
+        return NULL;
+    }
+    Py_buffer view;
+    if (PyObject_GetBuffer(args[1], &view, PyBUF_FORMAT) < 0) {
+        return NULL;
+    }
+    Py_ssize_t n = PyTuple_GET_SIZE(objs);
+    if (view.itemsize != 8 || view.format == NULL || view.format[0] != 'q' ||
+        view.len != n * 6 * 8 || cycle <= 0) {
+        PyBuffer_Release(&view);
+        PyErr_SetString(PyExc_ValueError, "walk: six numbers per table entry");
+        return NULL;
+    }
+    const long long *nums = (const long long *)view.buf;
+    for (Py_ssize_t e = 0; e < n; e++) { /* the shapes the loop indexes without checks */
+        PyObject *entry = PyTuple_GET_ITEM(objs, e);
+        int ok = PyTuple_CheckExact(entry) && PyTuple_GET_SIZE(entry) == 3 &&
+                 PyTuple_CheckExact(PyTuple_GET_ITEM(entry, 0)) &&
+                 PyTuple_CheckExact(PyTuple_GET_ITEM(entry, 1)) && nums[6 * e + 2] > 0 &&
+                 (nums[6 * e + 4] < 0 || (nums[6 * e + 5] > 0 &&
+                                          PyTuple_GET_SIZE(PyTuple_GET_ITEM(entry, 1)) > 0));
+        PyObject *tasks = ok ? PyTuple_GET_ITEM(entry, 0) : NULL;
+        for (Py_ssize_t k = 0; ok && k < PyTuple_GET_SIZE(tasks); k++) {
+            PyObject *item = PyTuple_GET_ITEM(tasks, k);
+            ok = PyTuple_CheckExact(item) && PyTuple_GET_SIZE(item) == 2;
+        }
+        if (!ok) {
+            PyBuffer_Release(&view);
+            PyErr_SetString(PyExc_ValueError, "walk: a table entry of another shape");
+            return NULL;
+        }
+    }
+    /* the loop's locals, as ``_advance`` binds them */
+    PyObject *nows = PyTuple_GET_ITEM(helpers, 0), *exact = PyTuple_GET_ITEM(helpers, 1);
+    Py_ssize_t kept = PyLong_AsSsize_t(PyTuple_GET_ITEM(helpers, 2));
+    PyObject *task_type = PyTuple_GET_ITEM(helpers, 3), *in_run = PyTuple_GET_ITEM(helpers, 4);
+    PyObject *fault_type = PyTuple_GET_ITEM(helpers, 5), *record = PyTuple_GET_ITEM(helpers, 6);
+    PyObject *values = PyTuple_GET_ITEM(helpers, 7), *deliver = PyTuple_GET_ITEM(helpers, 8);
+    PyObject *col = PyTuple_GET_ITEM(helpers, 9), *seek = PyTuple_GET_ITEM(helpers, 10);
+    PyObject *many_of = PyTuple_GET_ITEM(helpers, 11), *num = PyTuple_GET_ITEM(helpers, 12);
+    PyObject *den = PyTuple_GET_ITEM(helpers, 13);
+    int adapt = 0, has_many = PyDict_Check(many_of) && PyDict_GET_SIZE(many_of) > 0;
+    {
+        PyObject *a = PyObject_GetAttrString(sim, "_adapt");
+        if (a == NULL) {
+            PyBuffer_Release(&view);
+            return NULL;
+        }
+        adapt = a != Py_None;
+        Py_DECREF(a);
+    }
+    int failed = 1;
+    if (kept == -1 && PyErr_Occurred()) {
+        goto finish;
+    }
+    while (cursor <= until) {
+        long long base = (cursor / cycle) * cycle;
+        for (Py_ssize_t e = 0; e < n; e++) {
+            const long long *row = nums + 6 * e;
+            long long off = row[0], last_off = row[1], spacing = row[2];
+            long long m_last = row[4], m_step = row[5];
+            int log = (int)row[3];
+            PyObject *entry = PyTuple_GET_ITEM(objs, e);
+            PyObject *tasks = PyTuple_GET_ITEM(entry, 0), *hooks = PyTuple_GET_ITEM(entry, 1);
+            PyObject *batch = PyTuple_GET_ITEM(entry, 2);
+            long long first = base + off, last = base + last_off;
+            if (last < cursor) {
+                continue;
+            }
+            if (last_off != off && first >= cursor && last <= until && last < end) {
+                int ok = tick_lt_attr(sim, last, w_nit);
+                W_CHECK(ok);
+                int live = ok ? live_pending(sim) : 1;
+                W_CHECK(live);
+                if (ok && !live) {
+                    /* a whole run of hook-only instants: no checks per instant */
+                    if (PyTuple_GET_SIZE(hooks) == 1) {
+                        PyObject *hook = PyTuple_GET_ITEM(hooks, 0);
+                        long long start = first;
+                        PyObject *many = NULL;
+                        if (has_many) {
+                            many = PyDict_GetItemWithError(many_of, hook);
+                            if (many == NULL && PyErr_Occurred()) {
+                                goto finish;
+                            }
+                        }
+                        if (many != NULL && many != Py_None) {
+                            W_CHECK(set_tick(sim, w_tick, first));
+                            W_CHECK(set_tick(sim, w_run_first, first));
+                            W_CHECK(set_tick(sim, w_run_spacing, spacing));
+                            long long done = call_many(many, (last - first) / spacing + 1, seek);
+                            W_CHECK(done);
+                            if (done) {
+                                start = first + done * spacing;
+                                W_CHECK(set_tick(sim, w_tick, start - spacing));
+                            }
+                        }
+                        for (long long tick = start; tick <= last; tick += spacing) {
+                            W_CHECK(set_tick(sim, w_tick, tick));
+                            PyObject *r = PyObject_CallNoArgs(hook);
+                            if (r == NULL) {
+                                goto finish;
+                            }
+                            Py_DECREF(r);
+                        }
+                    } else {
+                        for (long long tick = first; tick <= last; tick += spacing) {
+                            W_CHECK(set_tick(sim, w_tick, tick));
+                            W_CHECK(call_hooks(hooks));
+                        }
+                    }
+                    cursor = last + 1;
+                    continue;
+                }
+            }
+            /* one instant (the usual entry) or a run the checks above refused */
+            long long step_by = last_off == off ? 1 : spacing;
+            long long stop = last_off == off ? first : last;
+            for (long long tick = first; tick <= stop; tick += step_by) {
+                if (tick < cursor) {
+                    continue;
+                }
+                if (tick > until) {
+                    cursor = tick;
+                    failed = 0;
+                    goto finish;
+                }
+                int before = tick_lt_attr(sim, tick, w_nit);
+                W_CHECK(before);
+                if (!before) { /* tick >= _next_instant_tick */
+                    int sources_later = 0;
+                    {
+                        PyObject *nst = PyObject_GetAttr(sim, w_nst);
+                        if (nst == NULL) {
+                            goto finish;
+                        }
+                        /* _next_source_tick > tick */
+                        PyObject *t = PyLong_FromLongLong(tick);
+                        sources_later = t == NULL ? -1 : PyObject_RichCompareBool(nst, t, Py_GT);
+                        Py_XDECREF(t);
+                        if (sources_later > 0) { /* deliveries alone are due */
+                            PyObject *ta = PyLong_FromLongLong(tick);
+                            PyObject *dargs[3] = {ta, values, col};
+                            PyObject *nxt = ta == NULL ? NULL
+                                                       : PyObject_Vectorcall(deliver, dargs, 3, NULL);
+                            Py_XDECREF(ta);
+                            /* source = _next_source_tick, read again after the delivery */
+                            PyObject *src = nxt == NULL ? NULL : PyObject_GetAttr(sim, w_nst);
+                            int less = src == NULL ? -1 : PyObject_RichCompareBool(nxt, src, Py_LT);
+                            if (less >= 0) {
+                                less = PyObject_SetAttr(sim, w_nit, less ? nxt : src);
+                            }
+                            Py_XDECREF(nxt);
+                            Py_XDECREF(src);
+                            sources_later = less < 0 ? -1 : 1;
+                        }
+                        Py_DECREF(nst);
+                    }
+                    W_CHECK(sources_later);
+                    if (!sources_later) {
+                        W_CHECK(call_method(sim, w_apply_instant, tick));
+                    }
+                }
+                W_CHECK(set_tick(sim, w_tick, tick));
+                int live = live_pending(sim);
+                W_CHECK(live);
+                if (live) {
+                    W_CHECK(call_method(sim, w_apply_live, -1));
+                }
+                if (PyTuple_GET_SIZE(tasks)) {
+                    if (adapt) {
+                        W_CHECK(call_method(sim, w_apply_adapt, -1));
+                    }
+                    PyObject *t = PyLong_FromLongLong(tick);
+                    if (t == NULL) {
+                        goto finish;
+                    }
+                    PyObject *now = PyDict_GetItemWithError(nows, t); /* borrowed */
+                    if (now != NULL) {
+                        Py_INCREF(now);
+                    } else if (!PyErr_Occurred()) {
+                        PyObject *tn = PyNumber_Multiply(t, num);
+                        PyObject *eargs[2] = {tn, den};
+                        now = tn == NULL ? NULL : PyObject_Vectorcall(exact, eargs, 2, NULL);
+                        Py_XDECREF(tn);
+                        if (now != NULL && PyDict_GET_SIZE(nows) < kept &&
+                            PyDict_SetItem(nows, t, now) < 0) {
+                            Py_CLEAR(now);
+                        }
+                    }
+                    PyObject *pair = now == NULL ? NULL : PyTuple_Pack(2, t, now);
+                    Py_DECREF(t);
+                    int set = pair == NULL ? -1 : PyObject_SetAttr(sim, w_now_cache, pair);
+                    Py_XDECREF(pair);
+                    if (set < 0) {
+                        Py_XDECREF(now);
+                        goto finish;
+                    }
+                    for (Py_ssize_t k = 0; k < PyTuple_GET_SIZE(tasks); k++) {
+                        PyObject *item = PyTuple_GET_ITEM(tasks, k);
+                        PyObject *task = PyTuple_GET_ITEM(item, 1);
+                        PyObject *targs[2] = {task, now};
+                        PyObject *r = PyObject_Vectorcall(PyTuple_GET_ITEM(item, 0), targs, 2, NULL);
+                        if (r != NULL) {
+                            Py_DECREF(r);
+                            continue;
+                        }
+                        /* a group's fault names its run: in_run(exc, task.run), raised
+                         * (the fault fetched first: isinstance may clear what is set) */
+                        if (PyErr_ExceptionMatches(fault_type)) {
+                            PyObject *type, *value, *tb;
+                            PyErr_Fetch(&type, &value, &tb);
+                            PyErr_NormalizeException(&type, &value, &tb);
+                            int is_task = PyObject_IsInstance(task, task_type);
+                            PyObject *run = is_task == 1 ? PyObject_GetAttr(task, w_run) : NULL;
+                            PyObject *marked = NULL;
+                            if (run != NULL && value != NULL) {
+                                PyObject *iargs[2] = {value, run};
+                                marked = PyObject_Vectorcall(in_run, iargs, 2, NULL);
+                            }
+                            Py_XDECREF(run);
+                            if (is_task == 0 || marked != NULL) {
+                                Py_XDECREF(marked);
+                                PyErr_Restore(type, value, tb);
+                            } else { /* isinstance's or in_run's own error replaces it */
+                                Py_XDECREF(type);
+                                Py_XDECREF(value);
+                                Py_XDECREF(tb);
+                            }
+                        }
+                        Py_DECREF(now);
+                        goto finish;
+                    }
+                    Py_DECREF(now);
+                }
+                if (log) {
+                    /* (tick * num) / den: int / int, correctly rounded */
+                    PyObject *t = PyLong_FromLongLong(tick);
+                    PyObject *tn = t == NULL ? NULL : PyNumber_Multiply(t, num);
+                    PyObject *ts = tn == NULL ? NULL : PyNumber_TrueDivide(tn, den);
+                    Py_XDECREF(t);
+                    Py_XDECREF(tn);
+                    PyObject *rargs[2] = {ts, values};
+                    PyObject *r = ts == NULL ? NULL : PyObject_Vectorcall(record, rargs, 2, NULL);
+                    Py_XDECREF(ts);
+                    if (r == NULL) {
+                        goto finish;
+                    }
+                    Py_DECREF(r);
+                }
+                if (tick < end) {
+                    if (m_last >= 0 && tick == first) {
+                        /* this instant's hook and the run of it alone that follows, in one
+                         * batch, when nothing else can happen in that run */
+                        long long run_last = base + m_last;
+                        int ok = run_last <= until && run_last < end;
+                        if (ok) {
+                            ok = tick_lt_attr(sim, run_last, w_nit);
+                            W_CHECK(ok);
+                        }
+                        if (ok) {
+                            int live = live_pending(sim);
+                            W_CHECK(live);
+                            ok = !live;
+                        }
+                        if (ok) {
+                            long long step = m_step;
+                            W_CHECK(set_tick(sim, w_run_first, tick));
+                            W_CHECK(set_tick(sim, w_run_spacing, step));
+                            long long done = call_many(batch, (run_last - tick) / step + 1, seek);
+                            W_CHECK(done);
+                            PyObject *hook = PyTuple_GET_ITEM(hooks, 0);
+                            for (long long rest = tick + done * step; rest <= run_last;
+                                 rest += step) {
+                                W_CHECK(set_tick(sim, w_tick, rest));
+                                PyObject *r = PyObject_CallNoArgs(hook);
+                                if (r == NULL) {
+                                    goto finish;
+                                }
+                                Py_DECREF(r);
+                            }
+                            W_CHECK(set_tick(sim, w_tick, run_last));
+                            cursor = run_last + 1;
+                            continue;
+                        }
+                    }
+                    W_CHECK(call_hooks(hooks));
+                }
+                cursor = tick + 1;
+            }
+        }
+        long long next_base = base + cycle;
+        cursor = cursor > next_base ? cursor : next_base;
+    }
+    failed = 0;
+finish:
+    PyBuffer_Release(&view);
+    {
+        /* after a fault inside a run of physics-only instants ``cursor`` is still the
+         * run's start; the instant that failed is ``_tick``: _cursor = max(cursor, _tick) */
+        PyObject *type, *value, *tb;
+        PyErr_Fetch(&type, &value, &tb);
+        PyObject *c = PyLong_FromLongLong(cursor);
+        PyObject *t = c == NULL ? NULL : PyObject_GetAttr(sim, w_tick);
+        int later = t == NULL ? -1 : PyObject_RichCompareBool(t, c, Py_GT);
+        int set = later < 0 ? -1 : PyObject_SetAttr(sim, w_cursor, later ? t : c);
+        Py_XDECREF(c);
+        Py_XDECREF(t);
+        if (failed || type != NULL) {
+            if (set < 0) { /* the fault is what the caller sees */
+                PyErr_Clear();
+            }
+            PyErr_Restore(type, value, tb);
+            return NULL;
+        }
+        if (set < 0) {
+            return NULL;
+        }
+    }
+    Py_RETURN_NONE;
+}
+
+static PyMethodDef kernel_functions[] = {
+    {"walk", (PyCFunction)(void (*)(void))walk, METH_FASTCALL,
+     "walk(sim, nums, objs, until, cursor, cycle, end, helpers): Simulation._advance's loop "
+     "(engine/walk.py)."},
+    {NULL, NULL, 0, NULL},
+};
+
 static struct PyModuleDef module = {
     PyModuleDef_HEAD_INIT, "_kernels",
-    "The standard components' steps as compiled bodies (engine/kernels.py).", -1, NULL,
+    "The standard components' steps as compiled bodies (engine/kernels.py) and the schedule "
+    "walk (engine/walk.py).", -1, kernel_functions,
 };
 
 PyMODINIT_FUNC PyInit__kernels(void) {
@@ -1273,6 +1751,19 @@ PyMODINIT_FUNC PyInit__kernels(void) {
     set_power_name = PyUnicode_InternFromString("set_power");
     behaviour_name = PyUnicode_InternFromString("_behaviour");
     pose_name = PyUnicode_InternFromString("_pose");
+    const char *const walk_texts[] = {"_tick",          "_run_first",    "_run_spacing",
+                                      "_now_cache",     "_next_instant_tick",
+                                      "_next_source_tick", "_pending_live", "_cursor",
+                                      "_apply_instant", "_apply_live",   "_apply_adapt", "run"};
+    PyObject **walk_names[] = {&w_tick,      &w_run_first,     &w_run_spacing, &w_now_cache,
+                               &w_nit,       &w_nst,           &w_pending,     &w_cursor,
+                               &w_apply_instant, &w_apply_live, &w_apply_adapt, &w_run};
+    for (int k = 0; k < 12; k++) {
+        *walk_names[k] = PyUnicode_InternFromString(walk_texts[k]);
+        if (*walk_names[k] == NULL) {
+            return NULL;
+        }
+    }
     const char *const drive_texts[] = {"update_drive", "_pending", "dirty",    "wheel",
                                        "deadband_pct", "_slot",    "_power_l", "_power_r",
                                        "_drive_l",     "_drive_r"};
