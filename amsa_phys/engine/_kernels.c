@@ -11,6 +11,7 @@
 #include <Python.h>
 
 #include <math.h>
+#include <string.h>
 
 /* Kernel(code, comp, ins, outs, values, fallback): a component whose do_step is plain
  * arithmetic on its inputs (and parameters), stepped without a Python call: ``step(task,
@@ -1717,10 +1718,141 @@ finish:
     Py_RETURN_NONE;
 }
 
+/* -- the single env's observation (``gym/observe.py``) -------------------------------------
+ *
+ * ``observe_one(values, plan, range_m, speed_mps, out)``: ``Observer.of_values`` for one
+ * vector of raw inputs, written into the float64 buffer ``out``: True, or False where it
+ * does not take them as the Python method would (a value not a float, a heading ``math``
+ * refuses, a scale not a float or zero): nothing is written then and the method runs.
+ * ``plan`` (an ``array('q')``) is the observer's rules as numbers: own (1 and x, y, heading,
+ * or 0 0 0 0), the relative pairs (their count, then x, y each), the rest (their count, then
+ * index and unit: 0 metres, 1 m/s, 2 an angle, 3 tanh). The same operations in the same
+ * order (built with -ffp-contract=off), ``math``'s cos, sin and tanh (libm's, as ``math``
+ * calls them), Python's float ``%``, and the same clip (``v if -1 <= v <= 1``, else 1 above,
+ * -1 below or NaN). */
+static double clip_unit(double v) { return -1.0 <= v && v <= 1.0 ? v : (v > 1.0 ? 1.0 : -1.0); }
+
+static PyObject *observe_one(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
+    (void)module;
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "observe_one(values, plan, range_m, speed_mps, out)");
+        return NULL;
+    }
+    PyObject *seq = args[0];
+    if (!PyTuple_CheckExact(seq) && !PyList_CheckExact(seq)) {
+        Py_RETURN_FALSE;
+    }
+    if (!PyFloat_CheckExact(args[2]) || !PyFloat_CheckExact(args[3])) {
+        Py_RETURN_FALSE;
+    }
+    double range_m = PyFloat_AS_DOUBLE(args[2]), speed = PyFloat_AS_DOUBLE(args[3]);
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    PyObject **items = PySequence_Fast_ITEMS(seq);
+    double vals[64];
+    if (n > 64) {
+        Py_RETURN_FALSE;
+    }
+    for (Py_ssize_t k = 0; k < n; k++) {
+        if (!PyFloat_CheckExact(items[k])) {
+            Py_RETURN_FALSE;
+        }
+        vals[k] = PyFloat_AS_DOUBLE(items[k]);
+    }
+    Py_buffer pv, ov;
+    if (PyObject_GetBuffer(args[1], &pv, PyBUF_FORMAT) < 0) {
+        return NULL;
+    }
+    if (PyObject_GetBuffer(args[4], &ov, PyBUF_WRITABLE | PyBUF_FORMAT) < 0) {
+        PyBuffer_Release(&pv);
+        return NULL;
+    }
+    PyObject *res = NULL;
+    const long long *plan = (const long long *)pv.buf;
+    Py_ssize_t np_ = pv.len / 8, no = ov.len / 8, at = 0, w = 0;
+    if (pv.itemsize != 8 || pv.format == NULL || pv.format[0] != 'q' || ov.itemsize != 8 ||
+        ov.format == NULL || ov.format[0] != 'd' || ov.format[1] != '\0' || np_ < 5) {
+        PyErr_SetString(PyExc_ValueError, "observe_one: a plan of int64, an out of float64");
+        goto done;
+    }
+    double out[64];
+#define PLAN(i) ((i) < np_ ? plan[(i)] : -1)
+#define VAL(i) (0 <= (i) && (i) < n ? vals[(i)] : NAN)
+#define BAD_INDEX(i) ((i) < 0 || (i) >= n)
+    int taken = 1;
+    long long own = PLAN(0), ox = PLAN(1), oy = PLAN(2), oh = PLAN(3), nrel = PLAN(4);
+    at = 5;
+    if (own) {
+        if (BAD_INDEX(ox) || BAD_INDEX(oy) || BAD_INDEX(oh) || isinf(vals[oh]) ||
+            range_m == 0.0) {
+            taken = 0; /* math.cos(inf) raises, x / 0.0 raises: the method's */
+        } else {
+            double c = cos(vals[oh]), s = sin(vals[oh]);
+            double x0 = vals[ox], y0 = vals[oy];
+            for (long long r = 0; r < nrel && taken; r++) {
+                long long ix = PLAN(at), iy = PLAN(at + 1);
+                at += 2;
+                if (BAD_INDEX(ix) || BAD_INDEX(iy) || w + 2 > 64) {
+                    taken = 0;
+                    break;
+                }
+                double dx = vals[ix] - x0, dy = vals[iy] - y0;
+                out[w++] = clip_unit((c * dx + s * dy) / range_m);
+                out[w++] = clip_unit((-s * dx + c * dy) / range_m);
+            }
+        }
+    }
+    long long nrest = PLAN(at);
+    at++;
+    for (long long r = 0; r < nrest && taken; r++) {
+        long long i = PLAN(at), unit = PLAN(at + 1);
+        at += 2;
+        if (BAD_INDEX(i) || w + 1 > 64) {
+            taken = 0;
+            break;
+        }
+        double v = VAL(i);
+        if (unit == 0) {
+            if (range_m == 0.0) {
+                taken = 0;
+                break;
+            }
+            v = v / range_m;
+        } else if (unit == 1) {
+            if (speed == 0.0) {
+                taken = 0;
+                break;
+            }
+            v = v / speed;
+        } else if (unit == 2) {
+            const double pi = 3.141592653589793;
+            v = (py_mod(v + pi, 2 * pi) - pi) / pi;
+        } else {
+            v = tanh(v);
+        }
+        out[w++] = clip_unit(v);
+    }
+#undef PLAN
+#undef VAL
+#undef BAD_INDEX
+    if (taken && w == no) {
+        memcpy(ov.buf, out, (size_t)w * sizeof(double));
+        res = Py_NewRef(Py_True);
+    } else {
+        res = Py_NewRef(Py_False);
+    }
+done:
+    PyBuffer_Release(&pv);
+    PyBuffer_Release(&ov);
+    return res;
+}
+
 static PyMethodDef kernel_functions[] = {
     {"walk", (PyCFunction)(void (*)(void))walk, METH_FASTCALL,
      "walk(sim, nums, objs, until, cursor, cycle, end, helpers): Simulation._advance's loop "
      "(engine/walk.py)."},
+    {"observe_one", (PyCFunction)(void (*)(void))observe_one, METH_FASTCALL,
+     "observe_one(values, plan, range_m, speed_mps, out): Observer.of_values in C "
+     "(gym/observe.py)."},
     {NULL, NULL, 0, NULL},
 };
 
