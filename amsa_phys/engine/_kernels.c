@@ -1248,6 +1248,162 @@ static PyTypeObject KernelType = {
     .tp_call = (ternaryfunc)Kernel_call,
 };
 
+/* -- a delayed Leaf's step (``engine/delayedstep.py``) --------------------------------------
+ *
+ * ``Delayed(comp, ports, ats, values, own, targets, line, send, gather, failed, finish)``,
+ * called as ``step(task, now)``: ``packed_delayed``'s step without its Python frame. The
+ * inputs gathered (``gather(ports, ats, values, own)``), ``comp.do_step(now, inp)`` called
+ * (what it raises goes to ``failed(exc, now)``, the scalar step's handler), and the usual
+ * answer, a dict of finite floats for known ports (str keys), put in flight as the Python
+ * step does: ``own.update(writes)`` then ``send(line, list(writes.items()))``. An empty dict
+ * publishes nothing. Anything else goes to ``finish(out, now)``, the Python step's own
+ * judging and sending of ``out`` (``tests/engine/test_delayed_compiled.py``). */
+typedef struct {
+    PyObject_HEAD
+    PyObject *comp, *ports, *ats, *values, *own, *targets, *line, *send, *gather, *failed,
+        *finish;
+} Delayed;
+
+static PyObject *do_step_name = NULL;
+
+static int Delayed_init(Delayed *self, PyObject *args, PyObject *kw) {
+    PyObject *a[11];
+    if (kw != NULL && PyDict_GET_SIZE(kw)) {
+        PyErr_SetString(PyExc_TypeError, "Delayed takes no keywords");
+        return -1;
+    }
+    if (!PyArg_ParseTuple(args, "OOOOO!O!OOOOO", &a[0], &a[1], &a[2], &a[3], &PyDict_Type, &a[4],
+                          &PyDict_Type, &a[5], &a[6], &a[7], &a[8], &a[9], &a[10])) {
+        return -1;
+    }
+    PyObject **slots[] = {&self->comp, &self->ports, &self->ats,    &self->values,
+                          &self->own,  &self->targets, &self->line, &self->send,
+                          &self->gather, &self->failed, &self->finish};
+    for (int k = 0; k < 11; k++) {
+        Py_XSETREF(*slots[k], Py_NewRef(a[k]));
+    }
+    return 0;
+}
+
+static int Delayed_traverse(Delayed *self, visitproc visit, void *arg) {
+    Py_VISIT(self->comp);
+    Py_VISIT(self->ports);
+    Py_VISIT(self->ats);
+    Py_VISIT(self->values);
+    Py_VISIT(self->own);
+    Py_VISIT(self->targets);
+    Py_VISIT(self->line);
+    Py_VISIT(self->send);
+    Py_VISIT(self->gather);
+    Py_VISIT(self->failed);
+    Py_VISIT(self->finish);
+    return 0;
+}
+
+static int Delayed_clear(Delayed *self) {
+    Py_CLEAR(self->comp);
+    Py_CLEAR(self->ports);
+    Py_CLEAR(self->ats);
+    Py_CLEAR(self->values);
+    Py_CLEAR(self->own);
+    Py_CLEAR(self->targets);
+    Py_CLEAR(self->line);
+    Py_CLEAR(self->send);
+    Py_CLEAR(self->gather);
+    Py_CLEAR(self->failed);
+    Py_CLEAR(self->finish);
+    return 0;
+}
+
+static void Delayed_dealloc(Delayed *self) {
+    PyObject_GC_UnTrack(self);
+    Delayed_clear(self);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static PyObject *Delayed_call(Delayed *self, PyObject *args, PyObject *kw) {
+    if (kw != NULL || !PyTuple_Check(args) || PyTuple_GET_SIZE(args) != 2) {
+        PyErr_SetString(PyExc_TypeError, "step(task, now)");
+        return NULL;
+    }
+    if (self->comp == NULL) {
+        PyErr_SetString(PyExc_TypeError, "Delayed not initialised");
+        return NULL;
+    }
+    PyObject *now = PyTuple_GET_ITEM(args, 1);
+    PyObject *gargs[4] = {self->ports, self->ats, self->values, self->own};
+    PyObject *inp = PyObject_Vectorcall(self->gather, gargs, 4, NULL);
+    if (inp == NULL) {
+        return NULL;
+    }
+    PyObject *out = PyObject_CallMethodObjArgs(self->comp, do_step_name, now, inp, NULL);
+    Py_DECREF(inp);
+    if (out == NULL) {
+        return hand_fault(self->failed, now);
+    }
+    PyObject *writes = NULL, *items = NULL, *res = NULL;
+    int plain = PyDict_CheckExact(out);
+    if (plain && PyDict_GET_SIZE(out) == 0) {
+        Py_DECREF(out);
+        Py_RETURN_NONE; /* ``if not out: return`` */
+    }
+    writes = plain ? PyDict_New() : NULL;
+    if (plain && writes == NULL) {
+        goto done;
+    }
+    Py_ssize_t pos = 0;
+    PyObject *key, *value;
+    while (plain && PyDict_Next(out, &pos, &key, &value)) {
+        if (!PyUnicode_CheckExact(key) || !PyFloat_CheckExact(value)) {
+            plain = 0;
+            break;
+        }
+        double v = PyFloat_AS_DOUBLE(value);
+        PyObject *at = PyDict_GetItemWithError(self->targets, key);
+        if (at == NULL || v - v != 0.0) {
+            if (PyErr_Occurred()) {
+                goto done;
+            }
+            plain = 0;
+            break;
+        }
+        if (PyDict_SetItem(writes, at, value) < 0) {
+            goto done;
+        }
+    }
+    if (!plain) { /* the Python step's judging and sending, from the start */
+        PyObject *fargs[2] = {out, now};
+        res = PyObject_Vectorcall(self->finish, fargs, 2, NULL);
+        goto done;
+    }
+    if (PyDict_Update(self->own, writes) < 0 || (items = PyDict_Items(writes)) == NULL) {
+        goto done;
+    }
+    PyObject *sargs[2] = {self->line, items};
+    res = PyObject_Vectorcall(self->send, sargs, 2, NULL);
+    if (res != NULL) {
+        Py_SETREF(res, Py_NewRef(Py_None));
+    }
+done:
+    Py_DECREF(out);
+    Py_XDECREF(writes);
+    Py_XDECREF(items);
+    return res;
+}
+
+static PyTypeObject DelayedType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "amsa_phys.engine._kernels.Delayed",
+    .tp_basicsize = sizeof(Delayed),
+    .tp_flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_HAVE_GC,
+    .tp_doc = "A delayed Leaf's step, step(task, now), in C (see _kernels.c).",
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)Delayed_init,
+    .tp_traverse = (traverseproc)Delayed_traverse,
+    .tp_clear = (inquiry)Delayed_clear,
+    .tp_dealloc = (destructor)Delayed_dealloc,
+    .tp_call = (ternaryfunc)Delayed_call,
+};
+
 /* -- the schedule walk (``engine/walk.py``) ------------------------------------------------
  *
  * ``walk(sim, nums, objs, until, cursor, cycle, end, helpers)``: ``Simulation._advance``'s
@@ -1866,6 +2022,13 @@ PyMODINIT_FUNC PyInit__kernels(void) {
     if (PyType_Ready(&KernelType) < 0) {
         return NULL;
     }
+    if (PyType_Ready(&DelayedType) < 0) {
+        return NULL;
+    }
+    do_step_name = PyUnicode_InternFromString("do_step");
+    if (do_step_name == NULL) {
+        return NULL;
+    }
     PyObject *math = PyImport_ImportModule("math");
     if (math == NULL) {
         return NULL;
@@ -1971,6 +2134,12 @@ PyMODINIT_FUNC PyInit__kernels(void) {
     Py_INCREF(&KernelType);
     if (PyModule_AddObject(m, "Kernel", (PyObject *)&KernelType) < 0) {
         Py_DECREF(&KernelType);
+        Py_DECREF(m);
+        return NULL;
+    }
+    Py_INCREF(&DelayedType);
+    if (PyModule_AddObject(m, "Delayed", (PyObject *)&DelayedType) < 0) {
+        Py_DECREF(&DelayedType);
         Py_DECREF(m);
         return NULL;
     }
