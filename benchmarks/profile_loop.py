@@ -28,7 +28,10 @@ reset and build        a reset: the scenario loaded, the simulation built and in
 
 Run: ``python -m benchmarks.profile_loop gym`` (or ``run``); ``--top N`` lists the N
 hottest lines: where the interpreter noticed the timer (its next call or loop jump), so
-read them as near the cost, the parts as the cost. The timer fires at the kernel's tick at
+read them as near the cost, the parts as the cost. A handler runs only between two Python
+instructions: C time that calls no Python meanwhile (the compiled schedule walk, the
+components' compiled bodies it calls) is charged to the next Python frame entered, mostly
+the physics step's or the agent's. The timer fires at the kernel's tick at
 best (often every 4 ms): the loops are long enough for a thousand samples or more. The
 shares are of the samples in the measured loop; the CPU time beside them is that share of
 the loop's measured CPU time per step (or per run).

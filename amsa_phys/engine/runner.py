@@ -36,7 +36,7 @@ from ..model.scenario import Change, Phase, Scenario
 from ..model.template import Template
 from ..model.timeline import Timeline
 from ..model.world import WorldSpec
-from . import batch, interrupt, layout, schedule
+from . import batch, interrupt, layout, schedule, walk
 from .adapt import AdaptRules
 from .build import build_components, make_task
 from .clock import NOWS_KEPT, TickGrid, exact, kept_times
@@ -254,6 +254,8 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
         self._sources[:0] = [TimelineSource(t, g, r) for r, t in enumerate(self.timelines)]
         self._next_source_tick = min(s.next_tick() for s in self._sources)
         self._next_instant_tick = min(self._next_source_tick, self.deliveries.next_due())
+        #: the compiled schedule walk (``walk.py``), or None: the Python loop of ``_advance``
+        self._walk = walk.prepare(self)
 
     def _lay_out(self, log_at: int | None, hooks: list[tuple[int, Hook]]) -> list[schedule.Instant]:
         """The cycle's instants with like components grouped (sets ``_cycle`` and
@@ -295,10 +297,18 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
         The hot loop of every run: per instant it does two integer compares, then calls what
         the precomputed table lists. Instant-level changes (deliveries, the timeline, rules)
         are found by comparing with the next one's tick only; hooks (the physics step) do not
-        run at the final instant, which ends the run.
+        run at the final instant, which ends the run. Where the extension is built this very
+        loop runs in C (``walk.py``); the Python below is its reference and the pure path.
         """
         self.initialize()
         until = min(until_tick, self._end)
+        # the same loop in one C call where built (``walk.py``); below, the reference
+        walker = self._walk
+        if walker is not None and not walk.current(walker, self):
+            walker = self._walk = walk.prepare(self)
+        if walker is not None:
+            walker(self, until)
+            return
         cycle = self._cycle
         table = self._plan
         end = self._end

@@ -21,6 +21,7 @@ infinite), as before.
 from __future__ import annotations
 
 import math
+from array import array
 from collections.abc import Sequence
 from typing import Any
 
@@ -49,6 +50,7 @@ class Observer:
         self.mode = mode
         self.raw_names = [p.name for p in ports]
         self._in_c: tuple[Any, ...] | None = None
+        self._one: tuple[Any, array] | None = None
         if mode == "absolute":
             self.names = list(self.raw_names)
             self.low = np.full(len(ports), -np.inf)
@@ -87,6 +89,7 @@ class Observer:
         self.low = np.full(len(self.names), -1.0)
         self.high = np.full(len(self.names), 1.0)
         self._in_c = _rows_in_c(self)
+        self._one = _one_in_c(self)
 
     def __call__(self, raw: np.ndarray) -> np.ndarray:
         """The observation of one raw input vector (float64, within ``low``..``high``)."""
@@ -143,6 +146,11 @@ class Observer:
         comprehension over the finished list was a function call of its own (issue 29)."""
         if self.mode == "absolute":
             return np.array(values, dtype=np.float64)
+        one = self._one
+        if one is not None:  # the same in one C call (``_kernels.observe_one``), if it takes them
+            obs = np.empty(len(self.names))
+            if one[0](values, one[1], self.range_m, self.speed_mps, obs):
+                return obs
         out: list[float] = []
         append = out.append
         if self.own is not None:
@@ -170,6 +178,31 @@ class Observer:
         # float64 array of them by itself, in half the time of parsing ``dtype=`` (an empty
         # list too)
         return np.array(out)
+
+
+#: ``_kernels.observe_one``'s codes of the units :meth:`Observer.of_values` tells apart
+_UNITS = {"m": 0, "m/s": 1, "rad": 2}
+
+
+def _one_in_c(observer: Observer) -> tuple[Any, array] | None:
+    """``_kernels.observe_one`` and the observer's rules as its numbers, where the extension
+    is built; None otherwise (``AMSA_PHYS_PURE=1`` included). Why: the env makes one
+    observation a step, and the Python method's few float operations, calls and list cost
+    more than a C call filling an empty array (``tests/gym/test_observe_compiled.py``)."""
+    from ..engine import publish
+
+    module = publish._extension("_kernels")
+    fn = getattr(module, "observe_one", None) if module is not None else None
+    if fn is None or len(observer.names) > 64 or len(observer.raw_names) > 64:
+        return None
+    plan = array("q", [1, *observer.own] if observer.own is not None else [0, 0, 0, 0])
+    plan.append(len(observer.relative))
+    for ix, iy in observer.relative:
+        plan.extend((ix, iy))
+    plan.append(len(observer.rest))
+    for i, unit in observer.rest:
+        plan.extend((i, _UNITS.get(unit, 3)))
+    return fn, plan
 
 
 def _rows_in_c(observer: Observer) -> tuple[Any, ...] | None:
