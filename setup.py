@@ -29,5 +29,13 @@ setup(
             libraries=["m"],
             optional=True,
         ),
+        Extension(
+            "amsa_phys.engine._groupbodies",
+            ["amsa_phys/engine/_groupbodies.c"],
+            # component groups' numpy arithmetic as one loop (``engine/batch_bodies.py``)
+            extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"],
+            libraries=["m"],
+            optional=True,
+        ),
     ]
 )
