@@ -129,16 +129,16 @@ static PyObject *gps_fix(PyObject *Py_UNUSED(module), PyObject *args)
 }
 
 /* ---- compass_heading: a Compass group's heading after its first step (sensors/compass.py) --
- * Compass.step_many's numpy path, member k, when no member has a deviation term:
+ * Compass.step_many's numpy path, member k:
  *   b = phi*b + q*g (in place)
  *   value = heading + mean + b + stddev*w; value += turn_on
- *   value += deviation(heading) with its four terms 0: nothing, unless the heading or its
- *            double is not finite (a sine of it is NaN, and so is the value)
+ *   value += deviation (numpy's sines and cosines, computed by the caller: numpy's may
+ *            differ from libm's in the last bit)
  *   value = (value + pi) % 2pi - pi (the floor modulo, as numpy's remainder)
  *   where precision > 0: value = (floor(value/precision + 0.5)*precision + pi) % 2pi - pi
  *   lost = u*100.0 < lostData; published = !lost
  * Returns the number of members lost. */
-#define COMPASS_ARGS 14
+#define COMPASS_ARGS 15
 static double floor_mod(double a, double b)
 {
     double mod = fmod(a, b);
@@ -155,12 +155,12 @@ static PyObject *compass_heading(PyObject *Py_UNUSED(module), PyObject *args)
 {
     static const char *names[COMPASS_ARGS] = {
         "heading", "w", "g", "u", "phi", "q", "mean", "turn_on", "stddev", "precision",
-        "lostData", "b", "value", "published"};
-    static const char kinds[COMPASS_ARGS + 1] = "dddddddddddDDB";
+        "lostData", "b", "value", "published", "deviation"};
+    static const char kinds[COMPASS_ARGS + 1] = "dddddddddddDDBd";
     PyObject *objs[COMPASS_ARGS];
-    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3],
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3],
                           &objs[4], &objs[5], &objs[6], &objs[7], &objs[8], &objs[9],
-                          &objs[10], &objs[11], &objs[12], &objs[13]))
+                          &objs[10], &objs[11], &objs[12], &objs[13], &objs[14]))
         return NULL;
     Py_buffer views[COMPASS_ARGS];
     Column c[COMPASS_ARGS];
@@ -176,9 +176,7 @@ static PyObject *compass_heading(PyObject *Py_UNUSED(module), PyObject *args)
         double value = AT(c[0], k, double) + AT(c[6], k, double) + b +
                        AT(c[8], k, double) * AT(c[1], k, double);
         value += AT(c[7], k, double);
-        const double h = AT(c[0], k, double);
-        if (!isfinite(2.0 * h)) /* the zero deviation terms of a heading (or its double) */
-            value += 0.0 * sin(h) + 0.0 * cos(h) + 0.0 * sin(2.0 * h) + 0.0 * cos(2.0 * h);
+        value += AT(c[14], k, double);
         value = floor_mod(value + pi, two_pi) - pi;
         const double precision = AT(c[9], k, double);
         if (precision > 0) {
@@ -200,7 +198,7 @@ static PyMethodDef methods[] = {
      "group's fix after its first step; returns how many members lost theirs."},
     {"compass_heading", compass_heading, METH_VARARGS,
      "compass_heading(heading, w, g, u, phi, q, mean, turn_on, stddev, precision, lostData, b, "
-     "value, published): a Compass group's heading (no deviation terms) after its "
+     "value, published, deviation): a Compass group's heading after its "
      "first step; returns how many members lost theirs."},
     {NULL, NULL, 0, NULL},
 };

@@ -186,12 +186,7 @@ class Compass(Template):
         else:
             phi, q = gauss_markov(state, sigma, tau, now - state["t_prev"])
             body = state["body"]
-            if body is not None and derived(
-                state,
-                "no_deviation",
-                (p.deviationB, p.deviationC, p.deviationD, p.deviationE),
-                _all_zero,
-            ):
+            if body is not None:
                 state["t_prev"] = now
                 return _heading_compiled(body, comps, inp, p, state, (w, g, u), phi, q)
             state["b"] = phi * state["b"] + q * g
@@ -222,11 +217,6 @@ def _turn_on_many(sign: np.ndarray, z: np.ndarray) -> Callable[[Any, Any], np.nd
     return lambda m, s: sign * (m + s * z)
 
 
-def _all_zero(*terms: np.ndarray) -> bool:
-    """Whether every copy's every deviation term is 0 (a NaN is not)."""
-    return not any(t.any() for t in terms)
-
-
 def _heading_compiled(
     body: Any,
     comps: Sequence[Any],
@@ -237,17 +227,19 @@ def _heading_compiled(
     phi: np.ndarray,
     q: np.ndarray,
 ) -> tuple[Mapping[str, Any], np.ndarray]:
-    """``step_many`` after the first step without deviation terms, in one compiled call
-    (``engine/batch_bodies.py``): the numpy path's operations in its order, so its floats;
-    the dynamic bias updated in place."""
+    """``step_many`` after the first step in one compiled call (``engine/batch_bodies.py``):
+    the numpy path's operations in its order, so its floats; the dynamic bias updated in
+    place. The deviation stays numpy's (its sines may differ from libm's in the last bit)."""
     sign, z = state["on_sign"], state["on_z"]
     turn_on = derived(state, "turn_on", (p.bias_mean, p.bias_stddev), _turn_on_many(sign, z))
     n = len(comps)
     value, published = np.empty(n), np.empty(n, dtype=bool)
     w, g, u = draws
+    h = inp["heading"]
+    dev = deviation(h, p.deviationB, p.deviationC, p.deviationD, p.deviationE)
     if body(
-        inp["heading"], w, g, u, phi, q, p.mean, turn_on, p.stddev, p.precision, p.lostData,
-        state["b"], value, published,
+        h, w, g, u, phi, q, p.mean, turn_on, p.stddev, p.precision, p.lostData,
+        state["b"], value, published, dev,
     ):  # fmt: skip
         for k in np.flatnonzero(~published).tolist():
             comps[k].lost += 1

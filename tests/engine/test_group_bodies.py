@@ -26,7 +26,8 @@ class Ctx:
         self.rng = np.random.default_rng(seed)
 
 
-#: one member each: quantised or not, losses, bursts, dynamic and turn-on biases
+#: one member each: quantised or not, losses, bursts, dynamic and turn-on biases (and, for
+#: the compass, deviation terms or none)
 GPS_MEMBERS: list[dict[str, Any]] = [
     {"stddev": 0.015, "dynamic_bias_stddev": 0.0055, "precision": 0.01, "lostDataGPS": 30},
     {"stddev": 0.5, "burstLoss": 30.0, "burstLength": 4.0, "precision": 0.0},
@@ -43,7 +44,7 @@ GPS_MEMBERS: list[dict[str, Any]] = [
     },
 ]
 COMPASS_MEMBERS: list[dict[str, Any]] = [
-    {"stddev": 0.01, "lostData": 20.0, "precision": 0.0017},
+    {"stddev": 0.01, "lostData": 20.0, "precision": 0.0017, "deviationB": 0.02},
     {  # unrounded, so the order of the sums shows in the last bits
         "stddev": 0.01,
         "mean": 0.05,
@@ -52,7 +53,16 @@ COMPASS_MEMBERS: list[dict[str, Any]] = [
         "precision": 0.0,
     },
     {"stddev": 0.0, "precision": 0.0, "mean": 0.3},
-    {"stddev": 0.02, "bias_mean": 0.01, "bias_stddev": 0.005, "precision": 0.0},
+    {
+        "stddev": 0.02,
+        "bias_mean": 0.01,
+        "bias_stddev": 0.005,
+        "deviationB": 0.02,
+        "deviationC": -0.013,
+        "deviationD": 0.005,
+        "deviationE": 0.0031,
+        "precision": 0.0,
+    },
 ]
 #: the true readings at each step, per member: ordinary ones, then what a blown-up physics
 #: would give (a double that overflows, an infinity, a NaN)
