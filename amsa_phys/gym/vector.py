@@ -169,13 +169,20 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         scale = self.single.action_scale
         episode = self._episode
         episode.step(a * scale)
-        collisions = episode.collisions()
-        new = collisions - self._seen
-        self._seen = collisions
         q = self.single.quality
         signal = episode.signals(q.signal)  # read once: the reward's and the info's
         reward = -np.abs(signal - q.reference) / q.tolerance
-        reward = reward - self.single.collision_penalty * new + 0.0
+        penalty = self.single.collision_penalty
+        if episode.columns is not None and not episode.alone:
+            # on columns no run collides before it goes alone: no new collisions, and the
+            # penalty (finite, >= 0: ``args.py``) times 0 is +0.0, whose subtraction changes
+            # no bit (the + 0.0 makes a -0.0 reward +0.0 either way)
+            reward = reward + 0.0
+        else:
+            collisions = episode.collisions()
+            new = collisions - self._seen
+            self._seen = collisions
+            reward = reward - penalty * new + 0.0
         truncated = np.full(n, episode.done)
         self._autoreset = episode.done
         info = self._info(signal.copy())
