@@ -3,7 +3,9 @@
 The vector env (``FollowVecEnv``, random actions) at each size in ``--vector``, per vector
 step, and a batched sweep (``--sweep``: ``--runs`` runs of 60 s, 25 Kv values, as
 ``bench_engine.py`` plans them, in this process), per run. Every group's ``step_many`` and
-every call of the column physics is timed (CPU), and in a sweep each batch's set-up (its
+every call of the column physics is timed (CPU), with the engine's share of each group's
+time (gathering its inputs, judging and writing its outputs: the group's time less its
+template's own ``step_many``), and in a sweep each batch's set-up (its
 runs' components built, then initialized and the schedule planned) and end (verdicts,
 metrics); "the rest" is the engine's loop, the agent's side of the vector env (actions,
 rewards, observations) and, in a sweep, the jobs' planning and preparation. The
@@ -31,6 +33,51 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 
 PHYSICS = "(column physics)"
+
+
+def _templates() -> list[type]:
+    """Every imported template class that defines its own ``step_many``."""
+    from amsa_phys.model.template import Template
+
+    seen: list[type] = []
+    todo = [Template]
+    while todo:
+        cls = todo.pop()
+        todo.extend(cls.__subclasses__())
+        if isinstance(cls.__dict__.get("step_many"), classmethod):
+            seen.append(cls)
+    return seen
+
+
+@contextmanager
+def own_steps(inner: collections.Counter) -> Iterator[None]:
+    """CPU seconds inside each template's own ``step_many`` (by class name), summed while
+    open: a group's time less this is the engine's (its inputs gathered, its outputs judged
+    and written). Templates made later (the vector env's agent) are not timed."""
+    clock = time.process_time
+    saved = {cls: cls.__dict__["step_many"] for cls in _templates()}
+    depth = [0]  # a template's step_many may call another's (a random leader's, a robot's)
+
+    def timed(cls: type, fn: Callable[..., Any]) -> classmethod:
+        def wrapper(klass: type, *args: Any) -> Any:
+            depth[0] += 1
+            t0 = clock()
+            try:
+                return fn(klass, *args)
+            finally:
+                depth[0] -= 1
+                if depth[0] == 0:  # the group's own template: the outermost call
+                    inner[cls.__name__] += clock() - t0
+
+        return classmethod(wrapper)
+
+    for cls, method in saved.items():
+        cls.step_many = timed(cls, method.__func__)  # type: ignore[attr-defined]
+    try:
+        yield
+    finally:
+        for cls, method in saved.items():
+            cls.step_many = method  # type: ignore[attr-defined]
 
 
 @contextmanager
@@ -67,15 +114,25 @@ def timers() -> Iterator[tuple[collections.Counter, collections.Counter]]:
 
 
 def table(
-    total: float, per: float, unit: str, cpu: collections.Counter, calls: dict, each: str
+    total: float,
+    per: float,
+    unit: str,
+    cpu: collections.Counter,
+    calls: dict,
+    each: str,
+    inner: collections.Counter | None = None,
 ) -> None:
     """``cpu`` (seconds over ``per`` vector steps or runs) as one line per part, with its
-    ``calls`` (counted ``each``)."""
+    ``calls`` (counted ``each``) and, for a group whose template's own time is in ``inner``,
+    the engine's share of it."""
     scale, digits = (1e6, 1) if unit == "us" else (1e3, 3)
     for name, sec in cpu.most_common():
+        engine = ""
+        if inner is not None and name in inner:
+            engine = f"; the engine's {(sec - inner[name]) / per * scale:.{digits}f} {unit}"
         print(
             f"  {name:24s} {sec / per * scale:9.{digits}f} {unit} ({sec / total:4.0%}), "
-            f"{calls[name]:,.1f} calls {each}"
+            f"{calls[name]:,.1f} calls {each}{engine}"
         )
     rest = total - sum(cpu.values())
     print(f"  {'the rest':24s} {rest / per * scale:9.{digits}f} {unit} ({rest / total:4.0%})")
@@ -86,6 +143,7 @@ def vector(n: int, steps: int) -> None:
     from amsa_phys.gym.vector import FollowVecEnv
 
     actions = np.random.default_rng(n).uniform(-1, 1, (steps + 3, n, 2))
+    inner: collections.Counter = collections.Counter()
     with timers() as (cpu, calls):
         env = FollowVecEnv(n, stepping="batch")
         env.reset(seed=0)
@@ -93,10 +151,11 @@ def vector(n: int, steps: int) -> None:
             env.step(a)
         cpu.clear()
         calls.clear()
-        t0 = time.process_time()
-        for a in actions[3:]:
-            env.step(a)
-        total = time.process_time() - t0
+        with own_steps(inner):  # the templates are imported by now
+            t0 = time.process_time()
+            for a in actions[3:]:
+                env.step(a)
+            total = time.process_time() - t0
         env.close()
     physics = cpu[PHYSICS]
     ceiling = f"; the physics alone would allow {steps * n / physics:,.0f}" if physics else ""
@@ -104,7 +163,7 @@ def vector(n: int, steps: int) -> None:
         f"vector env, {n} envs: {total / steps * 1e6:,.0f} us a vector step, "
         f"{steps * n / total:,.0f} env-steps/s{ceiling}"
     )
-    table(total, steps, "us", cpu, {k: v / steps for k, v in calls.items()}, "a vector step")
+    table(total, steps, "us", cpu, {k: v / steps for k, v in calls.items()}, "a vector step", inner)
 
 
 #: A sweep's parts outside the loop, timed on their own lines: the batch's set-up and end
