@@ -135,9 +135,12 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         if self._singles is not None:
             self._episode = self._singles  # type: ignore[assignment]
             return self._singles.start(drawn)
-        self._episode = VecEpisode(
-            single._scenario, single.path, drawn, single.observed, single.acted
-        )
+        from ..runs.batched import fewer_collections  # the sweep's module, imported lazily
+
+        with fewer_collections():  # a batch's build makes thousands of objects an env
+            self._episode = VecEpisode(
+                single._scenario, single.path, drawn, single.observed, single.acted
+            )
         self._seen = np.zeros(self.num_envs, dtype=np.int64)
         self._autoreset = False
         info = self._info()
