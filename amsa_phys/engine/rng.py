@@ -72,20 +72,24 @@ class Drawn:
         return self._it is self._unused
 
 
-#: the most bytes one :class:`DrawnMany` buffer holds (its block is chosen to fill it)
+#: the first block a :class:`DrawnMany` draws; each refill after it draws twice as many
+MANY_BLOCK_FIRST = 64
+#: the most bytes one :class:`DrawnMany` buffer holds (the largest block fills it)
 MANY_BYTES = 2 << 20
-#: the block a :class:`DrawnMany` of few streams draws at a time
+#: the largest block a :class:`DrawnMany` of few streams draws at a time
 MANY_BLOCK_MAX = 1024
 
 
 def many_block(streams: int) -> int:
-    """How many numbers a :class:`DrawnMany` of ``streams`` streams draws per stream at a
+    """The largest block a :class:`DrawnMany` of ``streams`` streams draws per stream at a
     refill: as many as :data:`MANY_BYTES` hold, between 64 and :data:`MANY_BLOCK_MAX`.
 
     Why: a refill is one Python call per stream (~1-2 µs) whatever the block. At 1,000
     streams and blocks of 64 that was ~30 µs of every draw's ~50 (a vector env's GPS and
     compass groups draw 15 times a vector step); blocks of 262 bring a draw to ~16 µs, for
-    2 MB a buffer. A stream's numbers do not depend on the block (a Generator fills in
+    2 MB a buffer. The blocks grow to it from :data:`MANY_BLOCK_FIRST`, doubling at each
+    refill, so a short run (a sweep's 60 s: 240 GPS fixes) draws at most about twice the
+    numbers it uses. A stream's numbers do not depend on the blocks (a Generator fills in
     sequence), so the runs do not either."""
     return max(64, min(MANY_BLOCK_MAX, MANY_BYTES // (8 * max(1, streams))))
 
@@ -109,7 +113,10 @@ class DrawnMany:
         if not all(d.fresh for d in streams):
             raise RuntimeError("a stream was drawn from before its group took it over")
         self._draws = [d._draw for d in streams]
-        self._block = many_block(len(streams)) if block is None else block
+        #: the largest block (``block`` given: every block); the first is at most
+        #: :data:`MANY_BLOCK_FIRST`, and each refill doubles it up to this
+        self._largest = many_block(len(streams)) if block is None else block
+        self._block = min(MANY_BLOCK_FIRST, self._largest) if block is None else block
         self._pos = self._block
         self._buf = np.empty((0, len(streams)))  # (block, streams) once filled
         #: every stream a Generator method that can fill a row in place (``out=``): a
@@ -120,6 +127,8 @@ class DrawnMany:
     def __call__(self) -> np.ndarray:
         """The next number of every stream."""
         if self._pos >= self._block:
+            if len(self._buf):  # not the first refill: a longer block
+                self._block = min(2 * self._block, self._largest)
             if self._in_place:
                 buf = np.empty((len(self._draws), self._block))
                 for draw, row in zip(self._draws, buf, strict=True):
