@@ -35,27 +35,16 @@ ROOT = Path(__file__).resolve().parent.parent
 PHYSICS = "(column physics)"
 
 
-def _templates() -> list[type]:
-    """Every imported template class that defines its own ``step_many``."""
-    from amsa_phys.model.template import Template
-
-    seen: list[type] = []
-    todo = [Template]
-    while todo:
-        cls = todo.pop()
-        todo.extend(cls.__subclasses__())
-        if isinstance(cls.__dict__.get("step_many"), classmethod):
-            seen.append(cls)
-    return seen
-
-
 @contextmanager
 def own_steps(inner: collections.Counter) -> Iterator[None]:
-    """CPU seconds inside each template's own ``step_many`` (by class name), summed while
-    open: a group's time less this is the engine's (its inputs gathered, its outputs judged
-    and written). Templates made later (the vector env's agent) are not timed."""
+    """CPU seconds inside each group template's own ``step_many`` (by class name), summed
+    while open: a group's time less this is the engine's (its inputs gathered, its outputs
+    judged and written). A template is timed from the first time a group of it steps (a
+    world's templates are imported as it is built); enter this after :func:`timers`."""
+    from amsa_phys.engine.tasks import Steppers
+
     clock = time.process_time
-    saved = {cls: cls.__dict__["step_many"] for cls in _templates()}
+    saved: dict[type, Any] = {}
     depth = [0]  # a template's step_many may call another's (a random leader's, a robot's)
 
     def timed(cls: type, fn: Callable[..., Any]) -> classmethod:
@@ -71,13 +60,28 @@ def own_steps(inner: collections.Counter) -> Iterator[None]:
 
         return classmethod(wrapper)
 
-    for cls, method in saved.items():
-        cls.step_many = timed(cls, method.__func__)  # type: ignore[attr-defined]
+    def wrap(cls: type) -> None:
+        for klass in cls.__mro__:  # the class that defines it (a subclass may inherit it)
+            method = klass.__dict__.get("step_many")
+            if isinstance(method, classmethod) and klass not in saved:
+                saved[klass] = method
+                klass.step_many = timed(klass, method.__func__)  # type: ignore[attr-defined]
+                return
+
+    step_group = Steppers.step_group
+
+    def seen(self: Any, group: Any, now: Any) -> Any:
+        if group.template not in saved:
+            wrap(group.template)
+        return step_group(self, group, now)
+
+    Steppers.step_group = seen  # type: ignore[method-assign]
     try:
         yield
     finally:
-        for cls, method in saved.items():
-            cls.step_many = method  # type: ignore[attr-defined]
+        Steppers.step_group = step_group  # type: ignore[method-assign]
+        for klass, method in saved.items():
+            klass.step_many = method  # type: ignore[attr-defined]
 
 
 @contextmanager
@@ -144,18 +148,18 @@ def vector(n: int, steps: int) -> None:
 
     actions = np.random.default_rng(n).uniform(-1, 1, (steps + 3, n, 2))
     inner: collections.Counter = collections.Counter()
-    with timers() as (cpu, calls):
+    with timers() as (cpu, calls), own_steps(inner):
         env = FollowVecEnv(n, stepping="batch")
         env.reset(seed=0)
         for a in actions[:3]:  # the columns and groups start at the first steps
             env.step(a)
         cpu.clear()
         calls.clear()
-        with own_steps(inner):  # the templates are imported by now
-            t0 = time.process_time()
-            for a in actions[3:]:
-                env.step(a)
-            total = time.process_time() - t0
+        inner.clear()
+        t0 = time.process_time()
+        for a in actions[3:]:
+            env.step(a)
+        total = time.process_time() - t0
         env.close()
     physics = cpu[PHYSICS]
     ceiling = f"; the physics alone would allow {steps * n / physics:,.0f}" if physics else ""
@@ -215,7 +219,8 @@ def sweep(scenario: str, runs: int) -> None:
     from benchmarks.bench_engine import sweep_plan
 
     jobs = sweep_plan(scenario, runs).jobs()
-    with timers() as (cpu, calls), phases(cpu, calls):
+    inner: collections.Counter = collections.Counter()
+    with timers() as (cpu, calls), phases(cpu, calls), own_steps(inner):
         t0 = time.process_time()
         units, _ = plan_units(jobs, 2)
         rows = list(iter_batched(units, 1, iter_local))
@@ -225,7 +230,7 @@ def sweep(scenario: str, runs: int) -> None:
         f"batched sweep, {scenario}, {n} runs in {len(units)} batches: "
         f"{total / n * 1e3:.2f} ms CPU a run"
     )
-    table(total, n, "ms", cpu, {k: v / len(units) for k, v in calls.items()}, "a batch")
+    table(total, n, "ms", cpu, {k: v / len(units) for k, v in calls.items()}, "a batch", inner)
 
 
 def main() -> None:
