@@ -37,5 +37,7 @@ setup(
             libraries=["m"],
             optional=True,
         ),
+        # numpy's SeedSequence state for the runs' random streams (``engine/rng.py``)
+        Extension("amsa_phys.engine._seeds", ["amsa_phys/engine/_seeds.c"], optional=True),
     ]
 )
