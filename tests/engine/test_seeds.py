@@ -16,7 +16,11 @@ import pytest
 from amsa_phys.engine import rng
 
 BUILT = importlib.util.find_spec("amsa_phys.engine._seeds") is not None
-needs_c = pytest.mark.skipif(not BUILT, reason="the seeding extension was not built")
+#: built and not switched off (``AMSA_PHYS_PURE=1``)
+needs_c = pytest.mark.skipif(
+    not BUILT or not isinstance(rng.seed_sequence(0, ()), rng.FastSeed),
+    reason="the seeding extension was not built, or the pure path was asked for",
+)
 
 
 def _numpy(entropy: int, key: tuple[int, ...]) -> np.random.Generator:
