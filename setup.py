@@ -29,5 +29,15 @@ setup(
             libraries=["m"],
             optional=True,
         ),
+        Extension(
+            "amsa_phys.engine._groupbodies",
+            ["amsa_phys/engine/_groupbodies.c"],
+            # component groups' numpy arithmetic as one loop (``engine/batch_bodies.py``)
+            extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"],
+            libraries=["m"],
+            optional=True,
+        ),
+        # numpy's SeedSequence state for the runs' random streams (``engine/rng.py``)
+        Extension("amsa_phys.engine._seeds", ["amsa_phys/engine/_seeds.c"], optional=True),
     ]
 )

@@ -51,6 +51,11 @@ class EpisodeColumns(ColumnPhysics):
             self._fused = None
         return model
 
+    def touched_count(self) -> int:
+        """How many runs were found within reach so far: one C call, where :attr:`touched`
+        builds a set (the vector env asks after every step whether any run is new)."""
+        return int(np.count_nonzero(self._touched))
+
     def _contacts(self, dt: float) -> None:
         """Find the runs within reach before this step (the batch's rule), then put every
         touched run's rovers back where they were before it."""

@@ -234,6 +234,8 @@ class VecEpisode:
         few as single episodes, more as batches of per-run Spaces (:data:`CHUNK` at most),
         each replayed with the agent's past outputs to this instant."""
         assert self.columns is not None
+        if self.columns.touched_count() == len(self.solo):
+            return  # no run newly within reach (the touched only grow; solo are touched)
         new = sorted(self.columns.touched.difference(self.solo))
         if not new:
             return

@@ -21,12 +21,13 @@ import numpy as np
 from .follow import FollowEnv
 
 #: Fewer envs than this step as single envs; this many or more as one batch. Measured on
-#: 2 shared cores (random actions, CPU time, both paths in the same sitting, medians of 3):
-#: batch / single envs 0.78 at 6 envs, 0.91 at 7, 1.08 at 8, 1.14 at 9, 1.16 at 10
-#: (``FollowVecEnv(n, stepping=...)`` timed as ``benchmarks/bench_speed.py`` times it).
-#: A faster single env moves the crossing up, a cheaper batch step down:
-#: re-measure both paths before changing it.
-SINGLES_BELOW = 8
+#: 2 shared cores (random actions, CPU time, both paths in the same sitting, medians of 3,
+#: load ~10): batch / single envs 0.80 at 5 envs, 0.93 at 6, 1.06 at 7, 1.15 at 8
+#: (``FollowVecEnv(n, stepping=...)`` timed as ``benchmarks/bench_speed.py`` times it; the
+#: batch's compiled GPS and compass bodies moved it down from 8). A faster single env
+#: moves the crossing up, a cheaper batch step down: re-measure both paths before changing
+#: it.
+SINGLES_BELOW = 7
 
 
 class Singles:

@@ -135,9 +135,12 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         if self._singles is not None:
             self._episode = self._singles  # type: ignore[assignment]
             return self._singles.start(drawn)
-        self._episode = VecEpisode(
-            single._scenario, single.path, drawn, single.observed, single.acted
-        )
+        from ..runs.batched import fewer_collections  # the sweep's module, imported lazily
+
+        with fewer_collections():  # a batch's build makes thousands of objects an env
+            self._episode = VecEpisode(
+                single._scenario, single.path, drawn, single.observed, single.acted
+            )
         self._seen = np.zeros(self.num_envs, dtype=np.int64)
         self._autoreset = False
         info = self._info()
@@ -169,13 +172,20 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         scale = self.single.action_scale
         episode = self._episode
         episode.step(a * scale)
-        collisions = episode.collisions()
-        new = collisions - self._seen
-        self._seen = collisions
         q = self.single.quality
         signal = episode.signals(q.signal)  # read once: the reward's and the info's
         reward = -np.abs(signal - q.reference) / q.tolerance
-        reward = reward - self.single.collision_penalty * new + 0.0
+        penalty = self.single.collision_penalty
+        if episode.columns is not None and not episode.alone:
+            # on columns no run collides before it goes alone: no new collisions, and the
+            # penalty (finite, >= 0: ``args.py``) times 0 is +0.0, whose subtraction changes
+            # no bit (the + 0.0 makes a -0.0 reward +0.0 either way)
+            reward = reward + 0.0
+        else:
+            collisions = episode.collisions()
+            new = collisions - self._seen
+            self._seen = collisions
+            reward = reward - penalty * new + 0.0
         truncated = np.full(n, episode.done)
         self._autoreset = episode.done
         info = self._info(signal.copy())

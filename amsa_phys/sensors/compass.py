@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from fractions import Fraction
 from typing import Any, ClassVar
 
 import numpy as np
 
+from ..engine import batch_bodies
 from ..engine import noise as nz
 from ..engine.batch import all_positive, derived, gauss_markov
 from ..engine.rng import Drawn, DrawnMany
@@ -173,6 +174,8 @@ class Compass(Template):
             state["on_z"] = np.array([c.turn_on.z[0] for c in comps])
             state["on_sign"] = np.array([c.turn_on.sign[0] for c in comps])
             state["t_prev"] = None
+            #: the heading after the first step as one compiled call, where built
+            state["body"] = batch_bodies.compass_heading()
         w = state["noise"]()
         g = state["bias"]()
         u = state["loss"]()
@@ -182,6 +185,10 @@ class Compass(Template):
             state["b"] = np.where(tau > 0, sigma * np.sqrt(tau / 2), 0.0) * state["gm_start"]
         else:
             phi, q = gauss_markov(state, sigma, tau, now - state["t_prev"])
+            body = state["body"]
+            if body is not None:
+                state["t_prev"] = now
+                return _heading_compiled(body, comps, inp, p, state, (w, g, u), phi, q)
             state["b"] = phi * state["b"] + q * g
         state["t_prev"] = now
         lost = u * 100.0 < p.lostData
@@ -192,9 +199,7 @@ class Compass(Template):
         # what depends on the parameters alone, computed again only when they change
         # (``batch.derived``): the same arithmetic, so the same floats
         sign, z = state["on_sign"], state["on_z"]
-        value += derived(
-            state, "turn_on", (p.bias_mean, p.bias_stddev), lambda m, s: sign * (m + s * z)
-        )
+        value += derived(state, "turn_on", (p.bias_mean, p.bias_stddev), _turn_on_many(sign, z))
         value += deviation(h, p.deviationB, p.deviationC, p.deviationD, p.deviationE)
         value = (value + math.pi) % _TWO_PI - math.pi
         precision = p.precision
@@ -204,6 +209,41 @@ class Compass(Template):
         q = nz.quantise_many(value, precision)
         value = np.where(precision > 0, (q + math.pi) % _TWO_PI - math.pi, value)
         return {"compassHeading": value}, ~lost
+
+
+def _turn_on_many(sign: np.ndarray, z: np.ndarray) -> Callable[[Any, Any], np.ndarray]:
+    """The copies' turn-on biases for parameter arrays ``(bias_mean, bias_stddev)``
+    (``noise.TurnOn.value``'s arithmetic), for :func:`~amsa_phys.engine.batch.derived`."""
+    return lambda m, s: sign * (m + s * z)
+
+
+def _heading_compiled(
+    body: Any,
+    comps: Sequence[Any],
+    inp: Mapping[str, Any],
+    p: Any,
+    state: dict[str, Any],
+    draws: tuple[np.ndarray, np.ndarray, np.ndarray],
+    phi: np.ndarray,
+    q: np.ndarray,
+) -> tuple[Mapping[str, Any], np.ndarray]:
+    """``step_many`` after the first step in one compiled call (``engine/batch_bodies.py``):
+    the numpy path's operations in its order, so its floats; the dynamic bias updated in
+    place. The deviation stays numpy's (its sines may differ from libm's in the last bit)."""
+    sign, z = state["on_sign"], state["on_z"]
+    turn_on = derived(state, "turn_on", (p.bias_mean, p.bias_stddev), _turn_on_many(sign, z))
+    n = len(comps)
+    value, published = np.empty(n), np.empty(n, dtype=bool)
+    w, g, u = draws
+    h = inp["heading"]
+    dev = deviation(h, p.deviationB, p.deviationC, p.deviationD, p.deviationE)
+    if body(
+        h, w, g, u, phi, q, p.mean, turn_on, p.stddev, p.precision, p.lostData,
+        state["b"], value, published, dev,
+    ):  # fmt: skip
+        for k in np.flatnonzero(~published).tolist():
+            comps[k].lost += 1
+    return {"compassHeading": value}, published
 
 
 #: Compass with the sensor's own clock: an output ``stamp`` (``model/sensorclock.py``)

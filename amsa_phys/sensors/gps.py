@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from fractions import Fraction
 from math import floor
 from typing import Any, ClassVar
 
 import numpy as np
 
+from ..engine import batch_bodies
 from ..engine import noise as nz
 from ..engine.batch import all_positive, derived, gauss_markov
 from ..engine.rng import Drawn, DrawnMany
@@ -182,6 +183,8 @@ class GPS(Template):
             state["bad"] = np.zeros(len(comps), dtype=bool)
             state["history"] = deque()
             state["t_prev"] = None
+            #: the fix after the first step as one compiled call, where built
+            state["fix"] = batch_bodies.gps_fix()
         ex = state["noise"]()
         ey = state["noise"]()
         gx = state["bias"]()
@@ -197,18 +200,20 @@ class GPS(Template):
             state["bad"] = u_burst * 100.0 < p.burstLoss
         else:
             phi, q = gauss_markov(state, sigma, tau, now - state["t_prev"])
+            fix = state["fix"]
+            if fix is not None and not (
+                state["history"] or derived(state, "any_latency", (p.latency,), np.any)
+            ):
+                state["t_prev"] = now
+                draws = (ex, ey, gx, gy, u_loss, u_burst)
+                return _fix_compiled(fix, comps, inp, p, state, draws, phi, q)
             state["bx"] = phi * state["bx"] + q * gx
             state["by"] = phi * state["by"] + q * gy
         state["t_prev"] = now
         # what depends on the parameters alone, computed again only when they change
         # (``batch.derived``): the same arithmetic, so the same floats
         z, sign = state["on_z"], state["on_sign"]
-        on_x, on_y = derived(
-            state,
-            "turn_on",
-            (p.bias_mean, p.bias_stddev),
-            lambda m, s: (sign[0] * (m + s * z[0]), sign[1] * (m + s * z[1])),
-        )
+        on_x, on_y = derived(state, "turn_on", (p.bias_mean, p.bias_stddev), _turn_on_many(sign, z))
         x = inp["posX"] + p.mean + on_x + state["bx"] + p.stddev * ex
         y = inp["posY"] + p.mean + on_y + state["by"] + p.stddev * ey
         precision = p.precision
@@ -232,6 +237,44 @@ class GPS(Template):
         for k in np.flatnonzero(lost).tolist():
             comps[k].lost += 1
         return {"gpsPosX": x, "gpsPosY": y}, published
+
+
+def _turn_on_many(
+    sign: np.ndarray, z: np.ndarray
+) -> Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """The copies' turn-on biases (x, y) for parameter arrays ``(bias_mean, bias_stddev)``
+    (``noise.TurnOn.value``'s arithmetic), for :func:`~amsa_phys.engine.batch.derived`."""
+    return lambda m, s: (sign[0] * (m + s * z[0]), sign[1] * (m + s * z[1]))
+
+
+def _fix_compiled(
+    fix: Any,
+    comps: Sequence[Any],
+    inp: Mapping[str, Any],
+    p: Any,
+    state: dict[str, Any],
+    draws: tuple[np.ndarray, ...],
+    phi: np.ndarray,
+    q: np.ndarray,
+) -> tuple[Mapping[str, Any], np.ndarray]:
+    """``step_many`` after the first step without latency, in one compiled call
+    (``engine/batch_bodies.py``): the numpy path's operations in its order, so its floats;
+    the dynamic biases and the burst state updated in place."""
+    z, sign = state["on_z"], state["on_sign"]
+    on_x, on_y = derived(state, "turn_on", (p.bias_mean, p.bias_stddev), _turn_on_many(sign, z))
+    enter, leave = derived(state, "burst_chance", (p.burstLoss, p.burstLength), _burst_many)
+    n = len(comps)
+    x, y = np.empty(n), np.empty(n)
+    published, lost = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
+    ex, ey, gx, gy, u_loss, u_burst = draws
+    if fix(
+        inp["posX"], inp["posY"], ex, ey, gx, gy, u_loss, u_burst, phi, q, p.mean, on_x, on_y,
+        p.stddev, p.precision, enter, leave, p.lostDataGPS, state["bx"], state["by"],
+        state["bad"], x, y, published, lost,
+    ):  # fmt: skip
+        for k in np.flatnonzero(lost).tolist():
+            comps[k].lost += 1
+    return {"gpsPosX": x, "gpsPosY": y}, published
 
 
 def _burst_many(burst_loss: np.ndarray, length: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,211 @@
+/* Component groups' arithmetic in one call each (``engine/batch_bodies.py``).
+ *
+ * Why: a group of like components (a batch's runs, a platoon's cars) steps through its
+ * template's ``step_many``, numpy over the members. At the sizes a vector env runs (16 to 64
+ * envs) each numpy call costs ~0.5 us whatever the size, and a GPS fix is ~30 of them: the
+ * fixed cost of a vector step was the groups' numpy calls, not their work. Here the same
+ * elementwise operations run as one loop over the members.
+ *
+ * Each body does the numpy path's operations in the same order, each rounded once (built with
+ * -ffp-contract=off, ``setup.py``: no fused multiply-add), so the floats are the numpy path's
+ * bit for bit (``tests/engine/test_group_bodies.py`` compares them). Arrays come as buffers of
+ * float64 ("d") or bool ("?") items, one per member, with any stride (a random stream's column
+ * of its block is strided); outputs are written in place.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <math.h>
+
+/* One argument's buffer: its items' base and stride (bytes). */
+typedef struct {
+    char *buf;
+    Py_ssize_t stride;
+} Column;
+
+#define AT(c, k, type) (*(type *)((c).buf + (k) * (c).stride))
+
+/* Take ``count`` buffers of ``n`` items each from ``objs``: ``kinds[i]`` is 'd' (float64) or
+ * '?' (bool), uppercase when the body writes it. On failure every view taken is released and
+ * -1 returned with a ValueError naming the argument. */
+static int take(PyObject **objs, const char *kinds, const char *const *names, int count,
+                Py_buffer *views, Column *cols, Py_ssize_t *n)
+{
+    int held = 0;
+    for (; held < count; held++) {
+        const char kind = kinds[held];
+        const int write = kind == 'D' || kind == 'B';
+        const char want = (kind == 'd' || kind == 'D') ? 'd' : '?';
+        int flags = PyBUF_STRIDES | PyBUF_FORMAT | (write ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[held], &views[held], flags) < 0)
+            goto fail;
+        const char *f = views[held].format ? views[held].format : "B";
+        if (*f == '<' || *f == '=' || *f == '@')
+            f++;
+        const Py_ssize_t size = want == 'd' ? 8 : 1;
+        if (views[held].ndim != 1 || views[held].itemsize != size || f[0] != want || f[1] != 0 ||
+            (held > 0 && views[held].shape[0] != *n)) {
+            PyErr_Format(PyExc_ValueError, "%s: one %s per member expected", names[held],
+                         want == 'd' ? "float64" : "bool");
+            held++;
+            goto fail;
+        }
+        if (held == 0)
+            *n = views[0].shape[0];
+        cols[held].buf = views[held].buf;
+        cols[held].stride = views[held].strides[0];
+    }
+    return 0;
+fail:
+    for (int i = 0; i < held; i++)
+        PyBuffer_Release(&views[i]);
+    return -1;
+}
+
+static void release(Py_buffer *views, int count)
+{
+    for (int i = 0; i < count; i++)
+        PyBuffer_Release(&views[i]);
+}
+
+/* ---- gps_fix: a GPS group's fix after its first step (sensors/gps.py) --------------------
+ * GPS.step_many's numpy path, member k:
+ *   bx = phi q: phi*bx + q*gx; by likewise (the dynamic biases, updated in place)
+ *   x = posX + mean + on_x + bx + stddev*ex; y likewise (left to right)
+ *   where precision > 0: x = floor(x/precision + 0.5)*precision; y likewise (quantise_many)
+ *   bad = bad ? u_burst >= leave : u_burst < enter (the Gilbert-Elliott state, in place)
+ *   lost = bad | (u_loss*100.0 < lostData); published = !lost
+ * Returns the number of members lost (the caller counts them per component). */
+#define GPS_ARGS 25
+static PyObject *gps_fix(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    static const char *names[GPS_ARGS] = {
+        "posX", "posY", "ex", "ey", "gx", "gy", "u_loss", "u_burst", "phi",
+        "q", "mean", "on_x", "on_y", "stddev", "precision", "enter", "leave",
+        "lostData", "bx", "by", "bad", "x", "y", "published", "lost"};
+    static const char kinds[GPS_ARGS + 1] = "ddddddddddddddddddDDBDDBB";
+    PyObject *objs[GPS_ARGS];
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOOOOOOOOOOOOO", &objs[0], &objs[1], &objs[2],
+                          &objs[3], &objs[4], &objs[5], &objs[6], &objs[7], &objs[8], &objs[9],
+                          &objs[10], &objs[11], &objs[12], &objs[13], &objs[14], &objs[15],
+                          &objs[16], &objs[17], &objs[18], &objs[19], &objs[20], &objs[21],
+                          &objs[22], &objs[23], &objs[24]))
+        return NULL;
+    Py_buffer views[GPS_ARGS];
+    Column c[GPS_ARGS];
+    Py_ssize_t n = 0;
+    if (take(objs, kinds, names, GPS_ARGS, views, c, &n) < 0)
+        return NULL;
+    Py_ssize_t lost_count = 0;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        const double phi = AT(c[8], k, double), q = AT(c[9], k, double);
+        const double bx = phi * AT(c[18], k, double) + q * AT(c[4], k, double);
+        const double by = phi * AT(c[19], k, double) + q * AT(c[5], k, double);
+        AT(c[18], k, double) = bx;
+        AT(c[19], k, double) = by;
+        const double mean = AT(c[10], k, double), stddev = AT(c[13], k, double);
+        double x = AT(c[0], k, double) + mean + AT(c[11], k, double) + bx +
+                   stddev * AT(c[2], k, double);
+        double y = AT(c[1], k, double) + mean + AT(c[12], k, double) + by +
+                   stddev * AT(c[3], k, double);
+        const double precision = AT(c[14], k, double);
+        if (precision > 0) { /* quantise_many: only where the precision is above 0 */
+            x = floor(x / precision + 0.5) * precision;
+            y = floor(y / precision + 0.5) * precision;
+        }
+        AT(c[21], k, double) = x;
+        AT(c[22], k, double) = y;
+        const double u_burst = AT(c[7], k, double);
+        const char bad =
+            AT(c[20], k, char) ? (u_burst >= AT(c[16], k, double)) : (u_burst < AT(c[15], k, double));
+        AT(c[20], k, char) = bad;
+        const char lost = bad | (AT(c[6], k, double) * 100.0 < AT(c[17], k, double));
+        AT(c[23], k, char) = !lost;
+        AT(c[24], k, char) = lost;
+        lost_count += lost;
+    }
+    release(views, GPS_ARGS);
+    return PyLong_FromSsize_t(lost_count);
+}
+
+/* ---- compass_heading: a Compass group's heading after its first step (sensors/compass.py) --
+ * Compass.step_many's numpy path, member k:
+ *   b = phi*b + q*g (in place)
+ *   value = heading + mean + b + stddev*w; value += turn_on
+ *   value += deviation (numpy's sines and cosines, computed by the caller: numpy's may
+ *            differ from libm's in the last bit)
+ *   value = (value + pi) % 2pi - pi (the floor modulo, as numpy's remainder)
+ *   where precision > 0: value = (floor(value/precision + 0.5)*precision + pi) % 2pi - pi
+ *   lost = u*100.0 < lostData; published = !lost
+ * Returns the number of members lost. */
+#define COMPASS_ARGS 15
+static double floor_mod(double a, double b)
+{
+    double mod = fmod(a, b);
+    if (mod != 0.0) {
+        if ((b < 0) != (mod < 0))
+            mod += b;
+    } else {
+        mod = copysign(0.0, b);
+    }
+    return mod;
+}
+
+static PyObject *compass_heading(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    static const char *names[COMPASS_ARGS] = {
+        "heading", "w", "g", "u", "phi", "q", "mean", "turn_on", "stddev", "precision",
+        "lostData", "b", "value", "published", "deviation"};
+    static const char kinds[COMPASS_ARGS + 1] = "dddddddddddDDBd";
+    PyObject *objs[COMPASS_ARGS];
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3],
+                          &objs[4], &objs[5], &objs[6], &objs[7], &objs[8], &objs[9],
+                          &objs[10], &objs[11], &objs[12], &objs[13], &objs[14]))
+        return NULL;
+    Py_buffer views[COMPASS_ARGS];
+    Column c[COMPASS_ARGS];
+    Py_ssize_t n = 0;
+    if (take(objs, kinds, names, COMPASS_ARGS, views, c, &n) < 0)
+        return NULL;
+    const double pi = 3.141592653589793, two_pi = 2 * 3.141592653589793;
+    Py_ssize_t lost_count = 0;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        const double b = AT(c[4], k, double) * AT(c[11], k, double) +
+                         AT(c[5], k, double) * AT(c[2], k, double);
+        AT(c[11], k, double) = b;
+        double value = AT(c[0], k, double) + AT(c[6], k, double) + b +
+                       AT(c[8], k, double) * AT(c[1], k, double);
+        value += AT(c[7], k, double);
+        value += AT(c[14], k, double);
+        value = floor_mod(value + pi, two_pi) - pi;
+        const double precision = AT(c[9], k, double);
+        if (precision > 0) {
+            value = floor_mod(floor(value / precision + 0.5) * precision + pi, two_pi) - pi;
+        }
+        AT(c[12], k, double) = value;
+        const char lost = AT(c[3], k, double) * 100.0 < AT(c[10], k, double);
+        AT(c[13], k, char) = !lost;
+        lost_count += lost;
+    }
+    release(views, COMPASS_ARGS);
+    return PyLong_FromSsize_t(lost_count);
+}
+
+static PyMethodDef methods[] = {
+    {"gps_fix", gps_fix, METH_VARARGS,
+     "gps_fix(posX, posY, ex, ey, gx, gy, u_loss, u_burst, phi, q, mean, on_x, on_y, stddev, "
+     "precision, enter, leave, lostData, bx, by, bad, x, y, published, lost): a GPS "
+     "group's fix after its first step; returns how many members lost theirs."},
+    {"compass_heading", compass_heading, METH_VARARGS,
+     "compass_heading(heading, w, g, u, phi, q, mean, turn_on, stddev, precision, lostData, b, "
+     "value, published, deviation): a Compass group's heading after its "
+     "first step; returns how many members lost theirs."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_groupbodies",
+    "Component groups' arithmetic in one call each (engine/batch_bodies.py).", -1, methods,
+};
+
+PyMODINIT_FUNC PyInit__groupbodies(void) { return PyModule_Create(&module); }

@@ -1,0 +1,168 @@
+"""The compiled group bodies (``engine/batch_bodies.py``, ``_groupbodies.c``) against the
+numpy path of the same ``step_many``: a GPS and a compass group whose members differ in
+every parameter the bodies read, stepped side by side, give the same outputs, the same
+published rows, the same loss counts and the same state, to the bit."""
+
+from __future__ import annotations
+
+import importlib.util
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+import pytest
+
+from amsa_phys.engine import batch_bodies
+from amsa_phys.engine.batch import ParamArrays
+from amsa_phys.sensors.compass import Compass
+from amsa_phys.sensors.gps import GPS
+
+BUILT = importlib.util.find_spec("amsa_phys.engine._groupbodies") is not None
+#: built and not switched off (``AMSA_PHYS_PURE=1``)
+needs_c = pytest.mark.skipif(
+    not BUILT or batch_bodies.gps_fix() is None,
+    reason="the group bodies were not built, or the pure path was asked for",
+)
+
+
+class Ctx:
+    def __init__(self, seed: int) -> None:
+        self.rng = np.random.default_rng(seed)
+
+
+#: one member each: quantised or not, losses, bursts, dynamic and turn-on biases (and, for
+#: the compass, deviation terms or none)
+GPS_MEMBERS: list[dict[str, Any]] = [
+    {"stddev": 0.015, "dynamic_bias_stddev": 0.0055, "precision": 0.01, "lostDataGPS": 30},
+    {"stddev": 0.5, "burstLoss": 30.0, "burstLength": 4.0, "precision": 0.0},
+    # unrounded, so the order of the sums shows in the last bits
+    {"stddev": 0.1, "bias_mean": 0.2, "bias_stddev": 0.05, "precision": 0.0, "mean": -0.1},
+    {
+        "stddev": 0.2,
+        "dynamic_bias_stddev": 0.01,
+        "dynamic_bias_correlation_time": 3.0,
+        "burstLoss": 10.0,
+        "burstLength": 2.0,
+        "lostDataGPS": 5,
+        "precision": 0.001,
+    },
+]
+COMPASS_MEMBERS: list[dict[str, Any]] = [
+    {"stddev": 0.01, "lostData": 20.0, "precision": 0.0017, "deviationB": 0.02},
+    {  # unrounded, so the order of the sums shows in the last bits
+        "stddev": 0.01,
+        "mean": 0.05,
+        "dynamic_bias_stddev": 0.003,
+        "dynamic_bias_correlation_time": 2.0,
+        "precision": 0.0,
+    },
+    {"stddev": 0.0, "precision": 0.0, "mean": 0.3},
+    {
+        "stddev": 0.02,
+        "bias_mean": 0.01,
+        "bias_stddev": 0.005,
+        "deviationB": 0.02,
+        "deviationC": -0.013,
+        "deviationD": 0.005,
+        "deviationE": 0.0031,
+        "precision": 0.0,
+    },
+]
+#: the true readings at each step, per member: ordinary ones, then what a blown-up physics
+#: would give (a double that overflows, an infinity, a NaN)
+READINGS = [1.0, 2.5, -3.25, 1e9, 3.1, 0.5, 6.0, -7.5] * 3 + [1.7e308, float("inf"), np.nan]
+
+
+def _group(cls: type, members: list[dict[str, Any]], seed: int) -> list[Any]:
+    comps = []
+    for k, params in enumerate(members):
+        comp = cls(f"S{k}", params)
+        comp.initialize(Ctx(seed + k))
+        comps.append(comp)
+    return comps
+
+
+def _steps(cls: type, members: list[dict[str, Any]], compiled: bool) -> list[Any]:
+    """Every step's (outputs' bytes, published, losses, state) of a group of ``members``."""
+    comps = _group(cls, members, 40)
+    params, state = ParamArrays(comps), {}
+    ports = [p.name for p in cls.inputs]
+    n = len(comps)
+    seen = []
+    with pytest.MonkeyPatch.context() as mp:
+        if not compiled:  # the numpy path: no body found
+            mp.setattr(batch_bodies, "_body", lambda name: None)
+        for k, value in enumerate(READINGS):
+            with np.errstate(all="ignore"):
+                reading = np.full(n, value) + np.arange(n)  # each member its own reading
+                inp = {port: reading * (j + 1) for j, port in enumerate(ports)}
+                out, published = cls.step_many(comps, Fraction(k, 4), inp, params, state)
+            rows = {port: np.asarray(arr)[published] for port, arr in out.items()}
+            kept = {
+                key: np.asarray(state[key]).tobytes()
+                for key in ("b", "bx", "by", "bad")
+                if key in state
+            }
+            seen.append(
+                (
+                    {port: arr.tobytes() for port, arr in rows.items()},
+                    published.tobytes(),
+                    [c.lost for c in comps],
+                    kept,
+                )
+            )
+    return seen
+
+
+@needs_c
+@pytest.mark.parametrize(
+    ("cls", "members"), [(GPS, GPS_MEMBERS), (Compass, COMPASS_MEMBERS)], ids=["gps", "compass"]
+)
+def test_the_compiled_body_steps_as_the_numpy_path(
+    cls: type, members: list[dict[str, Any]]
+) -> None:
+    compiled = _steps(cls, members, True)
+    numpy_path = _steps(cls, members, False)
+    for k, (got, want) in enumerate(zip(compiled, numpy_path, strict=True)):
+        assert got == want, f"step {k} (reading {READINGS[k]})"
+    # the members lose fixes and publish others: both branches were taken
+    losses = [c for _, _, c, _ in compiled]
+    assert any(losses[-1])
+    assert not all(losses[-1])
+
+
+@needs_c
+def test_the_body_is_what_a_group_after_its_first_step_runs() -> None:
+    """The compiled call is used (not the numpy path that the comparison above would also
+    pass), and only from the second step: the first sets the biases up in numpy."""
+    calls = []
+    real = batch_bodies.gps_fix()
+    comps = _group(GPS, GPS_MEMBERS, 1)
+    state: dict[str, Any] = {}
+    with pytest.MonkeyPatch.context() as mp:
+
+        def counted(*args: Any) -> Any:
+            calls.append(len(args))
+            return real(*args)
+
+        mp.setattr(batch_bodies, "gps_fix", lambda: counted)
+        inp = {"posX": np.zeros(4), "posY": np.ones(4)}
+        for k in range(3):
+            GPS.step_many(comps, Fraction(k), inp, ParamArrays(comps), state)
+    assert len(calls) == 2
+
+
+@needs_c
+def test_a_delayed_fix_takes_the_numpy_path() -> None:
+    """Latency keeps a history of fixes the body does not hold: the numpy path steps it."""
+    members = [{**m, "latency": 0.5} for m in GPS_MEMBERS]
+    assert _steps(GPS, members, True) == _steps(GPS, members, False)
+
+
+@needs_c
+def test_a_body_refuses_arrays_of_the_wrong_length() -> None:
+    fix = batch_bodies.gps_fix()
+    args = [np.zeros(3)] * 20 + [np.zeros(3, bool)] + [np.zeros(3)] * 2 + [np.zeros(3, bool)] * 2
+    args[5] = np.zeros(2)
+    with pytest.raises(ValueError, match="gy: one float64 per member"):
+        fix(*args)
