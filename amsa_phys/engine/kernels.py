@@ -18,6 +18,7 @@ run is the same bit for bit and fault for fault either way (``tests/engine/test_
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
@@ -83,10 +84,15 @@ def driver() -> tuple[type, Any, Any] | None:
     (and its ``_saturate``), or None if any was replaced (a test, a plugin), so the body
     calls ``rover.set_power`` in Python. Why: that call, two frames and two item writes,
     was a fifth of a robot's step, three and a half times an env-step. The body also checks
-    at every step that the rover is of this class and the methods are still these."""
-    from ..physics import rover
+    at every step that the rover is of this class and the methods are still these.
 
-    cls = rover.DiffDriveRover
+    The module is looked up by name, as the bodies' classes are (:data:`BODIES`): the engine
+    never imports the physics (``tests/structure/test_layers.py``); a robot's module has
+    loaded it before any robot is stepped."""
+    rover = sys.modules.get("amsa_phys.physics.rover")
+    cls = getattr(rover, "DiffDriveRover", None)
+    if cls is None:
+        return None
     set_power, update = cls.__dict__.get("set_power"), cls.__dict__.get("update_drive")
     mod = "amsa_phys.physics.rover"
     if (
