@@ -13,8 +13,10 @@ scenario gives each run's fastest path speed (C less the robustness) for an esti
 with a ``pathSpeed`` and a ``valid`` output. The *fastest* is the largest seed mean of it
 at any cell's chosen point; the rule sets the point ``steps`` grid steps below the robust
 point (a lower gain) when ``M`` is unsure and its path speed is above ``factor`` times the
-fastest, for ``hold`` seconds; and ``M``'s fallback to the robust point waits until the path
-speed is back below the fastest, so it does not restart the swing. Nothing here reads a
+fastest, for ``hold`` seconds, and only while ``M``'s held estimate lies where some cell rule
+sets another point than the robust one (a swing starts only there); and ``M``'s fallback to
+the robust point waits until the path speed is below ``RELEASE`` times the fastest, so it
+does not restart the swing. Nothing here reads a
 held-out sequence.
 """
 
@@ -32,6 +34,9 @@ from .table import SweepTable, read_table
 #: The damping rule fires above this multiple of the fastest path speed under a chosen point
 #: (on the shipped box: 0.28 m/s at the nominal cell's robust gain, swings 0.56-1.7 m/s).
 FACTOR = 1.5
+#: The motor fallback to the robust point waits for the path speed to fall below this
+#: multiple of the fastest: the robust gain, set on a swing still under way, carries it on.
+RELEASE = 1.25
 #: Grid steps below the robust point the damping rule sets (the shipped box: Kv 0.1).
 STEPS = 2
 #: Seconds the swing must show before the damping rule fires.
@@ -49,6 +54,7 @@ class Damping:
     leaf: str
     fastest: float
     speed: float
+    release: float
     point: dict[str, Any]
     rule: dict[str, Any]
 
@@ -112,7 +118,8 @@ def damping(
         "hold": int(hold) if float(hold).is_integer() else hold,
         "label": f"damp, {leaf} swinging",
     }
-    return Damping(leaf, round(fastest, 3), speed, point, rule)
+    release = round(RELEASE * fastest, 3)
+    return Damping(leaf, round(fastest, 3), speed, release, point, rule)
 
 
 def _below(table: SweepTable, point: tuple[Any, ...], steps: int) -> tuple[Any, ...]:

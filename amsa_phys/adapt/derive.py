@@ -274,13 +274,39 @@ def derive(
     if derivation.damping is not None:
         # the estimator's fallback waits for the swing to end: the robust gain restarts it
         valid = f"{derivation.damping.leaf}.valid"
-        below = {f"{derivation.damping.leaf}.pathSpeed": {"below": derivation.damping.fastest}}
+        below = {f"{derivation.damping.leaf}.pathSpeed": {"below": derivation.damping.release}}
         fallbacks = [
             {**r, "when": {**r["when"], **below}} if valid in r["when"] else r for r in fallbacks
         ]
+        derivation.damping.rule["when"].update(
+            _switched_band(cell_rules, derivation.robust, derivation.damping.leaf, found)
+        )
         fallbacks.insert(0, derivation.damping.rule)
     derivation.rules = fallbacks + cell_rules
     return derivation
+
+
+def _switched_band(
+    rules: list[dict[str, Any]], robust: dict[str, Any], leaf: str, found: list[Watch]
+) -> dict[str, dict[str, float]]:
+    """The band of ``leaf``'s estimates in which some cell rule sets a point other than the
+    robust one: a swing starts only where such a point was set, so the damping rule reads
+    the held estimate there and nowhere else (a robust gain's own swing on healthy motors
+    is not damped by a lower one: it only falls behind)."""
+    out: dict[str, dict[str, float]] = {}
+    away = [r for r in rules if r["set"] != robust]
+    for signal in (w.signal for w in found if w.signal.rpartition(".")[0] == leaf):
+        bands = [r["when"].get(signal) for r in away]
+        if not bands or any(b is None for b in bands):
+            continue
+        band: dict[str, float] = {}
+        if all("below" in b for b in bands):
+            band["below"] = max(b["below"] for b in bands)
+        if all("above" in b for b in bands):
+            band["above"] = min(b["above"] for b in bands)
+        if band:
+            out[signal] = band
+    return out
 
 
 def _why(unplaced: Sequence[str], name: str) -> str:

@@ -372,7 +372,7 @@ def table(found: Derivation) -> list[str]:
         lines.append(
             f"damping: {point} while {d.leaf} is unsure and its pathSpeed is above {d.speed:g} "
             f"(the fastest under a chosen point: {d.fastest:g}); its fallback waits for "
-            f"pathSpeed below {d.fastest:g}"
+            f"pathSpeed below {d.release:g}"
         )
     return lines
 
