@@ -16,8 +16,7 @@ point (a lower gain) when ``M`` is unsure and its path speed is above ``factor``
 fastest, for ``hold`` seconds, and only while ``M``'s held estimate lies where some cell rule
 sets another point than the robust one (a swing starts only there); and ``M``'s fallback to
 the robust point waits until the path speed is below ``RELEASE`` times the fastest, so it
-does not restart the swing. Nothing here reads a
-held-out sequence.
+does not restart the swing. Nothing here reads a held-out sequence.
 """
 
 from __future__ import annotations
