@@ -48,6 +48,7 @@ from typing import Any
 from ..control.estimators.watches import Watch, watches
 from ..errors import ConfigError
 from ..model.scenario import Scenario
+from .damping import FACTOR, STEPS, Damping, damping
 from .grid import lowest, robust_point, safe_best
 from .table import read_table
 
@@ -83,6 +84,9 @@ FALLBACK_HOLD: float | None = None
 #: after the hold alone undid every switch to very worn motors' gain within ~22 s
 #: (``adapt --validate`` on the shipped box: 8 % gained there instead of 22-30 %).
 FALLBACK_DWELL: float | None = None
+#: A damping rule fires above this multiple of the fastest path speed the sweep saw under a
+#: chosen point (0: no damping rule); see ``damping.py``.
+DAMP = FACTOR
 
 
 @dataclass
@@ -115,6 +119,8 @@ class Derivation:
     robust_mean: float = float("nan")
     oracle_mean: float = float("nan")
     refused: str | None = None
+    #: the damping rule, when the sweep measured the path speed (``damping.py``)
+    damping: Damping | None = None
 
     @property
     def gain(self) -> float:
@@ -137,6 +143,8 @@ def derive(
     fallback_dwell: float | None = FALLBACK_DWELL,
     near: float = NEAR,
     cell_gain: float = CELL_GAIN,
+    damp: float = DAMP,
+    damp_steps: int = STEPS,
 ) -> Derivation:
     """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
     is the fixed choice to fall back on (default: the sweep's least worst-case point)."""
@@ -254,10 +262,51 @@ def derive(
             )
         )
     wait = hold if fallback_hold is None else fallback_hold
-    derivation.rules = _fallbacks(scenario, found, placed, derivation.robust, wait, fallback_dwell)
-    sure = {signal: {"above": 0.5} for r in derivation.rules for signal in r["when"]}
-    derivation.rules += [{**r, "when": {**r["when"], **sure}} for r in _rules(placed, hold)]
+    fallbacks = _fallbacks(scenario, found, placed, derivation.robust, wait, fallback_dwell)
+    sure = {signal: {"above": 0.5} for r in fallbacks for signal in r["when"]}
+    cell_rules = [{**r, "when": {**r["when"], **sure}} for r in _rules(placed, hold)]
+    if damp > 0:
+        chosen = {key: tuple(c.best[k] for k in table.tuned) for key, c in cells.items() if c.best}
+        used = {s for c in placed for s in c.levels}
+        derivation.damping = damping(
+            results, scenario, table, chosen, robust, used, damp, damp_steps
+        )
+    if derivation.damping is not None:
+        # the estimator's fallback waits for the swing to end: the robust gain restarts it
+        valid = f"{derivation.damping.leaf}.valid"
+        below = {f"{derivation.damping.leaf}.pathSpeed": {"below": derivation.damping.release}}
+        fallbacks = [
+            {**r, "when": {**r["when"], **below}} if valid in r["when"] else r for r in fallbacks
+        ]
+        derivation.damping.rule["when"].update(
+            _switched_band(cell_rules, derivation.robust, derivation.damping.leaf, found)
+        )
+        fallbacks.insert(0, derivation.damping.rule)
+    derivation.rules = fallbacks + cell_rules
     return derivation
+
+
+def _switched_band(
+    rules: list[dict[str, Any]], robust: dict[str, Any], leaf: str, found: list[Watch]
+) -> dict[str, dict[str, float]]:
+    """The band of ``leaf``'s estimates in which some cell rule sets a point other than the
+    robust one: a swing starts only where such a point was set, so the damping rule reads
+    the held estimate there and nowhere else (a robust gain's own swing on healthy motors
+    is not damped by a lower one: it only falls behind)."""
+    out: dict[str, dict[str, float]] = {}
+    away = [r for r in rules if r["set"] != robust]
+    for signal in (w.signal for w in found if w.signal.rpartition(".")[0] == leaf):
+        bands = [r["when"].get(signal) for r in away]
+        if not bands or any(b is None for b in bands):
+            continue
+        band: dict[str, float] = {}
+        if all("below" in b for b in bands):
+            band["below"] = max(b["below"] for b in bands)
+        if all("above" in b for b in bands):
+            band["above"] = min(b["above"] for b in bands)
+        if band:
+            out[signal] = band
+    return out
 
 
 def _why(unplaced: Sequence[str], name: str) -> str:

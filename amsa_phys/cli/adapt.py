@@ -11,7 +11,8 @@ from pathlib import Path
 
 import yaml
 
-from ..adapt.derive import CELL_GAIN, MARGIN, MIN_GAIN, NEAR, Derivation, derive
+from ..adapt.damping import STEPS
+from ..adapt.derive import CELL_GAIN, DAMP, MARGIN, MIN_GAIN, NEAR, Derivation, derive
 from ..adapt.sweepdir import read_sweep_scenario
 from ..atomic import write_atomic
 from ..errors import ConfigError, one_line
@@ -99,6 +100,22 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="the fixed choice to fall back on and compare with (`amsa-phys tune`'s answer, "
         "on the sweep's grid; default: the sweep's least worst-case point)",
     )
+    p.add_argument(
+        "--damp",
+        type=float,
+        default=DAMP,
+        metavar="F",
+        help="when the sweep measured the follower's path speed (a requirement "
+        "always(M.pathSpeed <= C)), set a lower gain while it is above F times the fastest "
+        f"seen under a chosen point and M is unsure (default {DAMP:g}; 0: no damping rule)",
+    )
+    p.add_argument(
+        "--damp-steps",
+        type=int,
+        default=STEPS,
+        metavar="N",
+        help=f"the damping rule's point: N grid steps below the robust one (default {STEPS})",
+    )
     p.add_argument("--force", action="store_true", help="replace an existing rules file")
     p.add_argument(
         "--validate",
@@ -162,6 +179,10 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"must be in [0, 1), got {args.near}", key="--near")
     if not (0 <= args.cell_gain < 1):
         raise ConfigError(f"must be in [0, 1), got {args.cell_gain}", key="--cell-gain")
+    if not (0 <= args.damp < 100):
+        raise ConfigError(f"must be in [0, 100), got {args.damp}", key="--damp")
+    if not 1 <= args.damp_steps <= 1000:
+        raise ConfigError(f"must be 1..1000, got {args.damp_steps}", key="--damp-steps")
     if not (0 <= args.min_gain < 1):
         raise ConfigError(f"must be in [0, 1), got {args.min_gain}", key="--min-gain")
     if args.validate:
@@ -187,6 +208,8 @@ def run(args: argparse.Namespace) -> int:
         args.fallback_dwell,
         args.near,
         args.cell_gain,
+        args.damp,
+        args.damp_steps,
     )
     for line in table(found):
         print(one_line(line))
@@ -342,6 +365,14 @@ def table(found: Derivation) -> list[str]:
             f"robust fixed choice (least worst-case mean): {robust}, "
             f"mean {_shown(found, found.robust_mean):.4g}; switching per context (oracle): "
             f"{_shown(found, found.oracle_mean):.4g} ({100 * found.gain:.1f} % better)"
+        )
+    d = found.damping
+    if d is not None:
+        point = ", ".join(f"{k}={v}" for k, v in d.point.items())
+        lines.append(
+            f"damping: {point} while {d.leaf} is unsure and its pathSpeed is above {d.speed:g} "
+            f"(the fastest under a chosen point: {d.fastest:g}); its fallback waits for "
+            f"pathSpeed below {d.release:g}"
         )
     return lines
 

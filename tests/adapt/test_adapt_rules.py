@@ -315,7 +315,7 @@ def test_run_prints_the_rules_that_fired(tmp_path: Path, capsys) -> None:
     out = capsys.readouterr().out
     line = next(x for x in out.splitlines() if x.startswith("adapt:"))
     # the motor estimator is unsure until its window is full: the robust gain meanwhile
-    assert line == "adapt: 1 switch: at 10 s rule 1 (robust, MotorMonitor unsure): Kv=0.2"
+    assert line == "adapt: 1 switch: at 10 s rule 2 (robust, MotorMonitor unsure): Kv=0.2"
     assert main([*argv, "--no-adapt", "--out", str(tmp_path / "off")]) == 0
     assert "adapt:" not in capsys.readouterr().out
 

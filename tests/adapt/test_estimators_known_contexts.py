@@ -92,11 +92,13 @@ def _motor(share: float, reverse: int = 0) -> dict:
 
 def test_a_share_a_little_above_one_is_noise_published_as_one() -> None:
     out = _motor(1.08)
-    assert out == {"delivered": 1.0, "valid": 1.0}
+    speed = (1.08 * 20.0 - 2.9) / 100.0 * 5.5  # the path speed is the fixes' own
+    assert out == {"delivered": 1.0, "valid": 1.0, "pathSpeed": pytest.approx(speed)}
 
 
 def test_a_share_far_above_one_or_a_reversing_command_is_invalid() -> None:
-    assert _motor(1.5) == {"delivered": 1.0, "valid": 0.0}  # held at its start value
+    out = _motor(1.5)
+    assert (out["delivered"], out["valid"]) == (1.0, 0.0)  # held at its start value
     # two thirds of the command cancel out: worn motors (0.3) would read as healthy (0.9)
     assert _motor(0.3, reverse=3)["valid"] == 0.0
     assert _motor(0.6)["delivered"] == pytest.approx(0.6, abs=0.02)

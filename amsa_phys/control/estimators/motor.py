@@ -81,7 +81,7 @@ class MotorMonitor(Template):
     kind = Kind.OBSERVER
     uses_random = False
     #: the windows are sized once, at initialize
-    fixed_once_running = frozenset({"window"})
+    fixed_once_running = frozenset({"window", "speedWindow"})
     inputs = (
         Port("powerL", 0.0, "commanded left power", "%"),
         Port("powerR", 0.0, "commanded right power", "%"),
@@ -91,6 +91,7 @@ class MotorMonitor(Template):
     outputs = (
         Port("delivered", 1.0, "share of commanded power delivered (0..1)", ""),
         Port("valid", 0.0, "1 when the window's estimate can be trusted, else 0", ""),
+        Port("pathSpeed", 0.0, "mean path speed over speedWindow (0 until full)", "m/s"),
     )
     params = (
         Param("window", "float", "length of the estimate's window", 30.0, 1.0, 3600.0, "s"),
@@ -223,6 +224,15 @@ class MotorMonitor(Template):
             "",
         ),
         Param(
+            "speedWindow",
+            "float",
+            "window of pathSpeed (0: the estimate's window)",
+            0.0,
+            0.0,
+            3600.0,
+            "s",
+        ),
+        Param(
             "holdReverse",
             "float",
             "cancelling-out share of the window's command that ends validHold at once (1: never)",
@@ -238,6 +248,8 @@ class MotorMonitor(Template):
         """Healthy motors until shown otherwise."""
         self.power: Window[float] = Window(self.p.window)
         self.path: Window[float] = Window(self.p.window)
+        self.speed_path: Window[float] = Window(self.p.speedWindow or self.p.window)
+        self.path_speed = 0.0
         self.fix: tuple[float, float, float] | None = None
         #: each path segment as (duration, length, command sum, command count, counts), where
         #: it counts when its every command was forward and had been for ``settle`` s
@@ -259,6 +271,8 @@ class MotorMonitor(Template):
         elif now - self.fix[0] >= p.spacing - 1e-9:
             step = math.hypot(x - self.fix[1], y - self.fix[2])
             self.path.add(now, step)
+            self.speed_path.add(now, step)
+            self.path_speed = self._path_speed()
             # the segment's commands are those from its first fix up to (not with) this one
             counts = (
                 self.seg_count > 0
@@ -285,7 +299,23 @@ class MotorMonitor(Template):
                 self._forward_estimate(now)
         elif self.power.covered_s() >= p.window - 1e-9 and self.path.covered_s() > 0:
             self._window_estimate(now)
-        return {"delivered": self.estimate, "valid": self.valid}
+        return {"delivered": self.estimate, "valid": self.valid, "pathSpeed": self.path_speed}
+
+    def _path_speed(self) -> float:
+        """Path length over the speed window's span, once it is full (else 0).
+
+        The path counts backward travel as forward, so a follower swinging about its
+        reference shows a high path speed whatever its mean progress: what tells a loop
+        swinging on strong motors (0.46-0.88 m/s in docs/adaptation.md's runs) from a high
+        gain reversing now and then on weak ones (0.18-0.31 m/s), which the share's
+        confidence cannot (both make the window's command cancel out).
+        """
+        window = self.speed_path
+        if window.covered_s() < window.span_s - 1e-9:
+            return 0.0
+        steps = window.items
+        # the first segment ends at the window's start: it lies before the span
+        return (sum(d for _, d in steps) - steps[0][1]) / (steps[-1][0] - steps[0][0])
 
     def _window_estimate(self, now: float) -> None:
         """The share over the whole window (the default; see the class docstring)."""
