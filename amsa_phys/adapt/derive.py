@@ -37,7 +37,6 @@ best values settle to the same levels.
 
 from __future__ import annotations
 
-import itertools
 import math
 import statistics
 from collections.abc import Sequence
@@ -48,6 +47,8 @@ from typing import Any
 from ..control.estimators.watches import Watch, watches
 from ..errors import ConfigError
 from ..model.scenario import Scenario
+from .cellrules import cell_rules as rules_of_cells
+from .cellrules import whole
 from .damping import FACTOR, STEPS, Damping, damping
 from .grid import lowest, robust_point, safe_best
 from .table import read_table
@@ -56,8 +57,6 @@ from .table import read_table
 MARGIN = 0.5
 #: Default least gain of the oracle schedule over the robust point worth adapting for.
 MIN_GAIN = 0.05
-#: Share of the distance between two levels left to no rule on each side of the midpoint.
-GAP = 0.1
 #: A safe point at most this much worse than a cell's lowest safe mean counts as level with
 #: it, and the one nearest the robust point among those is the cell's best. A held-out level
 #: between two cells sits between their best gains, and the estimate that places it is never
@@ -264,7 +263,7 @@ def derive(
     wait = hold if fallback_hold is None else fallback_hold
     fallbacks = _fallbacks(scenario, found, placed, derivation.robust, wait, fallback_dwell)
     sure = {signal: {"above": 0.5} for r in fallbacks for signal in r["when"]}
-    cell_rules = [{**r, "when": {**r["when"], **sure}} for r in _rules(placed, hold)]
+    cell_rules = [{**r, "when": {**r["when"], **sure}} for r in rules_of_cells(placed, hold)]
     if damp > 0:
         chosen = {key: tuple(c.best[k] for k in table.tuned) for key, c in cells.items() if c.best}
         used = {s for c in placed for s in c.levels}
@@ -338,11 +337,11 @@ def _fallbacks(
         rule: dict[str, Any] = {
             "when": {valid: {"below": 0.5}},
             "set": dict(robust),
-            "hold": _whole(hold),
+            "hold": whole(hold),
         }
         wait = dwell if dwell is not None else _window(scenario, leaf)
         if wait is not None and wait > hold:
-            rule["dwell"] = _whole(wait)
+            rule["dwell"] = whole(wait)
         rule["label"] = f"robust, {leaf} unsure"
         out.append(rule)
     return out
@@ -355,10 +354,6 @@ def _window(scenario: Scenario, leaf: str) -> float | None:
         if change.key == f"{leaf}.window":
             value = change.value
     return float(value) if isinstance(value, int | float) and not isinstance(value, bool) else None
-
-
-def _whole(hold: float) -> float | int:
-    return int(hold) if float(hold).is_integer() else hold
 
 
 def _names(unplaced: Sequence[str]) -> set[str]:
@@ -422,88 +417,3 @@ def _place(cells: list[Cell], found: list[Watch], watched: set[str]) -> list[str
                     f"[{names}]{why}"
                 )
     return problems
-
-
-def _band(ls: list[float], i: int) -> dict[str, float]:
-    """The band of level ``ls[i]``: from the midpoints to its neighbours, less the gap."""
-    bound: dict[str, float] = {}
-    if i > 0:
-        mid, step = (ls[i - 1] + ls[i]) / 2, ls[i] - ls[i - 1]
-        bound["above"] = round(mid + GAP * step, 6)
-    if i < len(ls) - 1:
-        mid, step = (ls[i] + ls[i + 1]) / 2, ls[i + 1] - ls[i]
-        bound["below"] = round(mid - GAP * step, 6)
-    return bound
-
-
-def _rules(cells: list[Cell], hold: float) -> list[dict[str, Any]]:
-    """One rule per placed cell (cells at the same levels with the same best share one),
-    then one per combination of bands no cell has (:func:`_nearest_rules`)."""
-    signals = sorted({s for c in cells for s in c.levels})
-    levels = {s: sorted({c.levels[s] for c in cells if s in c.levels}) for s in signals}
-    rules: list[dict[str, Any]] = []
-    seen: dict[tuple[Any, ...], dict[str, Any]] = {}
-    for cell in cells:
-        when: dict[str, dict[str, float]] = {}
-        for s in signals:
-            ls = levels[s]
-            if len(ls) < 2 or s not in cell.levels:
-                continue
-            when[s] = _band(ls, ls.index(cell.levels[s]))
-        if not when:
-            continue
-        key = (
-            tuple(sorted((k, tuple(sorted(v.items()))) for k, v in when.items())),
-            tuple(sorted(cell.best.items())),
-        )
-        if key in seen:
-            seen[key]["label"] += f", {cell.name}"
-            continue
-        rule = {"when": when, "set": dict(cell.best), "hold": _whole(hold), "label": cell.name}
-        seen[key] = rule
-        rules.append(rule)
-    return rules + _nearest_rules(cells, levels, hold)
-
-
-def _nearest_rules(
-    cells: list[Cell], levels: dict[str, list[float]], hold: float
-) -> list[dict[str, Any]]:
-    """A rule for each combination of bands that no cell settles to: the nearest cell's best.
-
-    A sweep need not cover every combination of its estimators' levels (a random leader
-    with very worn motors, when it swept each alone). With no rule there, the gain in force
-    stays -- whatever the last context set -- or the robust one; the oracle schedule
-    ``adapt --validate`` compares with sets the nearest cell's best instead. So does this
-    rule: nearest in the estimators' levels, each output's distance a share of its span.
-    When two cells are equally near with different best values, no rule is written.
-    """
-    varying = [s for s, ls in levels.items() if len(ls) >= 2]
-    full = [c for c in cells if c.best and all(s in c.levels for s in varying)]
-    if not varying or not full:
-        return []
-    taken = {tuple(levels[s].index(c.levels[s]) for s in varying) for c in full}
-    span = {s: levels[s][-1] - levels[s][0] for s in varying}
-    out: list[dict[str, Any]] = []
-    for combo in itertools.product(*(range(len(levels[s])) for s in varying)):
-        if combo in taken:
-            continue
-
-        def distance(c: Cell, combo: tuple[int, ...] = combo) -> float:
-            return sum(
-                abs(c.levels[s] - levels[s][i]) / span[s]
-                for s, i in zip(varying, combo, strict=True)
-            )
-
-        least = min(distance(c) for c in full)
-        near = [c for c in full if math.isclose(distance(c), least)]
-        if len({tuple(sorted(c.best.items())) for c in near}) > 1:
-            continue  # equally near cells disagree: leave it to the gain in force
-        out.append(
-            {
-                "when": {s: _band(levels[s], i) for s, i in zip(varying, combo, strict=True)},
-                "set": dict(near[0].best),
-                "hold": _whole(hold),
-                "label": f"nearest {near[0].name} (no cell here)",
-            }
-        )
-    return out

@@ -122,6 +122,9 @@ def render() -> str:
 def main(argv: list[str] | None = None) -> int:
     """Write the page to the file named (or print it)."""
     args = sys.argv[1:] if argv is None else argv
+    if len(args) > 1 or (args and args[0].startswith("-")):
+        sys.stderr.write("usage: python -m amsa_phys.cli.reference [PAGE.md]\n")
+        return 0 if args[0] in ("-h", "--help") else 2
     text = render()
     if args:
         write_atomic(Path(args[0]), text.encode())
