@@ -3,13 +3,14 @@
 In lockstep the simulator outruns real time; ``rosbag record`` (a queue of 100 messages per
 topic) dropped messages from the middle of a run whenever it fell behind on a loaded machine.
 Here the recorder is starved on purpose: stopped (SIGSTOP) as the run starts and let go
-(SIGCONT) only once the run is over and its outputs are written, so every message of the run
-waits for it at once and the simulator must wait for it before the launch ends. The bag must
-still hold, on every Data topic, every value the trace shows, in order. Mutation-checked:
-``rosbag record`` as the launch's recorder again loses messages here; the package's recorder
-with a subscriber queue (``queue_size=100``) does too. The package is the session's build of
-``ros_short.yaml`` (``ros_short_workspace`` in conftest.py). Skipped, with the reason, where
-ROS, catkin, unshare or root is missing.
+(SIGCONT) only once the run is over and the simulator says it waits for the recorder, so every
+message of the run reaches it at once, and the launch must not end before it has written them.
+The bag must still hold, on every Data topic, every value the trace shows, in order.
+Mutation-checked: ``rosbag record`` as the launch's recorder again loses messages here; the
+package's recorder with a subscriber queue (``queue_size=100``) does too; a simulator that
+does not wait for the recorder at the end never says so, and the launch ends without a bag.
+The package is the session's build of ``ros_short.yaml`` (``ros_short_workspace`` in
+conftest.py). Skipped, with the reason, where ROS, catkin, unshare or root is missing.
 """
 
 from __future__ import annotations
@@ -20,7 +21,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 from collections.abc import Callable
 from fractions import Fraction
 from pathlib import Path
@@ -103,13 +103,11 @@ def test_a_starved_recorder_loses_no_message(
     recorder = _process(launch.token, "amsa_bag")
     os.kill(recorder, signal.SIGSTOP)
     try:
-        # the run is over once its metrics are written (the simulator then waits for the bag)
-        deadline = time.monotonic() + ros_launch.LAUNCH_TIMEOUT
-        while not (out / "metrics.json").exists() and launch.proc.poll() is None:
-            assert time.monotonic() < deadline, "the run did not end"
-            time.sleep(0.05)  # polling for the file: the event waited for
+        # the run is over, its outputs written, and the simulator waits for the recorder
+        waiting = launch.read_until("waiting for the bag recorder")
     finally:
         os.kill(recorder, signal.SIGCONT)
+    assert waiting, "".join(launch.lines)[-3000:]
     text = launch.finish()
     assert "amsa_simulator: done: 1 expectation passed" in text, text[-3000:]
     assert (out / "trace.csv").read_bytes() == (reference / "trace.csv").read_bytes()

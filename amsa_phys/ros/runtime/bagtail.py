@@ -103,6 +103,14 @@ class BagTail:
         if self.given_up:
             return False
         want = self.counts()
+        with self.cond:
+            behind = bool(self.short(want))
+        if behind:  # as good as always: the recorder has not said so since the last instant
+            print(
+                f"{names.SIMULATOR}: waiting for the bag recorder ({NODE}) to write the run's "
+                f"last messages (at most {self.timeout:g} s, timeout:=)",
+                flush=True,
+            )
         missing = self.wait(want)
         if missing:
             self.give_up(missing, want)
