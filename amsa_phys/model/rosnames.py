@@ -20,6 +20,8 @@ SIMULATOR = "amsa_simulator"
 SCENARIO = "amsa_scenario"
 #: The process that hosts every C++ Leaf (a nodelet manager: ros/files/amsa_leaves.cpp).
 CONTAINER = "amsa_leaves"
+#: The ``bag:=`` recorder (ros/runtime/bagrecord.py).
+BAG = "amsa_bag"
 #: Names a top-level component may not take (the framework's nodes and namespaces).
 RESERVED = {
     "amsa",
@@ -28,7 +30,7 @@ RESERVED = {
     "clock",
     "rosout",
     "rosout_agg",
-    "amsa_bag",
+    BAG,
     "amsa_boundary",  # the boundary node
     "amsa_adapt",  # the adapt node
     CONTAINER,
@@ -59,6 +61,10 @@ EVENTS = "/amsa/events"
 #: ``boundary:=true``: the simulator's values for the boundary node, and its flush answers.
 BOUNDARY_VALUES = "/amsa/boundary/values"
 BOUNDARY_FLUSHED = "/amsa/boundary/flushed"
+#: ``bag:=``: the simulator's count of each topic's messages at the run's end, and the
+#: recorder's answer once it has written as many (``ros/runtime/bagrecord.py``).
+BAG_FLUSH = "/amsa/bag/flush"
+BAG_WRITTEN = "/amsa/bag/written"
 
 # -- graph-wide parameters (the launch file's group of :data:`NAMESPACE_BASE`) -----------------
 P_SCENARIO = "/amsa/scenario"
@@ -87,6 +93,8 @@ FRAMEWORK: dict[str, str] = {
     "events": EVENTS,
     "boundary_values": BOUNDARY_VALUES,
     "boundary_flushed": BOUNDARY_FLUSHED,
+    "bag_flush": BAG_FLUSH,
+    "bag_written": BAG_WRITTEN,
     "p_scenario": P_SCENARIO,
     "p_mode": P_MODE,
     "p_local": P_LOCAL,

@@ -196,6 +196,14 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
         "boundary",
         Code(""),
     )
+    node(
+        names.BAG,
+        f"{names.BAG}: the bag:= recorder of {pkg}.",
+        "Records the topics it is given (-O FILE.bag TOPIC...) to a ROS 1 bag without a\n"
+        "queue: it never drops a message (a recorder behind slows the publishers instead).",
+        "bagrecord",
+        Code(""),
+    )
     adapt = any(s.adapt for s in scenarios)
     if adapt:
         node(

@@ -234,9 +234,15 @@ def launch_xml(
             lines.append(fill(node, when=when, c=common, t=f"{script}.py"))
     lines += [
         "",
-        "  <!-- bag:=FILE.bag records every Data topic (connected before the run starts) -->",
-        '  <node if="$(eval arg(\'bag\') != \'\')" pkg="rosbag" type="record" name="amsa_bag"',
-        fill('        args="-O $(arg bag) --tcpnodelay @@{topics:xml_attr}"/>', topics=data_topics),
+        "  <!-- bag:=FILE.bag records every Data topic (connected before the run starts; it"
+        " never drops a message: a recorder behind slows the run) -->",
+        fill(
+            '  <node if="$(eval arg(\'bag\') != \'\')" pkg="@@{pkg:xml_attr}"'
+            ' type="@@{bag:xml_attr}.py" name="@@{bag:xml_attr}" output="screen"',
+            pkg=pkg,
+            bag=names.BAG,
+        ),
+        fill('        args="-O $(arg bag) @@{topics:xml_attr}"/>', topics=data_topics),
         "</launch>",
     ]
     return "\n".join(lines) + "\n"

@@ -14,6 +14,7 @@ from ..errors import ConfigError
 # the names amsa-phys itself takes on a ROS graph, both targets' (model/rosnames.py: the
 # scenario loader judges ros2: names with them, below this layer)
 from ..model.rosnames import (
+    BAG,
     BASE,
     CONTAINER,
     DONE,
@@ -39,6 +40,7 @@ from ..model.rosnames import (
 from ..model.world import WorldSpec
 
 __all__ = [
+    "BAG",
     "BASE",
     "CONTAINER",
     "PHASE",

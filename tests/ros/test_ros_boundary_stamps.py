@@ -5,8 +5,9 @@ latest ``/clock``, which the simulator publishes only where a node steps (4 Hz i
 scenario1 of ``tests/fixtures/ros_short.yaml``): the 10 Hz Leader's ground truth and tf came
 up to 0.25 s late with repeated stamps (tf warns of repeated data), and a race between the
 ``/clock`` and data connections could stamp a message with another instant. Here a lockstep
-launch records the boundary's output with ``rosbag record``, and every message is looked up
-in the in-process MCAP bag of the same scenario and seed (``amsa-phys run --bag``, whose
+launch records the boundary's output with the package's recorder (``bag:=``'s: ``rosbag
+record`` dropped messages when starved), and every message is looked up in the in-process
+MCAP bag of the same scenario and seed (``amsa-phys run --bag``, whose
 stamps are each Leaf's step time): the message with that stamp on that topic must hold the
 same values, and stamps strictly increase per topic (per robot frame on ``/tf``).
 Mutation-checked: the boundary stamping with ``rospy.Time.now()`` again (``/clock``) fails
@@ -135,8 +136,8 @@ def test_lockstep_boundary_stamps_are_the_instants_of_their_values(
     prefix = f"/usr/bin/python3 {tmp_path / 'wait_recorder.py'} {' '.join(topics)} --"
     launch = original.replace(simulator, f'{simulator} launch-prefix="{prefix}"').replace(
         "</launch>",
-        '  <node pkg="rosbag" type="record" name="stamps_bag"'
-        f' args="-O {recorded} --tcpnodelay {" ".join(topics)}"/>\n</launch>',
+        f'  <node pkg="{PKG}" type="amsa_bag.py" name="stamps_bag"'
+        f' args="-O {recorded} {" ".join(topics)}"/>\n</launch>',
     )
     # in lockstep the boundary runs when asked
     args = (f"out:={tmp_path / 'lockstep'}", "plots:=false", "boundary:=true")

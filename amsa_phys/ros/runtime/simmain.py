@@ -74,6 +74,7 @@ def main() -> None:
                 file=sys.stderr,
                 flush=True,
             )
+        link.finish_bag()  # bag:=: the recorder has written the run's last messages
         _summary(outcome.metrics, out_dir)
         checks = check_expectations(scenario.expect, outcome.metrics, out_dir / "trace.csv")
         for check in checks:

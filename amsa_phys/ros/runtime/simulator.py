@@ -30,6 +30,7 @@ from .. import names
 from ..graph import RosGraph
 from . import readiness, rosio
 from .arrays import array_msg, elements, pack, read
+from .bagtail import BagTail
 from .boundary import FLUSH, FLUSHED, VALUES, format_values, readable
 from .config import NodeConfig
 from .container import Container, stepped
@@ -143,6 +144,9 @@ class Link:
         self.subs.append(rospy.Subscriber(names.PHASE, String, self._on_phase, tcp_nodelay=True))
         self.subs.append(rospy.Subscriber(names.READY, String, self._on_ready, tcp_nodelay=True))
         self.expected_ready = {*self.graph.remote, names.SCENARIO}
+        #: bag:= (the recorder counted among every topic's subscribers): keep within a window
+        #: of it, and wait for it at the end (``bagtail.py``)
+        self.bag_tail = BagTail(rospy, self.topic_counts, cfg.timeout) if self.graph.bag else None
 
     def _kind(self, data: str) -> Any:
         """The message class of a Data's topic."""
@@ -421,6 +425,23 @@ class Link:
         finally:
             sub.unregister()
 
+    def topic_counts(self) -> dict[str, int]:
+        """How many messages each Data topic has carried so far, as this process knows: its
+        own publications, and those of the nodes it received."""
+        local = self.graph.local
+        with self.cond:
+            return {
+                names.topic(d): self.published[d]
+                if self.graph.producer(d) in local
+                else self.received[d][0]
+                for d in self.graph.data()
+            }
+
+    def finish_bag(self) -> bool:
+        """The run is over: wait until the bag recorder has written every message counted
+        (bag:= only; at most ``timeout:=``); False if it had not (it said so)."""
+        return self.bag_tail.finish() if self.bag_tail is not None else True
+
     def reload(self, path: str, name: str, t: Fraction) -> None:
         """A remote Leaf re-reads one parameter now (a timeline change at its instant)."""
         if not self.lockstep:
@@ -471,6 +492,8 @@ class Link:
         if ns != self.last_clock:
             self.last_clock = ns
             self.clock_pub.publish(self.Clock(self.rospy.Time(ns // 10**9, ns % 10**9)))
+            if self.bag_tail is not None:
+                self.bag_tail.tick()
 
     def pace(self, t: Fraction) -> None:
         """Free mode: hold simulated time to ``speed`` x the wall clock, then publish it."""
