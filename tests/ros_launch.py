@@ -25,7 +25,9 @@ import pytest
 import ros_prebuild
 import sigint
 
-LAUNCH_TIMEOUT = 120  # s of wall time before a launch is declared hung (and killed)
+#: s of wall time before a launch is declared hung (and killed): a deadline for a failure,
+#: never a measured time, so set for a loaded machine (a launch there takes minutes)
+LAUNCH_TIMEOUT = 600
 
 
 def ros_missing() -> str | None:
@@ -76,9 +78,14 @@ class Launch:
             preexec_fn=sigint.at_default,
         )
         self.lines: list[str] = []
-        self.watchdog = threading.Timer(LAUNCH_TIMEOUT, self.kill)
+        self.hung = False  # the watchdog killed it
+        self.watchdog = threading.Timer(LAUNCH_TIMEOUT, self._hung)
         self.watchdog.daemon = True
         self.watchdog.start()
+
+    def _hung(self) -> None:
+        self.hung = True
+        self.kill()
 
     def kill(self) -> None:
         """End the launch and anything it started (by process id)."""
@@ -101,6 +108,8 @@ class Launch:
         self.lines += self.proc.stdout.readlines()
         self.proc.wait()
         self.watchdog.cancel()
+        if self.hung:  # say so: what follows (a missing bag, a cut output) is its consequence
+            pytest.fail(f"the launch was killed after {LAUNCH_TIMEOUT} s: {self.lines[-30:]}")
         left = _leftovers(self.token)
         if left:
             names = [Path(f"/proc/{p}/cmdline").read_bytes()[:80] for p in left]

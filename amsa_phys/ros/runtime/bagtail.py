@@ -21,6 +21,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable
+from typing import Any
 
 from ...model.rosnames import BAG_FLUSH, BAG_WRITTEN
 from .. import names
@@ -130,3 +131,16 @@ class BagTail:
             file=sys.stderr,
             flush=True,
         )
+
+
+def topic_counts(link: Any) -> dict[str, int]:
+    """How many messages each Data topic has carried so far, as the simulator's ``link``
+    knows: its own publications, and those of the nodes it received."""
+    graph = link.graph
+    with link.cond:
+        return {
+            names.topic(d): link.published[d]
+            if graph.producer(d) in graph.local
+            else link.received[d][0]
+            for d in graph.data()
+        }

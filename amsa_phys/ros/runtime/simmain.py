@@ -74,7 +74,8 @@ def main() -> None:
                 file=sys.stderr,
                 flush=True,
             )
-        link.finish_bag()  # bag:=: the recorder has written the run's last messages
+        if link.bag_tail is not None:  # bag:=: the recorder has written the run's last messages
+            link.bag_tail.finish()
         _summary(outcome.metrics, out_dir)
         checks = check_expectations(scenario.expect, outcome.metrics, out_dir / "trace.csv")
         for check in checks:

@@ -30,23 +30,13 @@ from .. import names
 from ..graph import RosGraph
 from . import readiness, rosio
 from .arrays import array_msg, elements, pack, read
-from .bagtail import BagTail
+from .bagtail import BagTail, topic_counts
 from .boundary import FLUSH, FLUSHED, VALUES, format_values, readable
 from .config import NodeConfig
 from .container import Container, stepped
 from .pipeline import Pipeline
+from .remoteerror import RemoteError
 from .waves import DueAt, chained, wave
-
-
-class RemoteError(Exception):
-    """An exception a node's ``do_step`` raised, shown as the node showed it (its repr)."""
-
-    def __init__(self, text: str) -> None:
-        super().__init__(text)
-        self.text = text
-
-    def __repr__(self) -> str:
-        return self.text
 
 
 class Link:
@@ -146,7 +136,9 @@ class Link:
         self.expected_ready = {*self.graph.remote, names.SCENARIO}
         #: bag:= (the recorder counted among every topic's subscribers): keep within a window
         #: of it, and wait for it at the end (``bagtail.py``)
-        self.bag_tail = BagTail(rospy, self.topic_counts, cfg.timeout) if self.graph.bag else None
+        self.bag_tail: BagTail | None = None
+        if self.graph.bag:
+            self.bag_tail = BagTail(rospy, lambda: topic_counts(self), cfg.timeout)
 
     def _kind(self, data: str) -> Any:
         """The message class of a Data's topic."""
@@ -424,23 +416,6 @@ class Link:
             return flushed.wait(timeout)
         finally:
             sub.unregister()
-
-    def topic_counts(self) -> dict[str, int]:
-        """How many messages each Data topic has carried so far, as this process knows: its
-        own publications, and those of the nodes it received."""
-        local = self.graph.local
-        with self.cond:
-            return {
-                names.topic(d): self.published[d]
-                if self.graph.producer(d) in local
-                else self.received[d][0]
-                for d in self.graph.data()
-            }
-
-    def finish_bag(self) -> bool:
-        """The run is over: wait until the bag recorder has written every message counted
-        (bag:= only; at most ``timeout:=``); False if it had not (it said so)."""
-        return self.bag_tail.finish() if self.bag_tail is not None else True
 
     def reload(self, path: str, name: str, t: Fraction) -> None:
         """A remote Leaf re-reads one parameter now (a timeline change at its instant)."""
