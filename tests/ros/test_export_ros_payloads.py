@@ -28,7 +28,7 @@ from amsa_phys.ros import generate
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 WORLD = ROOT / "worlds" / "mde_challenge.yaml"
-LAUNCH_TIMEOUT = 180  # s of wall time before a launch is declared hung (and killed)
+LAUNCH_TIMEOUT = 600  # s of wall time before a launch is declared hung: a failure deadline
 
 
 def _ros_missing() -> str | None:
