@@ -28,6 +28,12 @@ def compass_heading() -> Any:
     return _body("compass_heading")
 
 
+def write_outputs() -> Any:
+    """``_groupbodies.write_outputs`` (a group's finite float64 output columns written into the
+    store in one call, ``Steppers.step_group``), or None."""
+    return _body("write_outputs")
+
+
 def _body(name: str) -> Any:
     module = publish._extension("_groupbodies")
     return None if module is None else getattr(module, name, None)
