@@ -328,6 +328,72 @@ static PyObject *write_outputs(PyObject *Py_UNUSED(module), PyObject *args)
     return PyLong_FromSsize_t(done);
 }
 
+/* ---- gather_inputs: a group's input columns out of the store (engine/tasks.py) -----------
+ * Steppers.step_group's inputs: row r of ``block`` (a new C-contiguous float64 array of
+ * len(ats) rows and n columns) gets the store's values at ``ats[r]`` (a slice or an index
+ * array of intp, as Group.inputs holds them), each row a copy the template may keep or edit
+ * (as ``col[at].copy()`` was). A position outside the store is a ValueError (Group builds
+ * them from the store's own positions: never in a run). */
+static PyObject *gather_inputs(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    PyObject *col, *ats, *block;
+    if (!PyArg_ParseTuple(args, "OO!O", &col, &PyTuple_Type, &ats, &block))
+        return NULL;
+    Py_buffer store, rows;
+    if (PyObject_GetBuffer(col, &store, PyBUF_STRIDES | PyBUF_FORMAT) < 0)
+        return NULL;
+    if (PyObject_GetBuffer(block, &rows, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        PyBuffer_Release(&store);
+        return NULL;
+    }
+    const char *f = store.format ? store.format : "B";
+    const char *g = rows.format ? rows.format : "B";
+    if (*f == '<' || *f == '=' || *f == '@')
+        f++;
+    if (*g == '<' || *g == '=' || *g == '@')
+        g++;
+    const Py_ssize_t m = PyTuple_GET_SIZE(ats);
+    if (store.ndim != 1 || store.itemsize != 8 || f[0] != 'd' || f[1] != 0 || rows.ndim != 2 ||
+        rows.itemsize != 8 || g[0] != 'd' || g[1] != 0 || rows.shape[0] != m) {
+        PyBuffer_Release(&rows);
+        PyBuffer_Release(&store);
+        PyErr_SetString(PyExc_ValueError,
+                        "gather_inputs: the store's float64 array and a float64 block of one "
+                        "row an input expected");
+        return NULL;
+    }
+    const Py_ssize_t n = rows.shape[1], len = store.shape[0], sstride = store.strides[0];
+    const char *base = store.buf;
+    double *out = rows.buf;
+    for (Py_ssize_t r = 0; r < m; r++) {
+        Py_buffer index;
+        Py_ssize_t start = 0, step = 0;
+        if (!positions(PyTuple_GET_ITEM(ats, r), len, n, &index, &start, &step)) {
+            if (index.obj)
+                PyBuffer_Release(&index);
+            PyBuffer_Release(&rows);
+            PyBuffer_Release(&store);
+            PyErr_Format(PyExc_ValueError, "gather_inputs: input %zd's positions are not %zd "
+                         "places in the store", r, n);
+            return NULL;
+        }
+        double *row = out + r * n;
+        if (index.obj) {
+            for (Py_ssize_t k = 0; k < n; k++) {
+                const Py_ssize_t i = *(Py_ssize_t *)((char *)index.buf + k * index.strides[0]);
+                row[k] = *(const double *)(base + i * sstride);
+            }
+            PyBuffer_Release(&index);
+        } else {
+            for (Py_ssize_t k = 0; k < n; k++)
+                row[k] = *(const double *)(base + (start + k * step) * sstride);
+        }
+    }
+    PyBuffer_Release(&rows);
+    PyBuffer_Release(&store);
+    Py_RETURN_NONE;
+}
+
 static PyMethodDef methods[] = {
     {"gps_fix", gps_fix, METH_VARARGS,
      "gps_fix(posX, posY, ex, ey, gx, gy, u_loss, u_burst, phi, q, mean, on_x, on_y, stddev, "
@@ -341,6 +407,9 @@ static PyMethodDef methods[] = {
      "write_outputs(out, outputs, col, published, ndarray, n): a group's outputs written into "
      "the store's array, in order, while each is a finite float64 column of the members; "
      "returns how many were written (the caller's Python path takes the rest)."},
+    {"gather_inputs", gather_inputs, METH_VARARGS,
+     "gather_inputs(col, ats, block): row r of block gets the store col's values at ats[r] "
+     "(a slice or an intp index array): a group's inputs, one copy each."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -155,11 +155,10 @@ class Steppers:
         self._made: dict[int, tuple[Task, Callable[[Task, Fraction], None]]] = {}
         #: a group's outputs judged and written in one compiled call (``_groupbodies.c``)
         #: where built and the store is one float64 array
-        self._write = (
-            batch_bodies.write_outputs()
-            if isinstance(col, np.ndarray) and col.dtype == np.float64 and col.ndim == 1
-            else None
-        )
+        #: and its inputs gathered in one (both None on the pure path)
+        store = isinstance(col, np.ndarray) and col.dtype == np.float64 and col.ndim == 1
+        self._write = batch_bodies.write_outputs() if store else None
+        self._gather_in = batch_bodies.gather_inputs() if store else None
 
     def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:
         """How ``task`` steps: the lean scalar path, array ports, or through its delay line.
@@ -400,12 +399,23 @@ class Steppers:
     def step_group(self, group: batch.Group, now: Fraction) -> None:
         """Run a group of like components in one call (``engine/batch.py``).
 
-        Each input port is the members' column gathered in one numpy call (a copy: a
-        template may keep or edit its inputs), each output written back into the store's
-        array in place, in one call too (only the published rows, under a mask).
+        Each input port is the members' column, a copy (a template may keep or edit its
+        inputs), each output written back into the store's array in place (only the
+        published rows, under a mask). Compiled where built (``_groupbodies.c``): the inputs
+        gathered into one block's rows in one call, the usual outputs (finite float64
+        columns) judged and written in one; what the writer declines, and every output of a
+        delayed group, goes through the loop below, which names a bad output as ever.
         """
         col = self.col
-        inp = {port: col[at].copy() if type(at) is slice else col[at] for port, at in group.inputs}
+        n = len(group.paths)
+        if self._gather_in is None:
+            inp = {p: col[at].copy() if type(at) is slice else col[at] for p, at in group.inputs}
+        elif group.ats:  # one new block, a row an input: each row the template's to keep
+            block = np.empty((len(group.ats), n))
+            self._gather_in(col, group.ats, block)
+            inp = dict(zip(group.ports, block, strict=True))
+        else:
+            inp = {}
         who = self.who
         try:
             out, published = group.template.step_many(
@@ -423,7 +433,6 @@ class Steppers:
             raise RunFault(
                 who(group.paths[0]), now, f"step_many must return (outputs, published): {exc}"
             ) from exc
-        n = len(group.paths)
         if not (isinstance(out, Mapping) and (published is None or _is_mask(published, n))):
             raise RunFault(
                 who(group.paths[0]),

@@ -53,6 +53,8 @@ def _group(spread: bool) -> tuple[batch.Group, int]:
         tasks.append(t)
     for k in range(N):  # member k's buffers; a spread store puts a gap after the third
         names.append(f"Car{k + 1}.In.x")
+        if spread and k == 2:
+            names.append("gap.x")
     for p in PORTS:
         for k in range(N):
             names.append(f"Car{k + 1}.Pilot.{p}")
@@ -72,7 +74,7 @@ def _run(
     group, size = _group(spread)
     values = array("d", [-7.0] * size)
     col = np.frombuffer(values, dtype=np.float64)
-    col[:N] = np.arange(N, dtype=float)
+    col[group.inputs[0][1]] = np.arange(N, dtype=float)
     sent: list[Any] = []
     steppers = Steppers(values, lambda line, w: sent.append(w), lambda path: path, col)
     if not compiled:
@@ -123,7 +125,7 @@ def test_every_output_lands_at_its_members_buffers(spread: bool) -> None:
     if spread:  # a gap between members is no member's: never written
         group, _ = _group(spread)
         written = {int(i) for p in PORTS for i in group.outputs[p]}
-        gaps = sorted(set(range(N, len(store))) - written)  # past the inputs
+        gaps = sorted(set(range(N + 1, len(store))) - written)  # past the inputs
         assert len(gaps) == len(PORTS)
         assert store[gaps].tolist() == [-7.0] * len(PORTS)
 
@@ -226,13 +228,49 @@ def test_huge_finite_values_are_written() -> None:
     assert _cols(store, False)["a"].tobytes() == arr.tobytes()
 
 
-def test_inputs_are_copies_the_template_may_keep() -> None:
-    _run(({"a": np.zeros(N)}, None), False, compiled=True)
+@pytest.mark.parametrize("spread", [False, True])
+@pytest.mark.parametrize("compiled", [False, True])
+def test_inputs_are_copies_the_template_may_keep(spread: bool, compiled: bool) -> None:
+    """Each member's input, in members' order; the template's to keep or edit: editing it
+    changes neither the store nor another input, and the next step's inputs are new."""
+    group, size = _group(spread)
+    values = array("d", [-7.0] * size)
+    col = np.frombuffer(values, dtype=np.float64)
+    x = group.inputs[0][1]
+    col[x] = np.arange(N, dtype=float) * 1.5
+    steppers = Steppers(values, lambda line, w: None, lambda path: path, col)
+    if not compiled:
+        steppers._write = steppers._gather_in = None
+    elif steppers._gather_in is None:
+        pytest.skip("the compiled group gather is not built here")
+    Reply.result = ({}, None)
+    steppers.step_group(group, Fraction(1, 4))
     kept = Reply.seen["x"]
-    assert kept.tolist() == [0.0, 1.0, 2.0, 3.0, 4.0]
+    assert kept.tolist() == [0.0, 1.5, 3.0, 4.5, 6.0]
     kept[:] = 99.0
-    again = _run(({"a": np.zeros(N)}, None), False, compiled=True)[0]
-    assert again[:N].tolist() == [0.0, 1.0, 2.0, 3.0, 4.0]
+    assert col[x].tolist() == [0.0, 1.5, 3.0, 4.5, 6.0]
+    col[x] = -np.arange(N, dtype=float)
+    steppers.step_group(group, Fraction(1, 2))
+    assert Reply.seen["x"].tolist() == [-0.0, -1.0, -2.0, -3.0, -4.0]
+    assert kept.tolist() == [99.0] * N
+
+
+@pytest.mark.skipif(not COMPILED, reason="the compiled group writer is not built here")
+def test_the_gather_copies_each_row_from_its_positions() -> None:
+    gather = batch_bodies.gather_inputs()
+    col = np.arange(20, dtype=float) * 2.0
+    ats = (slice(1, 11, 2), np.array([19, 3, 0, 7, 5], dtype=np.intp), slice(4, 9, 1))
+    block = np.full((3, 5), -1.0)
+    gather(col, ats, block)
+    assert block.tolist() == [
+        [2.0, 6.0, 10.0, 14.0, 18.0],
+        [38.0, 6.0, 0.0, 14.0, 10.0],
+        [8.0, 10.0, 12.0, 14.0, 16.0],
+    ]
+    with pytest.raises(ValueError, match="input 0"):
+        gather(col, (np.array([0, 1, 2, 3, 20], dtype=np.intp),), np.empty((1, 5)))
+    with pytest.raises(ValueError, match="input 0"):
+        gather(col, (slice(16, 26, 1),), np.empty((1, 5)))
 
 
 @pytest.mark.skipif(not COMPILED, reason="the compiled group writer is not built here")
