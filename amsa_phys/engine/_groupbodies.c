@@ -199,7 +199,9 @@ static PyObject *compass_heading(PyObject *Py_UNUSED(module), PyObject *args)
  * position in ``col`` (the store's float64 array). ``published`` is None (every member) or a
  * bool array of n. Returns how many outputs were written: the first one not taken (anything
  * else, a value not finite) and all after it are left to the caller's Python path, which
- * judges and writes them as before, and names the first bad output as before. */
+ * judges and writes them as before, and names the first bad output as before. With ``col``
+ * None the outputs are judged alike and nothing written (a delayed group's: the caller sends
+ * the ones judged, then takes the rest). */
 static int positions(PyObject *at, Py_ssize_t len, Py_ssize_t n, Py_buffer *view,
                      Py_ssize_t *start, Py_ssize_t *step)
 {
@@ -239,29 +241,36 @@ static PyObject *write_outputs(PyObject *Py_UNUSED(module), PyObject *args)
                           &published, &ndarray, &n))
         return NULL;
     Py_buffer store, mask;
-    if (PyObject_GetBuffer(col, &store, PyBUF_STRIDES | PyBUF_FORMAT | PyBUF_WRITABLE) < 0)
-        return NULL;
-    const char *f = store.format ? store.format : "B";
-    if (*f == '<' || *f == '=' || *f == '@')
-        f++;
-    if (store.ndim != 1 || store.itemsize != 8 || f[0] != 'd' || f[1] != 0) {
-        PyBuffer_Release(&store);
-        PyErr_SetString(PyExc_ValueError, "col: the store's float64 array expected");
-        return NULL;
+    store.obj = NULL;
+    const int judge_only = col == Py_None;
+    if (!judge_only) {
+        if (PyObject_GetBuffer(col, &store, PyBUF_STRIDES | PyBUF_FORMAT | PyBUF_WRITABLE) < 0)
+            return NULL;
+        const char *f = store.format ? store.format : "B";
+        if (*f == '<' || *f == '=' || *f == '@')
+            f++;
+        if (store.ndim != 1 || store.itemsize != 8 || f[0] != 'd' || f[1] != 0) {
+            PyBuffer_Release(&store);
+            PyErr_SetString(PyExc_ValueError, "col: the store's float64 array expected");
+            return NULL;
+        }
     }
-    const Py_ssize_t len = store.shape[0], sstride = store.strides[0];
-    char *const base = store.buf;
+    const Py_ssize_t len = judge_only ? 0 : store.shape[0];
+    const Py_ssize_t sstride = judge_only ? 0 : store.strides[0];
+    char *const base = judge_only ? NULL : store.buf;
     mask.obj = NULL;
     if (published != Py_None) {
         if (PyObject_GetBuffer(published, &mask, PyBUF_STRIDES | PyBUF_FORMAT) < 0) {
-            PyBuffer_Release(&store);
+            if (store.obj)
+                PyBuffer_Release(&store);
             return NULL;
         }
         const char *g = mask.format ? mask.format : "B";
         if (mask.ndim != 1 || mask.shape[0] != n || mask.itemsize != 1 || g[0] != '?' ||
             g[1] != 0) {
             PyBuffer_Release(&mask);
-            PyBuffer_Release(&store);
+            if (store.obj)
+                PyBuffer_Release(&store);
             PyErr_SetString(PyExc_ValueError, "published: None or one bool per member expected");
             return NULL;
         }
@@ -291,7 +300,8 @@ static PyObject *write_outputs(PyObject *Py_UNUSED(module), PyObject *args)
         }
         const Py_ssize_t m = n, astride = arr.strides[0];
         Py_ssize_t start = 0, step = 0;
-        const int ok = positions(at, len, m, &index, &start, &step);
+        index.obj = NULL;
+        const int ok = judge_only || positions(at, len, m, &index, &start, &step);
         const int fine = ok && m > 0;
         const char *mk = mask.obj ? mask.buf : NULL;
         const Py_ssize_t mstride = mask.obj ? mask.strides[0] : 0;
@@ -305,7 +315,7 @@ static PyObject *write_outputs(PyObject *Py_UNUSED(module), PyObject *args)
                 break;
             }
         }
-        if (fine && finite) {
+        if (fine && finite && !judge_only) {
             for (Py_ssize_t k = 0; k < m; k++) {
                 if (mk && !mk[k * mstride])
                     continue;
@@ -324,7 +334,8 @@ static PyObject *write_outputs(PyObject *Py_UNUSED(module), PyObject *args)
     }
     if (mask.obj)
         PyBuffer_Release(&mask);
-    PyBuffer_Release(&store);
+    if (store.obj)
+        PyBuffer_Release(&store);
     return PyLong_FromSsize_t(done);
 }
 
@@ -406,7 +417,8 @@ static PyMethodDef methods[] = {
     {"write_outputs", write_outputs, METH_VARARGS,
      "write_outputs(out, outputs, col, published, ndarray, n): a group's outputs written into "
      "the store's array, in order, while each is a finite float64 column of the members; "
-     "returns how many were written (the caller's Python path takes the rest)."},
+     "returns how many were written (the caller's Python path takes the rest). With col "
+     "None: judged alike, nothing written."},
     {"gather_inputs", gather_inputs, METH_VARARGS,
      "gather_inputs(col, ats, block): row r of block gets the store col's values at ats[r] "
      "(a slice or an intp index array): a group's inputs, one copy each."},

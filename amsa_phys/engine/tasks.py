@@ -443,10 +443,15 @@ class Steppers:
             )
         outputs = group.outputs
         items: Any = out.items()
-        if self._write is not None and group.delay is None and type(out) is dict:
+        if self._write is not None and type(out) is dict:
             # the usual outputs in one call; the loop below takes whatever it left, from
-            # the first output it did not write, so a fault names the same output as before
-            done = self._write(out, outputs, col, published, np.ndarray, n)
+            # the first output it did not take, so a fault names the same output as before
+            if group.delay is None:
+                done = self._write(out, outputs, col, published, np.ndarray, n)
+            else:  # judged in one call, then sent in order as the loop sends them
+                done = self._write(out, outputs, None, published, np.ndarray, n)
+                for port, arr in islice(items, done):
+                    self._send_group(group, port, arr, published)
             if done == len(out):
                 return
             items = islice(items, done, None)
@@ -470,16 +475,24 @@ class Steppers:
             if k is not None:
                 fault = RunFault(who(group.paths[k]), now, f"output {port} is {arr[k]}")
                 raise in_run(fault, group.tasks[k].run)
-            if group.delay is not None:  # the copies' common latency (no jitter: batch.py)
-                # whole columns in flight (a copy: the template may reuse its array)
-                if published is None:
-                    self.send(group.delay, [(at, arr.copy())])
-                else:
-                    where = np.asarray(group.targets[port], dtype=np.intp)[published]
-                    self.send(group.delay, [(where, arr[published])])
+            if group.delay is not None:
+                self._send_group(group, port, arr, published)
             elif published is None:
                 col[at] = arr
             elif type(at) is slice:
                 np.copyto(col[at], arr, where=published)
             else:
                 col[at[published]] = arr[published]
+
+    def _send_group(
+        self, group: batch.Group, port: str, arr: np.ndarray, published: np.ndarray | None
+    ) -> None:
+        """A delayed group's judged output ``port`` put in flight: the copies' common
+        latency (no jitter: ``batch.py``), the whole column (a copy: the template may reuse
+        its array) or its published rows."""
+        assert group.delay is not None
+        if published is None:
+            self.send(group.delay, [(group.outputs[port], arr.copy())])
+        else:
+            where = np.asarray(group.targets[port], dtype=np.intp)[published]
+            self.send(group.delay, [(where, arr[published])])

@@ -67,16 +67,25 @@ def _group(spread: bool) -> tuple[batch.Group, int]:
 
 
 def _run(
-    result: Any, spread: bool, compiled: bool
+    result: Any, spread: bool, compiled: bool, delayed: bool = False
 ) -> tuple[np.ndarray, RunFault | None, list[Any]]:
     """The store after one group step returning ``result``, the fault if any, and what was
-    sent to a delay line (nothing here: the group has no delay)."""
+    sent to the group's delay line (``delayed``: the group's outputs go there instead)."""
     group, size = _group(spread)
+    if delayed:
+        group.delay = "line"  # type: ignore[assignment]  # only handed to send
     values = array("d", [-7.0] * size)
     col = np.frombuffer(values, dtype=np.float64)
     col[group.inputs[0][1]] = np.arange(N, dtype=float)
     sent: list[Any] = []
-    steppers = Steppers(values, lambda line, w: sent.append(w), lambda path: path, col)
+
+    def send(line: Any, writes: list[tuple[Any, np.ndarray]]) -> None:
+        assert line == "line"
+        for at, arr in writes:  # where, and the values: as plain positions and bytes
+            where = np.arange(size)[at] if type(at) is slice else np.asarray(at)
+            sent.append((where.tolist(), np.array(arr).tobytes()))
+
+    steppers = Steppers(values, send, lambda path: path, col)
     if not compiled:
         steppers._write = None
     elif steppers._write is None:
@@ -100,6 +109,35 @@ def _both(result_of: Callable[[], Any], spread: bool) -> tuple[np.ndarray, RunFa
         assert str(fast[1]) == str(pure[1])
         assert getattr(fast[1], "run", None) == getattr(pure[1], "run", None)
     return fast[0], fast[1]
+
+
+@pytest.mark.parametrize("spread", [False, True])
+@pytest.mark.parametrize("mask", [None, (0, 2, 3)])
+@pytest.mark.parametrize("bad_at", [None, "c"])
+def test_a_delayed_group_sends_the_same(spread: bool, mask: Any, bad_at: Any) -> None:
+    """A group with latency sends each output's column (or its published rows) in order;
+    with a bad output the ones before it were sent, the fault names it, none after."""
+
+    def result() -> Any:
+        out = {p: np.arange(N, dtype=float) + 10 * i for i, p in enumerate(PORTS)}
+        out["b"] = out["b"][::-1]  # a view of reversed strides
+        if bad_at is not None:
+            out[bad_at][2] = np.inf
+        return out, None if mask is None else _mask(*mask)
+
+    pure = _run(result(), spread, compiled=False, delayed=True)
+    fast = _run(result(), spread, compiled=True, delayed=True)
+    assert fast[2] == pure[2]
+    assert fast[0].tobytes() == pure[0].tobytes()  # the store itself: untouched
+    assert str(fast[1]) == str(pure[1])
+    assert len(fast[2]) == (2 if bad_at else len(PORTS))
+    if bad_at is not None:
+        assert fast[1] is not None
+        assert fast[1].cause == "output c is inf"
+    rows = list(range(N)) if mask is None else list(mask)
+    group, _ = _group(spread)
+    assert fast[2][0][0] == [int(i) for i in np.arange(len(fast[0]))[group.outputs["a"]][rows]]
+    assert np.frombuffer(fast[2][1][1]).tolist() == [float(4 - r) + 10 for r in rows]
 
 
 def _cols(store: np.ndarray, spread: bool) -> dict[str, np.ndarray]:
