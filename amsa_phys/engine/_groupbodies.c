@@ -193,7 +193,7 @@ static PyObject *compass_heading(PyObject *Py_UNUSED(module), PyObject *args)
 
 /* ---- write_outputs: a group's published columns into the store (engine/tasks.py) ---------
  * Steppers.step_group's usual case, output by output in the order of ``out`` (a dict): the
- * port is one of ``outputs`` (port -> the members' positions: a slice of the store, or an
+ * port is a str, one of ``outputs`` (port -> the members' positions: a slice of the store, or an
  * index array of intp), its value an ``ndarray`` (exactly that type) of ``n`` float64, every
  * published member's value finite; then each published member's value is copied to its
  * position in ``col`` (the store's float64 array). ``published`` is None (every member) or a
@@ -278,7 +278,8 @@ static PyObject *write_outputs(PyObject *Py_UNUSED(module), PyObject *args)
     Py_ssize_t pos = 0, done = 0;
     PyObject *port, *value;
     while (PyDict_Next(out, &pos, &port, &value)) {
-        if ((PyObject *)Py_TYPE(value) != ndarray)
+        /* a str port (its lookup runs no Python code while ``out`` is walked), an ndarray */
+        if (!PyUnicode_CheckExact(port) || (PyObject *)Py_TYPE(value) != ndarray)
             break;
         PyObject *at = PyDict_GetItemWithError(outputs, port);
         if (at == NULL) {

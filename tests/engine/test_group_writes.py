@@ -324,6 +324,7 @@ def test_the_writer_says_how_many_it_wrote() -> None:
     assert write({"a": good, "x": good, "b": good}, outputs, col, None, np.ndarray, 5) == 1
     assert col[[19, 17, 15, 13, 11]].tolist() == [0.0] * 5  # nothing after the declined one
     assert write({"b": good.tolist()}, outputs, col, None, np.ndarray, 5) == 0
+    assert write({"a": good, 7: good}, {**outputs, 7: slice(5, 10)}, col, None, np.ndarray, 5) == 1
     assert write({"a": np.zeros(4)}, outputs, col, None, np.ndarray, 5) == 0
     out_of_range = {"a": np.array([0, 1, 2, 3, 20], dtype=np.intp)}
     assert write({"a": good}, out_of_range, col, None, np.ndarray, 5) == 0
