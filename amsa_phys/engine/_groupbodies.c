@@ -191,6 +191,221 @@ static PyObject *compass_heading(PyObject *Py_UNUSED(module), PyObject *args)
     return PyLong_FromSsize_t(lost_count);
 }
 
+/* ---- write_outputs: a group's published columns into the store (engine/tasks.py) ---------
+ * Steppers.step_group's usual case, output by output in the order of ``out`` (a dict): the
+ * port is a str, one of ``outputs`` (port -> the members' positions: a slice of the store, or an
+ * index array of intp), its value an ``ndarray`` (exactly that type) of ``n`` float64, every
+ * published member's value finite; then each published member's value is copied to its
+ * position in ``col`` (the store's float64 array). ``published`` is None (every member) or a
+ * bool array of n. Returns how many outputs were written: the first one not taken (anything
+ * else, a value not finite) and all after it are left to the caller's Python path, which
+ * judges and writes them as before, and names the first bad output as before. With ``col``
+ * None the outputs are judged alike and nothing written (a delayed group's: the caller sends
+ * the ones judged, then takes the rest). */
+static int positions(PyObject *at, Py_ssize_t len, Py_ssize_t n, Py_buffer *view,
+                     Py_ssize_t *start, Py_ssize_t *step)
+{
+    view->obj = NULL;
+    if (PySlice_Check(at)) {
+        Py_ssize_t stop;
+        if (PySlice_Unpack(at, start, &stop, step) < 0) {
+            PyErr_Clear();
+            return 0;
+        }
+        return PySlice_AdjustIndices(len, start, &stop, *step) == n;
+    }
+    if (PyObject_GetBuffer(at, view, PyBUF_STRIDES | PyBUF_FORMAT) < 0) {
+        PyErr_Clear();
+        view->obj = NULL;
+        return 0;
+    }
+    const char *f = view->format ? view->format : "B";
+    if (*f == '<' || *f == '=' || *f == '@')
+        f++;
+    if (view->ndim != 1 || view->shape[0] != n || view->itemsize != sizeof(Py_ssize_t) ||
+        !(f[0] == 'l' || f[0] == 'q' || f[0] == 'n') || f[1] != 0)
+        return 0;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        const Py_ssize_t i = *(Py_ssize_t *)((char *)view->buf + k * view->strides[0]);
+        if (i < 0 || i >= len)
+            return 0;
+    }
+    return 1;
+}
+
+static PyObject *write_outputs(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    PyObject *out, *outputs, *col, *published, *ndarray;
+    Py_ssize_t n;
+    if (!PyArg_ParseTuple(args, "O!O!OOOn", &PyDict_Type, &out, &PyDict_Type, &outputs, &col,
+                          &published, &ndarray, &n))
+        return NULL;
+    Py_buffer store, mask;
+    store.obj = NULL;
+    const int judge_only = col == Py_None;
+    if (!judge_only) {
+        if (PyObject_GetBuffer(col, &store, PyBUF_STRIDES | PyBUF_FORMAT | PyBUF_WRITABLE) < 0)
+            return NULL;
+        const char *f = store.format ? store.format : "B";
+        if (*f == '<' || *f == '=' || *f == '@')
+            f++;
+        if (store.ndim != 1 || store.itemsize != 8 || f[0] != 'd' || f[1] != 0) {
+            PyBuffer_Release(&store);
+            PyErr_SetString(PyExc_ValueError, "col: the store's float64 array expected");
+            return NULL;
+        }
+    }
+    const Py_ssize_t len = judge_only ? 0 : store.shape[0];
+    const Py_ssize_t sstride = judge_only ? 0 : store.strides[0];
+    char *const base = judge_only ? NULL : store.buf;
+    mask.obj = NULL;
+    if (published != Py_None) {
+        if (PyObject_GetBuffer(published, &mask, PyBUF_STRIDES | PyBUF_FORMAT) < 0) {
+            if (store.obj)
+                PyBuffer_Release(&store);
+            return NULL;
+        }
+        const char *g = mask.format ? mask.format : "B";
+        if (mask.ndim != 1 || mask.shape[0] != n || mask.itemsize != 1 || g[0] != '?' ||
+            g[1] != 0) {
+            PyBuffer_Release(&mask);
+            if (store.obj)
+                PyBuffer_Release(&store);
+            PyErr_SetString(PyExc_ValueError, "published: None or one bool per member expected");
+            return NULL;
+        }
+    }
+    Py_ssize_t pos = 0, done = 0;
+    PyObject *port, *value;
+    while (PyDict_Next(out, &pos, &port, &value)) {
+        /* a str port (its lookup runs no Python code while ``out`` is walked), an ndarray */
+        if (!PyUnicode_CheckExact(port) || (PyObject *)Py_TYPE(value) != ndarray)
+            break;
+        PyObject *at = PyDict_GetItemWithError(outputs, port);
+        if (at == NULL) {
+            PyErr_Clear();
+            break;
+        }
+        Py_buffer arr, index;
+        if (PyObject_GetBuffer(value, &arr, PyBUF_STRIDES | PyBUF_FORMAT) < 0) {
+            PyErr_Clear();
+            break;
+        }
+        const char *h = arr.format ? arr.format : "B";
+        if (*h == '<' || *h == '=' || *h == '@')
+            h++;
+        if (arr.ndim != 1 || arr.shape[0] != n || arr.itemsize != 8 || h[0] != 'd' ||
+            h[1] != 0) {
+            PyBuffer_Release(&arr);
+            break;
+        }
+        const Py_ssize_t m = n, astride = arr.strides[0];
+        Py_ssize_t start = 0, step = 0;
+        index.obj = NULL;
+        const int ok = judge_only || positions(at, len, m, &index, &start, &step);
+        const int fine = ok && m > 0;
+        const char *mk = mask.obj ? mask.buf : NULL;
+        const Py_ssize_t mstride = mask.obj ? mask.strides[0] : 0;
+        int finite = 1;
+        for (Py_ssize_t k = 0; fine && k < m; k++) {
+            if (mk && !mk[k * mstride])
+                continue;
+            const double v = *(double *)((char *)arr.buf + k * astride);
+            if (!isfinite(v)) {
+                finite = 0;
+                break;
+            }
+        }
+        if (fine && finite && !judge_only) {
+            for (Py_ssize_t k = 0; k < m; k++) {
+                if (mk && !mk[k * mstride])
+                    continue;
+                const Py_ssize_t i =
+                    index.obj ? *(Py_ssize_t *)((char *)index.buf + k * index.strides[0])
+                              : start + k * step;
+                *(double *)(base + i * sstride) = *(double *)((char *)arr.buf + k * astride);
+            }
+        }
+        if (index.obj)
+            PyBuffer_Release(&index);
+        PyBuffer_Release(&arr);
+        if (!(fine && finite))
+            break;
+        done++;
+    }
+    if (mask.obj)
+        PyBuffer_Release(&mask);
+    if (store.obj)
+        PyBuffer_Release(&store);
+    return PyLong_FromSsize_t(done);
+}
+
+/* ---- gather_inputs: a group's input columns out of the store (engine/tasks.py) -----------
+ * Steppers.step_group's inputs: row r of ``block`` (a new C-contiguous float64 array of
+ * len(ats) rows and n columns) gets the store's values at ``ats[r]`` (a slice or an index
+ * array of intp, as Group.inputs holds them), each row a copy the template may keep or edit
+ * (as ``col[at].copy()`` was). A position outside the store is a ValueError (Group builds
+ * them from the store's own positions: never in a run). */
+static PyObject *gather_inputs(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    PyObject *col, *ats, *block;
+    if (!PyArg_ParseTuple(args, "OO!O", &col, &PyTuple_Type, &ats, &block))
+        return NULL;
+    Py_buffer store, rows;
+    if (PyObject_GetBuffer(col, &store, PyBUF_STRIDES | PyBUF_FORMAT) < 0)
+        return NULL;
+    if (PyObject_GetBuffer(block, &rows, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) < 0) {
+        PyBuffer_Release(&store);
+        return NULL;
+    }
+    const char *f = store.format ? store.format : "B";
+    const char *g = rows.format ? rows.format : "B";
+    if (*f == '<' || *f == '=' || *f == '@')
+        f++;
+    if (*g == '<' || *g == '=' || *g == '@')
+        g++;
+    const Py_ssize_t m = PyTuple_GET_SIZE(ats);
+    if (store.ndim != 1 || store.itemsize != 8 || f[0] != 'd' || f[1] != 0 || rows.ndim != 2 ||
+        rows.itemsize != 8 || g[0] != 'd' || g[1] != 0 || rows.shape[0] != m) {
+        PyBuffer_Release(&rows);
+        PyBuffer_Release(&store);
+        PyErr_SetString(PyExc_ValueError,
+                        "gather_inputs: the store's float64 array and a float64 block of one "
+                        "row an input expected");
+        return NULL;
+    }
+    const Py_ssize_t n = rows.shape[1], len = store.shape[0], sstride = store.strides[0];
+    const char *base = store.buf;
+    double *out = rows.buf;
+    for (Py_ssize_t r = 0; r < m; r++) {
+        Py_buffer index;
+        Py_ssize_t start = 0, step = 0;
+        if (!positions(PyTuple_GET_ITEM(ats, r), len, n, &index, &start, &step)) {
+            if (index.obj)
+                PyBuffer_Release(&index);
+            PyBuffer_Release(&rows);
+            PyBuffer_Release(&store);
+            PyErr_Format(PyExc_ValueError, "gather_inputs: input %zd's positions are not %zd "
+                         "places in the store", r, n);
+            return NULL;
+        }
+        double *row = out + r * n;
+        if (index.obj) {
+            for (Py_ssize_t k = 0; k < n; k++) {
+                const Py_ssize_t i = *(Py_ssize_t *)((char *)index.buf + k * index.strides[0]);
+                row[k] = *(const double *)(base + i * sstride);
+            }
+            PyBuffer_Release(&index);
+        } else {
+            for (Py_ssize_t k = 0; k < n; k++)
+                row[k] = *(const double *)(base + (start + k * step) * sstride);
+        }
+    }
+    PyBuffer_Release(&rows);
+    PyBuffer_Release(&store);
+    Py_RETURN_NONE;
+}
+
 static PyMethodDef methods[] = {
     {"gps_fix", gps_fix, METH_VARARGS,
      "gps_fix(posX, posY, ex, ey, gx, gy, u_loss, u_burst, phi, q, mean, on_x, on_y, stddev, "
@@ -200,6 +415,14 @@ static PyMethodDef methods[] = {
      "compass_heading(heading, w, g, u, phi, q, mean, turn_on, stddev, precision, lostData, b, "
      "value, published, deviation): a Compass group's heading after its "
      "first step; returns how many members lost theirs."},
+    {"write_outputs", write_outputs, METH_VARARGS,
+     "write_outputs(out, outputs, col, published, ndarray, n): a group's outputs written into "
+     "the store's array, in order, while each is a finite float64 column of the members; "
+     "returns how many were written (the caller's Python path takes the rest). With col "
+     "None: judged alike, nothing written."},
+    {"gather_inputs", gather_inputs, METH_VARARGS,
+     "gather_inputs(col, ats, block): row r of block gets the store col's values at ats[r] "
+     "(a slice or an intp index array): a group's inputs, one copy each."},
     {NULL, NULL, 0, NULL},
 };
 

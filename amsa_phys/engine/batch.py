@@ -92,6 +92,9 @@ class Group:
         self.inputs: list[tuple[str, Columns]] = [
             (port, columns([dict(t.reads)[port] for t in tasks])) for port in first
         ]
+        #: the same input ports and their positions apart, for the compiled gather
+        self.ports = tuple(port for port, _ in self.inputs)
+        self.ats = tuple(at for _, at in self.inputs)
         #: output port -> the members' positions, as a list (a delayed group's writes)
         self.targets = {port: [t.writes[port] for t in tasks] for port in tasks[0].writes}
         #: output port -> the same positions as a slice or index array

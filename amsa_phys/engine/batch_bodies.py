@@ -28,6 +28,18 @@ def compass_heading() -> Any:
     return _body("compass_heading")
 
 
+def write_outputs() -> Any:
+    """``_groupbodies.write_outputs`` (a group's finite float64 output columns written into the
+    store in one call, ``Steppers.step_group``), or None."""
+    return _body("write_outputs")
+
+
+def gather_inputs() -> Any:
+    """``_groupbodies.gather_inputs`` (a group's input columns copied out of the store into
+    the rows of one new block in one call, ``Steppers.step_group``), or None."""
+    return _body("gather_inputs")
+
+
 def _body(name: str) -> Any:
     module = publish._extension("_groupbodies")
     return None if module is None else getattr(module, name, None)

@@ -26,6 +26,7 @@ from array import array
 from collections.abc import Callable, Mapping, MutableMapping
 from dataclasses import dataclass, field
 from fractions import Fraction
+from itertools import islice
 from typing import Any
 
 import numpy as np
@@ -33,7 +34,7 @@ import numpy as np
 from ..errors import RunFault
 from ..model.params import short_repr
 from ..model.template import Template
-from . import batch, interrupt, kernels, publish
+from . import batch, batch_bodies, interrupt, kernels, publish
 from .delayedstep import packed_delayed
 from .timing import DelayLine
 from .verdicts import (
@@ -152,6 +153,12 @@ class Steppers:
         #: the compiled bodies' type (``kernels.py``), asked once per run, not per task
         self._kernel = publish.kernel() if packed else None
         self._made: dict[int, tuple[Task, Callable[[Task, Fraction], None]]] = {}
+        #: a group's outputs judged and written in one compiled call (``_groupbodies.c``)
+        #: where built and the store is one float64 array
+        #: and its inputs gathered in one (both None on the pure path)
+        store = isinstance(col, np.ndarray) and col.dtype == np.float64 and col.ndim == 1
+        self._write = batch_bodies.write_outputs() if store else None
+        self._gather_in = batch_bodies.gather_inputs() if store else None
 
     def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:
         """How ``task`` steps: the lean scalar path, array ports, or through its delay line.
@@ -392,12 +399,23 @@ class Steppers:
     def step_group(self, group: batch.Group, now: Fraction) -> None:
         """Run a group of like components in one call (``engine/batch.py``).
 
-        Each input port is the members' column gathered in one numpy call (a copy: a
-        template may keep or edit its inputs), each output written back into the store's
-        array in place, in one call too (only the published rows, under a mask).
+        Each input port is the members' column, a copy (a template may keep or edit its
+        inputs), each output written back into the store's array in place (only the
+        published rows, under a mask). Compiled where built (``_groupbodies.c``): the inputs
+        gathered into one block's rows in one call, the usual outputs (finite float64
+        columns) judged and written in one; what the writer declines, and every output of a
+        delayed group, goes through the loop below, which names a bad output as ever.
         """
         col = self.col
-        inp = {port: col[at].copy() if type(at) is slice else col[at] for port, at in group.inputs}
+        n = len(group.paths)
+        if self._gather_in is None:
+            inp = {p: col[at].copy() if type(at) is slice else col[at] for p, at in group.inputs}
+        elif group.ats:  # one new block, a row an input: each row the template's to keep
+            block = np.empty((len(group.ats), n))
+            self._gather_in(col, group.ats, block)
+            inp = dict(zip(group.ports, block, strict=True))
+        else:
+            inp = {}
         who = self.who
         try:
             out, published = group.template.step_many(
@@ -415,7 +433,6 @@ class Steppers:
             raise RunFault(
                 who(group.paths[0]), now, f"step_many must return (outputs, published): {exc}"
             ) from exc
-        n = len(group.paths)
         if not (isinstance(out, Mapping) and (published is None or _is_mask(published, n))):
             raise RunFault(
                 who(group.paths[0]),
@@ -425,7 +442,20 @@ class Steppers:
                 f"{short_repr(published)})",
             )
         outputs = group.outputs
-        for port, arr in out.items():
+        items: Any = out.items()
+        if self._write is not None and type(out) is dict:
+            # the usual outputs in one call; the loop below takes whatever it left, from
+            # the first output it did not take, so a fault names the same output as before
+            if group.delay is None:
+                done = self._write(out, outputs, col, published, np.ndarray, n)
+            else:  # judged in one call, then sent in order as the loop sends them
+                done = self._write(out, outputs, None, published, np.ndarray, n)
+                for port, arr in islice(items, done):
+                    self._send_group(group, port, arr, published)
+            if done == len(out):
+                return
+            items = islice(items, done, None)
+        for port, arr in items:
             at = outputs.get(port)
             if at is None:
                 raise RunFault(
@@ -445,16 +475,24 @@ class Steppers:
             if k is not None:
                 fault = RunFault(who(group.paths[k]), now, f"output {port} is {arr[k]}")
                 raise in_run(fault, group.tasks[k].run)
-            if group.delay is not None:  # the copies' common latency (no jitter: batch.py)
-                # whole columns in flight (a copy: the template may reuse its array)
-                if published is None:
-                    self.send(group.delay, [(at, arr.copy())])
-                else:
-                    where = np.asarray(group.targets[port], dtype=np.intp)[published]
-                    self.send(group.delay, [(where, arr[published])])
+            if group.delay is not None:
+                self._send_group(group, port, arr, published)
             elif published is None:
                 col[at] = arr
             elif type(at) is slice:
                 np.copyto(col[at], arr, where=published)
             else:
                 col[at[published]] = arr[published]
+
+    def _send_group(
+        self, group: batch.Group, port: str, arr: np.ndarray, published: np.ndarray | None
+    ) -> None:
+        """A delayed group's judged output ``port`` put in flight: the copies' common
+        latency (no jitter: ``batch.py``), the whole column (a copy: the template may reuse
+        its array) or its published rows."""
+        assert group.delay is not None
+        if published is None:
+            self.send(group.delay, [(group.outputs[port], arr.copy())])
+        else:
+            where = np.asarray(group.targets[port], dtype=np.intp)[published]
+            self.send(group.delay, [(where, arr[published])])
