@@ -11,11 +11,16 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
+from amsa_phys.engine import publish
 from amsa_phys.engine.tasks import Steppers, Task
 from amsa_phys.gym import FollowEnv
 
 BUILT = importlib.util.find_spec("amsa_phys.engine._kernels") is not None
-pytestmark = pytest.mark.skipif(not BUILT, reason="the extension was not built (no C compiler)")
+#: built and not switched off (``AMSA_PHYS_PURE=1``)
+pytestmark = pytest.mark.skipif(
+    not BUILT or publish._extension("_kernels") is None,
+    reason="the extension was not built (no C compiler), or the pure path was asked for",
+)
 
 
 class Comp:
