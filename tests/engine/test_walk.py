@@ -14,15 +14,21 @@ import yaml
 
 import amsa_phys as ap
 from amsa_phys.api.source import load
-from amsa_phys.engine import walk
+from amsa_phys.engine import publish, walk
 from amsa_phys.engine.runner import Simulation
 from amsa_phys.errors import RunFault
 from amsa_phys.gym import FollowEnv
 from amsa_phys.model.scenario import Change, load_scenario
 
 ROOT = Path(__file__).resolve().parents[2]
-BUILT = importlib.util.find_spec("amsa_phys.engine._kernels") is not None
-pytestmark = pytest.mark.skipif(not BUILT, reason="the extension was not built (no C compiler)")
+#: built, and not switched off (``AMSA_PHYS_PURE=1``: the Python paths alone run)
+BUILT = (
+    importlib.util.find_spec("amsa_phys.engine._kernels") is not None
+    and publish._extension("_kernels") is not None
+)
+pytestmark = pytest.mark.skipif(
+    not BUILT, reason="the extension was not built (no C compiler), or the pure path was asked for"
+)
 
 
 def _python_loop(monkeypatch: pytest.MonkeyPatch) -> None:
