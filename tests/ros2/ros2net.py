@@ -116,7 +116,12 @@ def run_with_nodes(
         lines.append(f"{cmd} >>{shlex.quote(str(log))} 2>&1 & pids+=($!)")
     amsa = " ".join(shlex.quote(str(a)) for a in [PY, "-m", "amsa_phys", *amsa_args])
     lines.append(f"{amsa} >{shlex.quote(str(out))} 2>{shlex.quote(str(err))}; rc=$?")
-    lines.append('for p in "${pids[@]}"; do kill "$p" 2>/dev/null; wait "$p" 2>/dev/null; done')
+    # each node stopped by SIGTERM, then (a failure deadline, a node that does not stop) SIGKILL
+    stop = (
+        'kill "$p" 2>/dev/null; for _ in $(seq 600); do kill -0 "$p" 2>/dev/null || break;'
+        ' sleep 0.1; done; kill -9 "$p" 2>/dev/null; wait "$p" 2>/dev/null'
+    )
+    lines.append(f'for p in "${{pids[@]}}"; do {stop}; done')
     lines.append("exit $rc")
     script = tmp / "run.sh"
     script.write_text("\n".join(lines) + "\n")
