@@ -208,3 +208,26 @@ def metrics_without_wall(run_dir: Path) -> dict:
     for key in ("wall_time_s", "real_time_factor"):
         data.pop(key)
     return data
+
+
+def bag_topics(bag: Path) -> dict[str, list[float]]:
+    """Every message of a ROS 1 bag, by topic, with rosbag's own reader (Debian's Python)."""
+    code = (
+        "import sys, json; sys.path.append('/usr/lib/python3/dist-packages'); import rosbag\n"
+        "out = {}\n"
+        f"for topic, msg, _ in rosbag.Bag({str(bag)!r}).read_messages():\n"
+        "    out.setdefault(topic, []).append(msg.data)\n"
+        "print(json.dumps(out))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+def runs(values: list[float]) -> list[float]:
+    """``values`` with consecutive repeats removed."""
+    out: list[float] = []
+    for v in values:
+        if not out or out[-1] != v:
+            out.append(v)
+    return out

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import pytest
 import ros_launch
-from ros_launch import Launch, package_edit, ros_missing
+from ros_launch import Launch, bag_topics, package_edit, ros_missing, runs
 
 from amsa_phys.cli.main import main
 from amsa_phys.model.scenario import load_scenario
@@ -69,29 +69,6 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
 _metrics = ros_launch.metrics_without_wall
 
 
-def _bag_topics(bag: Path) -> dict[str, list[float]]:
-    """Every message of the bag, by topic, with rosbag's own reader."""
-    code = (
-        "import sys, json; sys.path.append('/usr/lib/python3/dist-packages'); import rosbag\n"
-        "out = {}\n"
-        f"for topic, msg, _ in rosbag.Bag({str(bag)!r}).read_messages():\n"
-        "    out.setdefault(topic, []).append(msg.data)\n"
-        "print(json.dumps(out))\n"
-    )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
-    return json.loads(done.stdout)
-
-
-def _runs(values: list[float]) -> list[float]:
-    """``values`` with consecutive repeats removed."""
-    out: list[float] = []
-    for v in values:
-        if not out or out[-1] != v:
-            out.append(v)
-    return out
-
-
 def test_lockstep_reproduces_amsa_phys_run(
     workspace: Path, reference: Path, launcher: Callable[..., Launch], tmp_path: Path
 ) -> None:
@@ -118,13 +95,13 @@ def test_lockstep_reproduces_amsa_phys_run(
     world = load_scenario(SCENARIO).world
     delayed = {p for p, leaf in world.leaves.items() if leaf.timing.delayed}
     assert delayed == {"MyFollowerController", "FollowerGPS"}
-    topics = _bag_topics(bag)
+    topics = bag_topics(bag)
     rows = list(csv.reader((reference / "trace.csv").open()))
     for i, column in enumerate(rows[0][1:], start=1):
         topic = "/" + column.replace(".", "/")
         assert topic in topics, topic
-        trace = _runs([float(r[i]) for r in rows[1:]])
-        messages = _runs([trace[0], *topics[topic]])
+        trace = runs([float(r[i]) for r in rows[1:]])
+        messages = runs([trace[0], *topics[topic]])
         if column.rpartition(".")[0] in delayed:
             assert messages[: len(trace)] == trace, column
             assert len(messages) - len(trace) <= 3, column  # 0.75 s at 4 Hz: 3 in flight

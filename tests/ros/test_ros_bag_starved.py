@@ -16,18 +16,15 @@ conftest.py). Skipped, with the reason, where ROS, catkin, unshare or root is mi
 from __future__ import annotations
 
 import csv
-import json
 import os
 import signal
-import subprocess
-import sys
 from collections.abc import Callable
 from fractions import Fraction
 from pathlib import Path
 
 import pytest
 import ros_launch
-from ros_launch import Launch, ros_missing
+from ros_launch import Launch, bag_topics, ros_missing, runs
 
 from amsa_phys.cli.main import main
 from amsa_phys.model.scenario import load_scenario
@@ -54,29 +51,6 @@ def _process(token: str, name: str) -> int:
         if want in argv:
             return pid
     raise AssertionError(f"no process of node {name} in the launch")
-
-
-def _bag_topics(bag: Path) -> dict[str, list[float]]:
-    """Every message of the bag, by topic, with rosbag's own reader (Debian's Python)."""
-    code = (
-        "import sys, json; sys.path.append('/usr/lib/python3/dist-packages'); import rosbag\n"
-        "out = {}\n"
-        f"for topic, msg, _ in rosbag.Bag({str(bag)!r}).read_messages():\n"
-        "    out.setdefault(topic, []).append(msg.data)\n"
-        "print(json.dumps(out))\n"
-    )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
-    return json.loads(done.stdout)
-
-
-def _runs(values: list[float]) -> list[float]:
-    """``values`` with consecutive repeats removed."""
-    out: list[float] = []
-    for v in values:
-        if not out or out[-1] != v:
-            out.append(v)
-    return out
 
 
 def test_a_starved_recorder_loses_no_message(
@@ -115,13 +89,13 @@ def test_a_starved_recorder_loses_no_message(
     # 0.05 s, faster than any Leaf publishes); a delayed Leaf's last ones, in flight when the
     # run ends, are in the bag only
     delayed = {p for p, leaf in world.leaves.items() if leaf.timing.delayed}
-    topics = _bag_topics(bag)
+    topics = bag_topics(bag)
     rows = list(csv.reader((reference / "trace.csv").open()))
     for i, column in enumerate(rows[0][1:], start=1):
         topic = "/" + column.replace(".", "/")
         assert topic in topics, topic
-        trace = _runs([float(r[i]) for r in rows[1:]])
-        messages = _runs([trace[0], *topics[topic]])
+        trace = runs([float(r[i]) for r in rows[1:]])
+        messages = runs([trace[0], *topics[topic]])
         if column.rpartition(".")[0] in delayed:
             assert messages[: len(trace)] == trace, column
         else:
