@@ -9,6 +9,7 @@ their id).
 from __future__ import annotations
 
 import contextlib
+import csv
 import json
 import os
 import shutil
@@ -231,3 +232,26 @@ def runs(values: list[float]) -> list[float]:
         if not out or out[-1] != v:
             out.append(v)
     return out
+
+
+def assert_bag_holds_the_trace(bag: Path, trace_csv: Path, delayed: set[str]) -> dict[str, int]:
+    """Every Data topic of ``bag`` carries the values ``trace_csv`` shows, in the same order
+    (the trace samples faster than any Leaf publishes, so it sees each message that changes a
+    value). A delayed Leaf's messages reach the trace later: its last ones, still in flight
+    when the run ends, are in the bag only. Returns how many such extra values each delayed
+    Leaf's columns have."""
+    topics = bag_topics(bag)
+    with trace_csv.open() as f:
+        rows = list(csv.reader(f))
+    extra: dict[str, int] = {}
+    for i, column in enumerate(rows[0][1:], start=1):
+        topic = "/" + column.replace(".", "/")
+        assert topic in topics, topic
+        trace = runs([float(r[i]) for r in rows[1:]])
+        messages = runs([trace[0], *topics[topic]])
+        if column.rpartition(".")[0] in delayed:
+            assert messages[: len(trace)] == trace, column
+            extra[column] = len(messages) - len(trace)
+        else:
+            assert messages == trace, column
+    return extra

@@ -15,7 +15,6 @@ conftest.py). Skipped, with the reason, where ROS, catkin, unshare or root is mi
 
 from __future__ import annotations
 
-import csv
 import os
 import signal
 from collections.abc import Callable
@@ -24,7 +23,7 @@ from pathlib import Path
 
 import pytest
 import ros_launch
-from ros_launch import Launch, bag_topics, ros_missing, runs
+from ros_launch import Launch, assert_bag_holds_the_trace, ros_missing
 
 from amsa_phys.cli.main import main
 from amsa_phys.model.scenario import load_scenario
@@ -89,16 +88,6 @@ def test_a_starved_recorder_loses_no_message(
     # 0.05 s, faster than any Leaf publishes); a delayed Leaf's last ones, in flight when the
     # run ends, are in the bag only
     delayed = {p for p, leaf in world.leaves.items() if leaf.timing.delayed}
-    topics = bag_topics(bag)
-    rows = list(csv.reader((reference / "trace.csv").open()))
-    for i, column in enumerate(rows[0][1:], start=1):
-        topic = "/" + column.replace(".", "/")
-        assert topic in topics, topic
-        trace = runs([float(r[i]) for r in rows[1:]])
-        messages = runs([trace[0], *topics[topic]])
-        if column.rpartition(".")[0] in delayed:
-            assert messages[: len(trace)] == trace, column
-        else:
-            assert messages == trace, column
+    assert_bag_holds_the_trace(bag, reference / "trace.csv", delayed)
     # and the simulator saw the recorder write every message it counted before it ended
     assert "the bag is incomplete" not in text, text[-3000:]
