@@ -202,14 +202,18 @@ def main() -> None:
     except OSError as exc:
         rosio.fail(rospy, f"{NODE}: cannot write {path}: {exc.strerror}")
         return
-    startup.started()
-    for sig in startup.SIGNALS:
-        signal.signal(sig, lambda *_: stop.set())
-    rospy.on_shutdown(stop.set)
-    print(f"{NODE}: recording {len(topics)} topics to {path}", flush=True)
-    while not stop.wait(1.0):
-        pass
-    recorder.drain()
-    recorder.close()
+    # whatever ends the loop (a signal, or an exception: a KeyboardInterrupt in the instant
+    # between start-up's handlers and these), the bag is closed and given its name
+    try:
+        startup.started()
+        for sig in startup.SIGNALS:
+            signal.signal(sig, lambda *_: stop.set())
+        rospy.on_shutdown(stop.set)
+        print(f"{NODE}: recording {len(topics)} topics to {path}", flush=True)
+        while not stop.wait(1.0):
+            pass
+        recorder.drain()
+    finally:
+        recorder.close()
     print(f"{NODE}: {sum(recorder.counts.values())} messages in {path}", flush=True)
     rospy.signal_shutdown("recorded")
