@@ -59,17 +59,10 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Skip ``@pytest.mark.slow`` tests unless asked for; keep some tests on one worker.
+    """Skip ``@pytest.mark.slow`` tests unless asked for (``--runslow``, AMSA_RUNSLOW=1).
 
-    Under ``pytest -n 2 --dist loadgroup`` (the full suite's command) every ROS 1, ROS 2 and
-    build test runs on one worker, one after another, while the other worker takes the rest:
-    their package builds (module fixtures) happen once, two ROS graphs never compete for the
-    same two cores, and two workers never pip-install (or uninstall) the same package into
-    the one environment at once. Without xdist the group is ignored.
+    Which tests share a worker under ``pytest -n 2 --dist loadgroup`` is tests/tiers.py's.
     """
-    for item in items:
-        if any(item.get_closest_marker(m) for m in ("ros", "ros2", "build")):
-            item.add_marker(pytest.mark.xdist_group("serial"))
     if config.getoption("--runslow") or os.environ.get("AMSA_RUNSLOW") == "1":
         return
     skip = pytest.mark.skip(reason="slow: run with --runslow or AMSA_RUNSLOW=1")

@@ -36,14 +36,34 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     parser.addini("cpu_budget_s", "CPU seconds an unmarked test may spend", default=str(BUDGET_S))
 
 
+#: the kinds that share one worker under the full suite's ``pytest -n 2 --dist loadgroup``
+SERIAL_KINDS = ("ros", "ros2", "build")
+
+
+@pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the group marks
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """A test using a launch fixture is a ROS test."""
+    """A test using a launch fixture is a ROS test; ROS 1, ROS 2 and build tests share a worker.
+
+    Under ``pytest -n 2 --dist loadgroup`` (the full suite's command) those tests run on one
+    worker, one after another, while the other worker takes the rest: their package builds
+    (module fixtures) happen once, two ROS graphs never compete for the same two cores, and
+    two workers never pip-install (or uninstall) the same package into the one environment
+    at once. Without xdist the group is ignored.
+
+    xdist's worker turns the ``xdist_group`` marks into an ``@serial`` suffix of the node ids
+    in its own hook of this name, so this one runs first. With pytest 9.2 that suffix is lost
+    (pyproject.toml keeps pytest below it) and nothing was grouped: each such test was a work
+    unit of its own, one worker uninstalled the plugin another was using.
+    tests/test_serial_group.py fails if the suffix is missing again.
+    """
     for item in items:
         # not ``"ros" in item.keywords``: a test under tests/ros/ has that keyword (its folder)
         # and so was never marked
         needs_ros = ROS_FIXTURES & set(getattr(item, "fixturenames", ()))
         if needs_ros and item.get_closest_marker("ros") is None:
             item.add_marker(pytest.mark.ros)
+        if any(item.get_closest_marker(kind) for kind in SERIAL_KINDS):
+            item.add_marker(pytest.mark.xdist_group("serial"))
 
 
 def cpu_seconds() -> float:
