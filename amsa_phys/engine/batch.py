@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -298,6 +299,15 @@ def gauss_markov(state: dict[str, Any], sigma: Any, tau: Any, dt: float) -> Any:
     if hit is None or hit[0] is not sigma or hit[1] is not tau or hit[2] != dt:
         hit = state["_gauss_markov"] = (sigma, tau, dt, noise.gauss_markov_many(sigma, tau, dt))
     return hit[3]
+
+
+# the quick check below squares the values: finite values above ~1e154 overflow it, which
+# numpy reports as a RuntimeWarning attributed to this module. The overflow is expected and
+# handled (the exact check clears such values), so that one message from here is not shown;
+# a filter costs nothing per call, where ``np.errstate`` would cost more than the check.
+warnings.filterwarnings(
+    "ignore", message="overflow encountered in dot", category=RuntimeWarning, module=__name__
+)
 
 
 def first_bad(arr: np.ndarray, published: np.ndarray | None) -> int | None:

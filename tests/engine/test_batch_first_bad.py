@@ -47,3 +47,12 @@ def test_a_broadcast_view_is_checked_like_a_copy() -> None:
     """A template may return one number for every copy (``step_group`` broadcasts it)."""
     assert first_bad(np.broadcast_to(np.float64(np.nan), (4,)), None) == 0
     assert first_bad(np.broadcast_to(np.float64(2.0), (4,)), None) is None
+
+
+def test_huge_finite_values_raise_no_warning_a_user_would_see() -> None:
+    """The quick check's overflow is expected: a run with huge values prints no numpy warning."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as seen:
+        assert first_bad(np.array([1e200, 2.0]), None) is None
+    assert [str(w.message) for w in seen] == []
