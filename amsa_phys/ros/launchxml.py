@@ -235,10 +235,12 @@ def launch_xml(
     lines += [
         "",
         "  <!-- bag:=FILE.bag records every Data topic (connected before the run starts; it"
-        " never drops a message: a recorder behind slows the run) -->",
+        " never drops a message: a recorder behind slows the run; required: a bag it cannot"
+        " write ends the launch at once, saying why) -->",
         fill(
             '  <node if="$(eval arg(\'bag\') != \'\')" pkg="@@{pkg:xml_attr}"'
-            ' type="@@{bag:xml_attr}.py" name="@@{bag:xml_attr}" output="screen"',
+            ' type="@@{bag:xml_attr}.py" name="@@{bag:xml_attr}" required="true"'
+            ' output="screen"',
             pkg=pkg,
             bag=names.BAG,
         ),
