@@ -10,11 +10,15 @@ CPython does, or the traces would differ from the pure path's.
 
 from setuptools import Extension, setup
 
+#: Python's float ``%`` in C, included by three of the extensions (their angle wrapping)
+PYMOD = "amsa_phys/pymod.h"
+
 setup(
     ext_modules=[
         Extension(
             "amsa_phys.physics._step",
             ["amsa_phys/physics/_step.c"],
+            depends=[PYMOD],
             extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"],
             libraries=["m"],
             optional=True,
@@ -24,6 +28,7 @@ setup(
         Extension(
             "amsa_phys.engine._kernels",
             ["amsa_phys/engine/_kernels.c"],
+            depends=[PYMOD],
             # the components' bodies (``engine/kernels.py``) round as Python's arithmetic does
             extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"],
             libraries=["m"],
@@ -32,6 +37,7 @@ setup(
         Extension(
             "amsa_phys.engine._groupbodies",
             ["amsa_phys/engine/_groupbodies.c"],
+            depends=[PYMOD],
             # component groups' numpy arithmetic as one loop (``engine/batch_bodies.py``)
             extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"],
             libraries=["m"],

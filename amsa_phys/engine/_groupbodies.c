@@ -17,6 +17,8 @@
 
 #include <math.h>
 
+#include "../pymod.h" /* Python's float %, shared */
+
 /* One argument's buffer: its items' base and stride (bytes). */
 typedef struct {
     char *buf;
@@ -139,17 +141,6 @@ static PyObject *gps_fix(PyObject *Py_UNUSED(module), PyObject *args)
  *   lost = u*100.0 < lostData; published = !lost
  * Returns the number of members lost. */
 #define COMPASS_ARGS 15
-static double floor_mod(double a, double b)
-{
-    double mod = fmod(a, b);
-    if (mod != 0.0) {
-        if ((b < 0) != (mod < 0))
-            mod += b;
-    } else {
-        mod = copysign(0.0, b);
-    }
-    return mod;
-}
 
 static PyObject *compass_heading(PyObject *Py_UNUSED(module), PyObject *args)
 {
@@ -177,10 +168,10 @@ static PyObject *compass_heading(PyObject *Py_UNUSED(module), PyObject *args)
                        AT(c[8], k, double) * AT(c[1], k, double);
         value += AT(c[7], k, double);
         value += AT(c[14], k, double);
-        value = floor_mod(value + pi, two_pi) - pi;
+        value = py_mod(value + pi, two_pi) - pi;
         const double precision = AT(c[9], k, double);
         if (precision > 0) {
-            value = floor_mod(floor(value / precision + 0.5) * precision + pi, two_pi) - pi;
+            value = py_mod(floor(value / precision + 0.5) * precision + pi, two_pi) - pi;
         }
         AT(c[12], k, double) = value;
         const char lost = AT(c[3], k, double) * 100.0 < AT(c[10], k, double);

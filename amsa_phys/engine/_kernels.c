@@ -11,6 +11,8 @@
 #include <Python.h>
 
 #include <math.h>
+
+#include "../pymod.h" /* Python's float %, shared */
 #include <string.h>
 
 /* Kernel(code, comp, ins, outs, values, fallback): a component whose do_step is plain
@@ -284,18 +286,6 @@ static PyObject *hand_fault(PyObject *failed, PyObject *now) {
     return NULL;
 }
 
-/* Python's float ``x % y`` (Objects/floatobject.c float_rem), for y != 0. */
-static double py_mod(double x, double y) {
-    double mod = fmod(x, y);
-    if (mod) {
-        if ((y < 0) != (mod < 0)) {
-            mod += y;
-        }
-    } else {
-        mod = copysign(0.0, y);
-    }
-    return mod;
-}
 
 /* ``n`` exact floats of the sequence ``seq`` into ``out``: 1, or 0 for anything else. */
 static int floats_of(PyObject *seq, Py_ssize_t n, double *out) {

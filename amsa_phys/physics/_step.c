@@ -18,6 +18,8 @@
 #include <Python.h>
 #include <structmember.h>
 #include <math.h>
+
+#include "../pymod.h" /* Python's float %, shared */
 #include <stdint.h>
 #include <string.h>
 
@@ -1669,17 +1671,6 @@ done:
  * the floor-modulo of Python and numpy (fmod, then the divisor added when the signs differ,
  * +-0 given the divisor's sign); diff = gain * err; forward = power * (cos(err) if
  * cos(err) > 0 else 0, NaN giving 0); left = forward - diff, right = forward + diff. */
-static double floor_mod(double a, double b)
-{
-    double mod = fmod(a, b);
-    if (mod != 0.0) {
-        if ((b < 0) != (mod < 0))
-            mod += b;
-    } else {
-        mod = copysign(0.0, b);
-    }
-    return mod;
-}
 
 static PyObject *steer_random(PyObject *Py_UNUSED(module), PyObject *args)
 {
@@ -1707,7 +1698,7 @@ static PyObject *steer_random(PyObject *Py_UNUSED(module), PyObject *args)
     const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
     for (Py_ssize_t k = 0; k < n; k++) {
         const double power = cruise[k] * factor[k];
-        const double err = floor_mod(heading[k] - angle[k] + pi, two_pi) - pi;
+        const double err = py_mod(heading[k] - angle[k] + pi, two_pi) - pi;
         const double diff = gain[k] * err;
         const double c = cos(err);
         const double forward = power * (c > 0.0 ? c : 0.0);
@@ -1762,7 +1753,7 @@ static PyObject *robot_poses(PyObject *Py_UNUSED(module), PyObject *args)
         const double a = r[2];
         out[j] = r[0];
         out[m + j] = r[1];
-        out[2 * m + j] = floor_mod(a + pi, two_pi) - pi;
+        out[2 * m + j] = py_mod(a + pi, two_pi) - pi;
         out[3 * m + j] = r[3] * cos(a) + r[4] * sin(a);
         out[4 * m + j] = r[5];
         out[5 * m + j] = rims[k];
