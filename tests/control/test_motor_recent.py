@@ -69,6 +69,15 @@ def test_motors_that_recover_show_in_the_recent_share_within_its_window() -> Non
     assert outs[119.0]["recent"] == pytest.approx(0.8, abs=1e-3)  # settled
 
 
+def test_a_command_too_small_for_the_short_window_reads_zero() -> None:
+    """``minPower`` is the whole window's floor: a window 6 times shorter needs 6 times the
+    command (its path speed is 6 times noisier), so 10 % is judged over 15 s, not over 5 s."""
+    short = _drive(lambda t: 1.0, lambda t: 10.0, {"recentWindow": 5.0}, 90.0)
+    longer = _drive(lambda t: 1.0, lambda t: 10.0, {"recentWindow": 15.0}, 90.0)
+    assert all(o["recent"] == 0.0 for o in short.values())
+    assert longer[89.0]["recent"] == pytest.approx(1.0, abs=1e-3)
+
+
 def test_a_window_whose_command_cancels_out_reads_zero() -> None:
     """A loop swinging back and forth: its short windows cannot judge the motors."""
 

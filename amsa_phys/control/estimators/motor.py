@@ -371,7 +371,10 @@ class MotorMonitor(Template):
         power = self.recent_power.items
         command = sum(v for _, v in power) / len(power)
         magnitude = sum(abs(v) for _, v in power) / len(power)
-        if command < p.minPower or command < (1.0 - p.maxReverse) * magnitude:
+        # the least command scales as the window shortens: ``minPower`` is the whole
+        # window's, and a path speed over a window k times shorter is k times noisier
+        least = max(p.minPower, p.minPower * p.window / p.recentWindow)
+        if command < least or command < (1.0 - p.maxReverse) * magnitude:
             return 0.0
         share = (p.frictionPower + 100.0 * speed / p.maxSpeed) / command
         return min(share, 1.0) if share <= p.maxShare else 0.0
