@@ -51,6 +51,7 @@ from .cellrules import cell_rules as rules_of_cells
 from .cellrules import whole
 from .damping import FACTOR, STEPS, Damping, damping
 from .grid import lowest, robust_point, safe_best
+from .recovery import recovery
 from .table import read_table
 
 #: Default safety margin: a best point's grid neighbours may be at most this much worse.
@@ -120,6 +121,8 @@ class Derivation:
     refused: str | None = None
     #: the damping rule, when the sweep measured the path speed (``damping.py``)
     damping: Damping | None = None
+    #: the recovery rule, when the motor estimate has a recent share (``recovery.py``)
+    recovery: dict[str, Any] | None = None
 
     @property
     def gain(self) -> float:
@@ -281,6 +284,11 @@ def derive(
             _switched_band(cell_rules, derivation.robust, derivation.damping.leaf, found)
         )
         fallbacks.insert(0, derivation.damping.rule)
+    for w in found:
+        if derivation.recovery is None and w.signal in {s for c in placed for s in c.levels}:
+            derivation.recovery = recovery(scenario, cell_rules, derivation.robust, w.signal)
+    if derivation.recovery is not None:
+        fallbacks.insert(0, derivation.recovery)
     derivation.rules = fallbacks + cell_rules
     return derivation
 

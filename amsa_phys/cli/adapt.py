@@ -374,6 +374,17 @@ def table(found: Derivation) -> list[str]:
             f"(the fastest under a chosen point: {d.fastest:g}); its fallback waits for "
             f"pathSpeed below {d.release:g}"
         )
+    r = found.recovery
+    if r is not None:
+        point = ", ".join(f"{k}={v}" for k, v in r["set"].items())
+        when = " and ".join(
+            f"{k} {'above' if 'above' in b else 'below'} {b.get('above', b.get('below')):g}"
+            for k, b in r["when"].items()
+        )
+        lines.append(
+            f"recovery: {point} when {when} for {r['hold']:g} s (motors a high gain was set "
+            "for recover)"
+        )
     return lines
 
 

@@ -93,7 +93,12 @@ def _motor(share: float, reverse: int = 0) -> dict:
 def test_a_share_a_little_above_one_is_noise_published_as_one() -> None:
     out = _motor(1.08)
     speed = (1.08 * 20.0 - 2.9) / 100.0 * 5.5  # the path speed is the fixes' own
-    assert out == {"delivered": 1.0, "valid": 1.0, "pathSpeed": pytest.approx(speed)}
+    assert out == {
+        "delivered": 1.0,
+        "valid": 1.0,
+        "pathSpeed": pytest.approx(speed),
+        "recent": 0.0,  # off by default
+    }
 
 
 def test_a_share_far_above_one_or_a_reversing_command_is_invalid() -> None:

@@ -152,6 +152,8 @@ def _motor(rng: np.random.Generator) -> Case:
     # the held estimate's decaying confidence, and how much cancelling out ends it
     params["validHold"] = float(rng.choice([0.0, 20.0, rng.uniform(0.5, 60.0)]))
     params["holdReverse"] = float(rng.choice([1.0, 0.4, rng.uniform(0.0, 1.0)]))
+    # the recent share's short window: off, the world's, or anything in range
+    params["recentWindow"] = float(rng.choice([0.0, 5.0, 8.0, rng.uniform(0.5, 20.0)]))
     # the estimate over forward seconds only: off, the world's, or anything in range
     params["forwardPower"] = float(rng.choice([0.0, 3.0, 3.0, rng.uniform(0.0, 20.0)]))
     params["settle"] = float(rng.choice([5.0, 0.0, rng.uniform(0.0, 15.0)]))

@@ -81,7 +81,7 @@ class MotorMonitor(Template):
     kind = Kind.OBSERVER
     uses_random = False
     #: the windows are sized once, at initialize
-    fixed_once_running = frozenset({"window", "speedWindow"})
+    fixed_once_running = frozenset({"window", "speedWindow", "recentWindow"})
     inputs = (
         Port("powerL", 0.0, "commanded left power", "%"),
         Port("powerR", 0.0, "commanded right power", "%"),
@@ -92,6 +92,12 @@ class MotorMonitor(Template):
         Port("delivered", 1.0, "share of commanded power delivered (0..1)", ""),
         Port("valid", 0.0, "1 when the window's estimate can be trusted, else 0", ""),
         Port("pathSpeed", 0.0, "mean path speed over speedWindow (0 until full)", "m/s"),
+        Port(
+            "recent",
+            0.0,
+            "share over the last recentWindow s, 0 when that window cannot judge (0..1)",
+            "",
+        ),
     )
     params = (
         Param("window", "float", "length of the estimate's window", 30.0, 1.0, 3600.0, "s"),
@@ -233,6 +239,15 @@ class MotorMonitor(Template):
             "s",
         ),
         Param(
+            "recentWindow",
+            "float",
+            "window of the recent share (0: off, recent stays 0)",
+            0.0,
+            0.0,
+            3600.0,
+            "s",
+        ),
+        Param(
             "holdReverse",
             "float",
             "cancelling-out share of the window's command that ends validHold at once (1: never)",
@@ -250,6 +265,9 @@ class MotorMonitor(Template):
         self.path: Window[float] = Window(self.p.window)
         self.speed_path: Window[float] = Window(self.p.speedWindow or self.p.window)
         self.path_speed = 0.0
+        self.recent_power: Window[float] = Window(self.p.recentWindow)
+        self.recent_path: Window[float] = Window(self.p.recentWindow)
+        self.recent = 0.0
         self.fix: tuple[float, float, float] | None = None
         #: each path segment as (duration, length, command sum, command count, counts), where
         #: it counts when its every command was forward and had been for ``settle`` s
@@ -265,6 +283,8 @@ class MotorMonitor(Template):
         now = float(t)
         p = self.p
         self.power.add(now, 0.5 * (inp["powerL"] + inp["powerR"]))
+        if p.recentWindow > 0:
+            self.recent_power.add(now, 0.5 * (inp["powerL"] + inp["powerR"]))
         x, y = inp["posX"], inp["posY"]
         if self.fix is None:
             self.fix = (now, x, y)
@@ -273,6 +293,8 @@ class MotorMonitor(Template):
             self.path.add(now, step)
             self.speed_path.add(now, step)
             self.path_speed = self._path_speed()
+            if p.recentWindow > 0:
+                self.recent_path.add(now, step)
             # the segment's commands are those from its first fix up to (not with) this one
             counts = (
                 self.seg_count > 0
@@ -299,7 +321,14 @@ class MotorMonitor(Template):
                 self._forward_estimate(now)
         elif self.power.covered_s() >= p.window - 1e-9 and self.path.covered_s() > 0:
             self._window_estimate(now)
-        return {"delivered": self.estimate, "valid": self.valid, "pathSpeed": self.path_speed}
+        if p.recentWindow > 0:
+            self.recent = self._recent_share()
+        return {
+            "delivered": self.estimate,
+            "valid": self.valid,
+            "pathSpeed": self.path_speed,
+            "recent": self.recent,
+        }
 
     def _path_speed(self) -> float:
         """Path length over the speed window's span, once it is full (else 0).
@@ -316,6 +345,52 @@ class MotorMonitor(Template):
         steps = window.items
         # the first segment ends at the window's start: it lies before the span
         return (sum(d for _, d in steps) - steps[0][1]) / (steps[-1][0] - steps[0][0])
+
+    def _recent_share(self) -> float:
+        """The share over the last ``recentWindow`` s, judged as the whole window is (0 when
+        that window is not full, its command is too small or cancels out, or the share is
+        impossible); its speeds at the edges are taken over a quarter of it (at most ``edge``).
+
+        Why a second, short window: a high gain set for very worn motors stays in force on
+        motors that recover until the 30 s estimate turns unsure, and by then the loop swings.
+        Over a few seconds the follower, pushed by a worn motors' command on strong motors,
+        accelerates as those motors do: the short window shows the share going up before
+        the command reverses (docs/adaptation.md). It is not held: an unsure short window
+        says nothing, and a rule reading it fires only on a window that judged.
+        """
+        p = self.p
+        steps = self.recent_path.items
+        if self.recent_power.covered_s() < p.recentWindow - 1e-9 or len(steps) < 2:
+            return 0.0
+        span = steps[-1][0] - steps[0][0]
+        length = sum(d for _, d in steps) - steps[0][1]
+        edge = min(p.edge, 0.25 * p.recentWindow)
+        first = self._speed_over(list(steps), edge, True)
+        last = self._speed_over(list(reversed(steps)), edge, False)
+        speed = length / span + p.timeConstant * (last - first) / span
+        power = self.recent_power.items
+        command = sum(v for _, v in power) / len(power)
+        magnitude = sum(abs(v) for _, v in power) / len(power)
+        # the least command scales as the window shortens: ``minPower`` is the whole
+        # window's, and a path speed over a window k times shorter is k times noisier
+        least = max(p.minPower, p.minPower * p.window / p.recentWindow)
+        if command < least or command < (1.0 - p.maxReverse) * magnitude:
+            return 0.0
+        share = (p.frictionPower + 100.0 * speed / p.maxSpeed) / command
+        return min(share, 1.0) if share <= p.maxShare else 0.0
+
+    def _speed_over(self, steps: list[tuple[float, float]], edge: float, first: bool) -> float:
+        """Mean speed over ``edge`` s from ``steps[0]`` (oldest first when ``first``)."""
+        t_edge = steps[0][0]
+        total = count = 0.0
+        for i, (t, d) in enumerate(steps):
+            if i == 0 and first:
+                continue  # the first segment ends at the window's start
+            if abs(t - t_edge) > edge + 1e-9:
+                break
+            total += d
+            count += 1
+        return total / (count * self.p.spacing) if count else 0.0
 
     def _window_estimate(self, now: float) -> None:
         """The share over the whole window (the default; see the class docstring)."""
