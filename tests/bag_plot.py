@@ -29,10 +29,10 @@ SIGNAL = "/amsa/data/MyDistanceMonitor/distanceFollowerToLeader"
 
 
 def _short(detail: str) -> str:
-    """``phase 1 starts: A.b=1, C.d=2`` -> ``phase 1: A.b=1 ...`` (a label that fits)."""
+    """``phase 1 starts: A.b=1, C.d=2`` -> ``phase 1: A.b=1`` and ``C.d=2`` on the next line
+    (every value the phase sets: its first alone could name a value another one overrides)."""
     head, _, sets = detail.partition(" starts: ")
-    first, _, rest = sets.partition(", ")
-    return f"{head}: {first}{' ...' if rest else ''}" if first else head
+    return f"{head}: " + "\n".join(sets.split(", ")) if sets else head
 
 
 def plot_tracks(bag: Path, png: Path) -> dict[str, np.ndarray]:

@@ -182,9 +182,16 @@ class Timeline:
 
     def with_initial(self, changes: Iterable[Change]) -> Timeline:
         """The same timeline with ``changes`` added to the values at t = 0 (after the file's:
-        a later assignment of one parameter wins)."""
+        a later assignment of one parameter wins).
+
+        A file's assignment that one of ``changes`` overrides is dropped, not kept before it:
+        the value never takes effect, and whatever lists phase 0's values (a bag's events, a
+        run's description) would otherwise show the key twice with both values.
+        """
+        latest = {c.key: c for c in changes}  # of one key given twice, the last
         first = self.phases[0]
-        phase0 = dataclasses.replace(first, changes=[*first.changes, *changes])
+        kept = [c for c in first.changes if c.key not in latest]
+        phase0 = dataclasses.replace(first, changes=[*kept, *latest.values()])
         return dataclasses.replace(self, phases=(phase0, *self.phases[1:]))
 
 

@@ -186,6 +186,17 @@ def test_events_are_the_phases(tmp_path: Path) -> None:
     ]
 
 
+def test_an_overridden_value_is_listed_once_with_its_value(tmp_path: Path) -> None:
+    """``--set`` over a file's phase-0 value: the phase's event names the value in force only."""
+    _, bag = run_with_bag(tmp_path, "ov", "--duration", "10", "--set", "Leader.behavior=2")
+    _, msgs = read_mcap(bag)
+    (first, *_) = [m.detail for topic, _, m in msgs if topic == "/amsa/events"]
+    assert first == (
+        "phase 0 starts: LeaderGPS.lostDataGPS=0, MyNormalizePower.motorCoef=100, "
+        "MyFollowerController.Kv=0.35, Leader.behavior=2"
+    )
+
+
 def test_rosbags_reads_the_same_bag(mde: dict[str, Any]) -> None:
     """An independent reader (rosbags: its own MCAP parser and CDR deserialiser) finds the
     same topics, types, message counts and values."""

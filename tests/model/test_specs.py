@@ -69,9 +69,9 @@ def test_two_jobs_of_one_cached_scenario_do_not_see_each_others_values() -> None
         return Job(i, str(SCEN), (("MyFollowerController.Kv", kv),), 0, i + 1, (), 5.0)
 
     a, b = prepare_job(job(0, 0.1)), prepare_job(job(1, 0.3))
-    # the file's Kv, then the job's own: never the other job's
-    assert [c.value for c in a.timeline.initial if c.param == "Kv"] == [0.35, 0.1]
-    assert [c.value for c in b.timeline.initial if c.param == "Kv"] == [0.35, 0.3]
+    # the job's own Kv in place of the file's: never the other job's
+    assert [c.value for c in a.timeline.initial if c.param == "Kv"] == [0.1]
+    assert [c.value for c in b.timeline.initial if c.param == "Kv"] == [0.3]
     assert (a.seed, b.seed) == (1, 2)
 
 

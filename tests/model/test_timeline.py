@@ -88,10 +88,19 @@ def test_changes_of_finds_a_key_in_starts_and_steps_before_a_time() -> None:
 
 def test_with_initial_adds_after_the_files_values_without_sharing() -> None:
     tl = _timeline()
-    more = tl.with_initial([_c("Kv", 9)])
-    assert [c.value for c in more.initial] == [1, 9]
+    more = tl.with_initial([_c("Kw", 9)])
+    assert [(c.param, c.value) for c in more.initial] == [("Kv", 1), ("Kw", 9)]
     assert [c.value for c in tl.initial] == [1]
     assert more.points() == tl.points()
+
+
+def test_with_initial_drops_the_values_it_overrides() -> None:
+    """A value set over the file's is listed once, with the value in force (a bag's phase-0
+    event, a run's description): of one key given twice, the last."""
+    tl = _timeline()
+    more = tl.with_initial([_c("Kw", 2), _c("Kv", 9), _c("Kw", 3)])
+    assert [(c.param, c.value) for c in more.initial] == [("Kw", 3), ("Kv", 9)]
+    assert [c.value for c in tl.initial] == [1]
 
 
 def test_phases_and_steps_are_frozen() -> None:

@@ -39,7 +39,8 @@ def test_the_phases_a_cut_run_enters_and_the_values_at_the_start() -> None:
     assert started.initial == (kv,)  # in place of phase 0's, later phases kept
     assert started.phases[1:] == timeline.phases[1:]
     added = timeline.with_initial([kv])
-    assert added.initial[:-1] == timeline.initial
+    # the file's values but its Kv, then the given Kv (the one in force)
+    assert added.initial[:-1] == tuple(c for c in timeline.initial if c.key != kv.key)
     assert added.initial[-1] == kv
     assert timeline.initial != started.initial  # frozen: the given one is untouched
 
