@@ -148,6 +148,8 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
         self.live_changes: list[tuple[Fraction, Change]] = []
         self._pending_live: list[Change] = []
         self._initialized = False
+        #: whether :meth:`release` dropped the run (nothing of it can be used then)
+        self.released = False
         self._cursor = 0  # next tick to execute
         #: publications of delayed Leaves in flight (``delivery.py``)
         self.deliveries = Deliveries()
@@ -490,6 +492,27 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
             requirements=self.watch.judged()[0] if self.watch else None,
             adapt_switches=self._adapt.switches if self._adapt is not None else 0,
         )
+
+    def release(self) -> None:
+        """Drop everything the run holds, so reference counting frees it at once.
+
+        Why: a run's objects refer to one another (the tasks' compiled steps to the steppers
+        that made them and those to this run, the physics world to its Space's collision
+        handlers and back, the hooks to their owners), so left alone they wait for the
+        cyclic garbage collector, and an env reset every few hundred steps keeps it walking
+        each finished episode's hundreds of objects. Call it once nothing will step or
+        read the run again (``gym/episode.py`` does when an episode is closed); the
+        Simulation is unusable afterwards (:attr:`released` says so).
+        """
+        if self.released:
+            return
+        self._steppers.release()
+        for value in self.shared.values():  # what the components share: the physics world
+            release = getattr(value, "release_run", None)
+            if release is not None:
+                release()
+        self.__dict__.clear()
+        self.released = True
 
     def _who(self, path: str) -> str:
         leaf = self.world.leaves.get(path)

@@ -160,6 +160,11 @@ class Steppers:
         self._write = batch_bodies.write_outputs() if store else None
         self._gather_in = batch_bodies.gather_inputs() if store else None
 
+    def release(self) -> None:
+        """Forget the steps made (each compiled step holds this object's judges, which hold
+        it: a cycle ``Simulation.release`` breaks at a run's end)."""
+        self._made.clear()
+
     def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:
         """How ``task`` steps: the lean scalar path, array ports, or through its delay line.
         Made once per task, however many instants of the cycle it runs at."""
