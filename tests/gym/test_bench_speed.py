@@ -21,6 +21,7 @@ RESULTS = ROOT / "benchmarks" / "results" / "perf.json"
 #: every row of the table, as the benchmark names it
 ROWS = [
     "single env / LunarLander-v3",
+    "single env: garbage collector, % of its CPU",
     "vector env, 1 envs / SyncVectorEnv",
     "vector env, 4 envs / SyncVectorEnv",
     "vector env, 16 envs / SyncVectorEnv",
