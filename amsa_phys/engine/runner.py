@@ -48,6 +48,7 @@ from .instants import InstantSource, TimelineSource
 from .livechanges import LiveChanges
 from .log import RunLog
 from .plugs import Plugs
+from .release import Release
 from .signals import RequirementWatch
 from .store import BufferStore, ReadAPI
 from .tasks import COMPONENT_ERRORS, Steppers, Task, in_run
@@ -60,7 +61,7 @@ Wrap = Callable[[str, Template], Template]
 __all__ = ["COMPONENT_ERRORS", "Context", "Event", "RunResult", "Simulation", "Task", "Wrap"]
 
 
-class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
+class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario, Release):
     """One run of a scenario (or of a bare world, for tests).
 
     Read from outside with :meth:`read`, :meth:`read_many`, :meth:`column` and
@@ -148,8 +149,6 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
         self.live_changes: list[tuple[Fraction, Change]] = []
         self._pending_live: list[Change] = []
         self._initialized = False
-        #: whether :meth:`release` dropped the run (nothing of it can be used then)
-        self.released = False
         self._cursor = 0  # next tick to execute
         #: publications of delayed Leaves in flight (``delivery.py``)
         self.deliveries = Deliveries()
@@ -492,27 +491,6 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
             requirements=self.watch.judged()[0] if self.watch else None,
             adapt_switches=self._adapt.switches if self._adapt is not None else 0,
         )
-
-    def release(self) -> None:
-        """Drop everything the run holds, so reference counting frees it at once.
-
-        Why: a run's objects refer to one another (the tasks' compiled steps to the steppers
-        that made them and those to this run, the physics world to its Space's collision
-        handlers and back, the hooks to their owners), so left alone they wait for the
-        cyclic garbage collector, and an env reset every few hundred steps keeps it walking
-        each finished episode's hundreds of objects. Call it once nothing will step or
-        read the run again (``gym/episode.py`` does when an episode is closed); the
-        Simulation is unusable afterwards (:attr:`released` says so).
-        """
-        if self.released:
-            return
-        self._steppers.release()
-        for value in self.shared.values():  # what the components share: the physics world
-            release = getattr(value, "release_run", None)
-            if release is not None:
-                release()
-        self.__dict__.clear()
-        self.released = True
 
     def _who(self, path: str) -> str:
         leaf = self.world.leaves.get(path)

@@ -37,14 +37,7 @@ from ..model.template import Template
 from . import batch, batch_bodies, interrupt, kernels, publish
 from .delayedstep import packed_delayed
 from .timing import DelayLine
-from .verdicts import (
-    COMPONENT_ERRORS,
-    OUTPUT_ERRORS,
-    as_number,
-    bad_output,
-    in_run,
-    own_interrupt,
-)
+from .verdicts import COMPONENT_ERRORS, OUTPUT_ERRORS, as_number, bad_output, in_run, own_interrupt
 
 
 @dataclass
@@ -161,8 +154,7 @@ class Steppers:
         self._gather_in = batch_bodies.gather_inputs() if store else None
 
     def release(self) -> None:
-        """Forget the steps made (each compiled step holds this object's judges, which hold
-        it: a cycle ``Simulation.release`` breaks at a run's end)."""
+        """Forget the steps made (a delayed Leaf's, in Python, is a method of this object)."""
         self._made.clear()
 
     def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:

@@ -38,6 +38,7 @@ from .forces import ground_list, per_kind
 from .rover import DiffDriveRover, PendingPowers
 from .terrain import Terrain
 from .wheel import WheelModel
+from .worldrelease import release_world
 
 ROVER = 1
 OBSTACLE = 2
@@ -103,20 +104,8 @@ class PhysicsWorld:
                 batch(self.step, self.step_many)
 
     def release_run(self) -> None:
-        """Let the run go at its end (``Simulation.release``): the Space's collision
-        handlers call this world's methods, so world and Space held each other (and the
-        world holds the run) until the garbage collector found them; with handlers that
-        call nothing of the world, reference counting frees it all. The handlers stay
-        callable: pymunk calls ``separate`` for the pairs still touching when it frees the
-        Space. The rovers let go of the force model's state readers (its methods: the model
-        holds the rovers), and their list goes empty (the rovers and the pending commands
-        hold each other by it)."""
-        for kind in (ROVER, OBSTACLE):
-            self.space.on_collision(ROVER, kind, begin=_released, separate=_released)
-        for rover in self.rovers:
-            rover.attach_state(_no_state)
-            rover.attach_rims(_no_state)
-        self.rovers.clear()
+        """Let the run go at its end (``Simulation.release``; ``worldrelease.py`` says why)."""
+        release_world(self, [(ROVER, ROVER), (ROVER, OBSTACLE)])
 
     def _add_obstacles(self, obstacles: list[dict[str, Any]], walls: dict[str, Any] | None) -> None:
         static = self.space.static_body
@@ -431,15 +420,6 @@ class PhysicsWorld:
         self._seek(k)
         model.stop_batch()
         return self._steps + k
-
-
-def _released(_arbiter: pymunk.Arbiter, _space: pymunk.Space, _data: Any) -> None:
-    """A released world's collision handler (:meth:`PhysicsWorld.release_run`)."""
-
-
-def _no_state() -> Any:
-    """A released world's rovers' state reader (:meth:`PhysicsWorld.release_run`)."""
-    raise RuntimeError("the run was released: its rovers have no state")
 
 
 def resolvable_speed(rovers: Sequence[DiffDriveRover], space: pymunk.Space, dt: float) -> float:
