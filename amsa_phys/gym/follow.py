@@ -28,6 +28,7 @@ from gymnasium.utils import EzPickle
 
 from ..api.memory import check_trace_memory
 from ..api.source import Source, load
+from ..engine import publish
 from ..engine.tracemem import TraceMemory
 from ..errors import ConfigError
 from ..model.scenario import Scenario
@@ -221,7 +222,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
 
         ended, self._episode = self._episode, None
         self._close_frames()
-        with fewer_collections():
+        # the pure path's switch read once for the whole build, not at each of its ~30 asks
+        with fewer_collections(), publish.pinned():
             try:
                 memory = TraceMemory(list(scenario.world.buffers)) if self.record_trace else None
                 self._memory = memory
