@@ -169,7 +169,8 @@ class Episode:
             self.t = self.end
 
     def close(self) -> None:
-        """Stop the run (it leaves at the instant it is paused at); safe to call twice.
+        """Stop the run (it leaves at the instant it is paused at) and free it at once
+        (:meth:`_release`); safe to call twice.
 
         From another thread, or while the interpreter shuts down, the paused run cannot be
         resumed to leave: it is dropped as it is (greenlet unwinds it when it is collected)."""
