@@ -155,6 +155,9 @@ class SimDriver(SimView, Protocol):
     def close(self) -> None:
         """Release what the run holds outside the process (a ROS 2 graph), if anything."""
 
+    def release(self) -> None:
+        """Drop the finished run's objects at once (``release.py``); unusable afterwards."""
+
 
 @runtime_checkable
 class ServiceHost(Protocol):

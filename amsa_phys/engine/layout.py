@@ -38,11 +38,12 @@ Item = int | tuple[int, ...]
 
 @dataclass(frozen=True)
 class Layout:
-    """One structure's cycle: its length and, per instant, ``(offset, items, log, hooks)``
-    with tasks, groups and hooks by position."""
+    """One structure's cycle: its length and its table (``schedule.runs``: the runs of
+    physics-only instants already folded), per entry ``(offset, items, log, hooks, last,
+    spacing)`` with tasks, groups and hooks by position."""
 
     cycle: int
-    instants: tuple[tuple[int, tuple[Item, ...], bool, tuple[int, ...]], ...]
+    entries: tuple[tuple[int, tuple[Item, ...], bool, tuple[int, ...], int, int], ...]
 
 
 _kept: dict[Hashable, Layout] = {}
@@ -79,22 +80,24 @@ def kept(sig: Hashable) -> Layout | None:
 def keep(
     sig: Hashable,
     cycle: int,
-    instants: Sequence[schedule.Instant],
+    table: Sequence[schedule.Entry],
     tasks: Sequence[Task],
     hooks: Sequence[tuple[int, Callable[[], None]]],
 ) -> None:
-    """Record a freshly planned cycle (its instants' tasks as ``(step, item)`` pairs)."""
+    """Record a freshly planned cycle's table (its entries' tasks as ``(step, item)``
+    pairs)."""
     where = {id(t): k for k, t in enumerate(tasks)}
     fns = [fn for _, fn in hooks]
     rows = []
-    for inst in instants:
+    for off, pairs, log, entry_hooks, last, spacing in table:
         items: list[Item] = []
-        for _, item in inst.tasks:
+        for _, item in pairs:
             if isinstance(item, batch.Group):
                 items.append(tuple(where[id(m)] for m in item.tasks))
             else:
                 items.append(where[id(item)])
-        rows.append((inst.offset, tuple(items), inst.log, tuple(fns.index(h) for h in inst.hooks)))
+        at = tuple(fns.index(h) for h in entry_hooks)
+        rows.append((off, tuple(items), log, at, last, spacing))
     if len(_kept) >= MAX_LAYOUTS:
         _kept.pop(next(iter(_kept), None), None)  # another thread may have dropped it
     _kept[sig] = Layout(cycle, tuple(rows))
@@ -105,16 +108,19 @@ def rebuild(
     tasks: Sequence[Task],
     hooks: Sequence[tuple[int, Callable[[], None]]],
     steppers: Steppers,
-) -> tuple[list[schedule.Instant], dict[Member, list[batch.Group]]]:
-    """The cycle's instants with this run's tasks, groups and hooks, and the groups each
-    member steps in, as ``build.plan_groups`` returns them."""
+) -> tuple[list[schedule.Entry], dict[Member, list[batch.Group]]]:
+    """The cycle's table with this run's tasks, groups and hooks, as ``schedule.runs``
+    makes it from a fresh layout, and the groups each member steps in, as
+    ``build.plan_groups`` returns them. Why the table and not the instants: most instants
+    of a cycle are the physics step alone (44 of scenario1's 50), folded into a few
+    entries; made again at every reset, they were most of this rebuild."""
     step_group: Callable[..., None] = steppers.step_group
     for_task = steppers.for_task
     fns = [fn for _, fn in hooks]
     made: dict[tuple[int, ...], batch.Group] = {}
     groups_of: dict[Member, list[batch.Group]] = {}
-    out = []
-    for offset, items, log, hook_at in layout.instants:
+    out: list[schedule.Entry] = []
+    for off, items, log, hook_at, last, spacing in layout.entries:
         pairs: list[tuple[Any, Any]] = []
         for item in items:
             if type(item) is int:
@@ -129,7 +135,7 @@ def rebuild(
                 groups = groups_of.setdefault(batch.ident(member), [])
                 if group not in groups:
                     groups.append(group)
-        out.append(schedule.Instant(offset, pairs, log, [fns[k] for k in hook_at]))
+        out.append((off, tuple(pairs), log, tuple(fns[k] for k in hook_at), last, spacing))
     return out, groups_of
 
 
@@ -146,10 +152,10 @@ def lay_out(
     grid: TickGrid,
     log_at: int | None,
     hooks: list[tuple[int, Any]],
-) -> tuple[int, list[schedule.Instant], dict[Any, Any]]:
-    """A run's cycle length, its instants with like components grouped, and the groups:
-    by the layout kept from an earlier run of the same structure (a single run's, where
-    resets repeat it), else laid out afresh and kept."""
+) -> tuple[int, list[schedule.Entry], dict[Any, Any]]:
+    """A run's cycle length, its table (``schedule.runs``) with like components grouped,
+    and the groups: by the layout kept from an earlier run of the same structure (a single
+    run's, where resets repeat it), else laid out afresh and kept."""
     freq = lambda t: worlds[t.run].leaves[t.path].freq  # noqa: E731
     sig = None
     if len(worlds) == 1:
@@ -157,8 +163,8 @@ def lay_out(
         sig = signature(tasks, [key(t, freq(t)) for t in tasks], log_at, hooks, grouping)
         found = kept(sig)
         if found is not None:
-            cycle, groups_of = rebuild(found, tasks, hooks, steppers)
-            return found.cycle, cycle, groups_of
+            table, groups_of = rebuild(found, tasks, hooks, steppers)
+            return found.cycle, table, groups_of
     try:
         length, cycle = schedule.instants(tasks, log_at, hooks)
     except schedule.TooManyEvents as exc:
@@ -170,6 +176,7 @@ def lay_out(
             "commensurate frequencies",
         ) from None
     groups_of = plan_groups(cycle, tasks, freq, grouping, steppers)
+    table = schedule.runs(cycle)
     if sig is not None:
-        keep(sig, length, cycle, tasks, hooks)
-    return length, cycle, groups_of
+        keep(sig, length, table, tasks, hooks)
+    return length, table, groups_of

@@ -16,9 +16,11 @@ physics step too) or a build without a C compiler runs the Python loops alone.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
 from typing import Any
 
 #: the pure path's switch, shared with the physics step (``physics/step_path.py``)
@@ -62,12 +64,39 @@ def drawn() -> Any:
 
 
 #: the extensions once imported (False: not built); the switch is read at every call, so a
-#: test or a user may set it between runs
+#: test or a user may set it between runs (inside :func:`pinned`, once for all the calls)
 _modules: dict[str, Any] = {}
 
 
+class _Pinned(threading.local):
+    #: the switch as :func:`pinned` read it in this thread, or None: read it at every call
+    pure: bool | None = None
+
+
+_pinned = _Pinned()
+
+
+def _pure() -> bool:
+    return os.environ.get(PURE_ENV, "").strip() not in ("", "0")
+
+
+@contextlib.contextmanager
+def pinned() -> Iterator[None]:
+    """The switch read once for every call inside (in this thread): a Gymnasium reset
+    builds a run that asks ~30 times, and reading the environment was a few per cent of
+    the reset. Nested: the outermost reading holds."""
+    outer = _pinned.pure
+    if outer is None:
+        _pinned.pure = _pure()
+    try:
+        yield
+    finally:
+        _pinned.pure = outer
+
+
 def _extension(name: str = "_publish") -> Any:
-    if os.environ.get(PURE_ENV, "").strip() not in ("", "0"):
+    pure = _pinned.pure
+    if pure if pure is not None else _pure():
         return None
     module = _modules.get(name)
     if module is None:  # the import machinery once, not at every ask

@@ -48,6 +48,7 @@ from .instants import InstantSource, TimelineSource
 from .livechanges import LiveChanges
 from .log import RunLog
 from .plugs import Plugs
+from .release import Release
 from .signals import RequirementWatch
 from .store import BufferStore, ReadAPI
 from .tasks import COMPONENT_ERRORS, Steppers, Task, in_run
@@ -60,7 +61,7 @@ Wrap = Callable[[str, Template], Template]
 __all__ = ["COMPONENT_ERRORS", "Context", "Event", "RunResult", "Simulation", "Task", "Wrap"]
 
 
-class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
+class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario, Release):
     """One run of a scenario (or of a bare world, for tests).
 
     Read from outside with :meth:`read`, :meth:`read_many`, :meth:`column` and
@@ -247,8 +248,7 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
         self.keeps_log = bool(self._keep_log or self.log.listeners or self.log.has_trace)
         log_at = self._log_period if self.keeps_log else None
         hooks = [(g.ticks(1 / r), fn) for r, fn, _ in self._hooks]
-        cycle = self._lay_out(log_at, hooks)
-        self._table = schedule.runs(cycle)
+        self._table = self._lay_out(log_at, hooks)
         self._plan = schedule.merges(self._table, self._many)
         self._end = g.ticks(self.duration)
         self._sources[:0] = [TimelineSource(t, g, r) for r, t in enumerate(self.timelines)]
@@ -257,13 +257,13 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario):
         #: the compiled schedule walk (``walk.py``), or None: the Python loop of ``_advance``
         self._walk = walk.prepare(self)
 
-    def _lay_out(self, log_at: int | None, hooks: list[tuple[int, Hook]]) -> list[schedule.Instant]:
-        """The cycle's instants with like components grouped (sets ``_cycle`` and
+    def _lay_out(self, log_at: int | None, hooks: list[tuple[int, Hook]]) -> list[schedule.Entry]:
+        """The cycle's table with like components grouped (sets ``_cycle`` and
         ``_groups_of``): :func:`layout.lay_out`, afresh or as kept from an earlier run."""
-        self._cycle, cycle, self._groups_of = layout.lay_out(
+        self._cycle, table, self._groups_of = layout.lay_out(
             self._tasks, self.worlds, self.grouping, self._steppers, self.grid, log_at, hooks
         )
-        return cycle
+        return table
 
     # -- running --------------------------------------------------------------------------
     def run(self) -> RunResult:

@@ -37,14 +37,7 @@ from ..model.template import Template
 from . import batch, batch_bodies, interrupt, kernels, publish
 from .delayedstep import packed_delayed
 from .timing import DelayLine
-from .verdicts import (
-    COMPONENT_ERRORS,
-    OUTPUT_ERRORS,
-    as_number,
-    bad_output,
-    in_run,
-    own_interrupt,
-)
+from .verdicts import COMPONENT_ERRORS, OUTPUT_ERRORS, as_number, bad_output, in_run, own_interrupt
 
 
 @dataclass
@@ -159,6 +152,10 @@ class Steppers:
         store = isinstance(col, np.ndarray) and col.dtype == np.float64 and col.ndim == 1
         self._write = batch_bodies.write_outputs() if store else None
         self._gather_in = batch_bodies.gather_inputs() if store else None
+
+    def release(self) -> None:
+        """Forget the steps made (a delayed Leaf's, in Python, is a method of this object)."""
+        self._made.clear()
 
     def for_task(self, task: Task) -> Callable[[Task, Fraction], None]:
         """How ``task`` steps: the lean scalar path, array ports, or through its delay line.

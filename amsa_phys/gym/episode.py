@@ -24,8 +24,10 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import sys
+import weakref
 from collections.abc import Callable, Mapping
 from fractions import Fraction
+from typing import Any
 
 import greenlet
 
@@ -44,11 +46,18 @@ STOP = object()
 #: What the run's greenlet returns when the run is over (or was stopped)
 _ENDED = object()
 
-Exchange = Callable[[Fraction, Mapping[str, float]], Mapping[str, float]]
+#: each template's stand-in class, made once: a class is always in a reference cycle (its
+#: ``__mro__`` holds it), so one made per reset was garbage only the collector could free
+_STAND_INS: weakref.WeakKeyDictionary[type[Template], type[Template]] = weakref.WeakKeyDictionary()
 
 
-def stand_in(original: type[Template], exchange: Exchange) -> type[Template]:
-    """A template with ``original``'s declaration whose ``do_step`` is the agent's."""
+def stand_in(original: type[Template]) -> type[Template]:
+    """A template with ``original``'s declaration whose ``do_step`` is the agent's: each
+    instance's own ``do_step`` (:class:`Episode` sets it to its exchange), so one class
+    serves every episode."""
+    agent = _STAND_INS.get(original)
+    if agent is not None:
+        return agent
 
     class Agent(Template):
         """The agent, in place of a component (amsa_phys.gym)."""
@@ -61,10 +70,13 @@ def stand_in(original: type[Template], exchange: Exchange) -> type[Template]:
         #: its parameters act on nothing: the HUD does not list them as acting
         marks = (StandIn(),)
 
-        #: the paper's doStep, answered by the agent: ``exchange`` itself, not a method
-        #: calling it (the engine calls ``do_step`` once per env-step: a frame less, issue 29)
-        do_step = staticmethod(exchange)
+        def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
+            """Replaced on each instance by its episode's exchange (the engine looks
+            ``do_step`` up at every call: the exchange itself, not a method calling it, a
+            frame less per env-step)."""
+            raise RuntimeError("the agent's stand-in steps only inside its episode")
 
+    _STAND_INS[original] = Agent
     return Agent
 
 
@@ -92,11 +104,12 @@ class Episode:
         world = scenario.world
         self.path = path
         leaf = world.leaves[path]
-        agent = dataclasses.replace(leaf, template=stand_in(leaf.template, self._exchange))
+        agent = dataclasses.replace(leaf, template=stand_in(leaf.template))
         world = dataclasses.replace(world, leaves={**world.leaves, path: agent})
         self.sim = Simulation.from_scenario(
             dataclasses.replace(scenario, world=world), trace=trace, keep_log=keep_log
         )
+        self.sim.components[path].do_step = self._exchange  # type: ignore[method-assign]
         self.end = self.sim.duration
         self._end_num, self._end_den = self.end.numerator, self.end.denominator
         self.t = Fraction(0)
@@ -110,7 +123,10 @@ class Episode:
     def _main(self) -> object:
         try:
             self.sim.run()
-        except EpisodeStop:
+        except EpisodeStop as stop:
+            # its traceback's frames hold the run (and one of them the exception): a cycle
+            # that would keep the whole episode for the garbage collector
+            stop.__traceback__ = None
             return _ENDED
         return _ENDED  # an exception goes to the parent: raised by switch()
 
@@ -153,13 +169,22 @@ class Episode:
             self.t = self.end
 
     def close(self) -> None:
-        """Stop the run (it leaves at the instant it is paused at); safe to call twice.
+        """Stop the run (it leaves at the instant it is paused at) and free it at once
+        (:meth:`_release`); safe to call twice.
 
         From another thread, or while the interpreter shuts down, the paused run cannot be
         resumed to leave: it is dropped as it is (greenlet unwinds it when it is collected)."""
         run = self._run
         self.done = True
-        if run.dead or greenlet.getcurrent() is not self._agent or sys.is_finalizing():
-            return
-        with contextlib.suppress(EpisodeStop, greenlet.error):
-            run.switch(STOP)
+        if not run.dead:
+            if greenlet.getcurrent() is not self._agent or sys.is_finalizing():
+                return
+            with contextlib.suppress(EpisodeStop, greenlet.error):
+                run.switch(STOP)
+        if run.dead:
+            self._release()
+
+    def _release(self) -> None:
+        """Free the ended run by reference counting (``Simulation.release`` says why). The
+        episode keeps :attr:`t`, :attr:`done` and :attr:`end`."""
+        self.sim.release()

@@ -38,6 +38,7 @@ from .forces import ground_list, per_kind
 from .rover import DiffDriveRover, PendingPowers
 from .terrain import Terrain
 from .wheel import WheelModel
+from .worldrelease import release_world
 
 ROVER = 1
 OBSTACLE = 2
@@ -101,6 +102,10 @@ class PhysicsWorld:
             batch = getattr(sim, "batch_hook", None)  # a Simulation's (engine/runner.py)
             if batch is not None:
                 batch(self.step, self.step_many)
+
+    def release_run(self) -> None:
+        """Let the run go at its end (``Simulation.release``; ``worldrelease.py`` says why)."""
+        release_world(self, [(ROVER, ROVER), (ROVER, OBSTACLE)])
 
     def _add_obstacles(self, obstacles: list[dict[str, Any]], walls: dict[str, Any] | None) -> None:
         static = self.space.static_body

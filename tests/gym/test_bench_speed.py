@@ -21,6 +21,7 @@ RESULTS = ROOT / "benchmarks" / "results" / "perf.json"
 #: every row of the table, as the benchmark names it
 ROWS = [
     "single env / LunarLander-v3",
+    "single env: garbage collector, % of its CPU",
     "vector env, 1 envs / SyncVectorEnv",
     "vector env, 4 envs / SyncVectorEnv",
     "vector env, 16 envs / SyncVectorEnv",
@@ -52,8 +53,10 @@ def test_the_quick_run_prints_every_row_and_saves_nothing() -> None:
     for figure, (_, measured, _) in rows.items():
         # a ratio or rate with its spread, or a row skipped with its reason
         assert re.match(r"[\d.e+]+ \(min ", measured) or measured.startswith("skipped; "), figure
-    assert "SyncVectorEnv" in rows[ROWS[1]][1]  # the baseline's own figure beside the ratio
-    assert "CartPole-v1" in rows[ROWS[0]][1]
+    # the baseline's own figure beside the ratio
+    assert "SyncVectorEnv" in rows["vector env, 1 envs / SyncVectorEnv"][1]
+    assert "CartPole-v1" in rows["single env / LunarLander-v3"][1]
+    assert "its resets" in rows["single env: garbage collector, % of its CPU"][1]
     assert (RESULTS.read_bytes() if RESULTS.exists() else None) == before
 
 
