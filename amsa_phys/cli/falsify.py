@@ -172,7 +172,7 @@ def run(args: argparse.Namespace) -> int:
         if not out.is_dir():
             raise ConfigError("not a directory to resume", file=out, key="--resume")
     else:
-        prepare_run_dir(out, args.force, inputs=input_files(scenario))
+        prepare_run_dir(out, args.force, inputs=input_files(scenario), kind="falsify")
     record = {
         "scenario": str(Path(args.scenario).resolve()),
         "ranges": args.ranges,

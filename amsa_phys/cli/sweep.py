@@ -184,7 +184,7 @@ def run(args: argparse.Namespace) -> int:
         )
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-sweep")
-    prepare_run_dir(out, args.force, inputs=plan.inputs)
+    prepare_run_dir(out, args.force, inputs=plan.inputs, kind="sweep")
     # warned only once the sweep will run: a refused --out or option is the one line printed
     for warning in plan.warnings:
         print(f"warning: {warning}", file=sys.stderr)

@@ -6,7 +6,9 @@ Three rules keep a run from ever destroying a user's files:
   it one harmless path component (``..``, ``/etc`` or a control character can never
   name a directory outside the output root);
 * every directory amsa-phys creates for its outputs holds a marker file (:data:`MARKER`);
-  ``--force`` replaces only such a directory, never one the user made or filled;
+  ``--force`` replaces only such a directory, never one the user made or filled, and only
+  one of the same kind: a run's ``--force`` never wipes a sweep's or a search's results
+  (hours of work), the marker says which command made the directory;
 * a directory that holds the run's own inputs (the scenario or its world), or the current
   directory or one of its parents, is refused outright, with or without ``--force``.
 
@@ -80,6 +82,31 @@ def is_ours(path: Path) -> bool:
     return (path / MARKER).is_file() and not (path / MARKER).is_symlink()
 
 
+#: What made an output directory, as its marker says (``kind: sweep``); a run's by default.
+KINDS = {
+    "run": "a run's",
+    "sweep": "a sweep's",
+    "falsify": "a falsification search's",
+    "export": "an exported package's",
+}
+_KIND_LINE = re.compile(r"^kind: ([a-z]+)$", re.M)
+
+
+def kind_of(path: Path) -> str | None:
+    """The kind of output directory ``path`` is (its marker's ``kind:``), None if unsaid.
+
+    Markers written before kinds existed say none: such a directory may be replaced by any
+    command's ``--force``, as before. Only the marker's first 200 bytes are read.
+    """
+    try:
+        with open(path / MARKER, encoding="utf-8", errors="replace") as f:
+            head = f.read(200)
+    except OSError:
+        return None
+    found = _KIND_LINE.search(head)
+    return found.group(1) if found and found.group(1) in KINDS else None
+
+
 def _inside(child: Path, parent: Path) -> bool:
     return child == parent or parent in child.parents
 
@@ -118,12 +145,13 @@ def _without_dotdot(out: Path) -> Path:
 
 
 def check_output_dir(
-    out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "--out"
+    out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "--out", kind: str = "run"
 ) -> bool:
     """The refusals of :func:`prepare_run_dir`, touching nothing.
 
     Returns True if ``out`` exists and is not empty (and may be replaced: ``force`` was
-    given, amsa-phys made it and it holds none of ``inputs``).
+    given, amsa-phys made it for outputs of the same ``kind`` and it holds none of
+    ``inputs``).
     """
     inputs = list(inputs)
     out = _without_dotdot(out)
@@ -153,30 +181,40 @@ def check_output_dir(
             key=flag,
             file=out,
         )
+    made = kind_of(out)
+    if made is not None and made != kind:
+        raise ConfigError(
+            f"holds {KINDS[made]} outputs (amsa-phys {made}); --force replaces only "
+            f"{KINDS[kind]}: choose a new directory, or remove this one yourself",
+            key=flag,
+            file=out,
+        )
     return True
 
 
 def prepare_run_dir(
-    out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "--out"
+    out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "--out", kind: str = "run"
 ) -> Path:
-    """Create ``out`` for a run's outputs and mark it as ours.
+    """Create ``out`` for a run's (or a ``kind`` of command's) outputs and mark it as ours.
 
     A non-empty ``out`` is refused unless ``force``, and even then only replaced if amsa-phys
-    made it (:func:`is_ours`) and it holds none of ``inputs``. Symbolic links are never
-    followed into a removal.
+    made it (:func:`is_ours`) for the same kind of outputs and it holds none of ``inputs``.
+    Symbolic links are never followed into a removal.
     """
     inputs = list(inputs)
     out = _without_dotdot(out)
-    if check_output_dir(out, force, inputs, flag):
+    if check_output_dir(out, force, inputs, flag, kind):
         shutil.rmtree(out)
-    _make_marked(out, flag)
+    _make_marked(out, flag, kind)
     return out
 
 
-def _make_marked(out: Path, flag: str) -> None:
+def _make_marked(out: Path, flag: str, kind: str) -> None:
     try:
         out.mkdir(parents=True, exist_ok=True)
-        (out / MARKER).write_text("amsa-phys output directory; --force may replace it\n")
+        (out / MARKER).write_text(
+            f"amsa-phys output directory; --force may replace it\nkind: {kind}\n"
+        )
     except OSError as exc:
         raise ConfigError(f"cannot create directory: {exc.strerror}", key=flag, file=out) from None
     if not os.access(out, os.W_OK):
@@ -208,7 +246,9 @@ def check_output(path: Path, flag: str, make_parent: bool = False) -> Path:
     return path
 
 
-def staged_dir(out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "-o") -> Path:
+def staged_dir(
+    out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "-o", kind: str = "export"
+) -> Path:
     """A new, marked, empty directory beside ``out`` to write a whole output tree into.
 
     ``out`` is checked as :func:`prepare_run_dir` checks it (nothing is touched); the caller
@@ -216,11 +256,11 @@ def staged_dir(out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = 
     so a failure half-way leaves ``out`` as it was (and :func:`discard_staged` cleans up).
     """
     out = _without_dotdot(out)
-    check_output_dir(out, force, inputs, flag)
+    check_output_dir(out, force, inputs, flag, kind)
     staged = out.parent / f".{out.name}.amsa-tmp-{os.getpid()}"
     if staged.exists() or staged.is_symlink():
         discard_staged(staged)
-    _make_marked(staged, flag)
+    _make_marked(staged, flag, kind)
     return staged
 
 
