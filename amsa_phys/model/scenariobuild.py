@@ -10,6 +10,7 @@ and key of what it refuses.
 from __future__ import annotations
 
 import dataclasses
+import os
 from collections.abc import Sequence
 from fractions import Fraction
 from pathlib import Path
@@ -94,8 +95,11 @@ def _world(doc: YamlDoc, data: dict[str, Any]) -> WorldSpec:
         if world_path.is_dir():
             raise doc.error(("world",), f"{world_path} is a directory, expected a world file")
         if not world_path.exists():
+            # shown without its ``..`` (``s/../worlds/w.yaml`` is ``worlds/w.yaml``); only
+            # shown: with a symbolic link in the path, the lexical form may name elsewhere
+            shown = Path(os.path.normpath(world_path))
             raise doc.error(
-                ("world",), f"world file not found: {world_path}" + _nearby_file(world_path)
+                ("world",), f"world file not found: {shown}" + _nearby_file(world_path)
             )
         world = load_world(world_path)
     else:
@@ -333,6 +337,8 @@ def effective_log_rate(rate: Fraction, world: WorldSpec) -> Fraction:
 def _nearby_file(path: Path) -> str:
     """`` (did you mean x.yaml?)`` for a YAML file beside ``path`` with a close name
     (``x.yml`` for ``x.yaml``, a typo in the stem); empty if there is none."""
+    if not path.parent.is_dir():
+        return f" (there is no directory {os.path.normpath(path.parent)})"
     try:
         names = [p.name for p in path.parent.iterdir() if p.suffix in (".yaml", ".yml")]
     except OSError:

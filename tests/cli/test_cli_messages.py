@@ -126,6 +126,19 @@ def test_a_missing_world_file_suggests_the_other_extension(
     )
 
 
+def test_a_world_in_a_directory_that_does_not_exist_says_so_without_dotdot(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "scenarios").mkdir()
+    scenario = tmp_path / "scenarios" / "s.yaml"
+    scenario.write_text("world: ../wrlds/arena.yaml\nduration: 1\n")
+    assert main(["validate", str(scenario)]) == 2
+    assert capsys.readouterr().err == (
+        f"error: {scenario}:1: world: world file not found: {tmp_path / 'wrlds' / 'arena.yaml'} "
+        f"(there is no directory {tmp_path / 'wrlds'})\n"
+    )
+
+
 @pytest.mark.parametrize("where", ["before", "after"])
 def test_debug_shows_a_user_templates_traceback(
     tmp_path: Path,
