@@ -155,6 +155,11 @@ class Window:
 
     def frame(self, real_dt: float) -> bool:
         """One iteration: events, advance by ``speed * real_dt``, draw. False once closed."""
+        if self.finished and interrupt.requested():
+            # the run is whole: Ctrl-C or SIGTERM now closes the window as `q` would (the
+            # outputs are written as complete), not an interruption of a run that has ended
+            self.running = False
+            return False
         interrupt.check()  # Ctrl-C in the terminal, also while paused (advance checks too)
         for event in pygame.event.get():
             self.handle(event)
