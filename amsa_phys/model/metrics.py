@@ -231,6 +231,9 @@ def _metrics(
         overall = {"collisions": len(collisions)}
     if end < bounds[-1]:
         overall["partial"] = True
+    # a run shorter than its scenario says what it was meant to be: a plot's title can then
+    # say "1 of 4 phases", not only that the last one it ran was cut
+    planned = {"end": bounds[-1], "phases": len(bounds) - 1} if end < bounds[-1] else None
     busy = wall_s - idle_s
     return {
         "scenario": scenario.name,
@@ -238,6 +241,7 @@ def _metrics(
         "duration": float(scenario.duration),
         "simulated": result.t_end,
         "status": status,
+        **({"planned": planned} if planned else {}),
         "quality": (_quality_json(q) if q else None),
         "overall": overall,
         "phases": phases,

@@ -172,6 +172,22 @@ def _collisions(ax: Axes, events: list[dict[str, Any]], t: np.ndarray, s: np.nda
     )
 
 
+def _shortened(metrics: dict[str, Any], ran: float) -> str:
+    """`` — shortened to 60 s of 500 s by --duration (1 of 4 phases, the last cut)``; a run
+    whose metrics predate ``planned`` (or cannot be read) says ``its last phase cut``."""
+    planned = metrics.get("planned")
+    done = metrics.get("phases")
+    try:
+        total = int(planned["phases"])
+        end = float(planned["end"])
+    except (KeyError, TypeError, ValueError):
+        total, end = 0, 0.0
+    if not total or not isinstance(done, list) or not done:
+        return f" — shortened to {ran:g} s by --duration (its last phase cut)"
+    what = "its one phase" if total == 1 else f"{len(done)} of {total} phases, the last"
+    return f" — shortened to {ran:g} s of {end:g} s by --duration ({what} cut)"
+
+
 def cut_note(metrics: dict[str, Any]) -> str:
     """`` — cut at 42.5 s of 500 s (closed in the window)`` for a run that stopped before
     its end (the window closed, Ctrl-C, a fault, ``--duration``); empty for a whole run.
@@ -189,7 +205,7 @@ def cut_note(metrics: dict[str, Any]) -> str:
         # a whole run of a scenario that --duration shortened: its last phase is cut
         overall = metrics.get("overall")
         if isinstance(overall, dict) and overall.get("partial"):
-            return f" — shortened to {ran:g} s by --duration (its last phase cut)"
+            return _shortened(metrics, ran)
         return ""
     why = {"interrupted": "interrupted (Ctrl-C)"}.get(status, status)
     why = why.split(" at t=")[0]  # "closed in the window at t=42.5 s": the time is said once

@@ -148,7 +148,12 @@ def test_a_run_closed_in_the_window_says_where_in_its_plot_titles(tmp_path: Path
     out = run(tmp_path)
     metrics = json.loads((out / "metrics.json").read_text())
     # --duration 30 of a 500 s scenario: said too, as shortened (tryout: it said nothing)
-    assert cut_note(metrics) == " — shortened to 30 s by --duration (its last phase cut)"
+    assert cut_note(metrics) == (
+        " — shortened to 30 s of 500 s by --duration (1 of 2 phases, the last cut)"
+    )
+    # a run directory written before metrics.json said what was planned
+    old = {k: v for k, v in metrics.items() if k != "planned"}
+    assert cut_note(old) == " — shortened to 30 s by --duration (its last phase cut)"
     whole = {**metrics, "overall": {**metrics["overall"], "partial": False}}
     assert cut_note(whole) == ""
     metrics.update(simulated=12.5, duration=30.0, status="closed in the window at t=12.5 s")
