@@ -130,6 +130,8 @@ def plot_samples(
             zorder=4,
             label=f"worst {objective} (run {worst.get('run')})",
         )
+    if y_axis == metric and robust and xy:  # the bound the falsifying runs fall below
+        ax.axhline(0.0, color="black", ls="--", lw=1, zorder=1, label="robustness 0")
     if y_axis == metric and ok and not numeric:
         labels = _categories(ok, x_axis)
         ax.set_xticks(range(len(labels)), [str(v) for v in labels])

@@ -132,3 +132,20 @@ def test_a_trials_directory_points_at_its_trials(
     assert "2 trials" in err
     assert main(["plot", str(top / "trial-001")]) == 0
     assert (top / "trial-001" / "samples.png").is_file()
+
+
+def test_one_axis_draws_the_value_against_it_with_the_bound(
+    tmp_path: Path, figures: list[Figure]
+) -> None:
+    """A search over one parameter: robustness against it, the 0 it must fall below drawn."""
+    folder = _falsify_dir(tmp_path / "fals")
+    rows = (folder / "results.csv").read_text().splitlines()
+    cut = [",".join(c for i, c in enumerate(r.split(",")) if i != 2) for r in rows]
+    (folder / "results.csv").write_text("\n".join(cut) + "\n")  # KEYS[1] dropped
+    assert main(["plot", str(folder)]) == 0
+    ax = figures[0].axes[0]
+    assert ax.get_ylabel() == "robustness.band"
+    dots = _offsets(ax, "run")
+    assert sorted(map(tuple, dots.tolist())) == sorted((p[0], p[3]) for p in POINTS)
+    (bound,) = [ln for ln in ax.lines if ln.get_label() == "robustness 0"]
+    assert list(bound.get_ydata()) == [0.0, 0.0]
