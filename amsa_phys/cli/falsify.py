@@ -30,6 +30,7 @@ from ..falsify.trials import (
 from ..model.configure import duration_option
 from ..model.scenario import Scenario, load_scenario
 from ..model.schema import MAX_SEED
+from ..model.wording import plural
 from ..requirements.objective import requirement_of
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.suite import input_files
@@ -298,7 +299,7 @@ def _one_search(
         w = progress.worst()
         worst = describe_value(progress.verdicts[w].value) if w is not None else "none"
         type(bar).write(
-            f"generation {generation} done: {len(progress.rows)} runs, worst "
+            f"generation {generation} done: {plural(len(progress.rows), 'run')}, worst "
             f"{objective.label} {worst}",
             file=sys.stderr,
         )
@@ -323,7 +324,7 @@ def _one_search(
     )
     first = progress.first_violation()
     if first is not None and settings.stop_at_violation:
-        line += f"; first violation at run {first} ({first + 1} simulations)"
+        line += f"; first violation at run {first} ({plural(first + 1, 'simulation')})"
     with interrupt.sigterm_as_ctrl_c(), interrupt.deferred():
         write_results(progress.rows, keys, out / "results.csv")
         raw = "worst.yaml"

@@ -22,7 +22,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "rundir",
         nargs="*",
-        help="a run directory (`amsa-phys run`) or a sweep directory (`amsa-phys sweep`); "
+        help="a run directory (`amsa-phys run`), a sweep directory (`amsa-phys sweep`) or "
+        "a falsification's (`amsa-phys falsify`: its runs as samples.png); "
         "with --paper: the runs to draw, as run directories or scenario files (run in memory; "
         "default scenarios/paper_fig5_kv*.yaml or scenarios/paper_fig6.yaml)",
     )
@@ -45,7 +46,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--metric",
-        help="sweep only: the metric to plot, overall or phase<i>.<metric> (default rms_error)",
+        help="sweep or falsification only: the metric to plot, overall or "
+        "phase<i>.<metric> (default rms_error; a falsification: what it searched on)",
     )
 
 
@@ -65,7 +67,18 @@ def run(args: argparse.Namespace) -> int:
             "no such directory" if not rundir.exists() else "not a directory", file=rundir
         )
     if (rundir / "results.csv").is_file() and not (rundir / "trace.csv").exists():
+        from .plot_falsify import plot_falsify, record_of
+
+        if record_of(rundir) is not None:
+            return plot_falsify(rundir, args)
         return _plot_sweep(rundir, args)
+    trials = sorted(rundir.glob("trial-[0-9][0-9][0-9]"))
+    if trials and not (rundir / "trace.csv").exists():
+        raise ConfigError(
+            f"a falsification's {len(trials)} trials (their summary is trials.png): plot one "
+            f"of them, e.g. amsa-phys plot {trials[0]}",
+            file=rundir,
+        )
     if args.metric is not None:
         raise ConfigError("only for a sweep directory (with results.csv)", key="--metric")
     for name in ("trace.csv", "metrics.json"):

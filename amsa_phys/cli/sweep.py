@@ -36,6 +36,7 @@ from ..runs.sweep import (
     timeline_overlaps,
     unknown_metric,
 )
+from ..runs.sweepbest import best_line
 from .options import add_jobs
 from .progress import bar as progress_bar
 
@@ -231,6 +232,9 @@ def run(args: argparse.Namespace) -> int:
             f"results in {out}"
         )
     )
+    best = best_line(rows, keys, plan.metric)
+    if best is not None:  # the summary's star, in the terminal
+        print(one_line(best))
     for r in failed[:5]:
         print(one_line(f"run {r['run']}: {r['error']}"), file=sys.stderr)
     if interrupted:

@@ -11,6 +11,7 @@ from typing import Any
 from ..errors import ConfigError, one_line
 from ..model.changes import resolve_change
 from ..model.scenario import Scenario, load_scenario
+from ..model.wording import plural
 from ..tune.contexts import Sequence, box, sequences
 from ..tune.evaluate import evaluate
 from ..tune.robust import tail
@@ -41,7 +42,8 @@ def add_args(p: argparse.ArgumentParser) -> None:
         type=int,
         default=0,
         metavar="K",
-        help="instead of the named contexts, K contexts drawn from the box they span",
+        help="instead of the named contexts, K contexts (1..1000) drawn from the box they "
+        "span; 0 (the default): the named contexts themselves",
     )
     p.add_argument("--seeds", type=int, default=2, metavar="N", help="seeds per context (2)")
     p.add_argument("--budget", type=int, default=12, metavar="N", help="evaluations (12)")
@@ -137,8 +139,9 @@ def run(args: argparse.Namespace) -> int:
     sense = "higher" if args.metric.startswith("robustness.") else "lower"
     print(
         one_line(
-            f"tuning {', '.join(keys)} over {len(cases)} contexts x {args.seeds} seeds "
-            f"({args.measure} of {args.metric}, {sense} is better), budget {args.budget}"
+            f"tuning {', '.join(keys)} over {_over(len(cases), bool(args.box))} x "
+            f"{plural(args.seeds, 'seed')} ({args.measure} of {args.metric}, {sense} is "
+            f"better), budget {plural(args.budget, 'evaluation')}"
         )
     )
 
@@ -168,10 +171,20 @@ def run(args: argparse.Namespace) -> int:
     print(
         one_line(
             f"robust choice: {shown} ({args.measure} {_show(best.score, args.metric)} over "
-            f"{len(cases)} contexts x {args.seeds} seeds; {len(found.trials)} evaluations)"
+            f"{plural(len(cases), 'context')} x {plural(args.seeds, 'seed')}; "
+            f"{plural(len(found.trials), 'evaluation')})"
         )
     )
     return 0
+
+
+def _over(n: int, drawn: bool) -> str:
+    """What the contexts are: drawn from the box (``--box K``) or the named ones."""
+    return (
+        plural(n, "context drawn from their box", "contexts drawn from their box")
+        if drawn
+        else plural(n, "named context")
+    )
 
 
 def _show(score: float, metric: str) -> str:

@@ -151,13 +151,54 @@ def plot(run_dir: Path, requirement: str, out: Path, title: str) -> Path | None:
     data = np.loadtxt(run_dir / "trace.csv", delimiter=",", skiprows=1, usecols=cols, ndmin=2)
     fig, ax = plt.subplots(figsize=(8, 4), dpi=100)
     ax.plot(data[:, 0], data[:, 1], color="#1f4e79", lw=1.2, label=signal)
+    t0, t1 = interval(str(entry.get("formula", "")), float(data[-1, 0]))
+    if t0 > float(data[0, 0]) or t1 < float(data[-1, 0]):  # what the requirement reads
+        ax.axvspan(t0, t1, color="0.5", alpha=0.08, lw=0, label=f"judged: [{t0:g}, {t1:g}] s")
+    lows, highs = [float(np.min(data[:, 1]))], [float(np.max(data[:, 1]))]
     if band:
         c, k = float(band.group(2)), float(band.group(4))
-        ax.axhspan(c - k, c + k, color="#2e8b57", alpha=0.15, label=f"{c:g} ± {k:g}")
+        # over the requirement's interval only: before it the band does not apply
+        ax.fill_between(
+            [t0, t1], c - k, c + k, color="#2e8b57", alpha=0.15, lw=0, label=f"{c:g} ± {k:g}"
+        )
+        for edge in (c - k, c + k):
+            ax.plot([t0, t1], [edge, edge], color="#2e8b57", lw=1, ls="--")
+        lows.append(c - k)
+        highs.append(c + k)
     elif bound:
-        ax.axhline(float(bound.group(3)), color="#2e8b57", lw=1, ls="--", label="bound")
+        level = float(bound.group(3))
+        ax.plot([t0, t1], [level, level], color="#2e8b57", lw=1, ls="--", label="bound")
+        lows.append(level)
+        highs.append(level)
+    # a margin beyond both the signal and the bound: a band as tall as the axes reads as
+    # background, and a violation by 0.01 at its edge disappears into the frame
+    lo, hi = min(lows), max(highs)
+    pad = 0.15 * (hi - lo) if hi > lo else 1.0
+    ax.set_ylim(lo - pad, hi + pad)
     t = float(entry["instant"])
-    ax.axvline(t, color="#c0392b", lw=1.2, label=f"t = {t:g} s")
+    ax.axvline(t, color="#c0392b", lw=1, alpha=0.6)
+    # the broken sample itself, with its value: a violation by 0.01 is invisible at the
+    # band's scale, its number is not
+    value = float(np.interp(t, data[:, 0], data[:, 1]))
+    ax.plot(
+        [t],
+        [value],
+        marker="o",
+        ms=7,
+        color="#c0392b",
+        ls="none",
+        zorder=5,
+        label=f"broken: {value:.4g} at t = {t:g} s",
+    )
+    ax.annotate(
+        f"{value:.4g}",
+        (t, value),
+        xytext=(8, -4),
+        textcoords="offset points",
+        color="#c0392b",
+        fontsize=9,
+        va="top",
+    )
     ax.set_xlabel("t (s)")
     ax.set_ylabel(signal)
     rob = entry.get("robustness")
@@ -166,9 +207,26 @@ def plot(run_dir: Path, requirement: str, out: Path, title: str) -> Path | None:
         + ("none" if rob is None else f"{rob:.4g}")
         + f" at t = {t:g} s"
     )
-    ax.legend(loc="best", fontsize=8)
+    # below the axes: inside, "best" still sat on the signal or the band's edge
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=8, frameon=False)
+    fig.set_size_inches(8, 4.8)
     fig.tight_layout()
     return save_png(fig, out)
+
+
+def interval(formula: str, end: float) -> tuple[float, float]:
+    """The instants a requirement judges, as its outer ``always``/``eventually`` window
+    reads them (``always[10:120]`` judges 10..120 s); the whole run otherwise."""
+    from ..stl.syntax import FormulaError, parse
+
+    try:
+        node = parse(formula)
+    except FormulaError:
+        return 0.0, end
+    if node.op in ("always", "eventually") and node.lo is not None:
+        hi = end if node.hi is None else min(end, float(node.hi))
+        return float(node.lo), hi
+    return 0.0, end
 
 
 def replay(settings: Settings, point: Point, out: Path) -> Path:

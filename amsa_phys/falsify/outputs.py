@@ -12,6 +12,7 @@ import yaml
 
 from ..atomic import write_atomic
 from ..errors import one_line
+from ..model.wording import plural
 from ..runs.resolve import resolved_scenario
 from ..runs.sweep import Job, prepare_job
 from .objective import Objective
@@ -76,7 +77,7 @@ def headline(progress: Progress, k: int, keys: list[str], objective: Objective, 
     verdict = progress.verdicts[k]
     context = ", ".join(f"{key}={row[key]}" for key, _ in point_of(row, keys))
     line = (
-        f"worst of {len(progress.rows)} runs"
+        f"worst of {plural(len(progress.rows), 'run')}"
         + (f" (of a budget of {total})" if len(progress.rows) < total else "")
         + f": {context} -> {objective.label} = {describe_value(verdict.value)}"
         + f" (run {row['run']}, generation {row['generation']})"

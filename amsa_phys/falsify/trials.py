@@ -157,6 +157,7 @@ def plot_trials(summary: dict[str, Any], out: Path, title: str) -> Path:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     from ..plots.save import save_png
 
@@ -173,6 +174,8 @@ def plot_trials(summary: dict[str, Any], out: Path, title: str) -> Path:
     if summary["mean_simulations"] is not None:
         ax.axhline(summary["mean_simulations"], color="#333333", lw=1, ls="--", label="mean")
     ax.set_xlabel("trial")
+    # trials are counted: a tick on each (a locator put ticks at 0.75, 1.25... of one)
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True, nbins=min(len(xs), 20) or 1))
     ax.set_ylabel("simulations to the first violation")
     ax.set_ylim(0, budget * 1.05)
     rate = summary["falsification_rate"] or 0.0

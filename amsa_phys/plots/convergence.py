@@ -44,8 +44,8 @@ def plot_convergence(
         # generations are whole numbers: one colour each, a tick on each (not a 0.0-1.0 ramp)
         norm = BoundaryNorm([g - 0.5 for g in range(last + 2)], plt.get_cmap("viridis").N)
         dots = ax.scatter(
-            xs, finite, c=gens, cmap="viridis", norm=norm, s=14, zorder=2, label="run"
-        )
+            xs, finite, c=gens, cmap="viridis", norm=norm, s=14, zorder=4, label="run"
+        )  # above the worst-so-far line: the dot that set it was hidden under the step
         if last > 0:
             bar = fig.colorbar(dots, ax=ax, label="generation")
             bar.set_ticks(list(range(0, last + 1, max(1, (last + 1) // 10))))
@@ -64,6 +64,19 @@ def plot_convergence(
     if faults:
         edge = max(finite) if maximise and finite else (min(finite) if finite else 0.0)
         ax.plot(faults, [edge] * len(faults), "kx", label="fault or no value")
+    if threshold is not None and not maximise:  # a robustness: below the bound falsifies
+        bad = [(r, v) for r, v in zip(xs, finite, strict=True) if v < threshold]
+        if bad:
+            ax.scatter(
+                [r for r, _ in bad],
+                [v for _, v in bad],
+                s=90,
+                facecolors="none",
+                edgecolors="#c0392b",
+                linewidths=1.8,
+                zorder=5,
+                label=f"falsifying ({len(bad)})",
+            )
     if threshold is not None:
         ax.axhline(threshold, color="black", ls="--", lw=1, label=f"bound {threshold:g}")
     if reference is not None:
@@ -72,5 +85,7 @@ def plot_convergence(
     ax.set_ylabel(label)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
+    # below the axes: inside, "best" still covered a run's dot
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=5, fontsize=8, frameon=False)
+    fig.set_size_inches(8, 5)
     return save_png(fig, out)

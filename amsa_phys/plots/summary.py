@@ -18,6 +18,7 @@ import numpy as np
 from matplotlib.patches import Rectangle
 from matplotlib.ticker import MaxNLocator
 
+from ..model.wording import plural
 from .facets import plot_facets
 from .save import save_png
 from .sweepmarks import (
@@ -129,6 +130,8 @@ def plot_summary(
             groups[tuple(r[a] for a in others)][r[x_axis]].append(float(r[metric]))
         most = max((len(v) for by_x in groups.values() for v in by_x.values()), default=1)
         band = spread == "band" or (spread == "auto" and most >= BAND_SEEDS)
+        widest = 0.0  # the largest seed spread of a grid point: said, as bars can vanish
+        starred = False
         for key, by_x in groups.items():
             xs = sorted(by_x, key=lambda v: (str(type(v)), v))
             mean = [float(np.mean(by_x[x])) for x in xs]
@@ -136,13 +139,36 @@ def plot_summary(
             # matplotlib refuses a negative error bar (no summary.png at all)
             lo = [max(0.0, m - min(by_x[x])) for m, x in zip(mean, xs, strict=True)]
             hi = [max(0.0, max(by_x[x]) - m) for m, x in zip(mean, xs, strict=True)]
-            label = ", ".join(f"{a}={v}" for a, v in zip(others, key, strict=True)) or metric
+            widest = max([widest, *(max(by_x[x]) - min(by_x[x]) for x in xs)])
+            # one line: the legend says what its marks are (its name was just the metric)
+            label = ", ".join(f"{a}={v}" for a, v in zip(others, key, strict=True)) or (
+                f"mean of {plural(most, 'seed')}" + ("" if band else ", min–max bar")
+            )
             positions = xs if _numeric(xs) else list(range(len(xs)))
             if band:
                 _spread(ax, positions, [by_x[x] for x in xs], mean, label)
             else:
-                ax.errorbar(positions, mean, yerr=[lo, hi], marker="o", capsize=3, label=label)
+                bars = ax.errorbar(
+                    positions, mean, yerr=[lo, hi], marker="o", ms=4, capsize=6, label=label
+                )
+                if most > 1:  # every seed a dot too: a spread below a marker still shows
+                    for at, x in zip(positions, xs, strict=True):
+                        ax.plot(
+                            [at] * len(by_x[x]),
+                            by_x[x],
+                            ls="none",
+                            marker=".",
+                            ms=5,
+                            color=bars.lines[0].get_color(),
+                            gid="seed",
+                        )
             best = int(np.argmin(mean))
+            if others:
+                star = "lowest mean of each line" if not starred else "_"
+            else:
+                shown = f"{xs[best]:g}" if _numeric([xs[best]]) else str(xs[best])
+                star = f"best: {x_axis}={shown} ({mean[best]:.4g})"
+            starred = True
             ax.plot(
                 [positions[best]],
                 [mean[best]],
@@ -150,7 +176,9 @@ def plot_summary(
                 ms=14,
                 color="gold",
                 markeredgecolor="k",
+                ls="none",
                 zorder=5,
+                label=star,
             )
         never_at: dict[Any, int] = defaultdict(int)
         for r in nevers(rows, metric):
@@ -180,6 +208,15 @@ def plot_summary(
         ax.grid(alpha=0.3)
         if groups:  # no line when every run said "never"
             ax.legend(fontsize=8)
+            if most > 1 and not band:
+                low, high = ax.get_ylim()
+                share = widest / (high - low) if high > low else 0.0
+                if share < 0.02:  # bars this short read as "no spread": say how small
+                    ax.set_title(
+                        f"largest seed spread (min–max) {widest:.3g}: {share:.1%} of the axis"
+                        f" ({plural(most, 'seed')} each)",
+                        fontsize=9,
+                    )
     title += left_out_text(rows, ok, metric)
     if ax.get_title():  # the heatmap's best cell
         title += "\n" + ax.get_title()

@@ -45,7 +45,7 @@ def test_tune_a_gain_over_the_scenario_contexts(capsys) -> None:
     trials = [float(line.rsplit("worst ", 1)[1]) for line in out if line.startswith("  ")]
     assert len(trials) == 5
     assert out[-1].startswith("robust choice: MyFollowerController.Kv=")
-    assert f"(worst {min(trials):.4g} over 4 contexts x 1 seeds" in out[-1]
+    assert f"(worst {min(trials):.4g} over 4 contexts x 1 seed;" in out[-1]
 
 
 @pytest.mark.parametrize(
