@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from figcapture import keep_figures
 from matplotlib.collections import PathCollection, PolyCollection
 from matplotlib.figure import Figure
 
@@ -17,16 +18,7 @@ from amsa_phys.plots import convergence, save
 
 @pytest.fixture
 def figures(monkeypatch: pytest.MonkeyPatch) -> list[Figure]:
-    kept: list[Figure] = []
-
-    def keep(fig: Figure, out: Path, *args: object, **kwargs: object) -> Path:
-        fig.canvas.draw()  # the layout a saved PNG would have
-        kept.append(fig)
-        return out
-
-    monkeypatch.setattr(convergence, "save_png", keep)
-    monkeypatch.setattr(save, "save_png", keep)
-    return kept
+    return keep_figures(monkeypatch, convergence, save, draw=True)
 
 
 def test_trials_axis_counts_whole_trials(tmp_path: Path, figures: list[Figure]) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from matplotlib.figure import Figure
+from figcapture import keep_figures
 
 from amsa_phys.plots import convergence
 
@@ -15,13 +15,7 @@ def test_run_axis_names_the_file_that_numbers_the_runs(
 ) -> None:
     """The x axis sends the reader to the file whose `run` column it counts: falsify writes
     results.csv (there is no runs.csv), so the label must name results.csv."""
-    figures: list[Figure] = []
-
-    def keep(fig: Figure, out: Path, *args: object, **kwargs: object) -> Path:
-        figures.append(fig)
-        return out
-
-    monkeypatch.setattr(convergence, "save_png", keep)
+    figures = keep_figures(monkeypatch, convergence)
     convergence.plot_convergence(
         [0.4, 0.9, None, 1.3], [0, 0, 1, 1], "rms_error", True, tmp_path / "c.png", "t"
     )

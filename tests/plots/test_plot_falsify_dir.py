@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from figcapture import keep_figures
 from matplotlib.collections import PathCollection
 from matplotlib.figure import Figure
 
@@ -42,14 +43,7 @@ def _falsify_dir(folder: Path, objective: str = "robustness.band") -> Path:
 
 @pytest.fixture
 def figures(monkeypatch: pytest.MonkeyPatch) -> list[Figure]:
-    kept: list[Figure] = []
-
-    def keep(fig: Figure, out: Path, *args: object, **kwargs: object) -> Path:
-        kept.append(fig)
-        return out
-
-    monkeypatch.setattr(samples, "save_png", keep)
-    return kept
+    return keep_figures(monkeypatch, samples)
 
 
 def _offsets(ax: object, label_start: str) -> np.ndarray:

@@ -7,6 +7,7 @@ from collections import defaultdict
 from pathlib import Path
 
 import pytest
+from figcapture import keep_figures
 from matplotlib.figure import Figure
 
 from amsa_phys.cli.main import main
@@ -56,14 +57,7 @@ def test_best_point_ties_and_nothing() -> None:
 
 @pytest.fixture
 def figures(monkeypatch: pytest.MonkeyPatch) -> list[Figure]:
-    kept: list[Figure] = []
-
-    def keep(fig: Figure, out: Path, *args: object, **kwargs: object) -> Path:
-        kept.append(fig)
-        return out
-
-    monkeypatch.setattr(summary, "save_png", keep)
-    return kept
+    return keep_figures(monkeypatch, summary)
 
 
 ROWS = [  # two seeds a point, spreads far below a marker at this scale
