@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ..errors import ConfigError, one_line
 from ..interop.exporter import export_world
-from ..model.configure import with_overrides
+from ..model.configure import duration_option, with_overrides
 from ..model.scenario import (
     DEFAULT_LOG_RATE_HZ,
     Scenario,
@@ -88,19 +88,18 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _load(path: str, args: argparse.Namespace) -> Scenario:
-    """A scenario file, or a bare world as a scenario with no timeline."""
+    """A scenario file, or a bare world as a scenario with no timeline.
+
+    A scenario stays whole under ``--duration``: the package keeps the cut apart and its run
+    applies it as ``run --duration`` does (``ros/exported.py``); it is judged and warned about
+    here as that run would be."""
     doc = load_yaml(path)
     if isinstance(doc.data, dict) and "world" in doc.data:
-        scenario = load_scenario(
-            path,
-            overrides=args.overrides,
-            seed=args.seed,
-            duration=args.duration,
-            log_rate=args.log_rate,
-        )
+        options = {"overrides": args.overrides, "seed": args.seed, "log_rate": args.log_rate}
+        scenario = load_scenario(path, duration=args.duration, **options)
         for note in timeline_notes(scenario, args.overrides, "--set"):  # as `run` warns
             print(one_line(f"warning: {note}"), file=sys.stderr)
-        return scenario
+        return scenario if args.duration is None else load_scenario(path, **options)
     world = load_world(path)
     rate = Fraction(str(args.log_rate)) if args.log_rate else Fraction(DEFAULT_LOG_RATE_HZ)
     bare = Scenario(
@@ -120,6 +119,14 @@ def _load(path: str, args: argparse.Namespace) -> Scenario:
     return dataclasses.replace(scenario, log_rate=max([rate, *sensors]))
 
 
+def _cut(args: argparse.Namespace) -> Fraction | None:
+    """``--duration`` of a scenario's package, kept apart from its whole scenario (a bare
+    world's timeline already has that length)."""
+    if args.duration is None:
+        return None
+    return duration_option(args.duration)
+
+
 def _ros(args: argparse.Namespace, out: Path) -> int:
     from ..ros.generate import check_names, generate
 
@@ -128,7 +135,7 @@ def _ros(args: argparse.Namespace, out: Path) -> int:
     inputs = [p for s in scenarios for p in input_files(s)]
     staged = staged_dir(out, args.force, inputs)
     try:
-        package = generate(scenarios, list(args.files), args.mode, staged)
+        package = generate(scenarios, list(args.files), args.mode, staged, _cut(args))
         _commit(staged, out, args.force)
     except BaseException:
         discard_staged(staged)
@@ -153,7 +160,7 @@ def _ros2(args: argparse.Namespace, out: Path) -> int:
         )
     staged = staged_dir(out, args.force, input_files(scenario))
     try:
-        package = generate2(scenario, args.scenario, staged)
+        package = generate2(scenario, args.scenario, staged, _cut(args))
         _commit(staged, out, args.force)
     except BaseException:
         discard_staged(staged)
