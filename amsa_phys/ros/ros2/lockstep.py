@@ -55,6 +55,11 @@ class Package:
 
 def read_package(pkg: Path) -> Package:
     """Read the package's manifest and scenario (one line naming the file if either is bad)."""
+    if not pkg.is_dir():
+        what = "not a directory" if pkg.exists() else "no such directory"
+        raise ConfigError(
+            f"{what} (a package made by amsa-phys export ros2 SCENARIO -o DIR)", file=pkg
+        )
     manifest = pkg / MANIFEST
     if not manifest.is_file():
         raise ConfigError(
