@@ -43,11 +43,16 @@ def test_a_cut_package_validates_and_locksteps_as_run_duration(tmp_path: Path) -
     amsa("run", str(SCENARIO), "--headless", "--no-plot", "-q", "--out", str(ref), "--duration=100")
     script = tmp_path / "netns.sh"
     script.write_text(
-        f"ip link set lo up\n{PY} -m amsa_phys ros2 lockstep {pkg} --out {out} --no-plot -q\n"
+        f"ip link set lo up\n{PY} -m amsa_phys ros2 lockstep {pkg} --out {out} --no-plot\n"
     )
     log = tmp_path / "netns.log"
     rc, left = in_private_network(script, ENV, log)
-    assert rc == 0, log.read_text()
+    text = log.read_text()
+    assert rc == 0, text
+    # what it starts and waits for, said before the run (not a silent minute)
+    assert f"starting 6 nodes of {pkg} (LeaderGPS, FollowerGPS," in text
+    assert "then 100 simulated s in lockstep" in text
+    assert "waiting up to 60 s for ROS 2 node /MyFollowerController (ROS_DOMAIN_ID=" in text
     assert left == []
     assert (out / "trace.csv").read_bytes() == (ref / "trace.csv").read_bytes()
     # the same checks judged and skipped (phase 3's never reached), the same replay file

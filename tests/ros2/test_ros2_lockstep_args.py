@@ -27,7 +27,8 @@ def test_a_missing_package_is_said_before_a_missing_rclpy(
     missing = tmp_path / "NONEXIST"
     err = _err(capsys, "ros2", action, str(missing))
     assert f"{missing}: no such directory" in err
-    assert "rclpy" not in err and "amsa.yaml" not in err
+    assert "rclpy" not in err
+    assert "amsa.yaml" not in err
 
 
 def test_a_file_is_not_a_package(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
