@@ -127,6 +127,15 @@ def _cut(args: argparse.Namespace) -> Fraction | None:
     return duration_option(args.duration)
 
 
+def _cut_line(scenario: Scenario, cut: Fraction, where: str) -> str:
+    """What ``--duration`` made of the package: the run's length, kept apart."""
+    return (
+        f"it runs {float(cut):g} s ({where}; the scenario file keeps its "
+        f"{float(scenario.duration):g} s): as run --duration, the checks it cannot judge are "
+        "reported skipped"
+    )
+
+
 def _ros(args: argparse.Namespace, out: Path) -> int:
     from ..ros.generate import check_names, generate
 
@@ -147,6 +156,9 @@ def _ros(args: argparse.Namespace, out: Path) -> int:
         f"{', '.join(package.local) or 'none'}{cpp}); launch files: {', '.join(package.launch)}"
     )
     print(f"build it in a catkin workspace (WS/src/{package.name}): see {out / 'README.md'}")
+    cut = _cut(args)
+    if cut is not None:
+        print(_cut_line(scenarios[0], cut, "the launch files' duration:= default"))
     return 0
 
 
@@ -171,6 +183,9 @@ def _ros2(args: argparse.Namespace, out: Path) -> int:
         f"{', '.join(package.local) or 'none'})"
     )
     print(f"run it against the simulator: amsa-phys ros2 lockstep {out} --out RUNDIR")
+    cut = _cut(args)
+    if cut is not None:
+        print(_cut_line(scenario, cut, "config/amsa.yaml"))
     if package.robot:
         print(f"on a robot ({', '.join(package.robot)}): amsa-phys ros2 robot {out}")
     return 0

@@ -49,3 +49,13 @@ def test_an_uncut_package_runs_the_whole_scenario(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     assert _duration_default(_export(tmp_path, capsys)) == ""
+
+
+def test_the_export_says_how_long_the_package_runs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "pkg"
+    assert main(["export", "ros", str(SCENARIO), "-o", str(out), "--duration", "100"]) == 0
+    said = capsys.readouterr().out
+    assert "it runs 100 s (the launch files' duration:= default" in said
+    assert "the scenario file keeps its 500 s" in said
