@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ..errors import ConfigError, one_line
 from ..interop.exporter import export_world
-from ..model.configure import with_overrides
+from ..model.configure import duration_option, with_overrides
 from ..model.scenario import (
     DEFAULT_LOG_RATE_HZ,
     Scenario,
@@ -88,19 +88,18 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _load(path: str, args: argparse.Namespace) -> Scenario:
-    """A scenario file, or a bare world as a scenario with no timeline."""
+    """A scenario file, or a bare world as a scenario with no timeline.
+
+    A scenario stays whole under ``--duration``: the package keeps the cut apart and its run
+    applies it as ``run --duration`` does (``ros/exported.py``); it is judged and warned about
+    here as that run would be."""
     doc = load_yaml(path)
     if isinstance(doc.data, dict) and "world" in doc.data:
-        scenario = load_scenario(
-            path,
-            overrides=args.overrides,
-            seed=args.seed,
-            duration=args.duration,
-            log_rate=args.log_rate,
-        )
+        options = {"overrides": args.overrides, "seed": args.seed, "log_rate": args.log_rate}
+        scenario = load_scenario(path, duration=args.duration, **options)
         for note in timeline_notes(scenario, args.overrides, "--set"):  # as `run` warns
             print(one_line(f"warning: {note}"), file=sys.stderr)
-        return scenario
+        return scenario if args.duration is None else load_scenario(path, **options)
     world = load_world(path)
     rate = Fraction(str(args.log_rate)) if args.log_rate else Fraction(DEFAULT_LOG_RATE_HZ)
     bare = Scenario(
@@ -120,6 +119,23 @@ def _load(path: str, args: argparse.Namespace) -> Scenario:
     return dataclasses.replace(scenario, log_rate=max([rate, *sensors]))
 
 
+def _cut(args: argparse.Namespace) -> Fraction | None:
+    """``--duration`` of a scenario's package, kept apart from its whole scenario (a bare
+    world's timeline already has that length)."""
+    if args.duration is None:
+        return None
+    return duration_option(args.duration)
+
+
+def _cut_line(scenario: Scenario, cut: Fraction, where: str) -> str:
+    """What ``--duration`` made of the package: the run's length, kept apart."""
+    return (
+        f"it runs {float(cut):g} s ({where}; the scenario file keeps its "
+        f"{float(scenario.duration):g} s): as run --duration, the checks it cannot judge are "
+        "reported skipped"
+    )
+
+
 def _ros(args: argparse.Namespace, out: Path) -> int:
     from ..ros.generate import check_names, generate
 
@@ -128,7 +144,7 @@ def _ros(args: argparse.Namespace, out: Path) -> int:
     inputs = [p for s in scenarios for p in input_files(s)]
     staged = staged_dir(out, args.force, inputs)
     try:
-        package = generate(scenarios, list(args.files), args.mode, staged)
+        package = generate(scenarios, list(args.files), args.mode, staged, _cut(args))
         _commit(staged, out, args.force)
     except BaseException:
         discard_staged(staged)
@@ -140,6 +156,9 @@ def _ros(args: argparse.Namespace, out: Path) -> int:
         f"{', '.join(package.local) or 'none'}{cpp}); launch files: {', '.join(package.launch)}"
     )
     print(f"build it in a catkin workspace (WS/src/{package.name}): see {out / 'README.md'}")
+    cut = _cut(args)
+    if cut is not None:
+        print(_cut_line(scenarios[0], cut, "the launch files' duration:= default"))
     return 0
 
 
@@ -153,7 +172,7 @@ def _ros2(args: argparse.Namespace, out: Path) -> int:
         )
     staged = staged_dir(out, args.force, input_files(scenario))
     try:
-        package = generate2(scenario, args.scenario, staged)
+        package = generate2(scenario, args.scenario, staged, _cut(args))
         _commit(staged, out, args.force)
     except BaseException:
         discard_staged(staged)
@@ -164,6 +183,9 @@ def _ros2(args: argparse.Namespace, out: Path) -> int:
         f"{', '.join(package.local) or 'none'})"
     )
     print(f"run it against the simulator: amsa-phys ros2 lockstep {out} --out RUNDIR")
+    cut = _cut(args)
+    if cut is not None:
+        print(_cut_line(scenario, cut, "config/amsa.yaml"))
     if package.robot:
         print(f"on a robot ({', '.join(package.robot)}): amsa-phys ros2 robot {out}")
     return 0

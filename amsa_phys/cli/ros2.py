@@ -8,7 +8,8 @@ import sys
 from pathlib import Path
 
 from ..engine import interrupt
-from ..errors import one_line
+from ..errors import ConfigError, one_line
+from ..model.wording import plural
 from ..runs.expect import check_expectations
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
@@ -35,7 +36,11 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="wall seconds a node may take to answer a step (default 10)",
     )
     lock.add_argument("--no-plot", action="store_true", help="skip the plots")
-    lock.add_argument("-q", "--quiet", action="store_true", help="no summary table")
+    lock.add_argument(
+        "-q", "--quiet", action="store_true", help="no summary table, no start-up lines"
+    )
+    # refused with the way to do it: the package's length is set when it is exported
+    lock.add_argument("--duration", metavar="S", help=argparse.SUPPRESS)
     robot = sub.add_parser(
         "robot",
         help="run an exported ROS 2 package's controller side on a robot (sim:=false)",
@@ -65,8 +70,8 @@ def _robot(args: argparse.Namespace) -> int:
     from ..ros.ros2 import env, robotrun
     from ..ros.ros2.robotplan import table
 
-    env.rclpy("ros2 robot")
     the_plan = robotrun.plan(Path(args.package), args.speed, not args.no_frame_check)
+    env.rclpy("ros2 robot")  # after the package: a wrong path is said first
     side = ", ".join(the_plan.robot.plan.controller)
     print(f"robot side: {side} and amsa_boundary; standard messages:")
     for line in table(the_plan.robot):
@@ -82,14 +87,28 @@ def _robot(args: argparse.Namespace) -> int:
 
 def _lockstep(args: argparse.Namespace) -> int:
     """Start the nodes, run, stop the nodes, report."""
-    from ..ros.ros2 import env
+    from ..ros.ros2 import env, notice
     from ..ros.ros2.lockstep import nodes_running, plan, simulation
 
+    if args.duration is not None:
+        raise ConfigError(
+            "a package's duration is fixed when it is exported: amsa-phys export ros2 "
+            f"SCENARIO --duration {args.duration} -o {args.package} --force",
+            key="--duration",
+        )
+    if args.quiet:
+        notice.quiet()
+    the_plan = plan(Path(args.package), args.ros2_timeout)  # a bad path before a missing rclpy
     env.rclpy("ros2 lockstep")
-    the_plan = plan(Path(args.package), args.ros2_timeout)
     scenario = the_plan.scenario
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
     prepare_run_dir(out, args.force)
+    leaves = list(the_plan.commands)
+    notice.say(
+        f"starting {plural(len(leaves), 'node')} of {args.package} "
+        f"({', '.join(leaves) or 'none'}; ROS_DOMAIN_ID={notice.domain()}), then "
+        f"{float(scenario.duration):g} simulated s in lockstep"
+    )
     with interrupt.sigterm_as_ctrl_c(), nodes_running(the_plan.commands) as procs:
         outcome = run_scenario(
             scenario, out, plot=not args.no_plot, simulation=simulation(the_plan, procs)

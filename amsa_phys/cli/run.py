@@ -103,9 +103,11 @@ def _run(
         scenario = without_adapt(scenario)
     scenario = with_ros2(scenario, args.ros2, args.ros2_timeout)
     if scenario.ros2:  # before the run directory is made: one line if rclpy is missing
-        from ..ros.ros2 import env
+        from ..ros.ros2 import env, notice
 
         env.rclpy()
+        if args.quiet:  # no "waiting up to 60 s for ROS 2 node ..." line either
+            notice.quiet()
     for note in timeline_notes(scenario, args.overrides, "--set"):  # as the sweep warns
         print(one_line(f"warning: {note}"), file=sys.stderr)
     for note in reference_notes(scenario):

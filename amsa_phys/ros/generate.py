@@ -23,6 +23,7 @@ from __future__ import annotations
 import re
 import stat
 from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +48,7 @@ from .cppnode import (
     manifest_export,
     plugins_xml,
 )
+from .exported import cut_text, scenario_yaml
 from .external import start_values
 from .graph import RosGraph, classify
 from .launchxml import launch_xml
@@ -109,8 +111,16 @@ def check_same_world(scenarios: list[Scenario], sources: list[str]) -> WorldSpec
     return scenarios[0].world
 
 
-def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path) -> Package:
-    """Write the package for ``scenarios`` into the (staged, empty) directory ``out``."""
+def generate(
+    scenarios: list[Scenario],
+    sources: list[str],
+    mode: str,
+    out: Path,
+    cut: Fraction | None = None,
+) -> Package:
+    """Write the package for ``scenarios`` into the (staged, empty) directory ``out``; ``cut``
+    (``--duration``) becomes each launch file's ``duration:=`` default, the scenario files
+    stay whole (``exported.py``)."""
     if mode not in MODES:
         raise ConfigError(f"expected lockstep or free, got {mode!r}", key="--mode")
     check_names(scenarios, sources)
@@ -250,10 +260,18 @@ def generate(scenarios: list[Scenario], sources: list[str], mode: str, out: Path
             files[f"include/{pkg}/{header}"] = _fill(header)
     launches = []
     for scenario, fname in zip(scenarios, unique_names(s.name for s in scenarios), strict=True):
-        files[f"config/{fname}.yaml"] = yaml_dump(resolved_scenario(scenario))
+        files[f"config/{fname}.yaml"] = scenario_yaml(scenario)
         files[f"config/{fname}_params.yaml"] = _params_yaml(scenario)
         files[f"launch/{fname}.launch"] = launch_xml(
-            graph, pkg, fname, mode, cpp, source, adapt=bool(scenario.adapt), seed=scenario.seed
+            graph,
+            pkg,
+            fname,
+            mode,
+            cpp,
+            source,
+            adapt=bool(scenario.adapt),
+            seed=scenario.seed,
+            duration=cut_text(cut),
         )
         launches.append(f"{fname}.launch")
     python_nodes = sorted(f for f in files if f.startswith("nodes/"))

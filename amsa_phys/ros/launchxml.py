@@ -24,7 +24,8 @@ _ARGS = """\
   <arg name="force" default="false" doc="replace an out directory amsa-phys made"/>
   <arg name="bag" default="" doc="record every Data topic to this .bag file (an absolute path)"/>
   <arg name="speed" default="1.0" doc="free mode: simulated seconds per wall second"/>
-  <arg name="duration" default="" doc="simulated seconds to run (default: the scenario's)"/>
+  <arg name="duration" default="@@{duration:xml_attr}" doc="simulated seconds to run (empty: the\
+ scenario's; export --duration sets it)"/>
   <arg name="plots" default="true" doc="draw distance.png and trajectory.png"/>
   <arg name="timeout" default="60" doc="seconds to wait for a node before giving up"/>
   <arg name="waves" default="true" doc="lockstep: ask together the nodes of an instant whose\
@@ -125,10 +126,12 @@ def launch_xml(
     source: str,
     adapt: bool = False,
     seed: int = 0,
+    duration: str = "",
 ) -> str:
     """The launch file of the scenario whose config files are ``config/FNAME*.yaml``
     (``adapt``: it has ``adapt:`` rules, run by the adapt node when ``sim:=false``; ``seed``:
-    the scenario's, ``rosnames.P_SEED``, read by the C++ sensors for their random streams)."""
+    the scenario's, ``rosnames.P_SEED``, read by the C++ sensors for their random streams;
+    ``duration``: the ``duration:=`` default, ``export --duration``'s cut or "")."""
     data_topics = " ".join(graph.data_topics())
     local = [p for p in graph.world.leaves if p in graph.local]
     lines = [
@@ -143,7 +146,7 @@ def launch_xml(
             pkg=pkg,
         ),
         "<launch>",
-        fill(_ARGS, mode=mode),
+        fill(_ARGS, mode=mode, duration=duration),
     ]
     if cpp:
         lines.append(

@@ -45,8 +45,9 @@ Launch files: @@{launches:code}. Arguments: `mode` (`lockstep` or `free`, defaul
 an existing one is replaced only with `force:=true` and only if amsa-phys made it), `bag`
 (record every Data topic to this bag file; the package's recorder never drops a message: when
 it falls behind, the run waits for it), `speed` (free mode), `duration` (simulated seconds,
-default the scenario's), `plots`, `timeout`, `boundary` (the standard messages: by default in
-free mode and with `sim:=false`, in lockstep with `boundary:=true`)@@{cpp_arg:code}.
+default the scenario's, or the length `amsa-phys export ros --duration` gave the package),
+`plots`, `timeout`, `boundary` (the standard messages: by default in free mode and with
+`sim:=false`, in lockstep with `boundary:=true`)@@{cpp_arg:code}.
 The run ends by itself (the simulator is a required node); Ctrl-C stops every node and
 writes the outputs so far.
 

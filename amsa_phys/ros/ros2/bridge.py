@@ -33,7 +33,7 @@ from ...model.scenario import Scenario
 from ...model.template import Template
 from .. import external, names
 from ..external import ExternalLeaf as Wiring
-from . import env
+from . import env, notice
 
 #: How long one idle wait lasts before the bridge looks at the graph (a node gone, a
 #: publisher of the wrong type): a poll of the graph, not a sleep.
@@ -126,6 +126,7 @@ class Bridge:
         """Wait until the node listens on every input and ``/clock``, publishes every output
         and offers its parameter service (else a fault naming what is missing)."""
         wait = max(self.timeout_s, external.START_TIMEOUT_S)
+        notice.waiting(leaf.node, wait)  # at once: a node that never comes is a long wait
         deadline = time.monotonic() + wait
         while True:
             missing = self._missing(leaf)

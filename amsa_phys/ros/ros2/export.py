@@ -17,16 +17,18 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
 from ..._version import __version__
 from ...errors import ConfigError
 from ...model.scenario import Scenario
-from ...runs.resolve import resolved_scenario
 from .. import names
 from ..boundary import NODE as BOUNDARY
 from ..boundary import plan as boundary_plan
+from ..exported import KEY as CUT_KEY
+from ..exported import cut_seconds, scenario_yaml
 from ..external import start_values
 from ..graph import RosGraph, classify
 from ..quote import Code, check_name, fill, py_string, yaml_comment, yaml_dump
@@ -65,8 +67,11 @@ def _fill(file: str, **values: Any) -> Code:
     return fill((FILES / file).read_text(), **values)
 
 
-def generate(scenario: Scenario, source: str, out: Path) -> Package2:
-    """Write the package of ``scenario`` into the (staged, empty) directory ``out``."""
+def generate(
+    scenario: Scenario, source: str, out: Path, cut: Fraction | None = None
+) -> Package2:
+    """Write the package of ``scenario`` into the (staged, empty) directory ``out``; ``cut``
+    (``--duration``) is kept apart from the whole scenario, as ``exported.py`` says."""
     check_name(Path(source).name, "the file name", key=source)
     check_name(scenario.name, "the scenario name", file=source, key="name")
     world = scenario.world
@@ -134,18 +139,19 @@ def generate(scenario: Scenario, source: str, out: Path) -> Package2:
         nodes=Code("\n".join(launch_nodes)),
         boundary=BOUNDARY,
     )
-    files[f"config/{fname}.yaml"] = yaml_dump(resolved_scenario(scenario))
+    files[f"config/{fname}.yaml"] = scenario_yaml(scenario)
     files[f"config/{fname}_params.yaml"] = _params_yaml(scenario, remote)
-    files[MANIFEST] = yaml_dump(
-        {
-            "package": pkg,
-            "scenario": f"{fname}.yaml",
-            "params": f"{fname}_params.yaml",
-            "nodes": [{"leaf": p, "module": f"{pkg}/{names.script(p)}.py"} for p in remote],
-            "local": list(local),
-            "boundary": f"{pkg}/{BOUNDARY}.py",
-        }
-    )
+    manifest: dict[str, Any] = {
+        "package": pkg,
+        "scenario": f"{fname}.yaml",
+        "params": f"{fname}_params.yaml",
+        "nodes": [{"leaf": p, "module": f"{pkg}/{names.script(p)}.py"} for p in remote],
+        "local": list(local),
+        "boundary": f"{pkg}/{BOUNDARY}.py",
+    }
+    if cut is not None:
+        manifest[CUT_KEY] = cut_seconds(cut)
+    files[MANIFEST] = yaml_dump(manifest)
     for rel, text in files.items():
         target = out / rel
         target.parent.mkdir(parents=True, exist_ok=True)

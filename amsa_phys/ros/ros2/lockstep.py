@@ -24,6 +24,8 @@ from ...errors import ConfigError
 from ...model.scenario import Scenario, load_scenario
 from ...model.yamlio import load_yaml
 from .. import external, names
+from ..exported import KEY as CUT_KEY
+from ..exported import cut_of
 from .bridge import ExternalSimulation
 from .export import MANIFEST
 
@@ -53,6 +55,11 @@ class Package:
 
 def read_package(pkg: Path) -> Package:
     """Read the package's manifest and scenario (one line naming the file if either is bad)."""
+    if not pkg.is_dir():
+        what = "not a directory" if pkg.exists() else "no such directory"
+        raise ConfigError(
+            f"{what} (a package made by amsa-phys export ros2 SCENARIO -o DIR)", file=pkg
+        )
     manifest = pkg / MANIFEST
     if not manifest.is_file():
         raise ConfigError(
@@ -66,7 +73,19 @@ def read_package(pkg: Path) -> Package:
     for key in ("scenario", "params"):
         if not isinstance(data.get(key), str) or "/" in data[key] or data[key].startswith("."):
             raise doc.error((key,), "expected a file name in config/")
-    scenario = load_scenario(pkg / "config" / data["scenario"])
+    duration = data.get(CUT_KEY)
+    if duration is not None and (
+        isinstance(duration, bool) or not isinstance(duration, int | float)
+    ):
+        raise doc.error((CUT_KEY,), "expected seconds (export ros2 --duration)")
+    if duration is not None:
+        try:
+            cut_of(float(duration), CUT_KEY)
+        except ConfigError as exc:
+            raise doc.error((CUT_KEY,), exc.message) from None
+    # the whole scenario cut as `run --duration` cuts it: its checks skipped as there
+    seconds = None if duration is None else float(duration)
+    scenario = load_scenario(pkg / "config" / data["scenario"], duration=seconds)
 
     def script(value: Any, where: tuple[Any, ...]) -> Path:
         path = (pkg / value).resolve() if isinstance(value, str) else None
