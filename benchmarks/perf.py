@@ -288,7 +288,12 @@ def _gym_floor(env: Any) -> float:
     scenario = env._scenario
     leaf = scenario.world.leaves[env.path]
     out = dict.fromkeys(env.acted, 50.0)
-    const = dataclasses.replace(leaf, template=stand_in(leaf.template, lambda t, inp: out))
+
+    class Constant(stand_in(leaf.template)):  # type: ignore[misc,valid-type]
+        def do_step(self, t: Any, inp: Any) -> dict[str, float]:
+            return out
+
+    const = dataclasses.replace(leaf, template=Constant)
     world = dataclasses.replace(scenario.world, leaves={**scenario.world.leaves, env.path: const})
     sim = Simulation.from_scenario(dataclasses.replace(scenario, world=world))
     sim.initialize()
