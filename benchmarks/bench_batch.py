@@ -1,7 +1,7 @@
 """Batched sweeps: 1,000 and 10,000 runs of scenario1 (60 s each, Kv × context × seeds).
 
 Run: ``python benchmarks/bench_batch.py [--runs 1000] [--pool-runs 200] [--big 10000]``.
-Prints PASS/MISS lines for the targets of issue 18 and the ratio to today's process-pool
+Prints PASS/MISS lines for its targets and the ratio to today's process-pool
 sweep (``--executor local``) measured in the same run. The pool is timed on ``--pool-runs``
 spread over the same grid (its throughput is flat in the number of runs: one run per task) and
 scaled to the batch's run count; the memory of each sweep is the largest resident set of

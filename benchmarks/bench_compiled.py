@@ -1,4 +1,4 @@
-"""The compiled physics step and what is around the loop (issue 19), each against a baseline.
+"""The compiled physics step and what is around the loop, each against a baseline.
 
 * headless scenario1 in-process with the compiled step vs the pure-Python step, interleaved
   in one process (``AMSA_PHYS_PURE`` switched between runs): >= 2.3x, and >= 2,400x real time;

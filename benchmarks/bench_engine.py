@@ -1,4 +1,4 @@
-"""The engine's targets (issues 29 and 32): batched sweeps, the 1,000-rover platoon, the API.
+"""The engine's targets: batched sweeps, the 1,000-rover platoon, the API.
 
 * batched sweep against the process pool, 1,000 runs of 60 s, for scenario1 and scenario2
   (random leader, GPS loss): 25 Kv values x 40 seeds; targets >= 5x the pool, and 1,000

@@ -2,7 +2,7 @@
 
 The run is scenarios/platoon.yaml with the world's ``count:`` raised to 199 cars (200 rovers)
 for 30 simulated seconds, run as ``amsa-phys run --headless`` processes, with and without
-plots, interleaved so drifting machine load hits both alike. The target (issue 19): the run
+plots, interleaved so drifting machine load hits both alike. The target: the run
 with plots takes at most 1.3x the run without.
 Run: ``python benchmarks/bench_plots.py [--reps 3] [--cars 199]``.
 """

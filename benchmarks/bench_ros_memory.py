@@ -1,4 +1,4 @@
-"""The platoon's launch in memory (issue 26 item 5: under 1 GB), by kind of process.
+"""The platoon's launch in memory (under 1 GB), by kind of process.
 
 Exports ``worlds/platoon.yaml`` (10 cars: each a GPS, a GPS on the car ahead, a compass, a
 distance monitor, a controller and a drive), builds it with catkin (timed) and launches it

@@ -3,7 +3,7 @@
 ``amsa-phys run`` streams its trace to a file and says so above ~1 GB. ``amsa_phys.run``
 (and a Gymnasium env with ``record_trace=True``) keeps every row in memory instead, so
 ``ap.run(duration=1e9)`` would grow until the machine swaps or the kernel kills Python, hours
-in (issue 33, 8). Before the run starts:
+in. Before the run starts:
 
 * above :data:`~amsa_phys.model.tracecols.LARGE_TRACE_BYTES` (1 GB), a
   :class:`TraceSizeWarning` says how large, as the CLI's note does;

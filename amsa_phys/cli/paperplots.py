@@ -1,4 +1,5 @@
-"""``amsa-phys plot --paper fig6-sensed`` and ``fig5-start``: the figures of issue 31 (5, 6).
+"""``amsa-phys plot --paper fig6-sensed`` and ``fig5-start``: Fig. 6 in the sensed wiring,
+Fig. 5 against the initial gap.
 
 Each runs the paper's scenarios many times over (every GPS loss rate; every initial gap),
 in memory, through :func:`~amsa_phys.cli.paperruns.paper_run`, and hands the

@@ -12,7 +12,7 @@ from ..model.scenario import Scenario, load_scenario, traced_columns, without_ad
 from ..runs.rundir import check_output
 from ..runs.single import execute
 
-#: The fixed gains of the comparison (issue 27).
+#: The fixed gains of the comparison.
 GAINS = (0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35)
 
 

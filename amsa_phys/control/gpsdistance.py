@@ -2,7 +2,7 @@
 
 The 2019 model feeds the controller's ``distanceLeaderFollower`` from ``MyDistanceMonitor``,
 the *true* distance between the rovers: GPS noise and lost fixes then only reach the
-bearing, and a 90 % GPS loss barely moves the paper's Fig. 6 (issue 31, 5). A real follower
+bearing, and a 90 % GPS loss barely moves the paper's Fig. 6. A real follower
 has no such oracle. This component computes the distance from the fixes the controller
 already reads, so a lost leader fix (the GPS publishes nothing and its consumers keep the
 stale fix) is a stale distance, and GPS noise is distance noise. ``worlds/

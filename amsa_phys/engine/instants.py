@@ -11,7 +11,7 @@ if none) and ``due(tick)`` (the batches due at or before ``tick``, each ``(at, p
 changes)``: ``at`` the tick the changes are for — the time they are logged at, even if the
 loop first runs at a later tick — and ``phase`` the phase they belong to, or None to stay in
 the current one).
-Adaptation rules (issue 27) plug in here with
+Adaptation rules plug in here with
 :meth:`Simulation.add_instant_source`, and land exactly where a timeline entry at that
 instant would.
 """

@@ -52,7 +52,7 @@ def _respell(body: bytes) -> bytes:
     (memchr speed) and widened to their commas. The first version split every line holding
     such a number into its tokens in Python: in a 200-car platoon nearly every 60 KB row
     holds one (a stopped car's speed is ``1e-7``-small), so re-spelling took ~0.3 s of a
-    256-row chunk, ~40 % of the run, growing as cars stopped (issue 21.8: the real-time
+    256-row chunk, ~40 % of the run, growing as cars stopped (the real-time
     factor fell from 12.7 to 8.4 over ten minutes). A regular expression was no better:
     ``re`` scans 15 MB at ~30 MB/s. Here a chunk with 2,500 such numbers takes ~10 ms.
     """

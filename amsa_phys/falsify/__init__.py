@@ -1,4 +1,4 @@
-"""Falsification: search a box of context parameters for the worst case (issue 28).
+"""Falsification: search a box of context parameters for the worst case.
 
 ``space`` (the box), ``objective`` (a metric, or the robustness of ``expect``), ``search``
 (Latin hypercube then CMA-ES, each generation one batch through ``runs.evaluate``) and

@@ -1,4 +1,4 @@
-"""The environment's arguments, each judged before use (issue 33, 8).
+"""The environment's arguments, each judged before use.
 
 A wrong argument must be a :class:`~amsa_phys.errors.ConfigError` naming it, in one line,
 at the call that passed it, not an error from deep inside: ``render_size=(0, 0)`` was a

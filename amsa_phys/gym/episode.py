@@ -9,7 +9,7 @@ stand-in component (:func:`stand_in`) hands its inputs to the agent and is resum
 agent's outputs. Nothing else runs meanwhile, so the run is exactly the run the replaced
 component would have had, instant for instant and bit for bit, and as deterministic.
 
-That stack was a worker thread with two queues until issue 29: each env-step then paid two
+That stack was once a worker thread with two queues: each env-step then paid two
 thread hand-offs (a futex wake-up and a GIL transfer each, ~11 us CPU per round trip and
 more on a busy machine), a sixth of the step. A greenlet (the package made for exactly this:
 gevent and SQLAlchemy's asyncio bridge switch stacks with it) switches in ~1 us, in the

@@ -255,7 +255,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         """Publish ``action * action_scale`` as the component's outputs; run one period.
 
-        The per-step path is lean on purpose (issue 29: it was a third of an env-step): the
+        The per-step path is lean on purpose (it was a third of an env-step): the
         usual action (a float64 array of the right shape) skips the conversion, the quality
         signal is read once for the reward and the info, and the observation is built from
         the inputs the episode already holds.

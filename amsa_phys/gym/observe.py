@@ -143,7 +143,7 @@ class Observer:
         Python beats numpy per element, and each unit's rule was chosen once, in
         ``__init__``). Each element is clipped as it is made: ``v if -1 <= v <= 1`` else
         1 or -1 is ``min(1, max(-1, v))`` (NaN too: -1) at a third the time, and a
-        comprehension over the finished list was a function call of its own (issue 29)."""
+        comprehension over the finished list was a function call of its own."""
         if self.mode == "absolute":
             return np.array(values, dtype=np.float64)
         one = self._one

@@ -3,7 +3,7 @@
 :data:`METRICS` are the names an ``expect`` entry may give and the columns of a sweep's
 ``results.csv``; :func:`block_metrics` computes them, each a pure function of the sampled
 quality signal; :func:`compute_metrics` assembles them into a run's ``metrics.json``
-document, overall and per phase. (Issue 32: the names used to live in three places, the
+document, overall and per phase. (The names used to live in three places, the
 document in the run's module.)
 
 The signal is sampled at the trace's log rate. ``mean_error`` is signed (signal − reference:

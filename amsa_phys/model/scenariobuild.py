@@ -205,7 +205,7 @@ def _expectations(
                     "the window holds no instant",
                 )
             if "after" in e and Fraction(str(e["after"])) > duration:
-                raise doc.error(  # it would check nothing and pass (issue 33, 13)
+                raise doc.error(  # it would check nothing and pass
                     (*kp, "after"),
                     f"{e['after']:g} s is after the end of the scenario (duration "
                     f"{float(duration):g} s): the window would never hold a sample",

@@ -17,7 +17,7 @@ reader now asks a :class:`Timeline`:
   where each phase was planned to start and end.
 
 A Timeline is frozen: cutting or extending one returns a new one and never touches the
-phases a cached scenario shares with other runs. Adaptation rules (issue 27) are its next
+phases a cached scenario shares with other runs. Adaptation rules are its next
 client: a rule's change lands like a point, at an exact instant.
 """
 

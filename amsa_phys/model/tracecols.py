@@ -82,7 +82,7 @@ def estimate_trace_bytes(
 
     A float, computed in floats: the schema accepts any finite duration (``--duration
     1e308``), whose row count no longer fits a float, and an estimate must never be the
-    thing that fails (issue 33, 12). Beyond the float range the answer is ``inf``, which
+    thing that fails. Beyond the float range the answer is ``inf``, which
     compares and prints (:func:`size_text`) like any other size.
     """
     rows = float(rate_hz) * float(duration_s) + 1.0

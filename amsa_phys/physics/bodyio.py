@@ -237,7 +237,7 @@ class BodyIO:
     def step(self, dt: float, substeps: int = 1) -> None:
         """``space.step(dt)`` without pymunk's Python bookkeeping when there is none to do;
         in ``substeps`` equal steps (:func:`substeps`: a rover fast enough to cross a wall
-        within one step, issue 31) with the same forces.
+        within one step) with the same forces.
 
         ``Space.step`` wraps ``cpSpaceStep`` with work for bodies, shapes and callbacks queued
         while the space was locked (~1 µs of Python per step, half of the step for two

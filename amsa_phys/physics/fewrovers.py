@@ -4,7 +4,7 @@
 compiled ``compiled.CompiledFewRovers`` keeps its API from): it folds each rover's constants
 once, reads the bodies' state in one batch call, computes each rover's forces with the one
 copy of the arithmetic (``forces.rover_step``), writes them in one batch call, steps the
-space and checks the safety limits. Split from ``forces.py`` (issue 32) so that the
+space and checks the safety limits. Split from ``forces.py`` so that the
 arithmetic, which ``_step.c`` mirrors bit for bit, sits alone in its module.
 """
 

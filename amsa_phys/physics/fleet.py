@@ -7,7 +7,7 @@ batch's columns read and write them whole), the state as one array, one vectoris
 check. ``compiled.CompiledFleet`` and ``compiled.ColumnForces`` keep these arrays and hand the
 arithmetic to C.
 
-Why no numpy arithmetic any more (issue 32): the numpy pass was a third copy of the wheel
+Why no numpy arithmetic any more: the numpy pass was a third copy of the wheel
 model that rounded differently from the C step and the float path, so every change of the
 model was written three times and a batched row without the extension differed from its
 single run. Without a C compiler a large fleet now costs the float path's ~5 µs a rover and

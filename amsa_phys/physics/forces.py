@@ -24,7 +24,7 @@ The model per rover (``wheel.py`` states the wheel part and its closed forms):
   (``|F| <= mu N``); a wheel whose tyre saturates has its rim re-solved with that force.
 
 Why inlined float arithmetic rather than calls into ``wheel.py``: at 100 Hz with two rovers
-every microsecond per step is 3 % of the run (issue 8), and a Python call costs about as much
+every microsecond per step is 3 % of the run, and a Python call costs about as much
 as the arithmetic it wraps. The usual path (tyres gripping, rims turning, no current limit)
 is inlined; the rare branches call ``wheel.py``'s functions. ``reference.reference_forces`` is the
 same model written plainly; the tests check this code against it. :func:`rover_step` is the

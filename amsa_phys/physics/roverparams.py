@@ -2,7 +2,7 @@
 
 Shared by both robot templates (``robots.py``, ``freerobot.py``) and read by the physics
 world when it builds a rover (``space.py``); tests and benchmarks build rovers from
-:func:`rover_params`. Split from ``templates.py`` (issue 32): the table is data, the
+:func:`rover_params`. Split from ``templates.py``: the table is data, the
 templates are behaviour.
 """
 

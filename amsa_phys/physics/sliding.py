@@ -79,7 +79,7 @@ def slide_once(
     the ones that would cancel each slip *within the step* (the longitudinal one through the
     1 kg rim, the lateral one through the whole body), so their ratio, and with it the
     direction of the scaled force, was set by the masses and the step instead of by the
-    slip: a steady drift's yaw rate moved by 12 % between 100 and 1,600 Hz (issue 31).
+    slip: a steady drift's yaw rate moved by 12 % between 100 and 1,600 Hz.
     Here the tyre law itself, ``F = (N kappa / c_x, -N tan(alpha) / c_y) / max(1, |q|)``
     with ``q`` the two forces over their grips (the friction ellipse), is solved with the
     rim's next speed: ``M_w (u+ - u) / dt = F_m(u+) - R sign(u+) - F_x((u + u+) / 2)``

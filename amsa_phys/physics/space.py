@@ -254,7 +254,7 @@ class PhysicsWorld:
         reported.
 
         Why: at 100 Hz the step's two Python layers and the engine's loop around them were
-        ~0.3 us of each ~1.1 us step (issue 29).
+        ~0.3 us of each ~1.1 us step.
         """
         model: Any = self._model or self._start()
         space = self.space

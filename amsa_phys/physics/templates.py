@@ -7,7 +7,7 @@ behaviors"). At every step a robot publishes its true pose and applies the curre
 the physics advances between steps at ``physics.rate``.
 
 This module is where the template registry (``amsa_phys.physics.templates:FreeRobot``), the
-README and user code find them; each concept lives in a room of its own (issue 32): the
+README and user code find them; each concept lives in a room of its own: the
 parameter table in ``roverparams.py``, the common base and ``controlledRobot`` in
 ``robots.py``, ``freeRobot``'s behaviours in ``freerobot.py``.
 """

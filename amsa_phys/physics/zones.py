@@ -4,7 +4,7 @@ and resistance, or slope.
 The template lives here, beside the other templates of the physics package and above
 ``space.py``, while ``terrain.py`` holds only the zones' geometry and lookup that the physics
 world uses: when the template sat in ``terrain.py`` the two modules imported each other (the
-package's only import circle, issue 32).
+package's only import circle).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Fig. 6 at each GPS loss rate, in the sensed wiring beside the paper's (issue 31, 5).
+"""Fig. 6 at each GPS loss rate, in the sensed wiring beside the paper's.
 
 The paper's model feeds the controller the TRUE distance (``MyDistanceMonitor``), so losing
 the leader's GPS fixes only steers the bearing and Fig. 6 barely moves: 0 to 90 % loss

@@ -1,4 +1,4 @@
-"""Fig. 5's numbers against the initial gap between the rovers (issue 31, 6).
+"""Fig. 5's numbers against the initial gap between the rovers.
 
 The paper gives no initial conditions, and its Fig. 5 ordering — Kv 0.05 best, the maxima
 falling from 32 m (0.15) through 29 m (0.1) to 25 m (0.05) — depends on the start: from the

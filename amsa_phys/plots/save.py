@@ -36,7 +36,7 @@ def save_png(
         if fig.get_layout_engine() is None:
             # a label too wide to fit: matplotlib keeps its default layout and says "Tight
             # layout not applied"; the picture is still written, and the terminal is for
-            # amsa-phys's own messages (issue 30, item 5: no library warning reaches it)
+            # amsa-phys's own messages (no library warning reaches it)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 fig.tight_layout()

@@ -13,7 +13,7 @@ stages and renames (``runs.rundir.staged_dir``): nothing is half-written.
 
 One module per target file (``launchxml``, ``cppnode``, ``readme``; the node scripts,
 ``package.xml`` and ``CMakeLists.txt`` from ``files/*.in``), and every name reaches a file
-through :mod:`.quote`'s escaper for that file's language (issue 33). Names that would need
+through :mod:`.quote`'s escaper for that file's language. Names that would need
 escaping in code (quotes, backslashes, control characters) are refused first, in one line,
 by :func:`check_names`.
 """

@@ -1,7 +1,7 @@
 """One escaper per target language of the generated ROS package, and the filler that uses them.
 
 Every name or value that comes from a user's scenario, world, model or file name reaches a
-generated file through exactly one function here (issue 33: a scenario's ``name:`` with a
+generated file through exactly one function here (a scenario's ``name:`` with a
 newline ended a YAML comment and roslaunch's rosparam loader evaluated a ``!radians`` tag; a
 file name ran ``execute_process`` at ``catkin_make`` and closed a Python docstring). Escaping
 is the default path, as a template engine's autoescape is: a template's hole names its

@@ -32,7 +32,7 @@ class IMU(Template):
     ``v_b`` includes the sideslip: it is the chord of the last period rotated into the body
     at the mid-period heading and divided by ``sinc(dtheta/2)``, which is exact for a steady
     turn or drift (a constant body-frame velocity), where ``a_x = -w v_y``: a skidding
-    rover's sideways velocity shows up in the forward channel (issue 31: ignoring it left
+    rover's sideways velocity shows up in the forward channel (ignoring it left
     the accelerometer 3.2 m/s² off in a skid). Without the pose (the 2019 wiring: ``speed``
     and ``yawRate`` only) the sideways velocity is taken as 0: ``a_x = dv/dt``, ``a_y = v w``.
     Each channel adds the SDFormat noise of ``engine/noise.py`` with the prefix ``gyro_`` or

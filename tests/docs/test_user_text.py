@@ -338,3 +338,21 @@ def test_every_block_names_a_target_perf_measures(page: Path) -> None:
         # a block with a results file of its own (results.OWN_TABLES) is rendered from it
         unknown = set(m[2].replace(",", " ").split()) - targets - set(results.OWN_TABLES)
         assert not unknown, f"{_name(page)}: no perf.py target {sorted(unknown)}"
+
+
+#: the package's and the benchmarks' sources: their docstrings are the API reference and
+#: ``--help``, their messages what a user reads
+SOURCES = sorted(
+    [*ROOT.joinpath("amsa_phys").rglob("*.py"), *ROOT.joinpath("benchmarks").glob("*.py")]
+)
+TRACKER = re.compile(r"\bissues?\s+#?\d+", re.IGNORECASE)
+
+
+def test_no_issue_numbers_in_the_sources() -> None:
+    found = [
+        f"{path.relative_to(ROOT)}:{no}"
+        for path in SOURCES
+        for no, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+        if TRACKER.search(line)
+    ]
+    assert not found, f"sources name issues of the tracker (history goes in CHANGELOG.md): {found}"

@@ -4,7 +4,7 @@ Every generated node says on ``names.READY`` that its publishers have all their 
 (ROS 1 drops what is published before a subscriber connects). A user's own node need not: in
 free mode the simulator waits for its topics instead: each output the node publishes is
 connected to the simulator and has as many subscribers registered with the master as the
-graph expects (issue 26: such a node made the run abort after 120 s).
+graph expects (such a node made the run abort after 120 s).
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ The launch loads ``config/NAME_params.yaml`` onto the parameter server and every
 its parameters from there, so a user who edits that file (or sets a parameter before the
 run) changes the run. :func:`fold_server_values` writes such values into the scenario's
 phase 0, as a ``set:`` in the file would be: the engine applies them at t = 0 and the run's
-``scenario.yaml`` records them, so it replays the run (issue 33: it recorded the file's old
+``scenario.yaml`` records them, so it replays the run (it recorded the file's old
 value). :func:`cut` is ``duration:=S``, the same cut as ``amsa-phys run --duration S``.
 """
 

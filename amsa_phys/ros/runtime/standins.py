@@ -5,7 +5,7 @@ The engine builds every component and passes each through ``Simulation(wrap=...)
 :class:`RemoteLeaf` (stepping it is asking its node to step); a Leaf that steps here (it
 shares the pymunk world) becomes a :class:`PublishingLeaf`, the component itself with its
 outputs published on their topics after each step. Nothing replaces entries of
-``Simulation.components`` or methods of a component after construction (issue 32). In
+``Simulation.components`` or methods of a component after construction. In
 pipelined lockstep a Leaf of the C++ container is a ``pipeline.CheckedLeaf``: its template
 steps here and its node is asked to do the same, the answers checked.
 """
