@@ -101,7 +101,13 @@ def plot_samples(
             zorder=2,
             label=f"run ({len(xy)})",
         )
-        fig.colorbar(dots, ax=ax, label=metric)
+        bar = fig.colorbar(dots, ax=ax, label=metric)
+        # the values themselves on the ticks: an offset (``1e-6 + 5.494e-1``) above the bar
+        # makes runs that differ in the sixth digit look as far apart as a broken one
+        bar.formatter.set_useOffset(False)
+        bar.update_ticks()
+        if y_axis == metric:
+            ax.ticklabel_format(axis="y", useOffset=False)
 
     def at(r: dict[str, Any]) -> tuple[float, float]:
         if y_axis == metric:

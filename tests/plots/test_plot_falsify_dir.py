@@ -143,3 +143,26 @@ def test_one_axis_draws_the_value_against_it_with_the_bound(
     assert sorted(map(tuple, dots.tolist())) == sorted((p[0], p[3]) for p in POINTS)
     (bound,) = [ln for ln in ax.lines if ln.get_label() == "robustness 0"]
     assert list(bound.get_ydata()) == [0.0, 0.0]
+
+
+def test_values_that_differ_in_the_sixth_digit_are_shown_as_values_not_an_offset(
+    tmp_path: Path, figures: list[Figure]
+) -> None:
+    """A colour bar labelled ``1e-6 + 5.494e-1`` made near-equal runs look far apart."""
+    folder = _falsify_dir(tmp_path / "fals", objective="rms_error")
+    rows = (folder / "results.csv").read_text().splitlines()
+    header = rows[0].split(",")
+    at = header.index("rms_error")
+    near = []
+    for k, line in enumerate(rows[1:]):
+        cells = line.split(",")
+        cells[at] = f"{0.5494 + k * 1e-7:.7f}"
+        near.append(",".join(cells))
+    (folder / "results.csv").write_text("\n".join([rows[0], *near]) + "\n")
+    assert main(["plot", str(folder)]) == 0
+    fig = figures[0]
+    fig.canvas.draw()
+    (bar,) = [a for a in fig.axes if a.get_label() == "<colorbar>"]
+    assert bar.yaxis.get_major_formatter().get_offset() == ""
+    labels = [t.get_text() for t in bar.get_yticklabels() if t.get_text()]
+    assert labels and all(lab.startswith("0.5494") for lab in labels), labels
