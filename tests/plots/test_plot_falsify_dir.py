@@ -165,4 +165,5 @@ def test_values_that_differ_in_the_sixth_digit_are_shown_as_values_not_an_offset
     (bar,) = [a for a in fig.axes if a.get_label() == "<colorbar>"]
     assert bar.yaxis.get_major_formatter().get_offset() == ""
     labels = [t.get_text() for t in bar.get_yticklabels() if t.get_text()]
-    assert labels and all(lab.startswith("0.5494") for lab in labels), labels
+    assert labels
+    assert all(lab.startswith("0.5494") for lab in labels), labels
