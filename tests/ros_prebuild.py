@@ -38,13 +38,14 @@ ROS_SHORT: Key = (
 
 
 def build_commands(
-    ws: Path, scenario: Path, pkg: str, install: bool
+    ws: Path, scenario: Path, pkg: str, install: bool, export_args: tuple[str, ...] = ()
 ) -> list[tuple[list[str], dict[str, str]]]:
     """The commands (and their environments) that make ``ws``: ``amsa-phys export ros`` of
-    ``scenario`` as ``pkg`` into ``ws/src``, then catkin_make (and install). Every core for
-    make and no load limit: catkin's default ``-jN -lN`` makes the build serial as soon as
-    the machine's load average reaches its core count, on a loaded CI machine all along."""
-    export = [sys.executable, "-m", "amsa_phys", "export", "ros", str(scenario)]
+    ``scenario`` (with ``export_args``) as ``pkg`` into ``ws/src``, then catkin_make (and
+    install). Every core for make and no load limit: catkin's default ``-jN -lN`` makes the
+    build serial as soon as the machine's load average reaches its core count, on a loaded
+    CI machine all along."""
+    export = [sys.executable, "-m", "amsa_phys", "export", "ros", str(scenario), *export_args]
     catkin = ["catkin_make", *(["install"] if install else []), "-C", str(ws)]
     # Debian's python3 for catkin's own scripts (a venv's lacks catkin_pkg)
     catkin += [f"-j{os.cpu_count() or 1}", "-DPYTHON_EXECUTABLE=/usr/bin/python3"]

@@ -14,7 +14,6 @@ from pathlib import Path
 
 import pytest
 import ros_launch
-import ros_prebuild
 import yaml
 from ros_launch import Launch, build_workspace, ros_missing
 
@@ -31,15 +30,14 @@ SHORT = ROOT / "tests" / "fixtures" / "ros_short.yaml"
 
 
 def test_a_cut_package_launches_as_run_duration(
-    tmp_path: Path, launcher: Callable[..., Launch], monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, launcher: Callable[..., Launch]
 ) -> None:
     data = yaml.safe_load(SHORT.read_text())
     data["world"] = str((SHORT.parent / data["world"]).resolve())
     data["expect"].append({"metric": "max_distance", "phase": 2, "below": 17})
     scenario = tmp_path / "ros_short.yaml"
     scenario.write_text(yaml.safe_dump(data, sort_keys=False))
-    monkeypatch.setattr(ros_prebuild, "build_commands", _with_cut(ros_prebuild.build_commands, "8"))
-    ws = build_workspace(tmp_path / "ws", scenario, "mdeChallenge")
+    ws = build_workspace(tmp_path / "ws", scenario, "mdeChallenge", export_args=("--duration", "8"))
     config = ws / "src" / "mdeChallenge" / "config" / "ros_short.yaml"
     assert main(["validate", str(config)]) == 0
     out = tmp_path / "cut"
@@ -53,14 +51,3 @@ def test_a_cut_package_launches_as_run_duration(
     for key in ("phases", "overall"):
         assert got[key] == want[key], key
     assert (out / "scenario.yaml").read_text() == (ref / "scenario.yaml").read_text()
-
-
-def _with_cut(build: Callable[..., list], seconds: str) -> Callable[..., list]:
-    """``build_commands`` whose export has ``--duration seconds``."""
-
-    def commands(*args: object) -> list:
-        out = build(*args)
-        (export, env), *rest = out
-        return [([*export, "--duration", seconds], env), *rest]
-
-    return commands
