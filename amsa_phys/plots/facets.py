@@ -24,6 +24,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Rectangle
 
+from ..requirements.objective import higher_is_better
 from .save import save_png
 from .sweepmarks import (
     NEVER_COLOUR,
@@ -133,7 +134,9 @@ def plot_facets(
     for ax in flat[n:]:
         ax.set_visible(False)
     finite = grids[np.isfinite(grids)]
-    best = np.unravel_index(int(np.nanargmin(grids)), grids.shape) if finite.size else None
+    high = higher_is_better(metric)  # a requirement's robustness: its highest is best
+    pick = np.nanargmax if high else np.nanargmin
+    best = np.unravel_index(int(pick(grids)), grids.shape) if finite.size else None
     best_text = ""
     if heat:
         cmap = plt.get_cmap("viridis").with_extremes(bad="0.88")
@@ -165,7 +168,8 @@ def plot_facets(
             flat[p].plot(k, j - 0.25, marker="*", ms=10, color="gold", mec="k", ls="none")
             best_text = f"{x_axis}={_label(xs[k])}, {y_axis}={_label(ys[j])}"
         if image is not None and finite.size:  # no scale when every cell says "never"
-            fig.colorbar(image, ax=flat[:n], label=f"{metric} (seed mean; lowest ★)", shrink=0.9)
+            most = "highest" if high else "lowest"
+            fig.colorbar(image, ax=flat[:n], label=f"{metric} (seed mean; {most} ★)", shrink=0.9)
         for ax in flat[:n]:
             ax.set_xticks(_ticks(len(xs)), [_label(xs[t]) for t in _ticks(len(xs))])
             ax.set_yticks(_ticks(len(ys)), [_label(ys[t]) for t in _ticks(len(ys))])
@@ -206,7 +210,8 @@ def plot_facets(
         best_text = f"★ best: {best_text}, {where}"
         # equal values (axes that did not matter in these runs): the star marks the first,
         # and the title says the others are as good rather than implying one winner
-        ties = int(np.count_nonzero(np.isclose(finite, finite.min(), rtol=1e-9, atol=0.0))) - 1
+        top = finite.max() if high else finite.min()
+        ties = int(np.count_nonzero(np.isclose(finite, top, rtol=1e-9, atol=0.0))) - 1
         if ties:
             best_text += f" (tied with {ties} other grid point{'s' if ties > 1 else ''})"
     lines = [title, *left_out_text(rows, ok, metric).splitlines()[1:]]

@@ -19,6 +19,7 @@ from matplotlib.patches import Rectangle
 from matplotlib.ticker import MaxNLocator
 
 from ..model.wording import plural
+from ..requirements.objective import higher_is_better
 from .facets import plot_facets
 from .save import save_png
 from .sweepmarks import (
@@ -65,6 +66,9 @@ def plot_summary(
     :data:`BAND_SEEDS` seeds on, where bars would hide how the seeds spread).
     """
     ok = [r for r in rows if r.get(metric) is not None and not r.get("error")]
+    # the best point is starred: a metric's lowest, a requirement's robustness's highest
+    high = higher_is_better(metric)
+    most = "highest" if high else "lowest"
     # what is drawn: the runs with a value and those that never reached it ("never"), so a
     # sweep where no run settled still shows its grid, every cell saying "never"
     drawn = ok + nevers(rows, metric)
@@ -92,7 +96,8 @@ def plot_summary(
         im = ax.imshow(np.ma.masked_invalid(grid), origin="lower", aspect="auto", cmap=cmap)
         _cell_values(ax, grid, im.norm, cmap, never)
         if np.isfinite(grid).any():
-            j, i = np.unravel_index(int(np.nanargmin(grid)), grid.shape)
+            pick = np.nanargmax if high else np.nanargmin
+            j, i = np.unravel_index(int(pick(grid)), grid.shape)
             ax.add_patch(  # the best cell framed in gold (its value starred below), the
                 # frame inside the cell: on its border an edge cell's frame was cut in half
                 Rectangle(
@@ -108,7 +113,8 @@ def plot_summary(
             )
             ax.plot(i, j - 0.25, marker="*", ms=13, color="gold", mec="k", ls="none", zorder=4)
             finite = grid[np.isfinite(grid)]
-            ties = int(np.count_nonzero(np.isclose(finite, finite.min(), rtol=1e-9, atol=0.0)))
+            top = finite.max() if high else finite.min()
+            ties = int(np.count_nonzero(np.isclose(finite, top, rtol=1e-9, atol=0.0)))
             tied = f" (tied with {ties - 1} other grid point{'s' if ties > 2 else ''})"
             best = f"★ best: {axes[0]}={xs[i]:g}, {axes[1]}={ys[j]:g}"
             ax.set_title(best + (tied if ties > 1 else ""), fontsize=9)
@@ -117,7 +123,7 @@ def plot_summary(
         ax.set_xlabel(axes[0])
         ax.set_ylabel(axes[1])
         if np.isfinite(grid).any():  # no scale to show when every cell says "never"
-            bar = fig.colorbar(im, ax=ax, label=f"{metric} (seed mean; lowest ★)")
+            bar = fig.colorbar(im, ax=ax, label=f"{metric} (seed mean; {most} ★)")
             if is_count(metric):
                 bar.ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     else:
@@ -162,9 +168,9 @@ def plot_summary(
                             color=bars.lines[0].get_color(),
                             gid="seed",
                         )
-            best = int(np.argmin(mean))
+            best = int(np.argmax(mean) if high else np.argmin(mean))
             if others:
-                star = "lowest mean of each line" if not starred else "_"
+                star = f"{most} mean of each line" if not starred else "_"
             else:
                 shown = f"{xs[best]:g}" if _numeric([xs[best]]) else str(xs[best])
                 star = f"best: {x_axis}={shown} ({mean[best]:.4g})"

@@ -2,7 +2,9 @@
 
 The summary plot stars it, but a sweep run from a script or over ssh is read in the
 terminal: the point and its value belong on the last line too. "Best" is the lowest seed
-mean, as the summary's star (every metric a sweep plots is an error, a distance or a count).
+mean of a metric (an error, a distance, a count) and the highest of a requirement's
+robustness, as the summary's star (``requirements.objective.higher_is_better``, the rule
+``tune`` and ``falsify`` follow).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from collections import defaultdict
 from typing import Any
 
 from ..model.wording import plural
+from ..requirements.objective import higher_is_better
 
 
 def best_point(
@@ -29,10 +32,11 @@ def best_point(
     if not by_point:
         return None
     means = {p: sum(vs) / len(vs) for p, vs in by_point.items()}
-    point = min(means, key=lambda p: (means[p], str(p)))
-    low = means[point]
-    ties = sum(1 for p, m in means.items() if p != point and math.isclose(m, low, rel_tol=1e-9))
-    return point, low, len(by_point[point]), ties
+    sense = -1.0 if higher_is_better(metric) else 1.0
+    point = min(means, key=lambda p: (sense * means[p], str(p)))
+    best = means[point]
+    ties = sum(1 for p, m in means.items() if p != point and math.isclose(m, best, rel_tol=1e-9))
+    return point, best, len(by_point[point]), ties
 
 
 def best_line(rows: list[dict[str, Any]], axes: list[str], metric: str) -> str | None:
@@ -43,7 +47,8 @@ def best_line(rows: list[dict[str, Any]], axes: list[str], metric: str) -> str |
     point, mean, seeds, ties = found
     where = ", ".join(f"{k}={v}" for k, v in point) or "the scenario as written"
     mean_of = "mean " if seeds > 1 else ""
-    line = f"best (lowest {mean_of}{metric}): {where} -> {mean:.6g} ({plural(seeds, 'seed')})"
+    most = "highest" if higher_is_better(metric) else "lowest"
+    line = f"best ({most} {mean_of}{metric}): {where} -> {mean:.6g} ({plural(seeds, 'seed')})"
     if ties:
         line += f"; tied with {plural(ties, 'other grid point')}"
     return line

@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 from amsa_phys.cli.main import main
 from amsa_phys.plots import summary
 from amsa_phys.runs.sweep import read_results
-from amsa_phys.runs.sweepbest import best_point
+from amsa_phys.runs.sweepbest import best_line, best_point
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIO = ROOT / "scenarios" / "falsify_resonance.yaml"
@@ -88,3 +88,32 @@ def test_two_seed_spread_is_shown_and_said(tmp_path: Path, figures: list[Figure]
     ticks = sorted(float(y) for ln in ax.lines if ln.get_gid() == "seed" for y in ln.get_ydata())
     assert ticks == sorted(r["rms_error"] for r in ROWS)
     assert "largest seed spread (min–max) 0.0036" in ax.get_title()
+
+
+def test_a_requirements_robustness_is_best_at_its_highest(
+    tmp_path: Path, figures: list[Figure]
+) -> None:
+    """A robustness is a margin (higher is better, as ``tune`` and ``falsify`` read it): the
+    best point is its highest mean, in the last line and in the summary's star alike."""
+    rows = [{**r, "robustness.band": -r["rms_error"]} for r in ROWS]
+    point, mean, _, _ = best_point(rows, [AXIS], "robustness.band")  # type: ignore[misc]
+    assert point == ((AXIS, 30),)  # the lowest mean would be 14's -0.7776
+    assert mean == pytest.approx(-0.4153)
+    assert best_line(rows, [AXIS], "robustness.band").startswith(  # type: ignore[union-attr]
+        f"best (highest mean robustness.band): {AXIS}=30 -> "
+    )
+    summary.plot_summary(rows, [AXIS], "robustness.band", tmp_path / "s.png", "s")
+    texts = [t.get_text() for t in figures[0].axes[0].get_legend().get_texts()]
+    assert f"best: {AXIS}=30 (-0.4153)" in texts
+
+
+def test_a_two_axis_robustness_heatmap_frames_the_highest_cell(
+    tmp_path: Path, figures: list[Figure]
+) -> None:
+    rows = [
+        {AXIS: x, "K": k, "seed_index": 0, "error": "", "robustness.band": x * k}
+        for x in (1.0, 2.0)
+        for k in (1.0, 3.0)
+    ]
+    summary.plot_summary(rows, [AXIS, "K"], "robustness.band", tmp_path / "s.png", "s")
+    assert f"★ best: {AXIS}=2, K=3" in figures[0].axes[0].get_title()
