@@ -1,5 +1,5 @@
-"""The full suite's ``-n 2 --dist loadgroup`` really keeps ROS, ROS 2 and build tests on one
-worker: their node ids carry xdist's ``@serial`` group suffix.
+"""The full suite's ``-n 2 --dist loadgroup`` really groups the ROS and build tests: their node
+ids carry xdist's group suffix (``@ros1``, ``@ros2_build``: tests/tiers.py ``group_of``).
 
 Without it every such test is a scheduling unit of its own: two workers each set up a
 module's fixture (a pip-installed plugin, a catkin workspace) and one tears it down under the
@@ -11,14 +11,24 @@ from __future__ import annotations
 import pytest
 
 
-@pytest.mark.build  # a build test: it must be in the serial group
-def test_a_build_test_runs_in_the_serial_group(request: pytest.FixtureRequest) -> None:
+def _grouped(request: pytest.FixtureRequest) -> None:
     if not request.config.getvalue("loadgroup"):
         pytest.skip("groups exist only under pytest -n N --dist loadgroup (the full suite)")
-    assert request.node.nodeid.endswith("@serial"), request.node.nodeid
 
 
-def test_other_tests_are_not_serialised(request: pytest.FixtureRequest) -> None:
-    if not request.config.getvalue("loadgroup"):
-        pytest.skip("groups exist only under pytest -n N --dist loadgroup (the full suite)")
+@pytest.mark.build  # a build test: it must be in the group of the pip-installing tests
+def test_a_build_test_runs_in_its_group(request: pytest.FixtureRequest) -> None:
+    _grouped(request)
+    assert request.node.nodeid.endswith("@ros2_build"), request.node.nodeid
+
+
+@pytest.mark.ros
+@pytest.mark.build  # ROS 1 first: a catkin build is a ROS 1 test's
+def test_a_ros1_build_test_runs_with_the_ros1_tests(request: pytest.FixtureRequest) -> None:
+    _grouped(request)
+    assert request.node.nodeid.endswith("@ros1"), request.node.nodeid
+
+
+def test_other_tests_are_not_grouped(request: pytest.FixtureRequest) -> None:
+    _grouped(request)
     assert "@" not in request.node.nodeid, request.node.nodeid

@@ -36,21 +36,30 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     parser.addini("cpu_budget_s", "CPU seconds an unmarked test may spend", default=str(BUDGET_S))
 
 
-#: the kinds that share one worker under the full suite's ``pytest -n 2 --dist loadgroup``
-SERIAL_KINDS = ("ros", "ros2", "build")
+def group_of(item: pytest.Item) -> str | None:
+    """The xdist group a test runs in under ``pytest -n 2 --dist loadgroup``, or None.
+
+    ``ros1``: every ROS 1 test (catkin builds and launches, the C++ twins), one after another
+    on one worker: a module's workspace (a module fixture) is built once, and two ROS 1
+    graphs never share the two cores. ``ros2_build``: the ROS 2 tests and the other build
+    tests, in turn on one worker: no two workers pip-install (or uninstall) the same package
+    into the one environment at once. The two groups are two units of work, so each worker
+    takes one and both fill up with the rest (the ROS 1 group alone is most of a worker's
+    share; one group for all of them made it the suite's critical path).
+    """
+    if item.get_closest_marker("ros"):
+        return "ros1"
+    if item.get_closest_marker("ros2") or item.get_closest_marker("build"):
+        return "ros2_build"
+    return None
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the group marks
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """A test using a launch fixture is a ROS test; ROS 1, ROS 2 and build tests share a worker.
+    """A test using a launch fixture is a ROS test; ROS and build tests go to their group
+    (:func:`group_of`). Without xdist the groups are ignored.
 
-    Under ``pytest -n 2 --dist loadgroup`` (the full suite's command) those tests run on one
-    worker, one after another, while the other worker takes the rest: their package builds
-    (module fixtures) happen once, two ROS graphs never compete for the same two cores, and
-    two workers never pip-install (or uninstall) the same package into the one environment
-    at once. Without xdist the group is ignored.
-
-    xdist's worker turns the ``xdist_group`` marks into an ``@serial`` suffix of the node ids
+    xdist's worker turns the ``xdist_group`` marks into an ``@GROUP`` suffix of the node ids
     in its own hook of this name, so this one runs first. With pytest 9.2 that suffix is lost
     (pyproject.toml keeps pytest below it) and nothing was grouped: each such test was a work
     unit of its own, one worker uninstalled the plugin another was using.
@@ -62,8 +71,9 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         needs_ros = ROS_FIXTURES & set(getattr(item, "fixturenames", ()))
         if needs_ros and item.get_closest_marker("ros") is None:
             item.add_marker(pytest.mark.ros)
-        if any(item.get_closest_marker(kind) for kind in SERIAL_KINDS):
-            item.add_marker(pytest.mark.xdist_group("serial"))
+        group = group_of(item)
+        if group is not None:
+            item.add_marker(pytest.mark.xdist_group(group))
 
 
 def cpu_seconds() -> float:
