@@ -14,6 +14,7 @@ import random
 import shlex
 import shutil
 import subprocess
+import sys
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,6 +23,21 @@ ROOT = Path(__file__).resolve().parents[2]
 PY = ROOT / ".venv-ros2" / "bin" / "python"
 NODE = Path(__file__).resolve().parent / "follower_node.py"
 WALL_LIMIT_S = 600  # a hung run is killed (and fails the test), never waited for forever
+
+
+#: the environment of an export test's commands: headless, no ROS on PATH
+EXPORT_ENV = {"SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg", "PATH": "/usr/bin:/bin"}
+
+
+def amsa(*args: str, check: bool = True) -> subprocess.CompletedProcess[str]:
+    """amsa-phys of the test suite's own venv (no ROS), in :data:`EXPORT_ENV`."""
+    return subprocess.run(
+        [sys.executable, "-m", "amsa_phys", *args],
+        capture_output=True,
+        text=True,
+        env=EXPORT_ENV,
+        check=check,
+    )
 
 
 def ros2_missing() -> str | None:

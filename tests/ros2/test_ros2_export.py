@@ -11,32 +11,19 @@ from __future__ import annotations
 
 import ast
 import json
-import subprocess
-import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
 import yaml
-from ros2net import PY, ROOT, in_private_network, ros2_missing
+from ros2net import EXPORT_ENV, PY, ROOT, amsa, in_private_network, ros2_missing
 
 pytestmark = pytest.mark.ros2
 MISSING = ros2_missing()
 if MISSING:
     pytest.skip(MISSING, allow_module_level=True)
 
-ENV = {"SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg", "PATH": "/usr/bin:/bin"}
-
-
-def amsa(*args: str) -> subprocess.CompletedProcess[str]:
-    """amsa-phys of the test suite's own venv (no ROS)."""
-    return subprocess.run(
-        [sys.executable, "-m", "amsa_phys", *args],
-        capture_output=True,
-        text=True,
-        env=ENV,
-        check=True,
-    )
+ENV = EXPORT_ENV
 
 
 def in_netns(tmp: Path, body: str) -> tuple[int, str, list[int]]:

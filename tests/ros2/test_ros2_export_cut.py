@@ -9,30 +9,18 @@ the same checks skipped. ROS 2 runs in ``unshare -n`` (``ros2net.py``).
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
-from ros2net import PY, ROOT, in_private_network, ros2_missing
+from ros2net import EXPORT_ENV, PY, ROOT, amsa, in_private_network, ros2_missing
 
 pytestmark = pytest.mark.ros2
 MISSING = ros2_missing()
 if MISSING:
     pytest.skip(MISSING, allow_module_level=True)
 
-ENV = {"SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg", "PATH": "/usr/bin:/bin"}
+ENV = EXPORT_ENV
 SCENARIO = ROOT / "scenarios" / "scenario1.yaml"  # 4 phases, checks of phase 3; 100 s: 1
-
-
-def amsa(*args: str, check: bool = True) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "amsa_phys", *args],
-        capture_output=True,
-        text=True,
-        env=ENV,
-        check=check,
-    )
 
 
 def test_a_cut_package_validates_and_locksteps_as_run_duration(tmp_path: Path) -> None:
