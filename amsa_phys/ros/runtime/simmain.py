@@ -53,11 +53,18 @@ def main() -> None:
         missing = link.wait_ready(ready_timeout)
         if missing:
             raise RunFault("ROS graph", 0, f"not connected after {ready_timeout:g} s: {missing}")
-        print(
+        running = (
             f"amsa_simulator: {len(cfg.graph.remote)} nodes connected, running "
-            f"{scenario.name} ({cfg.mode}{', pipelined' if cfg.pipeline else ''})",
-            flush=True,
+            f"{scenario.name} ({cfg.mode}{', pipelined' if cfg.pipeline else ''})"
         )
+
+        def simulation(sc: Any, trace: Any) -> Any:
+            ros_sim = RosSimulation(sc, trace, link)
+            # said once the run has read the parameters it starts from: a `rosparam set`
+            # after this line is a live change (before it, the run took it as its start)
+            print(running, flush=True)
+            return ros_sim.sim
+
         startup.started()  # Ctrl-C and SIGTERM: the engine's, through the run
         with interrupt.sigterm_as_ctrl_c():
             outcome = run_scenario(
@@ -65,7 +72,7 @@ def main() -> None:
                 out_dir,
                 plot=bool(rospy.get_param("~plots", True)),
                 progress=False,
-                simulation=lambda sc, trace: RosSimulation(sc, trace, link).sim,
+                simulation=simulation,
             )
         if not link.drain_boundary(ready_timeout):
             print(
