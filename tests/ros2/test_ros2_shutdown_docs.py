@@ -18,6 +18,9 @@ MISSING = ros2_missing()
 if MISSING:
     pytest.skip(MISSING, allow_module_level=True)
 
+#: how long the node may take to end after the signal before it counts as hung (a bound
+#: on a failure, not an expected time: it ends in well under a second)
+ENDED_S = 120
 MARK = "<!-- docs-test: skip needs rclpy: tests/ros2/test_ros2_shutdown_docs.py"
 #: waits (no fixed sleep) until the node is on the graph, then exits 0
 SEEN = """\
@@ -47,6 +50,10 @@ def test_the_docs_node_ends_cleanly_on_a_signal(tmp_path: Path, sig: str) -> Non
         f"{PY} {tmp_path / 'node.py'} 2> {tmp_path / 'err'} & pid=$!\n"
         f"{PY} {tmp_path / 'seen.py'} || exit 9\n"
         f"kill -{sig} $pid\n"
+        # a hung node fails the test in ENDED_S, not at the harness's wall limit
+        f"for i in $(seq {ENDED_S * 10}); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done\n"
+        f'kill -0 $pid 2>/dev/null && {{ echo "still running {ENDED_S} s after SIG{sig}"; '
+        "kill -9 $pid; exit 7; }\n"
         "wait $pid\n"
     )
     rc, left = in_private_network(script, {"PATH": "/usr/bin:/bin"}, tmp_path / "log")

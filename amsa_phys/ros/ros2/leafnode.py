@@ -30,6 +30,7 @@ from ...model.scenario import load_scenario
 from .. import external, names
 from ..graph import NodeContext
 from . import env
+from .spin import spin_until_shutdown
 
 
 def _ros_value(value: Any) -> Any:
@@ -240,7 +241,7 @@ def main(path: str, scenario_file: str) -> None:
     rclpy.init(args=[a for a in sys.argv if a != "--amsa-step"])
     node = LeafNode()
     try:
-        rclpy.spin(node)
+        spin_until_shutdown(node)  # not rclpy.spin: spin.py says why
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:

@@ -41,6 +41,7 @@ from ..boundary import NODE, Refused, buffers_of, judge
 from ..runtime.arrays import ScanShape
 from . import env
 from .robotplan import COMMAND_QOS, ROS2_TYPE, SENSOR_QOS, Robot, robot_of
+from .spin import spin_until_shutdown
 
 #: ``/clock`` period (wall seconds): finer than any Leaf's period, as ROS 1's boundary
 CLOCK_PERIOD = 0.005
@@ -276,7 +277,7 @@ def main(scenario_file: str, manifest_file: str) -> None:
     clock = threading.Thread(target=boundary.run_clock, args=(speed, stop), daemon=True)
     clock.start()
     try:
-        rclpy.spin(node)
+        spin_until_shutdown(node)  # not rclpy.spin: spin.py says why
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
