@@ -18,6 +18,7 @@ from ...model.adaptrules import Rule
 from ...model.scenario import Change, Scenario
 from .. import names
 from . import adaptlink, rosio
+from .records import start_values
 from .standins import stand_ins
 
 
@@ -63,11 +64,15 @@ class RosSimulation(Plugs):
         #: node announces how many points it has applied, a phase's start or a step inside one
         points = enumerate(sim.timeline.points(), start=1)
         self.point_of = {id(c): k for k, point in points for c in point.changes}
-        # the parameter cache's values of every Leaf, as last seen (free mode: a change of the
-        # cache is an edit, recorded as an event whether the Leaf steps here or in its node;
-        # timeline changes are applied apart, at their instant)
+        # every Leaf's parameters as last seen (free mode: a value on the server that differs
+        # is an edit, recorded as an event whether the Leaf steps here or in its node; timeline
+        # changes are applied apart, at their instant). It starts from the values the run
+        # starts with (the server's, folded into phase 0 when the run began: records.py),
+        # not from a second read of the server: an edit landing between the two reads was
+        # taken as already seen, and lost
+        start = start_values(scenario)
         self.seen = {
-            (path, p.name): rosio.fetch_param(link.rospy, names.param(path, p.name))
+            (path, p.name): rosio.ros_value(start[(path, p.name)])
             for path in scenario.world.leaves
             for p in graph.leaf(path).template.params
         }
