@@ -182,7 +182,7 @@ def plot_trials(summary: dict[str, Any], out: Path, title: str) -> Path:
     mean = summary["mean_simulations"]
     ax.set_title(
         f"{title}: falsified {summary['falsified']}/{summary['trials']} ({rate:.0%})"
-        + (f", mean {mean:.1f} simulations" if mean is not None else "")
+        + (f", mean {mean:.3g} simulation{'' if mean == 1 else 's'}" if mean is not None else "")
     )
     ax.legend(loc="upper right")
     fig.tight_layout()
