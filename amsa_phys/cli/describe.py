@@ -188,6 +188,7 @@ def run(args: argparse.Namespace) -> int:
                 key = text.partition("=")[0].strip()
                 if key.startswith(PHYSICS_PREFIX):
                     physics_from[key.removeprefix(PHYSICS_PREFIX)] = "--set"
+        obj = with_ros2(obj, args.ros2)  # a refused Leaf before anything is printed
         print(
             f"scenario {one_line(obj.name)}: {float(obj.duration):g} s, seed {obj.seed}, "
             f"trace at {float(obj.log_rate):g} Hz"
@@ -208,7 +209,6 @@ def run(args: argparse.Namespace) -> int:
             print(f"expect {describe_what(e)} {describe_bound(e)}")
         for line in describe_rules(obj.adapt):
             print(f"adapt {line}")
-        obj = with_ros2(obj, args.ros2)
         if obj.ros2:
             for line in ros_external.table(
                 ros_external.describe(obj.world, obj.ros2), obj.ros2_timeout

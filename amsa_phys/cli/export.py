@@ -65,6 +65,14 @@ def add_args(p: argparse.ArgumentParser) -> None:
     ros2.add_argument("scenario", metavar="SCENARIO", help="the scenario")
     ros2.add_argument("-o", "--out", required=True, metavar="DIR", help="the package directory")
     ros2.add_argument("--force", action="store_true", help="replace a DIR amsa-phys made")
+    ros2.add_argument(
+        "--name",
+        metavar="PKG",
+        help="the package's name (default: the root component's in snake case, "
+        "mdeChallenge -> mde_challenge; give each scenario of one world its own to build "
+        "them in one workspace)",
+    )
+    ros2.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     add_scenario_overrides(ros2)
     amsa = sub.add_parser(
         "amsa",
@@ -172,11 +180,13 @@ def _ros2(args: argparse.Namespace, out: Path) -> int:
         )
     staged = staged_dir(out, args.force, input_files(scenario))
     try:
-        package = generate2(scenario, args.scenario, staged, _cut(args))
+        package = generate2(scenario, args.scenario, staged, _cut(args), args.name)
         _commit(staged, out, args.force)
     except BaseException:
         discard_staged(staged)
         raise
+    if args.quiet:
+        return 0
     print(
         f"wrote ROS 2 package {package.name} in {out}: {len(package.nodes)} rclpy nodes "
         f"({', '.join(package.nodes) or 'none'}; physics in amsa-phys: "

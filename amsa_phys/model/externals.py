@@ -64,9 +64,20 @@ def problem(world: WorldSpec, paths: Sequence[str]) -> str | None:
         world, lambda path: AloneContext(path, world, np.random.default_rng(0)), paths
     )
     if bodies:
+        body = bodies[0]
+        # what a user means by "my robot's controller": the Leaves feeding the body
+        feeds = sorted(
+            {
+                source
+                for buffer in world.leaves[body].inputs.values()
+                if (source := producer(world, buffer)) in world.leaves and source != body
+            }
+        )
+        hint = f" (its commands come from {', '.join(feeds)})" if feeds else ""
         return (
-            f"{bodies[0]} shares the simulator's physics world (a body, a ray-cast sensor), "
+            f"{body} shares the simulator's physics world (a body, a ray-cast sensor), "
             "so it stays in amsa-phys: a ROS 2 node can step a Leaf that only exchanges Data"
+            f"{hint}"
         )
     return None
 

@@ -8,8 +8,9 @@ and it forgets what it estimated. At exit it prints how many runs and steps it s
 
 ``--mode`` makes it misbehave for the fault tests: ``sign`` (the turning term's sign wrong),
 ``never`` (never answers), ``late`` (answers the 20th step after 3 s), ``nan``, ``wrongtype``
-(publishes LeftPower as Float32), ``die`` (exits at the 20th step), ``refuse`` (refuses Kv
-below 0.1).
+(publishes LeftPower as Float32), ``besteffort`` (publishes LeftPower BEST_EFFORT: a QoS the
+contract's RELIABLE subscription never matches), ``die`` (exits at the 20th step), ``refuse``
+(refuses Kv below 0.1).
 """
 
 from __future__ import annotations
@@ -75,7 +76,10 @@ class Follower(Node):
         for port, topic in INPUTS.items():
             self.create_subscription(Float64, topic, lambda m, p=port: self.on_input(p, m), QOS)
         left_type = Float32 if mode == "wrongtype" else Float64
-        self.left = self.create_publisher(left_type, "/MyFollowerController/LeftPower", QOS)
+        left_qos = QOS
+        if mode == "besteffort":
+            left_qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
+        self.left = self.create_publisher(left_type, "/MyFollowerController/LeftPower", left_qos)
         self.right = self.create_publisher(Float64, "/MyFollowerController/RightPower", QOS)
         self.speed = self.create_publisher(Float64, "/MyFollowerController/leaderSpeed", QOS)
 

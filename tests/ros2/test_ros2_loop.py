@@ -95,6 +95,11 @@ FAULTS = {
         "expected std_msgs/msg/Float64",
         False,
     ),
+    "besteffort": (
+        "publishes on /MyFollowerController/LeftPower with a QoS that cannot match the run's "
+        "(RELIABLE, VOLATILE): BEST_EFFORT",
+        False,
+    ),
     "die": ("/MyFollowerController/", True),
     "refuse": ("refused parameter Kv=0.05 (Kv below 0.1)", False),
 }

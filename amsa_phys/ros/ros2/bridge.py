@@ -38,6 +38,8 @@ from . import env, notice
 #: How long one idle wait lasts before the bridge looks at the graph (a node gone, a
 #: publisher of the wrong type): a poll of the graph, not a sleep.
 _LOOK_S = 0.2
+#: How long a service request waits for its answer before it is sent again (``_call``).
+_RESEND_S = 1.0
 
 
 class NodeFault(RunFault):
@@ -60,6 +62,7 @@ class Bridge:
         step_topics: bool = False,
     ) -> None:
         rclpy = env.rclpy()
+        from rclpy.event_handler import SubscriptionEventCallbacks
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
         from rosgraph_msgs.msg import Clock
@@ -85,6 +88,7 @@ class Bridge:
             durability=DurabilityPolicy.VOLATILE,
             history=HistoryPolicy.KEEP_LAST,
         )
+        self.qos = qos
         self.Clock = Clock
         self.types = {external.SCALAR: Float64, external.ARRAY: Float64MultiArray}
         self.clock_pub = self.node.create_publisher(Clock, "/clock", qos)
@@ -113,7 +117,12 @@ class Bridge:
                 box: deque[Any] = deque()
                 self.inbox[w.topic] = box
                 self.subs[w.topic] = self.node.create_subscription(
-                    self.types[w.type], w.topic, lambda m, box=box: box.append(m), qos
+                    self.types[w.type],
+                    w.topic,
+                    lambda m, box=box: box.append(m),
+                    qos,
+                    # rclpy's own warning would be a second line: _check_qos says it
+                    event_callbacks=SubscriptionEventCallbacks(incompatible_qos=_ignore),
                 )
             self.clients[leaf.path] = self.node.create_client(SetParameters, leaf.set_parameters)
             if step_topics:
@@ -133,6 +142,7 @@ class Bridge:
             if missing is None:
                 return
             self._check_types(leaf)
+            self._check_qos(leaf)
             self._check_watch(leaf)
             if time.monotonic() >= deadline:
                 raise self._fault(
@@ -167,9 +177,8 @@ class Bridge:
 
         req = SetParameters.Request()
         req.parameters = [_parameter(k, v).to_parameter_msg() for k, v in values.items()]
-        future = self.clients[leaf.path].call_async(req)
-        self.executor.spin_until_future_complete(future, timeout_sec=self.timeout_s)
-        if not future.done():
+        future = self._call(self.clients[leaf.path], req)
+        if future is None:
             raise self._fault(
                 leaf, f"{leaf.set_parameters} did not answer within {self.timeout_s:g} s"
             )
@@ -178,6 +187,30 @@ class Bridge:
                 why = result.reason or "refused"
                 raise self._fault(leaf, f"refused parameter {name}={value!r} ({why})")
         self.counts[leaf.path]["params_set"] += len(values)
+
+    def _call(self, client: Any, req: Any) -> Any:
+        """The first answer to ``req``, sent again every :data:`_RESEND_S` until one comes
+        (None after the timeout). A service's first answer can be lost while the discovery
+        of the client's reply reader is still under way (a DDS race: the node answered, the
+        answer went nowhere); setting the same values again is harmless."""
+        deadline = time.monotonic() + self.timeout_s
+        sent: list[Any] = []
+        answered = None
+        while answered is None:
+            now = time.monotonic()
+            if now >= deadline:
+                break
+            sent.append(client.call_async(req))
+            until = min(deadline, now + _RESEND_S)
+            while answered is None and time.monotonic() < until:
+                self.executor.spin_once(
+                    timeout_sec=max(0.0, min(_LOOK_S, until - time.monotonic()))
+                )
+                answered = next((f for f in sent if f.done()), None)
+        for f in sent:
+            if f is not answered:
+                client.remove_pending_request(f)
+        return answered
 
     # -- one step ---------------------------------------------------------------------------
     def step(self, leaf: Wiring, t: Fraction, inp: Mapping[str, Any]) -> dict[str, Any]:
@@ -275,6 +308,28 @@ class Bridge:
                         t,
                     )
 
+    def _check_qos(self, leaf: Wiring) -> None:
+        """A node whose publisher or subscription cannot match the contract's QoS is on the
+        graph but never connects: say so at once rather than a minute later as a node that
+        is not running. The run's side is RELIABLE and VOLATILE, so only two choices of the
+        node's cannot match: a BEST_EFFORT publisher of an output, a TRANSIENT_LOCAL
+        subscription of an input or ``/clock``. (rclpy's ``qos_check_compatible`` is not
+        used: on profiles read from the graph it reports deadlines nobody set.)"""
+        from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
+
+        for w in leaf.outputs:
+            for info in self.node.get_publishers_info_by_topic(w.topic):
+                if info.node_name == external.BRIDGE_NODE:
+                    continue
+                if info.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT:
+                    raise self._fault(leaf, _qos_line("publishes on", w.topic, "BEST_EFFORT"))
+        for topic in [w.topic for w in leaf.inputs] + ["/clock"]:
+            for info in self.node.get_subscriptions_info_by_topic(topic):
+                if info.node_name == external.BRIDGE_NODE:
+                    continue
+                if info.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL:
+                    raise self._fault(leaf, _qos_line("subscribes to", topic, "TRANSIENT_LOCAL"))
+
     def _check_alive(self, leaf: Wiring, waiting: Sequence[external.Wire], t: Fraction) -> None:
         """The node gone (its publishers left the graph) while a step waits for it."""
         for w in waiting:
@@ -309,6 +364,14 @@ class Bridge:
             self.leaves[p].node: {**c, "complete": c["steps"] == c["answers"]}
             for p, c in self.counts.items()
         }
+
+
+def _ignore(_event: Any) -> None:
+    """An event callback that does nothing (in place of rclpy's default warning)."""
+
+
+def _qos_line(verb: str, topic: str, theirs: str) -> str:
+    return f"{verb} {topic} with a QoS that cannot match the run's (RELIABLE, VOLATILE): {theirs}"
 
 
 def _param_value(value: Any) -> Any:

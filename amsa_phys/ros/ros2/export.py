@@ -32,6 +32,7 @@ from ..exported import cut_seconds, scenario_yaml
 from ..external import start_values
 from ..graph import RosGraph, classify
 from ..quote import Code, check_name, fill, py_string, yaml_comment, yaml_dump
+from .readme import readme
 
 FILES = Path(__file__).resolve().parent.parent / "files" / "ros2"
 #: A ROS 2 package name (REP 144): lower case letters, digits, underscores.
@@ -67,16 +68,33 @@ def _fill(file: str, **values: Any) -> Code:
     return fill((FILES / file).read_text(), **values)
 
 
+def check_package_name(name: str) -> str:
+    """``export ros2 --name``: a REP 144 package name, or a ConfigError (never written
+    anywhere otherwise: it names files, a Python package and XML text)."""
+    if not PACKAGE.match(name):
+        raise ConfigError(
+            f"--name {name!r} cannot name a ROS 2 package: a lowercase letter, then lowercase "
+            "letters, digits and _ (REP 144)"
+        )
+    return name
+
+
 def generate(
-    scenario: Scenario, source: str, out: Path, cut: Fraction | None = None
+    scenario: Scenario,
+    source: str,
+    out: Path,
+    cut: Fraction | None = None,
+    name: str | None = None,
 ) -> Package2:
     """Write the package of ``scenario`` into the (staged, empty) directory ``out``; ``cut``
-    (``--duration``) is kept apart from the whole scenario, as ``exported.py`` says."""
+    (``--duration``) is kept apart from the whole scenario, as ``exported.py`` says. ``name``:
+    the package's, else the root component's in snake case (two scenarios of one world then
+    share it: ``--name`` tells their packages apart in one workspace)."""
     check_name(Path(source).name, "the file name", key=source)
     check_name(scenario.name, "the scenario name", file=source, key="name")
     world = scenario.world
     names.check_world(world)
-    pkg = package_name(world.name)
+    pkg = check_package_name(name) if name is not None else package_name(world.name)
     local = classify(world, scenario.seed)
     remote = [p for p in world.leaves if p not in local]
     fname = re.sub(r"[^A-Za-z0-9_]", "_", scenario.name) or "scenario"
@@ -138,6 +156,17 @@ def generate(
         params=f"{fname}_params.yaml",
         nodes=Code("\n".join(launch_nodes)),
         boundary=BOUNDARY,
+    )
+    files["README.md"] = readme(
+        scenario,
+        pkg,
+        src,
+        f"{fname}.launch.py",
+        f"{fname}_params.yaml",
+        remote,
+        local,
+        side,
+        None if cut is None else float(cut),
     )
     files[f"config/{fname}.yaml"] = scenario_yaml(scenario)
     files[f"config/{fname}_params.yaml"] = _params_yaml(scenario, remote)
