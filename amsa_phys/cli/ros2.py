@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
 from ..engine import interrupt
 from ..errors import ConfigError, one_line
@@ -13,7 +14,10 @@ from ..model.wording import plural
 from ..runs.expect import check_expectations
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.single import run_scenario
+from .options import add_bag
+from .recording import recording_target
 from .report import print_summary
+from .run import bag_apart
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -36,6 +40,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="wall seconds a node may take to answer a step (default 10)",
     )
     lock.add_argument("--no-plot", action="store_true", help="skip the plots")
+    add_bag(lock)
     lock.add_argument(
         "-q", "--quiet", action="store_true", help="no summary table, no start-up lines"
     )
@@ -102,6 +107,9 @@ def _lockstep(args: argparse.Namespace) -> int:
     env.rclpy("ros2 lockstep")
     scenario = the_plan.scenario
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
+    bag_path = recording_target(args.bag, (".mcap",), "--bag", args.force) if args.bag else None
+    if bag_path is not None:
+        bag_apart(bag_path, out)
     prepare_run_dir(out, args.force)
     leaves = list(the_plan.commands)
     notice.say(
@@ -109,12 +117,28 @@ def _lockstep(args: argparse.Namespace) -> int:
         f"({', '.join(leaves) or 'none'}; ROS_DOMAIN_ID={notice.domain()}), then "
         f"{float(scenario.duration):g} simulated s in lockstep"
     )
-    with interrupt.sigterm_as_ctrl_c(), nodes_running(the_plan.commands) as procs:
-        outcome = run_scenario(
-            scenario, out, plot=not args.no_plot, simulation=simulation(the_plan, procs)
-        )
+    bag = None
+    if bag_path is not None:  # the bag a `run --bag` writes, byte for byte
+        from ..bag import BagRecorder
+
+        bag = BagRecorder(bag_path, scenario)
+    try:
+        with interrupt.sigterm_as_ctrl_c(), nodes_running(the_plan.commands) as procs:
+            make = simulation(the_plan, procs)
+
+            def recorded(sc: Any, trace: Any) -> Any:
+                sim = make(sc, trace)
+                if bag is not None:
+                    bag.attach(sim)
+                return sim
+
+            outcome = run_scenario(scenario, out, plot=not args.no_plot, simulation=recorded)
+    finally:
+        written = bag.close() if bag is not None else None  # whatever ended the run
     if not args.quiet:
         print_summary(outcome.metrics, out, sys.stdout)
+        if written is not None:
+            print(f"bag: {written}")
     checks = check_expectations(scenario.expect, outcome.metrics, out / "trace.csv")
     for check in checks:
         print(one_line(f"expect {check.describe()}"))

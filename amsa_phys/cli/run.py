@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
             plotter.close()
 
 
-def _bag_apart(bag: Path, out: Path) -> None:
+def bag_apart(bag: Path, out: Path) -> None:
     """Refuse, before running, a ``--bag`` that is the run directory or holds it: the run
     would end, then fail writing the bag."""
     where = bag.resolve()
@@ -122,7 +122,7 @@ def _run(
     bag_path = recording_target(args.bag, (".mcap",), "--bag", args.force) if args.bag else None
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
     if bag_path is not None:
-        _bag_apart(bag_path, out)
+        bag_apart(bag_path, out)
     prepare_run_dir(out, args.force, inputs=input_files(scenario))
     bag: BagRecorder | None = None
     if bag_path is not None:  # mcap and the message tables (~60 ms) only for --bag

@@ -1,4 +1,5 @@
-"""``export ros2 --name PKG``: two scenarios of one world, two packages, one workspace.
+"""``export ros2 --name PKG``: two scenarios of one world, two packages, one workspace;
+and ``ros2 lockstep --bag``.
 
 Without ``--name`` every export of a world is named after its root component, and a ROS 2
 workspace refuses two packages of one name. A named package is the same package under its
@@ -50,15 +51,22 @@ def test_a_named_package_locksteps_as_run(tmp_path: Path) -> None:
         pytest.skip(missing)
     pkg, ref, out = tmp_path / "pkg", tmp_path / "ref", tmp_path / "lock"
     amsa("export", "ros2", str(SCENARIO), "-o", str(pkg), "--duration", "20", "--name", "s1x")
-    amsa("run", str(SCENARIO), "--headless", "--no-plot", "-q", "--out", str(ref), "--duration=20")
+    ref_bag, bag = tmp_path / "ref.mcap", tmp_path / "lock.mcap"
+    amsa(
+        "run", str(SCENARIO), "--headless", "--no-plot", "-q", "--out", str(ref),
+        "--duration=20", "--bag", str(ref_bag),
+    )  # fmt: skip
     script = tmp_path / "netns.sh"
     # the README's own command, in the package folder
     assert "amsa-phys ros2 lockstep . --out RUNDIR" in (pkg / "README.md").read_text()
     script.write_text(
-        f"ip link set lo up\n{PY} -m amsa_phys ros2 lockstep . --out {out} --no-plot -q\n"
+        f"ip link set lo up\n{PY} -m amsa_phys ros2 lockstep . --out {out} --no-plot -q "
+        f"--bag {bag}\n"
     )
     log = tmp_path / "netns.log"
     rc, left = in_private_network(script, EXPORT_ENV, log, cwd=pkg)
     assert rc == 0, log.read_text()
     assert left == []
     assert (out / "trace.csv").read_bytes() == (ref / "trace.csv").read_bytes()
+    # and its bag is run --bag's, byte for byte
+    assert bag.read_bytes() == ref_bag.read_bytes()
