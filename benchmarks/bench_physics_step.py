@@ -282,13 +282,12 @@ def main(argv: list[str] | None = None) -> int:
 
         doc = results.table_doc(
             columns,
-            rows,
-            "the vector env's compiled column step alone (`_step.Columns.advance_many`, "
-            f"{STEPS_PER_CALL} steps a call, two rovers an env), CPU time, medians of "
-            f"{args.rounds} calls"
+            "The vector env's compiled column step alone (`_step.Columns.advance_many`, "
+            f"{STEPS_PER_CALL} steps a call, two rovers an env) of `{results.commit()}`, CPU "
+            f"time, medians of {args.rounds} calls"
             + (
-                f", interleaved with baseline {describe(args.baseline)} and compared with it "
-                "byte for byte after every call"
+                f", interleaved with the step of {describe(args.baseline)} and compared with "
+                "it byte for byte after every call"
                 if args.baseline
                 else ""
             ),
