@@ -282,6 +282,7 @@ def main(argv: list[str] | None = None) -> int:
 
         doc = results.table_doc(
             columns,
+            rows,
             "The vector env's compiled column step alone (`_step.Columns.advance_many`, "
             f"{STEPS_PER_CALL} steps a call, two rovers an env) of `{results.commit()}`, CPU "
             f"time, medians of {args.rounds} calls"

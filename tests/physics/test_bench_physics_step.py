@@ -94,3 +94,17 @@ def test_a_missing_baseline_is_one_line_and_exit_2(
     assert "nowhere" in err
     assert bench.main(["--baseline", str(tmp_path)]) == 2  # a directory without a build
     assert "build_ext --inplace" in capsys.readouterr().err
+
+
+@needs_c
+def test_save_writes_the_table_with_its_sitting(tmp_path: Path, monkeypatch: Any) -> None:
+    import results
+
+    monkeypatch.setattr(bench, "OUT", tmp_path / "physics_step.json")
+    monkeypatch.setattr(results, "write_pages", lambda: [])  # the docs stay as they are
+    assert bench.main(["--envs", "2", "--rounds", "2", "--save"]) == 0
+    doc = results.json.loads((tmp_path / "physics_step.json").read_text())
+    assert doc["columns"] == bench.ALONE
+    assert [row[0] for row in doc["rows"]] == ["2"]
+    assert doc["command"] == "python benchmarks/bench_physics_step.py --save"
+    assert "| 2 |" in results.table_markdown(doc)
