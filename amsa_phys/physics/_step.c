@@ -9,6 +9,8 @@
  * C doubles and its math.sin/cos/sqrt are libm's, so with no reassociation and no FMA
  * contraction (built with -ffp-contract=off, no -ffast-math) each result is the same double.
  * Keep it that way: change forces.py and this file together (the tests compare the traces).
+ * rover_pair repeats rover_forces' usual path for two rovers at once: change both
+ * (tests/physics/test_rover_pairs.py holds them to each other bit for bit).
  *
  * No second copy of Chipmunk: the Chipmunk functions are called through pointers taken from
  * pymunk's own cffi library (compiled.py passes them in), on pymunk's own bodies and space.
@@ -721,6 +723,167 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     *rim_r = upr;
 }
 
+/* ---- two rovers at once: rover_forces' usual path in lockstep --------------------------
+ * Why: one rover's step is a chain of dependent operations (libm's sin and cos, divisions,
+ * comparisons on their results) too long for the CPU to overlap with the next rover's; two
+ * rovers' chains side by side give it independent work at every point. Each lane is
+ * rover_forces' own expressions in its order (GCC may put the two lanes in one SSE2
+ * register: the same IEEE operations, so the same doubles). Only the usual path: no slope,
+ * no holding brake, rims turning, both tyres gripping in both passes without the scrub
+ * cap, no load transfer beyond its room, no tyre sliding. At the first sign of anything
+ * else nothing has been written and it returns 1: the caller calls rover_forces for each
+ * rover; 0: rover k's force and torque in out[0..2], rover k + 1's in out[3..5], both
+ * rovers' rims advanced. */
+#define LANES _Pragma("GCC unroll 2") for (int j = 0; j < 2; j++)
+static int rover_pair(Stepper *st, Py_ssize_t k, double out[6])
+{
+    const double dt = st->dt;
+    const double vmin = SLIP_SPEED_MIN, ivmin = 1.0 / SLIP_SPEED_MIN;
+    const Py_ssize_t *go = st->ground_off;
+    const double *p[2];
+    double *rim_l[2], *rim_r[2];
+    double ixl[2], iyl[2], rl[2], ixr[2], iyr[2], rr[2], ts[2];
+    double angle[2], vx[2], vy[2], w[2], co[2], si[2];
+    LANES {
+        const Py_ssize_t r = k + j;
+        p[j] = st->plan + r * PLAN_WIDTH;
+        const double *g = st->ground + r * st->ground_k;
+        if (g[go[7]] != 0.0 || g[go[8]] != 0.0 || p[j][P_BRAKE] != 0.0)
+            return 1; /* on a slope, or a holding brake */
+        const double *state = st->state + (st->offsets ? st->offsets[r] : 6 * r);
+        rim_l[j] = st->rims + r * st->rim_k;
+        rim_r[j] = rim_l[j] + st->rim_side;
+        ixl[j] = g[go[0]], iyl[j] = g[go[1]];
+        rl[j] = g[go[2]];
+        ixr[j] = g[go[3]], iyr[j] = g[go[4]];
+        rr[j] = g[go[5]];
+        ts[j] = g[go[6]];
+        angle[j] = state[2], vx[j] = state[3], vy[j] = state[4], w[j] = state[5];
+    }
+    LANES {
+        if (st->rot != NULL && same_bits(st->rot[3 * (k + j)], angle[j])) {
+            co[j] = st->rot[3 * (k + j) + 1];
+            si[j] = st->rot[3 * (k + j) + 2];
+        } else {
+            co[j] = cos(angle[j]);
+            si[j] = sin(angle[j]);
+        }
+    }
+    double ul[2], ur[2], vl0[2], vr0[2], ivl[2], ivr[2], kl[2], kr[2], f0l[2], f0r[2];
+    double isum[2], kphl[2], kphr[2], kphi[2], tl[2], tr[2];
+    LANES {
+        const double *q = p[j];
+        const double h = q[P_H], kx = q[P_KX], kp = q[P_KP], sphi = q[P_SPHI];
+        double v_fwd = vx[j] * co[j] + vy[j] * si[j];
+        double wh = w[j] * h;
+        ul[j] = *rim_l[j], ur[j] = *rim_r[j];
+        if (ul[j] == 0.0 && ur[j] == 0.0)
+            return 1; /* rims at rest */
+        double vl = v_fwd - wh;
+        double vr = v_fwd + wh;
+        vl0[j] = vl, vr0[j] = vr;
+        ivl[j] = vl > vmin ? 1.0 / vl : (vl < -vmin ? -1.0 / vl : ivmin);
+        ivr[j] = vr > vmin ? 1.0 / vr : (vr < -vmin ? -1.0 / vr : ivmin);
+        kl[j] = kx * ivl[j];
+        kr[j] = kx * ivr[j];
+        f0l[j] = kp * st->drives[k + j] - q[P_C_EXP] * ul[j];
+        f0r[j] = kp * st->drives[st->n + k + j] - q[P_C_EXP] * ur[j];
+        isum[j] = ivl[j] + ivr[j];
+        kphl[j] = sphi * ivl[j];
+        kphr[j] = sphi * ivr[j];
+        kphi[j] = sphi * isum[j];
+        double ysum = iyl[j] + iyr[j];
+        tl[j] = ysum > 0.0 ? ts[j] * iyr[j] / ysum : 0.5 * ts[j];
+        tr[j] = ts[j] - tl[j];
+    }
+    double fxl[2], fxr[2], upl[2], upr[2], vl[2], vr[2];
+    double torque[2] = {0.0, 0.0}, scrub[2] = {0.0, 0.0};
+    for (int pass = 0; pass < 2; pass++) {
+        LANES {
+            const double *q = p[j];
+            const double c = q[P_C], fmax = q[P_FMAX], mw = q[P_MW], bb = q[P_BB];
+            const double bbe = q[P_BBE], e2 = q[P_E2], h = q[P_H], dt_i = q[P_DT_I];
+            vl[j] = vl0[j] - scrub[j] * dt_i * h;
+            vr[j] = vr0[j] + scrub[j] * dt_i * h;
+            const double u_l = ul[j], u_r = ur[j], r_l = rl[j], r_r = rr[j];
+            double al = (mw * u_l + f0l[j] - (u_l > 0.0 ? r_l : (u_l < 0.0 ? -r_l : 0.0))) * bb;
+            double ar = (mw * u_r + f0r[j] - (u_r > 0.0 ? r_r : (u_r < 0.0 ? -r_r : 0.0))) * bb;
+            double gl = 1.0 + kl[j] * bbe;
+            double gr = 1.0 + kr[j] * bbe;
+            double cl = kl[j] * e2;
+            double cr = kr[j] * e2;
+            double bl = kl[j] * (al - vl[j]);
+            double br = kr[j] * (ar - vr[j]);
+            double det = gl * gr - cl * cr;
+            fxl[j] = (bl * gr - cl * br) / det;
+            fxr[j] = (br * gl - cr * bl) / det;
+            upl[j] = al - bb * fxl[j];
+            upr[j] = ar - bb * fxr[j];
+            double fml = f0l[j] - c * upl[j];
+            double fmr = f0r[j] - c * upr[j];
+            if (!(upl[j] * u_l > 0.0 && upr[j] * u_r > 0.0 && -fmax <= fml && fml <= fmax &&
+                  -fmax <= fmr && fmr <= fmax))
+                return 1; /* a tyre not gripping (wheel_pair) */
+            double t = (fxr[j] - fxl[j]) * h;
+            double base = w[j] + t * dt_i;
+            double den = 1.0 + kphi[j] * dt_i;
+            double s = -kphi[j] * base / den;
+            double wn = base / den;
+            double ql = kphl[j] * wn, qr = kphr[j] * wn;
+            if (!(-tl[j] <= ql && ql <= tl[j] && -tr[j] <= qr && qr <= tr[j]))
+                return 1; /* the scrub capped (patch_scrub) */
+            scrub[j] = s;
+            torque[j] = t + s;
+        }
+    }
+    double turn[2], cm[2], sm[2], ce[2], se[2], ch[2];
+    LANES {
+        turn[j] = w[j] * dt + torque[j] * p[j][P_TURN_K];
+        double end = angle[j] + turn[j];
+        double mid = angle[j] + 0.5 * turn[j];
+        cm[j] = cos(mid);
+        sm[j] = sin(mid);
+        ce[j] = cos(end);
+        se[j] = sin(end);
+        ch[j] = cos(0.5 * turn[j]);
+    }
+    double f[6];
+    LANES {
+        const double *q = p[j];
+        double fx = fxl[j] + fxr[j];
+        double a = fx * q[P_DT_M];
+        double side = (vy[j] + a * sm[j]) * ce[j] - (vx[j] + a * cm[j]) * se[j];
+        double kd = q[P_KY_DT_M] * isum[j];
+        double f_lat = q[P_NEG_M_DT] * side / ch[j] * kd / (1.0 + kd);
+        double fyl = f_lat * ivl[j] / isum[j];
+        double fyr = f_lat - fyl;
+        const double xfer = q[P_XFER];
+        double ftot = fxl[j] + fxr[j];
+        double d = xfer * ftot > 0.0 ? xfer * ftot : -(xfer * ftot);
+        double t1 = fxl[j] * ixl[j];
+        double t2 = fyl * iyl[j];
+        double t3 = fxr[j] * ixr[j];
+        double t4 = fyr * iyr[j];
+        double room = d < 1.0 ? (1.0 - d) * (1.0 - d) : 0.0;
+        if (xfer != 0.0 && (t1 * t1 + t2 * t2 > room || t3 * t3 + t4 * t4 > room))
+            return 1; /* the load transfer's limit */
+        if (t1 * t1 + t2 * t2 > 1.0 || t3 * t3 + t4 * t4 > 1.0)
+            return 1; /* a tyre sliding */
+        f[3 * j] = fx * cm[j] - f_lat * sm[j];
+        f[3 * j + 1] = fx * sm[j] + f_lat * cm[j];
+        f[3 * j + 2] = torque[j];
+    }
+    LANES {
+        out[3 * j] = f[3 * j];
+        out[3 * j + 1] = f[3 * j + 1];
+        out[3 * j + 2] = f[3 * j + 2];
+        *rim_l[j] = upl[j];
+        *rim_r[j] = upr[j];
+    }
+    return 0;
+}
+#undef LANES
+
 /* ---- the step's parts ------------------------------------------------------------------ */
 /* bodyio.substeps: Chipmunk steps in this physics step, so that no rover tunnels */
 static int substeps(double top2, double sub_speed)
@@ -731,14 +894,30 @@ static int substeps(double top2, double sub_speed)
     return (int)ceil(sqrt(top2) / sub_speed);
 }
 
+/* Every rover's force and torque for this step (rims advanced), into the (n, 3) out. */
+static void rovers_forces(Stepper *st, double *out)
+{
+    for (Py_ssize_t k = 0; k < st->n; k += 2) /* two by two where they can (rover_pair) */
+        if (k + 1 >= st->n || rover_pair(st, k, out + 3 * k) != 0) {
+            rover_forces(st, k, out + 3 * k);
+            if (k + 1 < st->n)
+                rover_forces(st, k + 1, out + 3 * k + 3);
+        }
+}
+
 static void apply_all(Stepper *st)
 {
-    for (Py_ssize_t k = 0; k < st->n; k++) {
-        double f[3];
-        rover_forces(st, k, f);
-        cpVect force = {f[0], f[1]};
-        st->set_force(st->bodies[k], force);
-        st->set_torque(st->bodies[k], f[2]);
+    for (Py_ssize_t k = 0; k < st->n; k += 2) {
+        double f[6];
+        const int both = k + 1 < st->n && rover_pair(st, k, f) == 0;
+        for (Py_ssize_t i = k; i < k + 2 && i < st->n; i++) {
+            double *fi = f + 3 * (i - k);
+            if (!both)
+                rover_forces(st, i, fi);
+            cpVect force = {fi[0], fi[1]};
+            st->set_force(st->bodies[i], force);
+            st->set_torque(st->bodies[i], fi[2]);
+        }
     }
 }
 
@@ -1201,9 +1380,7 @@ static PyObject *column_forces(PyObject *Py_UNUSED(module), PyObject *args)
         st.ground_off[t] = ground_rows[t] * n;
     st.state = views[4].buf;
     st.dt = dt;
-    double *forces = views[5].buf;
-    for (Py_ssize_t k = 0; k < n; k++)
-        rover_forces(&st, k, forces + 3 * k);
+    rovers_forces(&st, views[5].buf);
     result = Py_None;
     Py_INCREF(result);
 done:
@@ -1328,9 +1505,9 @@ static int Columns_move(Columns *c)
     const double half = 0.5 * dt;
     double *s = st->state;
     int ok = 1;
+    rovers_forces(st, c->forces); /* a rover's forces read only its own row */
     for (Py_ssize_t k = 0; k < st->n; k++) {
-        double *f = c->forces + 3 * k;
-        rover_forces(st, k, f);
+        const double *f = c->forces + 3 * k;
         double *r = s + 6 * k;
         const double vx = r[3], vy = r[4], w = r[5];
         r[0] = r[0] + (r[3] + 0.0) * dt;
