@@ -36,7 +36,7 @@ from ..model.scenario import Change, Phase, Scenario
 from ..model.template import Template
 from ..model.timeline import Timeline
 from ..model.world import WorldSpec
-from . import batch, interrupt, layout, schedule, walk
+from . import batch, interrupt, layout, schedule, skeleton, walk
 from .adapt import AdaptRules
 from .build import build_components, make_task
 from .clock import NOWS_KEPT, TickGrid, exact, kept_times
@@ -227,23 +227,16 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario, Release):
         return now
 
     def _compile(self) -> None:
-        order = self.world.order
-        periods = sorted({1 / w.leaves[p].freq for w in self.worlds for p in order})
-        periods += [1 / r for r, _, _ in self._hooks] + [1 / self.log_rate]
-        instants = [p.at for t in self.timelines for p in t.points()] + [self.duration]
-        #: each Leaf's timer phase in each run (0 unless the world gives or draws one)
-        phases = [run_phases(w, seed) for w, seed in zip(self.worlds, self.seeds, strict=True)]
-        self.timer_phases = phases[0]
-        instants += [ph for run in phases for ph in run.values() if ph]
-        self.grid = g = TickGrid.for_run(periods, instants)
+        # the grid, the phases and the tasks as an earlier run of this structure compiled
+        # them (``skeleton.py``: a reset's), else afresh below
+        kept = skeleton.kept(self)
+        if kept is not None:
+            self.timer_phases = dict(kept.phases)
+            self.grid = g = kept.grid
+            self._tasks = kept.tasks(self.members[0], self.seed)
+        else:
+            g = self._compile_tasks()
         self._tick_num, self._tick_den = g.tick.numerator, g.tick.denominator
-        self._tasks = [
-            make_task(w, path, members[path], g, ph[path], seed, self.store, run)
-            for path in order
-            for run, (w, members, ph, seed) in enumerate(
-                zip(self.worlds, self.members, phases, self.seeds, strict=True)
-            )
-        ]
         self._log_period = g.ticks(1 / self.log_rate)
         self.keeps_log = bool(self._keep_log or self.log.listeners or self.log.has_trace)
         log_at = self._log_period if self.keeps_log else None
@@ -256,6 +249,28 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario, Release):
         self._next_instant_tick = min(self._next_source_tick, self.deliveries.next_due())
         #: the compiled schedule walk (``walk.py``), or None: the Python loop of ``_advance``
         self._walk = walk.prepare(self)
+
+    def _compile_tasks(self) -> TickGrid:
+        """The tick grid, each Leaf's timer phase and its task, compiled afresh (and kept
+        for a later run of the same structure where it may reuse them)."""
+        order = self.world.order
+        periods = sorted({1 / w.leaves[p].freq for w in self.worlds for p in order})
+        periods += [1 / r for r, _, _ in self._hooks] + [1 / self.log_rate]
+        instants = [p.at for t in self.timelines for p in t.points()] + [self.duration]
+        #: each Leaf's timer phase in each run (0 unless the world gives or draws one)
+        phases = [run_phases(w, seed) for w, seed in zip(self.worlds, self.seeds, strict=True)]
+        self.timer_phases = phases[0]
+        instants += [ph for run in phases for ph in run.values() if ph]
+        self.grid = g = TickGrid.for_run(periods, instants)
+        self._tasks = [
+            make_task(w, path, members[path], g, ph[path], seed, self.store, run)
+            for path in order
+            for run, (w, members, ph, seed) in enumerate(
+                zip(self.worlds, self.members, phases, self.seeds, strict=True)
+            )
+        ]
+        skeleton.keep(self, phases[0], self._tasks)
+        return g
 
     def _lay_out(self, log_at: int | None, hooks: list[tuple[int, Hook]]) -> list[schedule.Entry]:
         """The cycle's table with like components grouped (sets ``_cycle`` and
