@@ -18,6 +18,7 @@ import pytest
 
 from amsa_phys.engine import runner, skeleton
 from amsa_phys.engine.runner import Simulation
+from amsa_phys.model.timeline import Phase
 from amsa_phys.model.world import load_world
 
 WORLD = """
@@ -54,13 +55,16 @@ def compiled(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     skeleton.forget()
 
 
-def run(world: Any, seed: int, duration: Fraction = Fraction(3)) -> tuple[Simulation, bytes]:
+def run(
+    world: Any, seed: int, duration: Fraction = Fraction(3), phases: Any = ()
+) -> tuple[Simulation, bytes]:
     """A whole run and its trace (every buffer at 100 Hz: a delivery's tick shows)."""
     rows: list[bytes] = []
     sim = Simulation(
         world,
         seed=seed,
         duration=duration,
+        phases=phases,
         log_rate=Fraction(100),
         trace=lambda t, row: rows.append(np.asarray([t, *row], dtype=np.float64).tobytes()),
     )
@@ -117,6 +121,27 @@ def test_another_duration_or_log_rate_is_compiled_afresh(world: Any, compiled: l
     assert compiled == ["C", "A", "C", "A"]
     Simulation(world, seed=1, duration=Fraction(2), log_rate=Fraction(7)).initialize()
     assert compiled == ["C", "A"] * 3
+
+
+def test_another_timeline_is_compiled_afresh(world: Any, compiled: list[str]) -> None:
+    """A phase starting at 1/7 s puts the run on a finer grid than the kept one's."""
+    run(world, 1)
+    phases = [Phase(Fraction(0), []), Phase(Fraction(1, 7), [])]
+    sim, trace = run(world, 1, phases=phases)
+    assert compiled == ["C", "A", "C", "A"]
+    skeleton.forget()
+    fresh, fresh_trace = run(world, 1, phases=phases)
+    assert sim.grid.tick == fresh.grid.tick == Fraction(1, 700)
+    assert trace == fresh_trace
+
+
+def test_other_hook_rates_are_compiled_afresh(world: Any, compiled: list[str]) -> None:
+    run(world, 1)
+    sim = Simulation(world, seed=1, duration=Fraction(3), log_rate=Fraction(100))
+    sim.add_hook(Fraction(30), lambda: None, "probe")
+    sim.initialize()
+    assert compiled == ["C", "A", "C", "A"]
+    assert sim.grid.tick == Fraction(1, 300)
 
 
 def test_timer_phases_drawn_per_seed_are_never_kept(tmp_path: Path, compiled: list[str]) -> None:
