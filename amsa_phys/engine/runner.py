@@ -39,8 +39,8 @@ from ..model.timeline import Timeline
 from ..model.world import WorldSpec
 from . import batch, interrupt, layout, schedule, skeleton, walk
 from .adapt import AdaptRules
-from .build import build_components, make_task
-from .clock import NOWS_KEPT, TickGrid, exact, kept_times
+from .build import build_components
+from .clock import NOWS_KEPT, exact, kept_times
 from .context import Context, Event, Hook, RunResult
 from .delivery import Deliveries
 from .facereads import FaceReads
@@ -53,7 +53,7 @@ from .release import Release
 from .signals import RequirementWatch
 from .store import BufferStore, ReadAPI
 from .tasks import COMPONENT_ERRORS, Steppers, Task, in_run
-from .timing import DelayLine, run_phases
+from .timing import DelayLine
 
 #: Wraps a component as it is built: ``wrap(path, component)`` returns what the engine runs
 #: in its place (the ROS simulator's remote Leaves), see :class:`Simulation`.
@@ -228,15 +228,10 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario, Release):
         return now
 
     def _compile(self) -> None:
-        # the grid, the phases and the tasks as an earlier run of this structure compiled
-        # them (``skeleton.py``: a reset's), else afresh below
-        kept = skeleton.kept(self)
-        if kept is not None:
-            self.timer_phases = dict(kept.phases)
-            self.grid = g = kept.grid
-            self._tasks = kept.tasks(self.members[0], self.seed)
-        else:
-            g = self._compile_tasks()
+        # the grid, the phases and the tasks: an earlier run's of this structure (a reset's)
+        # where ``skeleton.py`` kept them, else compiled afresh
+        self.grid, self.timer_phases, self._tasks = skeleton.compile_tasks(self)
+        g = self.grid
         self._tick_num, self._tick_den = g.tick.numerator, g.tick.denominator
         self._log_period = g.ticks(1 / self.log_rate)
         self.keeps_log = bool(self._keep_log or self.log.listeners or self.log.has_trace)
@@ -250,28 +245,6 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario, Release):
         self._next_instant_tick = min(self._next_source_tick, self.deliveries.next_due())
         #: the compiled schedule walk (``walk.py``), or None: the Python loop of ``_advance``
         self._walk = walk.prepare(self)
-
-    def _compile_tasks(self) -> TickGrid:
-        """The tick grid, each Leaf's timer phase and its task, compiled afresh (and kept
-        for a later run of the same structure where it may reuse them)."""
-        order = self.world.order
-        periods = sorted({1 / w.leaves[p].freq for w in self.worlds for p in order})
-        periods += [1 / r for r, _, _ in self._hooks] + [1 / self.log_rate]
-        instants = [p.at for t in self.timelines for p in t.points()] + [self.duration]
-        #: each Leaf's timer phase in each run (0 unless the world gives or draws one)
-        phases = [run_phases(w, seed) for w, seed in zip(self.worlds, self.seeds, strict=True)]
-        self.timer_phases = phases[0]
-        instants += [ph for run in phases for ph in run.values() if ph]
-        self.grid = g = TickGrid.for_run(periods, instants)
-        self._tasks = [
-            make_task(w, path, members[path], g, ph[path], seed, self.store, run)
-            for path in order
-            for run, (w, members, ph, seed) in enumerate(
-                zip(self.worlds, self.members, phases, self.seeds, strict=True)
-            )
-        ]
-        skeleton.keep(self, phases[0], self._tasks)
-        return g
 
     def _lay_out(self, log_at: int | None, hooks: list[tuple[int, Hook]]) -> list[schedule.Entry]:
         """The cycle's table with like components grouped (sets ``_cycle`` and
@@ -473,11 +446,8 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario, Release):
         self._next_instant_tick = min(nxt, self._next_source_tick)
 
     def _send(self, line: DelayLine, writes: list[tuple[int, float]]) -> None:
-        """Put a delayed Leaf's publication in flight: visible from ``line.due(now)``.
-
-        A fixed latency (no jitter: the single env's agent in place of a delayed controller,
-        at every env-step) is ``line.due`` and ``deliveries.push`` inlined, two calls fewer."""
-        if line.draw is None:
+        """Put a delayed Leaf's publication in flight: visible from ``line.due(now)``."""
+        if line.draw is None:  # ``due`` and ``push`` inlined: each step of the single env
             due = self._tick + line.fixed
             if due < line.last:
                 due = line.last

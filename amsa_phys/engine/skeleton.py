@@ -29,9 +29,10 @@ from typing import TYPE_CHECKING, Any
 from ..model.timeline import Timeline
 from ..model.timing import RANDOM
 from ..model.world import WorldSpec
+from .build import make_task
 from .clock import TickGrid
 from .tasks import Task
-from .timing import DelayLine
+from .timing import DelayLine, run_phases
 
 if TYPE_CHECKING:
     from .runner import Simulation
@@ -109,7 +110,7 @@ def kept(sim: Simulation) -> Skeleton | None:
     return found
 
 
-def keep(sim: Simulation, phases: dict[str, Fraction], tasks: list[Task]) -> None:
+def keep(sim: Simulation, grid: TickGrid, phases: dict[str, Fraction], tasks: list[Task]) -> None:
     """Record ``sim``'s freshly compiled grid, phases and tasks, if a later run of the same
     structure may reuse them (a single run, no adaptation rules, no drawn phases)."""
     world = sim.world
@@ -131,11 +132,37 @@ def keep(sim: Simulation, phases: dict[str, Fraction], tasks: list[Task]) -> Non
         sim.duration,
         sim.log_rate,
         hook_rates(sim),
-        sim.grid,
+        grid,
         dict(phases),
         tuple(protos),
         delayed,
     )
+
+
+def compile_tasks(sim: Simulation) -> tuple[TickGrid, dict[str, Fraction], list[Task]]:
+    """``sim``'s tick grid, its (first) run's timer phases and its tasks: from the skeleton
+    kept for its structure, else compiled afresh (and kept where a later run may reuse
+    them)."""
+    found = kept(sim)
+    if found is not None:
+        return found.grid, dict(found.phases), found.tasks(sim.members[0], sim.seed)
+    order = sim.world.order
+    periods = sorted({1 / w.leaves[p].freq for w in sim.worlds for p in order})
+    periods += [1 / r for r, _, _ in sim._hooks] + [1 / sim.log_rate]
+    instants = [p.at for t in sim.timelines for p in t.points()] + [sim.duration]
+    #: each Leaf's timer phase in each run (0 unless the world gives or draws one)
+    phases = [run_phases(w, seed) for w, seed in zip(sim.worlds, sim.seeds, strict=True)]
+    instants += [ph for run in phases for ph in run.values() if ph]
+    grid = TickGrid.for_run(periods, instants)
+    tasks = [
+        make_task(w, path, members[path], grid, ph[path], seed, sim.store, run)
+        for path in order
+        for run, (w, members, ph, seed) in enumerate(
+            zip(sim.worlds, sim.members, phases, sim.seeds, strict=True)
+        )
+    ]
+    keep(sim, grid, phases[0], tasks)
+    return grid, phases[0], tasks
 
 
 def forget() -> None:

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from amsa_phys.engine import runner, skeleton
+from amsa_phys.engine import skeleton
 from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.timeline import Phase
 from amsa_phys.model.world import load_world
@@ -46,9 +46,11 @@ def world(tmp_path: Path) -> Any:
 def compiled(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     """The paths whose task was compiled afresh (``make_task`` calls), in order."""
     calls: list[str] = []
-    fresh = runner.make_task
+    fresh = skeleton.make_task
     monkeypatch.setattr(
-        runner, "make_task", lambda w, path, *a, **k: calls.append(path) or fresh(w, path, *a, **k)
+        skeleton,
+        "make_task",
+        lambda w, path, *a, **k: calls.append(path) or fresh(w, path, *a, **k),
     )
     skeleton.forget()
     yield calls

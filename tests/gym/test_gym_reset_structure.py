@@ -16,7 +16,7 @@ import pytest
 
 gymnasium = pytest.importorskip("gymnasium", reason="the gym extra is not installed")
 
-from amsa_phys.engine import runner, skeleton  # noqa: E402
+from amsa_phys.engine import skeleton  # noqa: E402
 from amsa_phys.gym import FollowEnv  # noqa: E402
 from amsa_phys.gym.follow import DEFAULT_SCENARIO  # noqa: E402
 
@@ -52,9 +52,9 @@ def test_a_reset_compiles_no_task_again_and_keeps_the_agent_world(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     compiled: list[str] = []
-    fresh = runner.make_task
+    fresh = skeleton.make_task
     monkeypatch.setattr(
-        runner,
+        skeleton,
         "make_task",
         lambda w, path, *a, **k: compiled.append(path) or fresh(w, path, *a, **k),
     )
