@@ -14,6 +14,7 @@ from __future__ import annotations
 import heapq
 import math
 from collections.abc import MutableMapping
+from heapq import heappop
 from typing import Any
 
 import numpy as np
@@ -48,8 +49,8 @@ class Deliveries:
         numpy view) in one call."""
         heap = self._heap
         while heap and heap[0][0] <= tick:
-            for at, value in heapq.heappop(heap)[2]:
-                if col is None or type(at) is int:
+            for at, value in heappop(heap)[2]:  # a position first: a single run's every write
+                if type(at) is int or col is None:
                     values[at] = value
                 else:
                     col[at] = value

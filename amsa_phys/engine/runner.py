@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from fractions import Fraction
+from heapq import heappush
 from typing import Any
 
 from ..errors import RunFault
@@ -36,10 +37,10 @@ from ..model.scenario import Change, Phase, Scenario
 from ..model.template import Template
 from ..model.timeline import Timeline
 from ..model.world import WorldSpec
-from . import batch, interrupt, layout, schedule, walk
+from . import batch, interrupt, layout, schedule, skeleton, walk
 from .adapt import AdaptRules
-from .build import build_components, make_task
-from .clock import NOWS_KEPT, TickGrid, exact, kept_times
+from .build import build_components
+from .clock import NOWS_KEPT, exact, kept_times
 from .context import Context, Event, Hook, RunResult
 from .delivery import Deliveries
 from .facereads import FaceReads
@@ -52,7 +53,7 @@ from .release import Release
 from .signals import RequirementWatch
 from .store import BufferStore, ReadAPI
 from .tasks import COMPONENT_ERRORS, Steppers, Task, in_run
-from .timing import DelayLine, run_phases
+from .timing import DelayLine
 
 #: Wraps a component as it is built: ``wrap(path, component)`` returns what the engine runs
 #: in its place (the ROS simulator's remote Leaves), see :class:`Simulation`.
@@ -227,23 +228,11 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario, Release):
         return now
 
     def _compile(self) -> None:
-        order = self.world.order
-        periods = sorted({1 / w.leaves[p].freq for w in self.worlds for p in order})
-        periods += [1 / r for r, _, _ in self._hooks] + [1 / self.log_rate]
-        instants = [p.at for t in self.timelines for p in t.points()] + [self.duration]
-        #: each Leaf's timer phase in each run (0 unless the world gives or draws one)
-        phases = [run_phases(w, seed) for w, seed in zip(self.worlds, self.seeds, strict=True)]
-        self.timer_phases = phases[0]
-        instants += [ph for run in phases for ph in run.values() if ph]
-        self.grid = g = TickGrid.for_run(periods, instants)
+        # the grid, the phases and the tasks: an earlier run's of this structure (a reset's)
+        # where ``skeleton.py`` kept them, else compiled afresh
+        self.grid, self.timer_phases, self._tasks = skeleton.compile_tasks(self)
+        g = self.grid
         self._tick_num, self._tick_den = g.tick.numerator, g.tick.denominator
-        self._tasks = [
-            make_task(w, path, members[path], g, ph[path], seed, self.store, run)
-            for path in order
-            for run, (w, members, ph, seed) in enumerate(
-                zip(self.worlds, self.members, phases, self.seeds, strict=True)
-            )
-        ]
         self._log_period = g.ticks(1 / self.log_rate)
         self.keeps_log = bool(self._keep_log or self.log.listeners or self.log.has_trace)
         log_at = self._log_period if self.keeps_log else None
@@ -458,8 +447,17 @@ class Simulation(ReadAPI, FaceReads, LiveChanges, FromScenario, Release):
 
     def _send(self, line: DelayLine, writes: list[tuple[int, float]]) -> None:
         """Put a delayed Leaf's publication in flight: visible from ``line.due(now)``."""
-        due = line.due(self._tick)
-        self.deliveries.push(due, writes)
+        if line.draw is None:  # ``due`` and ``push`` inlined: each step of the single env
+            due = self._tick + line.fixed
+            if due < line.last:
+                due = line.last
+            line.last = due
+            heap = self.deliveries  # ``push`` inlined
+            heap._sent += 1
+            heappush(heap._heap, (due, heap._sent, writes))
+        else:
+            due = line.due(self._tick)
+            self.deliveries.push(due, writes)
         if due < self._next_instant_tick:
             self._next_instant_tick = due
 

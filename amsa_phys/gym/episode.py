@@ -34,6 +34,7 @@ import greenlet
 from ..engine.runner import Simulation
 from ..model.scenario import Scenario
 from ..model.template import Template
+from ..model.world import WorldSpec
 from ..templatemarks import StandIn
 
 
@@ -80,6 +81,30 @@ def stand_in(original: type[Template]) -> type[Template]:
     return Agent
 
 
+#: the world with the agent in place, by (id of the scenario's world, path): each reset of
+#: one env makes the same one, and the same object lets the next run reuse the structure the
+#: last one compiled (``engine/skeleton.py``); an entry holds its world, checked with ``is``
+_AGENT_WORLDS: dict[tuple[int, str], tuple[WorldSpec, WorldSpec]] = {}
+#: how many agent worlds are kept (the oldest dropped first): one env needs one
+MAX_AGENT_WORLDS = 8
+
+
+def agent_world(world: WorldSpec, path: str) -> WorldSpec:
+    """``world`` with the agent's stand-in in place of the Leaf ``path`` (made once per
+    world and path: a WorldSpec is frozen, a change is a new one)."""
+    key = (id(world), path)
+    found = _AGENT_WORLDS.get(key)
+    if found is not None and found[0] is world:
+        return found[1]
+    leaf = world.leaves[path]
+    agent = dataclasses.replace(leaf, template=stand_in(leaf.template))
+    made = dataclasses.replace(world, leaves={**world.leaves, path: agent})
+    if len(_AGENT_WORLDS) >= MAX_AGENT_WORLDS:
+        _AGENT_WORLDS.pop(next(iter(_AGENT_WORLDS), key), None)
+    _AGENT_WORLDS[key] = (world, made)
+    return made
+
+
 class Episode:
     """The scenario running with the agent in place of the Leaf ``path``.
 
@@ -101,11 +126,8 @@ class Episode:
         *,
         keep_log: bool = False,
     ) -> None:
-        world = scenario.world
         self.path = path
-        leaf = world.leaves[path]
-        agent = dataclasses.replace(leaf, template=stand_in(leaf.template))
-        world = dataclasses.replace(world, leaves={**world.leaves, path: agent})
+        world = agent_world(scenario.world, path)
         self.sim = Simulation.from_scenario(
             dataclasses.replace(scenario, world=world), trace=trace, keep_log=keep_log
         )
