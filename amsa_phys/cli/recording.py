@@ -26,9 +26,9 @@ MAX_SIDE = 7680
 def add_recording(p: argparse.ArgumentParser) -> None:
     """The video options of ``run``."""
     p.add_argument("--record", metavar="FILE", help="write a video: FILE.mp4 (H.264) or FILE.gif")
-    p.add_argument("--fps", type=int, default=30, help="video frames per second (default 30)")
+    p.add_argument("--fps", type=int, help="video frames per second (default 30)")
     p.add_argument(
-        "--size", default="1280x720", metavar="WxH", help="video size in pixels (default 1280x720)"
+        "--size", metavar="WxH", help="video (and --snapshot) size in pixels (default 1280x720)"
     )
     p.add_argument(
         "--snapshot",
@@ -43,7 +43,6 @@ def add_recording(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--speedup",
-        default="1",
         metavar="K",
         help="K simulated seconds per video second (default 1: video time = simulated time)",
     )
@@ -62,23 +61,40 @@ def parse_size(text: str) -> tuple[int, int]:
     return w, h
 
 
+DEFAULT_FPS = 30
+DEFAULT_SIZE = "1280x720"
+
+
 def recording_options(args: argparse.Namespace) -> RecordOptions | None:
-    """The checked recording request, or None without ``--record``."""
-    size = parse_size(args.size)
-    if not 1 <= args.fps <= 240:
-        raise ConfigError(f"{args.fps}: frames per second must be 1..240", key="--fps")
+    """The checked recording request, or None without ``--record``. A video option without
+    ``--record`` (``--size`` without ``--snapshot`` either) is refused: it would do nothing,
+    silently, as ``--snapshot-at`` without ``--snapshot`` would."""
+    if args.record is None:
+        given = [o for o, v in (("--fps", args.fps), ("--speedup", args.speedup)) if v is not None]
+        if args.size is not None and args.snapshot is None:
+            given.append("--size")
+        if given:
+            what = (
+                "--record FILE or --snapshot FILE.png" if given[0] == "--size" else "--record FILE"
+            )
+            raise ConfigError(f"needs {what}: alone it would do nothing", key=given[0])
+    size = parse_size(args.size or DEFAULT_SIZE)
+    fps = DEFAULT_FPS if args.fps is None else args.fps
+    if not 1 <= fps <= 240:
+        raise ConfigError(f"{fps}: frames per second must be 1..240", key="--fps")
+    text = "1" if args.speedup is None else args.speedup
     try:
-        speedup = Fraction(str(args.speedup).strip())
+        speedup = Fraction(str(text).strip())
     except (ValueError, ZeroDivisionError):
-        raise ConfigError(f"expected a number, got {args.speedup!r}", key="--speedup") from None
+        raise ConfigError(f"expected a number, got {text!r}", key="--speedup") from None
     if not 0 < speedup <= 10_000:
-        raise ConfigError(f"{args.speedup}: must be above 0 and at most 10000", key="--speedup")
+        raise ConfigError(f"{text}: must be above 0 and at most 10000", key="--speedup")
     if args.record is None:
         return None
     path = recording_target(args.record, FORMATS, "--record", args.force)
     from ..view.video import RecordOptions
 
-    return RecordOptions(path, size, args.fps, speedup)
+    return RecordOptions(path, size, fps, speedup)
 
 
 def snapshot_options(args: argparse.Namespace) -> SnapshotOptions | None:
@@ -95,7 +111,7 @@ def snapshot_options(args: argparse.Namespace) -> SnapshotOptions | None:
         at = Fraction(str(args.snapshot_at))
     from ..view.video import SnapshotOptions
 
-    return SnapshotOptions(path, parse_size(args.size), at)
+    return SnapshotOptions(path, parse_size(args.size or DEFAULT_SIZE), at)
 
 
 def recording_target(name: str, formats: tuple[str, ...], flag: str, force: bool) -> Path:

@@ -137,10 +137,12 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         self._tolerance = self.quality.tolerance
         self.path = controller if controller is not None else _default_controller(self._scenario)
         if self.path not in world.leaves:
-            raise ConfigError(
-                f"unknown component {self.path!r}" + did_you_mean(self.path, world.leaves),
-                key="controller",
-            )
+            hint = did_you_mean(self.path, world.leaves)
+            if not hint:  # nothing close: the ones an agent usually replaces
+                kinds = [p for p, lf in world.leaves.items() if lf.kind is Kind.CONTROLLER]
+                shown = ", ".join(kinds[:5]) + (", ..." if len(kinds) > 5 else "")
+                hint = f" (the world's controllers: {shown})" if kinds else ""
+            raise ConfigError(f"unknown component {self.path!r}{hint}", key="controller")
         leaf = world.leaves[self.path]
         ports = [p for p in leaf.template.inputs if p.name in leaf.inputs]
         arrays = [p.name for p in ports if p.array]

@@ -138,12 +138,7 @@ def resolved_scenario(
             out["timeline"].append(item)
     if scenario.adapt:
         out["adapt"] = written_rules(scenario.adapt)
-    written = float(duration if duration is not None else scenario.duration)
-    kept = [  # an STL window past the written end: its loader would refuse the file
-        e
-        for e in scenario.expect
-        if not any(e is d for d in drop) and (e.stl is None or reads_until(e.stl) <= written)
-    ]
+    kept = kept_expectations(scenario, duration, drop)
     if kept:
         out["expect"] = []
         for e in kept:
@@ -160,6 +155,19 @@ def resolved_scenario(
             )
             out["expect"].append({k: v for k, v in fields if v is not None})
     return out
+
+
+def kept_expectations(
+    scenario: Scenario, duration: Fraction | None, drop: Sequence[Expectation] = ()
+) -> list[Expectation]:
+    """The expectations a resolved scenario keeps: not those in ``drop``, nor an STL one
+    reading past the written end (its loader would refuse the file)."""
+    written = float(duration if duration is not None else scenario.duration)
+    return [
+        e
+        for e in scenario.expect
+        if not any(e is d for d in drop) and (e.stl is None or reads_until(e.stl) <= written)
+    ]
 
 
 def _expand_copies(comps: dict[str, Any], name: str, prefix: str, scenario: Scenario) -> None:

@@ -31,7 +31,7 @@ from ..view.encoder import EncoderError
 from .expect import already_broken, describe_bound, describe_what, skip_reason
 from .plotjob import PlotJob, plot_context
 from .provenance import provenance
-from .resolve import resolved_scenario
+from .resolve import kept_expectations, resolved_scenario
 
 if TYPE_CHECKING:  # pygame is imported only by runs that draw
     from ..view.video import Recorder, RecordOptions, Snapshot, SnapshotOptions
@@ -282,7 +282,8 @@ def execute(
         duration=sim.now if stopped_early else None,
         drop=drop,
     )
-    note = _cut_note(metrics, drop)
+    kept = kept_expectations(scenario, sim.now if stopped_early else None, drop)
+    note = _cut_note(metrics, [e for e in scenario.expect if not any(e is k for k in kept)])
     return Ended(scenario, sim, metrics, resolved, error, note, has_trace, unwritten)
 
 

@@ -213,3 +213,26 @@ def test_a_snapshot_after_the_end_is_refused_before_anything_runs(
     )
     assert not (tmp_path / "o").exists()
     assert not (tmp_path / "s.png").exists()
+
+
+@pytest.mark.parametrize(
+    ("given", "said"),
+    [
+        (["--fps", "10"], "error: --fps: needs --record FILE: alone it would do nothing\n"),
+        (["--speedup", "4"], "error: --speedup: needs --record FILE: alone it would do nothing\n"),
+        (
+            ["--size", "640x360"],
+            "error: --size: needs --record FILE or --snapshot FILE.png: alone it would do "
+            "nothing\n",
+        ),
+    ],
+)
+def test_a_video_option_without_a_video_is_refused_before_anything_runs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], given: list[str], said: str
+) -> None:
+    scenario = str(ROOT / "tests" / "fixtures" / "mde_short.yaml")
+    out = tmp_path / "o"
+    code = main(["run", scenario, "--headless", "--out", str(out), *given])
+    assert code == 2
+    assert capsys.readouterr().err == said
+    assert not out.exists()

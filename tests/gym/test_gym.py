@@ -184,6 +184,10 @@ def test_renders_with_the_projects_renderer() -> None:
             "controller: unknown component 'MyFollowerControler' "
             "(did you mean MyFollowerController?)",
         ),
+        (
+            {"controller": "Nope"},
+            "controller: unknown component 'Nope' (the world's controllers: MyFollowerController)",
+        ),
         ({"actions": ["Left"]}, "actions: MyFollowerController has no output 'Left'"),
         ({"render_mode": "ansi"}, "render_mode: unknown render mode 'ansi'"),
         ({"observation": "polar"}, "observation: unknown observation 'polar'"),
@@ -192,7 +196,7 @@ def test_renders_with_the_projects_renderer() -> None:
             'set={"MyFollowerController.Kvv": ...}: unknown parameter',
         ),
     ],
-    ids=["controller", "actions", "render-mode", "observation", "set"],
+    ids=["controller", "controller-far", "actions", "render-mode", "observation", "set"],
 )
 def test_bad_arguments_are_one_line_errors(kwargs: dict[str, object], message: str) -> None:
     with pytest.raises(ap.ConfigError) as err:

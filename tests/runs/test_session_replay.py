@@ -202,3 +202,26 @@ def test_a_trace_window_the_cut_run_stopped_inside_is_judged_only_if_broken() ->
     assert check_expectations([inside], cut, (header, data))[0].verdict == "pass"  # whole window
     data[-1, 1] = 14.0  # broke the bound before the cut: a real failure
     assert check_expectations([holds], cut, (header, data))[0].verdict == "FAIL"
+
+
+def test_the_replays_note_names_every_check_it_leaves_out(tmp_path: Path) -> None:
+    """An STL check reading past where the window was closed is left out of the replay
+    (its loader would refuse it): the comment heading scenario.yaml names it too."""
+    stl = "  - {stl: 'always[0:10](MyDistanceMonitor.distanceFollowerToLeader >= 0)', name: far}\n"
+
+    def close_at_four(sim: Simulation, scenario: Scenario, rec: Recorder | None) -> None:
+        w = Window(sim, scenario.quality, size=(320, 240))
+        while sim.now < 4:
+            w.frame(0.1)
+        press(pygame.K_q)
+        w.frame(0.1)
+
+    scenario = load_scenario(scenario_file(tmp_path, stl))
+    out = tmp_path / "early"
+    out.mkdir()
+    run_scenario(scenario, out, window=close_at_four, plot=False)
+    text = (out / "scenario.yaml").read_text()
+    note = text.splitlines()[0]
+    assert "expect" not in yaml.safe_load(text)
+    for what in ("max_distance (phase 0)", "max_distance (phase 1)", "rms_error", "far"):
+        assert what in note, note
