@@ -169,13 +169,24 @@ def draw_pane(
             text = f"{name}: no sample yet"
         else:
             lo, hi = float(finite.min()), float(finite.max())
-            text = f"{name} {v[-1]:.4g}  [{lo:.4g} .. {hi:.4g}]"
+            text = fit_text(small, name, f" {v[-1]:.4g}  [{lo:.4g} .. {hi:.4g}]", rect.w - 16)
             _polyline(surface, plot, t, v, t_end, lo, hi, colour)
         surface.blit(small.render(text, True, colour), (rect.x + 8, y))
         y += small.get_linesize()
     if math.isfinite(t_end):
         label = small.render(f"last {SPAN_S:g} s to t = {t_end:.2f} s", True, (110, 110, 116))
         surface.blit(label, (plot.right - label.get_width(), plot.bottom + 2))
+
+
+def fit_text(face: pygame.font.Font, name: str, rest: str, width: int) -> str:
+    """``name + rest`` in ``width`` pixels: the name loses its start first (``…Leader``:
+    the port at its end tells signals apart), the value and range are kept whole."""
+    text = name + rest
+    cut = 0
+    while face.size(text)[0] > width and cut < len(name) - 1:
+        cut += 1
+        text = "\u2026" + name[cut:] + rest
+    return text
 
 
 def _polyline(
