@@ -131,7 +131,7 @@ def test_a_cut_run_says_how_many_checks_it_left_out(tmp_path: Path) -> None:
     assert code == 0
     assert lines[-1] == (
         # "never closer than 3 m" is judged on the 100 s that ran; the rest reads later phases
-        "run_lockstep: pass: 1 expectation passed, 4 skipped (not judged by this run: see "
+        "run_lockstep: pass: 1 expectation passed, 5 skipped (not judged by this run: see "
         f"scenario.yaml) ({out})"
     )
 
