@@ -16,6 +16,8 @@ import pytest
 
 gymnasium = pytest.importorskip("gymnasium", reason="the gym extra is not installed")
 
+from test_gym_reset_reuse import episode as reuse_episode  # noqa: E402
+
 from amsa_phys.engine import skeleton  # noqa: E402
 from amsa_phys.gym import FollowEnv  # noqa: E402
 from amsa_phys.gym.follow import DEFAULT_SCENARIO  # noqa: E402
@@ -24,17 +26,8 @@ ACTIONS = np.clip(0.8 + np.random.default_rng(3).uniform(-0.4, 0.4, (100, 2)), -
 
 
 def episode(env: FollowEnv, seed: int) -> list[Any]:
-    """What the agent sees in one episode, as comparable bytes and numbers."""
-    obs, info = env.reset(seed=seed)
-    seen: list[Any] = [obs.tobytes(), sorted(info.items())]
-    for a in ACTIONS:
-        obs, reward, terminated, truncated, info = env.step(a)
-        seen.append((obs.tobytes(), reward, terminated, truncated, sorted(info.items())))
-        if terminated or truncated:
-            break
-    assert terminated or truncated, "the episode did not end: give more actions"
-    seen.append(env.trace().tobytes())
-    return seen
+    """What the agent sees in one episode (``test_gym_reset_reuse``'s, these actions)."""
+    return reuse_episode(env, seed, None, ACTIONS)
 
 
 def moved_leader(tmp_path: Path) -> Path:

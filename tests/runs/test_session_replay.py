@@ -128,14 +128,16 @@ def test_an_in_phase_entry_is_checked_with_its_own_line(tmp_path: Path) -> None:
     )
 
 
-def test_closing_the_window_early_skips_what_it_did_not_finish(tmp_path: Path) -> None:
-    def close_at_four(sim: Simulation, scenario: Scenario, rec: Recorder | None) -> None:
-        w = Window(sim, scenario.quality, size=(320, 240))
-        while sim.now < 4:
-            w.frame(0.1)
-        press(pygame.K_q)
+def close_at_four(sim: Simulation, scenario: Scenario, rec: Recorder | None) -> None:
+    """A window session closed with q at t = 4 s."""
+    w = Window(sim, scenario.quality, size=(320, 240))
+    while sim.now < 4:
         w.frame(0.1)
+    press(pygame.K_q)
+    w.frame(0.1)
 
+
+def test_closing_the_window_early_skips_what_it_did_not_finish(tmp_path: Path) -> None:
     scenario = load_scenario(scenario_file(tmp_path))
     out = tmp_path / "early"
     out.mkdir()
@@ -208,13 +210,6 @@ def test_the_replays_note_names_every_check_it_leaves_out(tmp_path: Path) -> Non
     """An STL check reading past where the window was closed is left out of the replay
     (its loader would refuse it): the comment heading scenario.yaml names it too."""
     stl = "  - {stl: 'always[0:10](MyDistanceMonitor.distanceFollowerToLeader >= 0)', name: far}\n"
-
-    def close_at_four(sim: Simulation, scenario: Scenario, rec: Recorder | None) -> None:
-        w = Window(sim, scenario.quality, size=(320, 240))
-        while sim.now < 4:
-            w.frame(0.1)
-        press(pygame.K_q)
-        w.frame(0.1)
 
     scenario = load_scenario(scenario_file(tmp_path, stl))
     out = tmp_path / "early"
