@@ -18,8 +18,10 @@ setup(
         Extension(
             "amsa_phys.physics._step",
             ["amsa_phys/physics/_step.c"],
-            depends=[PYMOD],
-            extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"],
+            # workers.h: the helper threads of a batch's column step
+            depends=[PYMOD, "amsa_phys/physics/workers.h"],
+            extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math", "-pthread"],
+            extra_link_args=["-pthread"],
             libraries=["m"],
             optional=True,
         ),

@@ -32,8 +32,9 @@ from ..physics.columns import ColumnPhysics
 class EpisodeColumns(ColumnPhysics):
     """:class:`ColumnPhysics` whose touched runs stop moving (see the module docstring)."""
 
-    def __init__(self) -> None:
+    def __init__(self, threads: int = 1) -> None:
         super().__init__()
+        self.threads = threads
         #: how many runs were touched when :attr:`_frozen` was last rebuilt
         self._seen = 0
         self._frozen: np.ndarray | None = None  # rover rows of the touched runs

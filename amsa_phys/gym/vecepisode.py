@@ -114,6 +114,7 @@ class VecEpisode:
         observed: Sequence[str],
         acted: Sequence[str],
         columns: bool = True,
+        threads: int = 1,
     ) -> None:
         world = scenario.world
         leaf = world.leaves[path]
@@ -125,7 +126,7 @@ class VecEpisode:
         #: why the runs cannot be columns (None: they are), ``runs/batched.py``'s reasons
         self.why_not_columns = _why_not_columns(runs[0]) if columns else "asked for Spaces"
         #: the runs' column physics, or None: each run steps its own Space
-        self.columns = EpisodeColumns() if self.why_not_columns is None else None
+        self.columns = EpisodeColumns(threads) if self.why_not_columns is None else None
         if self.columns is not None:
             self.sim = MultiRun(runs, columns=self.columns)
         else:  # a robot's group step would command every run's rovers through one Space

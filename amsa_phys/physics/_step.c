@@ -22,6 +22,7 @@
 #include <math.h>
 
 #include "../pymod.h" /* Python's float %, shared */
+#include "workers.h"       /* helper threads for a batch's column step (Columns) */
 #include <stdint.h>
 #include <string.h>
 
@@ -894,15 +895,23 @@ static int substeps(double top2, double sub_speed)
     return (int)ceil(sqrt(top2) / sub_speed);
 }
 
+/* Rovers k0 (even) to k1's force and torque for this step (rims advanced), into the (n, 3)
+ * out; two by two where they can (rover_pair), the pairs (0, 1), (2, 3), ... whatever the
+ * range, so a split at even indices pairs every rover as the whole range does. */
+static void rovers_forces_range(Stepper *st, double *out, Py_ssize_t k0, Py_ssize_t k1)
+{
+    for (Py_ssize_t k = k0; k < k1; k += 2)
+        if (k + 1 >= k1 || rover_pair(st, k, out + 3 * k) != 0) {
+            rover_forces(st, k, out + 3 * k);
+            if (k + 1 < k1)
+                rover_forces(st, k + 1, out + 3 * k + 3);
+        }
+}
+
 /* Every rover's force and torque for this step (rims advanced), into the (n, 3) out. */
 static void rovers_forces(Stepper *st, double *out)
 {
-    for (Py_ssize_t k = 0; k < st->n; k += 2) /* two by two where they can (rover_pair) */
-        if (k + 1 >= st->n || rover_pair(st, k, out + 3 * k) != 0) {
-            rover_forces(st, k, out + 3 * k);
-            if (k + 1 < st->n)
-                rover_forces(st, k + 1, out + 3 * k + 3);
-        }
+    rovers_forces_range(st, out, 0, st->n);
 }
 
 static void apply_all(Stepper *st)
@@ -1419,6 +1428,8 @@ typedef struct {
     double *reach; /* scratch: each rover's reach this step, then its bound */
     Py_ssize_t n_pairs, n_boxes, n_runs;
     double reach_m, max2, extent;
+    int threads; /* parts the move takes (workers.h): 1, or the workers' pool below */
+    Pool *pool;  /* started at the first threaded step */
 } Columns;
 
 /* np.maximum: NaN wins, else the larger (the first of two equal ones) */
@@ -1496,17 +1507,18 @@ static void Columns_screen(Columns *c)
     }
 }
 
-/* The step after the screening: every rover's forces, its integration and the check;
- * whether every rover passed. */
-static int Columns_move(Columns *c)
+/* The step after the screening for rovers k0 (even) to k1: their forces, their integration
+ * and the check; whether every one of them passed. A rover's forces and integration read
+ * and write only its own rows, so ranges can run at once (Columns_move_part). */
+static int Columns_move_range(Columns *c, Py_ssize_t k0, Py_ssize_t k1)
 {
     Stepper *st = &c->st;
     const double dt = st->dt;
     const double half = 0.5 * dt;
     double *s = st->state;
     int ok = 1;
-    rovers_forces(st, c->forces); /* a rover's forces read only its own row */
-    for (Py_ssize_t k = 0; k < st->n; k++) {
+    rovers_forces_range(st, c->forces, k0, k1); /* a rover's forces read only its own row */
+    for (Py_ssize_t k = k0; k < k1; k++) {
         const double *f = c->forces + 3 * k;
         double *r = s + 6 * k;
         const double vx = r[3], vy = r[4], w = r[5];
@@ -1526,14 +1538,53 @@ static int Columns_move(Columns *c)
     return ok;
 }
 
+/* Part ``part`` of ``parts`` of the move (a pool_job): the rovers between two even
+ * boundaries, in proportion. */
+static int Columns_move_part(void *ctx, int part, int parts)
+{
+    Columns *c = (Columns *)ctx;
+    const Py_ssize_t n = c->st.n;
+    Py_ssize_t k0 = (Py_ssize_t)((double)n * part / parts) & ~(Py_ssize_t)1;
+    Py_ssize_t k1 = part + 1 == parts ? n : (Py_ssize_t)((double)n * (part + 1) / parts) & ~(Py_ssize_t)1;
+    return k0 < k1 ? Columns_move_range(c, k0, k1) : 1;
+}
+
+/* The step after the screening: every rover's forces, its integration and the check;
+ * whether every rover passed. With ``threads`` above 1 (and at least two rovers a part)
+ * the rovers are split between this thread and the pool's workers; the GIL may be
+ * released meanwhile (no Python API below). */
+static int Columns_move(Columns *c)
+{
+    if (c->threads > 1 && c->st.n >= 2 * c->threads) {
+        if (c->pool == NULL) {
+            c->pool = (Pool *)PyMem_RawMalloc(sizeof(Pool));
+            if (c->pool == NULL) /* no memory for the pool: one thread, the same floats */
+                c->threads = 1;
+            else
+                pool_start(c->pool, c->threads);
+        }
+        if (c->pool != NULL)
+            return pool_run(c->pool, Columns_move_part, c);
+    }
+    return Columns_move_range(c, 0, c->st.n);
+}
+
 static PyObject *Columns_advance(Columns *c, PyObject *Py_UNUSED(ignored))
 {
+    int ok;
+    Py_BEGIN_ALLOW_THREADS
     Columns_screen(c);
-    return PyBool_FromLong(Columns_move(c));
+    ok = Columns_move(c);
+    Py_END_ALLOW_THREADS
+    return PyBool_FromLong(ok);
 }
 
 static void Columns_dealloc(Columns *c)
 {
+    if (c->pool != NULL) {
+        pool_stop(c->pool);
+        PyMem_RawFree(c->pool);
+    }
     for (int i = 0; i < c->n_views; i++)
         PyBuffer_Release(&c->views[i]);
     PyMem_Free(c->reach);
@@ -1565,18 +1616,24 @@ static int Columns_init(Columns *c, PyObject *args, PyObject *kwds)
     static char *kwlist[] = {"plan",   "drives", "rims",  "ground",  "state",  "forces",
                              "m_inv",  "i_inv",  "dt",    "max2",    "extent", "run",
                              "radius", "sub",    "reach", "pairs_a", "pairs_b", "boxes",
-                             "touched", NULL};
+                             "touched", "threads", NULL};
     PyObject *o[15];
     double dt, max2, extent, reach_m;
+    int threads = 1;
     if (c->n_views) {
         PyErr_SetString(PyExc_RuntimeError, "Columns is initialised once");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "OOOOOOOOdddOOOdOOOO", kwlist, &o[0], &o[1],
-                                     &o[2], &o[3], &o[4], &o[5], &o[6], &o[7], &dt, &max2,
-                                     &extent, &o[8], &o[9], &o[10], &reach_m, &o[11], &o[12],
-                                     &o[13], &o[14]))
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "OOOOOOOOdddOOOdOOOO|$i", kwlist, &o[0],
+                                     &o[1], &o[2], &o[3], &o[4], &o[5], &o[6], &o[7], &dt,
+                                     &max2, &extent, &o[8], &o[9], &o[10], &reach_m, &o[11],
+                                     &o[12], &o[13], &o[14], &threads))
         return -1;
+    if (threads < 1 || threads > POOL_MAX) {
+        PyErr_Format(PyExc_ValueError, "threads: 1 to %d, got %d", POOL_MAX, threads);
+        return -1;
+    }
+    c->threads = threads;
     Py_buffer probe;
     if (PyObject_GetBuffer(o[4], &probe, PyBUF_SIMPLE) < 0)
         return -1;
@@ -1659,7 +1716,9 @@ static PyObject *Columns_advance_many(Columns *c, PyObject *args)
     double *s = c->st.state;
     double *before = NULL; /* the frozen rows before the step (allocated when first needed) */
     Py_ssize_t done = 0;
-    int ok = 1;
+    int ok = 1, no_memory = 0;
+    /* no Python API in the loop: other Python threads run meanwhile (and the pool's) */
+    Py_BEGIN_ALLOW_THREADS
     while (done < count && ok) {
         Columns_screen(c);
         /* the rows to hold: those of runs marked, this step's screening included (the
@@ -1669,8 +1728,10 @@ static PyObject *Columns_advance_many(Columns *c, PyObject *args)
             for (Py_ssize_t r = 0; r < c->n_runs && !held; r++)
                 held = c->touched[r] != 0;
         if (held) {
-            if (before == NULL && (before = PyMem_Malloc(6 * n * sizeof(double))) == NULL)
-                return PyErr_NoMemory();
+            if (before == NULL && (before = PyMem_RawMalloc(6 * n * sizeof(double))) == NULL) {
+                no_memory = 1;
+                break;
+            }
             for (Py_ssize_t k = 0; k < n; k++)
                 if (c->touched[c->run[k]])
                     memcpy(before + 6 * k, s + 6 * k, 6 * sizeof(double));
@@ -1682,7 +1743,10 @@ static PyObject *Columns_advance_many(Columns *c, PyObject *args)
                     memcpy(s + 6 * k, before + 6 * k, 6 * sizeof(double));
         done++;
     }
-    PyMem_Free(before);
+    Py_END_ALLOW_THREADS
+    PyMem_RawFree(before);
+    if (no_memory)
+        return PyErr_NoMemory();
     return Py_BuildValue("(nO)", done, ok ? Py_True : Py_False);
 }
 
@@ -1696,6 +1760,17 @@ static PyMethodDef Columns_methods[] = {
     {NULL, NULL, 0, NULL},
 };
 
+static PyObject *Columns_workers(Columns *c, void *Py_UNUSED(closure))
+{
+    return PyLong_FromLong(c->pool == NULL ? 0 : c->pool->running);
+}
+
+static PyGetSetDef Columns_getset[] = {
+    {"workers", (getter)Columns_workers, NULL,
+     "Helper threads running beside the caller's (0 before the first threaded step).", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
 static PyTypeObject ColumnsType = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "amsa_phys.physics._step.Columns",
     .tp_basicsize = sizeof(Columns),
@@ -1705,6 +1780,7 @@ static PyTypeObject ColumnsType = {
     .tp_init = (initproc)Columns_init,
     .tp_dealloc = (destructor)Columns_dealloc,
     .tp_methods = Columns_methods,
+    .tp_getset = Columns_getset,
 };
 
 /* ---- column_powers: the robots' power commands into a batch's drives ---------------------

@@ -256,8 +256,14 @@ class ColumnPhysics:
                 "boxes": np.ascontiguousarray(self._boxes, dtype=np.float64).reshape(-1, 4),
                 "touched": self._touched,
             }
-            self._fused = model.columns(io.state, io._f, (m_inv, i_inv), screen)
+            self._fused = model.columns(
+                io.state, io._f, (m_inv, i_inv), screen, threads=self.threads
+            )
         return model
+
+    #: threads of the compiled column step (``compiled.ColumnForces.columns``); the numpy
+    #: path ignores it. Each rover is computed by the same code in any thread: the same floats
+    threads = 1
 
     #: whether a touched run's rovers stay where they were (the vector env's columns,
     #: ``gym/veccolumns.py``); a sweep lets them move (it makes the run again alone)

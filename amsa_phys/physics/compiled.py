@@ -434,13 +434,22 @@ class ColumnForces(Fleet):
         if self._span is None:
             self._out[self.rows] = out
 
-    def columns(self, state: np.ndarray, forces: np.ndarray, inverse: tuple, screen: dict) -> Any:
+    def columns(
+        self,
+        state: np.ndarray,
+        forces: np.ndarray,
+        inverse: tuple,
+        screen: dict,
+        threads: int = 1,
+    ) -> Any:
         """The whole column step in C (``_step.Columns``) over these arrays: contact screening
         on the state before the step, this model's forces, Chipmunk's integration of a body
         without contacts and the safety check, as ``columns.ColumnPhysics`` does them in
         numpy, in one call. ``inverse`` is (1/m, 1/I) per rover; ``screen`` the screening's
         arrays (``ColumnPhysics._start``); ``state`` and ``forces`` the io's, which the step
-        updates in place (this model's ``state`` becomes ``state``)."""
+        updates in place (this model's ``state`` becomes ``state``). ``threads`` above 1
+        splits each step's forces and integration between that many threads
+        (``workers.h``): the same floats, in a little over half the wall time on two cores."""
         self.state = state
         return _step.Columns(  # type: ignore[union-attr]
             self._plan,
@@ -454,4 +463,5 @@ class ColumnForces(Fleet):
             self.max_speed**2,
             self.extent,
             **screen,
+            threads=threads,
         )

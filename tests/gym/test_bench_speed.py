@@ -26,11 +26,12 @@ ROWS = [
     "vector env, 4 envs / SyncVectorEnv",
     "vector env, 16 envs / SyncVectorEnv",
     "vector env, 64 envs / SyncVectorEnv",
-    "vector env, 1000 envs, env-steps/s",
+    "vector env, 1000 envs, one thread, env-steps/s (CPU)",
+    "vector env, 1000 envs, threads=2, env-steps/s (wall)",
     "ap.run scenario1 / C step alone",
     "run --headless --no-plot process CPU / python -c pass",
 ]
-LINE = re.compile(r"^(PASS|MISS)  (.+?)\s{2,}(.*)   target ([<>]=? [\d.]+)$")
+LINE = re.compile(r"^(PASS|MISS|INFO)  (.+?)\s{2,}(.*)   target ([<>]=? [\d.]+|-)$")
 
 
 @pytest.mark.slow
@@ -57,6 +58,8 @@ def test_the_quick_run_prints_every_row_and_saves_nothing() -> None:
     assert "SyncVectorEnv" in rows["vector env, 1 envs / SyncVectorEnv"][1]
     assert "CartPole-v1" in rows["single env / LunarLander-v3"][1]
     assert "its resets" in rows["single env: garbage collector, % of its CPU"][1]
+    threaded = rows["vector env, 1000 envs, threads=2, env-steps/s (wall)"]
+    assert "x one thread's wall time" in threaded[1]
     assert (RESULTS.read_bytes() if RESULTS.exists() else None) == before
 
 
