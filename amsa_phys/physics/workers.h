@@ -29,7 +29,7 @@
 #define POOL_MAX 64
 /* pauses a worker spins for the next job before it sleeps (~50 us), and the caller for the
  * workers before it yields the core between checks (a worker descheduled on a busy machine) */
-#define POOL_SPIN 2000
+#define POOL_SPIN 20000
 #define POOL_WAIT_SPIN 20000
 
 typedef int (*pool_job)(void *ctx, int part, int parts);
