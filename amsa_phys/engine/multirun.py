@@ -215,6 +215,24 @@ class MultiRun(Simulation):
         inputs = tuple(sorted(p for p, _ in task.inputs))
         return (task.path, cls, freq, task.phase, latency, inputs)
 
+    def release(self) -> None:
+        """:meth:`Simulation.release` for every run: each run's shared services (its physics
+        world) let go of their cycles too, so an ended batch is freed by reference counting
+        (a vector env's reset drops ~230 objects an env; left to the cyclic collector, one
+        full collection walked them all: ~90 ms at 1,000 envs). Twice is fine."""
+        if self.released:
+            return
+        for run in self.runs:
+            for value in run.shared.values():
+                release = getattr(value, "release_run", None)
+                if release is not None:
+                    release()
+            run.shared.clear()
+        columns = self.column_physics
+        if columns is not None and hasattr(columns, "release"):
+            columns.release()
+        super().release()
+
     @staticmethod
     def run_of(fault: BaseException) -> int | None:
         """The run a fault belongs to (``tasks.in_run``), if any one run's."""

@@ -297,7 +297,10 @@ class VecEpisode:
             member.close()
         run = self._run
         self.done = True
-        if run.dead or greenlet.getcurrent() is not self._agent or sys.is_finalizing():
-            return
-        with contextlib.suppress(EpisodeStop, greenlet.error):
-            run.switch(STOP)
+        if not run.dead:
+            if greenlet.getcurrent() is not self._agent or sys.is_finalizing():
+                return
+            with contextlib.suppress(EpisodeStop, greenlet.error):
+                run.switch(STOP)
+        if run.dead:  # ended: freed at once by reference counting (``MultiRun.release``)
+            self.sim.release()

@@ -152,6 +152,18 @@ class ColumnPhysics:
         self.worlds.append(world)
         world.group = self
 
+    def release(self) -> None:
+        """Let the batch's worlds, rovers and force model go at the batch's end
+        (``MultiRun.release``): a world and the columns name each other (``world.group``),
+        and the model holds every rover, so an ended batch would wait for the cyclic
+        collector. The fused C step (and its helper threads) goes with them."""
+        self.worlds = []
+        self.rovers = []
+        self._model = None
+        self._fused = None
+        self._io = None
+        self.sim = None
+
     # -- the robots' group interface (as PhysicsWorld's, over every run) -------------------
     def index_of(self, rovers: Sequence[DiffDriveRover]) -> np.ndarray:
         """Positions of ``rovers`` in the columns."""

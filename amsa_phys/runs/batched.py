@@ -225,7 +225,10 @@ def _run_batch(jobs: Sequence[Job], stats: dict[str, int] | None) -> list[dict[s
             rows[job.index] = job_row(job, prepared)
         else:
             todo.append((job, prepared))
+    sim: MultiRun | None = None
     while todo:
+        if sim is not None:  # a batch given up (a fault, runs alone): freed at once
+            sim.release()
         t0 = time.perf_counter()
         sim = MultiRun([sc for _, sc in todo], columns=_columns())
         try:
@@ -258,6 +261,8 @@ def _run_batch(jobs: Sequence[Job], stats: dict[str, int] | None) -> list[dict[s
             metrics = compute_metrics(scenario, outcome, outcome.result, wall, "completed")
             rows[job.index] = fill_metrics(job_row(job), metrics)
         break
+    if sim is not None:  # by reference counting, not left to the cyclic collector
+        sim.release()
     return [rows[job.index] for job in jobs]
 
 
