@@ -159,9 +159,12 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         if self._singles is not None:
             self._episode = self._singles  # type: ignore[assignment]
             return self._singles.start(drawn)
+        from ..engine import publish
         from ..runs.batched import fewer_collections  # the sweep's module, imported lazily
 
-        with fewer_collections():  # a batch's build makes thousands of objects an env
+        # a batch's build makes thousands of objects an env, and asks ~18 times an env
+        # whether the compiled publishing is on (the environment read once instead)
+        with fewer_collections(), publish.pinned():
             self._episode = VecEpisode(
                 single._scenario,
                 single.path,

@@ -209,7 +209,10 @@ def run_batch(jobs: Sequence[Job], stats: dict[str, int] | None = None) -> list[
     batch) and ``contacts`` (shapes within reach), of which ``at_start`` were within reach
     at t = 0 and so were never computed in the batch.
     """
-    with fewer_collections():
+    from ..engine import publish
+
+    # the environment's switch for the compiled publishing read once for the whole batch
+    with fewer_collections(), publish.pinned():
         return _run_batch(jobs, stats)
 
 
