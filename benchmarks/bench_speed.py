@@ -16,7 +16,8 @@ repetition, and the 1-minute load average is recorded with each row. The rows:
   Gymnasium's ``SyncVectorEnv`` over the same number of single envs (``FollowEnv`` itself,
   no wrappers: the faster baseline), ratio of env-steps a second (target >= 1 below 16 envs,
   >= 5 from 16 up), and at 1,000 envs alone (a ``SyncVectorEnv`` of 1,000 single envs is
-  not built) over a whole episode's steps: with one thread in CPU time, then with
+  not built) over a whole episode's steps: with one thread in CPU time (its reset's CPU
+  beside it, an INFO row), then with
   ``threads=2`` in wall time, the time a second core saves, interleaved with one thread's
   wall time (target >= 250,000 env-steps a second on a quiet 2-core machine);
 * **the engine's floor**: ``amsa_phys.run`` of scenario1 (300 s) against the compiled
@@ -218,10 +219,20 @@ def single(reps: int, report: Report, quick: bool, mark: Mark = _nothing) -> Non
 
 
 # -- the vector env ------------------------------------------------------------------------
-def _vec_rate(env: Any, actions: np.ndarray, seed: int, clock: Any = time.process_time) -> float:
+def _vec_rate(
+    env: Any,
+    actions: np.ndarray,
+    seed: int,
+    clock: Any = time.process_time,
+    resets: list[float] | None = None,
+) -> float:
     """Env-steps a second (CPU, or ``clock``'s seconds) of a vector env over ``actions``
-    (steps, n, 2); its autoreset (NEXT_STEP) starts new episodes as they end."""
+    (steps, n, 2); its autoreset (NEXT_STEP) starts new episodes as they end. The reset
+    before them is not timed (``resets`` gets its seconds of ``clock``)."""
+    t0 = clock()
     env.reset(seed=seed)
+    if resets is not None:
+        resets.append(clock() - t0)
     step = env.step
     t0 = clock()
     for a in actions:
@@ -311,11 +322,19 @@ def vector(reps: int, report: Report, quick: bool, mark: Mark = _nothing) -> Non
     vec = FollowVecEnv(LARGE)
     steps = 3 if quick else LARGE_STEPS
     actions = np.random.default_rng(LARGE).uniform(-1, 1, (steps, LARGE, 2))
-    rates = [_vec_rate(vec, actions, i) for i in range(reps)]
+    resets: list[float] = []
+    rates = [_vec_rate(vec, actions, i, resets=resets) for i in range(reps)]
     share = physics_share(vec, actions, reps)
     report(
         f"vector env, {LARGE} envs, one thread, env-steps/s (CPU)",
         med(rates) + share,
+        "",
+        None,
+    )
+    report(
+        f"vector env, {LARGE} envs: a reset (every env's new episode), s (CPU)",
+        med(resets) + f"; {LARGE_STEPS} steps of an episode take "
+        f"{LARGE * LARGE_STEPS / statistics.median(rates):.2f} s",
         "",
         None,
     )

@@ -27,6 +27,7 @@ ROWS = [
     "vector env, 16 envs / SyncVectorEnv",
     "vector env, 64 envs / SyncVectorEnv",
     "vector env, 1000 envs, one thread, env-steps/s (CPU)",
+    "vector env, 1000 envs: a reset (every env's new episode), s (CPU)",
     "vector env, 1000 envs, threads=2, env-steps/s (wall)",
     "ap.run scenario1 / C step alone",
     "run --headless --no-plot process CPU / python -c pass",
