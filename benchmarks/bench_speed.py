@@ -351,8 +351,8 @@ def vector(reps: int, report: Report, quick: bool, mark: Mark = _nothing) -> Non
     speedup = [t / o for t, o in zip(two_wall, one_wall, strict=True)]
     report(
         f"vector env, {LARGE} envs, threads={THREADS}, env-steps/s (wall)",
-        f"{med(two_wall)}; {statistics.median(speedup):.2f}x one thread's wall time "
-        f"({statistics.median(one_wall):,.0f} env-steps/s)",
+        f"{med(two_wall)}; {statistics.median(speedup):.2f}x one thread's rate "
+        f"(one thread {statistics.median(one_wall):,.0f} env-steps/s, wall)",
         f">= {LARGE_RATE}",
         statistics.median(two_wall) >= LARGE_RATE,
     )

@@ -35,6 +35,7 @@ from ..model.scenario import Scenario
 from ..model.suggest import did_you_mean
 from ..model.template import Kind
 from . import args
+from .dropguard import DropGuard
 from .episode import Episode
 from .observe import Observer
 
@@ -88,7 +89,15 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         render_mode: str | None = None,
         render_size: tuple[int, int] = (640, 360),
         record_trace: bool = False,
+        threads: int | None = None,
     ) -> None:
+        if threads is not None:  # the vector env's, not ours: said, not a bare TypeError
+            raise ConfigError(
+                "threads is the vector env's argument (gymnasium.make_vec(..., "
+                'vectorization_mode="vector_entry_point", threads=N)); a single env, and '
+                "each env of a sync vector env, runs in the thread that steps it",
+                key="threads",
+            )
         EzPickle.__init__(
             self,
             scenario,
@@ -186,6 +195,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         self.render_size = size
         self.record_trace = record_trace
         self._episode: Episode | None = None
+        #: closes the episode in progress if this env is dropped without ``close()``
+        self._guard = DropGuard(self)
         self._memory: TraceMemory | None = None
         self._frames: Any = None
         self._collisions = 0
@@ -233,6 +244,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
                 # a picture samples the log (``view/scene.py``); the agent's step reads the store
                 keep_log = self.render_mode is not None
                 self._episode = Episode(scenario, self.path, trace, keep_log=keep_log)
+                self._guard.hold(self._episode)
             finally:
                 if ended is not None:
                     ended.close()
@@ -324,6 +336,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         """End the episode in progress and the window, if any (safe to call twice)."""
         if self._episode is not None:
             self._episode.close()
+        self._guard.hold(None)
         self._close_frames()
 
     def _close_frames(self) -> None:

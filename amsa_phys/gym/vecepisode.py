@@ -139,6 +139,8 @@ class VecEpisode:
         self.end = self.sim.duration
         self.t = Fraction(0)
         self.done = False
+        #: the episode was ended by a Ctrl-C inside a step (not by a run's fault)
+        self.interrupted = False
         #: the runs made alone (within reach of a contact): their indices and what makes
         #: them (a :class:`Solo`, or a VecEpisode of per-run Spaces), in hand-off order
         self.alone: list[tuple[np.ndarray, Solo | VecEpisode]] = []
@@ -211,12 +213,13 @@ class VecEpisode:
         outputs = np.array(outputs, dtype=np.float64)  # a copy: the replays keep it
         try:
             message = self._run.switch({name: outputs[:, j] for j, name in enumerate(self.acted)})
-        except greenlet.error as exc:  # greenlets switch only within their thread
+        except greenlet.error:  # greenlets switch only within their thread
             raise RuntimeError(
-                f"step() must be called from the thread that called reset() ({exc})"
+                "step() must be called from the thread that called reset()"
             ) from None
-        except BaseException:  # a run's fault (or Ctrl-C inside it) ends the episode
+        except BaseException as exc:  # a run's fault (or Ctrl-C inside it) ends the episode
             self.done = True
+            self.interrupted = isinstance(exc, KeyboardInterrupt)
             raise
         self._answer(message)
         if self.columns is None:
@@ -226,8 +229,9 @@ class VecEpisode:
             for runs, member in self.alone:
                 member.step(outputs[runs])
             self._hand_off()
-        except BaseException:
+        except BaseException as exc:
             self.done = True
+            self.interrupted = isinstance(exc, KeyboardInterrupt)
             raise
 
     def _hand_off(self) -> None:

@@ -17,9 +17,12 @@ is more than the runs' own work: the envs are then single envs stepped in turn
 ``stepping="batch"`` or ``"single"`` chooses either path whatever the size.
 
 ``threads=N`` splits the batch's physics step (every rover's forces and integration, most of
-its time from a few hundred envs up) between N threads: the same episodes bit for bit, in a
-little over half the wall time on two cores. One thread is the default: a vector env is
-often one of several processes sharing the cores. The single stepping runs in one thread.
+its time from a few hundred envs up) between N threads, in chunks of at least 64 rovers: the
+same episodes bit for bit, in about two thirds of the physics' wall time on two free cores.
+The step times itself with and without the helpers and keeps the faster way for a while, so
+on cores busy with other processes it goes on at about one thread's speed. One thread is
+the default: a vector env is often one of several processes sharing the cores. The single
+stepping runs in one thread.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ from gymnasium.vector.utils import batch_space
 
 from ..errors import ConfigError
 from . import args
+from .dropguard import DropGuard
 from .follow import FollowEnv
 from .vecepisode import VecEpisode
 from .vecsingles import SINGLES_BELOW, Singles
@@ -67,7 +71,12 @@ def check_size(num_envs: int, components: int) -> None:
 
 class FollowVecEnv(gymnasium.vector.VectorEnv):
     """``num_envs`` FollowEnv episodes stepped as one batch (arguments as FollowEnv's), or,
-    below :data:`SINGLES_BELOW` envs or with ``stepping="single"``, as single envs in turn."""
+    below :data:`SINGLES_BELOW` envs or with ``stepping="single"``, as single envs in turn.
+
+    ``threads`` (1 to :data:`MAX_THREADS`, default 1) splits the batch's physics step between
+    that many threads, the same episodes bit for bit; a batch of fewer than 128 rovers (64
+    envs of two) steps its physics on the calling thread alone (the module's docstring says
+    more)."""
 
     metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}  # noqa: RUF012
 
@@ -126,6 +135,8 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         self.action_space = batch_space(self.single_action_space, num_envs)
         self.metadata = {**self.metadata, "render_fps": self.single.metadata["render_fps"]}
         self._episode: VecEpisode | None = None
+        #: closes the batch in progress if this env is dropped without ``close()``
+        self._guard = DropGuard(self)
         #: the single envs of ``stepping="single"`` (the first is :attr:`single`)
         self._singles: Singles | None = None
         if self.stepping == "single":
@@ -173,6 +184,7 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
                 single.acted,
                 threads=self.threads,
             )
+            self._guard.hold(self._episode)
         self._seen = np.zeros(self.num_envs, dtype=np.int64)
         self._autoreset = False
         info = self._info()
@@ -190,8 +202,13 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
             obs, info = self._start([None] * n)
             zeros = np.zeros(n, dtype=bool)
             return obs, np.zeros(n), zeros, zeros.copy(), info
-        if self._episode.done:  # a fault in a run ended the batch (step raised it)
-            raise gymnasium.error.ResetNeeded("call reset() before step(): a run faulted")
+        if self._episode.done:  # a fault in a run, or a Ctrl-C, ended the batch (step raised it)
+            why = (
+                "a step was interrupted"
+                if getattr(self._episode, "interrupted", False)
+                else ("a run faulted")
+            )
+            raise gymnasium.error.ResetNeeded(f"call reset() before step(): {why}")
         a = np.asarray(actions, dtype=np.float64).reshape(n, -1)
         acted = self.single.acted
         if a.shape != (n, len(acted)):
@@ -243,3 +260,4 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         """Stop the episodes in progress (the batch's greenlet, or the single envs')."""
         if self._episode is not None:
             self._episode.close()
+        self._guard.hold(None)

@@ -1538,34 +1538,45 @@ static int Columns_move_range(Columns *c, Py_ssize_t k0, Py_ssize_t k1)
     return ok;
 }
 
-/* Part ``part`` of ``parts`` of the move (a pool_job): the rovers between two even
+/* Chunk ``chunk`` of ``chunks`` of the move (a pool_job): the rovers between two even
  * boundaries, in proportion. */
-static int Columns_move_part(void *ctx, int part, int parts)
+static int Columns_move_part(void *ctx, int chunk, int chunks)
 {
     Columns *c = (Columns *)ctx;
     const Py_ssize_t n = c->st.n;
-    Py_ssize_t k0 = (Py_ssize_t)((double)n * part / parts) & ~(Py_ssize_t)1;
-    Py_ssize_t k1 = part + 1 == parts ? n : (Py_ssize_t)((double)n * (part + 1) / parts) & ~(Py_ssize_t)1;
+    Py_ssize_t k0 = (Py_ssize_t)((double)n * chunk / chunks) & ~(Py_ssize_t)1;
+    Py_ssize_t k1 =
+        chunk + 1 == chunks ? n : (Py_ssize_t)((double)n * (chunk + 1) / chunks) & ~(Py_ssize_t)1;
     return k0 < k1 ? Columns_move_range(c, k0, k1) : 1;
 }
 
+/* A step's chunks: four a thread (a helper late for a step leaves the caller no long wait),
+ * each of at least COLUMN_CHUNK_MIN rovers (~7 us of work: below that a helper's wake-up
+ * costs more than it shares, and a batch of fewer rovers runs on the calling thread alone). */
+#define COLUMN_CHUNK_MIN 64
+static int column_chunks(Py_ssize_t n, int threads)
+{
+    Py_ssize_t most = n / COLUMN_CHUNK_MIN;
+    Py_ssize_t want = 4 * (Py_ssize_t)threads;
+    return (int)(most < 1 ? 1 : want < most ? want : most);
+}
+
 /* The step after the screening: every rover's forces, its integration and the check;
- * whether every rover passed. With ``threads`` above 1 (and at least two rovers a part)
- * the rovers are split between this thread and the pool's workers; the GIL may be
- * released meanwhile (no Python API below). */
+ * whether every rover passed. With ``threads`` above 1 (and rovers for more than one chunk)
+ * the chunks are shared between this thread and the pool's helpers (workers.h); the GIL may
+ * be released meanwhile (no Python API below). */
 static int Columns_move(Columns *c)
 {
-    if (c->threads > 1 && c->st.n >= 2 * c->threads) {
-        if (c->pool == NULL) {
-            c->pool = (Pool *)PyMem_RawMalloc(sizeof(Pool));
-            if (c->pool == NULL) /* no memory for the pool: one thread, the same floats */
-                c->threads = 1;
-            else
-                pool_start(c->pool, c->threads);
-        }
-        if (c->pool != NULL)
-            return pool_run(c->pool, Columns_move_part, c);
+    if (c->threads > 1 && c->pool == NULL) {
+        const int chunks = column_chunks(c->st.n, c->threads);
+        const int helpers = (chunks < c->threads ? chunks : c->threads) - 1;
+        if (helpers > 0 && (c->pool = (Pool *)PyMem_RawMalloc(sizeof(Pool))) != NULL)
+            pool_start(c->pool, helpers, Columns_move_part, c, chunks);
+        else
+            c->threads = 1; /* one chunk, or no memory for the pool: one thread, same floats */
     }
+    if (c->pool != NULL)
+        return pool_run(c->pool);
     return Columns_move_range(c, 0, c->st.n);
 }
 

@@ -1,19 +1,26 @@
-/* A few helper threads that run one loop's parts beside the calling thread (_step.c's Columns).
+/* A few helper threads that take a loop's chunks beside the calling thread (_step.c's Columns).
  *
- * Why: at 1,000 envs the rovers' column step is ~87 % of a vector env's CPU, and every rover's
- * forces and integration read and write only that rover's rows, so the step splits into parts
- * that need no lock: on a 2-core machine two threads take it in a little over half the time.
- * Each rover is computed by the same code whichever thread takes it, so the floats are the
- * same bit for bit with any number of threads (tests/gym/test_vector_threads.py).
+ * Why: at 1,000 envs the rovers' column step is most of a vector env's CPU, and every rover's
+ * forces and integration read and write only that rover's rows, so the step splits into
+ * chunks that need no lock: on a 2-core machine two threads take it in a little over half
+ * the time. Each rover is computed by the same code whichever thread takes its chunk, so the
+ * floats are the same bit for bit with any number of threads (tests/gym/test_vector_threads.py).
  *
- * The caller posts a job (a function and its context) and takes part 0 itself; each worker
- * takes its own part and counts down ``pending``. Between jobs a worker spins briefly (the
- * next step of a batch follows within microseconds), then sleeps on a condition variable,
- * so an idle pool costs nothing. No Python API is used here: the caller holds or releases
- * the GIL as it likes, and the workers never take it. Workers block every signal (a Ctrl-C
- * goes to Python's main thread, as without them). A forked child has no workers: the pool
- * notes the process that started them and starts new ones in another (a process pool's
- * child, ``multiprocessing`` with fork).
+ * How: the caller posts a step; every thread, the caller included, claims the next chunk
+ * from a shared counter until none is left, then the caller waits for the chunks still under
+ * way. A helper that wakes late (asleep, or its core busy with another process) claims
+ * nothing: the caller has taken its chunks, so a late helper never holds a step back (only
+ * one stopped inside a chunk does). The pool times its steps with the helpers and without
+ * them, and keeps the faster way for a while (pool_run): on a machine whose cores are busy
+ * with other processes, the caller goes on alone. Between steps a helper that took a chunk
+ * spins briefly (the next step of a batch follows within microseconds), then sleeps on a
+ * condition variable; one that came too late sleeps at once (spinning, it would take a
+ * core the caller may need). An idle pool costs nothing.
+ *
+ * No Python API is used here: the caller holds or releases the GIL as it likes, and the
+ * helpers never take it. Helpers block every signal (a Ctrl-C goes to Python's main thread,
+ * as without them). A forked child has no helpers: the pool notes the process that started
+ * them and starts new ones in another (a process pool's child, ``multiprocessing`` with fork).
  */
 #ifndef AMSA_WORKERS_H
 #define AMSA_WORKERS_H
@@ -24,38 +31,49 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #define POOL_MAX 64
-/* pauses (~25 ns each on the machines measured) a worker spins for the next job before it
+/* pauses (~25 ns each on the machines measured) a helper spins for the next step before it
  * sleeps (~0.5 ms: longer than the component groups' work between two of a vector step's
- * physics calls, so it rarely has to be woken), and the caller for the workers before it
- * yields the core between checks (~0.1 ms: a worker descheduled on a busy machine) */
+ * physics calls, so it rarely has to be woken), and the caller for a chunk under way before
+ * it counts the helper as stopped by another process (~0.1 ms: a chunk is a few dozen µs) */
 #define POOL_SPIN 20000
 #define POOL_WAIT_SPIN 4000
+/* steps of each trial (with the helpers, then alone), and steps the faster way is kept
+ * before both are tried again */
+#define POOL_TRIAL 64
+#define POOL_KEEP 2048
 
-typedef int (*pool_job)(void *ctx, int part, int parts);
+/* chunk ``chunk`` of ``chunks``: nonzero when every item of it passed */
+typedef int (*pool_job)(void *ctx, int chunk, int chunks);
 
 typedef struct Pool Pool;
 
 typedef struct {
     pthread_t tid;
     Pool *pool;
-    int part;
 } PoolWorker;
 
 struct Pool {
-    int parts;   /* threads taking part, the caller included (1: no workers) */
-    int running; /* workers started */
+    int running; /* helpers started */
+    int asked;   /* helpers asked for (a forked child starts as many) */
     pid_t owner; /* the process that started them */
-    pthread_mutex_t mu;
-    pthread_cond_t cv;
-    atomic_long go; /* the job's number: a worker takes a job when it changes */
-    atomic_int quit;
-    atomic_int pending; /* workers still on the current job */
     pool_job job;
     void *ctx;
-    int results[POOL_MAX];
+    int chunks; /* chunks a step, fixed */
+    int phase;  /* 0: trying the helpers, 1: trying the caller alone, 2: keeping the faster */
+    int count;  /* steps of the phase so far */
+    int alone;  /* in phase 2: the caller alone was faster */
+    double start, with_helpers; /* the phase's start; the helpers' trial, seconds */
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    atomic_long go; /* the step's number: a helper claims chunks when it changes */
+    atomic_int quit;
+    atomic_int next;      /* the next chunk to claim (chunks and beyond: none left) */
+    atomic_int remaining; /* chunks of the step not finished */
+    atomic_int failed;    /* some chunk returned zero */
     PoolWorker workers[POOL_MAX];
 };
 
@@ -68,14 +86,30 @@ static inline void pool_pause(void)
 #endif
 }
 
+/* Claim and run chunks until none is left. A helper late for a step finds the counter past
+ * the last chunk (the caller took them all) and claims nothing; the counter is set back to 0
+ * only for a new step, after the caller has written everything that step reads. */
+static int pool_take(Pool *p)
+{
+    int taken = 0;
+    for (;; taken++) {
+        int c = atomic_fetch_add_explicit(&p->next, 1, memory_order_acq_rel);
+        if (c >= p->chunks)
+            return taken;
+        if (!p->job(p->ctx, c, p->chunks))
+            atomic_store_explicit(&p->failed, 1, memory_order_relaxed);
+        atomic_fetch_sub_explicit(&p->remaining, 1, memory_order_acq_rel);
+    }
+}
+
 static void *pool_worker(void *arg)
 {
-    PoolWorker *w = (PoolWorker *)arg;
-    Pool *p = w->pool;
+    Pool *p = ((PoolWorker *)arg)->pool;
     long seen = 0;
+    int keen = 1; /* it took a chunk of the last step: spin for the next one before sleeping */
     for (;;) {
         long g;
-        int spins = 0;
+        int spins = keen ? 0 : POOL_SPIN; /* late: it would spin on a core the caller needs */
         while ((g = atomic_load_explicit(&p->go, memory_order_acquire)) == seen) {
             if (atomic_load_explicit(&p->quit, memory_order_acquire))
                 return NULL;
@@ -92,12 +126,11 @@ static void *pool_worker(void *arg)
         if (atomic_load_explicit(&p->quit, memory_order_acquire))
             return NULL;
         seen = g;
-        p->results[w->part] = p->job(p->ctx, w->part, p->parts);
-        atomic_fetch_sub_explicit(&p->pending, 1, memory_order_acq_rel);
+        keen = pool_take(p) > 0;
     }
 }
 
-/* Stop and join the workers (safe on a pool never started, or started in another process:
+/* Stop and join the helpers (safe on a pool never started, or started in another process:
  * a forked child's copy has no threads to join). */
 static void pool_stop(Pool *p)
 {
@@ -112,19 +145,21 @@ static void pool_stop(Pool *p)
         pthread_mutex_destroy(&p->mu);
     }
     p->running = 0;
-    p->parts = 1;
 }
 
-/* Start ``parts - 1`` workers (at most POOL_MAX - 1). Where a thread cannot be made the pool
- * keeps those it has: fewer parts, the same floats. */
-static void pool_start(Pool *p, int parts)
+/* Start ``helpers`` threads (at most POOL_MAX) for ``job`` on ``ctx`` in ``chunks`` chunks
+ * a step. Where a thread cannot be made the pool keeps those it has (none: the caller takes
+ * every chunk): fewer threads, the same floats. */
+static void pool_start(Pool *p, int helpers, pool_job job, void *ctx, int chunks)
 {
     memset(p, 0, sizeof *p);
-    p->parts = 1;
-    if (parts < 2)
+    p->job = job;
+    p->ctx = ctx;
+    p->chunks = chunks;
+    p->asked = helpers > POOL_MAX ? POOL_MAX : helpers;
+    atomic_store(&p->next, chunks); /* no step posted: nothing to claim */
+    if (p->asked < 1)
         return;
-    if (parts > POOL_MAX)
-        parts = POOL_MAX;
     if (pthread_mutex_init(&p->mu, NULL) != 0)
         return;
     if (pthread_cond_init(&p->cv, NULL) != 0) {
@@ -134,53 +169,93 @@ static void pool_start(Pool *p, int parts)
     p->owner = getpid();
     sigset_t all, old;
     sigfillset(&all);
-    pthread_sigmask(SIG_SETMASK, &all, &old); /* the workers inherit it: no signal for them */
-    for (int i = 0; i < parts - 1; i++) {
-        PoolWorker *w = &p->workers[i];
-        w->pool = p;
-        w->part = i + 1;
-        if (pthread_create(&w->tid, NULL, pool_worker, w) != 0)
+    pthread_sigmask(SIG_SETMASK, &all, &old); /* the helpers inherit it: no signal for them */
+    for (int i = 0; i < p->asked; i++) {
+        p->workers[i].pool = p;
+        if (pthread_create(&p->workers[i].tid, NULL, pool_worker, &p->workers[i]) != 0)
             break;
         p->running++;
     }
     pthread_sigmask(SIG_SETMASK, &old, NULL);
-    p->parts = p->running + 1;
     if (p->running == 0) {
         pthread_cond_destroy(&p->cv);
         pthread_mutex_destroy(&p->mu);
     }
 }
 
-/* Run ``job`` on every part (the caller takes part 0); whether every part returned nonzero. */
-static int pool_run(Pool *p, pool_job job, void *ctx)
+static double pool_now(void)
 {
-    if (p->running > 0 && p->owner != getpid()) { /* a forked child: its own workers */
-        int parts = p->running + 1;
-        p->running = 0;
-        pool_start(p, parts);
-    }
-    if (p->running == 0)
-        return job(ctx, 0, 1);
-    const int parts = p->parts;
-    p->job = job;
-    p->ctx = ctx;
-    atomic_store_explicit(&p->pending, parts - 1, memory_order_relaxed);
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* The step with the helpers: every thread claims chunks; the caller then waits for the
+ * chunks under way. */
+static int pool_shared(Pool *p)
+{
+    atomic_store_explicit(&p->failed, 0, memory_order_relaxed);
+    atomic_store_explicit(&p->remaining, p->chunks, memory_order_relaxed);
+    atomic_store_explicit(&p->next, 0, memory_order_release);
     pthread_mutex_lock(&p->mu);
     atomic_fetch_add_explicit(&p->go, 1, memory_order_release);
     pthread_cond_broadcast(&p->cv);
     pthread_mutex_unlock(&p->mu);
-    int ok = job(ctx, 0, parts) != 0;
+    pool_take(p);
     int spins = 0;
-    while (atomic_load_explicit(&p->pending, memory_order_acquire) != 0) {
+    while (atomic_load_explicit(&p->remaining, memory_order_acquire) != 0) {
         if (++spins < POOL_WAIT_SPIN) {
             pool_pause();
-        } else {
+        } else { /* a helper stopped inside a chunk: its core is another process's */
             sched_yield();
-            spins = 0;
         }
     }
-    for (int i = 1; i < parts; i++)
-        ok = ok && p->results[i] != 0;
+    return !atomic_load_explicit(&p->failed, memory_order_relaxed);
+}
+
+/* One step: every chunk run once; whether every chunk passed.
+ *
+ * With the helpers or by the caller alone, whichever was faster: POOL_TRIAL steps each way,
+ * timed by the wall clock from the trial's first step to its last (the Python work between
+ * a batch's calls included: a helper spinning on a core the caller needs slows that too),
+ * then the faster way for POOL_KEEP steps, then both again. On free cores the helpers win;
+ * on a machine whose cores are busy with other processes they get no core of their own,
+ * and the caller goes on alone at about one thread's speed. The floats are the same either
+ * way (the same chunks, the same code). */
+static int pool_run(Pool *p)
+{
+    if (p->running > 0 && p->owner != getpid()) /* a forked child: helpers of its own */
+        pool_start(p, p->asked, p->job, p->ctx, p->chunks);
+    if (p->running == 0) {
+        int ok = 1;
+        for (int c = 0; c < p->chunks; c++)
+            ok = p->job(p->ctx, c, p->chunks) && ok;
+        return ok;
+    }
+    if (p->count == 0)
+        p->start = pool_now();
+    const int shared = p->phase == 0 || (p->phase == 2 && !p->alone);
+    int ok = 1;
+    if (shared) {
+        ok = pool_shared(p);
+    } else {
+        for (int c = 0; c < p->chunks; c++)
+            ok = p->job(p->ctx, c, p->chunks) && ok;
+    }
+    p->count++;
+    if (p->phase < 2 && p->count == POOL_TRIAL) {
+        double spent = pool_now() - p->start;
+        if (p->phase == 0) {
+            p->with_helpers = spent;
+        } else {
+            p->alone = spent < p->with_helpers;
+        }
+        p->phase++;
+        p->count = 0;
+    } else if (p->phase == 2 && p->count == POOL_KEEP) {
+        p->phase = 0;
+        p->count = 0;
+    }
     return ok;
 }
 

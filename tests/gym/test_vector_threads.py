@@ -48,14 +48,14 @@ def _records(threads: int, actions: np.ndarray, seeds: list[int]) -> tuple[list[
 @needs_c
 @pytest.mark.parametrize("threads", [2, 3])
 def test_threads_give_the_bits_of_one_thread(threads: int) -> None:
-    """Eleven envs (22 rovers, an odd number of runs: the parts end at even rovers) for a
-    whole 30 s episode, random actions, two envs ramming their leaders (frozen in the
-    columns, then made alone): every record equal to one thread's, and the step did run
-    with ``threads - 1`` helpers."""
-    n, steps = 11, 120
+    """101 envs (202 rovers in three chunks, an odd number of runs: the chunks end at even
+    rovers) for a whole 30 s episode, random actions, two envs ramming their leaders (frozen
+    in the columns, then made alone): every record equal to one thread's, and the step did
+    run with ``threads - 1`` helpers."""
+    n, steps = 101, 120
     actions = np.random.default_rng(11).uniform(-1, 1, size=(steps, n, 2))
     actions[:, 3] = 1.0
-    actions[30:, 8] = 1.0
+    actions[10:, 8] = 1.0
     seeds = list(range(60, 60 + n))
     one, none = _records(1, actions, seeds)
     many, helpers = _records(threads, actions, seeds)
@@ -94,8 +94,8 @@ def test_a_forked_child_steps_with_workers_of_its_own() -> None:
     """A process forked after the helpers started has none of them (fork copies one
     thread): its steps start their own and give the parent's bits, where waiting for the
     parent's helpers would hang it."""
-    actions = np.random.default_rng(2).uniform(-1, 1, size=(6, 16, 2))
-    vec = FollowVecEnv(16, SCENARIO1, duration=30, stepping="batch", threads=2)
+    actions = np.random.default_rng(2).uniform(-1, 1, size=(6, 64, 2))
+    vec = FollowVecEnv(64, SCENARIO1, duration=30, stepping="batch", threads=2)
     vec.reset(seed=3)
     vec.step(actions[0])  # the helpers start
     episode = vec._episode
@@ -114,3 +114,16 @@ def test_a_forked_child_steps_with_workers_of_its_own() -> None:
         child.join()
     assert digest == _digest(vec, actions[1:])
     vec.close()
+
+
+def test_threads_given_to_a_single_env_is_said_to_be_the_vector_envs() -> None:
+    """``make_vec(..., vectorization_mode="sync", threads=2)`` hands it to every FollowEnv:
+    a one-line ConfigError naming the vector env's way, not a bare TypeError."""
+    import gymnasium
+
+    import amsa_phys  # noqa: F401  (registers the env)
+
+    with pytest.raises(ConfigError) as err:
+        gymnasium.make_vec("amsa_phys/Follow-v0", num_envs=2, vectorization_mode="sync", threads=2)
+    assert err.value.key == "threads"
+    assert 'vectorization_mode="vector_entry_point"' in str(err.value)
