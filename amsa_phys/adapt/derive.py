@@ -47,12 +47,13 @@ from typing import Any
 from ..control.estimators.watches import Watch, watches
 from ..errors import ConfigError
 from ..model.scenario import Scenario
+from .braking import Braking, braking, catch_ups
 from .cellrules import cell_rules as rules_of_cells
 from .cellrules import whole
 from .damping import FACTOR, STEPS, Damping, damping
 from .grid import lowest, robust_point, safe_best
 from .recovery import recovery
-from .table import read_table
+from .table import SweepTable, read_table
 
 #: Default safety margin: a best point's grid neighbours may be at most this much worse.
 MARGIN = 0.5
@@ -123,6 +124,10 @@ class Derivation:
     damping: Damping | None = None
     #: the recovery rule, when the motor estimate has a recent share (``recovery.py``)
     recovery: dict[str, Any] | None = None
+    #: the braking rule, when the sweep measured braking and has catch-ups (``braking.py``)
+    braking: Braking | None = None
+    #: the catch-up contexts (a cell started away from its reference): name -> its cell
+    catch_ups: dict[str, str] = field(default_factory=dict)
 
     @property
     def gain(self) -> float:
@@ -166,6 +171,16 @@ def derive(
             "watches, so rules have contexts to tell apart",
             file=results,
         )
+    # catch-ups are cells started away from their reference: read by the braking rule only
+    repeats = catch_ups(contexts, watched) if "context" in table.context_axes else {}
+    at = table.context_axes.index("context") if repeats else 0
+    every = dict(table.stats)
+    catchup_keys = {
+        key: (*key[:at], repeats[key[at]], *key[at + 1 :])
+        for key in every
+        if repeats and key[at] in repeats
+    }
+    table.stats = {k: v for k, v in every.items() if k not in catchup_keys}
     base = _base_values(scenario)
     cells: dict[tuple[Any, ...], Cell] = {}
     for key in table.stats:
@@ -224,6 +239,7 @@ def derive(
         if robust is not None and robust in by_point:
             cell.robust_score = by_point[robust].mean
     derivation = Derivation(metric, table.tuned, list(cells.values()), [], [], found)
+    derivation.catch_ups = dict(repeats)
     if robust is None:
         derivation.refused = (
             "no grid point finished in every context: there is no fixed choice to fall back "
@@ -280,10 +296,22 @@ def derive(
         fallbacks = [
             {**r, "when": {**r["when"], **below}} if valid in r["when"] else r for r in fallbacks
         ]
-        derivation.damping.rule["when"].update(
-            _switched_band(cell_rules, derivation.robust, derivation.damping.leaf, found)
-        )
+        band = _switched_band(cell_rules, derivation.robust, derivation.damping.leaf, found)
+        derivation.damping.rule["when"].update(band)
         fallbacks.insert(0, derivation.damping.rule)
+        derivation.braking = braking(
+            results,
+            scenario,
+            SweepTable(table.axes, table.context_axes, table.tuned, every, table.rows),
+            catchup_keys,
+            chosen,
+            robust,
+            derivation.damping.leaf,
+            band,
+            derivation.damping.point,
+        )
+        if derivation.braking is not None:
+            fallbacks.insert(0, derivation.braking.rule)
     for w in found:
         if derivation.recovery is None and w.signal in {s for c in placed for s in c.levels}:
             derivation.recovery = recovery(scenario, cell_rules, derivation.robust, w.signal)
