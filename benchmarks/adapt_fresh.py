@@ -110,6 +110,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     lost = loses(rows, 0.02)
     print(f"the rules lose (by more than 2 %) on {len(lost)} of {len(rows)}")
+    changes = [r.change for r in rows]
+    print(
+        f"change against the robust choice: worst {100 * max(changes):+.1f} %, mean "
+        f"{100 * sum(changes) / len(changes):+.1f} %"
+    )
     return 1 if lost else 0
 
 

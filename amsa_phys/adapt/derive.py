@@ -29,7 +29,9 @@ estimator with a ``valid`` output sets the robust point once it has been 0 (unsu
 ``fallback_hold`` seconds, but never within the estimator's own ``window`` seconds of a
 switch (the rule's ``dwell``: a switch's transient stays in the window that long, and a
 gain that is right for the context may blind the estimate while it settles), and the cell
-rules require every such estimator to be sure. Cells
+rules require every such estimator to be sure. A context that
+repeats another one with parameters no estimator watches (the follower started behind) is
+that cell's *catch-up*, not a cell: only the braking rule reads it (``braking.py``). Cells
 are reported, not guessed, when an estimator cannot place them (a context parameter no
 estimator watches, a value its mapping does not know) or when two cells with different
 best values settle to the same levels.
