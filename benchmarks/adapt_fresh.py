@@ -14,7 +14,9 @@ the counts only, so another draw (the docs' third, ``--draw 3000``) can be score
 replacing the committed one. A variant is scored without saving: ``--sweep FILE`` for DIR
 swept from another scenario (``scenarios/adaptive_sweep_braking.yaml``: the rules with the
 braking rule it derives), ``--rules FILE`` for a rules file instead of the derived rules (the
-committed rules on a draw, say). Deterministic: the same table at any load.
+committed rules on a draw, say), ``--guard`` for the rules derived with the guarded motor
+fallback. ``--draw 1000 --sequences 20`` is ``adapt --validate``'s twenty. Deterministic:
+the same table at any load.
 """
 
 from __future__ import annotations
@@ -62,17 +64,22 @@ def main(argv: list[str] | None = None) -> int:
         help="the swept scenario DIR ran (default: scenarios/adaptive_sweep.yaml)",
     )
     ap.add_argument(
+        "--guard",
+        action="store_true",
+        help="derive with the guarded fallback (derive(guard=True)); implies --no-save",
+    )
+    ap.add_argument(
         "--rules",
         type=Path,
         help="score this rules file (adapt: list) instead of the derived rules; implies --no-save",
     )
     args = ap.parse_args(argv)
     scenario = load_scenario(str(args.sweep))
-    found = derive(args.sweepdir / "results.csv", scenario)
+    found = derive(args.sweepdir / "results.csv", scenario, guard=args.guard)
     committed = yaml.safe_load(RULES.read_text())["adapt"]
     if args.rules is not None:
         found.rules = yaml.safe_load(args.rules.read_text())["adapt"]
-    if args.rules is not None or args.sweep.resolve() != SWEEP.resolve():
+    if args.rules is not None or args.guard or args.sweep.resolve() != SWEEP.resolve():
         args.no_save = True  # a variant: the committed table stays the shipped rules'
     elif found.rules != committed:
         print(f"warning: the rules derived from {args.sweepdir} differ from {RULES.name}")

@@ -154,6 +154,7 @@ def derive(
     cell_gain: float = CELL_GAIN,
     damp: float = DAMP,
     damp_steps: int = STEPS,
+    guard: bool = False,
 ) -> Derivation:
     """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
     is the fixed choice to fall back on (default: the sweep's least worst-case point)."""
@@ -314,6 +315,8 @@ def derive(
         )
         if derivation.braking is not None:
             fallbacks.insert(0, derivation.braking.rule)
+        if guard:
+            fallbacks = _guarded(fallbacks, valid, band)
     for w in found:
         if derivation.recovery is None and w.signal in {s for c in placed for s in c.levels}:
             derivation.recovery = recovery(scenario, cell_rules, derivation.robust, w.signal)
@@ -321,6 +324,39 @@ def derive(
         fallbacks.insert(0, derivation.recovery)
     derivation.rules = fallbacks + cell_rules
     return derivation
+
+
+def _guarded(
+    fallbacks: list[dict[str, Any]], valid: str, band: dict[str, dict[str, float]]
+) -> list[dict[str, Any]]:
+    """``fallbacks`` with one more after the damped estimator's: the robust point once it is
+    unsure with its held value above the switched band, whatever the path speed.
+
+    The damping rule reads only a held value inside the band, and the fallback waits for the
+    swing to end; a higher gain set just before the motors recover, whose last sure window
+    already reads them above the band, then swings on with no rule left to fire (the cell
+    transitions' largest losses, ``benchmarks/adapt_transitions.py``). Above the band no cell
+    sets a higher gain, so the robust point is right there, swing or not."""
+    out = []
+    for rule in fallbacks:
+        out.append(rule)
+        when = rule["when"]
+        released = any(k.endswith(".pathSpeed") and "below" in b for k, b in when.items())
+        if valid not in when or not released:
+            continue  # not the fallback that waits for a swing to end
+        above = {s: {"above": b["below"]} for s, b in band.items() if "below" in b}
+        if not above:
+            continue
+        extra = {k: v for k, v in rule.items() if k not in ("when", "label")}
+        leaf = valid.rpartition(".")[0]
+        out.append(
+            {
+                "when": {valid: {"below": 0.5}, **above},
+                **extra,
+                "label": f"robust, {leaf} unsure above the switched band",
+            }
+        )
+    return out
 
 
 def _switched_band(

@@ -174,3 +174,63 @@ def test_the_rule_fires_on_a_wrong_gains_braking_and_on_nothing_else(tmp_path: P
         "e": [_frame(-80, -80, held=1.0)] * 8,
     }.items():
         assert _fires(tmp_path / case, frames) == [], case
+
+
+def _all_rules_fire(tmp_path: Path, guard: bool, frame: dict[str, float], seconds: int) -> list:
+    """(instant, label) of every derived rule that fires on ``frame`` held for ``seconds``."""
+    sweep, results = _sweep(tmp_path)
+    scenario = load_scenario(sweep)
+    found = derive(results, scenario, "rms_error", 5, float("inf"), 0.0, guard=guard)
+    rules = parse_rules(YamlDoc(path=sweep, data={}), found.rules, scenario.world)
+    kv = {"Kv": 0.4}
+    engine = AdaptRules(rules, lambda leaf, p: kv[p])
+    out = []
+    for k in range(4 * seconds):
+        firing = engine.due(Fraction(k, 4), frame)
+        if firing is not None:
+            out.append((float(firing.t), firing.rule.label))
+            kv.update({c.param: c.value for c in firing.rule.changes})
+    return out
+
+
+#: a worn motors' gain swinging on motors that recovered before the estimate turned unsure:
+#: its held value above the switched band, the path speed far above the fallback's release
+DEADLOCK = {
+    "MotorMonitor.valid": 0.0,
+    "MotorMonitor.delivered": 0.75,
+    "MotorMonitor.pathSpeed": 1.2,
+    "LeaderMonitor.valid": 1.0,
+    "LeaderMonitor.turning": 0.0,
+    "MyFollowerController.LeftPower": 150.0,
+    "MyFollowerController.RightPower": 150.0,
+}
+
+
+def test_the_guard_sets_the_robust_point_where_no_other_rule_can_fire(tmp_path: Path) -> None:
+    # without the guard the swing goes on: the damping and braking rules read a held value
+    # in the band only, the fallback waits for the path speed to fall
+    assert _all_rules_fire(tmp_path / "a", False, DEADLOCK, 60) == []
+    fired = _all_rules_fire(tmp_path / "b", True, DEADLOCK, 60)
+    assert fired == [(5.0, "robust, MotorMonitor unsure above the switched band")]  # the hold
+    # inside the band the damping rule acts, and the guard stays out of it
+    inside = {**DEADLOCK, "MotorMonitor.delivered": 0.5}
+    labels = [label for _, label in _all_rules_fire(tmp_path / "c", True, inside, 60)]
+    assert labels == ["damp, MotorMonitor swinging"]
+
+
+def test_the_guard_is_the_motor_fallback_without_its_release(tmp_path: Path) -> None:
+    sweep, results = _sweep(tmp_path)
+    plain = derive(results, load_scenario(sweep), "rms_error", 5, float("inf"), 0.0)
+    found = derive(results, load_scenario(sweep), "rms_error", 5, float("inf"), 0.0, guard=True)
+    i = next(k for k, r in enumerate(found.rules) if r["label"] == "robust, MotorMonitor unsure")
+    fallback, guard = found.rules[i], found.rules[i + 1]
+    assert guard["when"] == {
+        "MotorMonitor.valid": {"below": 0.5},
+        "MotorMonitor.delivered": {"above": pytest.approx(0.7)},
+    }
+    assert (guard["set"], guard["hold"], guard.get("dwell")) == (
+        fallback["set"],
+        fallback["hold"],
+        fallback.get("dwell"),
+    )
+    assert found.rules[: i + 1] + found.rules[i + 2 :] == plain.rules
