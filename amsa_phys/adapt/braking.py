@@ -10,12 +10,13 @@ unsure and its held value lies where a cell set a higher gain, the damping point
 
 The level comes from the sweep, as data, in two kinds of runs:
 
-- *catch-ups*: a context of ``sweep.contexts`` that repeats a cell's context with more
-  parameters no estimator watches (the follower started 2 m behind its reference) is not a
-  cell (``catch_ups``): it is that cell started away from its reference, read only here. A
-  right gain switched in late (after the estimate's window and the rule's hold) catches up
-  from behind and brakes as it arrives; the hardest it brakes, over the switching cells and
-  their catch-ups at each cell's chosen point, is the *right* braking;
+- *catch-ups*: in a sweep that measures braking (below), a context of ``sweep.contexts``
+  that repeats a cell's context with more parameters no estimator watches (the follower
+  started 2 m behind its reference) is not a cell (``catch_ups``): it is that cell started
+  away from its reference, read only here. A right gain switched in late (after the
+  estimate's window and the rule's hold) catches up from behind and brakes as it arrives;
+  the hardest it brakes, over the switching cells and their catch-ups at each cell's chosen
+  point, is the *right* braking;
 - the *wrong* braking: the least hard a switching cell's point brakes on a cell that keeps
   the robust point (or its catch-up) where that point swings, its seed mean more than
   ``SWINGS`` above the cell's lowest (a high gain on motors stronger than its own).

@@ -29,9 +29,10 @@ estimator with a ``valid`` output sets the robust point once it has been 0 (unsu
 ``fallback_hold`` seconds, but never within the estimator's own ``window`` seconds of a
 switch (the rule's ``dwell``: a switch's transient stays in the window that long, and a
 gain that is right for the context may blind the estimate while it settles), and the cell
-rules require every such estimator to be sure. A context that
-repeats another one with parameters no estimator watches (the follower started behind) is
-that cell's *catch-up*, not a cell: only the braking rule reads it (``braking.py``). Cells
+rules require every such estimator to be sure. In a sweep that
+measures braking, a context that repeats another one with parameters no estimator watches
+(the follower started behind) is that cell's *catch-up*, not a cell: only the braking rule
+reads it (``braking.py``). Cells
 are reported, not guessed, when an estimator cannot place them (a context parameter no
 estimator watches, a value its mapping does not know) or when two cells with different
 best values settle to the same levels.
@@ -50,6 +51,7 @@ from ..control.estimators.watches import Watch, watches
 from ..errors import ConfigError
 from ..model.scenario import Scenario
 from .braking import Braking, braking, catch_ups
+from .braking import requirement as braking_requirement
 from .cellrules import cell_rules as rules_of_cells
 from .cellrules import whole
 from .damping import FACTOR, STEPS, Damping, damping
@@ -175,7 +177,10 @@ def derive(
             file=results,
         )
     # catch-ups are cells started away from their reference: read by the braking rule only
-    repeats = catch_ups(contexts, watched) if "context" in table.context_axes else {}
+    # (only in a sweep that measures braking, their one reader: elsewhere such a context is
+    # a cell the estimators cannot place, and is reported as one)
+    reads = "context" in table.context_axes and braking_requirement(scenario) is not None
+    repeats = catch_ups(contexts, watched) if reads else {}
     at = table.context_axes.index("context") if repeats else 0
     every = dict(table.stats)
     catchup_keys = {

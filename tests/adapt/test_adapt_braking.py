@@ -62,7 +62,9 @@ REQUIREMENTS = (
 )
 
 
-def _sweep(tmp_path: Path, behind: bool = True, braking: dict | None = None) -> tuple[Path, Path]:
+def _sweep(
+    tmp_path: Path, behind: bool = True, braking: dict | None = None, measured: bool = True
+) -> tuple[Path, Path]:
     """The fixture sweep (with its catch-ups, or not) beside a copy of its world."""
     braking = BRAKING if braking is None else braking
     (tmp_path / "worlds").mkdir(parents=True)
@@ -70,7 +72,8 @@ def _sweep(tmp_path: Path, behind: bool = True, braking: dict | None = None) -> 
     sweep = tmp_path / "sweep" / "sweep.yaml"
     sweep.parent.mkdir()
     text = (FIXTURE / "sweep.yaml").read_text().replace("../../../worlds", "../worlds")
-    sweep.write_text(text + (CATCH_UPS if behind else "") + REQUIREMENTS)
+    requirements = REQUIREMENTS if measured else REQUIREMENTS.rsplit("  - ", 1)[0]
+    sweep.write_text(text + (CATCH_UPS if behind else "") + requirements)
     rows = list(csv.reader((FIXTURE / "results.csv").open()))
     extra = [
         [str(len(rows) - 1 + i), ctx, kv, str(s), str(s + 1), "", f"{RMS[(ctx, kv)]:g}", "20"]
@@ -111,6 +114,15 @@ def test_catch_ups_are_not_cells_and_move_no_other_rule(tmp_path: Path) -> None:
     assert found.braking is not None
     assert found.rules[0] == found.braking.rule
     assert found.rules[1:] == plain.rules
+
+
+def test_without_the_braking_measurement_a_repeating_context_stays_a_cell(
+    tmp_path: Path,
+) -> None:
+    found = _derive(*_sweep(tmp_path, measured=False))
+    assert found.catch_ups == {}
+    assert found.braking is None
+    assert "worn, behind" in [c.name for c in found.cells]  # placed, or reported, as before
 
 
 def test_the_level_is_the_hardest_right_braking_and_the_rule_reads_both_wheels(
