@@ -11,7 +11,12 @@ prints the table and the two counts ``--validate`` prints, writes
 ``benchmarks/results/adapt_fresh.json`` (``--validate``'s results format) and rewrites the
 page's ``<!-- results: adapt-fresh -->`` block from it. ``--no-save`` prints the table and
 the counts only, so another draw (the docs' third, ``--draw 3000``) can be scored without
-replacing the committed one. Deterministic: the same table at any load.
+replacing the committed one. A variant is scored without saving: ``--sweep FILE`` for DIR
+swept from another scenario (``scenarios/adaptive_sweep_braking.yaml``: the rules with the
+braking rule it derives), ``--rules FILE`` for a rules file instead of the derived rules (the
+committed rules on a draw, say), ``--guard`` for the rules derived with the guarded motor
+fallback. ``--draw 1000 --sequences 20`` is ``adapt --validate``'s twenty. Deterministic:
+the same table at any load.
 """
 
 from __future__ import annotations
@@ -52,11 +57,31 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="print only: leave the results file and the page as they are",
     )
+    ap.add_argument(
+        "--sweep",
+        type=Path,
+        default=SWEEP,
+        help="the swept scenario DIR ran (default: scenarios/adaptive_sweep.yaml)",
+    )
+    ap.add_argument(
+        "--guard",
+        action="store_true",
+        help="derive with the guarded fallback (derive(guard=True)); implies --no-save",
+    )
+    ap.add_argument(
+        "--rules",
+        type=Path,
+        help="score this rules file (adapt: list) instead of the derived rules; implies --no-save",
+    )
     args = ap.parse_args(argv)
-    scenario = load_scenario(str(SWEEP))
-    found = derive(args.sweepdir / "results.csv", scenario)
+    scenario = load_scenario(str(args.sweep))
+    found = derive(args.sweepdir / "results.csv", scenario, guard=args.guard)
     committed = yaml.safe_load(RULES.read_text())["adapt"]
-    if found.rules != committed:
+    if args.rules is not None:
+        found.rules = yaml.safe_load(args.rules.read_text())["adapt"]
+    if args.rules is not None or args.guard or args.sweep.resolve() != SWEEP.resolve():
+        args.no_save = True  # a variant: the committed table stays the shipped rules'
+    elif found.rules != committed:
         print(f"warning: the rules derived from {args.sweepdir} differ from {RULES.name}")
     contexts = dict(scenario.data["sweep"]["contexts"])
     rows = validate(
@@ -92,6 +117,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     lost = loses(rows, 0.02)
     print(f"the rules lose (by more than 2 %) on {len(lost)} of {len(rows)}")
+    changes = [r.change for r in rows]
+    print(
+        f"change against the robust choice: worst {100 * max(changes):+.1f} %, mean "
+        f"{100 * sum(changes) / len(changes):+.1f} %"
+    )
     return 1 if lost else 0
 
 

@@ -9,7 +9,10 @@ them) with a straight or random leader, for 150, 170, 190 or 210 s, then motors 
 ``scenarios/rules/adaptive_rules.yaml``) against the robust fixed gain, seeds 1-3, 600 s,
 on ``scenarios/adaptive_sweep.yaml`` with its ``--set`` settings
 (``MotorMonitor.recentWindow=5`` for a rule that reads ``recent``), and prints every
-sequence where the rules lose by more than 2 %, then the counts. It writes nothing: a
+sequence where the rules lose by more than 2 %, then the counts (``--level P``: a braking
+rule's level moved to P %, to screen where between the right and the wrong braking it
+sits; ``--derive DIR`` [``--sweep FILE``] [``--guard``]: the rules derived from a sweep's
+output instead of a rules file). It writes nothing: a
 screening tool for a rule variant, on contexts of the sweep's own cells rather than on the
 held-out draws. Deterministic: the same numbers at any load.
 """
@@ -71,9 +74,40 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rules", type=Path, default=RULES, help="a rules file (adapt: list)")
     ap.add_argument("--set", type=setting, action="append", default=[], metavar="C.p=V")
+    ap.add_argument(
+        "--derive",
+        type=Path,
+        metavar="DIR",
+        help="score the rules derived from the sweep output DIR instead of --rules",
+    )
+    ap.add_argument(
+        "--sweep", type=Path, default=SWEEP, help="the scenario DIR was swept from (--derive)"
+    )
+    ap.add_argument(
+        "--guard", action="store_true", help="derive with the guarded motor fallback (--derive)"
+    )
+    ap.add_argument(
+        "--level",
+        type=float,
+        help="screen the braking rule (label 'damp, braking ...') at this level, %% of command",
+    )
     args = ap.parse_args(argv)
     scenario = load_scenario(str(SWEEP))
     rules = yaml.safe_load(args.rules.read_text())["adapt"]
+    if args.derive is not None:
+        from amsa_phys.adapt.derive import derive
+
+        found = derive(
+            args.derive / "results.csv", load_scenario(str(args.sweep)), guard=args.guard
+        )
+        rules = found.rules
+    if args.level is not None:
+        braking = [r for r in rules if str(r.get("label", "")).startswith("damp, braking")]
+        if not braking:
+            ap.error("--level: the rules have no braking rule")
+        for key, bound in braking[0]["when"].items():
+            if key.endswith("Power"):
+                bound["below"] = -args.level
     extra = dict(args.set)
     changes = []
     for sequence in transitions():

@@ -29,7 +29,10 @@ estimator with a ``valid`` output sets the robust point once it has been 0 (unsu
 ``fallback_hold`` seconds, but never within the estimator's own ``window`` seconds of a
 switch (the rule's ``dwell``: a switch's transient stays in the window that long, and a
 gain that is right for the context may blind the estimate while it settles), and the cell
-rules require every such estimator to be sure. Cells
+rules require every such estimator to be sure. In a sweep that
+measures braking, a context that repeats another one with parameters no estimator watches
+(the follower started behind) is that cell's *catch-up*, not a cell: only the braking rule
+reads it (``braking.py``). Cells
 are reported, not guessed, when an estimator cannot place them (a context parameter no
 estimator watches, a value its mapping does not know) or when two cells with different
 best values settle to the same levels.
@@ -47,12 +50,14 @@ from typing import Any
 from ..control.estimators.watches import Watch, watches
 from ..errors import ConfigError
 from ..model.scenario import Scenario
+from .braking import Braking, braking, catch_ups
+from .braking import requirement as braking_requirement
 from .cellrules import cell_rules as rules_of_cells
 from .cellrules import whole
 from .damping import FACTOR, STEPS, Damping, damping
 from .grid import lowest, robust_point, safe_best
 from .recovery import recovery
-from .table import read_table
+from .table import SweepTable, read_table
 
 #: Default safety margin: a best point's grid neighbours may be at most this much worse.
 MARGIN = 0.5
@@ -123,6 +128,10 @@ class Derivation:
     damping: Damping | None = None
     #: the recovery rule, when the motor estimate has a recent share (``recovery.py``)
     recovery: dict[str, Any] | None = None
+    #: the braking rule, when the sweep measured braking and has catch-ups (``braking.py``)
+    braking: Braking | None = None
+    #: the catch-up contexts (a cell started away from its reference): name -> its cell
+    catch_ups: dict[str, str] = field(default_factory=dict)
 
     @property
     def gain(self) -> float:
@@ -147,6 +156,7 @@ def derive(
     cell_gain: float = CELL_GAIN,
     damp: float = DAMP,
     damp_steps: int = STEPS,
+    guard: bool = False,
 ) -> Derivation:
     """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
     is the fixed choice to fall back on (default: the sweep's least worst-case point)."""
@@ -166,6 +176,19 @@ def derive(
             "watches, so rules have contexts to tell apart",
             file=results,
         )
+    # catch-ups are cells started away from their reference: read by the braking rule only
+    # (only in a sweep that measures braking, their one reader: elsewhere such a context is
+    # a cell the estimators cannot place, and is reported as one)
+    reads = "context" in table.context_axes and braking_requirement(scenario) is not None
+    repeats = catch_ups(contexts, watched) if reads else {}
+    at = table.context_axes.index("context") if repeats else 0
+    every = dict(table.stats)
+    catchup_keys = {
+        key: (*key[:at], repeats[key[at]], *key[at + 1 :])
+        for key in every
+        if repeats and key[at] in repeats
+    }
+    table.stats = {k: v for k, v in every.items() if k not in catchup_keys}
     base = _base_values(scenario)
     cells: dict[tuple[Any, ...], Cell] = {}
     for key in table.stats:
@@ -224,6 +247,7 @@ def derive(
         if robust is not None and robust in by_point:
             cell.robust_score = by_point[robust].mean
     derivation = Derivation(metric, table.tuned, list(cells.values()), [], [], found)
+    derivation.catch_ups = dict(repeats)
     if robust is None:
         derivation.refused = (
             "no grid point finished in every context: there is no fixed choice to fall back "
@@ -280,10 +304,24 @@ def derive(
         fallbacks = [
             {**r, "when": {**r["when"], **below}} if valid in r["when"] else r for r in fallbacks
         ]
-        derivation.damping.rule["when"].update(
-            _switched_band(cell_rules, derivation.robust, derivation.damping.leaf, found)
-        )
+        band = _switched_band(cell_rules, derivation.robust, derivation.damping.leaf, found)
+        derivation.damping.rule["when"].update(band)
         fallbacks.insert(0, derivation.damping.rule)
+        derivation.braking = braking(
+            results,
+            scenario,
+            SweepTable(table.axes, table.context_axes, table.tuned, every, table.rows),
+            catchup_keys,
+            chosen,
+            robust,
+            derivation.damping.leaf,
+            band,
+            derivation.damping.point,
+        )
+        if derivation.braking is not None:
+            fallbacks.insert(0, derivation.braking.rule)
+        if guard:
+            fallbacks = _guarded(fallbacks, valid, band)
     for w in found:
         if derivation.recovery is None and w.signal in {s for c in placed for s in c.levels}:
             derivation.recovery = recovery(scenario, cell_rules, derivation.robust, w.signal)
@@ -291,6 +329,39 @@ def derive(
         fallbacks.insert(0, derivation.recovery)
     derivation.rules = fallbacks + cell_rules
     return derivation
+
+
+def _guarded(
+    fallbacks: list[dict[str, Any]], valid: str, band: dict[str, dict[str, float]]
+) -> list[dict[str, Any]]:
+    """``fallbacks`` with one more after the damped estimator's: the robust point once it is
+    unsure with its held value above the switched band, whatever the path speed.
+
+    The damping rule reads only a held value inside the band, and the fallback waits for the
+    swing to end; a higher gain set just before the motors recover, whose last sure window
+    already reads them above the band, then swings on with no rule left to fire (the cell
+    transitions' largest losses, ``benchmarks/adapt_transitions.py``). Above the band no cell
+    sets a higher gain, so the robust point is right there, swing or not."""
+    out = []
+    for rule in fallbacks:
+        out.append(rule)
+        when = rule["when"]
+        released = any(k.endswith(".pathSpeed") and "below" in b for k, b in when.items())
+        if valid not in when or not released:
+            continue  # not the fallback that waits for a swing to end
+        above = {s: {"above": b["below"]} for s, b in band.items() if "below" in b}
+        if not above:
+            continue
+        extra = {k: v for k, v in rule.items() if k not in ("when", "label")}
+        leaf = valid.rpartition(".")[0]
+        out.append(
+            {
+                "when": {valid: {"below": 0.5}, **above},
+                **extra,
+                "label": f"robust, {leaf} unsure above the switched band",
+            }
+        )
+    return out
 
 
 def _switched_band(

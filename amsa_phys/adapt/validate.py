@@ -74,7 +74,8 @@ def validate(
     report: Callable[[str], None] | None = None,
 ) -> list[Row]:
     """Score ``found``'s rules on ``count`` held-out sequences; one :class:`Row` each."""
-    axes = box(scenario, contexts)
+    # the draws span the cells' box: a catch-up (a cell started elsewhere) is not a context
+    axes = box(scenario, {k: v for k, v in contexts.items() if k not in found.catch_ups})
     rows = []
     for sequence in sequences(axes, count, duration, seed):
         oracle_plan = [
