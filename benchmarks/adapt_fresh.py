@@ -14,9 +14,9 @@ the counts only, so another draw (the docs' third, ``--draw 3000``) can be score
 replacing the committed one. A variant is scored without saving: ``--sweep FILE`` for DIR
 swept from another scenario (``scenarios/adaptive_sweep_braking.yaml``: the rules with the
 braking rule it derives), ``--rules FILE`` for a rules file instead of the derived rules (the
-committed rules on a draw, say), ``--guard`` for the rules derived with the guarded motor
-fallback. ``--draw 1000 --sequences 20`` is ``adapt --validate``'s twenty. Deterministic:
-the same table at any load.
+committed rules on a draw, say), ``--no-guard`` for the rules derived without the guarded
+motor fallback (``adapt --no-guard``). ``--draw 1000 --sequences 20`` is ``adapt
+--validate``'s twenty. Deterministic: the same table at any load.
 """
 
 from __future__ import annotations
@@ -64,9 +64,10 @@ def main(argv: list[str] | None = None) -> int:
         help="the swept scenario DIR ran (default: scenarios/adaptive_sweep.yaml)",
     )
     ap.add_argument(
-        "--guard",
+        "--no-guard",
         action="store_true",
-        help="derive with the guarded fallback (derive(guard=True)); implies --no-save",
+        help="derive without the guarded motor fallback (adapt --no-guard: the rules as they "
+        "were before it shipped); implies --no-save",
     )
     ap.add_argument(
         "--rules",
@@ -75,11 +76,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = ap.parse_args(argv)
     scenario = load_scenario(str(args.sweep))
-    found = derive(args.sweepdir / "results.csv", scenario, guard=args.guard)
+    found = derive(args.sweepdir / "results.csv", scenario, guard=not args.no_guard)
     committed = yaml.safe_load(RULES.read_text())["adapt"]
     if args.rules is not None:
         found.rules = yaml.safe_load(args.rules.read_text())["adapt"]
-    if args.rules is not None or args.guard or args.sweep.resolve() != SWEEP.resolve():
+    if args.rules is not None or args.no_guard or args.sweep.resolve() != SWEEP.resolve():
         args.no_save = True  # a variant: the committed table stays the shipped rules'
     elif found.rules != committed:
         print(f"warning: the rules derived from {args.sweepdir} differ from {RULES.name}")

@@ -11,8 +11,9 @@ on ``scenarios/adaptive_sweep.yaml`` with its ``--set`` settings
 (``MotorMonitor.recentWindow=5`` for a rule that reads ``recent``), and prints every
 sequence where the rules lose by more than 2 %, then the counts (``--level P``: a braking
 rule's level moved to P %, to screen where between the right and the wrong braking it
-sits; ``--derive DIR`` [``--sweep FILE``] [``--guard``]: the rules derived from a sweep's
-output instead of a rules file). It writes nothing: a
+sits; ``--derive DIR`` [``--sweep FILE``] [``--no-guard``]: the rules derived from a sweep's
+output instead of a rules file, with the guarded motor fallback as ``adapt`` derives them,
+or without it). It writes nothing: a
 screening tool for a rule variant, on contexts of the sweep's own cells rather than on the
 held-out draws. Deterministic: the same numbers at any load.
 """
@@ -84,7 +85,9 @@ def main(argv: list[str] | None = None) -> int:
         "--sweep", type=Path, default=SWEEP, help="the scenario DIR was swept from (--derive)"
     )
     ap.add_argument(
-        "--guard", action="store_true", help="derive with the guarded motor fallback (--derive)"
+        "--no-guard",
+        action="store_true",
+        help="derive without the guarded motor fallback, as adapt --no-guard (--derive)",
     )
     ap.add_argument(
         "--level",
@@ -98,7 +101,7 @@ def main(argv: list[str] | None = None) -> int:
         from amsa_phys.adapt.derive import derive
 
         found = derive(
-            args.derive / "results.csv", load_scenario(str(args.sweep)), guard=args.guard
+            args.derive / "results.csv", load_scenario(str(args.sweep)), guard=not args.no_guard
         )
         rules = found.rules
     if args.level is not None:

@@ -156,7 +156,7 @@ def derive(
     cell_gain: float = CELL_GAIN,
     damp: float = DAMP,
     damp_steps: int = STEPS,
-    guard: bool = False,
+    guard: bool = True,
 ) -> Derivation:
     """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
     is the fixed choice to fall back on (default: the sweep's least worst-case point)."""

@@ -116,6 +116,13 @@ def add_args(p: argparse.ArgumentParser) -> None:
         metavar="N",
         help=f"the damping rule's point: N grid steps below the robust one (default {STEPS})",
     )
+    p.add_argument(
+        "--no-guard",
+        action="store_true",
+        help="leave out the guarded motor fallback (the robust choice once the damped "
+        "estimator is unsure with its held value above the switched band, swing or not): the "
+        "rules without it, for comparison",
+    )
     p.add_argument("--force", action="store_true", help="replace an existing rules file")
     p.add_argument(
         "--validate",
@@ -210,6 +217,7 @@ def run(args: argparse.Namespace) -> int:
         args.cell_gain,
         args.damp,
         args.damp_steps,
+        guard=not args.no_guard,
     )
     for line in table(found):
         print(one_line(line))
@@ -340,6 +348,8 @@ def _command(args: argparse.Namespace) -> str:
     ):
         if value != default:
             words += [flag, f"{value:g}"]
+    if args.no_guard:
+        words.append("--no-guard")
     words += ["--results", args.results]
     return shlex.join(one_line(w) for w in words)
 
