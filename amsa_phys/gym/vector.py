@@ -18,7 +18,7 @@ is more than the runs' own work: the envs are then single envs stepped in turn
 
 ``threads=N`` splits the batch's physics step (every rover's forces and integration, most of
 its time from a few hundred envs up) between N threads, in chunks of at least 64 rovers: the
-same episodes bit for bit, in about two thirds of the physics' wall time on two free cores.
+same episodes bit for bit, in less wall time on two free cores (the manual's Speed table).
 The step times itself with and without the helpers and keeps the faster way for a while, so
 on cores busy with other processes it goes on at about one thread's speed. One thread is
 the default: a vector env is often one of several processes sharing the cores. The single
