@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from adapt_speeds import SPEEDS
 
 from amsa_phys.adapt.derive import derive
 from amsa_phys.cli.main import main
@@ -23,22 +24,6 @@ from amsa_phys.model.scenario import load_scenario
 
 ROOT = Path(__file__).resolve().parents[2]
 FIXTURE = ROOT / "tests" / "fixtures" / "adapt"
-#: each (context, Kv)'s fastest path speed, m/s: the cells choose nominal 0.2, worn 0.4,
-#: random 0.4 and speed changes 0.1; nominal at 0.4 swings (not chosen)
-SPEEDS = {
-    ("nominal", "0.1"): 0.2,
-    ("nominal", "0.2"): 0.26,
-    ("nominal", "0.4"): 1.5,
-    ("worn", "0.1"): 0.2,
-    ("worn", "0.2"): 0.22,
-    ("worn", "0.4"): 0.31,
-    ("random", "0.1"): 0.2,
-    ("random", "0.2"): 0.2,
-    ("random", "0.4"): 0.24,
-    ("speed changes", "0.1"): 0.22,
-    ("speed changes", "0.2"): 0.9,
-    ("speed changes", "0.4"): 1.4,
-}
 REQUIREMENT = "  - {stl: 'always(MotorMonitor.pathSpeed <= 5)', name: path_speed}\n"
 
 

@@ -14,6 +14,7 @@ import shutil
 from pathlib import Path
 
 import yaml
+from adapt_speeds import SPEEDS
 
 from amsa_phys.cli.main import main
 
@@ -25,22 +26,6 @@ FALLBACK = "robust, MotorMonitor unsure"
 #: (its 0.4 made worse here) the robust 0.2: the higher gain is set on worn motors alone, so
 #: the motor estimate has a switched band (below the healthy level) for the guard to read
 RANDOM = {("random", "0.4"): "0.6"}
-#: each (context, Kv)'s fastest path speed, m/s: the sweep measured it, so there is a
-#: damping rule and a motor fallback that waits for the swing to end
-SPEEDS = {
-    ("nominal", "0.1"): 0.2,
-    ("nominal", "0.2"): 0.26,
-    ("nominal", "0.4"): 1.5,
-    ("worn", "0.1"): 0.2,
-    ("worn", "0.2"): 0.22,
-    ("worn", "0.4"): 0.31,
-    ("random", "0.1"): 0.2,
-    ("random", "0.2"): 0.2,
-    ("random", "0.4"): 0.24,
-    ("speed changes", "0.1"): 0.22,
-    ("speed changes", "0.2"): 0.9,
-    ("speed changes", "0.4"): 1.4,
-}
 
 
 def _sweepdir(tmp_path: Path) -> tuple[Path, Path]:
