@@ -46,8 +46,12 @@ class LeafTiming:
 
     @property
     def delayed(self) -> bool:
-        """Whether the Leaf's outputs travel through a delay line."""
-        return self.latency > 0 or self.jitter > 0
+        """Whether the Leaf's outputs travel through a delay line.
+
+        Both are never negative (``seconds`` refuses it), so "above 0" is "not 0": a
+        Fraction's truth is its numerator's, where ``> 0`` goes through Fraction's rich
+        comparison (~4 µs; a 1,000-env vector env's reset asks 8,000 times)."""
+        return bool(self.latency) or bool(self.jitter)
 
 
 def seconds(value: Any, what: str, limit: Fraction | None = MAX_DELAY_S) -> Fraction:
