@@ -47,6 +47,10 @@ from .spin import spin_until_shutdown
 CLOCK_PERIOD = 0.005
 #: How often the node looks for a driver publishing another type on a sensor topic (wall s)
 GRAPH_LOOK_S = 1.0
+#: the node name the graph gives a publisher whose node it has not discovered yet
+UNKNOWN_NODE = "_NODE_NAME_UNKNOWN_"
+#: graph looks a wrong-typed publisher may stay unnamed before it is said without its name
+UNNAMED_LOOKS = 10
 
 
 def qos(text: str) -> Any:
@@ -107,6 +111,8 @@ class Boundary:
         self.refusing: dict[str, set[str]] = {}
         self.refused: dict[str, int] = {}
         self.wrong_types: set[tuple[str, str]] = set()
+        #: graph looks so far at which a wrong-typed publisher's node had no name yet
+        self.unnamed: dict[tuple[str, str], int] = {}
         element = {e: a for a, elements in self.world.arrays.items() for e in elements}
         self.element = element
         self.data_pubs: dict[str, Any] = {}
@@ -182,17 +188,27 @@ class Boundary:
                 self.data_pubs[buf].publish(self.Float64(data=float(value)))
 
     def _look_at_graph(self) -> None:
-        """A driver publishing another type on a sensor topic never matches: say so, once."""
+        """A driver publishing another type on a sensor topic never matches: say so, once,
+        naming its node. The graph may list a publisher before it has discovered the
+        publisher's node (its name is then rmw's placeholder): it is said at a later look,
+        once named, or without a name after :data:`UNNAMED_LOOKS` looks."""
         for src in self.robot.inbound:
             want = ROS2_TYPE[src.role.msg]
             for info in self.node.get_publishers_info_by_topic(src.topic):
                 key = (src.topic, info.topic_type)
-                if info.topic_type != want and key not in self.wrong_types:
-                    self.wrong_types.add(key)
-                    self.node.get_logger().warning(
-                        f"{info.node_name} publishes {info.topic_type} on {src.topic}, "
-                        f"expected {want}: its messages are not read"
-                    )
+                if info.topic_type == want or key in self.wrong_types:
+                    continue
+                who = info.node_name
+                if not who or who == UNKNOWN_NODE:
+                    self.unnamed[key] = looks = self.unnamed.get(key, 0) + 1
+                    if looks < UNNAMED_LOOKS:
+                        continue
+                    who = "a node the ROS graph does not name"
+                self.wrong_types.add(key)
+                self.node.get_logger().warning(
+                    f"{who} publishes {info.topic_type} on {src.topic}, "
+                    f"expected {want}: its messages are not read"
+                )
 
     # -- out --------------------------------------------------------------------------------
     def _on_power(self, src: Source, buffer: str, msg: Any) -> None:
