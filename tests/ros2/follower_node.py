@@ -120,9 +120,20 @@ class Follower(Node):
         left, right, speed = self.law(float(t), inp)
         if self.mode == "nan" and self.steps == 20:
             left = math.nan
+        if self.steps == 1 and self.mode not in ("wrongtype", "besteffort"):
+            self.wait_matched()
         self.left.publish(Float32(data=left) if self.mode == "wrongtype" else Float64(data=left))
         self.right.publish(Float64(data=right))
         self.speed.publish(Float64(data=speed))
+
+    def wait_matched(self) -> None:
+        """The first answer waits for amsa-phys's subscribers (docs/ros2.md, "Hold your
+        first answer until it has a reader"): a VOLATILE publisher drops a message for a
+        subscriber it has not matched yet. (wrongtype and besteffort never match.)"""
+        pubs = (self.left, self.right, self.speed)
+        deadline = time.monotonic() + 60.0
+        while time.monotonic() < deadline and any(p.get_subscription_count() < 1 for p in pubs):
+            time.sleep(0.005)
 
     def law(self, t: float, inp: dict[str, float]) -> tuple[float, float, float]:
         """The paper's proportional follower law (Kv on distance, Kw on bearing)."""

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 import sys
+import time
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -165,6 +166,8 @@ def main(path: str, scenario_file: str) -> None:
                 w.port: (w, self.create_publisher(types[w.type], w.topic, qos))
                 for w in wiring.outputs
             }
+            #: whether every output's writer has matched a reader (see _amsa_wait_matched)
+            self.matched = not wiring.outputs
 
         def _amsa_judge(self, params: list[Any]) -> Any:
             new = dict(vars(self.comp.p))
@@ -184,6 +187,25 @@ def main(path: str, scenario_file: str) -> None:
                 setattr(self.comp.p, name, value)
                 self.comp.on_param_change(name, value)
             return SetParametersResult(successful=True)
+
+        def _amsa_wait_matched(self) -> None:
+            """Hold the first answer until each output's writer has matched a reader, when a
+            run waits for it (lockstep's own trigger, or amsa-phys's node on the graph).
+
+            Why: a RELIABLE, VOLATILE writer never delivers a message to a reader it had not
+            discovered when it wrote, and discovery is not symmetric: the run can see this
+            node's writer (and step it) before this node has seen the run's reader. Under load
+            the first answer was then lost, and the run waited for it in vain. Discovery runs
+            on the middleware's own threads, so a wait here sees it complete. A robot's node
+            (nobody to answer to) is never held."""
+            self.matched = True
+            if not self.triggered and external.BRIDGE_NODE not in self.get_node_names():
+                return
+            deadline = time.monotonic() + external.START_TIMEOUT_S
+            while time.monotonic() < deadline and any(
+                pub.get_subscription_count() < 1 for _, pub in self.pubs.values()
+            ):
+                time.sleep(0.005)
 
         def _amsa_on_trigger(self, msg: Any) -> None:
             self.t = Fraction(msg.clock.sec) + Fraction(msg.clock.nanosec, 1_000_000_000)
@@ -222,6 +244,8 @@ def main(path: str, scenario_file: str) -> None:
                 self.comp.initialize(NodeContext(scenario.seed, path, world))
             self.last_t = t
             out = self.comp.do_step(t, dict(self.inp)) or {}
+            if not self.matched:
+                self._amsa_wait_matched()
             for port, (w, pub) in self.pubs.items():
                 value = out.get(port, self.last_out[port])
                 self.last_out[port] = value
