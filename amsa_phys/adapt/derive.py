@@ -57,6 +57,8 @@ from .cellrules import whole
 from .damping import FACTOR, STEPS, Damping, damping
 from .grid import lowest, robust_point, safe_best
 from .recovery import recovery
+from .swing import FACTOR as SWING_FACTOR
+from .swing import Swing, swing
 from .table import SweepTable, read_table
 
 #: Default safety margin: a best point's grid neighbours may be at most this much worse.
@@ -92,6 +94,9 @@ FALLBACK_DWELL: float | None = None
 #: A damping rule fires above this multiple of the fastest path speed the sweep saw under a
 #: chosen point (0: no damping rule); see ``damping.py``.
 DAMP = FACTOR
+#: A swing rule fires above this multiple of the largest swing the sweep saw under a chosen
+#: point (0: no swing rule); see ``swing.py``. Only a sweep that measures the swing gets one.
+SWING = SWING_FACTOR
 
 
 @dataclass
@@ -132,6 +137,8 @@ class Derivation:
     braking: Braking | None = None
     #: the catch-up contexts (a cell started away from its reference): name -> its cell
     catch_ups: dict[str, str] = field(default_factory=dict)
+    #: the swing supervisor, when the sweep measured the swing (``swing.py``)
+    swing: Swing | None = None
 
     @property
     def gain(self) -> float:
@@ -157,6 +164,7 @@ def derive(
     damp: float = DAMP,
     damp_steps: int = STEPS,
     guard: bool = True,
+    swing_factor: float = SWING,
 ) -> Derivation:
     """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
     is the fixed choice to fall back on (default: the sweep's least worst-case point)."""
@@ -322,6 +330,25 @@ def derive(
             fallbacks.insert(0, derivation.braking.rule)
         if guard:
             fallbacks = _guarded(fallbacks, valid, band)
+    chosen_points = {
+        key: tuple(c.best[k] for k in table.tuned) for key, c in cells.items() if c.best
+    }
+    derivation.swing = swing(results, scenario, table, chosen_points, robust, swing_factor)
+    if derivation.swing is not None:
+        # a higher point waits for the swing to end; the robust point never does
+        held = derivation.swing.guard()
+        cell_rules = [
+            {**r, "when": {**r["when"], **held}} if r["set"] != derivation.robust else r
+            for r in cell_rules
+        ]
+        rule = derivation.swing.rule
+        if derivation.damping is not None:
+            # not on a swing the damping rule is taking: the two would undo each other
+            rule["when"][f"{derivation.damping.leaf}.pathSpeed"] = {
+                "below": derivation.damping.speed
+            }
+        after = 0 if derivation.damping is None else fallbacks.index(derivation.damping.rule) + 1
+        fallbacks.insert(after, rule)
     for w in found:
         if derivation.recovery is None and w.signal in {s for c in placed for s in c.levels}:
             derivation.recovery = recovery(scenario, cell_rules, derivation.robust, w.signal)
