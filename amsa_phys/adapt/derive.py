@@ -165,6 +165,7 @@ def derive(
     damp_steps: int = STEPS,
     guard: bool = True,
     swing_factor: float = SWING,
+    swing_holds: bool = True,
 ) -> Derivation:
     """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
     is the fixed choice to fall back on (default: the sweep's least worst-case point)."""
@@ -335,8 +336,8 @@ def derive(
     }
     derivation.swing = swing(results, scenario, table, chosen_points, robust, swing_factor)
     if derivation.swing is not None:
-        # a higher point waits for the swing to end; the robust point never does
-        held = derivation.swing.guard()
+        # a higher point waits for the swing to end (``swing_holds``); the robust one never
+        held = derivation.swing.guard() if swing_holds else {}
         cell_rules = [
             {**r, "when": {**r["when"], **held}} if r["set"] != derivation.robust else r
             for r in cell_rules
