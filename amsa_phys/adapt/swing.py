@@ -30,6 +30,7 @@ from typing import Any
 from ..errors import ConfigError
 from ..model.scenario import Scenario
 from .cellrules import whole
+from .damping import Damping
 from .table import SweepTable, read_table
 
 #: The rule fires above this multiple of the largest swing under a chosen point.
@@ -56,6 +57,26 @@ class Swing:
     def guard(self) -> dict[str, dict[str, float]]:
         """The condition a cell rule setting a higher point than the robust one adds."""
         return {f"{self.leaf}.amplitude": {"below": self.level}}
+
+    def supervise(
+        self,
+        cell_rules: list[dict[str, Any]],
+        fallbacks: list[dict[str, Any]],
+        robust: dict[str, Any],
+        damping: Damping | None,
+        holds: bool = True,
+    ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+        """(cell rules, fallbacks) with the swing rule: after the damping rule (not on a swing
+        the damping rule is taking, or the two would undo each other), and every cell rule
+        setting another point than the robust one waiting for the swing to end (``holds``)."""
+        held = self.guard() if holds else {}
+        cells = [
+            {**r, "when": {**r["when"], **held}} if r["set"] != robust else r for r in cell_rules
+        ]
+        if damping is not None:
+            self.rule["when"][f"{damping.leaf}.pathSpeed"] = {"below": damping.speed}
+        after = 0 if damping is None else fallbacks.index(damping.rule) + 1
+        return cells, [*fallbacks[:after], self.rule, *fallbacks[after:]]
 
 
 def swing_requirement(scenario: Scenario) -> tuple[str, str, float] | None:

@@ -361,7 +361,7 @@ def _command(args: argparse.Namespace) -> str:
     ):
         if value != default:
             words += [flag, f"{value:g}"]
-    if args.swing != SWING:
+    if getattr(args, "swing", SWING) != SWING:
         words += ["--swing", f"{args.swing:g}"]
     if args.no_guard:
         words.append("--no-guard")
