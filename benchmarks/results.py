@@ -261,6 +261,7 @@ OWN_TABLES = {
     "adapt-demo": ROOT / "benchmarks" / "results" / "adapt_demo.json",
     "adapt-outside": ROOT / "benchmarks" / "results" / "adapt_outside.json",
     "adapt-fresh": ROOT / "benchmarks" / "results" / "adapt_fresh.json",
+    "adapt-swing": ROOT / "benchmarks" / "results" / "adapt_swing.json",
     "physics-step": ROOT / "benchmarks" / "results" / "physics_step.json",
 }
 

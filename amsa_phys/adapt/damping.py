@@ -128,3 +128,36 @@ def _below(table: SweepTable, point: tuple[Any, ...], steps: int) -> tuple[Any, 
         values = sorted({p[i] for by in table.stats.values() for p in by})
         out.append(values[max(0, values.index(v) - steps)])
     return tuple(out)
+
+
+def guarded(
+    fallbacks: list[dict[str, Any]], valid: str, band: dict[str, dict[str, float]]
+) -> list[dict[str, Any]]:
+    """``fallbacks`` with one more after the damped estimator's: the robust point once it is
+    unsure with its held value above the switched band, whatever the path speed.
+
+    The damping rule reads only a held value inside the band, and the fallback waits for the
+    swing to end; a higher gain set just before the motors recover, whose last sure window
+    already reads them above the band, then swings on with no rule left to fire (the cell
+    transitions' largest losses, ``benchmarks/adapt_transitions.py``). Above the band no cell
+    sets a higher gain, so the robust point is right there, swing or not."""
+    out = []
+    for rule in fallbacks:
+        out.append(rule)
+        when = rule["when"]
+        released = any(k.endswith(".pathSpeed") and "below" in b for k, b in when.items())
+        if valid not in when or not released:
+            continue  # not the fallback that waits for a swing to end
+        above = {s: {"above": b["below"]} for s, b in band.items() if "below" in b}
+        if not above:
+            continue
+        extra = {k: v for k, v in rule.items() if k not in ("when", "label")}
+        leaf = valid.rpartition(".")[0]
+        out.append(
+            {
+                "when": {valid: {"below": 0.5}, **above},
+                **extra,
+                "label": f"robust, {leaf} unsure above the switched band",
+            }
+        )
+    return out

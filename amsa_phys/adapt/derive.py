@@ -55,8 +55,11 @@ from .braking import requirement as braking_requirement
 from .cellrules import cell_rules as rules_of_cells
 from .cellrules import whole
 from .damping import FACTOR, STEPS, Damping, damping
+from .damping import guarded as _guarded
 from .grid import lowest, robust_point, safe_best
 from .recovery import recovery
+from .swing import FACTOR as SWING_FACTOR
+from .swing import Swing, swing
 from .table import SweepTable, read_table
 
 #: Default safety margin: a best point's grid neighbours may be at most this much worse.
@@ -92,6 +95,9 @@ FALLBACK_DWELL: float | None = None
 #: A damping rule fires above this multiple of the fastest path speed the sweep saw under a
 #: chosen point (0: no damping rule); see ``damping.py``.
 DAMP = FACTOR
+#: A swing rule fires above this multiple of the largest swing the sweep saw under a chosen
+#: point (0: no swing rule); see ``swing.py``. Only a sweep that measures the swing gets one.
+SWING = SWING_FACTOR
 
 
 @dataclass
@@ -132,6 +138,8 @@ class Derivation:
     braking: Braking | None = None
     #: the catch-up contexts (a cell started away from its reference): name -> its cell
     catch_ups: dict[str, str] = field(default_factory=dict)
+    #: the swing supervisor, when the sweep measured the swing (``swing.py``)
+    swing: Swing | None = None
 
     @property
     def gain(self) -> float:
@@ -157,6 +165,8 @@ def derive(
     damp: float = DAMP,
     damp_steps: int = STEPS,
     guard: bool = True,
+    swing_factor: float = SWING,
+    swing_holds: bool = True,
 ) -> Derivation:
     """Rules from the sweep in ``results`` (a results.csv) run on ``scenario``; ``robust``
     is the fixed choice to fall back on (default: the sweep's least worst-case point)."""
@@ -291,8 +301,8 @@ def derive(
     fallbacks = _fallbacks(scenario, found, placed, derivation.robust, wait, fallback_dwell)
     sure = {signal: {"above": 0.5} for r in fallbacks for signal in r["when"]}
     cell_rules = [{**r, "when": {**r["when"], **sure}} for r in rules_of_cells(placed, hold)]
+    chosen = {key: tuple(c.best[k] for k in table.tuned) for key, c in cells.items() if c.best}
     if damp > 0:
-        chosen = {key: tuple(c.best[k] for k in table.tuned) for key, c in cells.items() if c.best}
         used = {s for c in placed for s in c.levels}
         derivation.damping = damping(
             results, scenario, table, chosen, robust, used, damp, damp_steps
@@ -322,6 +332,11 @@ def derive(
             fallbacks.insert(0, derivation.braking.rule)
         if guard:
             fallbacks = _guarded(fallbacks, valid, band)
+    derivation.swing = swing(results, scenario, table, chosen, robust, swing_factor)
+    if derivation.swing is not None:
+        cell_rules, fallbacks = derivation.swing.supervise(
+            cell_rules, fallbacks, derivation.robust, derivation.damping, swing_holds
+        )
     for w in found:
         if derivation.recovery is None and w.signal in {s for c in placed for s in c.levels}:
             derivation.recovery = recovery(scenario, cell_rules, derivation.robust, w.signal)
@@ -329,39 +344,6 @@ def derive(
         fallbacks.insert(0, derivation.recovery)
     derivation.rules = fallbacks + cell_rules
     return derivation
-
-
-def _guarded(
-    fallbacks: list[dict[str, Any]], valid: str, band: dict[str, dict[str, float]]
-) -> list[dict[str, Any]]:
-    """``fallbacks`` with one more after the damped estimator's: the robust point once it is
-    unsure with its held value above the switched band, whatever the path speed.
-
-    The damping rule reads only a held value inside the band, and the fallback waits for the
-    swing to end; a higher gain set just before the motors recover, whose last sure window
-    already reads them above the band, then swings on with no rule left to fire (the cell
-    transitions' largest losses, ``benchmarks/adapt_transitions.py``). Above the band no cell
-    sets a higher gain, so the robust point is right there, swing or not."""
-    out = []
-    for rule in fallbacks:
-        out.append(rule)
-        when = rule["when"]
-        released = any(k.endswith(".pathSpeed") and "below" in b for k, b in when.items())
-        if valid not in when or not released:
-            continue  # not the fallback that waits for a swing to end
-        above = {s: {"above": b["below"]} for s, b in band.items() if "below" in b}
-        if not above:
-            continue
-        extra = {k: v for k, v in rule.items() if k not in ("when", "label")}
-        leaf = valid.rpartition(".")[0]
-        out.append(
-            {
-                "when": {valid: {"below": 0.5}, **above},
-                **extra,
-                "label": f"robust, {leaf} unsure above the switched band",
-            }
-        )
-    return out
 
 
 def _switched_band(

@@ -12,7 +12,7 @@ from pathlib import Path
 import yaml
 
 from ..adapt.damping import STEPS
-from ..adapt.derive import CELL_GAIN, DAMP, MARGIN, MIN_GAIN, NEAR, Derivation, derive
+from ..adapt.derive import CELL_GAIN, DAMP, MARGIN, MIN_GAIN, NEAR, SWING, Derivation, derive
 from ..adapt.sweepdir import read_sweep_scenario
 from ..atomic import write_atomic
 from ..errors import ConfigError, one_line
@@ -117,6 +117,16 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help=f"the damping rule's point: N grid steps below the robust one (default {STEPS})",
     )
     p.add_argument(
+        "--swing",
+        type=float,
+        default=SWING,
+        metavar="F",
+        help="when the sweep measured the distance's swings (a requirement "
+        "always[a:b](S.amplitude <= C)), set the robust choice while S's amplitude is above F "
+        "times the largest seen under a chosen point, and hold higher choices back until it "
+        f"falls below (default {SWING:g}; 0: no swing rule)",
+    )
+    p.add_argument(
         "--no-guard",
         action="store_true",
         help="leave out the guarded motor fallback (the robust choice once the damped "
@@ -188,6 +198,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"must be in [0, 1), got {args.cell_gain}", key="--cell-gain")
     if not (0 <= args.damp < 100):
         raise ConfigError(f"must be in [0, 100), got {args.damp}", key="--damp")
+    if not (0 <= args.swing < 100):
+        raise ConfigError(f"must be in [0, 100), got {args.swing}", key="--swing")
     if not 1 <= args.damp_steps <= 1000:
         raise ConfigError(f"must be 1..1000, got {args.damp_steps}", key="--damp-steps")
     if not (0 <= args.min_gain < 1):
@@ -218,6 +230,7 @@ def run(args: argparse.Namespace) -> int:
         args.damp,
         args.damp_steps,
         guard=not args.no_guard,
+        swing_factor=args.swing,
     )
     for line in table(found):
         print(one_line(line))
@@ -348,6 +361,8 @@ def _command(args: argparse.Namespace) -> str:
     ):
         if value != default:
             words += [flag, f"{value:g}"]
+    if getattr(args, "swing", SWING) != SWING:
+        words += ["--swing", f"{args.swing:g}"]
     if args.no_guard:
         words.append("--no-guard")
     words += ["--results", args.results]
@@ -383,6 +398,14 @@ def table(found: Derivation) -> list[str]:
             f"damping: {point} while {d.leaf} is unsure and its pathSpeed is above {d.speed:g} "
             f"(the fastest under a chosen point: {d.fastest:g}); its fallback waits for "
             f"pathSpeed below {d.release:g}"
+        )
+    s = found.swing
+    if s is not None:
+        point = ", ".join(f"{k}={v}" for k, v in s.rule["set"].items())
+        lines.append(
+            f"swing: {point} while {s.leaf}'s amplitude is above {s.level:g} (the largest "
+            f"swing under a chosen point: {s.largest:g}); higher choices wait for it to fall "
+            "below"
         )
     r = found.recovery
     if r is not None:

@@ -255,6 +255,7 @@ BUILTINS: dict[str, str] = {
     "GPSLossMonitor": "amsa_phys.control.estimators.gpsloss:GPSLossMonitor",
     "MotorMonitor": "amsa_phys.control.estimators.motor:MotorMonitor",
     "LeaderMonitor": "amsa_phys.control.estimators.leader:LeaderMonitor",
+    "SwingMonitor": "amsa_phys.control.estimators.swing:SwingMonitor",
 }
 
 
