@@ -236,6 +236,7 @@ def score_draw(scenario, found, draw: int, count: int, seeds: list[int]) -> list
         row: dict[str, Any] = {
             "index": index,
             "sequence": sequence.describe(),
+            "segments": [[at, sets] for at, sets in sequence.segments],
             "seeds": {w: [] for w in WAYS},
             "stalls": {w: [] for w in WAYS},
         }
@@ -259,6 +260,70 @@ def score_draw(scenario, found, draw: int, count: int, seeds: list[int]) -> list
     return rows
 
 
+BEHAVIOR, MOTORS = "Leader.behavior", "MyNormalizePower.motorCoef"
+LEADERS = {1: "straight", 4: "random"}
+
+
+def stall_contexts(rows: list[dict[str, Any]], way: str) -> list[tuple[int, float]]:
+    """(leader behaviour, motor level) in force where each of ``way``'s stalls began."""
+    found = []
+    for r in rows:
+        for spells in r["stalls"][way]:
+            for start, _ in spells:
+                sets = [s for at, s in r.get("segments", []) if at <= start]
+                if sets:
+                    found.append((sets[-1].get(BEHAVIOR), sets[-1].get(MOTORS)))
+    return found
+
+
+def stall_cost(rows: list[dict[str, Any]]) -> list[tuple[float, float]]:
+    """(mean rms of the stalled seeds, of the other seeds) of each sequence in which the
+    robust gain alone stalls in some seeds but not all: what a stall costs, seed noise aside."""
+    found = []
+    for r in rows:
+        pairs = list(zip(r["seeds"]["robust"], r["stalls"]["robust"], strict=True))
+        stalled = [v for v, spells in pairs if spells]
+        other = [v for v, spells in pairs if not spells]
+        if stalled and other:
+            found.append((statistics.fmean(stalled), statistics.fmean(other)))
+    return found
+
+
+def _cost(found: list[tuple[float, float]]) -> str:
+    if not found:
+        return "–"
+    a = statistics.fmean(s for s, _ in found)
+    b = statistics.fmean(o for _, o in found)
+    return f"{a:.3g} / {b:.3g} ({len(found)} seq.)"
+
+
+def _contexts(found: list[tuple[int, float]]) -> str:
+    """``random leader 5 (motors 34–60 %)``: the stalls' contexts, per leader behaviour."""
+    parts = []
+    for behavior in sorted({b for b, _ in found}, key=str):
+        levels = [m for b, m in found if b == behavior]
+        name = LEADERS.get(behavior, f"behavior {behavior}")
+        span = f"{min(levels):g}" + ("" if min(levels) == max(levels) else f"–{max(levels):g}")
+        parts.append(f"{name} leader {len(levels)} (motors {span} %)")
+    return "; ".join(parts) or "–"
+
+
+def with_segments(scenario, found, entry: dict[str, Any]) -> dict[str, Any]:
+    """A saved draw's rows with their sequences' segments (drawn again: deterministic)."""
+    from amsa_phys.tune.contexts import box, sequences
+
+    if all("segments" in r for r in entry["rows"]):
+        return entry
+    contexts = dict(scenario.data["sweep"]["contexts"])
+    axes = box(scenario, {k: v for k, v in contexts.items() if k not in found.catch_ups})
+    drawn = sequences(axes, len(entry["rows"]), 600.0, entry["draw"])
+    for r, sequence in zip(entry["rows"], drawn, strict=True):
+        if r["sequence"] != sequence.describe():
+            raise SystemExit(f"adapt_seeds: draw {entry['draw']} #{r['index']} drawn otherwise")
+        r["segments"] = [[at, sets] for at, sets in sequence.segments]
+    return entry
+
+
 def _pct(x: float) -> str:
     return f"{100 * x:+.1f} %".replace("-", "−")
 
@@ -278,6 +343,8 @@ def tables(doc: dict[str, Any]) -> dict[str, Any]:
     )
     per_draw, lost_rows, stall_rows = [], [], []
     totals = {w: [0, 0] for w in WAYS}
+    every: list[tuple[int, float]] = []
+    costs: list[tuple[float, float]] = []
     for d in doc["draws"]:
         rows = d["rows"]
         few = summary(rows, seeds, first)
@@ -307,9 +374,23 @@ def tables(doc: dict[str, Any]) -> dict[str, Any]:
             totals[w][1] += seqs
             cells.append(f"{runs} ({seqs} seq.)")
         cells.append(str(len(rows) * len(seeds)))
+        cost = stall_cost(rows)
+        costs.extend(cost)
+        cells.append(_cost(cost))
+        found = stall_contexts(rows, "robust")
+        every.extend(found)
+        cells.append(_contexts(found))
         stall_rows.append(cells)
     n_runs = sum(len(d["rows"]) for d in doc["draws"]) * len(seeds)
-    stall_rows.append(["all", *(f"{a} ({b} seq.)" for a, b in totals.values()), str(n_runs)])
+    stall_rows.append(
+        [
+            "all",
+            *(f"{a} ({b} seq.)" for a, b in totals.values()),
+            str(n_runs),
+            _cost(costs),
+            _contexts(every),
+        ]
+    )
     return {
         "per_draw": {
             "columns": ["draw", "seeds 1–3", f"seeds {label}"],
@@ -326,7 +407,15 @@ def tables(doc: dict[str, Any]) -> dict[str, Any]:
             "rows": lost_rows,
         },
         "stalls": {
-            "columns": ["draw", "robust alone: runs (sequences)", "rules", "oracle", "runs"],
+            "columns": [
+                "draw",
+                "robust alone: runs (sequences)",
+                "rules",
+                "oracle",
+                "runs",
+                "robust rms, stalled seeds / the others (m)",
+                "in force where the robust gain's stalls began (spells)",
+            ],
             "rows": stall_rows,
         },
     }
@@ -397,7 +486,7 @@ def main(argv: list[str] | None = None) -> int:
     doc: dict[str, Any] = {"seeds": seeds, "command": command, "draws": []}
     for draw, count in draws:
         if draw in done and len(done[draw]["rows"]) == count:
-            entry = done[draw]
+            entry = with_segments(scenario, found, done[draw])
         else:
             entry = {"draw": draw, "rows": score_draw(scenario, found, draw, count, seeds)}
         doc["draws"] = sorted([*doc["draws"], entry], key=lambda d: d["draw"])

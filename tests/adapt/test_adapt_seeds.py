@@ -138,3 +138,23 @@ def test_summary_over_a_subset_of_seeds() -> None:
     # the oracle gains 20 % on the first and 15 % on the second; the rules reach only the second
     assert (few["worth"], few["reached"]) == (2, 1)
     assert many["mean"] == pytest.approx((many["worst"] - 0.15) / 2)
+
+
+def test_stall_cost_compares_seeds_of_the_same_sequence() -> None:
+    spell = [[100.0, 140.0]]
+    stalled_some = {"seeds": {"robust": [4.0, 1.0, 2.0]}, "stalls": {"robust": [spell, [], []]}}
+    stalled_all = {"seeds": {"robust": [9.0, 9.0]}, "stalls": {"robust": [spell, spell]}}
+    never = {"seeds": {"robust": [0.5, 0.5]}, "stalls": {"robust": [[], []]}}
+    # a sequence stalled in every seed, or in none, has nothing to compare with: left out
+    assert adapt_seeds.stall_cost([stalled_some, stalled_all, never]) == [(4.0, 1.5)]
+
+
+def test_stall_contexts_are_the_segment_in_force_at_the_start() -> None:
+    row = {
+        "segments": [
+            [0.0, {"Leader.behavior": 1, "MyNormalizePower.motorCoef": 80}],
+            [200, {"Leader.behavior": 4, "MyNormalizePower.motorCoef": 30}],
+        ],
+        "stalls": {"robust": [[[150.0, 210.0]], [[250.0, 290.0], [400.0, 430.0]]]},
+    }
+    assert adapt_seeds.stall_contexts([row], "robust") == [(1, 80), (4, 30), (4, 30)]
