@@ -252,7 +252,7 @@ def score_draw(scenario, found, draw: int, count: int, seeds: list[int]) -> list
         change = stats(row["seeds"]["robust"], row["seeds"]["rules"])
         stalled = ", ".join(f"{w} {sum(map(bool, row['stalls'][w]))}" for w in WAYS)
         print(
-            f"{draw} #{index}: {100 * change.change:+.1f} % ± {100 * change.se:.1f} | "
+            f"{draw} sequence {index}: {100 * change.change:+.1f} % ± {100 * change.se:.1f} | "
             f"stalls {stalled} | {row['sequence']}",
             flush=True,
         )
@@ -319,7 +319,9 @@ def with_segments(scenario, found, entry: dict[str, Any]) -> dict[str, Any]:
     drawn = sequences(axes, len(entry["rows"]), 600.0, entry["draw"])
     for r, sequence in zip(entry["rows"], drawn, strict=True):
         if r["sequence"] != sequence.describe():
-            raise SystemExit(f"adapt_seeds: draw {entry['draw']} #{r['index']} drawn otherwise")
+            raise SystemExit(
+                f"adapt_seeds: draw {entry['draw']}, sequence {r['index']} drawn otherwise"
+            )
         r["segments"] = [[at, sets] for at, sets in sequence.segments]
     return entry
 
@@ -359,7 +361,7 @@ def tables(doc: dict[str, Any]) -> dict[str, Any]:
             (c3, e3), (cn, en) = few["changes"][i], many["changes"][i]
             lost_rows.append(
                 [
-                    f"{NAMES.get(d['draw'], d['draw'])} #{i}",
+                    f"{NAMES.get(d['draw'], d['draw'])}, sequence {i}",
                     f"{_pct(c3)} ± {100 * e3:.1f}",
                     f"{_pct(cn)} ± {100 * en:.1f}",
                     per_seed,
