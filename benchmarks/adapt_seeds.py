@@ -10,12 +10,17 @@ the docs' draws (``--validate``'s twenty, generator seed 1000, and the thirty of
 600 s), for ``--seeds`` seeds (``10``: seeds 1-10; or a list, ``1-3`` or ``1,4,7``). Per
 draw it reports, for seeds 1-3 and for all the seeds: reached (sequences where the oracle
 gains 10 % or more on which the rules do too), losses above 2 %, the worst and the mean
-change against the robust gain; for every sequence lost on either, each seed's values and
-the standard error of the mean change (paired by seed).
+change against the robust gain; over all the seeds, the gains and losses beyond the noise
+(a mean change more than two standard errors below zero, or above the 2 % bound) and the
+median standard error; for every sequence lost on either, each seed's values and the
+standard error of the mean change (paired by seed).
 
 It also counts *stalls*: a spell of 20 s or more in which the follower's speed stays below
 0.05 m/s while it is more than 20 m from the leader (5 m behind its 15 m reference), read
-from each run's trace; per way (robust alone, rules, oracle), the runs with one.
+from each run's trace; per way (robust alone, rules, oracle), the runs with one; the robust
+gain's stalled runs whose rules run (same seed) stalls too; what a stall costs (the stalled
+seeds' rms against the other seeds' of the same sequences); and the leader and motors in
+force where each stall began.
 
 It writes ``benchmarks/results/adapt_seeds.json`` after each draw (``--resume`` keeps the
 draws already there that were run with the same seeds) and rewrites docs/adaptation.md's
@@ -276,6 +281,29 @@ def stall_contexts(rows: list[dict[str, Any]], way: str) -> list[tuple[int, floa
     return found
 
 
+def stalled_both(rows: list[dict[str, Any]]) -> int:
+    """Runs where the robust gain alone stalls and the rules, same sequence and seed, too."""
+    return sum(
+        bool(a) and bool(b)
+        for r in rows
+        for a, b in zip(r["stalls"]["robust"], r["stalls"]["rules"], strict=True)
+    )
+
+
+def beyond(changes: list[list[float]], tolerance: float = TOLERANCE) -> tuple[int, int]:
+    """(gains, losses) beyond the seed noise: a mean change more than two standard errors
+    below zero, or more than two above the tolerance."""
+    gains = sum(c < 0 and c < -2 * se for c, se in changes)
+    losses = sum(c - tolerance > 2 * se for c, se in changes)
+    return gains, losses
+
+
+def _beyond(s: dict[str, Any]) -> str:
+    gains, losses = beyond(s["changes"])
+    median = statistics.median(se for _, se in s["changes"])
+    return f"{gains}, {losses}; {100 * median:.1f} points"
+
+
 def stall_cost(rows: list[dict[str, Any]]) -> list[tuple[float, float]]:
     """(mean rms of the stalled seeds, of the other seeds) of each sequence in which the
     robust gain alone stalls in some seeds but not all: what a stall costs, seed noise aside."""
@@ -347,11 +375,14 @@ def tables(doc: dict[str, Any]) -> dict[str, Any]:
     totals = {w: [0, 0] for w in WAYS}
     every: list[tuple[int, float]] = []
     costs: list[tuple[float, float]] = []
+    together = 0
     for d in doc["draws"]:
         rows = d["rows"]
         few = summary(rows, seeds, first)
         many = summary(rows, seeds, seeds)
-        per_draw.append([NAMES.get(d["draw"], str(d["draw"])), _cell(few), _cell(many)])
+        per_draw.append(
+            [NAMES.get(d["draw"], str(d["draw"])), _cell(few), _cell(many), _beyond(many)]
+        )
         for i in sorted(set(few["lost"]) | set(many["lost"])):
             r = rows[i]
             per_seed = ", ".join(
@@ -376,6 +407,9 @@ def tables(doc: dict[str, Any]) -> dict[str, Any]:
             totals[w][1] += seqs
             cells.append(f"{runs} ({seqs} seq.)")
         cells.append(str(len(rows) * len(seeds)))
+        shared = stalled_both(rows)
+        together += shared
+        cells.append(str(shared))
         cost = stall_cost(rows)
         costs.extend(cost)
         cells.append(_cost(cost))
@@ -389,13 +423,19 @@ def tables(doc: dict[str, Any]) -> dict[str, Any]:
             "all",
             *(f"{a} ({b} seq.)" for a, b in totals.values()),
             str(n_runs),
+            str(together),
             _cost(costs),
             _contexts(every),
         ]
     )
     return {
         "per_draw": {
-            "columns": ["draw", "seeds 1–3", f"seeds {label}"],
+            "columns": [
+                "draw",
+                "seeds 1–3",
+                f"seeds {label}",
+                f"seeds {label}: gains, losses beyond the noise; median s.e.",
+            ],
             "rows": per_draw,
         },
         "lost": {
@@ -415,6 +455,7 @@ def tables(doc: dict[str, Any]) -> dict[str, Any]:
                 "rules",
                 "oracle",
                 "runs",
+                "robust stalls in a seed whose rules run stalls too",
                 "robust rms, stalled seeds / the others (m)",
                 "in force where the robust gain's stalls began (spells)",
             ],

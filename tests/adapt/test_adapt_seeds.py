@@ -158,3 +158,20 @@ def test_stall_contexts_are_the_segment_in_force_at_the_start() -> None:
         "stalls": {"robust": [[[150.0, 210.0]], [[250.0, 290.0], [400.0, 430.0]]]},
     }
     assert adapt_seeds.stall_contexts([row], "robust") == [(1, 80), (4, 30), (4, 30)]
+
+
+def test_beyond_the_noise() -> None:
+    changes = [
+        [-0.10, 0.02],  # a gain five standard errors out
+        [-0.03, 0.02],  # a gain within two
+        [0.09, 0.03],  # a loss: 7 points above the 2 % bound, more than two (6 points)
+        [0.07, 0.03],  # above the bound by 5 points: within two standard errors
+        [0.30, 0.30],  # one wild seed: far above the bound, and noise
+    ]
+    assert adapt_seeds.beyond(changes) == (1, 1)
+
+
+def test_stalled_both_counts_the_same_seed() -> None:
+    spell = [[100.0, 140.0]]
+    row = {"stalls": {"robust": [spell, spell, []], "rules": [spell, [], spell]}}
+    assert adapt_seeds.stalled_both([row]) == 1
