@@ -26,7 +26,9 @@ It writes ``benchmarks/results/adapt_seeds.json`` after each draw (``--resume`` 
 draws already there that were run with the same seeds) and rewrites docs/adaptation.md's
 ``<!-- results: adapt-seeds -->`` block from it; ``--no-save`` prints only. ``--draws``
 scores some draws only (``4000:30,5000:30``; implies ``--no-save`` unless all five).
-Deterministic: the same numbers at any load.
+It ends with the verdict ``--validate`` would give over these seeds, and how many of the
+losses are within the seed noise; exit 1 if the rules lose on any sequence. Deterministic:
+the same numbers at any load.
 """
 
 from __future__ import annotations
@@ -542,7 +544,27 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_save:
         for page in bench_results.write_pages():
             print(f"rewrote {page.relative_to(ROOT)}", file=sys.stderr)
-    return 0
+    lost, noisy, count = verdict(doc)
+    print(
+        f"the rules lose (by more than {100 * TOLERANCE:g} % in the mean over {len(seeds)} "
+        f"seeds) on {lost} of {count} held-out sequences, {noisy} of them within the seed noise"
+    )
+    return 1 if lost else 0
+
+
+def verdict(doc: dict[str, Any]) -> tuple[int, int, int]:
+    """(sequences lost over all the seeds, those of them within two standard errors of the
+    bound, sequences): the bound as ``--validate`` checks it, and how much of it is noise."""
+    seeds = doc["seeds"]
+    lost = noisy = count = 0
+    for d in doc["draws"]:
+        changes = summary(d["rows"], seeds, seeds)["changes"]
+        count += len(changes)
+        for c, se in changes:
+            if c > TOLERANCE:
+                lost += 1
+                noisy += not c - TOLERANCE > 2 * se
+    return lost, noisy, count
 
 
 if __name__ == "__main__":

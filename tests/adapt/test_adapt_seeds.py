@@ -175,3 +175,18 @@ def test_stalled_both_counts_the_same_seed() -> None:
     spell = [[100.0, 140.0]]
     row = {"stalls": {"robust": [spell, spell, []], "rules": [spell, [], spell]}}
     assert adapt_seeds.stalled_both([row]) == 1
+
+
+def test_verdict_counts_losses_and_the_noisy_ones() -> None:
+    def row(rules: list[float]) -> dict:
+        return {"seeds": {"robust": [1.0, 1.0, 1.0], "rules": rules, "oracle": [1.0] * 3}}
+
+    rows = [
+        row([1.033, 1.033, 1.034]),  # +3.3 %, every seed: a loss beyond the noise
+        row([1.0, 1.6, 0.95]),  # +18 % from one seed: a loss within the noise
+        row([1.016, 1.03, 1.044]),  # +3 % ± 0.8: a point over the bound, within two s.e.
+        row([1.01, 1.01, 1.01]),  # +1 %: inside the bound
+        row([0.8, 0.8, 0.8]),  # a gain
+    ]
+    doc = {"seeds": [1, 2, 3], "draws": [{"rows": rows[:3]}, {"rows": rows[3:]}]}
+    assert adapt_seeds.verdict(doc) == (3, 2, 5)
