@@ -262,6 +262,7 @@ OWN_TABLES = {
     "adapt-outside": ROOT / "benchmarks" / "results" / "adapt_outside.json",
     "adapt-fresh": ROOT / "benchmarks" / "results" / "adapt_fresh.json",
     "adapt-swing": ROOT / "benchmarks" / "results" / "adapt_swing.json",
+    "adapt-seeds": ROOT / "benchmarks" / "results" / "adapt_seeds.json",
     "physics-step": ROOT / "benchmarks" / "results" / "physics_step.json",
 }
 
@@ -274,6 +275,10 @@ def _own_table(target: str) -> str:
     doc = json.loads(path.read_text())
     if "columns" in doc:
         return table_markdown(doc)
+    if "draws" in doc:  # benchmarks/adapt_seeds.py's: three tables of its own
+        from benchmarks.adapt_seeds import markdown as seeds_markdown
+
+        return seeds_markdown(doc)
     from amsa_phys.adapt.validate import markdown
 
     return markdown(doc)
