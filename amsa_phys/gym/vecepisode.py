@@ -35,6 +35,7 @@ from typing import Any
 import greenlet
 import numpy as np
 
+from ..engine.clock import at_or_after
 from ..engine.multirun import MultiRun
 from ..model.scenario import Scenario
 from ..model.template import Template
@@ -137,6 +138,7 @@ class VecEpisode:
         self.acted = list(acted)
         self._inputs = [leaf.inputs[p] for p in self.observed]
         self.end = self.sim.duration
+        self._end_s = float(self.end)
         self.t = Fraction(0)
         self.done = False
         #: the episode was ended by a Ctrl-C inside a step (not by a run's fault)
@@ -168,7 +170,7 @@ class VecEpisode:
         self, t: Fraction, inputs: Mapping[str, Any], comps: Sequence[Any]
     ) -> tuple[Mapping[str, Any], Any]:
         order, back = self._run_order(comps)
-        if t >= self.end:  # the episode ended: publish nothing, keep the last action
+        if at_or_after(t, self.end, self._end_s):  # ended: publish nothing, keep the last action
             zeros = {name: np.zeros(len(comps)) for name in self.acted}
             return zeros, np.zeros(len(comps), dtype=bool)
         rows = self._rows

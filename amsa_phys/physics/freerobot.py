@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..engine.batch import derived
+from ..engine.clock import at_or_after
 from ..model.params import Param
 from ..model.template import Kind
 from .robots import POSE_OUTPUTS, ControlledRobot, Robot
@@ -194,18 +195,21 @@ class FreeRobot(Robot):
                 "heading": np.array([c.target_heading for c in comps], dtype=np.float64),
                 "factor": np.array([c.speed_factor for c in comps], dtype=np.float64),
                 "soonest": min(c.next_change for c in comps),
+                "soonest_s": float(min(c.next_change for c in comps)),
                 # the steering below in one C call (``_step.steer_random``) where built
                 "steer": _steer_random(),
             }
         comps = mine["comps"]
-        if t >= mine["soonest"]:  # some copies draw: each as alone, from its own generator
+        # some copies draw: each as alone, from its own generator
+        if at_or_after(t, mine["soonest"], mine["soonest_s"]):
             heading, factor = mine["heading"], mine["factor"]
             for k, c in enumerate(comps):
                 if t >= c.next_change:
                     c._change(t)
                     heading[k] = c.target_heading
                     factor[k] = c.speed_factor
-            mine["soonest"] = min(c.next_change for c in comps)
+            soonest = mine["soonest"] = min(c.next_change for c in comps)
+            mine["soonest_s"] = float(soonest)
         angle = comps[0].physics.kinematics_array(mine["index"])[:, 2]
         cruise, gain = derived(state, "_steering", (p.cruisePower, p.steerGain, rows), _rows_of)
         steer = mine["steer"]

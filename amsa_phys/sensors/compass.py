@@ -12,6 +12,7 @@ import numpy as np
 from ..engine import batch_bodies
 from ..engine import noise as nz
 from ..engine.batch import all_positive, derived, gauss_markov
+from ..engine.clock import seconds
 from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
 from ..model.sensorclock import stamped
@@ -179,7 +180,7 @@ class Compass(Template):
         w = state["noise"]()
         g = state["bias"]()
         u = state["loss"]()
-        now = float(t)
+        now = seconds(t)
         sigma, tau = p.dynamic_bias_stddev, p.dynamic_bias_correlation_time
         if state["t_prev"] is None:
             state["b"] = np.where(tau > 0, sigma * np.sqrt(tau / 2), 0.0) * state["gm_start"]
