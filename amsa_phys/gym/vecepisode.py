@@ -128,10 +128,13 @@ class VecEpisode:
         self.why_not_columns = _why_not_columns(runs[0]) if columns else "asked for Spaces"
         #: the runs' column physics, or None: each run steps its own Space
         self.columns = EpisodeColumns(threads) if self.why_not_columns is None else None
+        # no log kept (as the single env's run, ``episode.py``): nothing here reads the
+        # quality samples, and without them the physics steps between the components'
+        # instants go in fewer, longer calls (the same steps: ``Simulation.batch_hook``)
         if self.columns is not None:
-            self.sim = MultiRun(runs, columns=self.columns)
+            self.sim = MultiRun(runs, columns=self.columns, keep_log=False)
         else:  # a robot's group step would command every run's rovers through one Space
-            self.sim = MultiRun(runs, ungrouped=_holds_physics)
+            self.sim = MultiRun(runs, ungrouped=_holds_physics, keep_log=False)
         self.n = len(self.scenarios)
         self.path = path
         self.observed = list(observed)

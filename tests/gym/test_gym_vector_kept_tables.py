@@ -71,3 +71,17 @@ def test_kept_tables_follow_changes_and_resets(tmp_path: Path) -> None:
     with_terms = np.array(seen)[:, :, compass]
     np.testing.assert_array_equal(with_terms[:8], without[:8])
     assert (with_terms[9:17] != without[9:17]).all()
+
+
+def test_the_batch_keeps_no_log() -> None:
+    """Nothing reads a vector env's quality samples: its batch keeps none (as the single
+    env's run keeps no log), so an episode's memory does not grow with its instants and no
+    log instant splits the physics between the components' instants."""
+    vec = FollowVecEnv(4, stepping="batch")
+    vec.reset(seed=1)
+    for _ in range(12):
+        vec.step(np.zeros((4, 2)))
+    sim = vec._episode.sim
+    assert not sim.keeps_log
+    assert len(sim._q_rows) == 0
+    vec.close()
