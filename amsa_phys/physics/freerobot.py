@@ -18,7 +18,7 @@ from ..engine.batch import derived
 from ..engine.clock import at_or_after
 from ..model.params import Param
 from ..model.template import Kind
-from .robots import POSE_OUTPUTS, ControlledRobot, Robot
+from .robots import POSE_OUTPUTS, ControlledRobot, Robot, _pose_arrays
 from .roverparams import ROVER_PARAMS
 from .scrub import scrub_moment
 
@@ -210,14 +210,19 @@ class FreeRobot(Robot):
                     factor[k] = c.speed_factor
             soonest = mine["soonest"] = min(c.next_change for c in comps)
             mine["soonest_s"] = float(soonest)
-        angle = comps[0].physics.kinematics_array(mine["index"])[:, 2]
+        physics = comps[0].physics
+        arrays = _pose_arrays(physics)
+        if arrays is not None:  # rovers as arrays: the headings in one read, contiguous
+            angle = arrays[0][mine["index"], 2]
+        else:
+            angle = physics.kinematics_array(mine["index"])[:, 2]
         cruise, gain = derived(state, "_steering", (p.cruisePower, p.steerGain, rows), _rows_of)
         steer = mine["steer"]
         if steer is not None:  # the same operations as below, in C
             left, right = np.empty(len(comps)), np.empty(len(comps))
             steer(
                 mine["heading"],
-                np.ascontiguousarray(angle),
+                angle if arrays is not None else np.ascontiguousarray(angle),
                 cruise,
                 mine["factor"],
                 gain,

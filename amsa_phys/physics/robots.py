@@ -161,7 +161,7 @@ class ControlledRobot(Robot):
         """
         fixed = state.get("_fixed")
         if fixed is not None:
-            physics, supplied, rovers, index, poses = fixed
+            physics, supplied, rovers, index, poses, set_powers = fixed
         else:  # (freeRobot's batch step comes here too: it has no supply)
             if "supplied" not in state:
                 state["supplied"] = any(getattr(c, "supply", None) is not None for c in comps)
@@ -176,8 +176,8 @@ class ControlledRobot(Robot):
             inp = {**inp, "powerL": left, "powerR": right}
         if fixed is None:  # after the first supply step, as ever (``index_of`` starts columns)
             fixed = state["_fixed"] = _fixed(comps, state)
-            physics, supplied, rovers, index, poses = fixed
-        physics.set_powers(rovers, index, inp["powerL"], inp["powerR"])
+            physics, supplied, rovers, index, poses, set_powers = fixed
+        set_powers(rovers, index, inp["powerL"], inp["powerR"])
         arrays = _pose_arrays(physics) if poses is not None else None
         if arrays is not None:  # the same outputs in one C call (``_step.robot_poses``)
             out = np.empty((len(POSE_OUTPUTS), len(comps)))
@@ -209,7 +209,7 @@ def _robot_poses() -> Any:
 
 def _fixed(comps: Sequence[ControlledRobot], state: dict[str, Any]) -> tuple[Any, ...]:
     """What a robot group's step keeps for the run: ``(physics, supplied, rovers, index,
-    poses)``, also under the keys it was always kept by in ``state``."""
+    poses, set_powers)``, also under the keys it was always kept by in ``state``."""
     physics = comps[0].physics
     if "index" not in state:
         state["index"] = physics.index_of([c.rover for c in comps])
@@ -217,7 +217,11 @@ def _fixed(comps: Sequence[ControlledRobot], state: dict[str, Any]) -> tuple[Any
         state["rovers"] = [c.rover for c in comps]
     if "poses" not in state:
         state["poses"] = _robot_poses()
-    return physics, state["supplied"], state["rovers"], state["index"], state["poses"]
+    # a batch's columns command every run's rovers: straight to them (``PhysicsWorld``
+    # hands its ``set_powers`` to its group, fixed once the batch is built)
+    group = getattr(physics, "group", None)
+    set_powers = physics.set_powers if group is None else group.set_powers
+    return physics, state["supplied"], state["rovers"], state["index"], state["poses"], set_powers
 
 
 #: ``fleet.Fleet``, imported at the first robot group's step (``_pose_arrays``)
