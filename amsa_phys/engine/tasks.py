@@ -445,7 +445,7 @@ class Steppers:
         :meth:`step_group`, so every fault is the same. Why: a vector env steps ~10 groups
         an agent step, and the method's lookups and checks were ~1.3 µs of each call."""
         gather, write = self._gather_in, self._write
-        if gather is None or write is None or not group.ats or group.delay is not None:
+        if gather is None or write is None or group.delay is not None:
             return self.step_group
         col, ats, ports, k, n = self.col, group.ats, group.ports, len(group.ats), len(group.paths)
         step_many = group.template.step_many
@@ -457,12 +457,14 @@ class Steppers:
             if g is not group:  # never in a schedule; a caller with another group
                 step_group(g, now)
                 return
-            block = empty((k, n))  # as step_group: a new block, a row an input
-            gather(col, ats, block)
+            if k:  # as step_group: a new block, a row an input
+                block = empty((k, n))
+                gather(col, ats, block)
+                inp = dict(zip(ports, block, strict=True))
+            else:
+                inp = {}
             try:  # step_group's handlers, inlined (what they do not catch passes as ever)
-                out, published = step_many(
-                    comps, now, dict(zip(ports, block, strict=True)), params, state
-                )
+                out, published = step_many(comps, now, inp, params, state)
             except RunFault:
                 raise
             except KeyboardInterrupt as exc:

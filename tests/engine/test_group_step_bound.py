@@ -64,7 +64,7 @@ ANSWERS: dict[str, Callable[[dict[str, np.ndarray]], Any]] = {
 }
 
 
-def _group() -> tuple[batch.Group, int]:
+def _group(inputs: bool = True) -> tuple[batch.Group, int]:
     tasks = []
     for k in range(N):
         tasks.append(
@@ -72,7 +72,7 @@ def _group() -> tuple[batch.Group, int]:
                 path=f"Car{k + 1}.Pilot",
                 comp=Reply(),  # type: ignore[arg-type]
                 period=1,
-                inputs=[("x", f"Car{k + 1}.In.x")],
+                inputs=[("x", f"Car{k + 1}.In.x")] if inputs else [],
                 targets={p: f"Car{k + 1}.Pilot.{p}" for p in PORTS},
                 run=k,
             )
@@ -85,16 +85,27 @@ def _group() -> tuple[batch.Group, int]:
     return batch.Group(tasks), len(names)
 
 
-def _step(answer: str, bound: bool) -> tuple[bytes, str | None, Any]:
-    group, size = _group()
+def _step(answer: str, bound: bool, inputs: bool = True) -> tuple[bytes, str | None, Any]:
+    group, size = _group(inputs)
     values = array("d", [-7.0] * size)
     col = np.frombuffer(values, dtype=np.float64)
-    col[group.inputs[0][1]] = np.arange(N, dtype=float) + 0.25
+    if inputs:
+        col[group.inputs[0][1]] = np.arange(N, dtype=float) + 0.25
     steppers = Steppers(values, lambda line, writes: None, lambda path: f"<{path}>", col)
     step = steppers.for_group(group) if bound else steppers.step_group
     if bound:
         assert step != steppers.step_group  # the bound step itself is what runs here
-    Reply.answer = staticmethod(ANSWERS[answer])  # type: ignore[assignment]
+    if inputs:
+        Reply.answer = staticmethod(ANSWERS[answer])  # type: ignore[assignment]
+    else:  # a group without inputs (a leader's): its step gets an empty dict, its own
+        x = np.arange(N, dtype=float) + 0.25
+
+        def no_inputs(inp: dict[str, np.ndarray]) -> Any:
+            assert inp == {}
+            inp["x"] = x  # a template may use its dict as it likes
+            return ANSWERS[answer](inp)
+
+        Reply.answer = staticmethod(no_inputs)  # type: ignore[assignment]
     try:
         with np.errstate(all="ignore"):
             step(group, Fraction(1, 4))
@@ -107,6 +118,7 @@ def _step(answer: str, bound: bool) -> tuple[bytes, str | None, Any]:
 @pytest.mark.parametrize("answer", list(ANSWERS))
 def test_the_bound_step_is_step_group(answer: str) -> None:
     assert _step(answer, True) == _step(answer, False)
+    assert _step(answer, True, inputs=False) == _step(answer, False, inputs=False)
 
 
 @pytest.mark.skipif(not BUILT, reason="the group bodies were not built, or the pure path")
