@@ -18,7 +18,7 @@ from ..engine.batch import derived
 from ..engine.clock import at_or_after
 from ..model.params import Param
 from ..model.template import Kind
-from .robots import POSE_OUTPUTS, ControlledRobot, Robot, _pose_arrays
+from .robots import POSE_OUTPUTS, ControlledRobot, Robot, pose_arrays
 from .roverparams import ROVER_PARAMS
 from .scrub import scrub_moment
 
@@ -211,7 +211,7 @@ class FreeRobot(Robot):
             soonest = mine["soonest"] = min(c.next_change for c in comps)
             mine["soonest_s"] = float(soonest)
         physics = comps[0].physics
-        arrays = _pose_arrays(physics)
+        arrays = pose_arrays(physics)
         if arrays is not None:  # rovers as arrays: the headings in one read, contiguous
             angle = arrays[0][mine["index"], 2]
         else:

@@ -178,7 +178,7 @@ class ControlledRobot(Robot):
             fixed = state["_fixed"] = _fixed(comps, state)
             physics, supplied, rovers, index, poses, set_powers = fixed
         set_powers(rovers, index, inp["powerL"], inp["powerR"])
-        arrays = _pose_arrays(physics) if poses is not None else None
+        arrays = pose_arrays(physics) if poses is not None else None
         if arrays is not None:  # the same outputs in one C call (``_step.robot_poses``)
             out = np.empty((len(POSE_OUTPUTS), len(comps)))
             poses(*arrays, index, out)
@@ -224,11 +224,11 @@ def _fixed(comps: Sequence[ControlledRobot], state: dict[str, Any]) -> tuple[Any
     return physics, state["supplied"], state["rovers"], state["index"], state["poses"], set_powers
 
 
-#: ``fleet.Fleet``, imported at the first robot group's step (``_pose_arrays``)
+#: ``fleet.Fleet``, imported at the first robot group's step (``pose_arrays``)
 _FLEET: Any = None
 
 
-def _pose_arrays(physics: Any) -> tuple[np.ndarray, np.ndarray] | None:
+def pose_arrays(physics: Any) -> tuple[np.ndarray, np.ndarray] | None:
     """The (N, 6) state and (2, N) rims arrays a robot group's indices point into, when its
     rovers are arrays (a batch's columns, a large fleet: a ``fleet.Fleet``); else None.
     Asked at every step: a fleet may read its state into a new array."""
