@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from ..engine import libm
+from ..engine.clock import seconds
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
 
@@ -180,7 +181,7 @@ class FollowerController(Template):
         the slope is the same two-pass least squares, summed along the rows.
         """
         n = len(comps)
-        ts = float(t)
+        ts = seconds(t)
         if "fixes" not in state:
             state["fixes"] = _grow(None, n, 16)
             state["v"] = np.zeros(n)

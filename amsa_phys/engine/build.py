@@ -102,12 +102,17 @@ def plan_groups(
     keys = {batch.ident(t): grouping.key(t, freq(t)) for t in tasks}
     planned = batch.plan([i.tasks for i in cycle], keys, grouping.min_group, grouping.enabled)
     groups_of: dict[Member, list[batch.Group]] = {}
-    step_group: Callable[..., None] = steppers.step_group
+    steps: dict[int, Callable[..., None]] = {}  # a group's step, made once (``for_group``)
     for inst, seq in zip(cycle, planned, strict=True):
-        inst.tasks = [
-            (step_group, item) if isinstance(item, batch.Group) else (steppers.for_task(item), item)
-            for item in seq
-        ]
+        inst.tasks = []
+        for item in seq:
+            if isinstance(item, batch.Group):
+                step = steps.get(id(item))
+                if step is None:
+                    step = steps[id(item)] = steppers.for_group(item)
+                inst.tasks.append((step, item))
+            else:
+                inst.tasks.append((steppers.for_task(item), item))
         for item in seq:
             if isinstance(item, batch.Group):
                 for member in item.tasks:

@@ -18,9 +18,11 @@ from ..model.rates import MAX_EVENTS_PER_CYCLE
 __all__ = [
     "MAX_EVENTS_PER_CYCLE",
     "TickGrid",
+    "at_or_after",
     "exact",
     "fraction_gcd",
     "hyperperiod",
+    "seconds",
     "to_fraction",
 ]
 
@@ -41,6 +43,24 @@ def exact(n: int, d: int) -> Fraction:
 
 if getattr(Fraction, "__slots__", None) != ("_numerator", "_denominator"):  # not CPython's
     exact = Fraction  # type: ignore[assignment]  # same results, the constructor's speed
+
+
+def seconds(t: Fraction | float) -> float:
+    """``float(t)``, the same float, without the ABC method a Fraction's ``float()`` goes
+    through (``numbers.Rational.__float__``: int / int, ~1 µs): group steps ask it of the
+    instant's time at every instant."""
+    if t.__class__ is Fraction:
+        return t._numerator / t._denominator  # type: ignore[union-attr,no-any-return]
+    return float(t)
+
+
+def at_or_after(t: Fraction, then: Fraction, then_s: float) -> bool:
+    """``t >= then`` for Fractions, where ``then_s`` is ``float(then)``: exact, and a float
+    compare when it decides (rounding to float never reverses an order: ``t >= then``
+    implies ``float(t) >= float(then)``), instead of Fraction's cross-multiplied compare."""
+    if seconds(t) < then_s:
+        return False
+    return t >= then
 
 
 def to_fraction(value: float | int | str | Fraction) -> Fraction:

@@ -114,10 +114,11 @@ def rebuild(
     ``build.plan_groups`` returns them. Why the table and not the instants: most instants
     of a cycle are the physics step alone (44 of scenario1's 50), folded into a few
     entries; made again at every reset, they were most of this rebuild."""
-    step_group: Callable[..., None] = steppers.step_group
+    for_group = steppers.for_group
     for_task = steppers.for_task
     fns = [fn for _, fn in hooks]
     made: dict[tuple[int, ...], batch.Group] = {}
+    steps: dict[tuple[int, ...], Callable[..., None]] = {}  # each group's, made once
     groups_of: dict[Member, list[batch.Group]] = {}
     out: list[schedule.Entry] = []
     for off, items, log, hook_at, last, spacing in layout.entries:
@@ -130,7 +131,8 @@ def rebuild(
             group = made.get(item)  # type: ignore[arg-type]
             if group is None:
                 group = made[item] = batch.Group([tasks[k] for k in item])  # type: ignore[union-attr]
-            pairs.append((step_group, group))
+                steps[item] = for_group(group)  # type: ignore[index]
+            pairs.append((steps[item], group))  # type: ignore[index]
             for member in group.tasks:
                 groups = groups_of.setdefault(batch.ident(member), [])
                 if group not in groups:

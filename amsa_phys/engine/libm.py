@@ -23,6 +23,15 @@ __all__ = ["atan2", "exp", "expm1", "hypot", "hypot_exceeds"]
 
 
 def _map2(fn, a: np.ndarray, b: np.ndarray) -> np.ndarray:  # type: ignore[no-untyped-def]
+    if (  # a group's two columns (the usual call): no broadcast, ravel or reshape to make
+        type(a) is np.ndarray
+        and type(b) is np.ndarray
+        and a.ndim == 1
+        and a.shape == b.shape
+        and a.dtype == np.float64
+        and b.dtype == np.float64
+    ):
+        return np.fromiter(map(fn, a.tolist(), b.tolist()), np.float64, a.size)
     a, b = np.broadcast_arrays(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
     out = np.fromiter(map(fn, a.ravel().tolist(), b.ravel().tolist()), np.float64, a.size)
     return out.reshape(a.shape)

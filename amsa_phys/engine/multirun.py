@@ -149,6 +149,8 @@ class MultiRun(Simulation):
     ``step_many`` needs all members in one shared service (the robots' physics world, when
     each run steps its own), or says so of an initialized component: they step one by one.
     ``columns`` takes over the runs' physics steps (``physics/columns.py``).
+    ``keep_log=False`` (a vector env's batch, as the single env's run): no quality samples,
+    so no log instants unless a trace or listener asks for them (``Simulation``).
     """
 
     def __init__(
@@ -156,6 +158,7 @@ class MultiRun(Simulation):
         scenarios: Sequence[Scenario],
         ungrouped: Collection[type] | Callable[[Any], bool] = (),
         columns: Any = None,
+        keep_log: bool = True,
     ) -> None:
         self.scenarios = list(scenarios)
         #: the batch's column physics (``physics/columns.py``), which takes over every
@@ -172,6 +175,7 @@ class MultiRun(Simulation):
             grouping=batch.Grouping(self._batch_key, min_group=1),
             context=MultiRun._run_context,
             runs=self.scenarios,
+            keep_log=keep_log,
         )
         #: each run's quality signal: its position in the store (None: the run has none)
         store = self.store
@@ -188,7 +192,7 @@ class MultiRun(Simulation):
             self._q_where = where
         self._q_t = array("d")
         self._q_rows: list[np.ndarray] = []
-        if self._q_index:
+        if self._q_index and keep_log:
             self.add_log_listener(self._sample)
         #: the runs' STL requirements, judged as one batch (a column per run)
         self.watch = JudgedOnce.of(base, self)

@@ -200,8 +200,10 @@ class DrawnMany:
         #: :data:`MANY_BLOCK_FIRST`, and each refill doubles it up to this
         self._largest = many_block(len(streams)) if block is None else block
         self._block = min(MANY_BLOCK_FIRST, self._largest) if block is None else block
-        self._pos = self._block
         self._buf = np.empty((0, len(streams)))  # (block, streams) once filled
+        #: the rows of the block not handed out yet (a draw is ``next`` of it: ~0.1 µs,
+        #: where counting and indexing rows was ~0.4)
+        self._rows: Iterator[np.ndarray] = iter(())
         #: every stream a Generator method that can fill a row in place (``out=``): a
         #: refill then allocates one array, not one per stream plus the stacked copy
         #: (1,000 streams: ~0.95 ms instead of ~1.15; the same numbers either way)
@@ -209,21 +211,25 @@ class DrawnMany:
 
     def __call__(self) -> np.ndarray:
         """The next number of every stream."""
-        if self._pos >= self._block:
-            if len(self._buf):  # not the first refill: a longer block
-                self._block = min(2 * self._block, self._largest)
-            if self._in_place:
-                buf = np.empty((len(self._draws), self._block))
-                for draw, row in zip(self._draws, buf, strict=True):
-                    draw(out=row)
-            else:
-                buf = np.array([draw(self._block) for draw in self._draws])
-            # a new buffer each time: rows handed out stay valid
-            self._buf = np.ascontiguousarray(buf.T)
-            self._pos = 0
-        row = self._buf[self._pos]
-        self._pos += 1
+        row = next(self._rows, None)
+        if row is None:
+            self._refill()
+            row = next(self._rows)
         return row
+
+    def _refill(self) -> None:
+        """Draw the next block of every stream (see the class docstring)."""
+        if len(self._buf):  # not the first refill: a longer block
+            self._block = min(2 * self._block, self._largest)
+        if self._in_place:
+            buf = np.empty((len(self._draws), self._block))
+            for draw, row in zip(self._draws, buf, strict=True):
+                draw(out=row)
+        else:
+            buf = np.array([draw(self._block) for draw in self._draws])
+        # a new buffer each time: rows handed out stay valid
+        self._buf = np.ascontiguousarray(buf.T)
+        self._rows = iter(self._buf)
 
 
 #: Generator methods that draw float64s into ``out=`` exactly as ``method(size)`` would

@@ -4,7 +4,8 @@ A :class:`Task` is a Leaf as the schedule runs it: its inputs and outputs resolv
 names, its period and timer phase in ticks, its delay line. :class:`Steppers` holds the four
 ways a task steps — the lean scalar path, a Leaf with latency or jitter (its outputs go into
 the delivery heap), a Leaf with array ports, and a group of like copies stepped as arrays
-(``engine/batch.py``) — and every one of them judges a component the same way:
+(``engine/batch.py``; its steps in ``groupstep.py``, mixed in) — and every one of them
+judges a component the same way:
 
 * what its code raises is :data:`COMPONENT_ERRORS` (any exception, and ``sys.exit()``, which
   would otherwise end the whole program silently); KeyboardInterrupt is the user's and is
@@ -26,18 +27,26 @@ from array import array
 from collections.abc import Callable, Mapping, MutableMapping
 from dataclasses import dataclass, field
 from fractions import Fraction
-from itertools import islice
 from typing import Any
 
 import numpy as np
 
 from ..errors import RunFault
-from ..model.params import short_repr
 from ..model.template import Template
-from . import batch, batch_bodies, interrupt, kernels, publish
+from . import batch_bodies, interrupt, kernels, publish
 from .delayedstep import packed_delayed
+from .groupstep import GroupSteps
 from .timing import DelayLine
-from .verdicts import COMPONENT_ERRORS, OUTPUT_ERRORS, as_number, bad_output, in_run, own_interrupt
+from .verdicts import (  # in_run re-exported: the engine's modules take it from here
+    COMPONENT_ERRORS,
+    OUTPUT_ERRORS,
+    as_number,
+    bad_output,
+    in_run,
+    own_interrupt,
+)
+
+__all__ = ["COMPONENT_ERRORS", "Steppers", "Task", "checked_writes", "in_run"]
 
 
 @dataclass
@@ -108,16 +117,7 @@ def checked_writes(
         raise bad_output(who(task.path), now, targets, out) from None
 
 
-def _is_mask(published: Any, n: int) -> bool:
-    """Whether ``published`` is a boolean array with one entry per copy."""
-    return (
-        isinstance(published, np.ndarray)
-        and published.dtype == np.bool_
-        and published.shape == (n,)
-    )
-
-
-class Steppers:
+class Steppers(GroupSteps):
     """The ways a task steps, over one run's buffers (see the module docstring).
 
     ``send(line, writes)`` puts a delayed publication in flight (the delivery heap);
@@ -392,104 +392,3 @@ class Steppers:
             k = int(bad[0])
             raise RunFault(self.who(task.path), now, f"output {key}[{k}] is {arr[k]}")
         return arr.tolist()
-
-    def step_group(self, group: batch.Group, now: Fraction) -> None:
-        """Run a group of like components in one call (``engine/batch.py``).
-
-        Each input port is the members' column, a copy (a template may keep or edit its
-        inputs), each output written back into the store's array in place (only the
-        published rows, under a mask). Compiled where built (``_groupbodies.c``): the inputs
-        gathered into one block's rows in one call, the usual outputs (finite float64
-        columns) judged and written in one; what the writer declines, and every output of a
-        delayed group, goes through the loop below, which names a bad output as ever.
-        """
-        col = self.col
-        n = len(group.paths)
-        if self._gather_in is None:
-            inp = {p: col[at].copy() if type(at) is slice else col[at] for p, at in group.inputs}
-        elif group.ats:  # one new block, a row an input: each row the template's to keep
-            block = np.empty((len(group.ats), n))
-            self._gather_in(col, group.ats, block)
-            inp = dict(zip(group.ports, block, strict=True))
-        else:
-            inp = {}
-        who = self.who
-        try:
-            out, published = group.template.step_many(
-                group.comps, now, inp, group.params, group.state
-            )
-        except RunFault:
-            raise
-        except KeyboardInterrupt as exc:  # the user's Ctrl-C, or the component's own
-            if interrupt.users_interrupt():
-                raise
-            raise own_interrupt(who(group.paths[0]), now) from exc
-        except COMPONENT_ERRORS as exc:
-            raise RunFault(who(group.paths[0]), now, f"step_many raised {exc!r}") from exc
-        except (TypeError, ValueError) as exc:  # not a pair (outputs, published)
-            raise RunFault(
-                who(group.paths[0]), now, f"step_many must return (outputs, published): {exc}"
-            ) from exc
-        if not (isinstance(out, Mapping) and (published is None or _is_mask(published, n))):
-            raise RunFault(
-                who(group.paths[0]),
-                now,
-                f"step_many must return (outputs, published) with a mapping of outputs and "
-                f"None or a boolean mask of {n} rows, got ({short_repr(out)}, "
-                f"{short_repr(published)})",
-            )
-        outputs = group.outputs
-        items: Any = out.items()
-        if self._write is not None and type(out) is dict:
-            # the usual outputs in one call; the loop below takes whatever it left, from
-            # the first output it did not take, so a fault names the same output as before
-            if group.delay is None:
-                done = self._write(out, outputs, col, published, np.ndarray, n)
-            else:  # judged in one call, then sent in order as the loop sends them
-                done = self._write(out, outputs, None, published, np.ndarray, n)
-                for port, arr in islice(items, done):
-                    self._send_group(group, port, arr, published)
-            if done == len(out):
-                return
-            items = islice(items, done, None)
-        for port, arr in items:
-            at = outputs.get(port)
-            if at is None:
-                raise RunFault(
-                    who(group.paths[0]), now, f"published unknown output {short_repr(port)}"
-                )
-            if not (type(arr) is np.ndarray and arr.shape == (n,) and arr.dtype == np.float64):
-                try:
-                    arr = np.broadcast_to(np.asarray(arr, dtype=np.float64), (n,))
-                except (TypeError, ValueError, OverflowError):
-                    raise RunFault(
-                        who(group.paths[0]),
-                        now,
-                        f"output {port} of step_many has shape {np.shape(arr)}, expected "
-                        f"({n},): one number per copy",
-                    ) from None
-            k = batch.first_bad(arr, published)
-            if k is not None:
-                fault = RunFault(who(group.paths[k]), now, f"output {port} is {arr[k]}")
-                raise in_run(fault, group.tasks[k].run)
-            if group.delay is not None:
-                self._send_group(group, port, arr, published)
-            elif published is None:
-                col[at] = arr
-            elif type(at) is slice:
-                np.copyto(col[at], arr, where=published)
-            else:
-                col[at[published]] = arr[published]
-
-    def _send_group(
-        self, group: batch.Group, port: str, arr: np.ndarray, published: np.ndarray | None
-    ) -> None:
-        """A delayed group's judged output ``port`` put in flight: the copies' common
-        latency (no jitter: ``batch.py``), the whole column (a copy: the template may reuse
-        its array) or its published rows."""
-        assert group.delay is not None
-        if published is None:
-            self.send(group.delay, [(group.outputs[port], arr.copy())])
-        else:
-            where = np.asarray(group.targets[port], dtype=np.intp)[published]
-            self.send(group.delay, [(where, arr[published])])

@@ -15,9 +15,10 @@ from typing import Any
 import numpy as np
 
 from ..engine.batch import derived
+from ..engine.clock import at_or_after
 from ..model.params import Param
 from ..model.template import Kind
-from .robots import POSE_OUTPUTS, ControlledRobot, Robot
+from .robots import POSE_OUTPUTS, ControlledRobot, Robot, pose_arrays
 from .roverparams import ROVER_PARAMS
 from .scrub import scrub_moment
 
@@ -194,26 +195,34 @@ class FreeRobot(Robot):
                 "heading": np.array([c.target_heading for c in comps], dtype=np.float64),
                 "factor": np.array([c.speed_factor for c in comps], dtype=np.float64),
                 "soonest": min(c.next_change for c in comps),
+                "soonest_s": float(min(c.next_change for c in comps)),
                 # the steering below in one C call (``_step.steer_random``) where built
                 "steer": _steer_random(),
             }
         comps = mine["comps"]
-        if t >= mine["soonest"]:  # some copies draw: each as alone, from its own generator
+        # some copies draw: each as alone, from its own generator
+        if at_or_after(t, mine["soonest"], mine["soonest_s"]):
             heading, factor = mine["heading"], mine["factor"]
             for k, c in enumerate(comps):
                 if t >= c.next_change:
                     c._change(t)
                     heading[k] = c.target_heading
                     factor[k] = c.speed_factor
-            mine["soonest"] = min(c.next_change for c in comps)
-        angle = comps[0].physics.kinematics_array(mine["index"])[:, 2]
+            soonest = mine["soonest"] = min(c.next_change for c in comps)
+            mine["soonest_s"] = float(soonest)
+        physics = comps[0].physics
+        arrays = pose_arrays(physics)
+        if arrays is not None:  # rovers as arrays: the headings in one read, contiguous
+            angle = arrays[0][mine["index"], 2]
+        else:
+            angle = physics.kinematics_array(mine["index"])[:, 2]
         cruise, gain = derived(state, "_steering", (p.cruisePower, p.steerGain, rows), _rows_of)
         steer = mine["steer"]
         if steer is not None:  # the same operations as below, in C
             left, right = np.empty(len(comps)), np.empty(len(comps))
             steer(
                 mine["heading"],
-                np.ascontiguousarray(angle),
+                angle if arrays is not None else np.ascontiguousarray(angle),
                 cruise,
                 mine["factor"],
                 gain,

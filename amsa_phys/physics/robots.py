@@ -153,12 +153,20 @@ class ControlledRobot(Robot):
         p: Any,
         state: dict[str, Any],
     ) -> tuple[Mapping[str, Any], None]:
-        """``do_step`` for many copies at once (``engine/batch.py``)."""
-        physics = comps[0].physics
-        if "supplied" not in state:
-            # (freeRobot's batch step comes here too: it has no supply)
-            state["supplied"] = any(getattr(c, "supply", None) is not None for c in comps)
-        if state["supplied"]:  # per rover, as do_step (power.py)
+        """``do_step`` for many copies at once (``engine/batch.py``).
+
+        What the group's copies fix for the run (their world, whether any has a supply,
+        their rovers' positions, the compiled pose writer) is looked up at its first step
+        and kept as one tuple: a vector env steps this group at every instant.
+        """
+        fixed = state.get("_fixed")
+        if fixed is not None:
+            physics, supplied, rovers, index, poses, set_powers = fixed
+        else:  # (freeRobot's batch step comes here too: it has no supply)
+            if "supplied" not in state:
+                state["supplied"] = any(getattr(c, "supply", None) is not None for c in comps)
+            supplied = state["supplied"]
+        if supplied:  # per rover, as do_step (power.py)
             left, right = np.array(inp["powerL"], dtype=float), np.array(inp["powerR"], dtype=float)
             left = np.broadcast_to(left, (len(comps),)).copy()
             right = np.broadcast_to(right, (len(comps),)).copy()
@@ -166,20 +174,17 @@ class ControlledRobot(Robot):
                 if getattr(c, "supply", None) is not None:
                     left[i], right[i] = c.supplied(t, float(left[i]), float(right[i]))
             inp = {**inp, "powerL": left, "powerR": right}
-        if "index" not in state:
-            state["index"] = physics.index_of([c.rover for c in comps])
-        if "rovers" not in state:
-            state["rovers"] = [c.rover for c in comps]
-        physics.set_powers(state["rovers"], state["index"], inp["powerL"], inp["powerR"])
-        if "poses" not in state:
-            state["poses"] = _robot_poses()
-        arrays = _pose_arrays(physics) if state["poses"] is not None else None
+        if fixed is None:  # after the first supply step, as ever (``index_of`` starts columns)
+            fixed = state["_fixed"] = _fixed(comps, state)
+            physics, supplied, rovers, index, poses, set_powers = fixed
+        set_powers(rovers, index, inp["powerL"], inp["powerR"])
+        arrays = pose_arrays(physics) if poses is not None else None
         if arrays is not None:  # the same outputs in one C call (``_step.robot_poses``)
             out = np.empty((len(POSE_OUTPUTS), len(comps)))
-            state["poses"](*arrays, state["index"], out)
+            poses(*arrays, index, out)
             return dict(zip(POSE_NAMES, out, strict=True)), None
-        x, y, a, vx, vy, w = physics.kinematics_array(state["index"]).T
-        left, right = physics.rim_array(state["index"]).T
+        x, y, a, vx, vy, w = physics.kinematics_array(index).T
+        left, right = physics.rim_array(index).T
         return {
             "posX": x,
             "posY": y,
@@ -202,13 +207,38 @@ def _robot_poses() -> Any:
     return getattr(compiled._step, "robot_poses", None) if compiled.columns_compiled() else None
 
 
-def _pose_arrays(physics: Any) -> tuple[np.ndarray, np.ndarray] | None:
-    """The (N, 6) state and (2, N) rims arrays a robot group's indices point into, when its
-    rovers are arrays (a batch's columns, a large fleet: a ``fleet.Fleet``); else None."""
-    from .fleet import Fleet
+def _fixed(comps: Sequence[ControlledRobot], state: dict[str, Any]) -> tuple[Any, ...]:
+    """What a robot group's step keeps for the run: ``(physics, supplied, rovers, index,
+    poses, set_powers)``, also under the keys it was always kept by in ``state``."""
+    physics = comps[0].physics
+    if "index" not in state:
+        state["index"] = physics.index_of([c.rover for c in comps])
+    if "rovers" not in state:
+        state["rovers"] = [c.rover for c in comps]
+    if "poses" not in state:
+        state["poses"] = _robot_poses()
+    # a batch's columns command every run's rovers: straight to them (``PhysicsWorld``
+    # hands its ``set_powers`` to its group, fixed once the batch is built)
+    group = getattr(physics, "group", None)
+    set_powers = physics.set_powers if group is None else group.set_powers
+    return physics, state["supplied"], state["rovers"], state["index"], state["poses"], set_powers
 
+
+#: ``fleet.Fleet``, imported at the first robot group's step (``pose_arrays``)
+_FLEET: Any = None
+
+
+def pose_arrays(physics: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """The (N, 6) state and (2, N) rims arrays a robot group's indices point into, when its
+    rovers are arrays (a batch's columns, a large fleet: a ``fleet.Fleet``); else None.
+    Asked at every step: a fleet may read its state into a new array."""
+    global _FLEET
+    if _FLEET is None:
+        from .fleet import Fleet
+
+        _FLEET = Fleet
     group = physics.group
     model = group._model if group is not None else physics._model
-    if not isinstance(model, Fleet):
+    if not isinstance(model, _FLEET):
         return None
     return model.state, model.rims

@@ -12,6 +12,7 @@ import numpy as np
 from ..engine import batch_bodies
 from ..engine import noise as nz
 from ..engine.batch import all_positive, derived, gauss_markov
+from ..engine.clock import seconds
 from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
 from ..model.sensorclock import stamped
@@ -31,12 +32,8 @@ def deviation(heading: Any, b: Any, c: Any, d: Any, e: Any) -> Any:
     Works on floats and numpy arrays alike.
     """
     if isinstance(heading, np.ndarray):
-        return (
-            b * np.sin(heading)
-            + c * np.cos(heading)
-            + d * np.sin(2 * heading)
-            + e * np.cos(2 * heading)
-        )
+        twice = 2 * heading  # once for both terms: the same array
+        return b * np.sin(heading) + c * np.cos(heading) + d * np.sin(twice) + e * np.cos(twice)
     return (
         b * math.sin(heading)
         + c * math.cos(heading)
@@ -179,7 +176,7 @@ class Compass(Template):
         w = state["noise"]()
         g = state["bias"]()
         u = state["loss"]()
-        now = float(t)
+        now = seconds(t)
         sigma, tau = p.dynamic_bias_stddev, p.dynamic_bias_correlation_time
         if state["t_prev"] is None:
             state["b"] = np.where(tau > 0, sigma * np.sqrt(tau / 2), 0.0) * state["gm_start"]
@@ -236,7 +233,16 @@ def _heading_compiled(
     value, published = np.empty(n), np.empty(n, dtype=bool)
     w, g, u = draws
     h = inp["heading"]
-    dev = deviation(h, p.deviationB, p.deviationC, p.deviationD, p.deviationE)
+    coefficients = (p.deviationB, p.deviationC, p.deviationD, p.deviationE)
+    if derived(state, "no_deviation", coefficients, _all_zero):
+        # every term 0 * sin: a zero of either sign, which leaves the heading's bits as they
+        # are up to a zero's sign, and the wrap below makes -0.0 and +0.0 one value (the
+        # scalar step skips the term alike); headings are finite (a robot's judged pose)
+        dev = state.get("zero_deviation")
+        if dev is None or dev.shape != np.shape(h):
+            dev = state["zero_deviation"] = np.zeros(np.shape(h))
+    else:
+        dev = deviation(h, *coefficients)
     if body(
         h, w, g, u, phi, q, p.mean, turn_on, p.stddev, p.precision, p.lostData,
         state["b"], value, published, dev,
@@ -244,6 +250,11 @@ def _heading_compiled(
         for k in np.flatnonzero(~published).tolist():
             comps[k].lost += 1
     return {"compassHeading": value}, published
+
+
+def _all_zero(*coefficients: np.ndarray) -> bool:
+    """Whether every copy's deviation coefficients are all 0 (for ``derived``)."""
+    return not any(bool(np.any(c != 0)) for c in coefficients)
 
 
 #: Compass with the sensor's own clock: an output ``stamp`` (``model/sensorclock.py``)

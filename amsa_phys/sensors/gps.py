@@ -13,6 +13,7 @@ import numpy as np
 from ..engine import batch_bodies
 from ..engine import noise as nz
 from ..engine.batch import all_positive, derived, gauss_markov
+from ..engine.clock import seconds
 from ..engine.rng import Drawn, DrawnMany
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
@@ -191,7 +192,7 @@ class GPS(Template):
         gy = state["bias"]()
         u_loss = state["loss"]()
         u_burst = state["burst"]()
-        now = float(t)
+        now = seconds(t)
         sigma, tau = p.dynamic_bias_stddev, p.dynamic_bias_correlation_time
         first = state["t_prev"] is None
         if first:
