@@ -12,7 +12,8 @@ import pytest
 
 
 def _grouped(request: pytest.FixtureRequest) -> None:
-    if not request.config.getvalue("loadgroup"):
+    # xdist's workers set ``loadgroup``; a run without workers (no ``-n``) has no such option
+    if not getattr(request.config.option, "loadgroup", False):
         pytest.skip("groups exist only under pytest -n N --dist loadgroup (the full suite)")
 
 
