@@ -86,6 +86,7 @@ def summarise(runs: list[dict[str, Any]], seeds: list[int]) -> dict[str, Any]:
     """
     stalled_rms, other_rms = [], []
     lost = gained = stalled_runs = stalled_seqs = 0
+    losses: list[list[float]] = []  # [draw, index, change] of each sequence lost
     every = []
     for r in runs:
         every += r["rms"]
@@ -94,6 +95,8 @@ def summarise(runs: list[dict[str, Any]], seeds: list[int]) -> dict[str, Any]:
         mine, base = statistics.fmean(r["rms"]), statistics.fmean(r["robust"])
         lost += mine > (1 + TOLERANCE) * base
         gained += mine < (1 - TOLERANCE) * base
+        if mine > (1 + TOLERANCE) * base:
+            losses.append([r["draw"], r["index"], mine / base - 1.0])
         if r["stalled"]:
             pick = [i for i, s in enumerate(seeds) if s in r["stalled"]]
             stalled_rms += [r["rms"][i] for i in pick]
@@ -106,6 +109,8 @@ def summarise(runs: list[dict[str, Any]], seeds: list[int]) -> dict[str, Any]:
         "mean_rms": statistics.fmean(every),
         "lost": lost,
         "gained": gained,
+        "losses": losses,
+        "worst": max((c for *_, c in losses), default=0.0),
         "stalled_seeds_rms": statistics.fmean(stalled_rms) if stalled_rms else math.nan,
         "other_seeds_rms": statistics.fmean(other_rms) if other_rms else math.nan,
     }
@@ -126,7 +131,8 @@ def row(label: str, stalled: dict[str, Any], every: dict[str, Any] | None, sweep
         cells += [
             f"{every['stalled_runs']} of {every['runs']}",
             f"{every['mean_rms']:.3g}",
-            f"{every['gained']}, {every['lost']}",
+            f"{every['gained']}, {every['lost']}"
+            + (f" (worst +{100 * every['worst']:.1f} %)" if every["lost"] else ""),
         ]
     return [*cells, f"{sweep['worst']:.3g} / {sweep['cvar']:.3g} / {sweep['mean']:.3g}"]
 

@@ -57,6 +57,7 @@ def test_summary_keeps_stalled_seeds_apart_and_counts_gains_and_losses() -> None
     assert s["stalled_seeds_rms"] == pytest.approx(1.2)  # seed 2 of sequence 1 alone
     assert s["other_seeds_rms"] == pytest.approx(0.9)  # seed 1 of sequence 1 alone
     assert (s["gained"], s["lost"]) == (1, 1)
+    assert s["losses"] == [[1000, 0, pytest.approx(0.1)]]  # which one, by how much
     assert s["mean_rms"] == pytest.approx((1.1 * 2 + 0.9 + 1.2 + 1.98 * 2) / 6)
     stalled = summarise([{**runs[1], "stalls": [[[1.0, 30.0]], []]}], [1, 2])
     assert (stalled["stalled_runs"], stalled["stalled_sequences"]) == (1, 1)
