@@ -7,17 +7,19 @@ Adaptation schedules Kv only and cannot remove it. ``python -m benchmarks.adapt_
 ``benchmarks/results/adapt_seeds.json``, takes every held-out sequence in which the robust
 gain alone stalls in some seed, and runs it for the same seeds (600 s, as ``--validate``
 runs it, Kv 0.2) with each turning gain of :data:`KW` (0.04 as shipped). Per Kw it reports
-the stalled runs, the mean rms of the seeds that stall at Kw 0.04, of the other seeds of the
-same sequences, and the sequences whose other seeds lose more than 2 % to Kw 0.04; and, on
-the sweep's own contexts (``scenarios/adaptive_sweep.yaml``'s seven, seeds 1-3, its 200 s:
-what ``amsa-phys tune`` scores), the worst case and the CVaR (0.2). Then it tunes both gains
-as ``amsa-phys tune scenarios/adaptive_sweep.yaml --range MyFollowerController.Kv=0.1:0.4
---range MyFollowerController.Kw=0.02:0.2 --seeds 3 --budget N --measure cvar`` does
-(``--budget``, 24 by default) and runs its answer on the stalled sequences too.
+the stalled runs, the mean rms of the seeds that stall at Kw 0.04 and of the other seeds of
+the same sequences, and the sequences gained and lost (seed mean more than 2 % below, above
+Kw 0.04's); and, on the sweep's own contexts (``scenarios/adaptive_sweep.yaml``'s seven,
+seeds 1-3, its 200 s: what ``amsa-phys tune`` scores), the worst case, the CVaR (0.2) and
+the mean. Then it tunes both gains as ``amsa-phys tune scenarios/adaptive_sweep.yaml --range
+MyFollowerController.Kv=0.1:0.4 --range MyFollowerController.Kw=0.02:0.2 --seeds 3 --budget
+N --measure cvar`` does (``--budget``, 24 by default) and runs its answer on the stalled
+sequences too. Last, the longest part: Kw :data:`FULL_KW` on every held-out sequence (the
+shipped gains' runs there are ``adapt_seeds``' own), counted the same way.
 
 It writes ``benchmarks/results/adapt_stall.json`` and rewrites docs/adaptation.md's
-``<!-- results: adapt-stall -->`` block; ``--no-save`` prints only. Deterministic: the same
-numbers at any load. It changes no default: Kw stays 0.04 in the shipped world.
+``<!-- results: adapt-stall -->`` block, once before the full pass and once after;
+``--no-save`` prints only. Deterministic: the same numbers at any load. It changes no default: Kw stays 0.04 in the shipped world.
 """
 
 from __future__ import annotations
