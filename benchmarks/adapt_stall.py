@@ -19,7 +19,8 @@ shipped gains' runs there are ``adapt_seeds``' own), counted the same way.
 
 It writes ``benchmarks/results/adapt_stall.json`` and rewrites docs/adaptation.md's
 ``<!-- results: adapt-stall -->`` block, once before the full pass and once after;
-``--no-save`` prints only. Deterministic: the same numbers at any load. It changes no default: Kw stays 0.04 in the shipped world.
+``--no-save`` prints only. Deterministic: the same numbers at any load. It changes no
+default: Kw stays 0.04 in the shipped world.
 """
 
 from __future__ import annotations
