@@ -199,21 +199,11 @@ def run_case(scenario, sequence, settings, seed, duration, rules=None, plan=None
     from amsa_phys.model.scenario import traced_columns
     from amsa_phys.model.yamlio import YamlDoc
     from amsa_phys.runs.single import execute
-    from amsa_phys.tune.evaluate import case_data
+    from amsa_phys.tune.evaluate import add_timeline_settings, case_data
     from amsa_phys.tune.objective import objective_value
 
     data = case_data(scenario, sequence, settings, duration, rules)
-    for at, sets in plan or []:  # the oracle's switches, as evaluate() adds them
-        if at == 0:
-            data["set"].update(sets)
-            continue
-        entries = data.setdefault("timeline", [])
-        same = next((e for e in entries if e["at"] == at), None)
-        if same is None:
-            entries.append({"at": at, "set": dict(sets)})
-            entries.sort(key=lambda e: e["at"])
-        else:
-            same["set"].update(sets)
+    add_timeline_settings(data, plan or [])  # the oracle's switches, as evaluate() adds them
     signal = data["quality"]["signal"]
     data["trace_columns"] = [signal, SPEED]
     case = configure_scenario(YamlDoc(path=Path(scenario.path), data=data), None, seed)

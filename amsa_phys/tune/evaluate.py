@@ -48,6 +48,23 @@ def case_data(
     return data
 
 
+def add_timeline_settings(data: dict[str, Any], timed: Any) -> None:
+    """Add ``timed`` ((instant, {key: value}) pairs: the oracle's switches) to a case's
+    document: at 0 into its ``set``, later into the timeline entry of that instant (one
+    made, in time order, where there is none)."""
+    for at, sets in timed:
+        if at == 0:
+            data["set"].update(sets)
+            continue
+        entries = data.setdefault("timeline", [])
+        same = next((e for e in entries if e["at"] == at), None)
+        if same is None:
+            entries.append({"at": at, "set": dict(sets)})
+            entries.sort(key=lambda e: e["at"])
+        else:
+            same["set"].update(sets)
+
+
 def evaluate(
     scenario: Scenario,
     sequence: Sequence,
@@ -63,17 +80,7 @@ def evaluate(
     ``timeline_settings`` adds settings at given instants (the oracle's switches).
     """
     data = case_data(scenario, sequence, settings, duration, rules)
-    for at, sets in timeline_settings or []:
-        if at == 0:
-            data["set"].update(sets)
-            continue
-        entries = data.setdefault("timeline", [])
-        same = next((e for e in entries if e["at"] == at), None)
-        if same is None:
-            entries.append({"at": at, "set": dict(sets)})
-            entries.sort(key=lambda e: e["at"])
-        else:
-            same["set"].update(sets)
+    add_timeline_settings(data, timeline_settings or [])
     # the loader `run` and `ap.run` use, on the case as a document beside the scenario's
     # file (its relative paths resolve as the file's own)
     where = Path(scenario.path) if scenario.path else Path("<tune>")
