@@ -29,6 +29,12 @@ scores some draws only (``4000:30,5000:30``; implies ``--no-save`` unless all fi
 It ends with the verdict ``--validate`` would give over these seeds, and how many of the
 losses are within the seed noise; exit 1 if the rules lose on any sequence. Deterministic:
 the same numbers at any load.
+
+``--set KEY=VALUE`` (repeatable; ``MyFollowerController.Kw=0.1``) fixes a setting for every
+way, the robust gain's, the rules' and the oracle's runs alike: the rules are derived from a
+sweep run with it too (DIR's ``scenario.yaml`` must set the same value: the sweep's scenario
+with a ``set:`` line), are not checked against the committed ones, and the results go to
+``benchmarks/results/adapt_seeds_set.json`` and its own ``adapt-seeds-set`` block.
 """
 
 from __future__ import annotations
@@ -36,6 +42,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import statistics
 import sys
 from collections.abc import Iterable
@@ -49,6 +56,8 @@ sys.path.insert(0, str(ROOT))  # run as a script: `benchmarks` is the repository
 SWEEP = ROOT / "scenarios" / "adaptive_sweep.yaml"
 RULES = ROOT / "scenarios" / "rules" / "adaptive_rules.yaml"
 OUT = ROOT / "benchmarks" / "results" / "adapt_seeds.json"
+#: ``--set``'s results: rules derived and scored with a fixed setting (a sweep run with it)
+OUT_SET = ROOT / "benchmarks" / "results" / "adapt_seeds_set.json"
 #: (generator seed, sequences): the docs' draws (--validate's twenty is 1000), scored in this
 #: order: the two the three-seed runs lost on first, so an interrupted run (``--resume``) has them
 DRAWS = ((4000, 30), (5000, 30), (1000, 20), (2000, 30), (3000, 30))
@@ -111,6 +120,55 @@ def parse_draws(text: str) -> list[tuple[int, int]]:
     if len({d for d, _ in draws}) != len(draws):
         raise SpecError("--draws: a draw given twice")
     return draws
+
+
+def parse_set(texts: list[str]) -> dict[str, float]:
+    """``--set KEY=VALUE`` (repeatable): a fixed setting every way runs with (a number).
+
+    Only ``Component.param`` keys: the sweep's scenario sets them for every run, and a key
+    the world does not have fails there, before any run.
+    """
+    found: dict[str, float] = {}
+    for text in texts:
+        key, eq, value = text.partition("=")
+        key = key.strip()
+        if not (eq and re.fullmatch(r"[A-Za-z_]\w*\.[A-Za-z_]\w*", key)):
+            raise SpecError(f"--set: {text!r} is not Component.param=VALUE")
+        try:
+            number = float(value)
+        except ValueError:
+            raise SpecError(f"--set: {key}: {value.strip()!r} is not a number") from None
+        if not math.isfinite(number):
+            raise SpecError(f"--set: {key}: {value.strip()!r} is not a finite number")
+        if key in found:
+            raise SpecError(f"--set: {key} given twice")
+        found[key] = number
+    return found
+
+
+def check_sweep_set(sweepdir: Path, fixed: dict[str, float]) -> None:
+    """The sweep's output must have been run with the same fixed settings: rules derived at
+    one setting and scored at another measure neither. Raises SpecError naming the key."""
+    import yaml
+
+    path = sweepdir / "scenario.yaml"
+    if not path.is_file():
+        raise SpecError(f"{path}: no such file (DIR: a sweep's output)")
+    data = yaml.safe_load(path.read_text()) or {}
+    swept = data.get("set") or {} if isinstance(data, dict) else {}
+    for key, value in fixed.items():
+        if key not in swept:
+            raise SpecError(f"{path}: set: no {key} (sweep with {key}: {value:g} set)")
+        if not isinstance(swept[key], int | float) or float(swept[key]) != value:
+            raise SpecError(f"{path}: set: {key} is {swept[key]!r}, not {value:g}")
+
+
+def fix(scenario, fixed: dict[str, float]):
+    """The scenario with ``fixed`` in its ``set``: every case copies it (``case_data``), so the
+    robust gain, the rules and the oracle all run with it, as the sweep's runs did."""
+    if fixed:
+        scenario.data["set"] = {**(scenario.data.get("set") or {}), **fixed}
+    return scenario
 
 
 def stalls(
@@ -467,8 +525,15 @@ def markdown(doc: dict[str, Any]) -> str:
         lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in t["rows"]]
         parts.append("\n".join(lines))
     load_ = "–".join(f"{x:g}" for x in doc["load"])
+    fixed = doc.get("set") or {}
+    at = ", ".join(f"{k} {v:g}" for k, v in fixed.items())
+    what = (
+        f"Rules derived from a sweep with {at} vs the robust Kv 0.2, every way with {at}"
+        if fixed
+        else "Rules vs the robust Kv 0.2"
+    )
     parts.append(
-        f"*Rules vs the robust Kv 0.2, 600 s: reached, losses above 2 %, worst, mean change; "
+        f"*{what}, 600 s: reached, losses above 2 %, worst, mean change; "
         f"s.e.: standard error of the mean change, paired by seed; a stall: {LEAST:g} s or "
         f"more below {SLOW:g} m/s farther than {FAR:g} m from the leader (load {load_}, "
         f"{doc['date'][:10]}). Regenerate, DIR the sweep's output: `{doc['command']}`.*"
@@ -493,32 +558,51 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--draws", help="DRAW:COUNT,... (default: the docs' five draws)")
     ap.add_argument("--no-save", action="store_true", help="print only")
     ap.add_argument("--resume", action="store_true", help="keep the draws already saved")
+    ap.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="a fixed setting of every way (the sweep in DIR run with it too); "
+        f"results to benchmarks/results/{OUT_SET.name}",
+    )
     args = ap.parse_args(argv)
     try:
         seeds = parse_seeds(args.seeds)
         draws = parse_draws(args.draws) if args.draws else list(DRAWS)
+        fixed = parse_set(args.set)
+        if fixed:
+            check_sweep_set(args.sweepdir, fixed)
     except SpecError as e:
         print(f"adapt_seeds: {e}", file=sys.stderr)
         return 2
+    out = OUT_SET if fixed else OUT
     if sorted(draws) != sorted(DRAWS):
         args.no_save = True  # the committed table holds the docs' five draws
     results = args.sweepdir / "results.csv"
     if not results.is_file():
         print(f"adapt_seeds: {results}: no such file (DIR: a sweep's output)", file=sys.stderr)
         return 2
-    scenario = load_scenario(str(SWEEP))
+    scenario = fix(load_scenario(str(SWEEP)), fixed)
     found = derive(results, scenario)
-    if found.rules != yaml.safe_load(RULES.read_text())["adapt"]:
+    if fixed:
+        print(f"rules derived from {args.sweepdir} with {fixed}: {len(found.rules)} rules")
+    elif found.rules != yaml.safe_load(RULES.read_text())["adapt"]:
         print(f"warning: the rules derived from {args.sweepdir} differ from {RULES.name}")
     done: dict[int, dict[str, Any]] = {}
-    if args.resume and OUT.exists():
-        old = json.loads(OUT.read_text())
-        if old.get("seeds") == seeds:
+    if args.resume and out.exists():
+        old = json.loads(out.read_text())
+        if old.get("seeds") == seeds and (old.get("set") or {}) == fixed:
             done = {d["draw"]: d for d in old["draws"]}
-    command = "python -m benchmarks.adapt_seeds DIR" + (
-        "" if args.seeds == "10" else f" --seeds {args.seeds}"
+    command = (
+        "python -m benchmarks.adapt_seeds DIR"
+        + "".join(f" --set {k}={v:g}" for k, v in fixed.items())
+        + ("" if args.seeds == "10" else f" --seeds {args.seeds}")
     )
     doc: dict[str, Any] = {"seeds": seeds, "command": command, "draws": []}
+    if fixed:
+        doc["set"] = fixed
+        doc["rules"] = found.rules
     for draw, count in draws:
         if draw in done and len(done[draw]["rows"]) == count:
             entry = with_segments(scenario, found, done[draw])
@@ -528,8 +612,8 @@ def main(argv: list[str] | None = None) -> int:
         doc["load"] = [round(x, 2) for x in os.getloadavg()]
         doc["date"] = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
         if not args.no_save:
-            OUT.parent.mkdir(parents=True, exist_ok=True)
-            OUT.write_text(json.dumps(doc, indent=1, ensure_ascii=False) + "\n")
+            out.parent.mkdir(parents=True, exist_ok=True)
+            out.write_text(json.dumps(doc, indent=1, ensure_ascii=False) + "\n")
     print(markdown(doc))
     if not args.no_save:
         for page in bench_results.write_pages():
