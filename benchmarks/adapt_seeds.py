@@ -478,7 +478,7 @@ def tables(doc: dict[str, Any]) -> dict[str, Any]:
             _contexts(every),
         ]
     )
-    return {
+    found = {
         "per_draw": {
             "columns": [
                 "draw",
@@ -512,6 +512,12 @@ def tables(doc: dict[str, Any]) -> dict[str, Any]:
             "rows": stall_rows,
         },
     }
+    if seeds == first:  # seeds 1-3 only: the "all the seeds" columns would repeat them
+        for key in ("per_draw", "lost"):
+            found[key]["columns"].pop(1)
+            for r in found[key]["rows"]:
+                r.pop(1)
+    return found
 
 
 def markdown(doc: dict[str, Any]) -> str:

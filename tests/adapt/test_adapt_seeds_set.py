@@ -7,6 +7,7 @@ robust gain, the rules, the oracle), and that the docs' block says what was fixe
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -118,3 +119,27 @@ def test_the_block_says_what_was_fixed() -> None:
     assert f"every way with {KW} 0.1" in text
     del doc["set"]
     assert "*Rules vs the robust Kv 0.2, 600 s" in markdown(doc)
+
+
+def _row(robust: list[float], rules: list[float]) -> dict:
+    return {
+        "index": 0,
+        "sequence": "0 s {behavior 1, motorCoef 50}",
+        "segments": [[0.0, {"Leader.behavior": 1}]],
+        "seeds": {"robust": robust, "rules": rules, "oracle": robust},
+        "stalls": {w: [[] for _ in robust] for w in ("robust", "rules", "oracle")},
+    }
+
+
+@pytest.mark.parametrize(("seeds", "columns"), [([1, 2, 3], 1), ([1, 2, 3, 4], 2)])
+def test_three_seeds_are_one_column_not_two(seeds: list[int], columns: int) -> None:
+    """Scored on seeds 1-3 only, the per-draw and lost tables do not repeat the same figures
+    under two headings; with more seeds both the seeds 1-3 and the all-seeds columns show."""
+    lost = _row([1.0] * len(seeds), [1.1] * len(seeds))  # 10 % worse: a lost sequence
+    doc = {"seeds": seeds, "draws": [{"draw": 1000, "rows": [lost]}]}
+    found = adapt_seeds.tables(doc)
+    for key in ("per_draw", "lost"):
+        heads = found[key]["columns"]
+        per_seeds = [h for h in heads if re.fullmatch(r"(change ± s\.e\., )?seeds [0-9–]+", h)]
+        assert len(per_seeds) == columns
+        assert all(len(r) == len(heads) for r in found[key]["rows"])
