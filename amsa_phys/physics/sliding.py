@@ -116,17 +116,6 @@ def slide_once(
         scale = 1.0 / math.sqrt(qq) if qq > 1.0 else 1.0
         return fx * scale, scale
 
-    def excess(up: float, fr: float) -> float:
-        """``M_w (u+ - u)/dt - F_m(u+) + R_dir + F_x(u+)``: zero at the step's rim speed."""
-        fm = f0 - s.c * up
-        if fm > s.f_max:
-            fm = s.f_max
-        elif fm < -s.f_max:
-            fm = -s.f_max
-        if up * u < 0.0:  # through zero within the step: the resistance's mean over the path
-            fr = res * (abs(up) - abs(u)) / (up - u)
-        return s.mw * (up - u) - fm + fr + tyre_x(up)[0]
-
     f0_lim = f0 if -s.f_max <= f0 <= s.f_max else (s.f_max if f0 > 0 else -s.f_max)
     rest = f0_lim - tyre_x(0.0)[0]  # what moves the rim at rest, besides its resistance
     need = s.mw * u + rest
@@ -148,11 +137,28 @@ def slide_once(
             lo, hi, fr = 0.0, u + reach, res
         else:
             lo, hi, fr = u - reach, 0.0, -res
+        # the excess ``M_w (u+ - u)/dt - F_m(u+) + R_dir + F_x(u+)``, zero at the step's rim
+        # speed, written out in the loop (not through ``tyre_x``): the pure step spends most
+        # of a skid's time here, ~50 halvings a solve, and the calls were most of that. The
+        # same operations in the same order as ``_step.c``'s slide_excess: the same floats
+        mw, c, f_max, abs_u, qy2 = s.mw, s.c, s.f_max, abs(u), qy * qy
         for _ in range(SLIDE_ITERATIONS):
             mid = 0.5 * (lo + hi)
             if mid <= lo or mid >= hi:
                 break
-            if excess(mid, fr) > 0.0:
+            fm = f0 - c * mid
+            if fm > f_max:
+                fm = f_max
+            elif fm < -f_max:
+                fm = -f_max
+            # through zero within the step: the resistance's mean over the path
+            fr_mid = res * (abs(mid) - abs_u) / (mid - u) if mid * u < 0.0 else fr
+            fx = kx * (0.5 * (u + mid) - v) * ivs
+            qx = fx * ix
+            qq = qx * qx + qy2
+            if qq > 1.0:
+                fx = fx * (1.0 / math.sqrt(qq))
+            if mw * (mid - u) - fm + fr_mid + fx > 0.0:
                 hi = mid
             else:
                 lo = mid
