@@ -146,8 +146,14 @@ def simulated(
     )
     last = tr["t"] >= duration - 1.0
     rims = np.abs(np.concatenate([tr["Rover.wheelSpeedL"][last], tr["Rover.wheelSpeedR"][last]]))
+    # the sideways velocity, which the trace does not log: the central difference of the
+    # last three positions, across the heading between them (a steady circle's chord: within
+    # ~1e-4 of it at 50 Hz, a start for the law's solve, not a measurement)
+    t, x, y, heading = (tr[k][-3:] for k in ("t", "Rover.posX", "Rover.posY", "Rover.heading"))
+    vx, vy = (x[2] - x[0]) / (t[2] - t[0]), (y[2] - y[0]) / (t[2] - t[0])
     return {
         "u": float(tr["Rover.speed"][-1]),
+        "vy": float(vy * np.cos(heading[1]) - vx * np.sin(heading[1])),
         "w": float(tr["Rover.yawRate"][-1]),
         "ul": float(tr["Rover.wheelSpeedL"][-1]),
         "ur": float(tr["Rover.wheelSpeedR"][-1]),
@@ -162,7 +168,7 @@ def law_error(
     mass, c, stall, mu = case
     sim = simulated(tmp_path, case, duration)
     x = steady_state(
-        law(robot(mass, c, stall), mu), [sim["u"], 0.1, sim["w"], sim["ul"], sim["ur"]]
+        law(robot(mass, c, stall), mu), [sim["u"], sim["vy"], sim["w"], sim["ul"], sim["ur"]]
     )
     err = max(abs(sim["u"] / x[0] - 1.0), abs(sim["w"] / x[2] - 1.0))
     return err, {"sim": sim, "law": x.tolist()}
