@@ -37,6 +37,13 @@ import pytest
 from rig import ON_AXLE, drive
 
 from amsa_phys.physics import bodyio, forces, sliding
+from amsa_phys.physics.step_path import describe
+
+#: each test here runs 20 s of a skid at 6,400 Hz, ~0.5 s of CPU on the compiled step and ~6 s
+#: on the pure one (no C compiler at install, or ``AMSA_PHYS_PURE=1``), where the sliding
+#: tyre's bisection is Python: there they are the slow tier's (``--runslow``), over the quick
+#: tier's CPU budget with the coarser rates beside it (``tests/tiers.py``)
+pytestmark = [] if describe()[0] else [pytest.mark.slow]
 
 RATES = [100, 200, 400, 800]
 #: the rovers whose order is held (mass, tyres, geometry); measured position orders 1.15,
@@ -101,10 +108,16 @@ def convergence(tmp_path: Path, robot: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def mutant_off(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> float:
-    """The default rover's heading error at 100 Hz on the pure step (where the mutants are
-    patched in) against the compiled step's 6,400 Hz run (the real model)."""
+def mutant_off(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, module: Any, name: str, value: Any
+) -> float:
+    """The default rover's heading error at 100 Hz on the pure step with ``module.name``
+    patched to ``value`` (a mutant: the pure step is the one that reads it) against the real
+    model's 6,400 Hz run, made before the mutant is patched in: on the pure step (no C
+    compiler, or ``AMSA_PHYS_PURE=1``) the reference runs Python too, and patched first it
+    would be the mutant's own."""
     ref = pose(tmp_path / "ref", 6400, {})
+    monkeypatch.setattr(module, name, value)
     monkeypatch.setenv("AMSA_PHYS_PURE", "1")
     return abs(float(pose(tmp_path / "100", 100, {})[2] - ref[2]))
 
@@ -218,8 +231,7 @@ def test_each_mutant_of_the_step_puts_the_heading_off(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, mutant: str
 ) -> None:
     module, name, value, least = MUTANTS[mutant]
-    monkeypatch.setattr(module, name, value)
-    off = mutant_off(tmp_path, monkeypatch)
+    off = mutant_off(tmp_path, monkeypatch, module, name, value)
     assert off > least, off
 
 
