@@ -15,7 +15,7 @@ from regimes import DT, every_regime
 from amsa_phys.physics import compiled
 from amsa_phys.physics.columns import _ColumnIO
 from amsa_phys.physics.forces import ground_list
-from amsa_phys.physics.step_path import extension
+from amsa_phys.physics.step_path import PURE_ENV, extension
 
 pytestmark = pytest.mark.skipif(
     extension() is None, reason="the compiled step was not built (no C compiler at install)"
@@ -51,28 +51,36 @@ def _unusual(n: int) -> dict[str, np.ndarray]:
 
 def _usual(envs: int) -> dict[str, np.ndarray]:
     """The arrays of a vector env's rovers driven a while by random actions: the wheel
-    model's usual path, mostly."""
+    model's usual path, mostly.
+
+    The env runs on the compiled step even under ``AMSA_PHYS_PURE=1``: what is held is the C
+    step's pairing, and these arrays (its plan, drives, ground rows) are the compiled force
+    model's; the pure step has none to give (the two steps' equality is
+    ``test_compiled_step.py``'s)."""
     pytest.importorskip("gymnasium", reason="the gym extra is not installed")
     from amsa_phys.gym.vector import FollowVecEnv
 
-    env = FollowVecEnv(envs, stepping="batch")
-    try:
-        env.reset(seed=3)
-        rng = np.random.default_rng(3)
-        for _ in range(12):
-            env.step(rng.uniform(-1.0, 1.0, (envs, 2)))
-        columns = env._episode.columns  # type: ignore[union-attr]
-        columns._fused.advance_many(12, True)  # mid-period: the tyres settled on the command
-        model = columns._model
-        return {
-            "plan": model._plan.copy(),
-            "drives": np.array(model.drives, dtype=np.float64),
-            "rims": np.array(model.rims, dtype=np.float64),
-            "ground": np.array(model.ground, dtype=np.float64),
-            "state": columns._io.state.copy(),
-        }
-    finally:
-        env.close()
+    with pytest.MonkeyPatch.context() as m:
+        m.delenv(PURE_ENV, raising=False)
+        env = FollowVecEnv(envs, stepping="batch")
+        try:
+            env.reset(seed=3)
+            rng = np.random.default_rng(3)
+            for _ in range(12):
+                env.step(rng.uniform(-1.0, 1.0, (envs, 2)))
+            columns = env._episode.columns  # type: ignore[union-attr]
+            # mid-period: the tyres settled on the command
+            columns._fused.advance_many(12, True)
+            model = columns._model
+            return {
+                "plan": model._plan.copy(),
+                "drives": np.array(model.drives, dtype=np.float64),
+                "rims": np.array(model.rims, dtype=np.float64),
+                "ground": np.array(model.ground, dtype=np.float64),
+                "state": columns._io.state.copy(),
+            }
+        finally:
+            env.close()
 
 
 def _batch() -> tuple[dict[str, np.ndarray], np.ndarray]:
