@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from daskcluster import local_cluster
 
 from amsa_phys.cli.main import main
 from amsa_phys.engine.multirun import MultiRun
@@ -277,7 +278,7 @@ def test_a_batch_whose_worker_dies_costs_the_killing_run_only(
 def test_on_dask_a_batch_that_kills_its_workers_costs_the_killing_run_only(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    distributed = pytest.importorskip("distributed")
+    pytest.importorskip("distributed")
     import dask
 
     monkeypatch.setenv("PYTHONPATH", str(ROOT / "tests"))
@@ -291,9 +292,7 @@ def test_on_dask_a_batch_that_kills_its_workers_costs_the_killing_run_only(
     # one retry: a run queued on the worker the killing run takes down is run again
     with (
         dask.config.set({"distributed.scheduler.allowed-failures": 1}),
-        distributed.LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-        ) as cluster,
+        local_cluster() as cluster,
     ):
         code = main([*argv, "--scheduler", cluster.scheduler_address, "--out", str(tmp_path / "o")])
     assert code == 0

@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import socket
+import warnings
 from pathlib import Path
 
 import pytest
 import sigint
+from daskcluster import local_cluster
 
 from amsa_phys.cli.main import main
 
@@ -49,11 +53,9 @@ def test_j1_and_j2_give_identical_results(tmp_path: Path) -> None:
 
 
 def test_dask_local_cluster_gives_the_same_rows(tmp_path: Path) -> None:
-    distributed = pytest.importorskip("distributed")
+    pytest.importorskip("distributed")
     assert main(["sweep", str(SCEN), *GRID, "-j", "1", "--out", str(tmp_path / "local")]) == 0
-    with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-    ) as cluster:
+    with local_cluster() as cluster:
         code = main(
             [
                 "sweep",
@@ -71,8 +73,31 @@ def test_dask_local_cluster_gives_the_same_rows(tmp_path: Path) -> None:
     assert rows(tmp_path / "dask") == rows(tmp_path / "local")
 
 
+def test_a_dask_sweep_warns_of_no_dashboard_port(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """With 8787 taken (here by the test, else by whoever holds it), a sweep on the tests'
+    local cluster says nothing of a dashboard or a port: nobody asked for one."""
+    pytest.importorskip("distributed")
+    argv = ["sweep", str(SCEN), *GRID[:2], "--duration", "2", "--executor", "dask"]
+    with contextlib.ExitStack() as stack:
+        held = stack.enter_context(socket.socket())
+        with contextlib.suppress(OSError):  # already taken: as good
+            held.bind(("", 8787))
+            held.listen()
+        seen = stack.enter_context(warnings.catch_warnings(record=True))
+        warnings.simplefilter("always")
+        cluster = stack.enter_context(local_cluster())
+        out = tmp_path / "o"
+        assert main([*argv, "--scheduler", cluster.scheduler_address, "--out", str(out)]) == 0
+    said = capsys.readouterr().err + "".join(str(w.message) for w in seen)
+    assert "8787" not in said, said
+    assert "dashboard" not in said.lower(), said
+    assert len(rows(out)) == 2
+
+
 def test_on_dask_a_job_that_kills_its_workers_is_a_row_error(tmp_path: Path) -> None:
-    distributed = pytest.importorskip("distributed")
+    pytest.importorskip("distributed")
     import dask
 
     scen = tmp_path / "s.yaml"
@@ -81,9 +106,7 @@ def test_on_dask_a_job_that_kills_its_workers_is_a_row_error(tmp_path: Path) -> 
     # no retries on other workers: the test needs one death, not four
     with (
         dask.config.set({"distributed.scheduler.allowed-failures": 0}),
-        distributed.LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-        ) as cluster,
+        local_cluster() as cluster,
     ):
         code = main([*argv, "--scheduler", cluster.scheduler_address, "--out", str(tmp_path / "o")])
     assert code == 0
