@@ -37,13 +37,6 @@ import pytest
 from rig import ON_AXLE, drive
 
 from amsa_phys.physics import bodyio, forces, sliding
-from amsa_phys.physics.step_path import describe
-
-#: each test here runs 20 s of a skid at 6,400 Hz, ~0.5 s of CPU on the compiled step and ~6 s
-#: on the pure one (no C compiler at install, or ``AMSA_PHYS_PURE=1``), where the sliding
-#: tyre's bisection is Python: there they are the slow tier's (``--runslow``), over the quick
-#: tier's CPU budget with the coarser rates beside it (``tests/tiers.py``)
-pytestmark = [] if describe()[0] else [pytest.mark.slow]
 
 RATES = [100, 200, 400, 800]
 #: the rovers whose order is held (mass, tyres, geometry); measured position orders 1.15,
