@@ -35,6 +35,13 @@ way, the robust gain's, the rules' and the oracle's runs alike: the rules are de
 sweep run with it too (DIR's ``scenario.yaml`` must set the same value: the sweep's scenario
 with a ``set:`` line), are not checked against the committed ones, and the results go to
 ``benchmarks/results/adapt_seeds_set.json`` and its own ``adapt-seeds-set`` block.
+
+``--sweep FILE`` scores the rules derived from another swept scenario (DIR its output):
+``scenarios/adaptive_sweep_fine.yaml``, the shipped sweep with a level between each two whose
+best gains are more than a grid step apart. The held-out draws are the same (the box is the
+same), the rules are not checked against the committed ones, and the results go to
+``benchmarks/results/adapt_seeds_fine.json`` (``adapt_seeds_NAME.json`` for
+``adaptive_sweep_NAME.yaml``) and its own ``adapt-seeds-fine`` block.
 """
 
 from __future__ import annotations
@@ -161,6 +168,37 @@ def check_sweep_set(sweepdir: Path, fixed: dict[str, float]) -> None:
             raise SpecError(f"{path}: set: no {key} (sweep with {key}: {value:g} set)")
         if not isinstance(swept[key], int | float) or float(swept[key]) != value:
             raise SpecError(f"{path}: set: {key} is {swept[key]!r}, not {value:g}")
+
+
+def sweep_key(path: Path) -> str:
+    """``fine`` for ``adaptive_sweep_fine.yaml``: the name of its results file and block.
+    Raises SpecError for a file that is not one of the repository's adaptive sweeps."""
+    stem = path.name.removesuffix(".yaml")
+    key = stem.removeprefix("adaptive_sweep_")
+    if not path.name.endswith(".yaml") or key == stem or not re.fullmatch(r"[a-z0-9]+", key):
+        raise SpecError(f"--sweep: {path.name}: expected scenarios/adaptive_sweep_NAME.yaml")
+    if not path.is_file():
+        raise SpecError(f"--sweep: {path}: no such file")
+    return key
+
+
+def check_sweep_contexts(sweepdir: Path, scenario) -> None:
+    """DIR must be the output of the swept scenario the rules are derived for: the same
+    contexts, or the rules would be another sweep's. Raises SpecError naming both."""
+    import yaml
+
+    path = sweepdir / "scenario.yaml"
+    if not path.is_file():
+        raise SpecError(f"{path}: no such file (DIR: a sweep's output)")
+    data = yaml.safe_load(path.read_text()) or {}
+    sweep = data.get("sweep") if isinstance(data, dict) else None
+    ran = sorted((sweep or {}).get("contexts") or {}) if isinstance(sweep, dict) else []
+    want = sorted((scenario.data.get("sweep") or {}).get("contexts") or {})
+    if ran != want:
+        missing = sorted(set(want) - set(ran)) or sorted(set(ran) - set(want))
+        raise SpecError(
+            f"{path}: sweep: contexts differ from the swept scenario's ({', '.join(missing)})"
+        )
 
 
 def fix(scenario, fixed: dict[str, float]):
@@ -533,11 +571,12 @@ def markdown(doc: dict[str, Any]) -> str:
     load_ = "–".join(f"{x:g}" for x in doc["load"])
     fixed = doc.get("set") or {}
     at = ", ".join(f"{k} {v:g}" for k, v in fixed.items())
-    what = (
-        f"Rules derived from a sweep with {at} vs the robust Kv 0.2, every way with {at}"
-        if fixed
-        else "Rules vs the robust Kv 0.2"
-    )
+    if fixed:
+        what = f"Rules derived from a sweep with {at} vs the robust Kv 0.2, every way with {at}"
+    elif doc.get("sweep"):
+        what = f"Rules derived from `{doc['sweep']}` vs the robust Kv 0.2"
+    else:
+        what = "Rules vs the robust Kv 0.2"
     parts.append(
         f"*{what}, 600 s: reached, losses above 2 %, worst, mean change; "
         f"s.e.: standard error of the mean change, paired by seed; a stall: {LEAST:g} s or "
@@ -572,8 +611,18 @@ def main(argv: list[str] | None = None) -> int:
         help="a fixed setting of every way (the sweep in DIR run with it too); "
         f"results to benchmarks/results/{OUT_SET.name}",
     )
+    ap.add_argument(
+        "--sweep",
+        type=Path,
+        metavar="FILE",
+        help="the swept scenario DIR is the output of (default: scenarios/adaptive_sweep.yaml); "
+        "results to benchmarks/results/adapt_seeds_NAME.json",
+    )
     args = ap.parse_args(argv)
     try:
+        key = sweep_key(args.sweep) if args.sweep is not None else None
+        if key is not None and args.set:
+            raise SpecError("--sweep and --set: one at a time")
         seeds = parse_seeds(args.seeds)
         draws = parse_draws(args.draws) if args.draws else list(DRAWS)
         fixed = parse_set(args.set)
@@ -583,32 +632,47 @@ def main(argv: list[str] | None = None) -> int:
         print(f"adapt_seeds: {e}", file=sys.stderr)
         return 2
     out = OUT_SET if fixed else OUT
+    if key is not None:
+        out = OUT.with_name(f"adapt_seeds_{key}.json")
     if sorted(draws) != sorted(DRAWS):
         args.no_save = True  # the committed table holds the docs' five draws
     results = args.sweepdir / "results.csv"
     if not results.is_file():
         print(f"adapt_seeds: {results}: no such file (DIR: a sweep's output)", file=sys.stderr)
         return 2
-    scenario = fix(load_scenario(str(SWEEP)), fixed)
+    swept = SWEEP if args.sweep is None else args.sweep
+    scenario = fix(load_scenario(str(swept)), fixed)
+    if key is not None:
+        try:
+            check_sweep_contexts(args.sweepdir, scenario)
+        except SpecError as e:
+            print(f"adapt_seeds: {e}", file=sys.stderr)
+            return 2
     found = derive(results, scenario)
-    if fixed:
-        print(f"rules derived from {args.sweepdir} with {fixed}: {len(found.rules)} rules")
+    if fixed or key is not None:
+        what = f"with {fixed}" if fixed else f"of {swept.name}"
+        print(f"rules derived from {args.sweepdir} {what}: {len(found.rules)} rules")
     elif found.rules != yaml.safe_load(RULES.read_text())["adapt"]:
         print(f"warning: the rules derived from {args.sweepdir} differ from {RULES.name}")
     done: dict[int, dict[str, Any]] = {}
     if args.resume and out.exists():
         old = json.loads(out.read_text())
-        if old.get("seeds") == seeds and (old.get("set") or {}) == fixed:
+        same = old.get("rules") == found.rules if key is not None else True
+        if old.get("seeds") == seeds and (old.get("set") or {}) == fixed and same:
             done = {d["draw"]: d for d in old["draws"]}
     command = (
         "python -m benchmarks.adapt_seeds DIR"
         + "".join(f" --set {k}={v:g}" for k, v in fixed.items())
+        + (f" --sweep scenarios/{swept.name}" if key is not None else "")
         + ("" if args.seeds == "10" else f" --seeds {args.seeds}")
     )
     doc: dict[str, Any] = {"seeds": seeds, "command": command, "draws": []}
     if fixed:
         doc["set"] = fixed
+    if fixed or key is not None:
         doc["rules"] = found.rules
+    if key is not None:
+        doc["sweep"] = f"scenarios/{swept.name}"
     for draw, count in draws:
         if draw in done and len(done[draw]["rows"]) == count:
             entry = with_segments(scenario, found, done[draw])

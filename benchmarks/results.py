@@ -264,6 +264,7 @@ OWN_TABLES = {
     "adapt-swing": ROOT / "benchmarks" / "results" / "adapt_swing.json",
     "adapt-seeds": ROOT / "benchmarks" / "results" / "adapt_seeds.json",
     "adapt-seeds-set": ROOT / "benchmarks" / "results" / "adapt_seeds_set.json",
+    "adapt-seeds-fine": ROOT / "benchmarks" / "results" / "adapt_seeds_fine.json",
     "adapt-stall": ROOT / "benchmarks" / "results" / "adapt_stall.json",
     "physics-step": ROOT / "benchmarks" / "results" / "physics_step.json",
 }

@@ -43,6 +43,7 @@ FULL_SUITE_ONLY = {
     "long_mission",
     "adaptive",
     "adaptive_sweep",
+    "adaptive_sweep_fine",
     "adaptive_sweep_gps",
     "paper_fig6_urban",
     "paper_fig5_kv035",

@@ -20,7 +20,7 @@ FAILING = ROOT / "tests" / "fixtures" / "failing_expect.yaml"
 def test_shipped_scenarios_pass(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["test", str(ROOT / "scenarios"), "-j", "2"]) == 0
     out = capsys.readouterr().out
-    assert "19 scenarios, 56 checks: 56 passed, 0 failed" in out
+    assert "20 scenarios, 58 checks: 58 passed, 0 failed" in out
 
 
 def test_failing_scenario_gives_exit_1_a_table_and_junit(
