@@ -1800,6 +1800,17 @@ static PyTypeObject ColumnsType = {
  * there and as PhysicsWorld.set_powers per rover: NaN is -100, then clipped to [-100, 100],
  * then 0.0 inside the driver's deadband (-band < v < band); rover index[j] gets left[j] in
  * drives row 0 and right[j] in row 1 of the (2, n) array. */
+static inline double power_rule(double v, double band)
+{
+    if (v != v)
+        v = -100.0;
+    else if (v < -100.0)
+        v = -100.0;
+    else if (v > 100.0)
+        v = 100.0;
+    return (-band < v && v < band) ? 0.0 : v;
+}
+
 static PyObject *column_powers(PyObject *Py_UNUSED(module), PyObject *args)
 {
     PyObject *objs[5];
@@ -1827,17 +1838,8 @@ static PyObject *column_powers(PyObject *Py_UNUSED(module), PyObject *args)
         }
     for (Py_ssize_t j = 0; j < m; j++) {
         const Py_ssize_t k = (Py_ssize_t)index[j];
-        const double b = band[k];
-        for (int side = 0; side < 2; side++) {
-            double v = side ? right[j] : left[j];
-            if (v != v)
-                v = -100.0;
-            else if (v < -100.0)
-                v = -100.0;
-            else if (v > 100.0)
-                v = 100.0;
-            drives[side * n + k] = (-b < v && v < b) ? 0.0 : v;
-        }
+        drives[k] = power_rule(left[j], band[k]);
+        drives[n + k] = power_rule(right[j], band[k]);
     }
     result = Py_None;
     Py_INCREF(result);
@@ -1936,6 +1938,19 @@ done:
  * +-0 given the divisor's sign); diff = gain * err; forward = power * (cos(err) if
  * cos(err) > 0 else 0, NaN giving 0); left = forward - diff, right = forward + diff. */
 
+static inline void steer_one(double heading, double angle, double cruise, double factor,
+                             double gain, double *left, double *right)
+{
+    const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+    const double power = cruise * factor;
+    const double err = py_mod(heading - angle + pi, two_pi) - pi;
+    const double diff = gain * err;
+    const double c = cos(err);
+    const double forward = power * (c > 0.0 ? c : 0.0);
+    *left = forward - diff;
+    *right = forward + diff;
+}
+
 static PyObject *steer_random(PyObject *Py_UNUSED(module), PyObject *args)
 {
     PyObject *objs[7];
@@ -1959,16 +1974,8 @@ static PyObject *steer_random(PyObject *Py_UNUSED(module), PyObject *args)
     const double *heading = views[0].buf, *angle = views[1].buf, *cruise = views[2].buf;
     const double *factor = views[3].buf, *gain = views[4].buf;
     double *left = views[5].buf, *right = views[6].buf;
-    const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
-    for (Py_ssize_t k = 0; k < n; k++) {
-        const double power = cruise[k] * factor[k];
-        const double err = py_mod(heading[k] - angle[k] + pi, two_pi) - pi;
-        const double diff = gain[k] * err;
-        const double c = cos(err);
-        const double forward = power * (c > 0.0 ? c : 0.0);
-        left[k] = forward - diff;
-        right[k] = forward + diff;
-    }
+    for (Py_ssize_t k = 0; k < n; k++)
+        steer_one(heading[k], angle[k], cruise[k], factor[k], gain[k], &left[k], &right[k]);
     result = Py_None;
     Py_INCREF(result);
 done:
@@ -1984,6 +1991,21 @@ done:
  * out: x, y, (angle + pi) % (2 pi) - pi (the floor modulo, as Python's and numpy's), vx cos(a)
  * + vy sin(a) (libm's, what a run alone computes with math.cos and math.sin), w, left rim,
  * right rim. */
+static inline void pose_one(const double *state, const double *rims, Py_ssize_t big_n,
+                            Py_ssize_t k, double *out, Py_ssize_t m)
+{
+    const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+    const double *r = state + 6 * k;
+    const double a = r[2];
+    out[0] = r[0];
+    out[m] = r[1];
+    out[2 * m] = py_mod(a + pi, two_pi) - pi;
+    out[3 * m] = r[3] * cos(a) + r[4] * sin(a);
+    out[4 * m] = r[5];
+    out[5 * m] = rims[k];
+    out[6 * m] = rims[big_n + k];
+}
+
 static PyObject *robot_poses(PyObject *Py_UNUSED(module), PyObject *args)
 {
     PyObject *objs[4];
@@ -2010,18 +2032,63 @@ static PyObject *robot_poses(PyObject *Py_UNUSED(module), PyObject *args)
             PyErr_SetString(PyExc_IndexError, "robot_poses: a rover index out of range");
             goto done;
         }
-    const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+    for (Py_ssize_t j = 0; j < m; j++)
+        pose_one(state, rims, big_n, (Py_ssize_t)index[j], out + j, m);
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    for (int i = 0; i < held; i++)
+        PyBuffer_Release(&views[i]);
+    return result;
+}
+
+/* ---- leader_step: a random leader group's whole step (physics/freerobot.py) -------------
+ * Why: a random leader group (2.5 times a vector env's step) did steer_random, then
+ * ControlledRobot.step_many's column_powers and robot_poses: three calls, the angles
+ * gathered for the first, and ~8 us of Python around them whatever the batch's size. This
+ * is the three, one rover at a time, with their helpers (so their floats): rover index[j]'s
+ * steering from its angle (steer_one), its powers into the (2, n) drives (power_rule: the
+ * drives are read by no pose), its pose outputs into column j of the (7, m) out
+ * (pose_one). heading, cruise, factor, gain: (m,); band: (n,), as column_powers'. */
+static PyObject *leader_step(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    PyObject *objs[10];
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4],
+                          &objs[5], &objs[6], &objs[7], &objs[8], &objs[9]))
+        return NULL;
+    static const char *names[10] = {"heading", "state", "rims", "index", "cruise",
+                                    "factor",  "gain",  "band", "drives", "out"};
+    Py_buffer views[10];
+    PyObject *result = NULL;
+    const int held = acquire_views(objs, views, names, "dddiddddww", 10);
+    if (held < 10)
+        goto done;
+    const Py_ssize_t m = views[3].len / 8, big_n = views[1].len / (6 * 8);
+    if (views[0].len != m * 8 || views[4].len != m * 8 || views[5].len != m * 8 ||
+        views[6].len != m * 8 || views[1].len != big_n * 6 * 8 || views[2].len != 2 * big_n * 8 ||
+        views[7].len != big_n * 8 || views[8].len != 2 * big_n * 8 || views[9].len != 7 * m * 8) {
+        PyErr_SetString(PyExc_ValueError, "leader_step: heading, index, cruise, factor, gain "
+                                          "(m,), state (N, 6), rims (2, N), band (N,), drives "
+                                          "(2, N), out (7, m) expected");
+        goto done;
+    }
+    const double *heading = views[0].buf, *state = views[1].buf, *rims = views[2].buf;
+    const int64_t *index = views[3].buf;
+    const double *cruise = views[4].buf, *factor = views[5].buf, *gain = views[6].buf;
+    const double *band = views[7].buf;
+    double *drives = views[8].buf, *out = views[9].buf;
+    for (Py_ssize_t j = 0; j < m; j++)
+        if (index[j] < 0 || index[j] >= big_n) {
+            PyErr_SetString(PyExc_IndexError, "leader_step: a rover index out of range");
+            goto done;
+        }
     for (Py_ssize_t j = 0; j < m; j++) {
         const Py_ssize_t k = (Py_ssize_t)index[j];
-        const double *r = state + 6 * k;
-        const double a = r[2];
-        out[j] = r[0];
-        out[m + j] = r[1];
-        out[2 * m + j] = py_mod(a + pi, two_pi) - pi;
-        out[3 * m + j] = r[3] * cos(a) + r[4] * sin(a);
-        out[4 * m + j] = r[5];
-        out[5 * m + j] = rims[k];
-        out[6 * m + j] = rims[big_n + k];
+        double left, right;
+        steer_one(heading[j], state[6 * k + 2], cruise[j], factor[j], gain[j], &left, &right);
+        drives[k] = power_rule(left, band[k]);
+        drives[big_n + k] = power_rule(right, band[k]);
+        pose_one(state, rims, big_n, k, out + j, m);
     }
     result = Py_None;
     Py_INCREF(result);
@@ -2047,6 +2114,10 @@ static PyMethodDef module_methods[] = {
     {"robot_poses", robot_poses, METH_VARARGS,
      "robot_poses(state, rims, index, out): a robot group's pose outputs (x, y, heading, "
      "speed, yaw rate, rims) of the rovers at index into the (7, m) out."},
+    {"leader_step", leader_step, METH_VARARGS,
+     "leader_step(heading, state, rims, index, cruise, factor, gain, band, drives, out): a "
+     "random leader group's step (physics/freerobot.py): steer_random, column_powers and "
+     "robot_poses per rover."},
     {NULL, NULL, 0, NULL},
 };
 
