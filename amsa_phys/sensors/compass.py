@@ -242,7 +242,7 @@ def _heading_compiled(
         if dev is None or dev.shape != np.shape(h):
             dev = state["zero_deviation"] = np.zeros(np.shape(h))
     else:
-        dev = deviation(h, *coefficients)
+        dev = _deviation_many(state, h, coefficients)
     if body(
         h, w, g, u, phi, q, p.mean, turn_on, p.stddev, p.precision, p.lostData,
         state["b"], value, published, dev,
@@ -250,6 +250,28 @@ def _heading_compiled(
         for k in np.flatnonzero(~published).tolist():
             comps[k].lost += 1
     return {"compassHeading": value}, published
+
+
+def _deviation_many(
+    state: dict[str, Any], h: np.ndarray, coefficients: tuple[np.ndarray, ...]
+) -> np.ndarray:
+    """:func:`deviation` of the copies' headings ``h``: its four sines and cosines numpy's, as
+    there, and their products and sums in one compiled call where built
+    (``_groupbodies.deviation``: the same operations in the same order, so the same floats).
+    Why: those seven numpy calls were ~3 µs of a compass group's step."""
+    combine = state.get("deviation_body", _UNSET)
+    if combine is _UNSET:
+        combine = state["deviation_body"] = batch_bodies.deviation()
+    if combine is None or type(h) is not np.ndarray:
+        return deviation(h, *coefficients)  # type: ignore[no-any-return]
+    twice = 2 * h  # as deviation(): once for both terms
+    dev = np.empty(len(h))
+    combine(*coefficients, np.sin(h), np.cos(h), np.sin(twice), np.cos(twice), dev)
+    return dev
+
+
+#: a group's state before it asked for its compiled deviation
+_UNSET = object()
 
 
 def _all_zero(*coefficients: np.ndarray) -> bool:
