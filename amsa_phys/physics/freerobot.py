@@ -410,10 +410,16 @@ def _leader_step(
         return None
     step, columns = call
     cruise, gain = derived(state, "_steering", (p.cruisePower, p.steerGain, rows), _rows_of)
-    out = np.empty((len(POSE_NAMES), len(comps)))
+    kept = state.get("_lead_out")
+    if kept is None or kept[0].shape[1] != len(comps):
+        # the outputs' block and its rows, made once: the engine copies a group's outputs
+        # into the store at once (and sends copies), so a template may reuse its arrays;
+        # seven row views a step were ~1 µs
+        block = np.empty((len(POSE_NAMES), len(comps)))
+        kept = state["_lead_out"] = (block, dict(zip(POSE_NAMES, block, strict=True)))
     step(mine["heading"], arrays[0], arrays[1], index, cruise, mine["factor"], gain,
-         columns._band, columns._model.drives, out)  # fmt: skip
-    return dict(zip(POSE_NAMES, out, strict=True))
+         columns._band, columns._model.drives, kept[0])  # fmt: skip
+    return kept[1]  # type: ignore[no-any-return]
 
 
 def _lead_call(fixed: tuple[Any, ...], mine: dict[str, Any]) -> tuple[Any, Any] | None:
