@@ -230,7 +230,12 @@ def _heading_compiled(
     sign, z = state["on_sign"], state["on_z"]
     turn_on = derived(state, "turn_on", (p.bias_mean, p.bias_stddev), _turn_on_many(sign, z))
     n = len(comps)
-    value, published = np.empty(n), np.empty(n, dtype=bool)
+    kept = state.get("heading_out")
+    if kept is None or len(kept[0]) != n:
+        # made once a group: the engine copies a group's outputs and mask at once (and sends
+        # copies), so a template may reuse its arrays
+        kept = state["heading_out"] = (np.empty(n), np.empty(n, dtype=bool), {})
+    value, published, out = kept
     w, g, u = draws
     h = inp["heading"]
     coefficients = (p.deviationB, p.deviationC, p.deviationD, p.deviationE)
@@ -249,7 +254,8 @@ def _heading_compiled(
     ):  # fmt: skip
         for k in np.flatnonzero(~published).tolist():
             comps[k].lost += 1
-    return {"compassHeading": value}, published
+    out["compassHeading"] = value
+    return out, published
 
 
 def _deviation_many(
@@ -264,9 +270,17 @@ def _deviation_many(
         combine = state["deviation_body"] = batch_bodies.deviation()
     if combine is None or type(h) is not np.ndarray:
         return deviation(h, *coefficients)  # type: ignore[no-any-return]
-    twice = 2 * h  # as deviation(): once for both terms
-    dev = np.empty(len(h))
-    combine(*coefficients, np.sin(h), np.cos(h), np.sin(twice), np.cos(twice), dev)
+    scratch = state.get("deviation_scratch")
+    if scratch is None or len(scratch[0]) != len(h):  # the terms' arrays, made once a group
+        # each its own array, as the fresh ones numpy's deviation() makes
+        scratch = state["deviation_scratch"] = tuple(np.empty(len(h)) for _ in range(6))
+    twice, s1, c1, s2, c2, dev = scratch
+    np.multiply(2, h, out=twice)  # 2 * h, as deviation(): once for both terms
+    np.sin(h, out=s1)
+    np.cos(h, out=c1)
+    np.sin(twice, out=s2)
+    np.cos(twice, out=c2)
+    combine(*coefficients, s1, c1, s2, c2, dev)
     return dev
 
 

@@ -272,8 +272,15 @@ def _fix_compiled(
     and the burst chances (:func:`_fix_params`)."""
     on_x, on_y, enter, leave = held
     n = len(comps)
-    x, y = np.empty(n), np.empty(n)
-    published, lost = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
+    kept = state.get("fix_out")
+    if kept is None or len(kept[0]) != n:
+        # made once a group: the engine copies a group's outputs and mask at once (and sends
+        # copies), so a template may reuse its arrays
+        kept = state["fix_out"] = (
+            np.empty(n), np.empty(n), np.empty(n, dtype=bool), np.empty(n, dtype=bool),
+            {},
+        )  # fmt: skip
+    x, y, published, lost, out = kept
     ex, ey, gx, gy, u_loss, u_burst = draws
     if fix(
         inp["posX"], inp["posY"], ex, ey, gx, gy, u_loss, u_burst, phi, q, p.mean, on_x, on_y,
@@ -282,7 +289,8 @@ def _fix_compiled(
     ):  # fmt: skip
         for k in lost.nonzero()[0].tolist():
             comps[k].lost += 1
-    return {"gpsPosX": x, "gpsPosY": y}, published
+    out["gpsPosX"], out["gpsPosY"] = x, y
+    return out, published
 
 
 def _fix_params(z: np.ndarray, sign: np.ndarray) -> Callable[..., tuple[np.ndarray, ...] | None]:
