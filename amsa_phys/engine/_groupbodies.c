@@ -397,7 +397,90 @@ static PyObject *gather_inputs(PyObject *Py_UNUSED(module), PyObject *args)
     Py_RETURN_NONE;
 }
 
+/* ---- distance: a DistanceMonitor group's distances (control/monitor.py) -----------------
+ * DistanceMonitor.step_many's path, member k: math.hypot(xl - xf, yl - yf), the differences
+ * rounded once as numpy's, and the hypot called as math.hypot itself (its bits are
+ * CPython's, whatever the version: libm.hypot's element by element), into out.
+ * Why: mapping math.hypot over the members' lists from Python was ~0.1 us a member and most of
+ * the group's step at 64 envs. */
+static PyObject *hypot_fn = NULL;
+
+static PyObject *distance(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    static const char *names[5] = {"xLeader", "yLeader", "xFollower", "yFollower", "out"};
+    PyObject *objs[5];
+    if (!PyArg_ParseTuple(args, "OOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4]))
+        return NULL;
+    if (hypot_fn == NULL) {
+        PyObject *math = PyImport_ImportModule("math");
+        if (math == NULL)
+            return NULL;
+        hypot_fn = PyObject_GetAttrString(math, "hypot");
+        Py_DECREF(math);
+        if (hypot_fn == NULL)
+            return NULL;
+    }
+    Py_buffer views[5];
+    Column c[5];
+    Py_ssize_t n = 0;
+    if (take(objs, "ddddD", names, 5, views, c, &n) < 0)
+        return NULL;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        PyObject *pair[2];
+        pair[0] = PyFloat_FromDouble(AT(c[0], k, double) - AT(c[2], k, double));
+        pair[1] = PyFloat_FromDouble(AT(c[1], k, double) - AT(c[3], k, double));
+        PyObject *h = NULL;
+        if (pair[0] != NULL && pair[1] != NULL)
+            h = PyObject_Vectorcall(hypot_fn, pair, 2, NULL);
+        Py_XDECREF(pair[0]);
+        Py_XDECREF(pair[1]);
+        if (h == NULL) {
+            release(views, 5);
+            return NULL;
+        }
+        AT(c[4], k, double) = PyFloat_AS_DOUBLE(h);
+        Py_DECREF(h);
+    }
+    release(views, 5);
+    Py_RETURN_NONE;
+}
+
+/* ---- deviation: a Compass group's deviation from numpy's sines and cosines --------------
+ * compass.deviation's array arithmetic, member k, left to right:
+ *   b*sin(h) + c*cos(h) + d*sin(2h) + e*cos(2h)
+ * with the four functions' values computed by the caller with numpy (numpy's sines may differ
+ * from libm's in the last bit: they stay numpy's), the products and sums here, each rounded
+ * once, into out. Why: the seven products and sums were seven numpy calls a step. */
+static PyObject *deviation(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    static const char *names[9] = {"b", "c", "d", "e", "sin", "cos", "sin2", "cos2", "out"};
+    PyObject *objs[9];
+    if (!PyArg_ParseTuple(args, "OOOOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4],
+                          &objs[5], &objs[6], &objs[7], &objs[8]))
+        return NULL;
+    Py_buffer views[9];
+    Column c[9];
+    Py_ssize_t n = 0;
+    if (take(objs, "ddddddddD", names, 9, views, c, &n) < 0)
+        return NULL;
+    for (Py_ssize_t k = 0; k < n; k++) {
+        double v = AT(c[0], k, double) * AT(c[4], k, double);
+        v = v + AT(c[1], k, double) * AT(c[5], k, double);
+        v = v + AT(c[2], k, double) * AT(c[6], k, double);
+        v = v + AT(c[3], k, double) * AT(c[7], k, double);
+        AT(c[8], k, double) = v;
+    }
+    release(views, 9);
+    Py_RETURN_NONE;
+}
+
 static PyMethodDef methods[] = {
+    {"distance", distance, METH_VARARGS,
+     "distance(xLeader, yLeader, xFollower, yFollower, out): math.hypot of each member's "
+     "differences, into out (a DistanceMonitor group)."},
+    {"deviation", deviation, METH_VARARGS,
+     "deviation(b, c, d, e, sin, cos, sin2, cos2, out): b*sin + c*cos + d*sin2 + e*cos2 of "
+     "each member, left to right, into out (a Compass group's deviation)."},
     {"gps_fix", gps_fix, METH_VARARGS,
      "gps_fix(posX, posY, ex, ey, gx, gy, u_loss, u_burst, phi, q, mean, on_x, on_y, stddev, "
      "precision, enter, leave, lostData, bx, by, bad, x, y, published, lost): a GPS "

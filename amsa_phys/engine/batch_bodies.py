@@ -28,6 +28,18 @@ def compass_heading() -> Any:
     return _body("compass_heading")
 
 
+def distance() -> Any:
+    """``_groupbodies.distance`` (a DistanceMonitor group's ``math.hypot`` of each member's
+    differences), or None."""
+    return _body("distance")
+
+
+def deviation() -> Any:
+    """``_groupbodies.deviation`` (a compass group's deviation terms combined from numpy's
+    sines and cosines), or None."""
+    return _body("deviation")
+
+
 def write_outputs() -> Any:
     """``_groupbodies.write_outputs`` (a group's finite float64 output columns written into the
     store in one call, ``Steppers.step_group``), or None."""

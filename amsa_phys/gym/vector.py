@@ -235,7 +235,8 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
             new = collisions - self._seen
             self._seen = collisions
             reward = reward - penalty * new + 0.0
-        truncated = np.full(n, episode.done)
+        # np.zeros and np.ones: C calls, where np.full is Python around them
+        truncated = np.ones(n, dtype=bool) if episode.done else np.zeros(n, dtype=bool)
         self._autoreset = episode.done
         info = self._info(signal.copy())
         return self._observations(), reward, np.zeros(n, dtype=bool), truncated, info
@@ -250,8 +251,10 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         assert episode is not None
         if signal is None:
             signal = episode.signals(self.single.quality.signal)
+        t = np.empty(self.num_envs)
+        t.fill(float(episode.t))  # np.full's values, without its Python
         return {
-            "t": np.full(self.num_envs, float(episode.t)),
+            "t": t,
             "signal": signal,
             "collisions": self._seen.copy(),
         }

@@ -94,6 +94,13 @@ typedef struct {
      * rover_forces takes them instead of computing them again when its state's angle is
      * the cached one bit for bit (~5 % of the step). NULL: always computed. */
     double *rot;
+    /* Columns (rot_ahead set; rot then their own): the forces store each rover's predicted
+     * end angle with its cos and sin (computed for the lateral force) in rot, and the
+     * integration keeps them where it lands on that angle bit for bit, else computes them
+     * (Columns_move_range). Why: ~3 steps in 4 land on it, and the angle's cos and sin were
+     * ~9 % of a batch's physics. A pure function of the angle: the same doubles either way,
+     * and the forces still take rot only where its angle is their state's bit for bit. */
+    int rot_ahead;
     /* each rover's vx, vy, w before the Chipmunk step under way (3k..3k+2): the trapezoid's
      * other end (second_order below) */
     double *v0;
@@ -616,9 +623,16 @@ static void rover_forces(Stepper *st, Py_ssize_t k, double out[3])
     double mid = angle + 0.5 * turn;
     double cm = cos(mid);
     double sm = sin(mid);
+    double ce = cos(end);
+    double se = sin(end);
+    if (st->rot_ahead) {
+        st->rot[3 * k] = end;
+        st->rot[3 * k + 1] = ce;
+        st->rot[3 * k + 2] = se;
+    }
     double fx = fxl + fxr;
     double a = fx * dt_m;
-    double side = (vy + a * sm) * cos(end) - (vx + a * cm) * sin(end);
+    double side = (vy + a * sm) * ce - (vx + a * cm) * se;
     double kd = ky_dt_m * isum;
     double f_lat = rigid ? neg_m_dt * side / cos(0.5 * turn)
                          : neg_m_dt * side / cos(0.5 * turn) * kd / (1.0 + kd);
@@ -847,6 +861,11 @@ static int rover_pair(Stepper *st, Py_ssize_t k, double out[6])
         ce[j] = cos(end);
         se[j] = sin(end);
         ch[j] = cos(0.5 * turn[j]);
+        if (st->rot_ahead) { /* a true triple even if rover_forces takes over below */
+            st->rot[3 * (k + j)] = end;
+            st->rot[3 * (k + j) + 1] = ce[j];
+            st->rot[3 * (k + j) + 2] = se[j];
+        }
     }
     double f[6];
     LANES {
@@ -1426,6 +1445,7 @@ typedef struct {
     const int64_t *run, *pa, *pb;
     uint8_t *touched;
     double *reach; /* scratch: each rover's reach this step, then its bound */
+    Py_ssize_t *miss; /* scratch: the rovers whose new angle is not their predicted one */
     Py_ssize_t n_pairs, n_boxes, n_runs;
     double reach_m, max2, extent;
     int threads; /* parts the move takes (workers.h): 1, or the workers' pool below */
@@ -1517,6 +1537,7 @@ static int Columns_move_range(Columns *c, Py_ssize_t k0, Py_ssize_t k1)
     const double half = 0.5 * dt;
     double *s = st->state;
     int ok = 1;
+    Py_ssize_t *miss = c->miss + k0, m = 0;
     rovers_forces_range(st, c->forces, k0, k1); /* a rover's forces read only its own row */
     for (Py_ssize_t k = k0; k < k1; k++) {
         const double *f = c->forces + 3 * k;
@@ -1534,6 +1555,17 @@ static int Columns_move_range(Columns *c, Py_ssize_t k0, Py_ssize_t k1)
         double v2 = r[3] * r[3] + r[4] * r[4];
         if (!(v2 <= c->max2 && fabs(r[0]) <= c->extent && fabs(r[1]) <= c->extent))
             ok = 0;
+        /* the angle's cos and sin for the next step's forces: the forces' end angle's where
+         * the integration landed on it bit for bit (most steps), listed without a branch */
+        miss[m] = k;
+        m += !same_bits(st->rot[3 * k], r[2]);
+    }
+    for (Py_ssize_t i = 0; i < m; i++) { /* the others: computed as rover_forces would */
+        const Py_ssize_t k = miss[i];
+        const double a = s[6 * k + 2];
+        st->rot[3 * k] = a;
+        st->rot[3 * k + 1] = cos(a);
+        st->rot[3 * k + 2] = sin(a);
     }
     return ok;
 }
@@ -1599,6 +1631,8 @@ static void Columns_dealloc(Columns *c)
     for (int i = 0; i < c->n_views; i++)
         PyBuffer_Release(&c->views[i]);
     PyMem_Free(c->reach);
+    PyMem_Free(c->miss);
+    PyMem_Free(c->st.rot);
     Py_TYPE(c)->tp_free((PyObject *)c);
 }
 
@@ -1685,10 +1719,19 @@ static int Columns_init(Columns *c, PyObject *args, PyObject *kwds)
             return -1;
         }
     c->reach = PyMem_Malloc((n ? 2 * n : 1) * sizeof(double));
-    if (c->reach == NULL) {
+    c->miss = PyMem_Malloc((n ? n : 1) * sizeof(Py_ssize_t));
+    st->rot = PyMem_Malloc((n ? 3 * n : 1) * sizeof(double));
+    if (c->reach == NULL || c->miss == NULL || st->rot == NULL) {
         PyErr_NoMemory();
         return -1;
     }
+    for (Py_ssize_t k = 0; k < n; k++) { /* the state given: computed as rover_forces does */
+        const double a = st->state[6 * k + 2];
+        st->rot[3 * k] = a;
+        st->rot[3 * k + 1] = cos(a);
+        st->rot[3 * k + 2] = sin(a);
+    }
+    st->rot_ahead = 1;
     st->rim_k = 1;
     st->rim_side = n;
     st->ground_k = 1;
@@ -1800,6 +1843,17 @@ static PyTypeObject ColumnsType = {
  * there and as PhysicsWorld.set_powers per rover: NaN is -100, then clipped to [-100, 100],
  * then 0.0 inside the driver's deadband (-band < v < band); rover index[j] gets left[j] in
  * drives row 0 and right[j] in row 1 of the (2, n) array. */
+static inline double power_rule(double v, double band)
+{
+    if (v != v)
+        v = -100.0;
+    else if (v < -100.0)
+        v = -100.0;
+    else if (v > 100.0)
+        v = 100.0;
+    return (-band < v && v < band) ? 0.0 : v;
+}
+
 static PyObject *column_powers(PyObject *Py_UNUSED(module), PyObject *args)
 {
     PyObject *objs[5];
@@ -1827,17 +1881,8 @@ static PyObject *column_powers(PyObject *Py_UNUSED(module), PyObject *args)
         }
     for (Py_ssize_t j = 0; j < m; j++) {
         const Py_ssize_t k = (Py_ssize_t)index[j];
-        const double b = band[k];
-        for (int side = 0; side < 2; side++) {
-            double v = side ? right[j] : left[j];
-            if (v != v)
-                v = -100.0;
-            else if (v < -100.0)
-                v = -100.0;
-            else if (v > 100.0)
-                v = 100.0;
-            drives[side * n + k] = (-b < v && v < b) ? 0.0 : v;
-        }
+        drives[k] = power_rule(left[j], band[k]);
+        drives[n + k] = power_rule(right[j], band[k]);
     }
     result = Py_None;
     Py_INCREF(result);
@@ -1936,6 +1981,19 @@ done:
  * +-0 given the divisor's sign); diff = gain * err; forward = power * (cos(err) if
  * cos(err) > 0 else 0, NaN giving 0); left = forward - diff, right = forward + diff. */
 
+static inline void steer_one(double heading, double angle, double cruise, double factor,
+                             double gain, double *left, double *right)
+{
+    const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+    const double power = cruise * factor;
+    const double err = py_mod(heading - angle + pi, two_pi) - pi;
+    const double diff = gain * err;
+    const double c = cos(err);
+    const double forward = power * (c > 0.0 ? c : 0.0);
+    *left = forward - diff;
+    *right = forward + diff;
+}
+
 static PyObject *steer_random(PyObject *Py_UNUSED(module), PyObject *args)
 {
     PyObject *objs[7];
@@ -1959,16 +2017,8 @@ static PyObject *steer_random(PyObject *Py_UNUSED(module), PyObject *args)
     const double *heading = views[0].buf, *angle = views[1].buf, *cruise = views[2].buf;
     const double *factor = views[3].buf, *gain = views[4].buf;
     double *left = views[5].buf, *right = views[6].buf;
-    const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
-    for (Py_ssize_t k = 0; k < n; k++) {
-        const double power = cruise[k] * factor[k];
-        const double err = py_mod(heading[k] - angle[k] + pi, two_pi) - pi;
-        const double diff = gain[k] * err;
-        const double c = cos(err);
-        const double forward = power * (c > 0.0 ? c : 0.0);
-        left[k] = forward - diff;
-        right[k] = forward + diff;
-    }
+    for (Py_ssize_t k = 0; k < n; k++)
+        steer_one(heading[k], angle[k], cruise[k], factor[k], gain[k], &left[k], &right[k]);
     result = Py_None;
     Py_INCREF(result);
 done:
@@ -1984,6 +2034,21 @@ done:
  * out: x, y, (angle + pi) % (2 pi) - pi (the floor modulo, as Python's and numpy's), vx cos(a)
  * + vy sin(a) (libm's, what a run alone computes with math.cos and math.sin), w, left rim,
  * right rim. */
+static inline void pose_one(const double *state, const double *rims, Py_ssize_t big_n,
+                            Py_ssize_t k, double *out, Py_ssize_t m)
+{
+    const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+    const double *r = state + 6 * k;
+    const double a = r[2];
+    out[0] = r[0];
+    out[m] = r[1];
+    out[2 * m] = py_mod(a + pi, two_pi) - pi;
+    out[3 * m] = r[3] * cos(a) + r[4] * sin(a);
+    out[4 * m] = r[5];
+    out[5 * m] = rims[k];
+    out[6 * m] = rims[big_n + k];
+}
+
 static PyObject *robot_poses(PyObject *Py_UNUSED(module), PyObject *args)
 {
     PyObject *objs[4];
@@ -2010,18 +2075,63 @@ static PyObject *robot_poses(PyObject *Py_UNUSED(module), PyObject *args)
             PyErr_SetString(PyExc_IndexError, "robot_poses: a rover index out of range");
             goto done;
         }
-    const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+    for (Py_ssize_t j = 0; j < m; j++)
+        pose_one(state, rims, big_n, (Py_ssize_t)index[j], out + j, m);
+    result = Py_None;
+    Py_INCREF(result);
+done:
+    for (int i = 0; i < held; i++)
+        PyBuffer_Release(&views[i]);
+    return result;
+}
+
+/* ---- leader_step: a random leader group's whole step (physics/freerobot.py) -------------
+ * Why: a random leader group (2.5 times a vector env's step) did steer_random, then
+ * ControlledRobot.step_many's column_powers and robot_poses: three calls, the angles
+ * gathered for the first, and ~8 us of Python around them whatever the batch's size. This
+ * is the three, one rover at a time, with their helpers (so their floats): rover index[j]'s
+ * steering from its angle (steer_one), its powers into the (2, n) drives (power_rule: the
+ * drives are read by no pose), its pose outputs into column j of the (7, m) out
+ * (pose_one). heading, cruise, factor, gain: (m,); band: (n,), as column_powers'. */
+static PyObject *leader_step(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    PyObject *objs[10];
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4],
+                          &objs[5], &objs[6], &objs[7], &objs[8], &objs[9]))
+        return NULL;
+    static const char *names[10] = {"heading", "state", "rims", "index", "cruise",
+                                    "factor",  "gain",  "band", "drives", "out"};
+    Py_buffer views[10];
+    PyObject *result = NULL;
+    const int held = acquire_views(objs, views, names, "dddiddddww", 10);
+    if (held < 10)
+        goto done;
+    const Py_ssize_t m = views[3].len / 8, big_n = views[1].len / (6 * 8);
+    if (views[0].len != m * 8 || views[4].len != m * 8 || views[5].len != m * 8 ||
+        views[6].len != m * 8 || views[1].len != big_n * 6 * 8 || views[2].len != 2 * big_n * 8 ||
+        views[7].len != big_n * 8 || views[8].len != 2 * big_n * 8 || views[9].len != 7 * m * 8) {
+        PyErr_SetString(PyExc_ValueError, "leader_step: heading, index, cruise, factor, gain "
+                                          "(m,), state (N, 6), rims (2, N), band (N,), drives "
+                                          "(2, N), out (7, m) expected");
+        goto done;
+    }
+    const double *heading = views[0].buf, *state = views[1].buf, *rims = views[2].buf;
+    const int64_t *index = views[3].buf;
+    const double *cruise = views[4].buf, *factor = views[5].buf, *gain = views[6].buf;
+    const double *band = views[7].buf;
+    double *drives = views[8].buf, *out = views[9].buf;
+    for (Py_ssize_t j = 0; j < m; j++)
+        if (index[j] < 0 || index[j] >= big_n) {
+            PyErr_SetString(PyExc_IndexError, "leader_step: a rover index out of range");
+            goto done;
+        }
     for (Py_ssize_t j = 0; j < m; j++) {
         const Py_ssize_t k = (Py_ssize_t)index[j];
-        const double *r = state + 6 * k;
-        const double a = r[2];
-        out[j] = r[0];
-        out[m + j] = r[1];
-        out[2 * m + j] = py_mod(a + pi, two_pi) - pi;
-        out[3 * m + j] = r[3] * cos(a) + r[4] * sin(a);
-        out[4 * m + j] = r[5];
-        out[5 * m + j] = rims[k];
-        out[6 * m + j] = rims[big_n + k];
+        double left, right;
+        steer_one(heading[j], state[6 * k + 2], cruise[j], factor[j], gain[j], &left, &right);
+        drives[k] = power_rule(left, band[k]);
+        drives[big_n + k] = power_rule(right, band[k]);
+        pose_one(state, rims, big_n, k, out + j, m);
     }
     result = Py_None;
     Py_INCREF(result);
@@ -2047,6 +2157,10 @@ static PyMethodDef module_methods[] = {
     {"robot_poses", robot_poses, METH_VARARGS,
      "robot_poses(state, rims, index, out): a robot group's pose outputs (x, y, heading, "
      "speed, yaw rate, rims) of the rovers at index into the (7, m) out."},
+    {"leader_step", leader_step, METH_VARARGS,
+     "leader_step(heading, state, rims, index, cruise, factor, gain, band, drives, out): a "
+     "random leader group's step (physics/freerobot.py): steer_random, column_powers and "
+     "robot_poses per rover."},
     {NULL, NULL, 0, NULL},
 };
 

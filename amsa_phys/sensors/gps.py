@@ -202,12 +202,19 @@ class GPS(Template):
         else:
             phi, q = gauss_markov(state, sigma, tau, now - state["t_prev"])
             fix = state["fix"]
-            if fix is not None and not (
-                state["history"] or derived(state, "any_latency", (p.latency,), np.any)
-            ):
-                state["t_prev"] = now
-                draws = (ex, ey, gx, gy, u_loss, u_burst)
-                return _fix_compiled(fix, comps, inp, p, state, draws, phi, q)
+            if fix is not None and not state["history"]:
+                # what the body reads that depends on the parameters alone, None with a
+                # latency (the numpy path keeps the history): one lookup a step
+                held = derived(
+                    state,
+                    "fix_params",
+                    (p.bias_mean, p.bias_stddev, p.burstLoss, p.burstLength, p.latency),
+                    _fix_params(state["on_z"], state["on_sign"]),
+                )
+                if held is not None:
+                    state["t_prev"] = now
+                    draws = (ex, ey, gx, gy, u_loss, u_burst)
+                    return _fix_compiled(fix, comps, inp, p, state, draws, phi, q, held)
             state["bx"] = phi * state["bx"] + q * gx
             state["by"] = phi * state["by"] + q * gy
         state["t_prev"] = now
@@ -257,25 +264,49 @@ def _fix_compiled(
     draws: tuple[np.ndarray, ...],
     phi: np.ndarray,
     q: np.ndarray,
+    held: tuple[np.ndarray, ...],
 ) -> tuple[Mapping[str, Any], np.ndarray]:
     """``step_many`` after the first step without latency, in one compiled call
     (``engine/batch_bodies.py``): the numpy path's operations in its order, so its floats;
-    the dynamic biases and the burst state updated in place."""
-    z, sign = state["on_z"], state["on_sign"]
-    on_x, on_y = derived(state, "turn_on", (p.bias_mean, p.bias_stddev), _turn_on_many(sign, z))
-    enter, leave = derived(state, "burst_chance", (p.burstLoss, p.burstLength), _burst_many)
+    the dynamic biases and the burst state updated in place. ``held``: the turn-on biases
+    and the burst chances (:func:`_fix_params`)."""
+    on_x, on_y, enter, leave = held
     n = len(comps)
-    x, y = np.empty(n), np.empty(n)
-    published, lost = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
+    kept = state.get("fix_out")
+    if kept is None or len(kept[0]) != n:
+        # made once a group: the engine copies a group's outputs and mask at once (and sends
+        # copies), so a template may reuse its arrays
+        kept = state["fix_out"] = (
+            np.empty(n), np.empty(n), np.empty(n, dtype=bool), np.empty(n, dtype=bool),
+            {},
+        )  # fmt: skip
+    x, y, published, lost, out = kept
     ex, ey, gx, gy, u_loss, u_burst = draws
     if fix(
         inp["posX"], inp["posY"], ex, ey, gx, gy, u_loss, u_burst, phi, q, p.mean, on_x, on_y,
         p.stddev, p.precision, enter, leave, p.lostDataGPS, state["bx"], state["by"],
         state["bad"], x, y, published, lost,
     ):  # fmt: skip
-        for k in np.flatnonzero(lost).tolist():
+        for k in lost.nonzero()[0].tolist():
             comps[k].lost += 1
-    return {"gpsPosX": x, "gpsPosY": y}, published
+    out["gpsPosX"], out["gpsPosY"] = x, y
+    return out, published
+
+
+def _fix_params(z: np.ndarray, sign: np.ndarray) -> Callable[..., tuple[np.ndarray, ...] | None]:
+    """For :func:`~amsa_phys.engine.batch.derived`: from parameter arrays ``(bias_mean,
+    bias_stddev, burstLoss, burstLength, latency)``, the compiled fix's ``(on_x, on_y,
+    enter, leave)`` (the numpy path's arithmetic: :func:`_turn_on_many`, :func:`_burst_many`),
+    or None when a copy has a latency (the numpy path's history then)."""
+
+    def make(
+        mean: np.ndarray, std: np.ndarray, loss: np.ndarray, length: np.ndarray, lat: np.ndarray
+    ) -> tuple[np.ndarray, ...] | None:
+        if np.any(lat):
+            return None
+        return (*_turn_on_many(sign, z)(mean, std), *_burst_many(loss, length))
+
+    return make
 
 
 def _burst_many(burst_loss: np.ndarray, length: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

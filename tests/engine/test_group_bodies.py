@@ -1,11 +1,13 @@
 """The compiled group bodies (``engine/batch_bodies.py``, ``_groupbodies.c``) against the
 numpy path of the same ``step_many``: a GPS and a compass group whose members differ in
 every parameter the bodies read, stepped side by side, give the same outputs, the same
-published rows, the same loss counts and the same state, to the bit."""
+published rows, the same loss counts and the same state, to the bit; a distance group's
+distances are ``math.hypot``'s, and a compass group's deviation is numpy's."""
 
 from __future__ import annotations
 
 import importlib.util
+import math
 from fractions import Fraction
 from typing import Any
 
@@ -166,3 +168,49 @@ def test_a_body_refuses_arrays_of_the_wrong_length() -> None:
     args[5] = np.zeros(2)
     with pytest.raises(ValueError, match="gy: one float64 per member"):
         fix(*args)
+
+
+@needs_c
+def test_a_distance_group_is_math_hypot_of_each_member() -> None:
+    """The DistanceMonitor group's compiled distances are ``math.hypot`` of each member's
+    differences (what a run alone computes), on ordinary, huge, tiny, signed-zero, infinite
+    and NaN coordinates, and the numpy path's."""
+    from amsa_phys.control.monitor import DistanceMonitor
+
+    rng = np.random.default_rng(8)
+    edges = [0.0, -0.0, 1e-310, -1e-310, 1.7e308, -1.7e308, np.inf, -np.inf, np.nan, 3.0, 4.0]
+    cols = [rng.normal(0, 50, 300) for _ in range(4)]
+    for col in cols:
+        col[: 3 * len(edges)] = rng.choice(edges, 3 * len(edges))
+    inp = dict(zip(("xLeader", "yLeader", "xFollower", "yFollower"), cols, strict=True))
+    comps = [object()] * 300
+    out, published = DistanceMonitor.step_many(comps, Fraction(0), inp, None, {})
+    got = out["distanceFollowerToLeader"]
+    assert published is None
+    with np.errstate(all="ignore"):
+        dx, dy = cols[0] - cols[2], cols[1] - cols[3]
+    want = [math.hypot(x, y) for x, y in zip(dx.tolist(), dy.tolist(), strict=True)]
+    assert got.tobytes() == np.array(want).tobytes()
+    with pytest.MonkeyPatch.context() as mp:  # the numpy path: no body found
+        mp.setattr(batch_bodies, "_body", lambda name: None)
+        with np.errstate(all="ignore"):
+            numpy_path, _ = DistanceMonitor.step_many(comps, Fraction(0), inp, None, {})
+    assert numpy_path["distanceFollowerToLeader"].tobytes() == got.tobytes()
+    assert np.isinf(got).any()
+    assert np.isnan(got).any()
+
+
+@needs_c
+def test_the_compass_deviation_body_is_the_numpy_deviation() -> None:
+    """The deviation's products and sums in C equal ``compass.deviation`` on arrays (numpy's
+    sines, then its products and sums), on headings of every size and each coefficient
+    mix, signed zeros and NaN included."""
+    from amsa_phys.sensors.compass import _deviation_many, deviation
+
+    rng = np.random.default_rng(9)
+    n = 400
+    h = np.concatenate([rng.uniform(-4, 4, n - 6), [0.0, -0.0, 1e6, -1e-300, np.nan, np.pi]])
+    coefficients = tuple(rng.choice([0.0, -0.0, 0.02, -0.013, 0.5, 1e-9], n) for _ in range(4))
+    got = _deviation_many({}, h, coefficients)
+    want = deviation(h, *coefficients)
+    assert got.tobytes() == want.tobytes()
