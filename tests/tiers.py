@@ -103,10 +103,11 @@ def cpu_seconds() -> float:
     """CPU seconds of this process and its waited-for children, less the background
     builds' (not any test's)."""
     own = resource.getrusage(resource.RUSAGE_SELF)
-    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
-    total = own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
     prebuild = sys.modules.get("ros_prebuild")
-    return total - (prebuild.cpu_spent() if prebuild is not None else 0.0)
+    if prebuild is not None:  # the builds' CPU taken off in the same reading (its lock)
+        return own.ru_utime + own.ru_stime + prebuild.tests_children_cpu()
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
 def unmarked(item: pytest.Item) -> bool:
