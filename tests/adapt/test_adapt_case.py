@@ -8,7 +8,6 @@ is one line and exit 2.
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
@@ -20,7 +19,6 @@ from amsa_phys.tune.contexts import box, sequences
 from amsa_phys.tune.evaluate import evaluate
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
 
 from benchmarks import adapt_case  # noqa: E402
 

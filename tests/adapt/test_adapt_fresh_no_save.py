@@ -14,7 +14,6 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
 
 from benchmarks import adapt_fresh  # noqa: E402
 from benchmarks import results as bench_results  # noqa: E402

@@ -9,17 +9,12 @@ from __future__ import annotations
 
 import math
 import statistics
-import sys
-from pathlib import Path
 
 import pytest
 from refusal import assert_one_line_refusal
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))  # `benchmarks` is the checkout's, not installed
-
-from benchmarks import adapt_seeds  # noqa: E402
-from benchmarks.adapt_seeds import (  # noqa: E402
+from benchmarks import adapt_seeds
+from benchmarks.adapt_seeds import (
     SpecError,
     parse_draws,
     parse_seeds,

@@ -11,7 +11,6 @@ save, keeps the saved ones as they were, and a resume over other seeds keeps not
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -20,12 +19,8 @@ import pytest
 import yaml
 
 from amsa_phys.adapt import derive
-
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))  # `benchmarks` is the checkout's, not installed
-
-from benchmarks import adapt_seeds  # noqa: E402
-from benchmarks import results as bench_results  # noqa: E402
+from benchmarks import adapt_seeds
+from benchmarks import results as bench_results
 
 
 class Stop(Exception):

@@ -8,18 +8,14 @@ robust gain, the rules, the oracle), and that the docs' block says what was fixe
 from __future__ import annotations
 
 import re
-import sys
 from pathlib import Path
 
 import pytest
 import yaml
 from refusal import assert_one_line_refusal
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))  # `benchmarks` is the checkout's, not installed
-
-from benchmarks import adapt_seeds  # noqa: E402
-from benchmarks.adapt_seeds import (  # noqa: E402
+from benchmarks import adapt_seeds
+from benchmarks.adapt_seeds import (
     SpecError,
     check_sweep_set,
     fix,

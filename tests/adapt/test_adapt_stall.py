@@ -8,13 +8,11 @@ sequences gained and lost against the shipped gains).
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))  # `benchmarks` is the checkout's, not installed
 
 from benchmarks import adapt_stall  # noqa: E402
 from benchmarks.adapt_stall import stalled_cases, summarise  # noqa: E402

@@ -3,15 +3,11 @@ is caught (exit 1, the sequence printed) while one that never switches is not.""
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT))
-
-from benchmarks import adapt_transitions  # noqa: E402
+from benchmarks import adapt_transitions
 
 
 def test_every_sequence_is_motors_that_recover() -> None:
