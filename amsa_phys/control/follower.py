@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from ..engine import libm
+from ..engine import batch_bodies, libm
 from ..engine.clock import seconds
 from ..model.params import Param
 from ..model.template import Kind, Port, Template
@@ -185,8 +185,12 @@ class FollowerController(Template):
         if "fixes" not in state:
             state["fixes"] = _grow(None, n, 16)
             state["v"] = np.zeros(n)
+            #: the whole step as one compiled call, where built (``engine/batch_bodies.py``)
+            state["body"] = batch_bodies.follower()
         v_leader = state["v"]
         xl, yl, d = inp["xLeader"], inp["yLeader"], inp["distanceLeaderFollower"]
+        if state["body"] is not None:
+            return _step_compiled(state, n, ts, inp, p), None
         active = d > 0.0
         # _update_speed, for the active copies whose leader fix is new
         T, X, Y, used = state["fixes"]
@@ -240,6 +244,42 @@ class FollowerController(Template):
             "RightPower": np.where(active, forward + turn, zero),
             "leaderSpeed": v_leader.copy(),
         }, None
+
+
+def _step_compiled(
+    state: dict[str, Any], n: int, ts: float, inp: Mapping[str, Any], p: Any
+) -> dict[str, np.ndarray]:
+    """``step_many``'s numpy path below as one compiled call (``_groupbodies.follower``): the
+    same floats bit for bit (``tests/engine/test_group_bodies.py``). The body changes nothing
+    and says so when a member's window needs more slots than there are: they double, as
+    the numpy path doubles them, and it runs again."""
+    out = {"LeftPower": np.empty(n), "RightPower": np.empty(n), "leaderSpeed": np.empty(n)}
+    fresh = state.get("fresh")
+    if fresh is None or len(fresh) != n:
+        fresh = state["fresh"] = np.zeros(n, dtype=bool)
+    args = (
+        inp["xLeader"],
+        inp["yLeader"],
+        inp["xFollower"],
+        inp["yFollower"],
+        inp["headingFollower"],
+        inp["distanceLeaderFollower"],
+        state["v"],
+        p.Kv,
+        p.Kw,
+        p.distanceRef,
+        p.Kff,
+        p.maxSpeed,
+        p.frictionPower,
+        p.speedWindow,
+        out["LeftPower"],
+        out["RightPower"],
+        out["leaderSpeed"],
+        fresh,
+    )
+    while not state["body"](ts, *state["fixes"], *args):
+        state["fixes"] = _grow(state["fixes"], n, 2 * state["fixes"][0].shape[1])
+    return out
 
 
 def _in_order(a: np.ndarray) -> np.ndarray:

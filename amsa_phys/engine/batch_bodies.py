@@ -40,6 +40,12 @@ def deviation() -> Any:
     return _body("deviation")
 
 
+def follower() -> Any:
+    """``_groupbodies.follower`` (a FollowerController group's whole step: its leader-speed
+    estimate and its powers), or None."""
+    return _body("follower")
+
+
 def write_outputs() -> Any:
     """``_groupbodies.write_outputs`` (a group's finite float64 output columns written into the
     store in one call, ``Steppers.step_group``), or None."""

@@ -214,3 +214,103 @@ def test_the_compass_deviation_body_is_the_numpy_deviation() -> None:
     got = _deviation_many({}, h, coefficients)
     want = deviation(h, *coefficients)
     assert got.tobytes() == want.tobytes()
+
+
+def _follower_steps(compiled: bool, steps: int = 120) -> list[bytes]:
+    """A FollowerController group stepped ``steps`` times at 10 Hz, every output and the
+    speed estimate's state after each step, as bytes: members whose leader fix repeats
+    (lost samples), jumps (a glitch), stays unmeasured (distance 0), or whose window holds
+    more fixes than the first slots (they double), with feed-forward on and off."""
+    from amsa_phys.control.follower import FollowerController
+
+    n = 12
+    rng = np.random.default_rng(11)
+    settings = [
+        {"Kv": 0.2, "Kw": 0.04, "Kff": 0.0, "speedWindow": 3.0},
+        {"Kv": 0.35, "Kw": 0.1, "Kff": 1.0, "speedWindow": 3.0},
+        {"Kv": 0.1, "Kw": 0.02, "Kff": 0.5, "speedWindow": 4.5},  # > 16 fixes: slots double
+        {"Kv": 0.6, "Kw": 0.3, "Kff": 2.0, "speedWindow": 0.25, "maxSpeed": 0.5},
+    ]
+    comps = [FollowerController(f"F{k}", settings[k % len(settings)]) for k in range(n)]
+    p = ParamArrays(comps)
+    state: dict[str, Any] = {}
+    xl = rng.uniform(-50, 50, n)
+    yl = rng.uniform(-50, 50, n)
+    seen: list[bytes] = []
+    with pytest.MonkeyPatch.context() as mp:
+        if not compiled:
+            mp.setattr(batch_bodies, "_body", lambda name: None)
+        for i in range(steps):
+            t = Fraction(i, 10)
+            moving = rng.random(n) < 0.8  # the rest repeat their last fix (a lost sample)
+            xl = np.where(moving, xl + rng.normal(0.05, 0.02, n), xl)
+            yl = np.where(moving, yl + rng.normal(0.03, 0.02, n), yl)
+            if i in (40, 41, 90):
+                # an impossible jump; 0.4 m where maxSpeed is 0.5 m/s, within a 0.25 s floor's
+                # reach of 2 x 0.5 x 0.25 = 0.25 m of it
+                k = np.arange(n)
+                xl = xl + np.where(k % 4 == 3, 0.4, np.where(k % 3 == 0, 40.0, 0.0))
+            xf = xl - rng.uniform(5, 25, n)
+            yf = yl + rng.normal(0, 2, n)
+            d = np.hypot(xl - xf, yl - yf)
+            d[np.arange(n) % 5 == 4] = 0.0 if i < 60 else d[np.arange(n) % 5 == 4]
+            inp = {
+                "xLeader": xl.copy(),
+                "yLeader": yl.copy(),
+                "xFollower": xf,
+                "yFollower": yf,
+                "headingFollower": rng.uniform(-4, 4, n),
+                "distanceLeaderFollower": d,
+            }
+            out, published = FollowerController.step_many(comps, t, inp, p, state)
+            assert published is None
+            seen.append(b"".join(np.asarray(out[k]).tobytes() for k in sorted(out)))
+            seen.append(b"".join(a.tobytes() for a in state["fixes"]) + state["v"].tobytes())
+    assert state["fixes"][0].shape[1] > 16  # the long window's slots doubled
+    return seen
+
+
+@needs_c
+def test_a_follower_group_is_its_numpy_path_bit_for_bit() -> None:
+    """The FollowerController group's compiled step gives the numpy path's powers, speed
+    estimates and fix windows, to the bit, step by step: through lost samples, impossible
+    jumps, unmeasured distances, feed-forward and a window that outgrows its slots."""
+    assert batch_bodies.follower() is not None
+    assert _follower_steps(True) == _follower_steps(False)
+
+
+@needs_c
+def test_a_follower_group_is_each_member_stepped_alone() -> None:
+    """Each member of a compiled FollowerController group commands what ``do_step`` of a
+    copy stepped alone commands (a batched sweep's rows are the runs made alone)."""
+    from amsa_phys.control.follower import FollowerController
+
+    n = 6
+    rng = np.random.default_rng(12)
+    settings = [{"Kff": 0.5 * (k % 3), "Kv": 0.1 + 0.05 * k} for k in range(n)]
+    group = [FollowerController(f"G{k}", settings[k]) for k in range(n)]
+    alone = [FollowerController(f"A{k}", settings[k]) for k in range(n)]
+    for a in alone:
+        a.initialize(None)
+    p = ParamArrays(group)
+    state: dict[str, Any] = {}
+    xl = rng.uniform(-20, 20, n)
+    for i in range(80):
+        t = Fraction(i, 10)
+        xl = xl + np.where(rng.random(n) < 0.7, 0.04, 0.0)
+        yl = np.full(n, 3.0)
+        xf, yf = xl - 15.5, yl + rng.normal(0, 0.5, n)
+        inp = {
+            "xLeader": xl,
+            "yLeader": yl,
+            "xFollower": xf,
+            "yFollower": yf,
+            "headingFollower": rng.uniform(-0.5, 0.5, n),
+            "distanceLeaderFollower": np.hypot(xl - xf, yl - yf),
+        }
+        out, _ = FollowerController.step_many(group, t, inp, p, state)
+        for k, a in enumerate(alone):
+            want = a.do_step(t, {name: float(col[k]) for name, col in inp.items()})
+            for name, value in want.items():
+                assert out[name][k] == value or (math.isnan(value) and math.isnan(out[name][k]))
+                assert math.copysign(1.0, out[name][k]) == math.copysign(1.0, value)
