@@ -558,6 +558,20 @@ def tables(doc: dict[str, Any]) -> dict[str, Any]:
     return found
 
 
+def robust_text(doc: dict[str, Any]) -> str:
+    """``Kv 0.2``: the robust point the rules fall back on, read from the rules scored (the
+    doc's own, or the committed file's): a sweep run with another setting may have another."""
+    import yaml
+
+    rules = doc.get("rules")
+    if rules is None:
+        rules = yaml.safe_load(RULES.read_text())["adapt"]
+    for rule in rules:
+        if str(rule.get("label", "")).startswith("robust"):
+            return ", ".join(f"{k.rsplit('.', 1)[-1]} {v:g}" for k, v in dict(rule["set"]).items())
+    return "fixed choice"
+
+
 def markdown(doc: dict[str, Any]) -> str:
     """The page's block: the three tables, then how they were made."""
     parts = []
@@ -571,12 +585,13 @@ def markdown(doc: dict[str, Any]) -> str:
     load_ = "–".join(f"{x:g}" for x in doc["load"])
     fixed = doc.get("set") or {}
     at = ", ".join(f"{k} {v:g}" for k, v in fixed.items())
+    robust = robust_text(doc)
     if fixed:
-        what = f"Rules derived from a sweep with {at} vs the robust Kv 0.2, every way with {at}"
+        what = f"Rules derived from a sweep with {at} vs the robust {robust}, every way with {at}"
     elif doc.get("sweep"):
-        what = f"Rules derived from `{doc['sweep']}` vs the robust Kv 0.2"
+        what = f"Rules derived from `{doc['sweep']}` vs the robust {robust}"
     else:
-        what = "Rules vs the robust Kv 0.2"
+        what = f"Rules vs the robust {robust}"
     parts.append(
         f"*{what}, 600 s: reached, losses above 2 %, worst, mean change; "
         f"s.e.: standard error of the mean change, paired by seed; a stall: {LEAST:g} s or "

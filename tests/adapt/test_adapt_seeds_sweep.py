@@ -120,3 +120,23 @@ def test_the_committed_fine_rules_are_the_fine_sweeps(tmp_path: Path) -> None:
     # the finer cells have rules of their own: measured between the coarser levels
     assert "part-worn motors" in labels
     assert "part-worn, random leader" in labels
+
+
+def test_the_block_names_the_robust_point_the_rules_fall_back_on() -> None:
+    """A sweep run with another setting may have another robust point: the caption says the
+    one the scored rules fall back on, not the shipped rules' Kv 0.2."""
+    doc = {
+        "seeds": [1, 2],
+        "command": "python -m benchmarks.adapt_seeds DIR --set MyFollowerController.Kff=1",
+        "draws": [],
+        "load": [1.0, 1.0, 1.0],
+        "date": "2026-11-29T17:00:00+00:00",
+        "set": {"MyFollowerController.Kff": 1.0},
+        "rules": [
+            {"when": {}, "set": {"MyFollowerController.Kv": 0.05}, "label": "damp, swinging"},
+            {"when": {}, "set": {"MyFollowerController.Kv": 0.15}, "label": "robust, unsure"},
+        ],
+    }
+    text = markdown(doc)
+    assert "vs the robust Kv 0.15, every way with MyFollowerController.Kff 1" in text
+    assert "Kv 0.2" not in text
