@@ -45,6 +45,7 @@ _MAIN = threading.main_thread().ident
 
 _installed = 0  # deferrals whose handler is in place (nested runs share one request)
 _requested = False
+_seen = False  # whether the pending request has been read (:func:`requested`) since it came
 _external: Any = None  # a worker process's stop flag, set by its parent (multiprocessing.Event)
 _stepping = 0  # main-thread runs inside ``advance`` (:func:`stepping`)
 _alarm: Any = None  # the SIGALRM handler replaced while the grace timer is armed
@@ -116,7 +117,11 @@ def stepping() -> Iterator[None]:
 
 def requested() -> bool:
     """Whether a stop was requested during the current run (or by this worker's parent)."""
-    return _requested or (_external is not None and _external.is_set())
+    global _seen
+    if _requested:
+        _seen = True  # somebody now knows: the deferral's end need not raise it (deferred)
+        return True
+    return _external is not None and _external.is_set()
 
 
 def follow(stop: Any) -> None:
@@ -142,24 +147,38 @@ def check() -> None:
 @contextmanager
 def deferred() -> Iterator[None]:
     """While active, SIGINT (if Python's default handler has it) and the CLI's SIGTERM
-    (:func:`sigterm_as_ctrl_c`, whoever owns SIGINT) only request a stop."""
-    global _installed, _requested
+    (:func:`sigterm_as_ctrl_c`, whoever owns SIGINT) only request a stop.
+
+    A request nobody read (:func:`requested`) by the time the outermost deferral ends, and
+    the block ended without an exception, is raised then, as KeyboardInterrupt: it came
+    after the block's last look (a Ctrl-C while a progress bar closed, say), and dropping it
+    would ignore the user's Ctrl-C, as a falsify run once did, finishing its search and
+    exiting 1 instead of 130. A request that was read is the reader's to act on.
+    """
+    global _installed, _requested, _seen
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     take_sigint = signal.getsignal(signal.SIGINT) in (signal.default_int_handler, request)
     previous = signal.signal(signal.SIGINT, request) if take_sigint else None
     if not _installed:
-        _requested = False
+        _requested = _seen = False
     _installed += 1
+    failed = False
     try:
         yield
+    except BaseException:
+        failed = True
+        raise
     finally:
         _installed -= 1
         if take_sigint:
             signal.signal(signal.SIGINT, previous)
         if not _installed:
-            _requested = False
+            unread = _requested and not _seen
+            _requested = _seen = False
+            if unread and not failed:
+                raise KeyboardInterrupt
 
 
 @contextmanager

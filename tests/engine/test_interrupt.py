@@ -92,3 +92,30 @@ def test_ctrl_c_after_the_last_instant_keeps_complete_outputs(tmp_path: Path) ->
     metrics = json.loads((tmp_path / "metrics.json").read_text())
     assert (metrics["status"], metrics["simulated"]) == ("completed", 3.0)
     assert (tmp_path / "scenario.yaml").exists()
+
+
+def test_a_request_after_the_blocks_last_look_is_raised_at_its_end() -> None:
+    """A Ctrl-C noted after the deferring block last looked (while a progress bar closes)
+    is raised when the block ends, not dropped: the command stops as the user asked."""
+    with pytest.raises(KeyboardInterrupt), interrupt.deferred():
+        os.kill(os.getpid(), signal.SIGINT)  # noted; nobody reads it before the end
+    assert not interrupt.requested()
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_a_request_read_in_the_block_is_the_readers_to_act_on() -> None:
+    """A request the block read (and acted on: a run that ends its outputs, say) is not
+    raised again at its end; nor does it replace an exception the block raised."""
+    with interrupt.deferred():
+        with interrupt.deferred():  # nested: the outermost end decides
+            os.kill(os.getpid(), signal.SIGINT)
+        assert interrupt.requested()
+
+    def fails() -> None:
+        with interrupt.deferred():
+            os.kill(os.getpid(), signal.SIGINT)
+            raise ValueError("the block's own")
+
+    with pytest.raises(ValueError, match="the block's own"):
+        fails()
+    assert not interrupt.requested()
