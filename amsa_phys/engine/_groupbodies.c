@@ -553,6 +553,15 @@ static int hypot_exceeds(double x, double y, double limit)
     return exact > limit;
 }
 
+/* Three running sums of a row's items, as the numpy path's in-order sum (the last item of
+ * ``np.cumsum``) makes them: item 0 as it is (not 0.0 + it), then each item added. */
+static inline void add_in_order(Py_ssize_t j, double acc[3], double a, double b, double c)
+{
+    acc[0] = j ? acc[0] + a : a;
+    acc[1] = j ? acc[1] + b : b;
+    acc[2] = j ? acc[2] + c : c;
+}
+
 /* A C-contiguous (n, slots) buffer of float64 ('d') or bool ('?') items, writable. */
 static int take_slots(PyObject *obj, char want, const char *name, Py_ssize_t n,
                       Py_ssize_t *slots, Py_buffer *view)
@@ -653,38 +662,20 @@ static PyObject *follower(PyObject *Py_UNUSED(module), PyObject *args)
         m[last] = 1;
         const double oldest = ts - AT(c[13], k, double);
         Py_ssize_t count = 0;
-        double st = 0.0, sx = 0.0, sy = 0.0;
+        double mean[3] = {0.0, 0.0, 0.0}; /* t, x, y */
         for (Py_ssize_t j = 0; j < slots; j++) {
             m[j] = m[j] && t_[j] >= oldest;
             count += m[j];
-            const double a = m[j] ? t_[j] : 0.0, b = m[j] ? x_[j] : 0.0,
-                         e = m[j] ? y_[j] : 0.0;
-            if (j == 0) { /* cumsum starts from the first item, not from 0.0 + it */
-                st = a;
-                sx = b;
-                sy = e;
-            } else {
-                st = st + a;
-                sx = sx + b;
-                sy = sy + e;
-            }
+            add_in_order(j, mean, m[j] ? t_[j] : 0.0, m[j] ? x_[j] : 0.0, m[j] ? y_[j] : 0.0);
         }
         const double div = (double)(count > 1 ? count : 1);
-        const double mt = st / div, mx = sx / div, my = sy / div;
-        double stt = 0.0, stx = 0.0, sty = 0.0;
+        const double mt = mean[0] / div, mx = mean[1] / div, my = mean[2] / div;
+        double s[3] = {0.0, 0.0, 0.0}; /* stt, stx, sty */
         for (Py_ssize_t j = 0; j < slots; j++) {
             const double d = m[j] ? t_[j] - mt : 0.0;
-            const double tt = d * d, tx = d * (x_[j] - mx), ty = d * (y_[j] - my);
-            if (j == 0) {
-                stt = tt;
-                stx = tx;
-                sty = ty;
-            } else {
-                stt = stt + tt;
-                stx = stx + tx;
-                sty = sty + ty;
-            }
+            add_in_order(j, s, d * d, d * (x_[j] - mx), d * (y_[j] - my));
         }
+        const double stt = s[0], stx = s[1], sty = s[2];
         if (count >= 2 && stt > 0) {
             double v;
             if (py_hypot(stx / stt, sty / stt, &v) < 0)
