@@ -136,16 +136,32 @@ def test_free_mode_metrics_within_bounds(
     logs = "".join(p.read_text() for p in (workspace / "roshome" / "log").rglob("*.log"))
     assert "/MyFollowerController/Kv: 20 is above the maximum 10" in logs
     # the scenario node's change of the C++ node's motorCoef (100 -> 80 at t = 46/3 s) took
-    # effect: every delivered power is a commanded one times 1.0 before, times 0.8 after
+    # effect: a delivered power is a commanded one times 1.0 before, times 0.8 after. The
+    # trace samples both topics at its own rate, so a command the node took may never have
+    # been sampled (on a loaded machine the controller can publish twice between two rows):
+    # nearly every row, not every one, shows the commanded value it was delivered from
     rows = list(csv.reader((out / "trace.csv").open()))
     col = {c: i for i, c in enumerate(rows[0])}
     commanded = {float(r[col["MyFollowerController.LeftPower"]]) for r in rows[1:]}
-    for r in rows[1:]:
-        t, delivered = float(r[0]), float(r[col["MyNormalizePower.normalizedPowerL"]])
-        if t < 15.2 and delivered != 0.0:
-            assert any(min(100.0, max(-100.0, u)) * 1.0 == delivered for u in commanded), t
-        if t > 17.0:  # the node takes the new value at its next step
-            assert any(min(100.0, max(-100.0, u)) * 0.8 == delivered for u in commanded), t
+
+    def share(coef: float, keep: Callable[[float, float], bool]) -> tuple[float, int]:
+        """(share of the kept rows whose delivered power is a commanded one times coef,
+        kept rows)"""
+        kept = [
+            float(r[col["MyNormalizePower.normalizedPowerL"]])
+            for r in rows[1:]
+            if keep(float(r[0]), float(r[col["MyNormalizePower.normalizedPowerL"]]))
+        ]
+        hits = sum(any(min(100.0, max(-100.0, u)) * coef == d for u in commanded) for d in kept)
+        return hits / max(1, len(kept)), len(kept)
+
+    before, n_before = share(1.0, lambda t, d: t < 15.2 and d != 0.0)
+    after, n_after = share(0.8, lambda t, d: t > 17.0)  # taken at the node's next step
+    assert n_before >= 10, n_before
+    assert n_after >= 10, n_after
+    assert before >= 0.9, before
+    assert after >= 0.9, after
+    assert share(1.0, lambda t, d: t > 17.0 and d != 0.0)[0] <= 0.1  # not the old coefficient
 
 
 def test_ctrl_c_stops_every_node_and_keeps_the_outputs(
