@@ -398,49 +398,60 @@ static PyObject *gather_inputs(PyObject *Py_UNUSED(module), PyObject *args)
     Py_RETURN_NONE;
 }
 
+/* math.hypot, CPython's own algorithm (libm's hypot may round otherwise), looked up once. */
+static PyObject *hypot_fn = NULL;
+
+/* math.hypot(x, y) into *out; -1 with the Python error set on failure. */
+static int py_hypot(double x, double y, double *out)
+{
+    if (hypot_fn == NULL) {
+        PyObject *math = PyImport_ImportModule("math");
+        if (math == NULL)
+            return -1;
+        hypot_fn = PyObject_GetAttrString(math, "hypot");
+        Py_DECREF(math);
+        if (hypot_fn == NULL)
+            return -1;
+    }
+    PyObject *pair[2];
+    pair[0] = PyFloat_FromDouble(x);
+    pair[1] = PyFloat_FromDouble(y);
+    PyObject *h = NULL;
+    if (pair[0] != NULL && pair[1] != NULL)
+        h = PyObject_Vectorcall(hypot_fn, pair, 2, NULL);
+    Py_XDECREF(pair[0]);
+    Py_XDECREF(pair[1]);
+    if (h == NULL)
+        return -1;
+    *out = PyFloat_AS_DOUBLE(h);
+    Py_DECREF(h);
+    return 0;
+}
+
 /* ---- distance: a DistanceMonitor group's distances (control/monitor.py) -----------------
  * DistanceMonitor.step_many's path, member k: math.hypot(xl - xf, yl - yf), the differences
  * rounded once as numpy's, and the hypot called as math.hypot itself (its bits are
  * CPython's, whatever the version: libm.hypot's element by element), into out.
  * Why: mapping math.hypot over the members' lists from Python was ~0.1 us a member and most of
  * the group's step at 64 envs. */
-static PyObject *hypot_fn = NULL;
-
 static PyObject *distance(PyObject *Py_UNUSED(module), PyObject *args)
 {
     static const char *names[5] = {"xLeader", "yLeader", "xFollower", "yFollower", "out"};
     PyObject *objs[5];
     if (!PyArg_ParseTuple(args, "OOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4]))
         return NULL;
-    if (hypot_fn == NULL) {
-        PyObject *math = PyImport_ImportModule("math");
-        if (math == NULL)
-            return NULL;
-        hypot_fn = PyObject_GetAttrString(math, "hypot");
-        Py_DECREF(math);
-        if (hypot_fn == NULL)
-            return NULL;
-    }
     Py_buffer views[5];
     Column c[5];
     Py_ssize_t n = 0;
     if (take(objs, "ddddD", names, 5, views, c, &n) < 0)
         return NULL;
     for (Py_ssize_t k = 0; k < n; k++) {
-        PyObject *pair[2];
-        pair[0] = PyFloat_FromDouble(AT(c[0], k, double) - AT(c[2], k, double));
-        pair[1] = PyFloat_FromDouble(AT(c[1], k, double) - AT(c[3], k, double));
-        PyObject *h = NULL;
-        if (pair[0] != NULL && pair[1] != NULL)
-            h = PyObject_Vectorcall(hypot_fn, pair, 2, NULL);
-        Py_XDECREF(pair[0]);
-        Py_XDECREF(pair[1]);
-        if (h == NULL) {
+        const double dx = AT(c[0], k, double) - AT(c[2], k, double);
+        const double dy = AT(c[1], k, double) - AT(c[3], k, double);
+        if (py_hypot(dx, dy, &AT(c[4], k, double)) < 0) {
             release(views, 5);
             return NULL;
         }
-        AT(c[4], k, double) = PyFloat_AS_DOUBLE(h);
-        Py_DECREF(h);
     }
     release(views, 5);
     Py_RETURN_NONE;
@@ -510,33 +521,6 @@ static double m_atan2(double y, double x)
     if (isinf(x) || y == 0.0)
         return copysign(copysign(1.0, x) == 1.0 ? 0.0 : Py_MATH_PI, y);
     return atan2(y, x);
-}
-
-/* math.hypot(x, y) into *out; -1 with the Python error set on failure. */
-static int py_hypot(double x, double y, double *out)
-{
-    if (hypot_fn == NULL) {
-        PyObject *math = PyImport_ImportModule("math");
-        if (math == NULL)
-            return -1;
-        hypot_fn = PyObject_GetAttrString(math, "hypot");
-        Py_DECREF(math);
-        if (hypot_fn == NULL)
-            return -1;
-    }
-    PyObject *pair[2];
-    pair[0] = PyFloat_FromDouble(x);
-    pair[1] = PyFloat_FromDouble(y);
-    PyObject *h = NULL;
-    if (pair[0] != NULL && pair[1] != NULL)
-        h = PyObject_Vectorcall(hypot_fn, pair, 2, NULL);
-    Py_XDECREF(pair[0]);
-    Py_XDECREF(pair[1]);
-    if (h == NULL)
-        return -1;
-    *out = PyFloat_AS_DOUBLE(h);
-    Py_DECREF(h);
-    return 0;
 }
 
 /* math.hypot(x, y) > limit (libm.hypot_exceeds): libm's hypot decides wherever it is
