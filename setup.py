@@ -1,5 +1,6 @@
 """The optional compiled physics step (``amsa_phys/physics/_step.c``) and the engine's compiled
-write of published outputs (``amsa_phys/engine/_publish.c``); the rest is pyproject.toml.
+write of published outputs (``amsa_phys/engine/_publish.c``) and its other C helpers; the rest
+is pyproject.toml.
 
 ``optional=True``: where there is no C compiler (or no Python headers) the build of the
 extension fails quietly and the install goes on; ``amsa_phys.physics.compiled`` then finds no
@@ -8,7 +9,33 @@ extension fails quietly and the install goes on; ``amsa_phys.physics.compiled`` 
 CPython does, or the traces would differ from the pure path's.
 """
 
+import os
+
 from setuptools import Extension, setup
+
+
+def _numpy_random() -> list[Extension]:
+    """The draws extension (``amsa_phys/engine/_draws.c``), linked with the static library of
+    numpy's distributions that numpy ships for extensions; none where numpy (a build
+    requirement) cannot be imported or ships no such library."""
+    try:
+        import numpy
+    except ImportError:
+        return []
+    lib = os.path.join(os.path.dirname(numpy.__file__), "random", "lib")
+    if not os.path.exists(os.path.join(lib, "libnpyrandom.a")):
+        return []
+    return [
+        Extension(
+            "amsa_phys.engine._draws",
+            ["amsa_phys/engine/_draws.c"],
+            include_dirs=[numpy.get_include()],
+            library_dirs=[lib],
+            libraries=["npyrandom", "m"],
+            optional=True,
+        )
+    ]
+
 
 #: Python's float ``%`` in C, included by three of the extensions (their angle wrapping)
 PYMOD = "amsa_phys/pymod.h"
@@ -47,5 +74,7 @@ setup(
         ),
         # numpy's SeedSequence state for the runs' random streams (``engine/rng.py``)
         Extension("amsa_phys.engine._seeds", ["amsa_phys/engine/_seeds.c"], optional=True),
+        # a group's random streams refilled in one call (``engine/rng.py``)
+        *_numpy_random(),
     ]
 )
