@@ -88,7 +88,7 @@ def _run(
         from ..view.window import open_display
 
         try:
-            open_display()
+            open_display(interactive=True)
         except RuntimeError as exc:
             raise ConfigError(f"{exc}; run with --headless", key="run") from None
     scenario = load_scenario(

@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
     from ..view.window import open_display
 
     try:
-        open_display()
+        open_display(interactive=True)
     except RuntimeError as exc:
         raise ConfigError(
             f"{exc}; `amsa-phys plot` draws the run's pictures without one", key="view"

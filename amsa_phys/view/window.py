@@ -62,7 +62,11 @@ HELP = [  # every key _key and _panel_key handle
 ]
 
 
-def open_display() -> None:
+#: SDL's video drivers that show nothing: a window on them is never seen
+INVISIBLE_DRIVERS = ("offscreen", "dummy")
+
+
+def open_display(interactive: bool = False) -> None:
     """Start SDL's video, or raise ``RuntimeError`` saying why no window can be shown.
 
     With no X11/Wayland display SDL quietly falls back to its ``offscreen`` driver: a window
@@ -70,7 +74,18 @@ def open_display() -> None:
     asked for an offscreen driver explicitly with ``SDL_VIDEODRIVER``. On Linux with neither
     ``DISPLAY`` nor ``WAYLAND_DISPLAY`` set we refuse before asking SDL: its Wayland probe
     would print its own ``error: XDG_RUNTIME_DIR ...`` line above ours.
+
+    ``interactive``: a session that ends only when its window is closed (``run`` without
+    ``--headless``, ``view``). On an invisible driver nobody can close it, so it is refused
+    even when ``SDL_VIDEODRIVER`` asks for that driver (``SDL_VIDEODRIVER=dummy`` is a common
+    setting for headless tests; with it such a session used to wait for ever).
     """
+    asked = os.environ.get("SDL_VIDEODRIVER", "")
+    if interactive and asked.strip().lower() in INVISIBLE_DRIVERS:
+        raise RuntimeError(
+            f"SDL_VIDEODRIVER={asked.strip()} shows no window, and the session would wait for "
+            "ever for it to be closed"
+        )
     env = os.environ
     if (
         sys.platform.startswith("linux")
@@ -84,8 +99,12 @@ def open_display() -> None:
     except pygame.error as exc:
         raise RuntimeError(f"cannot open a window: {exc}") from None
     driver = pygame.display.get_driver()
-    if driver in ("offscreen", "dummy") and not os.environ.get("SDL_VIDEODRIVER"):
+    if driver in INVISIBLE_DRIVERS and (interactive or not asked):
         pygame.display.quit()
+        if asked:  # another name SDL maps to an invisible driver
+            raise RuntimeError(
+                f"SDL_VIDEODRIVER={asked} opens SDL's {driver} driver, which shows no window"
+            )
         raise RuntimeError("no display to open a window on (no X11 or Wayland session)")
 
 

@@ -32,7 +32,7 @@ class _Shown:
 def no_window(monkeypatch: pytest.MonkeyPatch) -> type[_Shown]:
     _Shown.scenes = []
     monkeypatch.setattr(player_module, "Player", _Shown)
-    monkeypatch.setattr(window_module, "open_display", lambda: None)
+    monkeypatch.setattr(window_module, "open_display", lambda interactive=False: None)
     return _Shown
 
 

@@ -166,6 +166,63 @@ def test_a_window_without_a_display_is_refused_clearly(tmp_path: Path) -> None:
     assert not (tmp_path / "w").exists()
 
 
+@pytest.mark.parametrize("driver", ["dummy", "offscreen", " Dummy "])
+def test_a_window_on_an_invisible_driver_is_refused_not_waited_on(
+    tmp_path: Path, driver: str
+) -> None:
+    """``SDL_VIDEODRIVER=dummy`` (a common headless setting) and ``run`` without
+    ``--headless``: the window could never be closed, so the run would wait for ever after
+    its end. Refused, one line, nothing written; ``view`` alike."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "SDL_VIDEODRIVER": driver}
+    out = tmp_path / "w"
+    proc = subprocess.run(
+        [sys.executable, "-m", "amsa_phys", "run", str(SCENARIO), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=False,
+        timeout=120,  # a hang fails here instead of holding the suite
+    )
+    assert proc.returncode == 2
+    assert proc.stderr == (
+        f"error: run: SDL_VIDEODRIVER={driver.strip()} shows no window, and the session "
+        "would wait for ever for it to be closed; run with --headless\n"
+    )
+    assert not out.exists()
+    rundir = tmp_path / "r"
+    assert (
+        main(
+            [
+                "run",
+                str(SCENARIO),
+                "--headless",
+                "--out",
+                str(rundir),
+                "-q",
+                "--no-plot",
+                "--duration",
+                "2",
+            ]
+        )
+        == 0
+    )
+    proc = subprocess.run(
+        [sys.executable, "-m", "amsa_phys", "view", str(rundir)],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=False,
+        timeout=120,
+    )
+    assert proc.returncode == 2
+    assert proc.stderr.startswith(f"error: view: SDL_VIDEODRIVER={driver.strip()} shows no window")
+    assert proc.stderr.count("\n") == 1
+
+
 @pytest.mark.usefixtures("python_sigint")
 def test_ctrl_c_in_the_terminal_stops_a_paused_window(tmp_path: Path) -> None:
     import json
