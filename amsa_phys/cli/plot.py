@@ -8,11 +8,12 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import AmsaError, ConfigError, one_line
+from ..requirements.objective import requirement_of
 from ..runs.plotjob import draw_run_plots, plot_context
 from ..runs.rundata import read_world
 from ..runs.rundir import check_output
 from ..runs.runfiles import read_metrics, trace_header
-from ..runs.sweep import read_results, unknown_metric
+from ..runs.sweep import read_results, unknown_sweep_metric
 from .paperplots import plot_losses, plot_starts
 from .paperruns import paper_run, paper_scenarios
 
@@ -121,7 +122,8 @@ def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
     rows, axes = read_results(sweepdir / "results.csv")
     metric = args.metric or "rms_error"
     phases = sum(1 for key in rows[0] if key.endswith(".rms_error")) if rows else 0
-    why = unknown_metric(metric, phases)
+    requirements = [k for k in (requirement_of(c) for c in (rows[0] if rows else ())) if k]
+    why = unknown_sweep_metric(metric, phases, requirements)
     if why is not None:
         raise ConfigError(why, key="--metric")
     seeds = len({r["seed_index"] for r in rows})

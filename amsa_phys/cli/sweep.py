@@ -34,7 +34,7 @@ from ..runs.sweep import (
     parse_grid,
     parse_range,
     timeline_overlaps,
-    unknown_metric,
+    unknown_sweep_metric,
 )
 from ..runs.sweepbest import best_line
 from .options import add_jobs
@@ -128,7 +128,11 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
                 raise doc.error(("sweep", "contexts", name, key), str(exc)) from None
     metric = args.metric or section.get("metric", "rms_error")
     end = args.duration if args.duration is not None else scenario.duration
-    why = unknown_metric(metric, len(scenario.timeline.phases_before(end)))
+    why = unknown_sweep_metric(
+        metric,
+        len(scenario.timeline.phases_before(end)),
+        [str(e.name) for e in scenario.expect if e.stl is not None],
+    )
     if why is not None:
         if args.metric is None:
             raise doc.error(("sweep", "metric"), why)

@@ -10,6 +10,7 @@ import csv
 import io
 import math
 import re
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -17,6 +18,7 @@ from ..errors import ConfigError
 from ..model.metrics import METRICS
 from ..model.params import short_repr
 from ..model.suggest import did_you_mean
+from ..requirements.objective import requirement_of, unknown_objective
 
 #: Metric columns written for the overall block and each phase.
 METRIC_KEYS = METRICS
@@ -51,6 +53,15 @@ def unknown_metric(metric: str, n_phases: int) -> str | None:
         else "; or phase0.<metric>" * n_phases
     )
     return f"unknown metric {metric!r}{hint}; known: {', '.join(METRIC_KEYS)}{phases}"
+
+
+def unknown_sweep_metric(metric: str, n_phases: int, requirements: Sequence[str]) -> str | None:
+    """Why ``metric`` names no column of a sweep's ``results.csv`` (None if it does): a
+    metric as :func:`unknown_metric` says, or ``robustness.NAME`` of one of the scenario's
+    STL ``requirements`` (the column each adds)."""
+    if requirement_of(metric) is not None:
+        return unknown_objective(metric, n_phases, requirements)
+    return unknown_metric(metric, n_phases)
 
 
 def read_results(path: Path) -> tuple[list[dict[str, Any]], list[str]]:

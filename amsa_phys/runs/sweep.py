@@ -47,6 +47,7 @@ from .results import METRIC_KEYS as METRIC_KEYS
 from .results import metric_names as metric_names
 from .results import read_results as read_results
 from .results import unknown_metric as unknown_metric
+from .results import unknown_sweep_metric as unknown_sweep_metric
 from .rundir import prepare_run_dir
 from .single import compute_metrics, default_simulation, run_scenario
 

@@ -32,3 +32,48 @@ def test_a_phase_the_runs_do_not_reach_is_not_called_a_typo() -> None:
 def test_a_known_column_is_accepted() -> None:
     assert unknown_metric("phase1.max_after_approach", 2) is None
     assert unknown_metric("max_after_approach", 0) is None
+
+
+def test_a_requirements_robustness_is_a_sweep_column() -> None:
+    """``robustness.NAME`` of one of the scenario's STL requirements names its column; a
+    misspelt requirement gets the nearest name and the list of those there are."""
+    from amsa_phys.runs.results import unknown_sweep_metric
+
+    assert unknown_sweep_metric("robustness.band", 1, ["band", "settled"]) is None
+    assert unknown_sweep_metric("rms_error", 1, ["band"]) is None
+    why = unknown_sweep_metric("robustness.bnd", 1, ["band", "settled"])
+    assert why == "unknown requirement 'bnd' (did you mean band?); known: band, settled"
+    why = unknown_sweep_metric("robustness.band", 1, [])
+    assert why is not None and why.startswith("unknown requirement 'band'; known: none")
+    assert unknown_sweep_metric("max_after", 1, ["band"]) == unknown_metric("max_after", 1)
+
+
+def test_sweep_and_plot_take_a_robustness_metric(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    """The end to end of the docs' promise: ``sweep --metric robustness.NAME`` runs, prints
+    the highest mean as best, and ``plot --metric robustness.NAME`` redraws its summary; a
+    misspelt name is refused by both, exit 2, one line."""
+    from pathlib import Path
+
+    from amsa_phys.cli.main import main
+
+    scenario = Path(__file__).resolve().parents[2] / "scenarios" / "paper_fig5_kv01.yaml"
+    out = tmp_path / "s"
+    argv = ["sweep", str(scenario), "--grid", "MyFollowerController.Kv=0.05,0.1", "-j", "1"]
+    argv += ["--out", str(out), "--metric", "robustness.settled_by_150"]
+    assert main(argv) == 0
+    said = capsys.readouterr().out.splitlines()
+    assert said[-1].startswith(
+        "best (highest robustness.settled_by_150): MyFollowerController.Kv=0.1 -> "
+    )
+    png = tmp_path / "r.png"
+    assert main(["plot", str(out), "--metric", "robustness.settled_by_150", "-o", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    capsys.readouterr()
+    assert main(["plot", str(out), "--metric", "robustness.setled_by_150"]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        "error: --metric: unknown requirement 'setled_by_150' (did you mean settled_by_150?); "
+        "known: settled_by_150\n"
+    )
+    assert main([*argv[:-4], "--out", str(tmp_path / "t"), "--metric", "robustness.x"]) == 2
+    assert not (tmp_path / "t").exists()
