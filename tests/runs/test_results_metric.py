@@ -44,7 +44,8 @@ def test_a_requirements_robustness_is_a_sweep_column() -> None:
     why = unknown_sweep_metric("robustness.bnd", 1, ["band", "settled"])
     assert why == "unknown requirement 'bnd' (did you mean band?); known: band, settled"
     why = unknown_sweep_metric("robustness.band", 1, [])
-    assert why is not None and why.startswith("unknown requirement 'band'; known: none")
+    assert why is not None
+    assert why.startswith("unknown requirement 'band'; known: none")
     assert unknown_sweep_metric("max_after", 1, ["band"]) == unknown_metric("max_after", 1)
 
 
