@@ -201,7 +201,22 @@ def build_parser(only: str | Literal[False] | None = False) -> argparse.Argument
             module = command_module(name)
             module.add_args(p)
             p.set_defaults(func=module.run)
+            _debug_in_nested(p, debug_help)
     return parser
+
+
+def _debug_in_nested(parser: argparse.ArgumentParser, debug_help: str) -> None:
+    """``--debug`` accepted after a command's own subcommand too (``amsa-phys export ros2 ...
+    --debug``), as after the command: each nested parser gets it, defaulting to SUPPRESS
+    so that a ``--debug`` given earlier stands."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for nested in dict.fromkeys(action.choices.values()):
+                if "--debug" not in nested._option_string_actions:
+                    nested.add_argument(
+                        "--debug", action="store_true", default=argparse.SUPPRESS, help=debug_help
+                    )
+                _debug_in_nested(nested, debug_help)
 
 
 #: Exit code when the reader of our output went away (``amsa-phys templates | head -1``):

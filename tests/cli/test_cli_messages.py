@@ -236,3 +236,24 @@ def test_a_video_option_without_a_video_is_refused_before_anything_runs(
     assert code == 2
     assert capsys.readouterr().err == said
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["export", "amsa", "w.yaml", "-o", "X"],
+        ["export", "ros2", "w.yaml", "-o", "X"],
+        ["export", "ros", "w.yaml", "-o", "X"],
+        ["ros2", "lockstep", "PKG"],
+    ],
+)
+def test_debug_is_taken_after_a_commands_own_subcommand(argv: list[str]) -> None:
+    """``--debug`` goes before or after the command (the docs); after a nested subcommand
+    too, where it was refused (``unrecognized arguments: --debug (did you mean --debug?)``).
+    Given before, a nested parser does not reset it."""
+    from amsa_phys.cli.main import build_parser
+
+    parser = build_parser(only=argv[0])
+    assert parser.parse_args([*argv, "--debug"]).debug is True
+    assert parser.parse_args(["--debug", *argv]).debug is True
+    assert parser.parse_args(argv).debug is False
