@@ -176,8 +176,47 @@ def read_run(
         resolved = doc.data if isinstance(doc.data, dict) else None
         if resolved is None:
             raise doc.error((), "not a resolved scenario: expected a mapping")
-        world = world_of(doc, trace_header(trace), note)
+        world = _checked_world(doc, trace_header(trace), note)
     return RunDir(rundir, metrics, trace, resolved, world, notes)
+
+
+def _checked_world(doc: YamlDoc, trace_columns: Sequence[str], warn: Warn) -> RunWorld:
+    """:func:`world_of` a resolved scenario checked first as a scenario (its keys and their
+    shapes) and after for what it sets on built-in templates: a hand edit is refused with
+    its line and key, as ``amsa-phys validate`` refuses it."""
+    if not isinstance(doc.data, dict):
+        raise doc.error((), "not a resolved scenario: expected a mapping")
+    schema.validate(doc.data, schema.SCENARIO, doc)
+    world = world_of(doc, trace_columns, warn)
+    _check_sets(doc, doc.data, world)
+    return world
+
+
+def _check_sets(doc: YamlDoc, resolved: dict[str, Any], world: RunWorld) -> None:
+    """Each value ``set:`` and the timeline give a parameter of a built-in template, judged by
+    the template's own parameter (a number where a number is declared, within its range);
+    a parameter of a template that is not built in, or a key naming no leaf, is left as
+    written (judging it would need the template's code, which a reader never imports)."""
+    places: list[tuple[tuple[Any, ...], Any]] = [(("set",), resolved.get("set"))]
+    places += [
+        (("timeline", i, "set"), entry.get("set"))
+        for i, entry in enumerate(resolved.get("timeline") or [])
+    ]
+    for where, values in places:
+        for key, value in (values or {}).items():
+            leaf_path, _, param = str(key).rpartition(".")
+            leaf = world.leaves.get(leaf_path)
+            cls = leaf.template.cls if leaf is not None else None
+            if cls is None:
+                continue
+            declared = {p.name: p for p in cls.params}
+            name = cls.canonical(param)
+            if name not in declared:
+                raise doc.error((*where, key), f"unknown parameter of template {leaf.template.ref}")
+            try:
+                declared[name].coerce(value)
+            except ValueError as exc:
+                raise doc.error((*where, key), str(exc)) from None
 
 
 def timeline_of(resolved: Any) -> Timeline:
@@ -232,8 +271,9 @@ def _changes(said: Any) -> list[Change]:
 
 
 def read_world(path: Path, trace_columns: Sequence[str] = (), warn: Warn | None = None) -> RunWorld:
-    """The world of a resolved ``scenario.yaml`` at ``path``, as data (see the module)."""
-    return world_of(load_yaml(path), trace_columns, warn or _stderr)
+    """The world of a resolved ``scenario.yaml`` at ``path``, as data (see the module),
+    the file checked as :func:`read_run` checks it."""
+    return _checked_world(load_yaml(path), trace_columns, warn or _stderr)
 
 
 def world_of(doc: YamlDoc, trace_columns: Sequence[str], warn: Warn) -> RunWorld:

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
+from ..model.metrics import METRICS
 from ..model.schema import MAX_DURATION_S
 from ..model.yamlio import read_regular_file
 
@@ -53,6 +54,8 @@ def metrics_problem(metrics: Any) -> str | None:
         return "scenario is not text"
     if not isinstance(metrics.get("overall", {}), dict | None):
         return "overall is not an object"
+    if (why := _values_problem(metrics.get("overall"))) is not None:
+        return f"overall{why}"
     phases = metrics.get("phases", [])
     if not isinstance(phases, list):
         return "phases is not a list"
@@ -86,6 +89,8 @@ def _phase_problem(phase: Any) -> str | None:
         return f".end {why}"
     if "label" in phase and not isinstance(phase["label"], str | None):
         return ".label is not text"
+    if (why := _values_problem(phase)) is not None:
+        return why
     if (why := _set_problem(phase.get("set", {}))) is not None:
         return f".set{why}"
     changes = phase.get("changes", [])
@@ -100,6 +105,19 @@ def _phase_problem(phase: Any) -> str | None:
             return f".changes[{j}].label is not text"
         if (why := _set_problem(change.get("set", {}))) is not None:
             return f".changes[{j}].set{why}"
+    return None
+
+
+def _values_problem(block: Any) -> str | None:
+    """A block's metrics (``max_distance``, ``settling_time``, ...): each a number, or null
+    for one never reached (a settling time); ``partial`` a flag."""
+    if not isinstance(block, dict):
+        return None
+    for key in METRICS:
+        if key in block and block[key] is not None and not _number(block[key]):
+            return f".{key} is not a number"
+    if "partial" in block and not isinstance(block["partial"], bool):
+        return ".partial is not true or false"
     return None
 
 

@@ -123,6 +123,18 @@ REFUSED = {
         _metrics(_set("phases/0/label", 3)),
         "phases[0].label is not text",
     ),
+    "overall-metric-text": (
+        _metrics(_set("overall/rms_error", "oops")),
+        "metrics.json: not a run's metrics: overall.rms_error is not a number",
+    ),
+    "phase-metric-a-list": (
+        _metrics(_set("phases/0/max_distance", [1])),
+        "phases[0].max_distance is not a number",
+    ),
+    "overall-partial-text": (
+        _metrics(_set("overall/partial", "yes")),
+        "overall.partial is not true or false",
+    ),
     "quality-reference-inf": (
         _raw_metrics('{"quality": {"signal": "a", "reference": Infinity, "tolerance": 1}}'),
         "quality.reference is not a finite number",
@@ -199,3 +211,63 @@ def test_unplottable_values_are_drawn_as_gaps(clean_run: Path, tmp_path: Path, c
     assert (run / "trajectory.png").stat().st_size > 0
     scene = load_run(run)
     scene.frame(scene.rows - 1)  # the replay draws a frame of it
+
+
+def _scenario_line(old: str, new: str) -> Callable[[Path], None]:
+    def edit(run: Path) -> None:
+        text = (run / "scenario.yaml").read_text()
+        assert old in text
+        (run / "scenario.yaml").write_text(text.replace(old, new, 1))
+
+    return edit
+
+
+#: hand edits of the resolved scenario.yaml -> what the one line says (file:line: key: why)
+SCENARIO_EDITS = {
+    "a-misspelt-key": (
+        _scenario_line("\nduration: 4\n", "\nduraton: 4\n"),
+        "scenario.yaml:197: duraton: unknown key (did you mean duration?)",
+    ),
+    "a-gain-as-text": (
+        _scenario_line("MyFollowerController.Kv: 0.35", "MyFollowerController.Kv: x"),
+        "scenario.yaml:204: set.MyFollowerController.Kv: expected a number, got string 'x'",
+    ),
+    "an-unknown-parameter": (
+        _scenario_line("MyFollowerController.Kv: 0.35", "MyFollowerController.Kz: 0.35"),
+        "scenario.yaml:204: set.MyFollowerController.Kz: unknown parameter of template",
+    ),
+    "a-timeline-entry-without-set": (
+        _scenario_line("\nduration: 4\n", "\nduration: 4\ntimeline: [{at: 2}]\n"),
+        "scenario.yaml:198: timeline[0]: missing required key 'set'",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", SCENARIO_EDITS, ids=list(SCENARIO_EDITS))
+def test_a_hand_edited_scenario_is_refused_by_view_and_said_by_plot(
+    clean_run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], case: str
+) -> None:
+    """``view`` draws from the resolved scenario.yaml, so an edit it cannot trust is refused
+    with its line and key, as ``validate`` refuses it; ``plot`` says the same line and draws
+    the paths without the world (what it does whenever that file cannot be read)."""
+    from amsa_phys.cli.view import load_run
+    from amsa_phys.errors import ConfigError
+
+    edit, said = SCENARIO_EDITS[case]
+    run = _damaged(clean_run, tmp_path, edit)
+    with pytest.raises(ConfigError) as caught:
+        load_run(run)
+    assert said in str(caught.value)
+    assert main(["plot", str(run)]) == 0
+    err = capsys.readouterr().err
+    assert said in err
+    assert err.strip().endswith("the paths are drawn without the world")
+    assert len(err.strip().splitlines()) == 1, err
+
+
+def test_the_clean_run_is_read_whole(clean_run: Path) -> None:
+    """The checks refuse no run as a run writes it."""
+    from amsa_phys.cli.view import load_run
+
+    scene = load_run(clean_run)
+    assert scene.t[-1] > 3.9
