@@ -98,9 +98,10 @@ def _world(doc: YamlDoc, data: dict[str, Any]) -> WorldSpec:
             # shown without its ``..`` (``s/../worlds/w.yaml`` is ``worlds/w.yaml``); only
             # shown: with a symbolic link in the path, the lexical form may name elsewhere
             shown = Path(os.path.normpath(world_path))
-            raise doc.error(
-                ("world",), f"world file not found: {shown}" + _nearby_file(world_path)
-            )
+            notes = [] if str(shown) == world_ref else [f"written {world_ref}"]
+            notes += _nearby_file(world_path)
+            said = f" ({'; '.join(notes)})" if notes else ""
+            raise doc.error(("world",), f"world file not found: {shown}{said}")
         world = load_world(world_path)
     else:
         world = build_world(world_ref, doc, ("world",))
@@ -334,17 +335,21 @@ def effective_log_rate(rate: Fraction, world: WorldSpec) -> Fraction:
     return max([rate, *sensors])
 
 
-def _nearby_file(path: Path) -> str:
-    """`` (did you mean x.yaml?)`` for a YAML file beside ``path`` with a close name
-    (``x.yml`` for ``x.yaml``, a typo in the stem); empty if there is none."""
+def _nearby_file(path: Path) -> list[str]:
+    """``did you mean x.yaml?`` for a YAML file beside ``path`` with a close name (``x.yml``
+    for ``x.yaml``, a typo in the stem), or that its directory does not exist; none if
+    neither."""
     if not path.parent.is_dir():
-        return f" (there is no directory {os.path.normpath(path.parent)})"
+        return [f"there is no directory {os.path.normpath(path.parent)}"]
     try:
         names = [p.name for p in path.parent.iterdir() if p.suffix in (".yaml", ".yml")]
     except OSError:
-        return ""
+        return []
     same_stem = [n for n in names if Path(n).stem == path.stem]
-    return f" (did you mean {same_stem[0]}?)" if same_stem else did_you_mean(path.name, names)
+    if same_stem:
+        return [f"did you mean {same_stem[0]}?"]
+    hint = did_you_mean(path.name, names)  # " (did you mean x?)" or ""
+    return [hint.strip()[1:-1]] if hint else []
 
 
 def scenario_cycle_problem(scenario: Scenario) -> str | None:

@@ -138,7 +138,8 @@ def test_relative_world_of_a_mapping_resolves_against_the_cwd_by_default(
     with pytest.raises(ap.ConfigError) as err:
         ap.run({"world": "mde_challenge.yaml", "duration": 1}, base_dir=ROOT)
     assert str(err.value) == (
-        f"<mapping>: world: world file not found: {ROOT / 'mde_challenge.yaml'}"
+        f"<mapping>: world: world file not found: {ROOT / 'mde_challenge.yaml'} "
+        "(written mde_challenge.yaml)"
     )
 
 

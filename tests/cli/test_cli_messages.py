@@ -122,11 +122,11 @@ def test_a_missing_world_file_suggests_the_other_extension(
     assert main(["validate", str(scenario)]) == 2
     assert capsys.readouterr().err == (
         f"error: {scenario}:1: world: world file not found: {tmp_path / 'arena.yml'} "
-        "(did you mean arena.yaml?)\n"
+        "(written arena.yml; did you mean arena.yaml?)\n"
     )
 
 
-def test_a_world_in_a_directory_that_does_not_exist_says_so_without_dotdot(
+def test_a_world_in_a_directory_that_does_not_exist_says_so_and_what_was_written(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     (tmp_path / "scenarios").mkdir()
@@ -135,7 +135,7 @@ def test_a_world_in_a_directory_that_does_not_exist_says_so_without_dotdot(
     assert main(["validate", str(scenario)]) == 2
     assert capsys.readouterr().err == (
         f"error: {scenario}:1: world: world file not found: {tmp_path / 'wrlds' / 'arena.yaml'} "
-        f"(there is no directory {tmp_path / 'wrlds'})\n"
+        f"(written ../wrlds/arena.yaml; there is no directory {tmp_path / 'wrlds'})\n"
     )
 
 
