@@ -17,6 +17,7 @@ import yaml
 
 from ..atomic import write_atomic
 from ..errors import ConfigError, one_line
+from ..model import schema
 from ..model.scenario import Scenario, load_scenario
 from ..model.template import BUILTINS
 from ..model.yamlio import load_yaml
@@ -45,23 +46,30 @@ def read_sweep_scenario(sweepdir: Path) -> Scenario:
             file=sweepdir,
         )
     doc = load_yaml(path)
-    world = doc.data.get("world") if isinstance(doc.data, dict) else None
+    if not isinstance(doc.data, dict):
+        raise doc.error((), "not a sweep's scenario: expected a mapping")
+    # every key first (a hand edit's ``wrold:`` named with its line), as the loader would
+    schema.validate(doc.data, schema.SCENARIO, doc)
+    world = doc.data["world"]
     if not isinstance(world, dict):
-        raise ConfigError("not a sweep's scenario: no world inlined", file=path)
-    for name, template in _templates(world.get("components")):
+        raise doc.error(("world",), "not a sweep's scenario: the world is not inlined")
+    for name, template, keys in _templates(world.get("components"), ("world", "components")):
         if template not in BUILTINS:
-            raise ConfigError(
+            raise doc.error(
+                (*keys, "template"),
                 f"component {one_line(name)} names template {one_line(str(template))!r}, not "
                 "built in; not imported: a sweep directory is data (give --scenario with the "
                 "scenario's own file to load it)",
-                file=path,
             )
     return load_scenario(path)
 
 
-def _templates(components: Any, prefix: str = "") -> list[tuple[str, Any]]:
-    """Every (component path, template) of a world's ``components`` (Composites walked)."""
-    out: list[tuple[str, Any]] = []
+def _templates(
+    components: Any, keys: tuple[Any, ...], prefix: str = ""
+) -> list[tuple[str, Any, tuple[Any, ...]]]:
+    """Every (component path, template, key path) of a world's ``components`` (Composites
+    walked), ``keys`` the key path of ``components`` in the file."""
+    out: list[tuple[str, Any, tuple[Any, ...]]] = []
     if not isinstance(components, dict):
         return out
     for name, body in components.items():
@@ -69,7 +77,7 @@ def _templates(components: Any, prefix: str = "") -> list[tuple[str, Any]]:
         if not isinstance(body, dict):
             continue
         if "components" in body:
-            out += _templates(body["components"], f"{path}.")
+            out += _templates(body["components"], (*keys, name, "components"), f"{path}.")
         if "template" in body:
-            out.append((path, body["template"]))
+            out.append((path, body["template"], (*keys, name)))
     return out
