@@ -68,7 +68,7 @@ def plot_summary(
     ok = [r for r in rows if r.get(metric) is not None and not r.get("error")]
     # the best point is starred: a metric's lowest, a requirement's robustness's highest
     high = higher_is_better(metric)
-    most = "highest" if high else "lowest"
+    best_word = "highest" if high else "lowest"
     # what is drawn: the runs with a value and those that never reached it ("never"), so a
     # sweep where no run settled still shows its grid, every cell saying "never"
     drawn = ok + nevers(rows, metric)
@@ -123,7 +123,7 @@ def plot_summary(
         ax.set_xlabel(axes[0])
         ax.set_ylabel(axes[1])
         if np.isfinite(grid).any():  # no scale to show when every cell says "never"
-            bar = fig.colorbar(im, ax=ax, label=f"{metric} (seed mean; {most} ★)")
+            bar = fig.colorbar(im, ax=ax, label=f"{metric} (seed mean; {best_word} ★)")
             if is_count(metric):
                 bar.ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     else:
@@ -170,7 +170,7 @@ def plot_summary(
                         )
             best = int(np.argmax(mean) if high else np.argmin(mean))
             if others:
-                star = f"{most} mean of each line" if not starred else "_"
+                star = f"{best_word} mean of each line" if not starred else "_"
             else:
                 shown = f"{xs[best]:g}" if _numeric([xs[best]]) else str(xs[best])
                 star = f"best: {x_axis}={shown} ({mean[best]:.4g})"

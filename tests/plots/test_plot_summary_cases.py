@@ -89,3 +89,32 @@ def test_a_two_axis_heatmap_says_when_its_best_is_tied(
         assert "★ best: K=0.2, m=40 (tied with 1 other grid point)" in title
     finally:
         plt.close(caught[0])
+
+
+@pytest.mark.parametrize(
+    ("metric", "word"), [("rms_error", "lowest"), ("robustness.band", "highest")]
+)
+def test_lines_of_one_axis_say_which_mean_is_starred(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, metric: str, word: str
+) -> None:
+    """Three lines (a context axis beside Kv), two seeds: the star's legend entry says the
+    sense of the best ("lowest mean of each line"), never the seed count ("2 mean ...")."""
+    rows = [
+        {"K": k, "ctx": c, "seed": s, "error": "", metric: k * (1 + i) + 0.01 * s}
+        for k in (0.1, 0.2, 0.3)
+        for i, c in enumerate(("a", "b", "c"))
+        for s in (0, 1)
+    ]
+    caught: list[Any] = []
+    monkeypatch.setattr(summary, "save_png", lambda fig, out, **kw: caught.append(fig) or out)
+    summary.plot_summary(rows, ["K", "ctx"], metric, tmp_path / "s.png", "sweep")
+    try:
+        labels = [
+            t.get_text()
+            for ax in caught[0].axes
+            if ax.get_legend()
+            for t in ax.get_legend().get_texts()
+        ]
+        assert f"{word} mean of each line" in labels, labels
+    finally:
+        plt.close(caught[0])
