@@ -445,10 +445,23 @@ def rules_text(found: Derivation, sweepdir: str) -> str:
     head += [f"not placed: {p}" for p in found.unplaced]
     # a comment is one line whatever a name holds: newlines and control characters escaped
     comments = "".join(f"# {one_line(line)}\n" for line in head)
-    body = yaml.safe_dump(
-        {"adapt": found.rules}, sort_keys=False, default_flow_style=None, width=100
+    body = yaml.dump(
+        {"adapt": found.rules},
+        Dumper=_PlainDumper,
+        sort_keys=False,
+        default_flow_style=None,
+        width=100,
     )
     return comments + body
+
+
+class _PlainDumper(yaml.SafeDumper):
+    """``yaml.safe_dump`` without anchors and aliases: rules share their ``set:`` and
+    ``when:`` objects, which the dumper would write once as ``&id001`` and then as
+    ``*id001``; a rules file is read and edited by people, so every rule says its own."""
+
+    def ignore_aliases(self, data: object) -> bool:
+        return True
 
 
 def _check_loads(text: str, out: Path, scenario: Scenario) -> None:

@@ -271,6 +271,22 @@ def test_adapt_command_writes_a_rules_file_a_scenario_can_name(tmp_path: Path) -
     scenario.write_text(yaml.safe_dump({**_scenario(None), "adapt": "rules.yaml"}))
     loaded = load_scenario(scenario)
     assert [r.label for r in loaded.adapt][2:4] == ["worn", "random"]
+    # a file people read and edit: every rule says its own set: and when:, no YAML anchors
+    # (rules share those objects; the dumper would write &id001 and then *id001)
+    text = rules.read_text()
+    assert "&id" not in text
+    assert "*id" not in text
+    sets = [line for line in text.splitlines() if line.strip().startswith("set:")]
+    assert len(sets) == len(loaded.adapt)
+
+
+def test_the_shipped_rules_files_hold_no_anchors() -> None:
+    for path in sorted(
+        (Path(__file__).resolve().parents[2] / "scenarios" / "rules").glob("*.yaml")
+    ):
+        text = path.read_text()
+        assert "&id" not in text, path
+        assert "*id" not in text, path
 
 
 def test_sweeps_of_adaptive_runs_batched_equal_pool(tmp_path: Path) -> None:
