@@ -35,7 +35,7 @@ from ..requirements.objective import requirement_of
 from ..runs.rundir import default_run_dir, prepare_run_dir
 from ..runs.suite import input_files
 from ..runs.sweep import MAX_RUNS, timeline_overlaps, unknown_metric
-from ..stl.requirement import reads_until
+from ..stl.requirement import cut_windows
 from .options import add_jobs
 from .progress import bar as progress_bar
 
@@ -155,12 +155,11 @@ def run(args: argparse.Namespace) -> int:
     end = args.duration if args.duration is not None else float(scenario.duration)
     n_phases = len(scenario.timeline.phases_before(end))
     objective, warnings = _objective(args, scenario, n_phases)
-    for e in scenario.expect:  # a window cut by a shorter run judges fewer samples
-        if e.stl is not None and e.name in objective.requirements and reads_until(e.stl) > end:
-            warnings.append(
-                f"the requirement {e.name} reads until t={reads_until(e.stl):g} s: runs of "
-                f"{end:g} s cut its windows, so its robustness judges only what they log"
-            )
+    for name, until in cut_windows(scenario.expect, end, objective.requirements):
+        warnings.append(  # a window cut by a shorter run judges fewer samples
+            f"the requirement {name} reads until t={until:g} s: runs of {end:g} s cut its "
+            "windows, so its robustness judges only what they log"
+        )
     if args.search_on and not objective.falsifies:
         warnings.append("--search-on only matters with --requirement: the whole budget is spent")
     keys = [d.key for d in space.dims]

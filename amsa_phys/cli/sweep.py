@@ -37,6 +37,7 @@ from ..runs.sweep import (
     unknown_sweep_metric,
 )
 from ..runs.sweepbest import best_line
+from ..stl.requirement import cut_windows
 from .options import add_jobs
 from .progress import bar as progress_bar
 
@@ -148,7 +149,14 @@ def build_plan(args: argparse.Namespace) -> SweepPlan:
         metric,
         args.duration,
         inputs=tuple(input_files(scenario)),
-        warnings=tuple(timeline_overlaps(swept, scenario, Fraction(str(end)))),
+        warnings=(
+            *timeline_overlaps(swept, scenario, Fraction(str(end))),
+            *(
+                f"the requirement {name} reads until t={until:g} s: runs of {float(end):g} s "
+                f"cannot judge it, so results.csv's robustness.{name} stays empty"
+                for name, until in cut_windows(scenario.expect, float(end))
+            ),
+        ),
     )
     if seeds > 1 and (same := same_seeds_warning(plan, scenario)):
         plan.warnings += (same,)

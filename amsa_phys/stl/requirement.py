@@ -84,6 +84,22 @@ def reads_until(formula: str) -> float:
     return float(horizon(parse(formula))[1])
 
 
+def cut_windows(
+    expect: Sequence[Any], end: float, only: Sequence[str] | None = None
+) -> list[tuple[str, float]]:
+    """``(name, reads until)`` of each STL requirement of ``expect`` (those named in
+    ``only``, if given) whose windows read past ``end``, the runs' length: runs that short
+    cannot judge it whole (``sweep`` and ``falsify`` say so once, before any run)."""
+    out = []
+    for e in expect:
+        if e.stl is None or (only is not None and e.name not in only):
+            continue
+        until = reads_until(e.stl)
+        if until > end:
+            out.append((str(e.name), until))
+    return out
+
+
 def _check_sampling(node: Node, period: Fraction) -> None:
     from .monitor import samples
 

@@ -78,3 +78,26 @@ def test_sweep_and_plot_take_a_robustness_metric(tmp_path, capsys) -> None:  # t
     )
     assert main([*argv[:-4], "--out", str(tmp_path / "t"), "--metric", "robustness.x"]) == 2
     assert not (tmp_path / "t").exists()
+
+
+def test_a_sweep_too_short_for_a_requirement_says_its_column_stays_empty(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    """``--duration`` shorter than a requirement's windows: said once before the runs, and
+    the column is indeed empty (it was left empty without a word)."""
+    import csv
+    from pathlib import Path
+
+    from amsa_phys.cli.main import main
+
+    scenario = Path(__file__).resolve().parents[2] / "scenarios" / "paper_fig5_kv01.yaml"
+    out = tmp_path / "s"
+    argv = ["sweep", str(scenario), "--grid", "MyFollowerController.Kv=0.05,0.1", "-j", "1"]
+    assert main([*argv, "--out", str(out), "--duration", "30"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert err == [
+        "warning: the requirement settled_by_150 reads until t=300 s: runs of 30 s cannot "
+        "judge it, so results.csv's robustness.settled_by_150 stays empty"
+    ]
+    with (out / "results.csv").open() as fh:
+        assert all(row["robustness.settled_by_150"] == "" for row in csv.DictReader(fh))
+    assert main([*argv, "--out", str(tmp_path / "full")]) == 0
+    assert "warning" not in capsys.readouterr().err
