@@ -219,7 +219,7 @@ def plot_summary(
                 share = widest / (high - low) if high > low else 0.0
                 if share < 0.02:  # bars this short read as "no spread": say how small
                     ax.set_title(
-                        f"largest seed spread (min–max) {widest:.3g}: {share:.1%} of the axis"
+                        f"largest seed spread (min–max) {widest:.3g}: {axis_share(share)}"
                         f" ({plural(most, 'seed')} each)",
                         fontsize=9,
                     )
@@ -282,3 +282,14 @@ def _cell_values(
             fontsize=8,
             color=colour,
         )
+
+
+def axis_share(share: float) -> str:
+    """A spread's share of the axis as the title says it: ``0.9% of the axis``; a spread
+    below what one decimal shows is not called 0.0 % (``none``: the seeds agree exactly;
+    ``under 0.1% of the axis`` otherwise)."""
+    if share <= 0.0:
+        return "none (the seeds agree exactly)"
+    if share < 0.0005:
+        return "under 0.1% of the axis"
+    return f"{share:.1%} of the axis"

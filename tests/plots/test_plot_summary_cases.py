@@ -118,3 +118,10 @@ def test_lines_of_one_axis_say_which_mean_is_starred(
         assert f"{word} mean of each line" in labels, labels
     finally:
         plt.close(caught[0])
+
+
+def test_a_tiny_seed_spread_is_never_said_as_zero_percent() -> None:
+    """A spread of 3e-6 of the axis read "0.0% of the axis", as if there were none."""
+    assert summary.axis_share(0.009) == "0.9% of the axis"
+    assert summary.axis_share(3e-6) == "under 0.1% of the axis"
+    assert summary.axis_share(0.0) == "none (the seeds agree exactly)"
