@@ -45,7 +45,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
         help="instead of the named contexts, K contexts (1..1000) drawn from the box they "
         "span; 0 (the default): the named contexts themselves",
     )
-    p.add_argument("--seeds", type=int, default=2, metavar="N", help="seeds per context (default 2)")
+    p.add_argument(
+        "--seeds", type=int, default=2, metavar="N", help="seeds per context (default 2)"
+    )
     p.add_argument("--budget", type=int, default=12, metavar="N", help="evaluations (default 12)")
     p.add_argument(
         "--measure",
