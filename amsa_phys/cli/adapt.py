@@ -19,6 +19,7 @@ from ..errors import ConfigError, one_line
 from ..model import schema
 from ..model.adaptrules import FILE, parse_rules
 from ..model.scenario import Scenario, load_scenario
+from ..model.wording import plural
 from ..model.yamlio import parse_yaml
 from ..runs.rundir import check_output
 from ..tune.objective import ROBUSTNESS
@@ -297,7 +298,8 @@ def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -
         )
     print(
         one_line(
-            f"validating on {args.sequences} held-out sequences x {args.seeds} seeds "
+            f"validating on {plural(args.sequences, 'held-out sequence')} x "
+            f"{plural(args.seeds, 'seed')} "
             f"({found.metric}, seed means, lower is better):"
         )
     )
@@ -334,8 +336,8 @@ def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -
         print(
             one_line(
                 f"warning: the rules lose to the robust fixed choice on {len(lost)} of "
-                f"{len(rows)} held-out sequences (by more than {100 * args.tolerance:g} % "
-                f"in the mean over {args.seeds} seeds)"
+                f"{plural(len(rows), 'held-out sequence')} (by more than "
+                f"{100 * args.tolerance:g} % in the mean over {plural(args.seeds, 'seed')})"
             ),
             file=sys.stderr,
         )
@@ -343,8 +345,8 @@ def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -
     print(
         one_line(
             f"the rules hold: never more than {100 * args.tolerance:g} % worse than the "
-            f"robust fixed choice on {len(rows)} held-out sequences, in the mean over "
-            f"{args.seeds} seeds"
+            f"robust fixed choice on {plural(len(rows), 'held-out sequence')}, in the mean "
+            f"over {plural(args.seeds, 'seed')}"
         )
     )
     return 0

@@ -21,3 +21,18 @@ def test_the_verdict_names_the_seed_count(tmp_path, capsys) -> None:
     err = capsys.readouterr().err
     assert code == 1
     assert "(by more than 2 % in the mean over 3 seeds)" in err
+
+
+def test_one_sequence_and_one_seed_are_said_in_the_singular(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    path, sweep = two_context_sweep(
+        tmp_path,
+        {("healthy", 0.2): 0.5, ("healthy", 0.8): 0.3, ("worn", 0.2): 0.5, ("worn", 0.8): 0.6},
+    )
+    argv = ["adapt", str(sweep), "--scenario", str(path), "-o", str(tmp_path / "r.yaml")]
+    argv += ["--validate", "--margin", "inf", "--sequences", "1", "--seeds", "1"]
+    main([*argv, "--duration", "240"])
+    said = capsys.readouterr()
+    assert "\nvalidating on 1 held-out sequence x 1 seed (" in said.out
+    assert said.out.endswith("on 1 held-out sequence, in the mean over 1 seed\n") or (
+        "1 of 1 held-out sequence (by more than 2 % in the mean over 1 seed)" in said.err
+    )
