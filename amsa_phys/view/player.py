@@ -116,7 +116,10 @@ class Player:
         else:
             found = next((e for e in reversed(events) if e.t < now - 1e-9), None)
         if found is None:
-            self.notice = "no later event" if direction > 0 else "no earlier event"
+            # the run's start is no event (phase 0 starts with it): Home goes there
+            self.notice = (
+                "no later event" if direction > 0 else "no earlier event (Home: the start)"
+            )
             self._notice_row = self.row
             return None
         self.seek(found.t)

@@ -128,7 +128,7 @@ def test_phase_keys_jump_to_phase_starts(tmp_path: Path) -> None:
     assert p.scene.frame(p.row).phase_text.startswith("phase 1 (of 0–1) from 125 s: Kv=0.15")
     press(pygame.K_PAGEUP)
     p.frame(0.0)
-    assert "no earlier event" in p.notice
+    assert p.notice == "no earlier event (Home: the start)"
 
 
 def test_plot_pane_draws_a_picked_signal(player: Player) -> None:
