@@ -106,7 +106,37 @@ typedef struct {
     double *v0;
     Py_ssize_t batch_i; /* advance_many: the step under way (0: the first) */
     int stop;           /* advance_many: end after the step under way */
+    /* the bodies' fields read (and the position written) in place, at the offsets below,
+     * instead of through Chipmunk's getters and cpBodySetPosition: compiled.body_layout_ok
+     * confirmed the layout in this process (0: every access a call) */
+    int direct;
 } Stepper;
+
+/* Where Chipmunk's cpBody keeps what the step reads (chipmunk_structs.h, Chipmunk 7 and
+ * pymunk's Munk2D alike: two function pointers, m, m_inv, i, i_inv, then cog, p, v, f, a,
+ * w, t, transform {a, b, c, d, tx, ty}). Used only where compiled.body_layout_ok found every
+ * one of them where a getter says it is (``body_fields`` below reads them for it). Why:
+ * a 1,000-rover step made ~17 calls a rover into Chipmunk's getters and setters, and
+ * cpBodySetPosition's own transform (a sincos) is overwritten by cpBodySetAngle's at once. */
+#define BODY_COG 48
+#define BODY_P 64
+#define BODY_V 80
+#define BODY_A 112
+#define BODY_W 120
+#define BODY_T 136
+
+static inline const double *body_at(const void *body, size_t offset)
+{
+    return (const double *)((const char *)body + offset);
+}
+
+/* cpBodyGetPosition: cpTransformPoint(body->transform, cpvzero), the same operations */
+static inline cpVect body_position(const void *body)
+{
+    const double *t = body_at(body, BODY_T);
+    cpVect p = {t[0] * 0.0 + t[2] * 0.0 + t[4], t[1] * 0.0 + t[3] * 0.0 + t[5]};
+    return p;
+}
 
 /* ---- wheel.py's rare branches --------------------------------------------------------- */
 typedef struct {
@@ -958,21 +988,36 @@ static Py_ssize_t read_check(Stepper *st)
     for (Py_ssize_t k = 0; k < st->n; k++) {
         void *b = st->bodies[k];
         double *s = st->state + st->offsets[k];
-        cpVect p = st->get_position(b);
-        cpVect v = st->get_velocity(b);
+        cpVect p, v;
+        if (st->direct) {
+            const double *bv = body_at(b, BODY_V);
+            p = body_position(b);
+            v.x = bv[0];
+            v.y = bv[1];
+            s[2] = *body_at(b, BODY_A);
+            s[5] = *body_at(b, BODY_W);
+        } else {
+            p = st->get_position(b);
+            v = st->get_velocity(b);
+            s[2] = st->get_angle(b);
+            s[5] = st->get_angular_velocity(b);
+        }
         s[0] = p.x;
         s[1] = p.y;
-        s[2] = st->get_angle(b);
         if (st->rot != NULL) {
-            cpVect r = st->get_rotation(b);
             double *c = st->rot + 3 * k;
             c[0] = s[2];
-            c[1] = r.x;
-            c[2] = r.y;
+            if (st->direct) { /* cpBodyGetRotation: the transform's a and b */
+                c[1] = body_at(b, BODY_T)[0];
+                c[2] = body_at(b, BODY_T)[1];
+            } else {
+                cpVect r = st->get_rotation(b);
+                c[1] = r.x;
+                c[2] = r.y;
+            }
         }
         s[3] = v.x;
         s[4] = v.y;
-        s[5] = st->get_angular_velocity(b);
         double v2 = v.x * v.x + v.y * v.y;
         if (v2 > top2)
             top2 = v2;
@@ -1000,8 +1045,15 @@ static void velocities_before(Stepper *st)
 {
     for (Py_ssize_t k = 0; k < st->n; k++) {
         void *b = st->bodies[k];
-        cpVect v = st->get_velocity(b);
         double *w0 = st->v0 + 3 * k;
+        if (st->direct) {
+            const double *bv = body_at(b, BODY_V);
+            w0[0] = bv[0];
+            w0[1] = bv[1];
+            w0[2] = *body_at(b, BODY_W);
+            continue;
+        }
+        cpVect v = st->get_velocity(b);
         w0[0] = v.x;
         w0[1] = v.y;
         w0[2] = st->get_angular_velocity(b);
@@ -1013,6 +1065,21 @@ static void second_order(Stepper *st, double half)
     for (Py_ssize_t k = 0; k < st->n; k++) {
         void *b = st->bodies[k];
         const double *w0 = st->v0 + 3 * k;
+        if (st->direct) {
+            const double *bv = body_at(b, BODY_V), *t = body_at(b, BODY_T);
+            const double *cog = body_at(b, BODY_COG);
+            cpVect p = body_position(b);
+            double a = *body_at(b, BODY_A);
+            double w = *body_at(b, BODY_W);
+            cpVect q = {p.x + (bv[0] - w0[0]) * half, p.y + (bv[1] - w0[1]) * half};
+            /* cpBodySetPosition(b, q) but its transform, which cpBodySetAngle sets again
+             * from the same p at once: body->p = cpvadd(cpTransformVect(transform, cog), q) */
+            double *bp = (double *)((char *)b + BODY_P);
+            bp[0] = (t[0] * cog[0] + t[2] * cog[1]) + q.x;
+            bp[1] = (t[1] * cog[0] + t[3] * cog[1]) + q.y;
+            st->set_angle(b, a + (w - w0[2]) * half);
+            continue;
+        }
         cpVect p = st->get_position(b);
         cpVect v = st->get_velocity(b);
         double a = st->get_angle(b);
@@ -1169,21 +1236,23 @@ static int Stepper_init(Stepper *st, PyObject *args, PyObject *kwds)
 {
     static char *kwlist[] = {"space",  "functions", "bodies",   "offsets", "plan",
                              "drives", "rims",      "rim_strides", "ground", "ground_layout",
-                             "state",  "dt",        "max2",     "extent",  "sub_speed", NULL};
+                             "state",  "dt",        "max2",     "extent",  "sub_speed",
+                             "direct", NULL};
     unsigned long long space;
     PyObject *fns, *bodies, *offsets, *plan, *drives, *rims, *ground, *state;
     Py_ssize_t rim_k, rim_side, ground_k;
     Py_ssize_t go[GROUND_TERMS];
     double dt, max2, extent, sub_speed = INFINITY;
+    int direct = 0;
     if (st->n_views) {
         PyErr_SetString(PyExc_RuntimeError, "Stepper is initialised once");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "KO!OOOOO(nn)O(n(nnnnnnnnn))Oddd|d", kwlist, &space,
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "KO!OOOOO(nn)O(n(nnnnnnnnn))Oddd|dp", kwlist, &space,
                                      &PyTuple_Type, &fns, &bodies, &offsets, &plan, &drives,
                                      &rims, &rim_k, &rim_side, &ground, &ground_k, &go[0],
                                      &go[1], &go[2], &go[3], &go[4], &go[5], &go[6], &go[7], &go[8], &state, &dt,
-                                     &max2, &extent, &sub_speed))
+                                     &max2, &extent, &sub_speed, &direct))
         return -1;
     const Py_ssize_t n_fns = PyTuple_GET_SIZE(fns);
     if (n_fns != 9 && n_fns != 10) {
@@ -1262,6 +1331,7 @@ static int Stepper_init(Stepper *st, PyObject *args, PyObject *kwds)
     st->max2 = max2;
     st->extent = extent;
     st->sub_speed = sub_speed;
+    st->direct = direct;
     st->top2 = 0.0;
     st->v0 = PyMem_Malloc((nb ? 3 * nb : 1) * sizeof(double));
     if (st->v0 == NULL) {
@@ -2141,7 +2211,27 @@ done:
     return result;
 }
 
+/* body_fields(address): the 14 doubles of a cpBody at the offsets the direct access reads
+ * (cog, p, v, a, w, transform), for compiled.body_layout_ok to compare with what pymunk's
+ * getters say of a body it set up; nothing else reads memory through it. */
+static PyObject *body_fields(PyObject *Py_UNUSED(module), PyObject *arg)
+{
+    void *body = PyLong_AsVoidPtr(arg);
+    if (body == NULL) {
+        if (!PyErr_Occurred())
+            PyErr_SetString(PyExc_ValueError, "a null body");
+        return NULL;
+    }
+    const double *cog = body_at(body, BODY_COG), *p = body_at(body, BODY_P);
+    const double *v = body_at(body, BODY_V), *t = body_at(body, BODY_T);
+    return Py_BuildValue("(dddddddddddddd)", cog[0], cog[1], p[0], p[1], v[0], v[1],
+                         *body_at(body, BODY_A), *body_at(body, BODY_W), t[0], t[1], t[2], t[3],
+                         t[4], t[5]);
+}
+
 static PyMethodDef module_methods[] = {
+    {"body_fields", body_fields, METH_O,
+     "body_fields(address): a cpBody's cog, p, v, a, w and transform as the direct access reads them"},
     {"column_forces", column_forces, METH_VARARGS,
      "column_forces(plan, drives, rims, ground, state, forces, dt): every rover's force and "
      "torque into forces (n, 3), its rims advanced in place; no Space."},
