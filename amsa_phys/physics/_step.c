@@ -107,14 +107,14 @@ typedef struct {
     Py_ssize_t batch_i; /* advance_many: the step under way (0: the first) */
     int stop;           /* advance_many: end after the step under way */
     /* the bodies' fields read (and the position written) in place, at the offsets below,
-     * instead of through Chipmunk's getters and cpBodySetPosition: compiled.body_layout_ok
+     * instead of through Chipmunk's getters and cpBodySetPosition: bodylayout.body_layout_ok
      * confirmed the layout in this process (0: every access a call) */
     int direct;
 } Stepper;
 
 /* Where Chipmunk's cpBody keeps what the step reads (chipmunk_structs.h, Chipmunk 7 and
  * pymunk's Munk2D alike: two function pointers, m, m_inv, i, i_inv, then cog, p, v, f, a,
- * w, t, transform {a, b, c, d, tx, ty}). Used only where compiled.body_layout_ok found every
+ * w, t, transform {a, b, c, d, tx, ty}). Used only where bodylayout.body_layout_ok found every
  * one of them where a getter says it is (``body_fields`` below reads them for it). Why:
  * a 1,000-rover step made ~17 calls a rover into Chipmunk's getters and setters, and
  * cpBodySetPosition's own transform (a sincos) is overwritten by cpBodySetAngle's at once. */
@@ -2212,7 +2212,7 @@ done:
 }
 
 /* body_fields(address): the 14 doubles of a cpBody at the offsets the direct access reads
- * (cog, p, v, a, w, transform), for compiled.body_layout_ok to compare with what pymunk's
+ * (cog, p, v, a, w, transform), for bodylayout.body_layout_ok to compare with what pymunk's
  * getters say of a body it set up; nothing else reads memory through it. */
 static PyObject *body_fields(PyObject *Py_UNUSED(module), PyObject *arg)
 {

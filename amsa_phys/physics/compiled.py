@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from . import bodylayout
 from .bodyio import STATE, BodyIO, locked_step, substeps
 from .fewrovers import FewRovers
 from .fleet import GROUND_ROWS, Fleet
@@ -136,55 +137,6 @@ def _rotation_is_libms(samples: int = 200) -> bool:
     return True
 
 
-_layout: bool | None = None
-
-
-def body_layout_ok() -> bool:
-    """Whether the C step may read this pymunk's bodies in place (``_step.c``'s ``BODY_*``
-    offsets, its ``direct`` mode): a body set up with a distinct value in every field it
-    reads, each found at its offset as pymunk's own getters report it, and the position it
-    writes related to the transform as ``cpBodySetPosition`` relates them (Python's float
-    arithmetic, which rounds as C without contraction does). Checked once a process; any
-    difference (another Chipmunk layout, a build that fuses multiply-adds) keeps every
-    access a call into Chipmunk."""
-    global _layout
-    if _layout is None:
-        _layout = _check_layout()
-    return _layout
-
-
-def _check_layout() -> bool:
-    if _step is None or not hasattr(_step, "body_fields"):
-        return False
-    try:
-        import pymunk
-        from pymunk._chipmunk import lib
-
-        body = pymunk.Body(2.0, 3.0)
-        body.center_of_gravity = (0.125, -0.375)
-        body.angle = 0.7
-        body.position = (1.5, -2.25)
-        body.velocity = (3.5, -4.75)
-        body.angular_velocity = 1.25
-        cx, cy, px, py, vx, vy, a, w, ta, tb, tc, td, tx, ty = _step.body_fields(
-            _address(body._body)
-        )
-        rot = lib.cpBodyGetRotation(body._body)
-        pos = body.position
-        return (
-            (cx, cy) == (0.125, -0.375)
-            and (vx, vy) == (3.5, -4.75)
-            and (a, w) == (0.7, 1.25)
-            and (ta, tb) == (rot.x, rot.y)
-            and (tc, td) == (-rot.y, rot.x)
-            and (ta * 0.0 + tc * 0.0 + tx, tb * 0.0 + td * 0.0 + ty) == (pos.x, pos.y)
-            and tx == px - (cx * ta - cy * tb)
-            and ty == py - (cx * tb + cy * ta)
-        )
-    except Exception:  # another pymunk layout: every access a call
-        return False
-
-
 def _address(handle: Any) -> int:
     from pymunk._chipmunk import ffi
 
@@ -280,7 +232,7 @@ class CompiledFewRovers(FewRovers):
             self._max2,
             self.extent,
             self.sub_speed,
-            direct=body_layout_ok(),
+            direct=bodylayout.body_layout_ok(),
         )
         #: ``advance_many(count)``: up to ``count`` steps in one C call, each as
         #: :meth:`advance` takes it: (steps taken, the first bad rover's index after the
@@ -399,7 +351,7 @@ class CompiledFleet(Fleet):
             self.max_speed * self.max_speed * (1 - 1e-12),
             self.extent,
             self.sub_speed,
-            direct=body_layout_ok(),
+            direct=bodylayout.body_layout_ok(),
         )
 
     # as CompiledFewRovers: assigning rims or state copies into the C step's arrays

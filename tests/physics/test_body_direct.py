@@ -1,5 +1,5 @@
 """The compiled step reading (and writing the position of) Chipmunk's bodies in place
-(``_step.c``'s ``direct`` mode, ``compiled.body_layout_ok``) changes no bit: the same states
+(``_step.c``'s ``direct`` mode, ``bodylayout.body_layout_ok``) changes no bit: the same states
 after every step, contacts and sub-steps included, as every access through Chipmunk's own
 getters and setters; and a layout the check does not recognise keeps the calls."""
 
@@ -13,7 +13,7 @@ import pytest
 from regimes import DT, every_regime
 from test_collision_index import pile_up, run
 
-from amsa_phys.physics import compiled
+from amsa_phys.physics import bodylayout, compiled
 from amsa_phys.physics.bodyio import BodyIO
 from amsa_phys.physics.forces import ground_list
 from amsa_phys.physics.step_path import extension
@@ -27,23 +27,24 @@ built = pytest.mark.skipif(
 @built
 def test_the_layout_is_recognised_with_this_pymunk(monkeypatch: pytest.MonkeyPatch) -> None:
     """Else every step would go through the calls, and the tests below compare nothing."""
-    monkeypatch.setattr(compiled, "_layout", None)
-    assert compiled.body_layout_ok() is True
+    monkeypatch.setattr(bodylayout, "_layout", None)
+    assert bodylayout.body_layout_ok() is True
 
 
 @built
 def test_a_layout_that_is_not_recognised_keeps_the_calls(monkeypatch: pytest.MonkeyPatch) -> None:
     """Fields one slot off (as another Chipmunk would lay them out): not used."""
-    real = compiled._step.body_fields
-    monkeypatch.setattr(compiled, "_layout", None)
-    monkeypatch.setattr(compiled._step, "body_fields", lambda a: (*real(a)[1:], 0.0))
-    assert compiled.body_layout_ok() is False
+    step = extension()
+    real = step.body_fields
+    monkeypatch.setattr(bodylayout, "_layout", None)
+    monkeypatch.setattr(step, "body_fields", lambda a: (*real(a)[1:], 0.0))
+    assert bodylayout.body_layout_ok() is False
 
 
 def _regimes(
     cls: Any, direct: bool, monkeypatch: pytest.MonkeyPatch, cog: bool = False
 ) -> list[Any]:
-    monkeypatch.setattr(compiled, "_layout", direct)
+    monkeypatch.setattr(bodylayout, "_layout", direct)
     space, rovers, rims, grounds = every_regime(60)
     if cog:  # a body whose centre of gravity is off its origin: the written position's term
         for k, r in enumerate(rovers):
@@ -78,9 +79,9 @@ def test_a_pile_up_collides_alike_in_place_and_through_calls(
     """120 rovers (the fleet path, the spatial hash) whose tail piles up: the same collisions
     at the same instants and the same final states, bit for bit."""
     scen = pile_up(tmp_path, 52)
-    monkeypatch.setattr(compiled, "_layout", True)
+    monkeypatch.setattr(bodylayout, "_layout", True)
     direct = run(scen, None, monkeypatch)
-    monkeypatch.setattr(compiled, "_layout", False)
+    monkeypatch.setattr(bodylayout, "_layout", False)
     calls = run(scen, None, monkeypatch)
     assert direct["count"] >= 2  # contacts were solved, or this would compare little
     assert direct["events"] == calls["events"]

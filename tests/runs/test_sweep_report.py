@@ -35,7 +35,10 @@ def test_sweeping_what_the_timeline_changes_warns_once(
     args += ["--grid", "MyFollowerController.Kw=0.04", "--duration", "130", "-j", "1"]
     assert main([*args, "--out", str(tmp_path / "s")]) == 0
     err = capsys.readouterr().err
-    assert err.count("warning:") == 1  # Kv only: the timeline never sets Kw
+    # Kv only: the timeline never sets Kw (the other warning: runs of 130 s cannot judge
+    # the scenario's requirement read until 500 s)
+    assert err.count("warning: MyFollowerController.") == 1
+    assert err.count("warning:") == 2
     assert (
         "warning: MyFollowerController.Kv is swept, but the timeline also sets it (at 125 s): "
         "each run's value holds only until 125 s, so the axis affects phase 0 only; compare "
@@ -48,7 +51,9 @@ def test_a_sweep_the_timeline_does_not_touch_does_not_warn(
 ) -> None:
     args = ["sweep", str(SCENARIO1), "--grid", "MyFollowerController.Kv=0.1,0.2"]
     assert main([*args, "--duration", "100", "-j", "1", "--out", str(tmp_path / "s")]) == 0
-    assert "warning" not in capsys.readouterr().err  # cut at 100 s: no Kv step is reached
+    err = capsys.readouterr().err
+    assert "is swept, but the timeline" not in err  # cut at 100 s: no Kv step is reached
+    assert err.count("warning:") == 1  # the requirement read until 500 s, said once
 
 
 def test_heatmap_writes_each_value_and_frames_the_best(
