@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import ConfigError
+from ..runs.rundir import unwritable
 from ..view.encoder import FORMATS
 
 if TYPE_CHECKING:
@@ -116,6 +117,8 @@ def snapshot_options(args: argparse.Namespace) -> SnapshotOptions | None:
 
 def recording_target(name: str, formats: tuple[str, ...], flag: str, force: bool) -> Path:
     """An output file we may write: known extension, existing writable directory, no clobber."""
+    if not str(name).strip():
+        raise ConfigError("an empty file name", key=flag)
     path = Path(name)
     if path.suffix.lower() not in formats:
         hint = ""
@@ -133,9 +136,14 @@ def recording_target(name: str, formats: tuple[str, ...], flag: str, force: bool
     if path.is_dir():
         raise ConfigError("is a directory; give a file name", key=flag, file=path)
     if not parent.is_dir():
-        raise ConfigError("directory does not exist", key=flag, file=path)
-    if not os.access(parent, os.W_OK):
-        raise ConfigError("directory is not writable", key=flag, file=path)
+        why = f"{parent} is not a directory" if parent.exists() else "directory does not exist"
+        raise ConfigError(why, key=flag, file=path)
+    if not os.access(parent, os.W_OK) or (why := unwritable(parent)) is not None:
+        raise ConfigError(
+            f"directory is not writable ({why})" if why else "directory is not writable",
+            key=flag,
+            file=path,
+        )
     if path.exists() and not force:
         raise ConfigError("file exists (use --force to replace it)", key=flag, file=path)
     return path

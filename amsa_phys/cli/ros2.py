@@ -107,7 +107,11 @@ def _lockstep(args: argparse.Namespace) -> int:
     env.rclpy("ros2 lockstep")
     scenario = the_plan.scenario
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
-    bag_path = recording_target(args.bag, (".mcap",), "--bag", args.force) if args.bag else None
+    bag_path = (
+        recording_target(args.bag, (".mcap",), "--bag", args.force)
+        if args.bag is not None
+        else None
+    )
     if bag_path is not None:
         bag_apart(bag_path, out)
     prepare_run_dir(out, args.force)

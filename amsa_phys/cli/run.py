@@ -119,7 +119,11 @@ def _run(
             key="--snapshot-at",
         )
     warn_if_trace_is_large(scenario)
-    bag_path = recording_target(args.bag, (".mcap",), "--bag", args.force) if args.bag else None
+    bag_path = (
+        recording_target(args.bag, (".mcap",), "--bag", args.force)
+        if args.bag is not None
+        else None
+    )
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
     if bag_path is not None:
         bag_apart(bag_path, out)

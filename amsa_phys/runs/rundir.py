@@ -18,9 +18,11 @@ reported before the run starts, not after minutes of simulation.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import shutil
+import tempfile
 import time
 from collections.abc import Iterable
 from pathlib import Path
@@ -221,6 +223,21 @@ def _make_marked(out: Path, flag: str, kind: str) -> None:
         raise ConfigError("directory is not writable", key=flag, file=out)
 
 
+def unwritable(directory: Path) -> str | None:
+    """Why no file can be made in ``directory`` (None if one can): a probe file is made and
+    removed at once. Why a probe: ``os.access`` answers for permissions only, and yes for
+    root everywhere, where a file system that takes no new files (``/proc``, a read-only
+    mount) refuses only the write itself, then half-way through a run."""
+    try:
+        fd, probe = tempfile.mkstemp(dir=directory, prefix=".amsa-phys-probe-")
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(probe)
+    return None
+
+
 def check_output(path: Path, flag: str, make_parent: bool = False) -> Path:
     """An output file's path, checked before any work (exit 2 naming ``flag``).
 
@@ -240,8 +257,9 @@ def check_output(path: Path, flag: str, make_parent: bool = False) -> Path:
                 f"cannot create directory: {exc.strerror}", key=flag, file=parent
             ) from None
     if not parent.is_dir():
-        raise ConfigError("directory does not exist", key=flag, file=parent)
-    if not os.access(parent, os.W_OK):
+        why = "is not a directory" if parent.exists() else "directory does not exist"
+        raise ConfigError(why, key=flag, file=parent)
+    if not os.access(parent, os.W_OK) or (why := unwritable(parent)) is not None:
         raise ConfigError("directory is not writable", key=flag, file=parent)
     return path
 

@@ -286,3 +286,33 @@ def test_metrics_json_stays_json_when_a_metric_overflows(
         "phases[0].rms_error",
     ]
     assert (out / "distance.png").stat().st_size > 0
+
+
+def test_a_bag_where_no_file_can_be_made_is_refused_before_the_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--bag /proc/x.mcap`` (a directory root may write to by its permissions, where no
+    file can be made) ended the run with exit 3 and a run directory without trace or
+    metrics; an empty name was ignored, a file taken for a directory called missing. Each is
+    refused before the run, naming --bag, exit 2, nothing written."""
+    scen = scenario(tmp_path)
+    (tmp_path / "plain").write_text("a file\n")
+    run = ["run", str(scen), "--headless", "-q", "--out", str(tmp_path / "o")]
+    cases = [
+        ("", "error: --bag: an empty file name"),
+        (
+            str(tmp_path / "plain" / "x.mcap"),
+            f"error: {tmp_path / 'plain' / 'x.mcap'}: --bag: {tmp_path / 'plain'} is not a "
+            "directory",
+        ),
+        (
+            str(tmp_path / "none" / "x.mcap"),
+            f"error: {tmp_path / 'none' / 'x.mcap'}: --bag: directory does not exist",
+        ),
+    ]
+    if Path("/proc").is_dir():  # a directory that takes no new file, root or not
+        cases.append(("/proc/x.mcap", "error: /proc/x.mcap: --bag: directory is not writable"))
+    for bag, said in cases:
+        assert main([*run, "--bag", bag]) == 2
+        assert one_line(capsys).startswith(said)
+        assert not (tmp_path / "o").exists()
