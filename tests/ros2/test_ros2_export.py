@@ -153,7 +153,27 @@ def test_a_package_node_that_dies_is_the_runs_fault_and_every_node_is_stopped(
     assert rc == 2, text
     errors = [line for line in text.splitlines() if line.startswith("error:")]
     assert len(errors) == 1, text
-    assert "MyNormalizePower" in errors[0], errors
+    # named after the node that died, not after the Leaf the run was waiting for then
+    assert " in ROS 2 node /MyNormalizePower: " in errors[0], errors
     rows = (out / "trace.csv").read_bytes().count(b"\n") - 1
     assert rows > 1  # the instants before the fault are kept
+    assert left == []
+
+
+def test_a_package_node_that_cannot_start_is_named_not_the_node_waited_for(
+    tmp_path: Path,
+) -> None:
+    """A node that fails at its import (a user's edit gone wrong) exits before the run's first
+    step, while the run waits for another Leaf's node: the fault names the dead node."""
+    pkg, out = tmp_path / "pkg", tmp_path / "lock"
+    amsa("export", "ros2", str(ROOT / "scenarios" / "scenario1.yaml"), "-o", str(pkg))
+    node = pkg / "mde_challenge" / "MyNormalizePower.py"
+    node.write_text("import no_such_module_in_this_test\n" + node.read_text())
+    rc, text, left = in_netns(
+        tmp_path, f"$PY -m amsa_phys ros2 lockstep {pkg} --out {out} --no-plot -q --ros2-timeout 5"
+    )
+    assert rc == 2, text
+    errors = [line for line in text.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1, text
+    assert " in ROS 2 node /MyNormalizePower: " in errors[0], errors
     assert left == []

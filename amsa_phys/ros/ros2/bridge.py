@@ -58,7 +58,7 @@ class Bridge:
         timeout_s: float,
         now: Callable[[], Fraction],
         arrays: Mapping[str, Sequence[str]],
-        watch: Callable[[], str | None] | None = None,
+        watch: Callable[[], tuple[str, str] | None] | None = None,
         step_topics: bool = False,
     ) -> None:
         rclpy = env.rclpy()
@@ -71,7 +71,8 @@ class Bridge:
         self.rclpy = rclpy
         self.timeout_s = float(timeout_s)
         self._now = now
-        #: says why the nodes cannot answer any more (a process amsa-phys started exited)
+        #: says which Leaf's node cannot answer any more and why (a process amsa-phys
+        #: started exited): (leaf path, why), or None
         self._watch = watch or (lambda: None)
         #: array port -> its element buffers (the length a message must have)
         self.arrays = {k: len(v) for k, v in arrays.items()}
@@ -339,9 +340,12 @@ class Bridge:
                 )
 
     def _check_watch(self, leaf: Wiring, t: Fraction | None = None) -> None:
-        why = self._watch()
-        if why is not None:
-            raise self._fault(leaf, why, t)
+        """The fault of a node the watch found gone, named after that node (not after the
+        Leaf being waited for, which only noticed)."""
+        found = self._watch()
+        if found is not None:
+            path, why = found
+            raise self._fault(self.leaves.get(path, leaf), why, t)
 
     def _fault(self, leaf: Wiring, why: str, t: Fraction | None = None) -> NodeFault:
         return NodeFault(f"ROS 2 node {leaf.node}", self._now() if t is None else t, why)
@@ -447,7 +451,7 @@ class ExternalSimulation(Simulation):
         scenario: Scenario,
         timeout_s: float,
         private_inputs: bool = False,
-        watch: Callable[[], str | None] | None = None,
+        watch: Callable[[], tuple[str, str] | None] | None = None,
         **kw: Any,
     ) -> None:
         wirings = external.describe(scenario.world, scenario.ros2, private_inputs)

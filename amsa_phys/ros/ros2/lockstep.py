@@ -156,10 +156,10 @@ def nodes_running(commands: dict[str, list[str]]) -> Iterator[dict[str, subproce
 def simulation(plan: Plan, procs: dict[str, subprocess.Popen[Any]]) -> Any:
     """The factory ``run_scenario`` calls: the bridge, watching the node processes."""
 
-    def dead() -> str | None:
+    def dead() -> tuple[str, str] | None:
         for path, proc in procs.items():
             if proc.poll() is not None:
-                return f"the node of {path} exited with status {proc.returncode}"
+                return path, f"the node of {path} exited with status {proc.returncode}"
         return None
 
     def make(scenario: Scenario, trace: Any) -> ExternalSimulation:
