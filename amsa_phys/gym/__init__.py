@@ -19,7 +19,8 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
 
 from ..gymreg import ENVIRONMENTS, register
 from .follow import FollowEnv
+from .vector import FollowVecEnv
 
 register(gymnasium)
 
-__all__ = ["ENVIRONMENTS", "FollowEnv"]
+__all__ = ["ENVIRONMENTS", "FollowEnv", "FollowVecEnv"]

@@ -137,6 +137,9 @@ class Episode:
         self.t = Fraction(0)
         self.inputs: dict[str, float] = {}
         self.done = False
+        #: why the episode ended before its end, for the next step's refusal (None: it
+        #: did not, or it reached its end)
+        self.ended_by: str | None = None
         self._agent = greenlet.getcurrent()
         self._run = greenlet.greenlet(self._main, parent=self._agent)
         self._answer(self._run.switch())
@@ -180,11 +183,15 @@ class Episode:
         try:
             message = self._run.switch(outputs)
         except greenlet.error as exc:  # greenlets switch only within their thread
-            raise RuntimeError(
-                f"step() must be called from the thread that called reset() ({exc})"
-            ) from None
-        except BaseException:  # the run's fault (or Ctrl-C inside it) ends the episode
+            # greenlet's own message spans several lines (the greenlets' reprs): not said
+            raise RuntimeError("step() must be called from the thread that called reset()") from exc
+        except BaseException as exc:  # the run's fault (or Ctrl-C inside it) ends the episode
             self.done = True
+            self.ended_by = (
+                "a step was interrupted"
+                if isinstance(exc, KeyboardInterrupt)
+                else "its run faulted"
+            )
             raise
         if message is _ENDED:  # ``_answer`` inlined: once per env-step
             self.done = True

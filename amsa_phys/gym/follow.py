@@ -276,7 +276,8 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         """
         episode = self._episode
         if episode is None or episode.done:
-            raise gymnasium.error.ResetNeeded("call reset() before step(): the episode has ended")
+            why = (episode.ended_by if episode is not None else None) or "the episode has ended"
+            raise gymnasium.error.ResetNeeded(f"call reset() before step(): {why}")
         if (
             type(action) is np.ndarray
             and action.dtype is _F64

@@ -69,6 +69,16 @@ def check_size(num_envs: int, components: int) -> None:
     )
 
 
+def masked(info: dict[str, Any], n: int) -> dict[str, Any]:
+    """``info`` with Gymnasium's mask beside each key (``_t``, ``_signal``, ...: which envs
+    the key's values are for), as ``SyncVectorEnv`` gives them; every env reports every key
+    at every step, so each mask is all True. Why: code written against one vectorization
+    mode indexes ``info["_t"]``, and should not break in the other."""
+    for key in list(info):
+        info["_" + key] = np.ones(n, dtype=bool)
+    return info
+
+
 class FollowVecEnv(gymnasium.vector.VectorEnv):
     """``num_envs`` FollowEnv episodes stepped as one batch (arguments as FollowEnv's), or,
     below :data:`SINGLES_BELOW` envs or with ``stepping="single"``, as single envs in turn.
@@ -160,7 +170,8 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
             base = args.seed(seed)
             super().reset(seed=base)
             seeds = [None if base is None else base + i for i in range(self.num_envs)]
-        return self._start(seeds)
+        obs, info = self._start(seeds)
+        return obs, masked(info, self.num_envs)
 
     def _start(self, seeds: list[int | None]) -> tuple[np.ndarray, dict[str, Any]]:
         drawn = [s if s is not None else int(self.np_random.integers(0, 2**31 - 1)) for s in seeds]
@@ -201,7 +212,7 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         if self._autoreset:  # the previous step ended every episode: start new ones
             obs, info = self._start([None] * n)
             zeros = np.zeros(n, dtype=bool)
-            return obs, np.zeros(n), zeros, zeros.copy(), info
+            return obs, np.zeros(n), zeros, zeros.copy(), masked(info, n)
         if self._episode.done:  # a fault in a run, or a Ctrl-C, ended the batch (step raised it)
             why = (
                 "a step was interrupted"
@@ -209,15 +220,17 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
                 else ("a run faulted")
             )
             raise gymnasium.error.ResetNeeded(f"call reset() before step(): {why}")
-        a = np.asarray(actions, dtype=np.float64).reshape(n, -1)
+        a = np.asarray(actions, dtype=np.float64)
         acted = self.single.acted
-        if a.shape != (n, len(acted)):
+        if a.size != n * len(acted) or (a.ndim == 2 and a.shape != (n, len(acted))):
+            # said as the single env says it, not as numpy's reshape would
             raise ValueError(f"expected actions of shape ({n}, {len(acted)}), got {a.shape}")
+        a = a.reshape(n, len(acted))
         if self._singles is not None:
             obs, reward, info = self._singles.step(a)
             done = self._singles.done
             self._autoreset = done
-            return obs, reward, np.zeros(n, dtype=bool), np.full(n, done), info
+            return obs, reward, np.zeros(n, dtype=bool), np.full(n, done), masked(info, n)
         scale = self.single.action_scale
         episode = self._episode
         episode.step(a * scale)
@@ -238,7 +251,7 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         # np.zeros and np.ones: C calls, where np.full is Python around them
         truncated = np.ones(n, dtype=bool) if episode.done else np.zeros(n, dtype=bool)
         self._autoreset = episode.done
-        info = self._info(signal.copy())
+        info = masked(self._info(signal.copy()), n)
         return self._observations(), reward, np.zeros(n, dtype=bool), truncated, info
 
     def _observations(self) -> np.ndarray:
