@@ -44,6 +44,30 @@ def test_a_name_that_cannot_name_a_package_is_refused(tmp_path: Path, bad: str) 
     assert not out.exists()
 
 
+@pytest.mark.parametrize(
+    ("name", "why"),
+    [
+        ("rclpy", "the nodes import the Python module rclpy"),
+        ("amsa_phys", "the nodes import the Python module amsa_phys"),
+        ("std_msgs", "the nodes import the Python module std_msgs"),
+        ("json", "json is a module of Python's standard library"),
+    ],
+)
+def test_a_name_that_would_shadow_a_module_the_nodes_import_is_refused(
+    tmp_path: Path, name: str, why: str
+) -> None:
+    """A package is a Python package of its name too: called ``rclpy`` it would shadow
+    rclpy itself wherever both are installed."""
+    out = tmp_path / "pkg"
+    res = amsa("export", "ros2", str(SCENARIO), "-o", str(out), "--name", name, check=False)
+    assert res.returncode == 2, res.stderr
+    assert (
+        res.stderr == f"error: --name {name!r}: {why}, which the package would shadow; "
+        "choose another\n"
+    )
+    assert not out.exists()
+
+
 @pytest.mark.ros2
 def test_a_named_package_locksteps_as_run(tmp_path: Path) -> None:
     missing = ros2_missing()

@@ -16,6 +16,7 @@ judged first (``names.check_world``).
 from __future__ import annotations
 
 import re
+import sys
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
@@ -37,6 +38,41 @@ from .readme import readme
 FILES = Path(__file__).resolve().parent.parent / "files" / "ros2"
 #: A ROS 2 package name (REP 144): lower case letters, digits, underscores.
 PACKAGE = re.compile(r"^[a-z][a-z0-9_]*$")
+#: Python modules the package's nodes and launch file import, besides the standard library:
+#: a package (which is also a Python package of that name) may not be called after one, or
+#: installed beside it the one would shadow the other
+SHADOWED = frozenset(
+    {
+        "amsa_phys",
+        "rclpy",
+        "launch",
+        "launch_ros",
+        "ament_index_python",
+        "numpy",
+        "pymunk",
+        "yaml",
+        "greenlet",
+        "std_msgs",
+        "sensor_msgs",
+        "nav_msgs",
+        "geometry_msgs",
+        "builtin_interfaces",
+        "rosgraph_msgs",
+        "tf2_msgs",
+        "rcl_interfaces",
+    }
+)
+
+
+def shadowing(name: str) -> str | None:
+    """Why a package called ``name`` would shadow a module its nodes import (None if not)."""
+    if name in SHADOWED:
+        return f"the nodes import the Python module {name}, which the package would shadow"
+    if name in getattr(sys, "stdlib_module_names", ()):
+        return f"{name} is a module of Python's standard library, which the package would shadow"
+    return None
+
+
 MANIFEST = "config/amsa.yaml"
 
 
@@ -61,6 +97,12 @@ def package_name(world_name: str) -> str:
             "then letters, digits and _): rename the world",
             key="world",
         )
+    if (why := shadowing(snake)) is not None:
+        raise ConfigError(
+            f"the root component's name {world_name!r} gives the package name {snake!r}: "
+            f"{why}; rename the world or give --name",
+            key="world",
+        )
     return snake
 
 
@@ -76,6 +118,8 @@ def check_package_name(name: str) -> str:
             f"--name {name!r} cannot name a ROS 2 package: a lowercase letter, then lowercase "
             "letters, digits and _ (REP 144)"
         )
+    if (why := shadowing(name)) is not None:
+        raise ConfigError(f"--name {name!r}: {why}; choose another")
     return name
 
 
