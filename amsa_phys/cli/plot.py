@@ -117,7 +117,7 @@ def _world_of(rundir: Path) -> dict[str, Any] | None:
 
 def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
     """summary.png again, for any metric column: no need to rerun the sweep to see another."""
-    from ..plots.summary import nevers, plot_summary  # matplotlib: once the rows are read
+    from ..plots.summary import cut_of, nevers, plot_summary  # matplotlib: once rows are read
 
     rows, axes = read_results(sweepdir / "results.csv")
     metric = args.metric or "rms_error"
@@ -130,7 +130,10 @@ def _plot_sweep(sweepdir: Path, args: argparse.Namespace) -> int:
     out = Path(args.output) if args.output else sweepdir / "summary.png"
     check_output(out, "--output")
     name = _sweep_scenario(sweepdir)
-    title = one_line(f"{name}: {metric} ({seeds} seed{'s' if seeds != 1 else ''})")
+    cut = cut_of(sweepdir / "summary.png")  # what the sweep's own title said of its runs
+    title = one_line(
+        f"{name}: {metric} ({seeds} seed{'s' if seeds != 1 else ''})" + (f"; {cut}" if cut else "")
+    )
     plot_summary(rows, axes, metric, out, title, scenario=name)
     print(one_line(f"wrote {out}"))
     failed = sum(1 for r in rows if r.get("error"))

@@ -203,9 +203,12 @@ def run(args: argparse.Namespace) -> int:
         print(f"warning: {warning}", file=sys.stderr)
     from ..adapt.sweepdir import write_sweep_scenario  # what `adapt SWEEPDIR` reads back
 
+    recorded = load_scenario(args.scenario)
+    full = float(recorded.duration)
+    cut = plan.duration is not None and float(plan.duration) < full
     write_sweep_scenario(
         out,
-        load_scenario(args.scenario),
+        recorded,
         {"contexts": plan.contexts, "metric": plan.metric, "seeds": plan.seeds},
     )
     if args.keep_runs:
@@ -235,7 +238,7 @@ def run(args: argparse.Namespace) -> int:
         write_results(rows, keys, out / "results.csv")
         drawn = any(not r["error"] for r in rows)  # nothing to draw: no picture saying so
         if drawn:
-            _summary(rows, keys, plan, out, name, interrupted, len(jobs))
+            _summary(rows, keys, plan, out, name, interrupted, len(jobs), full if cut else None)
         late = interrupt.requested()
     failed = [r for r in rows if r["error"]]
     print(
@@ -266,9 +269,11 @@ def _summary(
     name: str,
     interrupted: bool,
     planned: int,
+    full: float | None = None,
 ) -> None:
-    """``summary.png`` of the completed rows (only called when there is one)."""
-    from ..plots.summary import plot_summary  # matplotlib: only once the rows are in
+    """``summary.png`` of the completed rows (only called when there is one); ``full``: the
+    scenario's length where ``--duration`` cut the runs shorter (the title says so)."""
+    from ..plots.summary import cut_note, plot_summary  # matplotlib: once the rows are in
 
     plot_summary(
         rows,
@@ -277,6 +282,7 @@ def _summary(
         out / "summary.png",
         one_line(
             f"{name}: {plan.metric} ({plan.seeds} seed{'s' if plan.seeds > 1 else ''})"
+            + (f"; {cut_note(float(plan.duration), full)}" if full is not None else "")
             + (f"; interrupted: {len(rows)} of {planned} runs" if interrupted else "")
         ),
     )

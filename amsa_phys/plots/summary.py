@@ -6,6 +6,7 @@ three-axis sweep of 13 values each had 169."""
 
 from __future__ import annotations
 
+import re
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
@@ -229,6 +230,25 @@ def plot_summary(
     ax.set_title(title, fontsize=10)
     name = scenario if scenario is not None else title.split("\n")[0].rpartition(": ")[0]
     return save_png(fig, out, metadata={"Title": title, SCENARIO_KEY: name})
+
+
+def cut_note(duration: float, full: float) -> str:
+    """What a summary's title says of a sweep whose runs ``--duration`` shortened (the
+    scenario's ``full`` length cut to ``duration``): a metric of 30 s is not one of 500 s."""
+    return f"runs cut to {duration:g} s of {full:g} s"
+
+
+#: :func:`cut_note`'s words in a title, read back by :func:`cut_of`
+_CUT = re.compile(r"runs cut to [0-9.e+]+ s of [0-9.e+]+ s")
+
+
+def cut_of(summary_png: Path) -> str | None:
+    """The :func:`cut_note` a sweep's ``summary.png`` title carries (None if none): a redraw
+    (``plot SWEEPDIR``) says it again; results.csv does not hold the runs' length."""
+    from .save import png_text
+
+    found = _CUT.search(png_text(summary_png).get("Title", ""))
+    return found.group(0) if found else None
 
 
 def scenario_of(summary_png: Path) -> str | None:

@@ -99,5 +99,17 @@ def test_a_sweep_too_short_for_a_requirement_says_its_column_stays_empty(tmp_pat
     ]
     with (out / "results.csv").open() as fh:
         assert all(row["robustness.settled_by_150"] == "" for row in csv.DictReader(fh))
+    # the summary's title says the runs were cut, and so does a redraw of another metric
+    from amsa_phys.plots.save import png_text
+
+    assert png_text(out / "summary.png")["Title"].startswith(
+        "paper_fig5_kv01: rms_error (1 seed); runs cut to 30 s of 300 s"
+    )
+    assert main(["plot", str(out), "--metric", "max_distance"]) == 0
+    assert png_text(out / "summary.png")["Title"].startswith(
+        "paper_fig5_kv01: max_distance (1 seed); runs cut to 30 s of 300 s"
+    )
+    capsys.readouterr()
     assert main([*argv, "--out", str(tmp_path / "full")]) == 0
     assert "warning" not in capsys.readouterr().err
+    assert "runs cut" not in png_text(tmp_path / "full" / "summary.png")["Title"]
