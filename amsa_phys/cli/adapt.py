@@ -296,6 +296,17 @@ def _validate(args: argparse.Namespace, scenario: Scenario, found: Derivation) -
             "--validate draws held-out contexts from the sweep's contexts; this sweep has none",
             key="--validate",
         )
+    from ..tune.contexts import MIN_SEGMENT_S
+
+    if args.duration < 2 * MIN_SEGMENT_S:
+        print(
+            one_line(
+                f"warning: held-out sequences of {args.duration:g} s hold one context each (a "
+                f"context lasts at least {MIN_SEGMENT_S:g} s): no switch between contexts is "
+                f"scored; give --duration {2 * MIN_SEGMENT_S:g} or more"
+            ),
+            file=sys.stderr,
+        )
     print(
         one_line(
             f"validating on {plural(args.sequences, 'held-out sequence')} x "

@@ -86,13 +86,18 @@ class Sequence:
         return "; ".join(parts)
 
 
+#: the shortest context of a held-out sequence (s): an estimator's window (30 s by default)
+#: fills well inside it
+MIN_SEGMENT_S = 60.0
+
+
 def sequences(
     axes: list[Axis],
     n: int,
     duration: float,
     seed: int,
     segments: tuple[int, int] = (2, 4),
-    min_segment: float = 60.0,
+    min_segment: float = MIN_SEGMENT_S,
 ) -> list[Sequence]:
     """``n`` random context sequences over ``duration`` seconds (reproducible by ``seed``)."""
     rng = np.random.default_rng(seed)

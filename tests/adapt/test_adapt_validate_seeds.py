@@ -36,3 +36,21 @@ def test_one_sequence_and_one_seed_are_said_in_the_singular(tmp_path, capsys) ->
     assert said.out.endswith("on 1 held-out sequence, in the mean over 1 seed\n") or (
         "1 of 1 held-out sequence (by more than 2 % in the mean over 1 seed)" in said.err
     )
+
+
+def test_sequences_too_short_for_a_switch_are_said(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
+    """60 s sequences hold one context each: the verdict scores no switch, and says so."""
+    path, sweep = two_context_sweep(
+        tmp_path,
+        {("healthy", 0.2): 0.5, ("healthy", 0.8): 0.3, ("worn", 0.2): 0.5, ("worn", 0.8): 0.6},
+    )
+    argv = ["adapt", str(sweep), "--scenario", str(path), "-o", str(tmp_path / "r.yaml")]
+    argv += ["--validate", "--margin", "inf", "--sequences", "1", "--seeds", "1"]
+    main([*argv, "--duration", "60"])
+    err = capsys.readouterr().err
+    assert (
+        "warning: held-out sequences of 60 s hold one context each (a context lasts at least "
+        "60 s): no switch between contexts is scored; give --duration 120 or more"
+    ) in err
+    main([*argv, "--duration", "240", "--force"])
+    assert "hold one context each" not in capsys.readouterr().err
