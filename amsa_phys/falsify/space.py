@@ -157,7 +157,7 @@ def build_space(scenario: Scenario, ranges: list[str], grids: list[str]) -> Spac
         if key in seen:
             raise ConfigError(f"{key} appears twice", key="falsify")
         seen.add(key)
-    check_axes(axes, scenario)
+    check_axes(axes, scenario, ranges="lo:hi")
     for axis in axes:
         if len(set(map(repr, axis.values))) != len(axis.values):
             raise ConfigError("a value appears twice", key=f"--grid {axis.key}")

@@ -41,6 +41,8 @@ MAX_VALUE_NODES = 10_000
 MAX_DEPTH = 64
 
 _STR = "tag:yaml.org,2002:str"
+#: the implicit tags PyYAML gives base-60 scalars (``1:30``)
+_BASE_60 = frozenset({"tag:yaml.org,2002:int", "tag:yaml.org,2002:float"})
 _MERGE = "tag:yaml.org,2002:merge"
 _C_LOADER = getattr(yaml, "CSafeLoader", None)
 
@@ -134,6 +136,11 @@ class _Builder:
     def scalar(self, node: yaml.ScalarNode, keypath: KeyPath) -> Any:
         tag = node.tag
         if tag == _STR:
+            return node.value
+        if tag in _BASE_60 and ":" in node.value:
+            # YAML 1.1's base-60 numbers (``1:30`` is 90, ``0:30`` 30): YAML 1.2 has none,
+            # and a user who wrote ``1:30`` meant a range or a time, never 90; kept as the
+            # text written, which the parameter then refuses, saying what it was
             return node.value
         if tag not in _SAFE_SCALAR_TAGS:
             raise self.fail(node, f"tag {tag!r} is not allowed (only plain YAML values)", keypath)

@@ -223,8 +223,10 @@ def check_size(axes: list[Axis], seeds: int) -> None:
         )
 
 
-def check_axes(axes: list[Axis], scenario: Scenario) -> None:
-    """Judge every grid value up front, so a typo fails before any run starts."""
+def check_axes(axes: list[Axis], scenario: Scenario, ranges: str = "start:stop:n") -> None:
+    """Judge every grid value up front, so a typo fails before any run starts; ``ranges``:
+    how the command's ``--range`` is written (``falsify``'s is ``lo:hi``), for the hint a
+    range given to ``--grid`` gets."""
     seen = set()
     for axis in axes:
         if axis.key in seen:
@@ -237,7 +239,7 @@ def check_axes(axes: list[Axis], scenario: Scenario) -> None:
             try:
                 resolve_change(axis.key, value, scenario.world)
             except ValueError as exc:
-                hint = range_hint(axis, value)
+                hint = range_hint(axis, value, ranges)
                 raise ConfigError(f"{exc}{hint}", key=f"{axis.option} {axis.key}") from None
 
 
@@ -246,14 +248,18 @@ _NUM = r"\s*[-+]?[\d.]+(?:e[-+]?\d+)?\s*"
 _RANGE_LIKE = re.compile(rf"{_NUM}:{_NUM}(?::\s*\d+)?\s*")
 
 
-def range_hint(axis: Axis, value: Any) -> str:
+def range_hint(axis: Axis, value: Any, ranges: str = "start:stop:n") -> str:
     """`` (a range start:stop:n is --range ...)`` when a ``--grid`` value looks like one: the
-    user meant the other option, and "expected a number" alone does not say so."""
+    user meant the other option, and "expected a number" alone does not say so. ``ranges``
+    is the form the command's ``--range`` takes (``lo:hi`` for ``falsify``)."""
     if axis.option != "--grid" or not isinstance(value, str) or not _RANGE_LIKE.fullmatch(value):
         return ""
     parts = [x.strip() for x in value.split(":")]
-    spec = ":".join(parts) if len(parts) == 3 else f"{parts[0]}:{parts[1]}:5"
-    return f" (a range start:stop:n is given by --range: --range {axis.key}={spec})"
+    if ranges == "lo:hi":
+        spec = f"{parts[0]}:{parts[1]}"
+    else:
+        spec = ":".join(parts) if len(parts) == 3 else f"{parts[0]}:{parts[1]}:5"
+    return f" (a range {ranges} is given by --range: --range {axis.key}={spec})"
 
 
 def apply_setting(scenario: Scenario, key: str, value: Any) -> Scenario:

@@ -113,3 +113,34 @@ def test_a_sweep_too_short_for_a_requirement_says_its_column_stays_empty(tmp_pat
     assert main([*argv, "--out", str(tmp_path / "full")]) == 0
     assert "warning" not in capsys.readouterr().err
     assert "runs cut" not in png_text(tmp_path / "full" / "summary.png")["Title"]
+
+
+@pytest.mark.parametrize("command", ["sweep", "falsify"])
+def test_an_integer_range_given_to_grid_is_never_read_as_base_60(tmp_path, capsys, command) -> None:  # type: ignore[no-untyped-def]
+    """YAML 1.1 reads ``1:30`` as 90 (base 60): ``--grid Leader.cruisePower=1:30`` ran
+    cruisePower 90 without a word. It is the text written, refused with the hint of the
+    command's own --range."""
+    from pathlib import Path
+
+    from amsa_phys.cli.main import main
+
+    scenario = Path(__file__).resolve().parents[2] / "scenarios" / "scenario1.yaml"
+    argv = [command, str(scenario), "--grid", "Leader.cruisePower=1:30", "-j", "1"]
+    argv += ["--out", str(tmp_path / "o"), "--duration", "5"]
+    if command == "falsify":
+        argv += ["--budget", "2"]
+    assert main(argv) == 2
+    spec = "1:30:5" if command == "sweep" else "1:30"
+    form = "start:stop:n" if command == "sweep" else "lo:hi"
+    assert capsys.readouterr().err == (
+        "error: --grid Leader.cruisePower: expected a number, got string '1:30' (a range "
+        f"{form} is given by --range: --range Leader.cruisePower={spec})\n"
+    )
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_base_60_looking_value_in_a_scenario_is_text(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from amsa_phys.model.yamlio import parse_yaml
+
+    doc = parse_yaml("a: 1:30\nb: 0:30.5\nc: 90\nd: 1.5\n", "t.yaml")
+    assert doc.data == {"a": "1:30", "b": "0:30.5", "c": 90, "d": 1.5}
