@@ -341,6 +341,15 @@ def _one_search(
         _plot(progress, objective, name, out, interrupted, args.budget)
         late = interrupt.requested()
     print(f"{line}; results in {out}")
+    if progress.exhausted and len(progress.rows) < args.budget:
+        print(
+            one_line(
+                f"the search stopped after {len(progress.rows)} of its {args.budget} runs: "
+                "every point of the box was run (its axes are all --grid lists), or the "
+                "optimizer proposed only points already run"
+            ),
+            file=sys.stderr,
+        )
     if args.resume:
         print(f"resumed: {progress.reused} finished runs taken from results.csv", file=sys.stderr)
     failed = [r for r in progress.rows if r["error"]]

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from ..engine import interrupt
 from ..runs.evaluate import evaluate
 from .objective import Objective, Verdict
 from .space import Space
@@ -48,6 +49,10 @@ RESTART_CANDIDATES = 256
 #: the pool (processes, imports, the scenario loaded in each) costs more than a handful of
 #: batched runs, and a search starts one per generation. Rows are the same either way.
 SMALL_GENERATION = 32
+#: Restarts in a row that propose only points already run before the search gives up on
+#: the rest of its budget: a box of few points (``--grid`` axes) is exhausted long before,
+#: and the optimizer's population doubles at every restart.
+MAX_EMPTY_GENERATIONS = 8
 OPTIMIZERS = ("cma", "random")
 
 
@@ -85,6 +90,9 @@ class Progress:
     cached: dict[int, dict[str, Any]] = field(default_factory=dict)
     #: how many rows were taken from ``cached`` instead of run
     reused: int = 0
+    #: the search stopped before its budget: every point of a finite box (``--grid`` axes
+    #: only) was run, or the optimizer proposed only points already run many times in a row
+    exhausted: bool = False
 
     def first_violation(self) -> int | None:
         """The run number of the first violating run (in run order), or None."""
@@ -230,7 +238,8 @@ def search(
     u0 = latin_hypercube(rng, n0, len(space.numeric))
     c0 = stratified_choices(rng, n0, [len(d.choices) for d in space.categorical])
     points = [space.decode(list(u), list(c)) for u, c in zip(u0, c0, strict=True)]
-    yield from _evaluate(points, 0, objective, settings, progress)
+    # a box of few points (``--grid`` axes) repeats some: each is run once, as later ones are
+    yield from _evaluate(list(dict.fromkeys(points)), 0, objective, settings, progress)
     if len(progress.rows) >= budget or _found(settings, progress):
         return
     first = [progress.score_of[p] for p in points]
@@ -240,19 +249,27 @@ def search(
     cma.start([float(x) for x in u0[best]])
     generation = 0
     best_here, stalled = math.inf, 0  # this CMA-ES run's best score, generations since
+    points_in_box = box_points(space)
+    empty = 0  # generations in a row that proposed nothing not run yet
     while len(progress.rows) < budget:
+        if len(progress.score_of) >= points_in_box or empty >= MAX_EMPTY_GENERATIONS:
+            progress.exhausted = True  # every point of a finite box run: nothing left
+            return
+        interrupt.check()  # a Ctrl-C noted while generations propose only old points
         generation += 1
         asked = cma.ask()
         decoded = [space.decode(u, cats) for _, u, cats in asked]
         fresh = list(dict.fromkeys(p for p in decoded if p not in progress.score_of))
         fresh = fresh[: budget - len(progress.rows)]
-        yield from _evaluate(fresh, generation, objective, settings, progress)
-        if _found(settings, progress):
-            return
         if not fresh:  # converged on points already run: look elsewhere
+            empty += 1
             cma.restart([space.encode(p) for p in progress.score_of])
             best_here, stalled = math.inf, 0
             continue
+        empty = 0
+        yield from _evaluate(fresh, generation, objective, settings, progress)
+        if _found(settings, progress):
+            return
         if any(p not in progress.score_of for p in decoded):
             continue  # the budget ran out inside this generation
         scores = finite_scores(
@@ -267,6 +284,19 @@ def search(
         if cma.should_stop() or stalled >= STALL_GENERATIONS:
             cma.restart([space.encode(p) for p in progress.score_of])
             best_here, stalled = math.inf, 0
+
+
+def box_points(space: Space) -> float:
+    """How many distinct points the box holds: finite only where every axis is a ``--grid``
+    (or an integer axis the optimizer steps through): infinity with a continuous axis."""
+    total = 1.0
+    for d in space.numeric:
+        if not d.is_integer:
+            return math.inf
+        total *= len(d.levels())
+    for c in space.categorical:
+        total *= len(c.choices)
+    return total
 
 
 def _found(settings: Settings, progress: Progress) -> bool:
