@@ -81,6 +81,12 @@ def with_log_rate(scenario: Scenario, log_rate: float) -> Scenario:
     why = scenario_cycle_problem(out)
     if why is not None:
         raise ConfigError(why, key="--log-rate")
+    from ..stl.requirement import sampling_problem
+
+    rate = effective_log_rate(out.log_rate, out.world)
+    for e in out.expect:  # the loader judged them at the file's rate
+        if e.stl is not None and (why := sampling_problem(e.stl, rate)) is not None:
+            raise ConfigError(f"the requirement {e.name} cannot be judged: {why}", key="--log-rate")
     return out
 
 

@@ -78,6 +78,19 @@ def check_formula(
     return node
 
 
+def sampling_problem(formula: str, log_rate: Fraction) -> str | None:
+    """Why a run logged at ``log_rate`` cannot judge ``formula`` (a window bound that is not
+    a whole number of log periods), or None: ``--log-rate`` asks it again of a scenario the
+    loader judged at the file's rate."""
+    try:
+        _check_sampling(parse(formula), 1 / Fraction(log_rate))
+    except SamplingError as exc:
+        return str(exc)
+    except FormulaError:  # judged at load already
+        return None
+    return None
+
+
 def reads_until(formula: str) -> float:
     """The last instant (s) a formula reads from t = 0: a run that ends before it cannot
     judge it (its windows would be cut short)."""

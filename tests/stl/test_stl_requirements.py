@@ -142,3 +142,26 @@ def test_a_run_cut_before_a_formulas_end_skips_it_and_its_replay_loads(
     assert entry["verdict"] == "skipped"
     assert entry["note"] == "it reads until t=40 s; the run ended at t=30 s"
     assert main(["validate", str(out / "scenario.yaml")]) == 0
+
+
+def test_a_log_rate_given_on_the_command_line_is_asked_the_same(tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    """The loader judges a window against the file's log rate; ``--log-rate 4`` on a file
+    logging at 20 Hz ran to the end, then died with a SamplingError traceback (no metrics).
+    Refused before the run, one line naming --log-rate, exit 2."""
+    from amsa_phys.cli.main import main
+
+    path = scenario(
+        tmp_path,
+        '{stl: "always[0:10.1](MyDistanceMonitor.distanceFollowerToLeader <= 90)", name: a}',
+    )
+    path.write_text(path.read_text().replace("log_rate: 4\n", "log_rate: 20\n"))
+    out = tmp_path / "o"
+    assert main(["run", str(path), "--headless", "-q", "--no-plot", "--out", str(out)]) == 0
+    capsys.readouterr()
+    argv = ["run", str(path), "--headless", "-q", "--no-plot", "--log-rate", "4"]
+    assert main([*argv, "--out", str(tmp_path / "p")]) == 2
+    assert capsys.readouterr().err == (
+        "error: --log-rate: the requirement a cannot be judged: always[0:10.1]: 10.1 s is not "
+        "a multiple of the log period 0.25 s (the run logs no sample there)\n"
+    )
+    assert not (tmp_path / "p").exists()
