@@ -82,6 +82,8 @@ def _ranges(texts: list[str], scenario: Scenario) -> list[tuple[str, float, floa
                 f"expected Comp.param=lo:hi with lo < hi, got {one_line(text)!r}", key="--range"
             ) from None
         key = key.strip()
+        if any(key == k for k, *_ in out):
+            raise ConfigError(f"{one_line(key)} appears twice", key="--range")
         try:
             for v in (lo, hi):
                 change = resolve_change(key, v, scenario.world)
@@ -91,6 +93,29 @@ def _ranges(texts: list[str], scenario: Scenario) -> list[tuple[str, float, floa
     if not out:
         raise ConfigError("give at least one parameter to tune", key="--range")
     return out
+
+
+def _check_metric(metric: str, scenario: Scenario, duration: float) -> None:
+    """Refuse, before any run, a ``--metric`` no run would give a value for: an unknown
+    metric or requirement, or a requirement whose windows runs of ``duration`` cut (every
+    evaluation would score the worst there is, and the budget would be spent for nothing)."""
+    from fractions import Fraction
+
+    from ..requirements.objective import requirement_of, unknown_objective
+    from ..stl.requirement import cut_windows
+
+    names = [str(e.name) for e in scenario.expect if e.stl is not None]
+    phases = len(scenario.timeline.phases_before(Fraction(str(duration))))
+    why = unknown_objective(metric, phases, names)
+    if why is not None:
+        raise ConfigError(why, key="--metric")
+    req = requirement_of(metric)
+    for name, until in cut_windows(scenario.expect, duration, [req] if req else []):
+        raise ConfigError(
+            f"the requirement {name} reads until t={until:g} s: runs of {duration:g} s cannot "
+            "judge it (give a longer --duration)",
+            key="--metric",
+        )
 
 
 def _contexts(args: argparse.Namespace, scenario: Scenario) -> dict[str, dict[str, Any]]:
@@ -133,6 +158,7 @@ def run(args: argparse.Namespace) -> int:
     duration = float(scenario.duration) if args.duration is None else args.duration
     if not (0 < duration <= 1_000_000 and math.isfinite(duration)):
         raise ConfigError(f"must be a positive number of seconds, got {duration}", key="--duration")
+    _check_metric(args.metric, scenario, duration)
     if args.box:
         cases = sequences(box(scenario, contexts), args.box, duration, seed=7, segments=(1, 1))
     else:

@@ -18,6 +18,7 @@ from ..errors import RunFault
 from ..model.configure import configure_scenario
 from ..model.scenario import Scenario, traced_columns
 from ..model.yamlio import YamlDoc
+from ..requirements.objective import requirement_of
 from ..runs.single import execute
 from .contexts import Sequence
 from .objective import objective_value
@@ -29,11 +30,24 @@ def case_data(
     settings: dict[str, Any],
     duration: float,
     rules: list[dict[str, Any]] | None,
+    requirement: str | None = None,
 ) -> dict[str, Any]:
-    """The scenario mapping of one case (``rules`` None: no adaptation)."""
+    """The scenario mapping of one case (``rules`` None: no adaptation). ``requirement``:
+    the STL requirement the objective is the robustness of (``robustness.NAME``), kept
+    among the checks a case otherwise drops (the run computes its robustness)."""
     data = copy.deepcopy(scenario.data)
+    kept = [
+        e
+        for e in data.get("expect") or []
+        if requirement is not None
+        and isinstance(e, dict)
+        and e.get("name") == requirement
+        and "stl" in e
+    ]
     for key in ("sweep", "timeline", "adapt", "expect", "trace_columns"):
         data.pop(key, None)
+    if kept:
+        data["expect"] = kept
     first = sequence.segments[0][1]
     data["set"] = {**(data.get("set") or {}), **first, **settings}
     data["duration"] = duration
@@ -79,7 +93,7 @@ def evaluate(
 
     ``timeline_settings`` adds settings at given instants (the oracle's switches).
     """
-    data = case_data(scenario, sequence, settings, duration, rules)
+    data = case_data(scenario, sequence, settings, duration, rules, requirement_of(objective))
     add_timeline_settings(data, timeline_settings or [])
     # the loader `run` and `ap.run` use, on the case as a document beside the scenario's
     # file (its relative paths resolve as the file's own)

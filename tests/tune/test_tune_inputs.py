@@ -1,0 +1,54 @@
+"""``tune`` judges its objective and its ranges before any run, and a requirement's
+robustness is an objective it can reach, found trying it as a user: ``--metric
+robustness.NAME`` scored every point -inf (the cases dropped the scenario's requirements),
+a misspelt metric spent the whole budget on nothing, and a parameter given twice was tuned
+twice."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from amsa_phys.cli.main import main
+
+ROOT = Path(__file__).resolve().parents[2]
+SWEEP = ROOT / "scenarios" / "adaptive_sweep.yaml"
+ARGS = ["tune", str(SWEEP), "--range", "MyFollowerController.Kv=0.05:0.8", "--seeds", "1"]
+
+
+def test_a_requirements_robustness_is_tuned_for(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([*ARGS, "--budget", "2", "--metric", "robustness.no_contact"]) == 0
+    out = capsys.readouterr().out
+    assert "worst -inf" not in out
+    assert "robust choice: MyFollowerController.Kv=" in out
+    worsts = [float(line.rsplit(" ", 1)[1]) for line in out.splitlines() if ": worst " in line]
+    assert len(worsts) == 2
+    assert all(w > 0 for w in worsts)  # no collision: the distance stays above 3 m
+
+
+@pytest.mark.parametrize(
+    ("extra", "said"),
+    [
+        (
+            ["--metric", "rms_err"],
+            "error: --metric: unknown objective 'rms_err' (did you mean rms_error?)",
+        ),
+        (
+            ["--metric", "robustness.nope"],
+            "error: --metric: unknown requirement 'nope'; known: no_contact, path_speed",
+        ),
+        (
+            ["--range", "MyFollowerController.Kv=0.1:0.2"],
+            "error: --range: MyFollowerController.Kv appears twice",
+        ),
+    ],
+)
+def test_what_no_run_could_answer_is_refused_before_any(
+    extra: list[str], said: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main([*ARGS, "--budget", "2", *extra]) == 2
+    out, err = capsys.readouterr()
+    assert err.startswith(said)
+    assert len(err.splitlines()) == 1
+    assert "worst" not in out  # nothing ran
