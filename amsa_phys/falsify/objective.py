@@ -48,12 +48,21 @@ def row_metrics(row: dict[str, Any]) -> dict[str, Any]:
             phases[i][m.group(2)] = value
         name = requirement_of(key)
         if name is not None:
-            ok = value is not None and value >= 0
+            if value is None:  # the run could not judge it (its windows cut by the run's end)
+                reqs[name] = {"robustness": None, "verdict": "skipped", "note": SKIPPED}
+                continue
+            ok = value >= 0
             reqs[name] = {"robustness": value, "verdict": "pass" if ok else "fail"}
-    out = {"overall": {k: row.get(k) for k in METRICS}, "phases": phases}
+    # a row says which requirements its run judged (an empty column: not judged), so the
+    # run's length, which a row does not hold, is not needed to tell: none is cut by it here
+    out = {"overall": {k: row.get(k) for k in METRICS}, "phases": phases, "simulated": math.inf}
     if reqs:
         out["requirements"] = reqs
     return out
+
+
+#: why a requirement whose robustness column is empty was not judged
+SKIPPED = "the run could not judge it (its windows reach past the run's end)"
 
 
 def has_metrics(row: dict[str, Any]) -> bool:

@@ -152,6 +152,8 @@ def _stl_check(e: Expectation, metrics: dict[str, Any]) -> Check:
         return Check(e, None, True, skipped=True, why=why)
     if entry is None:
         return Check(e, None, False, note="not judged: the run kept no samples of it")
+    if entry.get("verdict") == "skipped":  # judged nothing: its windows were cut
+        return Check(e, None, True, skipped=True, why=str(entry.get("note") or "not judged"))
     rob = entry.get("robustness")
     note = ""
     if entry.get("instant") is not None:

@@ -166,3 +166,23 @@ def test_minimised_counterexample_still_falsifies_and_is_no_further_from_nominal
     assert distance(point(out / "worst.yaml"), nom, space) <= distance(raw_point, nom, space)
     assert (out / "worst_raw.yaml").is_file()
     assert (out / "counterexample.png").stat().st_size > 0
+
+
+def test_expect_judges_the_stl_requirements_too(tmp_path: Path) -> None:
+    """``--expect`` takes the scenario's STL requirements with its metric checks: each row's
+    robustness is at most each requirement's (it was judged from a result row as "the run
+    ended at t=0 s", skipped, and a run breaking only the requirement passed)."""
+    import csv
+
+    from amsa_phys.cli.main import main
+
+    scen = Path(__file__).resolve().parents[2] / "scenarios" / "falsify_resonance.yaml"
+    out = tmp_path / "f"
+    argv = ["falsify", str(scen), "--range", "Leader.cruisePower=20:80", "--budget", "10"]
+    argv += ["--expect", "-j", "1", "--out", str(out)]
+    main(argv)
+    with (out / "results.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert rows
+    for r in rows:
+        assert float(r["robustness"]) <= float(r["robustness.band"])
