@@ -194,6 +194,18 @@ def run(args: argparse.Namespace) -> int:
         if done is not None:
             trials.append(done)
             violated = violated or done.falsified
+            if args.trials == 1:  # nothing left to run: say what the finished search found
+                found = (
+                    f"falsified after {done.simulations} simulations"
+                    if done.falsified and done.simulations is not None
+                    else "no violation"
+                )
+                print(
+                    one_line(
+                        f"already finished: {done.runs} runs, {found}; results in {here} "
+                        "(nothing run again)"
+                    )
+                )
             continue
         here.mkdir(exist_ok=True)
         settings = Settings(

@@ -40,3 +40,19 @@ def test_the_box_counts_its_points() -> None:
     assert search.box_points(grid) == 6
     mixed = build_space(scenario, ["MyFollowerController.Kv=0.1:0.3"], ["Leader.behavior=1,4"])
     assert search.box_points(mixed) == float("inf")
+
+
+def test_resuming_a_finished_search_says_what_it_found(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--resume`` of a search that had finished printed nothing at all."""
+    out = tmp_path / "f"
+    argv = ["falsify", str(SCENARIO), "--budget", "3", "-j", "1", "--duration", "5"]
+    argv += ["--range", "MyFollowerController.Kv=0.05:0.3", "--out", str(out)]
+    assert main(argv) == 0
+    before = (out / "results.csv").read_bytes()
+    capsys.readouterr()
+    assert main([*argv, "--resume"]) == 0
+    said = capsys.readouterr().out
+    assert said == f"already finished: 3 runs, no violation; results in {out} (nothing run again)\n"
+    assert (out / "results.csv").read_bytes() == before
