@@ -50,6 +50,7 @@ from typing import Any
 from ..control.estimators.watches import Watch, watches
 from ..errors import ConfigError
 from ..model.scenario import Scenario
+from ..requirements.objective import higher_is_better
 from .braking import Braking, braking, catch_ups
 from .braking import requirement as braking_requirement
 from .cellrules import cell_rules as rules_of_cells
@@ -270,7 +271,8 @@ def derive(
     derivation.oracle_mean = statistics.fmean(c.score for c in scored)
     if derivation.gain < min_gain:
         derivation.refused = (
-            f"not worth adapting: switching to each context's best would lower the mean "
+            f"not worth adapting: switching to each context's best would "
+            f"{'raise' if higher_is_better(metric) else 'lower'} the mean "
             f"{metric} by {100 * derivation.gain:.1f} % over the robust choice "
             f"({_show(derivation.robust)}), less than {100 * min_gain:g} %; run that "
             "fixed choice instead"

@@ -103,6 +103,7 @@ def test_not_worth_adapting_writes_no_rules(tmp_path, capsys):
     assert _adapt(_sweep(tmp_path, "\n".join(same) + "\n"), out) == 0
     text = capsys.readouterr().out
     assert "no rules written: not worth adapting" in text
+    assert "would lower the mean rms_error by" in text  # a robustness.NAME: "raise"
     assert "MyFollowerController.Kv=0.2" in text
     assert not out.exists()
 
