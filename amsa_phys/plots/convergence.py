@@ -10,6 +10,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from matplotlib.colors import BoundaryNorm
+from matplotlib.ticker import MaxNLocator
 
 from .save import save_png
 
@@ -82,6 +83,9 @@ def plot_convergence(
     if reference is not None:
         ax.axhline(reference[0], color="tab:blue", ls=":", lw=1.5, label=reference[1])
     ax.set_xlabel("run (as numbered in results.csv)")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))  # runs are whole: no run 2.5
+    # values as they are, never "1e-5 + 1.004e-1" above the axis when they lie close together
+    ax.ticklabel_format(axis="y", useOffset=False)
     ax.set_ylabel(label)
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)

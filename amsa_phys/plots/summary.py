@@ -206,6 +206,8 @@ def plot_summary(
                 f" ({most} seeds: dots, quartiles, min–max; ★ best mean)"
                 if band
                 else " (seed min–max as bars, ★ best)"
+                if most > 1
+                else " (★ best)"  # one seed: no spread to draw
             )
         )
         if is_count(metric):  # 0, 1, 2 collisions: no tick at 0.5 of one

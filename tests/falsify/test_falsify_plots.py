@@ -114,3 +114,17 @@ def test_interval_of_a_formula() -> None:
     assert counterexample.interval("always[10:120](x <= 1)", 60.0) == (10.0, 60.0)
     assert counterexample.interval("always(x <= 1)", 60.0) == (0.0, 60.0)
     assert counterexample.interval("not a formula (", 60.0) == (0.0, 60.0)
+
+
+def test_convergence_counts_whole_runs_and_says_values_as_they_are(
+    tmp_path: Path, figures: list[Figure]
+) -> None:
+    """Eight runs: no tick at run 2.5; values 1e-5 apart: no "1e-5 + 1.004e-1" offset
+    above the axis (found on a short search's convergence.png)."""
+    values = [0.1004485, 0.1004485, 0.1004485, 0.1004485, 0.1004485, 0.1004418, 0.100435, 0.1004485]
+    convergence.plot_convergence(values, [0] * 8, "rms_error", True, tmp_path / "c.png", "t")
+    ax = figures[-1].axes[0]
+    ticks = [t for t in ax.get_xticks() if -0.5 <= t <= 7.5]
+    assert ticks
+    assert all(float(t).is_integer() for t in ticks)
+    assert ax.yaxis.get_offset_text().get_text() == ""

@@ -40,7 +40,7 @@ def test_plot_of_a_renamed_sweep_folder_is_titled_with_the_scenario(tmp_path: Pa
     moved = out.rename(tmp_path / "whatever-I-called-it")
     assert main(["plot", str(moved), "--metric", "collisions"]) == 0
     title = png_text(moved / "summary.png")["Title"]
-    assert title == "mde_short: collisions (1 seed)"
+    assert title == "mde_short: collisions (1 seed); runs cut to 3 s of 500 s"
 
 
 def test_an_old_sweep_without_the_record_falls_back_to_the_folder_name(
