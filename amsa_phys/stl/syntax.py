@@ -215,7 +215,8 @@ class _Parser:
     def need_formula(self, node: Node) -> Node:
         if not node.is_formula:
             raise FormulaError(
-                f"{node.text()} is a number, not a formula: compare it (e.g. {node.text()} > 0)"
+                f"{node.text()} is a value (a signal or a number), not a formula: compare it "
+                f"(e.g. {node.text()} > 0)"
             )
         return node
 
@@ -353,5 +354,8 @@ def _parse(text: str) -> Node:
     if p.i != len(p.toks):
         raise FormulaError(f"unexpected {p.where()}")
     if not node.is_formula:
-        raise FormulaError(f"{node.text()} is a number, not a formula: compare it")
+        raise FormulaError(
+            f"{node.text()} is a value (a signal or a number), not a formula: compare it "
+            f"(e.g. {node.text()} > 0)"
+        )
     return node

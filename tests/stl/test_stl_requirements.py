@@ -165,3 +165,15 @@ def test_a_log_rate_given_on_the_command_line_is_asked_the_same(tmp_path: Path, 
         "a multiple of the log period 0.25 s (the run logs no sample there)\n"
     )
     assert not (tmp_path / "p").exists()
+
+
+@pytest.mark.parametrize("text", ["foo", "MyDistanceMonitor.distanceFollowerToLeader", "3"])
+def test_a_value_alone_is_said_to_be_a_value_not_a_number(text: str) -> None:
+    """A signal alone read "foo is a number, not a formula"."""
+    from amsa_phys.stl.syntax import FormulaError, parse
+
+    with pytest.raises(FormulaError) as caught:
+        parse(text)
+    assert str(caught.value) == (
+        f"{text} is a value (a signal or a number), not a formula: compare it (e.g. {text} > 0)"
+    )
