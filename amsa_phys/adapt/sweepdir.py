@@ -39,6 +39,12 @@ def write_sweep_scenario(out: Path, scenario: Scenario, sweep: dict[str, Any]) -
 def read_sweep_scenario(sweepdir: Path) -> Scenario:
     """The scenario ``sweepdir`` records, loaded without importing any module it names."""
     path = Path(sweepdir) / NAME
+    if not path.is_file() and (Path(sweepdir) / "falsify.json").is_file():
+        raise ConfigError(
+            "a falsify directory, not a sweep's: adapt derives rules from a sweep over the "
+            "contexts (amsa-phys sweep SCENARIO --out DIR, its sweep: contexts)",
+            file=sweepdir,
+        )
     if not path.is_file():
         raise ConfigError(
             f"records no {NAME} (made before sweeps recorded their scenario?); give the "

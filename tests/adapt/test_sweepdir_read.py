@@ -65,3 +65,10 @@ def test_a_template_not_built_in_is_named_where_it_is_written(sweepdir: Path) ->
         f"{path}:{line}: world.components.MyFollowerController.template: component "
         "MyFollowerController names template 'evil:Mod', not built in; not imported"
     )
+
+
+def test_a_falsify_directory_is_named_for_what_it_is(tmp_path: Path) -> None:
+    (tmp_path / "falsify.json").write_text("{}\n")
+    with pytest.raises(ConfigError) as caught:
+        read_sweep_scenario(tmp_path)
+    assert "a falsify directory, not a sweep's" in str(caught.value)
