@@ -155,9 +155,9 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--duration",
         type=float,
-        default=600.0,
+        default=None,
         metavar="S",
-        help="length of a held-out sequence in seconds (default 600)",
+        help="with --validate: length of a held-out sequence in seconds (default 600)",
     )
     p.add_argument(
         "--results",
@@ -182,6 +182,14 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(
             f"no results.csv in {one_line(str(sweepdir))} (is it a sweep's --out?)", key="adapt"
         )
+    if args.duration is not None and not args.validate:
+        raise ConfigError(
+            "sets the length of --validate's held-out sequences: give --validate (the rules "
+            "are derived from the sweep's runs as they are)",
+            key="--duration",
+        )
+    if args.duration is None:
+        args.duration = 600.0
     if not (args.hold >= 0 and math.isfinite(args.hold)):
         raise ConfigError(f"must be a number of seconds >= 0, got {args.hold}", key="--hold")
     if args.fallback_hold is not None and not (

@@ -72,3 +72,16 @@ def test_a_falsify_directory_is_named_for_what_it_is(tmp_path: Path) -> None:
     with pytest.raises(ConfigError) as caught:
         read_sweep_scenario(tmp_path)
     assert "a falsify directory, not a sweep's" in str(caught.value)
+
+
+def test_duration_without_validate_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``adapt DIR --duration S`` without ``--validate`` was silently ignored."""
+    from amsa_phys.cli.main import main
+
+    (tmp_path / "results.csv").write_text("run\n")
+    assert main(["adapt", str(tmp_path), "-o", str(tmp_path / "r.yaml"), "--duration", "100"]) == 2
+    assert capsys.readouterr().err.startswith(
+        "error: --duration: sets the length of --validate's held-out sequences: give --validate"
+    )
