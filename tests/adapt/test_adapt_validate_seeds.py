@@ -9,14 +9,20 @@ from sweepfiles import two_context_sweep
 from amsa_phys.cli.main import main
 
 
-def test_the_verdict_names_the_seed_count(tmp_path, capsys) -> None:
-    # a lying sweep (Kv 0.8 best with healthy motors): the rules lose on held-out sequences
+def _validate_lying_sweep(tmp_path) -> list[str]:  # type: ignore[no-untyped-def]
+    """``adapt --validate`` of a lying sweep (Kv 0.8 best with healthy motors): the rules
+    lose on held-out sequences."""
     path, sweep = two_context_sweep(
         tmp_path,
         {("healthy", 0.2): 0.5, ("healthy", 0.8): 0.3, ("worn", 0.2): 0.5, ("worn", 0.8): 0.6},
     )
     argv = ["adapt", str(sweep), "--scenario", str(path), "-o", str(tmp_path / "r.yaml")]
-    argv += ["--validate", "--margin", "inf", "--sequences", "2", "--seeds", "3"]
+    return [*argv, "--validate", "--margin", "inf"]
+
+
+def test_the_verdict_names_the_seed_count(tmp_path, capsys) -> None:
+    argv = _validate_lying_sweep(tmp_path)
+    argv += ["--sequences", "2", "--seeds", "3"]
     code = main([*argv, "--duration", "240"])
     err = capsys.readouterr().err
     assert code == 1
@@ -24,12 +30,8 @@ def test_the_verdict_names_the_seed_count(tmp_path, capsys) -> None:
 
 
 def test_one_sequence_and_one_seed_are_said_in_the_singular(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
-    path, sweep = two_context_sweep(
-        tmp_path,
-        {("healthy", 0.2): 0.5, ("healthy", 0.8): 0.3, ("worn", 0.2): 0.5, ("worn", 0.8): 0.6},
-    )
-    argv = ["adapt", str(sweep), "--scenario", str(path), "-o", str(tmp_path / "r.yaml")]
-    argv += ["--validate", "--margin", "inf", "--sequences", "1", "--seeds", "1"]
+    argv = _validate_lying_sweep(tmp_path)
+    argv += ["--sequences", "1", "--seeds", "1"]
     main([*argv, "--duration", "240"])
     said = capsys.readouterr()
     assert "\nvalidating on 1 held-out sequence x 1 seed (" in said.out
@@ -40,12 +42,8 @@ def test_one_sequence_and_one_seed_are_said_in_the_singular(tmp_path, capsys) ->
 
 def test_sequences_too_short_for_a_switch_are_said(tmp_path, capsys) -> None:  # type: ignore[no-untyped-def]
     """60 s sequences hold one context each: the verdict scores no switch, and says so."""
-    path, sweep = two_context_sweep(
-        tmp_path,
-        {("healthy", 0.2): 0.5, ("healthy", 0.8): 0.3, ("worn", 0.2): 0.5, ("worn", 0.8): 0.6},
-    )
-    argv = ["adapt", str(sweep), "--scenario", str(path), "-o", str(tmp_path / "r.yaml")]
-    argv += ["--validate", "--margin", "inf", "--sequences", "1", "--seeds", "1"]
+    argv = _validate_lying_sweep(tmp_path)
+    argv += ["--sequences", "1", "--seeds", "1"]
     main([*argv, "--duration", "60"])
     err = capsys.readouterr().err
     assert (
