@@ -55,5 +55,3 @@ def _check_layout() -> bool:
         )
     except Exception:  # another pymunk layout: every access a call
         return False
-
-

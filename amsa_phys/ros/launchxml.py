@@ -241,7 +241,7 @@ def launch_xml(
         " never drops a message: a recorder behind slows the run; required: a bag it cannot"
         " write ends the launch at once, saying why) -->",
         fill(
-            '  <node if="$(eval arg(\'bag\') != \'\')" pkg="@@{pkg:xml_attr}"'
+            "  <node if=\"$(eval arg('bag') != '')\" pkg=\"@@{pkg:xml_attr}\""
             ' type="@@{bag:xml_attr}.py" name="@@{bag:xml_attr}" required="true"'
             ' output="screen"',
             pkg=pkg,
