@@ -31,7 +31,7 @@ class DiffDriveRover:
 
     def __init__(
         self,
-        space: pymunk.Space,
+        space: pymunk.Space | None,
         name: str,
         *,
         mass_kg: float,
@@ -61,7 +61,8 @@ class DiffDriveRover:
         self.shape.friction = 0.6
         self.shape.elasticity = 0.1
         self.shape.collision_type = collision_type
-        space.add(self.body, self.shape)
+        if space is not None:  # None: a batch's rover, whose columns move it (``space.py``)
+            space.add(self.body, self.shape)
         # the commands behind the ``power_l`` ... ``drive_r`` properties
         self._power_l = 0.0
         self._power_r = 0.0

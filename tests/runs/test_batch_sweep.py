@@ -349,3 +349,28 @@ def test_the_shipped_context_sweep_gives_the_same_results_batched_or_one_run_per
     assert main([*argv, "--executor", "local", "--out", str(tmp_path / "local")]) == 0
     batched = (tmp_path / "batch" / "results.csv").read_bytes()
     assert batched == (tmp_path / "local" / "results.csv").read_bytes()
+
+
+def test_a_gnss_street_batched_gives_the_rows_of_its_runs_made_alone(tmp_path: Path) -> None:
+    """A GNSS receiver casts its sky's rays in its run's Space, ignoring every rover. A
+    batch's rovers are not in their Space (it is never stepped): the buildings block the
+    same sky, so each batched row is its run's made alone (the compiled path: equal; the
+    pure path within :data:`TOL`), with the rovers 4 m from a facade (the fixes' multipath
+    and blocked sky differ from the open sky's: the rows would too)."""
+    scen = tmp_path / "street.yaml"
+    scen.write_text(
+        f"world: {ROOT / 'worlds' / 'mde_challenge_urban.yaml'}\nduration: 40\nseed: 1\n"
+        "quality: {signal: MyDistanceMonitor.distanceFollowerToLeader, reference: 15, "
+        "tolerance: 1.5}\n"
+        "set: {Leader.behavior: 4, Leader.cruisePower: 9.0}\n"
+    )
+    plan = SweepPlan(scen, [Axis("MyFollowerController.Kv", (0.1, 0.35))], seeds=2, base_seed=1)
+    jobs = plan.jobs()
+    stats: dict[str, int] = {}
+    batched = run_batch(jobs, stats)
+    alone = [run_job(job) for job in jobs]
+    path = "pure" if extension() is None else "compiled"
+    for a, b in zip(alone, batched, strict=True):
+        assert_rows_close(a, b, path)
+    assert stats["contacts"] < len(jobs)  # rows from the batch's columns (a leader may hit a wall)
+    assert len({r["rms_error"] for r in alone}) == len(alone)
