@@ -160,13 +160,19 @@ def resolved_scenario(
 def kept_expectations(
     scenario: Scenario, duration: Fraction | None, drop: Sequence[Expectation] = ()
 ) -> list[Expectation]:
-    """The expectations a resolved scenario keeps: not those in ``drop``, nor an STL one
-    reading past the written end (its loader would refuse the file)."""
-    written = float(duration if duration is not None else scenario.duration)
+    """The expectations a resolved scenario keeps: not those in ``drop``, nor any its loader
+    would refuse at the written end: an STL one reading past it, a check of a phase that
+    starts at or after it (``falsify --duration`` writes ``worst.yaml`` at the runs' length),
+    a window opening after it."""
+    end = Fraction(duration if duration is not None else scenario.duration)
+    phases = 1 + sum(1 for p in scenario.timeline.points() if p.starts_phase and p.at < end)
     return [
         e
         for e in scenario.expect
-        if not any(e is d for d in drop) and (e.stl is None or reads_until(e.stl) <= written)
+        if not any(e is d for d in drop)
+        and (e.stl is None or reads_until(e.stl) <= float(end))
+        and (e.phase is None or e.phase < phases)
+        and (e.after is None or Fraction(str(e.after)) <= end)
     ]
 
 

@@ -50,16 +50,20 @@ def has_expectations(path: Path) -> bool:
 
 
 def in_run_directory(path: Path) -> bool:
-    """Whether ``path`` is an output of a run (a run directory's resolved ``scenario.yaml``).
+    """Whether ``path`` is an output of amsa-phys (a run directory's resolved
+    ``scenario.yaml``, a falsify trial's ``worst.yaml``, anything else in an output folder).
 
     A folder search skips those: ``test runs/`` would otherwise rerun every old run as a
-    test. A run directory holds amsa-phys's marker file, or (made before the marker) a
+    test, and an output folder is data someone may have handed over, whose files may name a
+    plugin template to import. Every folder above ``path`` is looked at, not only its own:
+    ``falsify --trials`` writes each trial's ``worst.yaml`` one folder below the marker. An
+    output folder holds amsa-phys's marker file, or (a run made before the marker) a
     ``metrics.json`` beside its ``scenario.yaml``.
     """
     parent = path.parent
-    if (parent / MARKER).is_file():
+    if path.name == "scenario.yaml" and (parent / "metrics.json").is_file():
         return True
-    return path.name == "scenario.yaml" and (parent / "metrics.json").is_file()
+    return any((folder / MARKER).is_file() for folder in path.absolute().parents)
 
 
 def find_scenarios(paths: list[str], skipped: list[Path] | None = None) -> list[Path]:

@@ -257,3 +257,39 @@ def test_debug_is_taken_after_a_commands_own_subcommand(argv: list[str]) -> None
     assert parser.parse_args([*argv, "--debug"]).debug is True
     assert parser.parse_args(["--debug", *argv]).debug is True
     assert parser.parse_args(argv).debug is False
+
+
+#: a plugin module that leaves a file behind when imported
+TELLTALE = """\
+from pathlib import Path
+
+Path(__file__).with_name("IMPORTED").write_text("x")
+
+from amsa_phys.model.template import Kind, Template
+
+
+class Evil(Template):
+    kind = Kind.CONTROLLER
+"""
+
+
+def test_test_on_a_folder_imports_nothing_from_a_falsify_directory(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``falsify --trials`` writes each trial's ``worst.yaml`` (with its ``expect:``) one
+    folder below the output's marker. A handed-over falsify directory whose trial names a
+    plugin template must not make ``test`` on the folder import it: the files of an output
+    folder are data, at any depth below its marker."""
+    out = tmp_path / "found"
+    argv = ["falsify", str(SCENARIO1), "--range", "MyNormalizePower.motorCoef=50:100"]
+    argv += ["--budget", "2", "--duration", "2", "-j", "1", "--trials", "2", "--out", str(out)]
+    assert main(argv) in (0, 1)
+    worst = out / "trial-001" / "worst.yaml"
+    worst.write_text(worst.read_text().replace("template: controlledRobot", "template: evil:Evil"))
+    assert "expect:" in worst.read_text()
+    (tmp_path / "evil.py").write_text(TELLTALE)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    capsys.readouterr()
+    assert main(["test", str(out), "-j", "1"]) == 2  # no scenario test left to run
+    assert not (tmp_path / "IMPORTED").exists()
+    assert "skipped 2 resolved scenarios in run directories" in capsys.readouterr().err
