@@ -25,7 +25,7 @@ from ..errors import ConfigError, Interrupted
 from ..model.configure import with_ros2
 from ..model.scenario import Scenario, traced_columns
 from ..runs.expect import Check, check_expectations
-from ..runs.rundir import default_run_dir, prepare_run_dir
+from ..runs.rundir import default_run_dir, run_dir_for
 from ..runs.single import Ended, execute, write_run_files
 from ..runs.suite import input_files
 from .memory import check_trace_memory
@@ -94,9 +94,9 @@ class Run:
         """
         path = Path(out) if out is not None else default_run_dir(self._loaded.name)
         inputs = [p for p in input_files(self._loaded) if p.is_file()]  # a mapping has none
-        prepare_run_dir(path, force, inputs=inputs)
-        self._memory.save(path / "trace.csv")
-        unwritten = write_run_files(path, self._ended, plot=plot)
+        with run_dir_for(path, force, inputs=inputs) as work:  # an earlier run whole till done
+            self._memory.save(work / "trace.csv")
+            unwritten = write_run_files(work, self._ended, plot=plot)
         if unwritten:  # a full disk: every file that could be written was, say the first
             raise unwritten[0]
         return path

@@ -16,7 +16,7 @@ from ..runs.expect import check_expectations
 from ..runs.overrides import timeline_notes
 from ..runs.plotjob import PlotJob
 from ..runs.references import reference_notes
-from ..runs.rundir import default_run_dir, prepare_run_dir
+from ..runs.rundir import default_run_dir, run_dir_for
 from ..runs.single import run_scenario
 from ..runs.suite import input_files
 from .options import (
@@ -127,26 +127,27 @@ def _run(
     out = Path(args.out) if args.out else default_run_dir(scenario.name)
     if bag_path is not None:
         bag_apart(bag_path, out)
-    prepare_run_dir(out, args.force, inputs=input_files(scenario))
-    bag: BagRecorder | None = None
-    if bag_path is not None:  # mcap and the message tables (~60 ms) only for --bag
-        from ..bag import BagRecorder
+    with run_dir_for(out, args.force, inputs=input_files(scenario)) as work:
+        bag: BagRecorder | None = None
+        if bag_path is not None:  # mcap and the message tables (~60 ms) only for --bag
+            from ..bag import BagRecorder
 
-        bag = BagRecorder(bag_path, scenario)
-    try:
-        with interrupt.sigterm_as_ctrl_c():
-            outcome = run_scenario(
-                scenario,
-                out,
-                plot=not args.no_plot,
-                record=record,
-                snapshot=snapshot,
-                window=not args.headless,
-                plotter=plotter,
-                simulation=bag.simulation if bag is not None else None,
-            )
-    finally:
-        written = bag.close() if bag is not None else None  # whatever ended the run
+            bag = BagRecorder(bag_path, scenario)
+        try:
+            with interrupt.sigterm_as_ctrl_c():
+                outcome = run_scenario(
+                    scenario,
+                    work,
+                    plot=not args.no_plot,
+                    record=record,
+                    snapshot=snapshot,
+                    window=not args.headless,
+                    plotter=plotter,
+                    simulation=bag.simulation if bag is not None else None,
+                    shown=out,
+                )
+        finally:
+            written = bag.close() if bag is not None else None  # whatever ended the run
     if not args.quiet:
         print_summary(outcome.metrics, out, sys.stdout)
         if written is not None:

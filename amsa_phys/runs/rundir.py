@@ -24,10 +24,10 @@ import re
 import shutil
 import tempfile
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
-from ..errors import ConfigError
+from ..errors import AmsaError, ConfigError
 
 #: The file that says "amsa-phys made this directory": ``--force`` replaces nothing else.
 MARKER = ".amsa-phys-run"
@@ -209,6 +209,34 @@ def prepare_run_dir(
         shutil.rmtree(out)
     _make_marked(out, flag, kind)
     return out
+
+
+@contextlib.contextmanager
+def run_dir_for(
+    out: Path, force: bool, inputs: Iterable[Path] = (), flag: str = "--out", kind: str = "run"
+) -> Iterator[Path]:
+    """The directory to write ``out``'s outputs into, checked as :func:`prepare_run_dir`
+    checks ``out``.
+
+    Where ``force`` replaces an earlier run, the new one is written into a staged directory
+    beside it and put in its place in one rename when the run ends (completed, faulted or
+    interrupted: its outputs are the run's), so the earlier run stays whole until then, and
+    stays if the process dies or fails outside the run. Otherwise ``out`` itself.
+    """
+    out = _without_dotdot(out)
+    if not check_output_dir(out, force, inputs, flag, kind):
+        yield prepare_run_dir(out, force, inputs, flag, kind)
+        return
+    staged = staged_dir(out, force, inputs, flag, kind)
+    try:
+        yield staged
+    except (AmsaError, KeyboardInterrupt):
+        commit_staged(staged, out)  # a fault's or an interruption's outputs: the run's own
+        raise
+    except BaseException:
+        discard_staged(staged)
+        raise
+    commit_staged(staged, out)
 
 
 def _make_marked(out: Path, flag: str, kind: str) -> None:

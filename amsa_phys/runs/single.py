@@ -62,8 +62,12 @@ def run_scenario(
     window: bool | WindowDriver = False,
     plotter: PlotJob | None = None,
     simulation: SimulationFactory | None = None,
+    shown: Path | None = None,
 ) -> RunOutcome:
     """Run ``scenario`` and write its run directory (which must exist and be empty).
+
+    ``shown`` is the directory the messages name, where ``out_dir`` is staged to become it
+    once the run has ended (``rundir.run_dir_for``: a run replacing another with --force).
 
     ``record`` also writes a video, ``snapshot`` a PNG of one instant (in a window session:
     of the moment it was closed, without trails). ``window`` runs the scenario in the
@@ -88,6 +92,7 @@ def run_scenario(
             window=window,
             plotter=plotter,
             simulation=simulation,
+            shown=Path(shown) if shown is not None else Path(out_dir),
         )
 
 
@@ -121,6 +126,7 @@ def _run_scenario(
     window: bool | WindowDriver,
     plotter: PlotJob | None,
     simulation: SimulationFactory | None = None,
+    shown: Path,
 ) -> RunOutcome:
     trace = TraceWriter(out_dir / "trace.csv", traced_columns(scenario))
     ended = execute(
@@ -144,7 +150,7 @@ def _run_scenario(
     t_end = ended.metrics["simulated"]
     if isinstance(error, KeyboardInterrupt):
         raise Interrupted(
-            one_line(f"interrupted at t={t_end:.2f} s; outputs so far are in {out_dir}")
+            one_line(f"interrupted at t={t_end:.2f} s; outputs so far are in {shown}")
         ) from None
     if error is not None:
         raise error
@@ -152,10 +158,10 @@ def _run_scenario(
         raise Interrupted(
             one_line(
                 f"interrupted after the run ended at t={t_end:.2f} s; "
-                f"its outputs are complete in {out_dir}"
+                f"its outputs are complete in {shown}"
             )
         )
-    return RunOutcome(out_dir, ended.metrics, ended.simulation)
+    return RunOutcome(shown, ended.metrics, ended.simulation)
 
 
 class TraceSink(Protocol):

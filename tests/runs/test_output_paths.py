@@ -12,6 +12,7 @@ import os
 from pathlib import Path
 
 import pytest
+import yaml
 
 from amsa_phys.cli.main import main
 from amsa_phys.runs.rundir import MARKER, safe_name, unique_names
@@ -132,6 +133,88 @@ def test_force_replaces_a_run_directory(tmp_path: Path, capsys: pytest.CaptureFi
     assert main(args) == 2  # without --force an existing run directory is kept
     assert main([*args, "--force"]) == 0
     assert (out / "metrics.json").read_text() != "stale"
+    capsys.readouterr()
+
+
+#: an observer that, at its first step, copies what ``--out`` holds then (the earlier run's
+#: metrics.json) to a file beside it
+WITNESS = """\
+from pathlib import Path
+
+from amsa_phys.model.template import Kind, Port, Template
+
+
+class Witness(Template):
+    kind = Kind.OBSERVER
+    inputs = (Port("x"),)
+    outputs = (Port("y", 0.0),)
+    params = ()
+
+    def do_step(self, t, inp):
+        here = Path(__file__).parent
+        seen = here / "seen.txt"
+        if not seen.exists():
+            old = here / "run" / "metrics.json"
+            seen.write_text(old.read_text() if old.exists() else "nothing")
+        return {"y": 0.0}
+"""
+
+
+def _witnessed(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """A scenario of the MDE world with the :data:`WITNESS` observer added."""
+    (tmp_path / "witness.py").write_text(WITNESS)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    world = yaml.safe_load(WORLD.read_text())
+    world["components"]["W"] = {
+        "template": "witness:Witness",
+        "freq": 1,
+        "inputs": {"x": "MyDistanceMonitor.distanceFollowerToLeader"},
+    }
+    (tmp_path / "w.yaml").write_text(yaml.safe_dump(world))
+    scen = _scenario(tmp_path / "s.yaml", "s")
+    scen.write_text(scen.read_text().replace(f"world: {WORLD}", "world: w.yaml"))
+    return scen
+
+
+def test_force_keeps_the_earlier_run_whole_until_the_new_one_ends(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """While a run replaces another with --force, the earlier one stays whole in ``--out``
+    (the new one is written beside it and renamed into place when it ends), and no staged
+    directory is left behind."""
+    scen = _witnessed(tmp_path, monkeypatch)
+    out = tmp_path / "run"
+    args = ["run", str(scen), "--headless", "--no-plot", "--out", str(out), "-q"]
+    assert main(args) == 0
+    (out / "metrics.json").write_text("the earlier run")
+    (tmp_path / "seen.txt").unlink()
+    assert main([*args, "--force"]) == 0
+    assert (tmp_path / "seen.txt").read_text() == "the earlier run"  # whole during the run
+    assert (out / "metrics.json").read_text() != "the earlier run"  # replaced at its end
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
+    capsys.readouterr()
+
+
+def test_force_keeps_the_earlier_run_when_the_new_one_fails_outside_the_run(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A failure that is not the run's (here: the trace's writer cannot start) leaves the
+    earlier run as it was, and no staged directory behind; a run that faults replaces it
+    with its own outputs, as an interrupted one does (they are the run's)."""
+    scen = _scenario(tmp_path / "s.yaml", "s")
+    out = tmp_path / "run"
+    args = ["run", str(scen), "--headless", "--no-plot", "--out", str(out), "-q"]
+    assert main(args) == 0
+    before = _snapshot(out)
+
+    def broken(*_args: object, **_kwargs: object) -> None:
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr("amsa_phys.runs.single.TraceWriter", broken)
+    with pytest.raises(RuntimeError, match="a bug"):
+        main([*args, "--force"])
+    assert _snapshot(out) == before
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
     capsys.readouterr()
 
 
