@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from typing import Any, NamedTuple
 
 from ..errors import ConfigError, one_line
 from ..model import timing
 from ..model.adaptrules import describe_rules
+from ..model.changes import parse_setting
 from ..model.configure import with_ros2
 from ..model.scenario import PHYSICS_PREFIX, Scenario, load_scenario
 from ..model.wording import plural
@@ -41,6 +42,15 @@ def add_args(p: argparse.ArgumentParser) -> None:
 Source = str
 
 
+class Start(NamedTuple):
+    """A parameter's value at t = 0 that a scenario gives, where it comes from, and the
+    scenario's own value when a ``--set`` replaced it with another (None otherwise)."""
+
+    value: Any
+    source: Source
+    replaced: Any = None
+
+
 def raw_params(world: WorldSpec, leaf: LeafSpec) -> dict[str, Any]:
     """The parameters a world file writes for ``leaf`` (not the template's defaults)."""
     body: Any = world.data
@@ -52,7 +62,7 @@ def raw_params(world: WorldSpec, leaf: LeafSpec) -> dict[str, Any]:
 
 def describe_world(
     world: WorldSpec,
-    start: dict[str, dict[str, tuple[Any, Source]]] | None = None,
+    start: dict[str, dict[str, Start]] | None = None,
     physics_from: dict[str, Source] | None = None,
     seed: int | None = None,
 ) -> list[str]:
@@ -60,7 +70,9 @@ def describe_world(
 
     Every parameter is shown with the value it starts with and where that comes from: the
     template's default, the world file, or (``start``, for a scenario) the scenario's
-    ``set:`` or a ``--set``, with the world's value it replaced. A Leaf's loop timing
+    ``set:`` or a ``--set``, with each value it replaced (``--set; scenario 0.35, world
+    0.05``: the scenario's ``set:`` replaced the world's 0.05, the ``--set`` the scenario's
+    0.35); a value equal to the one it replaced does not repeat it. A Leaf's loop timing
     (latency, jitter, phase) follows its frequency; for a scenario (``seed`` given) a random
     phase is shown as drawn.
     """
@@ -84,12 +96,13 @@ def describe_world(
             source = "world" if p.name in written else "default"
             value = world_value
             if p.name in start.get(path, {}):
-                value, source = start[path][p.name]
-                if value != world_value:
-                    source += f"; world {_short(world_value)}"
+                value, source, replaced = start[path][p.name]
+                before = [] if replaced is None else [f"scenario {_short(replaced)}"]
+                before += [f"world {_short(world_value)}"] * (value != world_value)
+                source += "; " + ", ".join(before) if before else ""
             rng = p.range_text()
             unit = f" {p.unit}" if p.unit else ""
-            text = f"      {p.name} = {value!r}{unit}" + (f"  {rng}" if rng else "")
+            text = f"      {p.name} = {_short(value)}{unit}" + (f"  {rng}" if rng else "")
             lines.append(f"{text}  ({source})")
         for port, buf in leaf.inputs.items():
             size = f" ({len(world.arrays[buf])} values)" if buf in world.arrays else ""
@@ -158,14 +171,41 @@ def _short(value: Any) -> str:
     return value_text(value)  # as the run's table and the window print it
 
 
-def scenario_start(scenario: Scenario, in_file: int) -> dict[str, dict[str, tuple[Any, Source]]]:
-    """Each parameter phase 0 sets, with its source: the first ``in_file`` changes are the
-    scenario's ``set:``, the rest ``--set``."""
-    start: dict[str, dict[str, tuple[Any, Source]]] = {}
-    for i, change in enumerate(scenario.timeline.initial):
-        source = "scenario set" if i < in_file else "--set"
-        start.setdefault(change.leaf, {})[change.param] = (change.value, source)
+def scenario_start(
+    file: Scenario, final: Scenario, set_keys: set[str]
+) -> dict[str, dict[str, Start]]:
+    """Each parameter phase 0 of ``final`` sets, with its source: ``--set`` for a key in
+    ``set_keys`` (the ``Leaf.param`` keys the command line gave), else the scenario's
+    ``set:``.
+
+    Sources go by key, not by position in phase 0: a ``--set`` of a key the file's ``set:``
+    already gives replaces the file's entry, so counting the file's entries first would name
+    the wrong ones.
+    """
+    in_file = {c.key: c.value for c in file.timeline.initial}
+    start: dict[str, dict[str, Start]] = {}
+    for change in final.timeline.initial:
+        if change.key in set_keys:
+            scenario = in_file.get(change.key)
+            replaced = scenario if change.key in in_file and scenario != change.value else None
+            entry = Start(change.value, "--set", replaced)
+        else:
+            entry = Start(change.value, "scenario set")
+        start.setdefault(change.leaf, {})[change.param] = entry
     return start
+
+
+def set_keys(overrides: list[str], scenario: Scenario) -> set[str]:
+    """The ``Leaf.param`` keys of parameters ``--set`` gives (an alias resolved to the
+    declared name; physics settings and frequencies are not parameters of phase 0)."""
+    keys = set()
+    for text in overrides:
+        if text.strip().startswith(PHYSICS_PREFIX):
+            continue
+        change, _ = parse_setting(text, scenario.world)
+        if change is not None:
+            keys.add(change.key)
+    return keys
 
 
 def run(args: argparse.Namespace) -> int:
@@ -176,7 +216,7 @@ def run(args: argparse.Namespace) -> int:
     if kind == "world" and args.ros2:
         raise ConfigError("only for a scenario: run a scenario with --ros2", key="--ros2")
     if kind == "scenario":
-        in_file = len(obj.timeline.initial)
+        file_scenario, given = obj, set()
         physics_from = {
             f"{k}.{sub}" if isinstance(v, dict) else k: "scenario physics"
             for k, v in (obj.data.get("physics") or {}).items()
@@ -184,6 +224,7 @@ def run(args: argparse.Namespace) -> int:
         }
         if args.overrides:
             obj = load_scenario(args.file, overrides=args.overrides)
+            given = set_keys(args.overrides, file_scenario)
             for text in args.overrides:
                 key = text.partition("=")[0].strip()
                 if key.startswith(PHYSICS_PREFIX):
@@ -198,9 +239,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"quality: {q.signal} vs {q.reference:g} ± {q.tolerance:g}")
         # a --set of a key the file's set: already gives replaces it: show the value in force
         final = {c.key: c.value for c in obj.timeline.initial}
-        print("phase 0 at 0 s: " + (", ".join(f"{k}={v!r}" for k, v in final.items()) or "-"))
+        print("phase 0 at 0 s: " + (", ".join(f"{k}={_short(v)}" for k, v in final.items()) or "-"))
         for point in obj.timeline.points():
-            changes = ", ".join(f"{c.key}={c.value!r}" for c in point.changes)
+            changes = ", ".join(f"{c.key}={_short(c.value)}" for c in point.changes)
             if point.starts_phase:
                 print(f"phase {point.phase} at {float(point.at):g} s: {changes or '-'}")
             else:
@@ -215,10 +256,11 @@ def run(args: argparse.Namespace) -> int:
             ):
                 print(line)
         print(
-            "values in force at t = 0, each with where it comes from: default (the "
-            "template's), world, scenario set, --set"
+            "values in force at t = 0, each with where it comes from (default: the "
+            "template's; world; scenario set; --set) and any value it replaced"
         )
-        lines = describe_world(obj.world, scenario_start(obj, in_file), physics_from, seed=obj.seed)
+        start = scenario_start(file_scenario, obj, given)
+        lines = describe_world(obj.world, start, physics_from, seed=obj.seed)
     else:
         lines = describe_world(obj)
     print("\n".join(lines))

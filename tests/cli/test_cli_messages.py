@@ -44,8 +44,8 @@ def test_describe_shows_the_values_in_force_at_t0_and_their_source(
     lines = [line.strip() for line in capsys.readouterr().out.splitlines()]
     assert "Kv = 0.35 1/m  [0, 10]  (scenario set; world 0.05)" in lines  # not the world's 0.05
     assert "Kw = 0.1 1/rad  [0, 10]  (--set; world 0.04)" in lines
-    assert "distanceRef = 15.0 m  [0, 1000]  (world)" in lines
-    assert "Kff = 0.0  [0, 2]  (default)" in lines  # the paper's law: no feed-forward
+    assert "distanceRef = 15 m  [0, 1000]  (world)" in lines
+    assert "Kff = 0  [0, 2]  (default)" in lines  # the paper's law: no feed-forward
     assert "MyFollowerController: FollowerController (controller) at 4 Hz, latency 0.75 s" in lines
     physics = next(line for line in lines if line.startswith("physics:"))
     assert "ground.friction 0.5 (--set)" in physics
@@ -185,6 +185,39 @@ def test_describe_lists_a_set_key_once_with_the_value_in_force(
     )
     assert phase0.count("MyFollowerController.Kv=") == 1
     assert "MyFollowerController.Kv=0.3" in phase0
+
+
+SCENARIO2 = ROOT / "scenarios" / "scenario2.yaml"  # set: gives Kv 0.35, cruisePower 9.0
+
+
+def _param_line(out: str, name: str) -> str:
+    return next(line.strip() for line in out.splitlines() if line.strip().startswith(f"{name} ="))
+
+
+@pytest.mark.parametrize("first", [[], ["--set", "MyFollowerController.Kw=0.05"]])
+def test_describe_names_a_set_that_replaces_the_files_set_as_set_with_both_values_replaced(
+    capsys: pytest.CaptureFixture[str], first: list[str]
+) -> None:
+    argv = ["describe", str(SCENARIO2), *first, "--set", "MyFollowerController.Kv=0.2"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert _param_line(out, "Kv") == "Kv = 0.2 1/m  [0, 10]  (--set; scenario 0.35, world 0.05)"
+    if first:  # given only by --set: not the file's, whatever its place in phase 0
+        assert _param_line(out, "Kw") == "Kw = 0.05 1/rad  [0, 10]  (--set; world 0.04)"
+    assert (
+        _param_line(out, "cruisePower") == "cruisePower = 9 %  [-100, 100]  (scenario set; world 7)"
+    )
+
+
+def test_describe_spells_values_as_the_run_table_does(capsys: pytest.CaptureFixture[str]) -> None:
+    from amsa_phys.valuetext import value_text
+
+    assert main(["describe", str(SCENARIO2)]) == 0
+    out = capsys.readouterr().out
+    phase0 = next(line for line in out.splitlines() if line.startswith("phase 0 "))
+    assert f"Leader.cruisePower={value_text(9.0)}," in phase0  # the file writes 9.0
+    assert "cruisePower=9.0" not in out
+    assert _param_line(out, "x").startswith(f"x = {value_text(15.0)} m ")
 
 
 def test_a_snapshot_after_the_end_is_refused_before_anything_runs(
