@@ -150,10 +150,9 @@ def with_overrides(scenario: Scenario, overrides: list[str], doc: YamlDoc | None
         else:
             key, _, raw = text.partition("=")
             _refuse_conflict(given, key.strip(), text, raw.strip())
-    in_file = len(scenario.timeline.initial)
     timeline = scenario.timeline.with_initial(added)
     out = dataclasses.replace(scenario, world=world, timeline=timeline)
-    check_phases(out, doc, in_file)
+    check_phases(out, doc, {c.key for c in added})
     return out
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -380,23 +380,23 @@ def _own_values(data: dict[str, Any]) -> int:
     return 1 + sum(count(v) for k, v in data.items() if k != "world")
 
 
-def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = None) -> None:
+def check_phases(scenario: Scenario, doc: YamlDoc | None, overridden: Collection[str] = ()) -> None:
     """Refuse a scenario whose phases would break a template's rules, before anything runs.
 
     Each leaf's values are followed through the phases: after every phase, a leaf it changed
     must pass its template's ``check_params`` (powerMin <= powerMax, ...), and a timeline
     entry must not change a parameter read only by ``initialize`` (a rover's mass: the
-    change would fault mid-run). Only the first ``in_file`` changes of phase 0 come from the
-    file's ``set``; later ones are ``--set`` overrides and are named as such. Without a
-    ``doc`` (a sweep's grid point) the error names the change only.
+    change would fault mid-run). A change at t = 0 of a key in ``overridden`` is a ``--set``
+    (which replaced the file's own, if any: ``Timeline.with_initial``) and is named as such.
+    Without a ``doc`` (a sweep's grid point) the error names the change only.
     """
     world = scenario.world
     values = {path: dict(leaf.params) for path, leaf in world.leaves.items()}
 
-    def error(entry: int | None, index: int, change: Change, message: str) -> ConfigError:
+    def error(entry: int | None, change: Change, message: str) -> ConfigError:
         if doc is None:
             return ConfigError(message, key=change.written_key)
-        if entry is None and in_file is not None and index >= in_file:
+        if entry is None and change.key in overridden:
             return ConfigError(message, key=f"--set {change.written_key}")
         where = ("set",) if entry is None else ("timeline", entry, "set")
         return doc.error((*where, change.written_key), message)
@@ -405,21 +405,20 @@ def check_phases(scenario: Scenario, doc: YamlDoc | None, in_file: int | None = 
     steps: list[tuple[bool, int | None, Sequence[Change]]] = [(True, None, timeline.initial)]
     steps += [(False, p.entry, p.changes) for p in timeline.points()]  # (at t = 0, entry, ...)
     for initial, entry, changes in steps:
-        last: dict[str, tuple[int, Change]] = {}
-        for j, change in enumerate(changes):
+        last: dict[str, Change] = {}
+        for change in changes:
             template = world.leaves[change.leaf].template
             if not initial and change.param in template.fixed_once_running:
                 raise error(
                     entry,
-                    j,
                     change,
                     f"{change.param} is read only when the run starts; "
                     "set it in set: or in the world",
                 )
             values[change.leaf][change.param] = change.value
-            last[change.leaf] = (j, change)
-        for leaf, (j, change) in last.items():
+            last[change.leaf] = change
+        for leaf, change in last.items():
             try:
                 world.leaves[leaf].template.check_params(values[leaf])
             except ValueError as exc:
-                raise error(entry, j, change, str(exc)) from None
+                raise error(entry, change, str(exc)) from None

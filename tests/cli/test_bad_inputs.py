@@ -13,6 +13,7 @@ from amsa_phys.cli.main import main
 
 BAD = sorted((Path(__file__).parent.parent / "fixtures" / "bad").glob("*.yaml"))
 SCENARIO = Path(__file__).parent.parent.parent / "scenarios" / "scenario1.yaml"
+WORLD = SCENARIO.parent.parent / "worlds" / "mde_challenge.yaml"
 
 
 def expected(path: Path) -> str:
@@ -93,6 +94,25 @@ def test_overrides_that_break_a_rule_name_the_override(
     assert main(argv) == 2
     assert capsys.readouterr().err == (
         "error: --set MyNormalizePower.powerMax: powerMin 80 is above powerMax 20\n"
+    )
+    assert not (tmp_path / "o").exists()
+
+
+def test_an_override_of_a_key_the_file_sets_is_named_as_the_override(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--set`` replacing a value the file's ``set:`` gives, and breaking a rule with the
+    file's other values, is the override's fault: named ``--set``, not the file's line."""
+    scen = tmp_path / "s.yaml"
+    scen.write_text(
+        f"world: {WORLD}\nduration: 5\n"
+        "set: {MyNormalizePower.powerMax: 80, MyNormalizePower.powerMin: -50, "
+        "Leader.cruisePower: 9}\n"
+    )
+    argv = ["run", str(scen), "--headless", "--out", str(tmp_path / "o")]
+    assert main([*argv, "--set", "MyNormalizePower.powerMax=-60"]) == 2
+    assert capsys.readouterr().err == (
+        "error: --set MyNormalizePower.powerMax: powerMin -50 is above powerMax -60\n"
     )
     assert not (tmp_path / "o").exists()
 
