@@ -53,7 +53,13 @@ def add_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--no-plot", action="store_true", help="skip the plots (distance.png, trajectory.png)"
     )
-    p.add_argument("-q", "--quiet", action="store_true", help="no summary table")
+    p.add_argument(
+        "-q",
+        "--quiet",
+        action="store_true",
+        help="no summary table (nor the lines under it, bag: or the ROS 2 waiting line); "
+        "the expect verdicts, warnings and errors still print",
+    )
 
 
 def run(args: argparse.Namespace) -> int:
