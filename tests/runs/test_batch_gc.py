@@ -68,3 +68,47 @@ def test_a_higher_threshold_of_the_users_is_kept(thresholds: Any) -> None:
     with batched.fewer_collections():
         assert gc.get_threshold() == (10 * batched.YOUNG_GC, 9, 8)
     assert gc.get_threshold() == (10 * batched.YOUNG_GC, 9, 8)
+
+
+def test_a_batch_freezes_what_it_built_while_it_runs_and_lets_it_go_after(
+    thresholds: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The batch's set-up runs with the collector off and what it built is frozen while the
+    loop runs (never traversed again); at its end nothing stays frozen, the collector is on,
+    also when the set-up faults or the loop is interrupted."""
+    seen: list[tuple[bool, int]] = []
+    real = batched._run_whole
+
+    def watching(sim: Any) -> None:
+        seen.append((gc.isenabled(), gc.get_freeze_count()))
+        real(sim)
+
+    monkeypatch.setattr(batched, "_run_whole", watching)
+    batched.run_batch(_jobs())
+    assert seen[0][0]
+    assert seen[0][1] > 0  # the batch's objects frozen during the loop
+    assert gc.isenabled()
+    assert gc.get_freeze_count() == 0
+
+    def interrupted(sim: Any) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(batched, "_run_whole", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        batched.run_batch(_jobs())
+    assert gc.isenabled()
+    assert gc.get_freeze_count() == 0
+
+
+def test_objects_the_process_froze_are_left_frozen(thresholds: Any) -> None:
+    """A process that froze objects of its own (a forking server): the batch freezes nothing
+    (one unfreeze would let the process's go too) and unfreezes nothing."""
+    gc.freeze()
+    try:
+        frozen = gc.get_freeze_count()
+        rows = batched.run_batch(_jobs())
+        assert [r["error"] for r in rows] == ["", ""]
+        # nothing added, nothing let go (frozen objects freed by reference counting leave)
+        assert 0 < gc.get_freeze_count() <= frozen
+    finally:
+        gc.unfreeze()
