@@ -182,11 +182,12 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
             self._episode = self._singles  # type: ignore[assignment]
             return self._singles.start(drawn)
         from ..engine import publish
-        from ..runs.batched import fewer_collections  # the sweep's module, imported lazily
+        from ..runs.batched import built_uncollected, fewer_collections  # imported lazily
 
-        # a batch's build makes thousands of objects an env, and asks ~18 times an env
-        # whether the compiled publishing is on (the environment read once instead)
-        with fewer_collections(), publish.pinned():
+        # a batch's build makes thousands of objects an env (built with the collector off:
+        # they live as long as the episode), and asks ~18 times an env whether the compiled
+        # publishing is on (the environment read once instead)
+        with fewer_collections(), publish.pinned(), built_uncollected():
             self._episode = VecEpisode(
                 single._scenario,
                 single.path,

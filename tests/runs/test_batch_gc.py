@@ -112,3 +112,30 @@ def test_objects_the_process_froze_are_left_frozen(thresholds: Any) -> None:
         assert 0 < gc.get_freeze_count() <= frozen
     finally:
         gc.unfreeze()
+
+
+def test_a_vector_env_builds_its_episode_uncollected_and_leaves_nothing_frozen(
+    thresholds: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The vector env's reset builds its batch with the collector off (what it builds lives
+    as long as the episode) and lets it back at once: after the reset and a step the
+    collector is on, nothing is frozen and the thresholds are the process's."""
+    from amsa_phys.gym import vecepisode
+    from amsa_phys.gym.vector import FollowVecEnv
+
+    seen: list[bool] = []
+    real = vecepisode.VecEpisode.__init__
+
+    def watching(self: Any, *args: Any, **kwargs: Any) -> None:
+        seen.append(gc.isenabled())
+        real(self, *args, **kwargs)
+
+    monkeypatch.setattr(vecepisode.VecEpisode, "__init__", watching)
+    env = FollowVecEnv(32, stepping="batch")
+    env.reset(seed=1)
+    env.step(env.action_space.sample())
+    assert seen == [False]
+    assert gc.isenabled()
+    assert gc.get_freeze_count() == 0
+    assert gc.get_threshold() == (700, 9, 8)
+    env.close()
