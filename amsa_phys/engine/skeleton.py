@@ -147,9 +147,14 @@ def compile_tasks(sim: Simulation) -> tuple[TickGrid, dict[str, Fraction], list[
     if found is not None:
         return found.grid, dict(found.phases), found.tasks(sim.members[0], sim.seed)
     order = sim.world.order
-    periods = sorted({1 / w.leaves[p].freq for w in sim.worlds for p in order})
+    # a batch's runs share their world and timeline objects point by point: each is read
+    # once (a Fraction division a Leaf and run, and a timeline's points a run, were a third
+    # of this function in a 250-run batch)
+    worlds = {id(w): w for w in sim.worlds}.values()
+    timelines = {id(t): t for t in sim.timelines}.values()
+    periods = sorted({1 / f for f in {w.leaves[p].freq for w in worlds for p in order}})
     periods += [1 / r for r, _, _ in sim._hooks] + [1 / sim.log_rate]
-    instants = [p.at for t in sim.timelines for p in t.points()] + [sim.duration]
+    instants = [p.at for t in timelines for p in t.points()] + [sim.duration]
     #: each Leaf's timer phase in each run (0 unless the world gives or draws one)
     phases = [run_phases(w, seed) for w, seed in zip(sim.worlds, sim.seeds, strict=True)]
     instants += [ph for run in phases for ph in run.values() if ph]
