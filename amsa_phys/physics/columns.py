@@ -58,7 +58,8 @@ from .fleet import Fleet
 from .force_model import make_force_model
 from .forces import ground_list
 from .rover import DiffDriveRover
-from .space import PhysicsWorld, resolvable_speed
+from .space import PhysicsWorld
+from .tunnelling import resolvable_speed
 
 #: Two shapes of a run closer than this (plus two steps of their motion): the run may be
 #: about to touch, and its row is made alone.

@@ -37,6 +37,7 @@ from .force_model import ForceModel, make_force_model
 from .forces import ground_list, per_kind
 from .rover import DiffDriveRover, PendingPowers
 from .terrain import Terrain
+from .tunnelling import resolvable_speed
 from .wheel import WheelModel
 from .worldrelease import release_world
 
@@ -431,40 +432,6 @@ class PhysicsWorld:
         self._seek(k)
         model.stop_batch()
         return self._steps + k
-
-
-def resolvable_speed(rovers: Sequence[DiffDriveRover], space: pymunk.Space, dt: float) -> float:
-    """The speed (m/s) up to which one Chipmunk step of ``dt`` cannot let a rover tunnel.
-
-    Chipmunk tests overlaps at the step's end positions: a rover that moves further in one
-    step than half the thinnest pair of shapes it can meet (itself and a wall, or two rovers
-    closing at twice the speed) may stop past the middle and be pushed out the far side.
-    So a step resolves a speed ``v`` when ``v dt`` is at most half of ``t_r + t_s`` (the
-    thinnest rover and the thinnest static shape) and a quarter of ``2 t_r`` (two rovers
-    head-on); faster, the step is cut into sub-steps (``bodyio.substeps``).
-    """
-    if not rovers:
-        return math.inf
-    rover = min(min(r.length, r.width) for r in rovers)
-    statics = [s for s in space.shapes if s.body.body_type == pymunk.Body.STATIC]
-    thin = min((_thickness(s) for s in statics), default=math.inf)
-    return min(0.5 * rover, 0.5 * (rover + thin)) / dt
-
-
-def _thickness(shape: pymunk.Shape) -> float:
-    """The thinnest width of a static shape (m): a segment's or circle's diameter, a
-    polygon's narrowest projection on its edges' normals (plus its rounding)."""
-    if isinstance(shape, pymunk.Segment | pymunk.Circle):
-        return 2.0 * shape.radius
-    if isinstance(shape, pymunk.Poly):
-        pts = shape.get_vertices()
-        widths = []
-        for a, b in zip(pts, [*pts[1:], pts[0]], strict=True):
-            n = (b - a).perpendicular_normal()
-            proj = [p.dot(n) for p in pts]
-            widths.append(max(proj) - min(proj))
-        return min(widths) + 2.0 * shape.radius
-    return math.inf
 
 
 def wheel_model(p: Any, gravity: float) -> WheelModel:
