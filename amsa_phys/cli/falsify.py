@@ -16,17 +16,16 @@ from ..errors import ConfigError, Interrupted, one_line
 from ..falsify import counterexample
 from ..falsify.objective import Objective, build_objective, requirement_objective
 from ..falsify.outputs import describe_value, headline, write_results, write_worst
-from ..falsify.search import Progress, Settings, search
-from ..falsify.space import Space, build_space
-from ..falsify.trials import (
-    Trial,
+from ..falsify.resume import (
     check_same_search,
-    plot_trials,
+    check_trial_dirs,
+    make_trial_dir,
     read_cached,
     read_trial,
-    summarize,
-    write_trial,
 )
+from ..falsify.search import Progress, Settings, search
+from ..falsify.space import Space, build_space
+from ..falsify.trials import Trial, plot_trials, summarize, write_trial
 from ..model.configure import duration_option
 from ..model.scenario import Scenario, load_scenario
 from ..model.schema import MAX_SEED
@@ -169,6 +168,13 @@ def run(args: argparse.Namespace) -> int:
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-falsify")
     if args.resume:
+        if out.is_symlink():  # as a new --out (check_output_dir): never written through
+            raise ConfigError(
+                "is a symbolic link; give the real directory (amsa-phys does not write "
+                "through links)",
+                file=out,
+                key="--out",
+            )
         if not out.is_dir():
             raise ConfigError("not a directory to resume", file=out, key="--resume")
     else:
@@ -186,11 +192,15 @@ def run(args: argparse.Namespace) -> int:
         "duration": args.duration,
     }
     check_same_search(out / "falsify.json", record, args.resume)
+    places = [out] if args.trials == 1 else [out / f"trial-{k + 1:03d}" for k in range(args.trials)]
+    check_trial_dirs(places)  # before any trial writes: no link is ever written through
+    finished = [  # every record judged before a trial runs again
+        read_trial(here / "trial.json", args.seed + k, args.budget) if args.resume else None
+        for k, here in enumerate(places)
+    ]
     trials: list[Trial] = []
     violated = False
-    for k in range(args.trials):
-        here = out if args.trials == 1 else out / f"trial-{k + 1:03d}"
-        done = read_trial(here / "trial.json") if args.resume else None
+    for k, (here, done) in enumerate(zip(places, finished, strict=True)):
         if done is not None:
             trials.append(done)
             violated = violated or done.falsified
@@ -207,7 +217,7 @@ def run(args: argparse.Namespace) -> int:
                     )
                 )
             continue
-        here.mkdir(exist_ok=True)
+        make_trial_dir(here)
         settings = Settings(
             Path(args.scenario).resolve(),
             args.budget,
@@ -301,7 +311,7 @@ def _one_search(
     keys = [d.key for d in space.dims]
     progress = Progress()
     if args.resume:
-        progress.cached = read_cached(out / "results.csv")
+        progress.cached = read_cached(out / "results.csv", args.budget)
     interrupted = False
     cpu0 = _cpu()
     bar = progress_bar(args.budget, "run" if args.trials == 1 else f"trial {k + 1} run")

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError, one_line
+from ..falsify.records import read_record
 from ..runs.rundir import check_output
 from ..runs.sweep import read_results
 
@@ -25,12 +25,11 @@ def record_of(folder: Path) -> Path | None:
 
 
 def _read_record(path: Path) -> dict[str, Any]:
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise ConfigError(f"not a falsification's record: {exc}", file=path) from None
-    if not isinstance(doc, dict):
-        raise ConfigError("not a falsification's record (not a JSON object)", file=path)
+    """The record's fields the plot reads, checked (a directory handed over is data)."""
+    doc = read_record(path, "a falsification's record")
+    for key in ("objective", "scenario"):
+        if not isinstance(doc.get(key), str | None):
+            raise ConfigError("is not text (not a falsification's record)", file=path, key=key)
     return doc
 
 

@@ -10,13 +10,12 @@ the **robustness reached** by trials that did not falsify. ``summary.json`` hold
 
 An interrupted search resumes (``--resume``): a finished trial is read back from its
 ``trial.json``; an unfinished one replays its search, which is deterministic, taking every
-row its ``results.csv`` already holds instead of running it again.
+row its ``results.csv`` already holds instead of running it again. What it reads back is
+judged as data in ``resume.py``.
 """
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 import statistics
@@ -25,11 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from ..atomic import write_atomic
-from ..errors import ConfigError
 from .search import Progress
-
-#: Columns of results.csv that are not numbers.
-TEXT_COLUMNS = ("error",)
 
 
 @dataclass
@@ -86,68 +81,6 @@ def summarize(trials: list[Trial], budget: int, label: str) -> dict[str, Any]:
 def write_trial(trial: Trial, path: Path) -> None:
     """``trial.json``: a finished trial (what ``--resume`` skips)."""
     write_atomic(path, json.dumps(asdict(trial), indent=1) + "\n")
-
-
-def read_trial(path: Path) -> Trial | None:
-    """A finished trial back, or None if its file is missing or not one."""
-    try:
-        doc = json.loads(path.read_text())
-        return Trial(**doc)
-    except (OSError, ValueError, TypeError):
-        return None
-
-
-def _cell(key: str, text: str) -> Any:
-    if key in TEXT_COLUMNS:
-        return text
-    if text == "":
-        return None
-    if text.lstrip("-").isdigit():  # written from an int (a float always shows "." or "e")
-        return int(text)
-    try:
-        return float(text)
-    except ValueError:
-        return text  # a categorical axis's value
-
-
-def read_cached(path: Path) -> dict[int, dict[str, Any]]:
-    """The rows of an interrupted search's results.csv, by run number (none: no file)."""
-    if not path.is_file():
-        return {}
-    try:
-        reader = csv.DictReader(io.StringIO(path.read_text(encoding="utf-8")))
-        rows = [{k: _cell(k, v) for k, v in r.items()} for r in reader]
-    except (OSError, UnicodeDecodeError, csv.Error, ValueError) as exc:
-        raise ConfigError(f"cannot resume from it: {exc}", file=path) from None
-    out = {}
-    for r in rows:
-        if not isinstance(r.get("run"), int):
-            raise ConfigError("cannot resume from it: a row without a run number", file=path)
-        r.pop("robustness", None)  # judged again
-        r.pop("generation", None)
-        out[r["run"]] = r
-    return out
-
-
-def check_same_search(path: Path, settings: dict[str, Any], resume: bool) -> None:
-    """``falsify.json`` records the search's settings; ``--resume`` refuses a directory of
-    another search (its rows would be taken for this one's)."""
-    if resume:
-        try:
-            before = json.loads(path.read_text())
-        except (OSError, ValueError):
-            raise ConfigError(
-                "not a falsification to resume (no falsify.json)", file=path.parent
-            ) from None
-        if before != settings:
-            changed = sorted(k for k in settings if before.get(k) != settings[k])
-            raise ConfigError(
-                f"cannot resume: this search differs in {', '.join(changed) or 'its settings'}",
-                file=path.parent,
-                key="--resume",
-            )
-        return
-    write_atomic(path, json.dumps(settings, indent=1, sort_keys=True) + "\n")
 
 
 def plot_trials(summary: dict[str, Any], out: Path, title: str) -> Path:
