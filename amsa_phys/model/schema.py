@@ -462,8 +462,15 @@ def _locate(
 
 
 def too_large(value: int) -> str:
-    """Why an integer is refused as a number: ``401 digits; a number must fit a float``."""
-    return f"{len(str(abs(value)))} digits; a number must fit a float, at most about 1.8e308"
+    """Why an integer is refused as a number: ``401 digits; a number must fit a float``.
+
+    A very long integer (``0x`` and 5 000 hex digits reads in) cannot even be written in
+    decimal past Python's digit limit: it is then "more than N digits"."""
+    try:
+        digits = f"{len(str(abs(value)))} digits"
+    except ValueError:  # over sys.get_int_max_str_digits()
+        digits = f"more than {sys.get_int_max_str_digits()} digits"
+    return f"{digits}; a number must fit a float, at most about 1.8e308"
 
 
 def doc_value(data: Any, keypath: KeyPath) -> Any:
