@@ -119,17 +119,20 @@ def _number(value: Any, integer: bool) -> Any:
                 raise ValueError(f"expected an integer, got {value}")
             value = int(value)
         if abs(value) > MAX_INT:
-            raise ValueError(f"integer too large ({_digits(value)}; at most {MAX_INT})")
+            raise ValueError(f"integer too large ({digits_text(value)}; at most {MAX_INT})")
         return value
     try:
         return float(value)
     except OverflowError:
         raise ValueError(
-            f"number too large ({_digits(value)}; a number must fit a float, at most about 1.8e308)"
+            f"number too large ({digits_text(value)}; a number must fit a float, at most "
+            "about 1.8e308)"
         ) from None
 
 
-def _digits(value: int) -> str:
+def digits_text(value: int) -> str:
+    """``401 digits``; past Python's digit limit (``0x`` and 5 000 hex digits reads in, but
+    cannot be written in decimal) ``more than 4300 digits``."""
     try:
         return f"{len(str(abs(value)))} digits"
     except ValueError:  # past Python's digit limit, it cannot even be written in decimal

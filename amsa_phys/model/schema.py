@@ -14,7 +14,7 @@ import sys
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
-from .params import number_text_hint, short_repr, yaml_type
+from .params import digits_text, number_text_hint, short_repr, yaml_type
 from .rates import MAX_RATE_HZ, MIN_PHYSICS_RATE_HZ, MIN_RATE_HZ
 from .ruleshapes import FILE as RULES_FILE
 from .ruleshapes import SCHEMA as ADAPT
@@ -319,12 +319,9 @@ _TYPE_WORDS = {
 def validate(
     data: Any, schema: dict[str, Any], doc: YamlDoc, prefix: KeyPath = (), quote: bool = True
 ) -> None:
-    """Raise the ConfigError of the first shape error (by line), or return.
-
-    ``quote=False`` for a file another file names (a scenario's ``world:`` or ``adapt:``):
-    until it has the shape asked for it may be any YAML file of the machine, so a refusal
-    names its keys (its structure, what a typo needs) and the kind of a wrong value, never
-    the value."""
+    """Raise the ConfigError of the first shape error (by line), or return. ``quote=False``:
+    a file another names (``world:``, ``adapt:``), maybe any YAML file of the machine, whose
+    refusal names keys (what a typo needs) and a wrong value's kind, never the value."""
     bad = _first_nonfinite(data, prefix)
     if bad is not None:
         value = doc_value(data, bad[len(prefix) :])
@@ -389,7 +386,6 @@ def _locate(
         if not path and "world" in extra and "components" not in inst and "components" in known:
             # a scenario where a world is wanted (``graph``, ``export amsa``, a world: naming a
             # scenario): say which is which, as the reverse case does
-            # (its world: is quoted even from a file another names: the file is a scenario)
             named = inst["world"] if isinstance(inst["world"], str) else "its world"
             return ("world",), (
                 "this is a scenario file (it names its world: here); a world file is expected "
@@ -424,18 +420,16 @@ def _locate(
     if kind in ("minimum", "maximum") and err.schema.get("description") == "rate":
         lo, hi = err.schema["minimum"], err.schema["maximum"]
         if inst <= 0:
-            return path, f"must be > 0, got{shown(inst)}" if quote else "must be > 0"
-        if not quote:
-            return path, f"is outside the rates amsa-phys runs ({lo:g} to {hi:g} Hz)"
-        return path, f"{inst:g} Hz is outside the rates amsa-phys runs ({lo:g} to {hi:g} Hz)"
+            return path, "must be > 0" + (f", got {inst}" if quote else "")
+        said = f"{inst:g} Hz " if quote else ""
+        return path, f"{said}is outside the rates amsa-phys runs ({lo:g} to {hi:g} Hz)"
     if kind in ("exclusiveMinimum", "minimum", "maximum"):
         sign = {"exclusiveMinimum": ">", "minimum": ">=", "maximum": "<="}[kind]
         return path, f"must be {sign} {err.validator_value}" + (f", got {inst}" if quote else "")
     if kind in ("enum", "const"):
         allowed = err.validator_value if kind == "enum" else [err.validator_value]
-        return path, f"expected one of {', '.join(map(str, allowed))}, got{shown(inst)}" + (
-            "" if quote else f" {yaml_type(inst)}"
-        )
+        got = short_repr(inst) if quote else yaml_type(inst)
+        return path, f"expected one of {', '.join(map(str, allowed))}, got {got}"
     if kind == "pattern":
         if "propertyNames" in err.schema_path:  # a bad key: point at the key itself
             path = (*path, inst)
@@ -462,15 +456,8 @@ def _locate(
 
 
 def too_large(value: int) -> str:
-    """Why an integer is refused as a number: ``401 digits; a number must fit a float``.
-
-    A very long integer (``0x`` and 5 000 hex digits reads in) cannot even be written in
-    decimal past Python's digit limit: it is then "more than N digits"."""
-    try:
-        digits = f"{len(str(abs(value)))} digits"
-    except ValueError:  # over sys.get_int_max_str_digits()
-        digits = f"more than {sys.get_int_max_str_digits()} digits"
-    return f"{digits}; a number must fit a float, at most about 1.8e308"
+    """Why an integer is refused as a number: ``401 digits; a number must fit a float``."""
+    return f"{digits_text(value)}; a number must fit a float, at most about 1.8e308"
 
 
 def doc_value(data: Any, keypath: KeyPath) -> Any:
