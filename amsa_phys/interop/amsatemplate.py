@@ -88,14 +88,26 @@ def read_templates(path: Path) -> dict[str, TemplateDecl]:
     return parse_templates(text, path)
 
 
+#: How a message names a token it did not expect: by its kind, never its text, since the file
+#: may be one a model named that is no template file at all (its words are not for the
+#: terminal). Punctuation is the grammar's own.
+_KINDS = {"id": "a name", "number": "a number", "string": "a string", "eof": "the end of the file"}
+
+
+def _found(kind: str, value: str) -> str:
+    """What an unexpected token is, without its text (``'{'`` for the grammar's punctuation)."""
+    return repr(value) if kind == "punct" else _KINDS.get(kind, "something else")
+
+
 def _tokens(text: str, path: Path) -> Iterator[tuple[str, str, int]]:
     pos = 0
     line = 1
     while pos < len(text):
         m = _TOKEN.match(text, pos)
         if m is None:
+            column = pos - (text.rfind("\n", 0, pos) + 1) + 1
             raise ConfigError(
-                f"unexpected character {text[pos]!r} (expected AMSA template syntax)",
+                f"column {column}: a character AMSA template syntax does not have",
                 file=path,
                 line=line,
             )
@@ -114,14 +126,14 @@ def parse_templates(text: str, path: Path) -> dict[str, TemplateDecl]:
     out: dict[str, TemplateDecl] = {}
 
     def peek() -> tuple[str, str, int]:
-        return toks[i] if i < len(toks) else ("eof", "end of file", toks[-1][2] if toks else 1)
+        return toks[i] if i < len(toks) else ("eof", "", toks[-1][2] if toks else 1)
 
     def expect(value: str | None = None, kind: str | None = None) -> tuple[str, str, int]:
         nonlocal i
         k, v, line = peek()
         if (value is not None and v != value) or (kind is not None and k != kind):
             want = repr(value) if value is not None else "a name"
-            raise ConfigError(f"expected {want}, found {v!r}", file=path, line=line)
+            raise ConfigError(f"expected {want}, found {_found(k, v)}", file=path, line=line)
         i += 1
         return k, v, line
 
@@ -135,13 +147,14 @@ def parse_templates(text: str, path: Path) -> dict[str, TemplateDecl]:
     if not toks:
         raise ConfigError("declares no template (expected AMSA template syntax)", file=path)
     while i < len(toks):
-        _, word, line = expect(kind="id")
+        kind, word, line = peek()
         if word != "Template":
             raise ConfigError(
-                f"expected 'Template', found {word!r} (is this an AMSA template file?)",
+                f"expected 'Template', found {_found(kind, word)} (is this an AMSA template file?)",
                 file=path,
                 line=line,
             )
+        expect("Template")
         _, name, line = expect(kind="id")
         name = name.lstrip("^")
         if name in out:
@@ -170,7 +183,7 @@ def parse_templates(text: str, path: Path) -> dict[str, TemplateDecl]:
                     k, default, _ = peek()
                     if k not in ("number", "string", "id"):
                         raise ConfigError(
-                            f"expected a value, found {default!r}", file=path, line=pline
+                            f"expected a value, found {_found(k, default)}", file=path, line=pline
                         )
                     expect()
                 expect(";")

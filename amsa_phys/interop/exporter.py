@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 from xml.sax.saxutils import quoteattr
 
+from ..model.filenames import file_name_problem
 from ..model.template import BUILTINS, Template
 from ..model.timing import LeafTiming
 from ..model.world import CompositeSpec, LeafSpec, WorldSpec
@@ -35,8 +36,11 @@ class Exported:
 
 
 def export_world(world: WorldSpec) -> Exported:
-    """The ``.amsacore`` and ``.amsatemplate`` texts of ``world``."""
+    """The ``.amsacore`` and ``.amsatemplate`` texts of ``world``; ``ValueError`` if the
+    world's name cannot name them."""
     name = world.name
+    if (why := file_name_problem(name, "the world's name")) is not None:
+        raise ValueError(f"{why}: shorten it")
     tfile = f"{name}.amsatemplate"
     templates = _templates(world)
     writer = _Writer(world, tfile)

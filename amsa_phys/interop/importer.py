@@ -72,18 +72,43 @@ def import_model(
 
 
 def _templates_file(model: Model) -> Path:
+    """The template file the model names, which must sit next to it.
+
+    The model is data from elsewhere: a name with a directory part (``/etc/passwd``,
+    ``../secret``) or a link that leads out of the model's folder is refused, so a model can
+    make import read no file but its own sibling (``--templates FILE`` reads any file the
+    user names)."""
     hrefs = [model.templates_href] + [leaf.template_href for leaf in model.leaves.values()]
     for href in hrefs:
         name = (href or "").partition("#")[0]
         if name:
-            path = model.path.parent / name
-            if not path.is_file():
-                raise ConfigError(
-                    f"the model's templates {name!r} are not next to it; give --templates FILE",
-                    file=model.path,
-                )
-            return path
+            return _sibling(model, name)
     raise ConfigError("names no template file; give --templates FILE", file=model.path)
+
+
+def _sibling(model: Model, name: str) -> Path:
+    """``name`` in the model's folder, or a one-line ConfigError (never the file's text)."""
+    folder = model.path.parent
+    plain = Path(name).name == name and "\\" not in name and name not in (".", "..")
+    if not plain:
+        raise ConfigError(
+            "the model names a template file outside its folder; only a file next to the "
+            "model is read: give --templates FILE",
+            file=model.path,
+        )
+    path = folder / name
+    if not path.is_file():
+        raise ConfigError(
+            f"the model's templates {name!r} are not next to it; give --templates FILE",
+            file=model.path,
+        )
+    if path.resolve().parent != folder.resolve():
+        raise ConfigError(
+            f"the model's templates {name!r} link to a file outside its folder; only a file "
+            "next to the model is read: give --templates FILE",
+            file=model.path,
+        )
+    return path
 
 
 class _Importer:

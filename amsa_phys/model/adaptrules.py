@@ -76,7 +76,7 @@ def load_rules(doc: YamlDoc, entries: list[dict[str, Any]] | str, world: Any) ->
     if not path.is_file():
         raise doc.error(("adapt",), f"rules file not found: {path}")
     rules_doc = load_yaml(path)
-    schema.validate(rules_doc.data, FILE, rules_doc)
+    schema.validate(rules_doc.data, FILE, rules_doc, quote=False)  # any file: no value shown
     return parse_rules(rules_doc, rules_doc.data["adapt"], world)
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import re
 import reprlib
+import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -118,18 +119,24 @@ def _number(value: Any, integer: bool) -> Any:
                 raise ValueError(f"expected an integer, got {value}")
             value = int(value)
         if abs(value) > MAX_INT:
-            raise ValueError(f"integer too large ({_digits(value)}; at most {MAX_INT})")
+            raise ValueError(f"integer too large ({digits_text(value)}; at most {MAX_INT})")
         return value
     try:
         return float(value)
     except OverflowError:
         raise ValueError(
-            f"number too large ({_digits(value)}; a number must fit a float, at most about 1.8e308)"
+            f"number too large ({digits_text(value)}; a number must fit a float, at most "
+            "about 1.8e308)"
         ) from None
 
 
-def _digits(value: int) -> str:
-    return f"{len(str(abs(value)))} digits"
+def digits_text(value: int) -> str:
+    """``401 digits``; past Python's digit limit (``0x`` and 5 000 hex digits reads in, but
+    cannot be written in decimal) ``more than 4300 digits``."""
+    try:
+        return f"{len(str(abs(value)))} digits"
+    except ValueError:  # past Python's digit limit, it cannot even be written in decimal
+        return f"more than {sys.get_int_max_str_digits()} digits"
 
 
 _YAML_TYPES = {
@@ -159,13 +166,27 @@ def short_repr(value: Any) -> str:
     Bounded work whatever the value: a list shared a billion times over by YAML aliases
     is not spelled out before it is cut.
     """
-    text = _REPR.repr(value)
+    text = _cut_repr(value)
+    if text is not None:
+        return text
+    huge = f"a number of more than {sys.get_int_max_str_digits()} digits"
+    return huge if isinstance(value, int) else f"a {yaml_type(value)} holding {huge}"
+
+
+def _cut_repr(value: Any) -> str | None:
+    """The cut ``repr``, or None for a value holding an integer past Python's digit limit
+    (``0x`` and 5 000 hex digits reads in, but cannot be written in decimal)."""
+    try:
+        text = _REPR.repr(value)
+    except ValueError:
+        return None
     return text if len(text) <= 40 else text[:37] + "..."
 
 
 def _show(value: Any) -> str:
     """Describe a wrong value briefly: its YAML type and its (cut) repr."""
-    return f"{yaml_type(value)} {short_repr(value)}"
+    text = _cut_repr(value)
+    return short_repr(value) if text is None else f"{yaml_type(value)} {text}"
 
 
 #: A number in exponent notation that YAML 1.1 reads as text (mantissa, exponent).

@@ -102,7 +102,7 @@ def _world(doc: YamlDoc, data: dict[str, Any]) -> WorldSpec:
             notes += _nearby_file(world_path)
             said = f" ({'; '.join(notes)})" if notes else ""
             raise doc.error(("world",), f"world file not found: {shown}{said}")
-        world = load_world(world_path)
+        world = load_world(world_path, quote=False)  # any file: no value shown until a world
     else:
         world = build_world(world_ref, doc, ("world",))
     if "physics" in data:

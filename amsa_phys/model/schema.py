@@ -14,7 +14,7 @@ import sys
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
-from .params import number_text_hint, short_repr, yaml_type
+from .params import digits_text, number_text_hint, short_repr, yaml_type
 from .rates import MAX_RATE_HZ, MIN_PHYSICS_RATE_HZ, MIN_RATE_HZ
 from .ruleshapes import FILE as RULES_FILE
 from .ruleshapes import SCHEMA as ADAPT
@@ -316,8 +316,12 @@ _TYPE_WORDS = {
 }
 
 
-def validate(data: Any, schema: dict[str, Any], doc: YamlDoc, prefix: KeyPath = ()) -> None:
-    """Raise the ConfigError of the first shape error (by line), or return."""
+def validate(
+    data: Any, schema: dict[str, Any], doc: YamlDoc, prefix: KeyPath = (), quote: bool = True
+) -> None:
+    """Raise the ConfigError of the first shape error (by line), or return. ``quote=False``:
+    a file another names (``world:``, ``adapt:``), maybe any YAML file of the machine, whose
+    refusal names keys (what a typo needs) and a wrong value's kind, never the value."""
     bad = _first_nonfinite(data, prefix)
     if bad is not None:
         value = doc_value(data, bad[len(prefix) :])
@@ -332,7 +336,7 @@ def validate(data: Any, schema: dict[str, Any], doc: YamlDoc, prefix: KeyPath = 
     errors = list(validator.iter_errors(data))
     if not errors:
         return
-    located = [_locate(err, prefix) for err in _leaves(errors)]
+    located = [_locate(err, prefix, quote) for err in _leaves(errors)]
     keypath, message = min(located, key=lambda km: (doc.line(km[0]) or 0, -len(km[0])))
     raise doc.error(keypath, message)
 
@@ -365,10 +369,16 @@ def _leaves(errors: list[jsonschema.ValidationError]) -> list[jsonschema.Validat
     return out
 
 
-def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, str]:
+def _locate(
+    err: jsonschema.ValidationError, prefix: KeyPath, quote: bool = True
+) -> tuple[KeyPath, str]:
     path = (*prefix, *err.absolute_path)
     inst = err.instance
     kind = err.validator
+
+    def shown(value: Any) -> str:  # " 'x'", or nothing where the file's values stay unsaid
+        return f" {short_repr(value)}" if quote else ""
+
     if kind == "additionalProperties" and isinstance(inst, dict):
         known = list(err.schema.get("properties", {}))
         extra = [k for k in inst if k not in known]
@@ -405,19 +415,21 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
         words = " or ".join(_TYPE_WORDS.get(w, w) for w in wants)
         if not path:  # the whole file: say what it is, never echo what it holds
             return path, f"expected {words}, got {yaml_type(inst)}: not a world or scenario file"
-        hint = number_text_hint(inst) if {"number", "integer"} & set(wants) else ""
-        return path, f"expected {words}, got {yaml_type(inst)} {short_repr(inst)}{hint}"
+        hint = number_text_hint(inst) if {"number", "integer"} & set(wants) and quote else ""
+        return path, f"expected {words}, got {yaml_type(inst)}{shown(inst)}{hint}"
     if kind in ("minimum", "maximum") and err.schema.get("description") == "rate":
         lo, hi = err.schema["minimum"], err.schema["maximum"]
         if inst <= 0:
-            return path, f"must be > 0, got {inst}"
-        return path, f"{inst:g} Hz is outside the rates amsa-phys runs ({lo:g} to {hi:g} Hz)"
+            return path, "must be > 0" + (f", got {inst}" if quote else "")
+        said = f"{inst:g} Hz " if quote else ""
+        return path, f"{said}is outside the rates amsa-phys runs ({lo:g} to {hi:g} Hz)"
     if kind in ("exclusiveMinimum", "minimum", "maximum"):
         sign = {"exclusiveMinimum": ">", "minimum": ">=", "maximum": "<="}[kind]
-        return path, f"must be {sign} {err.validator_value}, got {inst}"
+        return path, f"must be {sign} {err.validator_value}" + (f", got {inst}" if quote else "")
     if kind in ("enum", "const"):
         allowed = err.validator_value if kind == "enum" else [err.validator_value]
-        return path, f"expected one of {', '.join(map(str, allowed))}, got {short_repr(inst)}"
+        got = short_repr(inst) if quote else yaml_type(inst)
+        return path, f"expected one of {', '.join(map(str, allowed))}, got {got}"
     if kind == "pattern":
         if "propertyNames" in err.schema_path:  # a bad key: point at the key itself
             path = (*path, inst)
@@ -426,10 +438,11 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
         )
     if kind == "anyOf" and err.validator_value == _time["anyOf"]:
         if isinstance(inst, int | float) and not isinstance(inst, bool):
-            return path, f"must be > 0, got {inst}"
+            return path, "must be > 0" + (f", got {inst}" if quote else "")
+        hint = number_text_hint(inst) if quote else ""
         return path, (
             'expected a positive number of seconds or an exact fraction such as "7/3", '
-            f"got {yaml_type(inst)} {short_repr(inst)}{number_text_hint(inst)}"
+            f"got {yaml_type(inst)}{shown(inst)}{hint}"
         )
     if kind == "anyOf" and isinstance(inst, dict):
         return path, "needs 'below' or 'above'"
@@ -444,7 +457,7 @@ def _locate(err: jsonschema.ValidationError, prefix: KeyPath) -> tuple[KeyPath, 
 
 def too_large(value: int) -> str:
     """Why an integer is refused as a number: ``401 digits; a number must fit a float``."""
-    return f"{len(str(abs(value)))} digits; a number must fit a float, at most about 1.8e308"
+    return f"{digits_text(value)}; a number must fit a float, at most about 1.8e308"
 
 
 def doc_value(data: Any, keypath: KeyPath) -> Any:

@@ -61,13 +61,14 @@ def with_leaf(world: WorldSpec, leaf: LeafSpec) -> WorldSpec:
     return replace(world, leaves={**world.leaves, leaf.path: leaf}, root=swap(world.root))
 
 
-def load_world(path: str | Path) -> WorldSpec:
-    """Load and check a world file."""
+def load_world(path: str | Path, quote: bool = True) -> WorldSpec:
+    """Load and check a world file (``quote=False``: one another file names, whose values
+    its shape errors never show, ``schema.validate``)."""
     doc = load_yaml(path)
-    return build_world(doc.data, doc, ())
+    return build_world(doc.data, doc, (), quote)
 
 
-def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
+def build_world(data: Any, doc: YamlDoc, prefix: KeyPath, quote: bool = True) -> WorldSpec:
     """Check ``data`` (found at ``prefix`` in ``doc``) and build the WorldSpec."""
 
     def err(keypath: KeyPath, message: str) -> ConfigError:
@@ -75,7 +76,7 @@ def build_world(data: Any, doc: YamlDoc, prefix: KeyPath) -> WorldSpec:
 
     if isinstance(data, dict) and isinstance(data.get("components"), dict):
         _check_size(data["components"], err)  # before the (slow) shape check, too
-    schema.validate(data, schema.WORLD, doc, prefix)
+    schema.validate(data, schema.WORLD, doc, prefix, quote)
     _check_walls(data.get("physics", {}).get("walls"), err)
 
     leaves: dict[str, LeafSpec] = {}

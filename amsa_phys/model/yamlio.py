@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import os
 import stat
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -41,6 +42,7 @@ MAX_VALUE_NODES = 10_000
 MAX_DEPTH = 64
 
 _STR = "tag:yaml.org,2002:str"
+_INT = "tag:yaml.org,2002:int"
 #: the implicit tags PyYAML gives base-60 scalars (``1:30``)
 _BASE_60 = frozenset({"tag:yaml.org,2002:int", "tag:yaml.org,2002:float"})
 _MERGE = "tag:yaml.org,2002:merge"
@@ -144,6 +146,15 @@ class _Builder:
             return node.value
         if tag not in _SAFE_SCALAR_TAGS:
             raise self.fail(node, f"tag {tag!r} is not allowed (only plain YAML values)", keypath)
+        limit = sys.get_int_max_str_digits()
+        if tag == _INT and limit and sum(c.isdigit() for c in node.value) > limit:
+            # Python would refuse to read it, in words about its own settings
+            raise self.fail(
+                node,
+                f"number too large (more than {limit} digits; a number must fit a float, at "
+                "most about 1.8e308)",
+                keypath,
+            )
         try:
             return self.scalars[tag](self.constructor, node)
         except (yaml.YAMLError, ValueError, OverflowError) as exc:
@@ -315,7 +326,32 @@ def _compose(text: str, path: Path, max_nodes: int) -> yaml.Node | None:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise ConfigError(f"YAML error: {first}", file=path) from None
     except RecursionError:
-        raise ConfigError("YAML nesting too deep", file=path) from None
+        raise ConfigError(
+            f"YAML nesting too deep (over {MAX_DEPTH} levels)", file=path, line=_too_deep(text)
+        ) from None
+
+
+def _too_deep(text: str) -> int | None:
+    """The line where ``text`` nests deeper than ``MAX_DEPTH`` (None if it does not).
+
+    The composer recurses once per level and runs out of stack before saying where; the
+    parser's event stream is flat, so it finds the line in one pass."""
+    # libyaml stops at its own depth limit, at times before the events that reach ours
+    for loader in (_C_LOADER, yaml.SafeLoader):
+        if loader is None:
+            continue
+        depth = 0
+        try:
+            for event in yaml.parse(text, Loader=loader):
+                if isinstance(event, yaml.CollectionStartEvent):
+                    depth += 1
+                    if depth > MAX_DEPTH:
+                        return int(event.start_mark.line) + 1
+                elif isinstance(event, yaml.CollectionEndEvent):
+                    depth -= 1
+        except yaml.YAMLError:
+            continue
+    return None
 
 
 def _values_over(events: Any, limit: int) -> bool:

@@ -30,6 +30,7 @@ from typing import Any
 from .._version import __version__
 from ..engine.timing import run_phases
 from ..errors import ConfigError
+from ..model.filenames import file_name_problem
 from ..model.rosnames import FRAMEWORK, PHASE
 from ..model.scenario import Scenario
 from ..model.world import WorldSpec
@@ -132,6 +133,8 @@ def generate(
             "letters, digits and _): rename the world",
             file=sources[0],
         )
+    if (why := file_name_problem(pkg, "the root component's name")) is not None:
+        raise ConfigError(f"{why}: rename the world", file=sources[0])
     names.check_world(world)
     arrays = {e for elements in world.arrays.values() for e in elements}
     for buffer in world.buffers.values():

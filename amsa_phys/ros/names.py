@@ -10,6 +10,7 @@ simulator and scenario nodes are ``/amsa_simulator`` and ``/amsa_scenario``.
 from __future__ import annotations
 
 from ..errors import ConfigError
+from ..model.filenames import file_name_problem, shown
 
 # the names amsa-phys itself takes on a ROS graph, both targets' (model/rosnames.py: the
 # scenario loader judges ros2: names with them, below this layer)
@@ -103,7 +104,8 @@ def script(path: str) -> str:
 
 
 def check_world(world: WorldSpec) -> None:
-    """Every component, output and parameter name must be a valid ROS name (else one line)."""
+    """Every component, output and parameter name must be a valid ROS name, and a Leaf's path
+    short enough to name its node's file (else one line)."""
     for path, leaf in world.leaves.items():
         parts = path.split(".")
         for part in parts:
@@ -112,6 +114,9 @@ def check_world(world: WorldSpec) -> None:
                     f"{part!r} is not a valid ROS name (a letter, then letters, digits, _)",
                     key=f"component {path}",
                 )
+        # the node's script is named after the whole path
+        if (why := file_name_problem(script(path), "the node's file name")) is not None:
+            raise ConfigError(f"{why}: shorten the names", key=f"component {shown(path)}")
         if parts[0] in RESERVED:
             raise ConfigError(
                 f"{parts[0]!r} is a name the ROS package uses itself; rename the component",

@@ -22,13 +22,18 @@ from __future__ import annotations
 import functools
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from fractions import Fraction
 
 #: Longest formula accepted: a requirement is a line of a scenario, not a program.
 MAX_LENGTH = 4000
-#: Deepest nesting accepted (the parser and monitor recurse).
+#: Deepest nesting of parentheses and prefix operators (``not``, ``always``, ``abs``, unary
+#: ``-``) accepted: the parser recurses once per level.
 MAX_DEPTH = 60
+#: Deepest formula tree accepted, whatever the operators: a chain ``a + b + c`` is as deep as
+#: it is long. Every walk of the tree (signals, horizon, monitor, messages) recurses once per
+#: level, so a bound here keeps them all inside Python's stack.
+MAX_TREE_DEPTH = 200
 
 UNARY_TEMPORAL = ("always", "eventually", "historically", "once")
 BINARY_TEMPORAL = ("until", "since")
@@ -58,6 +63,12 @@ class FormulaError(ValueError):
     """A formula that does not parse; the message says where."""
 
 
+_TOO_DEEP = (
+    f"nested too deeply: more than {MAX_TREE_DEPTH} operators inside one another (a chain "
+    "such as a + b + c counts one level per operator)"
+)
+
+
 @dataclass(frozen=True)
 class Node:
     """One node of a formula: ``op`` and its ``args``.
@@ -73,6 +84,15 @@ class Node:
     name: str = ""
     lo: Fraction | None = None
     hi: Fraction | None = None
+    depth: int = field(default=1, init=False, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        # Counted as the tree is built, children first, so no node deeper than the bound
+        # ever exists for a recursive walk to overflow on.
+        depth = 1 + max((a.depth for a in self.args), default=0)
+        if depth > MAX_TREE_DEPTH:
+            raise FormulaError(_TOO_DEEP)
+        object.__setattr__(self, "depth", depth)
 
     @property
     def is_formula(self) -> bool:
@@ -161,7 +181,10 @@ class _Parser:
     def deeper(self) -> None:
         self.depth += 1
         if self.depth > MAX_DEPTH:
-            raise FormulaError(f"nested deeper than {MAX_DEPTH} levels")
+            raise FormulaError(
+                f"nested too deeply: more than {MAX_DEPTH} levels of parentheses or prefix "
+                "operators"
+            )
 
     # formula levels
     def formula(self) -> Node:
@@ -271,7 +294,10 @@ class _Parser:
         tok = self.peek()
         if tok == "-":
             self.take()
-            return Node("neg", (self.factor(),))
+            self.deeper()
+            out = Node("neg", (self.factor(),))
+            self.depth -= 1
+            return out
         if tok == "(":
             self.take()
             self.deeper()
@@ -291,7 +317,9 @@ class _Parser:
         if kind == "name" and text == "abs":
             self.take()
             self.take("(")
+            self.deeper()
             inner = self.sum()
+            self.depth -= 1
             self.take(")")
             return Node("abs", (inner,))
         if kind == "name" and text not in _KEYWORDS:
@@ -350,7 +378,10 @@ def _parse(text: str) -> Node:
     p = _Parser(text)
     if not p.toks:
         raise FormulaError("the formula is empty")
-    node = p.formula()
+    try:
+        node = p.formula()
+    except RecursionError:  # the bounds above should make this unreachable: a backstop
+        raise FormulaError(_TOO_DEEP) from None
     if p.i != len(p.toks):
         raise FormulaError(f"unexpected {p.where()}")
     if not node.is_formula:

@@ -24,6 +24,7 @@ from typing import Any
 
 from ..._version import __version__
 from ...errors import ConfigError
+from ...model.filenames import file_name_problem
 from ...model.scenario import Scenario
 from .. import names
 from ..boundary import NODE as BOUNDARY
@@ -91,6 +92,8 @@ class Package2:
 def package_name(world_name: str) -> str:
     """``mdeChallenge`` -> ``mde_challenge`` (REP 144), or a ConfigError."""
     snake = re.sub(r"(?<=[a-z0-9])([A-Z])", r"_\1", world_name).lower()
+    if (why := file_name_problem(snake, "the package name")) is not None:
+        raise ConfigError(f"{why}: rename the world or give --name", key="world")
     if not PACKAGE.match(snake):
         raise ConfigError(
             f"the root component's name {world_name!r} cannot name a ROS 2 package (a letter, "
@@ -113,6 +116,8 @@ def _fill(file: str, **values: Any) -> Code:
 def check_package_name(name: str) -> str:
     """``export ros2 --name``: a REP 144 package name, or a ConfigError (never written
     anywhere otherwise: it names files, a Python package and XML text)."""
+    if (why := file_name_problem(name, "the package name")) is not None:
+        raise ConfigError(why, key="--name")
     if not PACKAGE.match(name):
         raise ConfigError(
             f"--name {name!r} cannot name a ROS 2 package: a lowercase letter, then lowercase "
@@ -142,6 +147,8 @@ def generate(
     local = classify(world, scenario.seed)
     remote = [p for p in world.leaves if p not in local]
     fname = re.sub(r"[^A-Za-z0-9_]", "_", scenario.name) or "scenario"
+    if (why := file_name_problem(fname, "the scenario's name")) is not None:
+        raise ConfigError(f"{why}: shorten it", file=source, key="name")
     files: dict[str, str] = {}
     src = Path(source).name
     scripts = []
