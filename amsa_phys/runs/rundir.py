@@ -157,7 +157,7 @@ def check_output_dir(
     """
     inputs = list(inputs)
     out = _without_dotdot(out)
-    if out.is_symlink() and (force or out.exists()):
+    if out.is_symlink():  # to a directory or dangling: never written through
         raise ConfigError(
             "is a symbolic link; give the real directory (amsa-phys does not replace links)",
             key=flag,

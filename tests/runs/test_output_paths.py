@@ -260,6 +260,23 @@ def test_force_does_not_follow_a_symlink(
     assert (target / "keep.txt").read_text() == "keep"
 
 
+@pytest.mark.parametrize("force", [False, True])
+def test_a_dangling_link_as_out_is_refused_as_a_link(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], force: bool
+) -> None:
+    """``--out`` a link to nothing (yet): refused as a link, with or without --force, and
+    nothing is made where it points."""
+    scen = _scenario(tmp_path / "s.yaml", "s")
+    link = tmp_path / "link"
+    link.symlink_to(tmp_path / "elsewhere")
+    argv = ["run", str(scen), "--headless", "--out", str(link), "-q", *(["--force"] * force)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert "is a symbolic link" in err[0]
+    assert not (tmp_path / "elsewhere").exists()
+
+
 def test_safe_name_is_one_harmless_component() -> None:
     assert safe_name("..") == "__"
     assert safe_name(".") == "_"
