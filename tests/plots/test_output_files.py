@@ -31,7 +31,7 @@ def _sweep(tmp_path: Path) -> Path:
     return sweep
 
 
-@pytest.mark.parametrize("name", ["g.png", "g.dot"])
+@pytest.mark.parametrize("name", ["g.png", "g.svg", "g.dot"])
 def test_graph_replaces_its_own_picture_and_refuses_anything_else(
     tmp_path: Path, capsys, name: str
 ) -> None:
