@@ -4,8 +4,9 @@
 every axis cell is judged by the same rules a scenario's value is (``resolve_change``: the
 parameter's type and range), every metric cell must be empty (a failed run) or a finite
 number, and the first bad cell is one line naming the file, the row and the column. The
-file is read a row at a time and only per-(cell, grid point) sums are kept, so memory is
-bounded by the grid's size (at most ``MAX_POINTS`` points), not by the file's.
+file is read a row at a time (a regular file of at most ``MAX_RESULTS_BYTES``, no line over
+``MAX_LINE_CHARS``) and only per-(cell, grid point) sums are kept, so memory is bounded by
+the grid's size (at most ``MAX_POINTS`` points), not by the file's.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from ..errors import ConfigError, one_line
 from ..model.changes import resolve_change
 from ..model.params import short_repr
 from ..model.world import WorldSpec
+from ..runs.results import bounded_lines, open_results
 from ..tune.objective import ROBUSTNESS
 
 #: Columns of every results.csv that are not metrics (never a ``--metric``).
@@ -67,12 +69,9 @@ def read_table(
     watched: set[str],
 ) -> SweepTable:
     """Stream ``path`` into per-cell stats of ``metric``; refuse the first bad cell."""
-    try:
-        handle = open(path, encoding="utf-8", newline="")  # noqa: SIM115 (closed below)
-    except OSError as exc:
-        raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
+    handle = open_results(path)  # a FIFO, a file over the limit: refused before a read
     with handle:
-        reader = csv.reader(handle)
+        reader = csv.reader(bounded_lines(handle, path))
         try:
             return _read(reader, path, metric, world, contexts, watched)
         except UnicodeDecodeError as exc:
@@ -83,6 +82,8 @@ def read_table(
             raise ConfigError(
                 f"not a results.csv: {exc}", file=path, line=reader.line_num
             ) from None
+        except OSError as exc:
+            raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
 
 
 def _read(

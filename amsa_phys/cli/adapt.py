@@ -21,7 +21,7 @@ from ..model.adaptrules import FILE, parse_rules
 from ..model.scenario import Scenario, load_scenario
 from ..model.wording import plural
 from ..model.yamlio import parse_yaml
-from ..runs.rundir import check_output
+from ..runs.outfile import check_output_file
 from ..tune.objective import ROBUSTNESS
 
 
@@ -134,7 +134,7 @@ def add_args(p: argparse.ArgumentParser) -> None:
         "estimator is unsure with its held value above the switched band, swing or not): the "
         "rules without it, for comparison",
     )
-    p.add_argument("--force", action="store_true", help="replace an existing rules file")
+    p.add_argument("--force", action="store_true", help="replace an existing -o or --results")
     p.add_argument(
         "--validate",
         action="store_true",
@@ -220,13 +220,15 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"must be in [0, 1), got {args.min_gain}", key="--min-gain")
     if args.validate:
         _check_validate_args(args)
-    out = check_output(Path(args.output), "-o")
+    # the sweep's own files are inputs: replacing one would lose the sweep (even with --force)
+    inputs = [results, sweepdir / "scenario.yaml", *map(Path, filter(None, [args.scenario]))]
+    out = check_output_file(Path(args.output), "-o", args.force, inputs)
     if args.results is not None:
         if not args.validate:
             raise ConfigError("needs --validate (it holds the validation's table)", key="--results")
-        check_output(Path(args.results), "--results")
-    if out.exists() and not args.force:
-        raise ConfigError(f"{one_line(str(out))} exists; use --force to replace it", key="-o")
+        if Path(args.results).resolve() == out.resolve():
+            raise ConfigError("names the rules file (-o) too; choose another", key="--results")
+        check_output_file(Path(args.results), "--results", args.force, inputs)
     scenario = load_scenario(args.scenario) if args.scenario else read_sweep_scenario(sweepdir)
     robust = _robust_option(args.robust, scenario)
     found = derive(

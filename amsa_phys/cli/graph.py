@@ -7,14 +7,24 @@ import sys
 from pathlib import Path
 
 from ..errors import ConfigError, one_line
-from ..runs.rundir import check_output
+from ..runs.outfile import check_output_file, drawn_by_us
 from .loading import load_any
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
     """Arguments of ``amsa-phys graph``."""
     p.add_argument("file", help="world or scenario YAML file")
-    p.add_argument("-o", "--output", required=True, help="OUT.png, OUT.svg or OUT.dot")
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="OUT.png, OUT.svg or OUT.dot; an existing file is replaced only if amsa-phys drew it",
+    )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="replace an existing -o file that amsa-phys did not draw (a link: the link)",
+    )
     p.add_argument(
         "--expand",
         action="store_true",
@@ -27,7 +37,7 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.output)
     if out.suffix.lower() not in (".png", ".svg", ".dot"):
         raise ConfigError("expected a .png, .svg or .dot file name", key="--output", file=out)
-    check_output(out, "--output")
+    check_output_file(out, "--output", args.force, [Path(args.file)], ours=drawn_by_us)
     kind, obj = load_any(args.file)
     world = obj.world if kind == "scenario" else obj
     from ..plots.graph import MAX_BOXES, SLOW_BOXES, draw, structure  # matplotlib: here

@@ -9,6 +9,7 @@ from typing import Any
 
 from ..errors import AmsaError, ConfigError, one_line
 from ..requirements.objective import requirement_of
+from ..runs.outfile import check_output_file, drawn_by_us
 from ..runs.plotjob import draw_run_plots, plot_context
 from ..runs.rundata import read_world
 from ..runs.rundir import check_output
@@ -43,7 +44,13 @@ def add_args(p: argparse.ArgumentParser) -> None:
         "--output",
         help="distance plot PNG (default RUNDIR/distance.png; the trajectory plot "
         "goes next to it as <name>-trajectory.png, or RUNDIR/trajectory.png); "
-        "for a sweep: the summary PNG (default DIR/summary.png)",
+        "for a sweep: the summary PNG (default DIR/summary.png); an existing file is "
+        "replaced only if amsa-phys drew it",
+    )
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="replace an existing -o file that amsa-phys did not draw (a link: the link)",
     )
     p.add_argument(
         "--metric",
@@ -52,8 +59,16 @@ def add_args(p: argparse.ArgumentParser) -> None:
     )
 
 
+#: The files of a run, sweep or falsify directory that ``plot`` reads: never an -o
+INPUTS = ("results.csv", "scenario.yaml", "trace.csv", "metrics.json", "falsify.json")
+
+
 def run(args: argparse.Namespace) -> int:
     """Draw the plot."""
+    if args.output is not None:  # every kind of plot: the rule for a file given with -o
+        check_output_file(
+            Path(args.output), "--output", args.force, _inputs(args), ours=drawn_by_us
+        )
     if args.paper:
         if args.metric is not None:
             raise ConfigError("only for a sweep directory (with results.csv)", key="--metric")
@@ -93,11 +108,21 @@ def run(args: argparse.Namespace) -> int:
     traj = out.with_name(out.stem + "-trajectory.png") if args.output else rundir / "trajectory.png"
     for target in (out, traj):
         check_output(target, "--output")
+    if args.output:  # the trajectory beside -o: the same rule
+        check_output_file(traj, "--output", args.force, _inputs(args), ours=drawn_by_us)
     written = draw_run_plots(rundir / "trace.csv", metrics, out, traj, _world_of(rundir))
     print(one_line("wrote " + " and ".join(str(p) for p in written)))
     if out not in written:
         print(f"no {out.name}: the scenario has no quality: section (no signal to plot)")
     return 0
+
+
+def _inputs(args: argparse.Namespace) -> list[Path]:
+    """The files this plot reads (a directory's files by name, a scenario file itself)."""
+    found: list[Path] = []
+    for given in map(Path, args.rundir):
+        found += [given / name for name in INPUTS] if given.is_dir() else [given]
+    return found
 
 
 def _world_of(rundir: Path) -> dict[str, Any] | None:

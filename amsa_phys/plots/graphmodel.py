@@ -160,11 +160,16 @@ def _numbers_text(which: set[int]) -> str:
     return ", ".join(str(n) for n in sorted(which))
 
 
+#: The DOT graph's comment that says amsa-phys wrote it (``graph -o`` replaces such a file)
+DOT_MARK = "drawn by amsa-phys graph"
+
+
 def to_dot(world: WorldSpec, collapse: bool = True) -> str:
     """The architecture as Graphviz DOT text."""
     st = structure(world, collapse)
     lines = [
         f'digraph "{world.name}" {{',
+        f'  comment="{DOT_MARK}";',
         "  rankdir=LR;",
         '  node [shape=box, style="rounded,filled", fontname="Helvetica"];',
     ]

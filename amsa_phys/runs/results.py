@@ -9,16 +9,27 @@ from __future__ import annotations
 import csv
 import io
 import math
+import os
 import re
-from collections.abc import Sequence
+import stat
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 from ..errors import ConfigError
 from ..model.metrics import METRICS
 from ..model.params import short_repr
 from ..model.suggest import did_you_mean
+from ..model.yamlio import read_regular_file
 from ..requirements.objective import requirement_of, unknown_objective
+
+#: The largest results.csv read (``plot``, ``adapt``): a row is ~100-500 bytes, so this is
+#: hundreds of thousands of runs; a larger file is refused before a byte of it is read.
+MAX_RESULTS_BYTES = 128 << 20
+#: The longest line of a results.csv read as a stream (a row is far shorter)
+MAX_LINE_CHARS = 1 << 20
+#: What a refusal says was expected
+EXPECTED = "a sweep's results.csv"
 
 #: Metric columns written for the overall block and each phase.
 METRIC_KEYS = METRICS
@@ -72,14 +83,13 @@ def read_results(path: Path) -> tuple[list[dict[str, Any]], list[str]]:
     not a sweep's results (binary, a column missing, a row of the wrong width, text where a
     metric belongs) is refused with one line naming the line.
     """
+    raw = read_regular_file(Path(path), MAX_RESULTS_BYTES, EXPECTED)  # a FIFO, 1 GiB: refused
     try:
-        text = Path(path).read_bytes().decode("utf-8")
+        text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise ConfigError(
             f"not a results.csv: not UTF-8 text (byte {exc.start})", file=path
         ) from None
-    except OSError as exc:
-        raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
     try:
         table = list(csv.reader(io.StringIO(text, newline="")))
     except csv.Error as exc:
@@ -118,6 +128,54 @@ def read_results(path: Path) -> tuple[list[dict[str, Any]], list[str]]:
                 ) from None
         rows.append(row)
     return rows, axes
+
+
+def open_results(path: Path) -> IO[str]:
+    """``path`` opened as UTF-8 text for a streamed read, if it is a regular file of at most
+    :data:`MAX_RESULTS_BYTES` (else one line, as :func:`read_regular_file` says it).
+
+    Opened without blocking and judged through the descriptor, so a FIFO planted as
+    results.csv is refused rather than waited on; read it with :func:`bounded_lines`.
+    """
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    except FileNotFoundError:
+        raise ConfigError("file not found", file=path) from None
+    except OSError as exc:
+        raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISREG(st.st_mode) and st.st_size <= MAX_RESULTS_BYTES:
+            return open(fd, encoding="utf-8", newline="", closefd=True)
+    except OSError as exc:
+        os.close(fd)
+        raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
+    os.close(fd)
+    # not a regular file, or too large: the project's one check says which, in its words
+    # (it opens without blocking and reads nothing of such a file)
+    read_regular_file(Path(path), MAX_RESULTS_BYTES, EXPECTED)
+    raise ConfigError(f"changed while opened, expected {EXPECTED}", file=path)
+
+
+def bounded_lines(handle: IO[str], path: Path) -> Iterator[str]:
+    """The lines of ``handle``, none longer than :data:`MAX_LINE_CHARS` and at most
+    :data:`MAX_RESULTS_BYTES` characters in all (a file that grows while read is cut off
+    there): a reader's memory never holds more than one line, whatever the file holds."""
+    total = 0
+    while True:
+        line = handle.readline(MAX_LINE_CHARS + 1)
+        if not line:
+            return
+        if len(line) > MAX_LINE_CHARS:
+            raise ConfigError(
+                f"not a results.csv: a line longer than {MAX_LINE_CHARS // 1024} KiB", file=path
+            )
+        total += len(line)
+        if total > MAX_RESULTS_BYTES:
+            raise ConfigError(
+                f"file too large (more than {MAX_RESULTS_BYTES >> 20} MiB read)", file=path
+            )
+        yield line
 
 
 def _number_or_text(text: str) -> Any:
