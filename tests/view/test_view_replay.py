@@ -301,10 +301,20 @@ def test_view_in_a_real_x_window_scrubs_to_an_event_and_draws_the_traced_pose(
     argv = [str(script), "view", str(rundir), "--size", "800x480"]
     with (tmp_path / "stderr.txt").open("w") as err_file:  # a file: a full pipe would block it
         viewer = subprocess.Popen(argv, env=env, stderr=err_file, text=True)
+
+    def said() -> str:  # what the viewer said by then, for a failure's message
+        code = viewer.poll()
+        text = (tmp_path / "stderr.txt").read_text()[-2000:]
+        return f"viewer {'running' if code is None else f'exited {code}'}; stderr: {text!r}"
+
+    def window_shown() -> str | None:
+        found = _x(xdisplay, "xdotool", "search", "--class", "amsa-phys")
+        if not found and viewer.poll() is not None:  # it ended: no window will come
+            raise AssertionError(f"no window: {said()}")
+        return found or None
+
     try:
-        window = _poll(
-            "the window", lambda: _x(xdisplay, "xdotool", "search", "--class", "amsa-phys") or None
-        ).splitlines()[0]
+        window = _poll("the window", window_shown, said).splitlines()[0]
         _x(xdisplay, "xdotool", "windowfocus", "--sync", window)
         # End then b lands on the same event however often it is pressed: pressed again
         # while the window does not show it yet (keys sent before the viewer listens for
@@ -333,7 +343,7 @@ def test_view_in_a_real_x_window_scrubs_to_an_event_and_draws_the_traced_pose(
             ok = all(tuple(image.get_at(px))[:3] == colour for px, colour in expected)
             return True if ok and tuple(image.get_at(cursor))[:3] == INK else None
 
-        _poll(f"the rovers and the slider at t = {target.t:g} s in the real window", matches)
+        _poll(f"the rovers and the slider at t = {target.t:g} s in the real window", matches, said)
         image = pygame.image.load(str(shot))
         assert tuple(image.get_at((12, bar_y)))[:3] != INK  # the cursor left the start
     finally:
