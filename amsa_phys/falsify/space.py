@@ -149,7 +149,10 @@ def build_space(scenario: Scenario, ranges: list[str], grids: list[str]) -> Spac
     template's min/max refuses or a grid value it refuses: one line each, before any run.
     """
     if not ranges and not grids:
-        raise ConfigError("nothing to search: give --range Comp.param=lo:hi", key="falsify")
+        raise ConfigError(
+            "nothing to search: give --range Comp.param=lo:hi or --grid Comp.param=a,b,...",
+            key="falsify",
+        )
     numeric = [_numeric_dim(r, scenario) for r in ranges]
     axes: list[Axis] = [parse_grid(g) for g in grids]
     seen: set[str] = set()

@@ -78,7 +78,12 @@ def scenario():
             [],
             "falsify: Leader.cruisePower appears twice",
         ),
-        ([], [], "falsify: nothing to search: give --range Comp.param=lo:hi"),
+        (
+            [],
+            [],
+            "falsify: nothing to search: give --range Comp.param=lo:hi"
+            " or --grid Comp.param=a,b,...",
+        ),
         (
             [],
             ["Leader.behavior=1,7"],
