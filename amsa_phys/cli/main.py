@@ -171,6 +171,11 @@ class _Parser(argparse.ArgumentParser):
         if extra is not None:
             words = extra.group(1).split(" ")
             message = "unrecognized arguments: " + " ".join(w + self._option_hint(w) for w in words)
+        # argparse quotes the value it refused whole ("invalid int value: '999...'"): a value
+        # of thousands of characters is said by its ends, so the line stays one to read
+        message = re.sub(
+            r"'([^']{81,})'", lambda m: f"'{m.group(1)[:40]}...{m.group(1)[-20:]}'", message
+        )
         self.exit(2, one_line(f"error: {self.prog}: {message} (see {self.prog} --help)") + "\n")
 
 

@@ -144,3 +144,18 @@ def test_a_set_override_can_repair_a_rule_the_file_breaks(tmp_path: Path) -> Non
     assert main(["validate", str(scen)]) == 2  # the file alone breaks powerMin <= powerMax
     argv = ["run", str(scen), "--headless", "-q", "--no-plot", "--out", str(tmp_path / "o")]
     assert main([*argv, "--set", "MyNormalizePower.powerMin=-10"]) == 0
+
+
+def test_a_refused_option_value_of_thousands_of_characters_is_said_by_its_ends(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """argparse quotes the value it refused whole: 5,000 characters made a 5,000-character
+    line. The value is said by its first 40 and last 20 characters."""
+    value = "x" + "9" * 5000
+    with pytest.raises(SystemExit) as exited:
+        main(["run", str(SCENARIO), "--headless", "--seed", value])
+    assert exited.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert len(err) < 200
+    assert f"'{value[:40]}...{value[-20:]}'" in err
