@@ -232,7 +232,7 @@ def _commit(staged: Path, out: Path, force: bool) -> None:
     wins and the others fail here (exit 2) instead of silently replacing it.
     """
     if force:
-        commit_staged(staged, out)
+        commit_staged(staged, out, flag="-o")
         return
     try:
         os.rename(staged, out)

@@ -25,7 +25,7 @@ MAX_RECORD_BYTES = MAX_FILE_BYTES
 
 def read_record(path: Path, expected: str) -> dict[str, Any]:
     """The JSON object in ``path`` (one line naming the file if it is not one)."""
-    raw = read_regular_file(Path(path), MAX_RECORD_BYTES, expected)
+    raw = read_regular_file(Path(path), MAX_RECORD_BYTES, expected, follow=False)
     try:
         doc = json.loads(raw)
     except json.JSONDecodeError as exc:

@@ -119,7 +119,9 @@ def read_cached(path: Path, budget: int) -> dict[int, dict[str, Any]]:
     """The rows of an interrupted search's results.csv, by run number (none: no file)."""
     if not os.path.lexists(path):
         return {}
-    raw = read_regular_file(path, results_limit(budget), "a falsification's results.csv")
+    raw = read_regular_file(
+        path, results_limit(budget), "a falsification's results.csv", follow=False
+    )
     text = io.TextIOWrapper(io.BytesIO(raw), encoding="utf-8", newline="")
     reader = csv.reader(text)
     out: dict[int, dict[str, Any]] = {}

@@ -18,6 +18,7 @@ that the message is PyYAML's, the same with or without libyaml.
 
 from __future__ import annotations
 
+import errno
 import os
 import stat
 import sys
@@ -218,19 +219,28 @@ def load_yaml(path: str | Path) -> YamlDoc:
     return parse_yaml(read_regular_file(path, MAX_FILE_BYTES, "a YAML file"), path)
 
 
-def read_regular_file(path: Path, max_bytes: int, expected: str) -> bytes:
+def read_regular_file(path: Path, max_bytes: int, expected: str, follow: bool = True) -> bytes:
     """The bytes of ``path`` if it is a regular file of at most ``max_bytes``; else one line.
 
     The one check every loader of a user's file uses (YAML, AMSA models and templates): the
     file is opened without blocking and checked through its descriptor, so a FIFO or a device
     (``/dev/zero`` never ends) is refused even if swapped in after a check, and never more
-    than ``max_bytes`` are read, even from a file that grows meanwhile.
+    than ``max_bytes`` are read, even from a file that grows meanwhile. ``follow=False``: a
+    symbolic link is refused too (a file of a directory someone handed over, which must not
+    lead out of it).
     """
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+    if not follow:
+        flags |= getattr(os, "O_NOFOLLOW", 0)
     try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+        fd = os.open(path, flags)
     except FileNotFoundError:
         raise ConfigError("file not found", file=path) from None
     except OSError as exc:
+        if not follow and exc.errno == errno.ELOOP:
+            raise ConfigError(
+                f"is a symbolic link, expected {expected} of its own", file=path
+            ) from None
         raise ConfigError(f"cannot read: {exc.strerror}", file=path) from None
     try:
         st = os.fstat(fd)

@@ -19,8 +19,10 @@ reported before the run starts, not after minutes of simulation.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import re
+import secrets
 import shutil
 import tempfile
 import time
@@ -231,12 +233,12 @@ def run_dir_for(
     try:
         yield staged
     except (AmsaError, KeyboardInterrupt):
-        commit_staged(staged, out)  # a fault's or an interruption's outputs: the run's own
+        commit_staged(staged, out, flag)  # a fault's or an interruption's outputs: the run's own
         raise
     except BaseException:
         discard_staged(staged)
         raise
-    commit_staged(staged, out)
+    commit_staged(staged, out, flag)
 
 
 def _make_marked(out: Path, flag: str, kind: str) -> None:
@@ -300,25 +302,64 @@ def staged_dir(
     ``out`` is checked as :func:`prepare_run_dir` checks it (nothing is touched); the caller
     fills the returned directory, then :func:`commit_staged` puts it in place in one rename,
     so a failure half-way leaves ``out`` as it was (and :func:`discard_staged` cleans up).
+    The directory is made afresh under a name nothing held (:func:`_fresh_beside`): a link or
+    a directory someone left at a name we would choose is never written through.
     """
     out = _without_dotdot(out)
     check_output_dir(out, force, inputs, flag, kind)
-    staged = out.parent / f".{out.name}.amsa-tmp-{os.getpid()}"
-    if staged.exists() or staged.is_symlink():
-        discard_staged(staged)
+    staged = _fresh_beside(out, "amsa-tmp", flag)
     _make_marked(staged, flag, kind)
     return staged
 
 
-def commit_staged(staged: Path, out: Path) -> None:
-    """Replace ``out`` (checked by :func:`staged_dir`: absent, empty or ours) by ``staged``."""
-    old = out.parent / f".{out.name}.amsa-old-{os.getpid()}"
-    moved = False
-    if out.exists():
-        os.replace(out, old)
-        moved = True
-    os.replace(staged, out)
-    if moved:
+def _fresh_beside(out: Path, tag: str, flag: str) -> Path:
+    """A new empty directory ``.NAME.TAG-PID-XXXXXXXX`` beside ``out``, made by ``mkdir``
+    itself (which fails on anything already there, a link included, and follows none)."""
+    for _ in range(100):
+        path = out.parent / f".{out.name}.{tag}-{os.getpid()}-{secrets.token_hex(4)}"
+        try:
+            os.mkdir(path)
+        except FileExistsError:
+            continue
+        except OSError as exc:
+            raise ConfigError(
+                f"cannot create a directory beside it: {exc.strerror}", key=flag, file=out
+            ) from None
+        return path
+    raise ConfigError("cannot create a directory beside it: every name taken", key=flag, file=out)
+
+
+def commit_staged(staged: Path, out: Path, flag: str = "--out") -> None:
+    """Replace ``out`` (checked by :func:`staged_dir`: absent, empty or ours) by ``staged``.
+
+    The earlier ``out`` is first renamed onto a fresh empty directory beside it, then
+    removed. Another command that put its own ``out`` in place meanwhile wins: this one says
+    so in one line and where its outputs are kept (nothing is removed)."""
+    old: Path | None = None
+    if out.exists() or out.is_symlink():
+        old = _fresh_beside(out, "amsa-old", flag)
+        try:
+            os.replace(out, old)  # onto the empty directory just made
+        except FileNotFoundError:  # moved away meanwhile by another command
+            old.rmdir()
+            old = None
+        except OSError as exc:
+            old.rmdir()
+            raise ConfigError(f"cannot replace it: {exc.strerror}", key=flag, file=out) from None
+    try:
+        os.replace(staged, out)
+    except OSError as exc:
+        if exc.errno in (errno.EEXIST, errno.ENOTEMPTY, errno.ENOTDIR, errno.EISDIR):
+            if old is not None and not out.exists():
+                os.replace(old, out)
+            raise ConfigError(
+                f"was replaced by another command while this one wrote; its outputs are in "
+                f"{staged}",
+                key=flag,
+                file=out,
+            ) from None
+        raise ConfigError(f"cannot write: {exc.strerror}", key=flag, file=out) from None
+    if old is not None:
         if is_ours(old):
             shutil.rmtree(old)
         else:

@@ -146,12 +146,30 @@ def test_resume_refuses_an_out_that_is_a_link(
 def test_a_record_that_is_a_device_is_refused_unread(
     fdir: Path, capsys: pytest.CaptureFixture[str], name: str
 ) -> None:
-    """trial.json linked to /dev/zero grew to 12 GB before the kernel killed it."""
+    """trial.json linked to /dev/zero grew to 12 GB before the kernel killed it: a file of
+    the directory that is a link is refused unread (it must not lead out of it)."""
     (fdir / name).unlink()
     (fdir / name).symlink_to("/dev/zero")
     capsys.readouterr()
     assert resume(fdir) == 2
-    assert "not a regular file" in refused(capsys, name)
+    assert "is a symbolic link" in refused(capsys, name)
+
+
+def test_a_results_file_linked_out_of_the_directory_is_refused_unread(
+    fdir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An unfinished trial's results.csv linked to a file outside: resume read it and said
+    its first bad cell (a credential) in the error. Refused as a link, never read."""
+    secret = tmp_path / "creds.csv"
+    secret.write_text("run,seed_index,seed,error,api_token\n0,0,1,,sk-LIVE-SECRET\n")
+    (fdir / "trial-002" / "trial.json").unlink()
+    (fdir / "trial-002" / "results.csv").unlink()
+    (fdir / "trial-002" / "results.csv").symlink_to(secret)
+    capsys.readouterr()
+    assert resume(fdir) == 2
+    line = refused(capsys, "trial-002/results.csv")
+    assert "is a symbolic link" in line
+    assert "SECRET" not in line
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="FIFOs are POSIX")

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 import pytest
 import yaml
@@ -308,3 +309,64 @@ def test_out_through_a_new_directory_and_back_is_judged_as_where_it_lands(
         "the outputs\n"
     )
     assert _snapshot(tmp_path) == before
+
+
+def test_a_link_planted_where_the_staged_run_would_go_is_never_written_through(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``run --force`` stages the new run in a directory beside ``--out`` made by ``mkdir``
+    under a fresh name: a link someone planted at a name it would choose (here: the very
+    first) is skipped, and the directory it points to gets nothing. The same for the name
+    the earlier run is moved to before it is removed."""
+    scen = _scenario(tmp_path / "s.yaml", "s")
+    out = tmp_path / "run"
+    args = ["run", str(scen), "--headless", "--no-plot", "--out", str(out), "-q"]
+    assert main(args) == 0
+    victim = tmp_path / "victim"
+    victim.mkdir()
+    (victim / "p.txt").write_text("precious")
+    pid = os.getpid()
+    (tmp_path / f".run.amsa-tmp-{pid}-planted1").symlink_to(victim)
+    old = tmp_path / f".run.amsa-old-{pid}-planted2"
+    old.mkdir()
+    (old / "x").write_text("someone's")
+    # the first name each would take is taken: the staged run goes to fresh001, the
+    # earlier run to fresh002
+    tokens = iter(["planted1", "fresh001", "planted2", "fresh002"])
+    monkeypatch.setattr("amsa_phys.runs.rundir.secrets.token_hex", lambda _n: next(tokens))
+    assert main([*args, "--force"]) == 0
+    assert sorted(p.name for p in victim.iterdir()) == ["p.txt"]
+    assert (old / "x").read_text() == "someone's"
+    assert not out.is_symlink()
+    assert (out / "metrics.json").is_file()
+    left = sorted(p.name for p in tmp_path.iterdir() if p.name.startswith("."))
+    assert left == [f".run.amsa-old-{pid}-planted2", f".run.amsa-tmp-{pid}-planted1"]
+    capsys.readouterr()
+
+
+def test_a_run_whose_output_another_put_in_place_meanwhile_says_so_in_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Two commands replacing one directory: the one that renames its outputs into place
+    last finds the other's there. It removes nothing, and says in one line where its own
+    outputs are kept."""
+    from amsa_phys.errors import ConfigError
+    from amsa_phys.runs import rundir
+
+    out = tmp_path / "run"
+    staged = rundir.staged_dir(out, force=False, flag="--out", kind="run")
+    (staged / "trace.csv").write_text("mine")
+    real = os.replace
+
+    def another_first(src: Any, dst: Any) -> None:
+        if Path(dst) == out and not out.exists():  # the other command's rename lands first
+            out.mkdir()
+            (out / "trace.csv").write_text("theirs")
+        real(src, dst)
+
+    monkeypatch.setattr(rundir.os, "replace", another_first)
+    with pytest.raises(ConfigError, match="was replaced by another command") as err:
+        rundir.commit_staged(staged, out)
+    assert str(staged) in str(err.value)
+    assert (out / "trace.csv").read_text() == "theirs"
+    assert (staged / "trace.csv").read_text() == "mine"
