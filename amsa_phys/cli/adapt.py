@@ -21,7 +21,8 @@ from ..model.adaptrules import FILE, parse_rules
 from ..model.scenario import Scenario, load_scenario
 from ..model.wording import plural
 from ..model.yamlio import parse_yaml
-from ..runs.outfile import check_output_file
+from ..runs.outfile import check_output_file, refuse_input_file
+from ..runs.suite import input_files
 from ..tune.objective import ROBUSTNESS
 
 
@@ -230,6 +231,10 @@ def run(args: argparse.Namespace) -> int:
             raise ConfigError("names the rules file (-o) too; choose another", key="--results")
         check_output_file(Path(args.results), "--results", args.force, inputs)
     scenario = load_scenario(args.scenario) if args.scenario else read_sweep_scenario(sweepdir)
+    if args.scenario:  # the world --scenario's file names is read too
+        refuse_input_file(out, input_files(scenario), "-o")
+        if args.results is not None:
+            refuse_input_file(Path(args.results), input_files(scenario), "--results")
     robust = _robust_option(args.robust, scenario)
     found = derive(
         results,

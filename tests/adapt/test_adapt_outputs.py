@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+import yaml
 from refusal import assert_one_line_refusal
 from sweepfiles import two_context_sweep
 
@@ -36,6 +37,22 @@ def test_an_output_that_is_an_input_is_refused_even_with_force(
     # the sweep still reads: adapt on it again writes its rules
     argv = ["adapt", str(sweep), "--scenario", str(scenario), "-o", str(tmp_path / "r.yaml")]
     assert main([*argv, "--margin", "inf", "--min-gain", "0"]) == 0
+
+
+def test_the_world_of_the_scenario_given_is_an_input_too(tmp_path: Path, capsys) -> None:
+    """``--scenario S.yaml``: the world file S names is read too, so ``-o`` naming it is
+    refused even with ``--force`` (only S itself was protected)."""
+    scenario, sweep = _sweep(tmp_path)
+    doc = yaml.safe_load(scenario.read_text())
+    world = tmp_path / "world.yaml"
+    world.write_bytes(Path(doc["world"]).read_bytes())
+    doc["world"] = str(world)
+    scenario.write_text(yaml.safe_dump(doc))
+    before = world.read_bytes()
+    argv = ["adapt", str(sweep), "--scenario", str(scenario), "-o", str(world), "--force"]
+    code = main([*argv, "--margin", "inf", "--min-gain", "0"])
+    assert_one_line_refusal(code, capsys.readouterr().err, "is an input of this command", "error:")
+    assert world.read_bytes() == before
 
 
 def test_the_recorded_scenario_is_an_input_too(tmp_path: Path, capsys) -> None:
