@@ -11,12 +11,11 @@ search so ``plot`` reads a record without importing the search.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from ..model.yamlio import MAX_FILE_BYTES, read_regular_file
+from ..model.yamlio import MAX_FILE_BYTES, parse_json, read_regular_file
 
 #: the largest record read: a user's file's limit (amsa-phys writes a few hundred bytes, a
 #: few hundred kilobytes for a search with long ``--grid`` lists)
@@ -26,14 +25,7 @@ MAX_RECORD_BYTES = MAX_FILE_BYTES
 def read_record(path: Path, expected: str) -> dict[str, Any]:
     """The JSON object in ``path`` (one line naming the file if it is not one)."""
     raw = read_regular_file(Path(path), MAX_RECORD_BYTES, expected, follow=False)
-    try:
-        doc = json.loads(raw)
-    except json.JSONDecodeError as exc:
-        raise ConfigError(f"invalid JSON: {exc.msg}", file=path, line=exc.lineno) from None
-    except UnicodeDecodeError:
-        raise ConfigError("invalid JSON: not UTF-8 text", file=path) from None
-    except RecursionError:
-        raise ConfigError("invalid JSON: nested too deeply", file=path) from None
+    doc = parse_json(raw, path)
     if not isinstance(doc, dict):
         raise ConfigError(f"not {expected}: expected a JSON object, got {_kind(doc)}", file=path)
     return doc

@@ -324,4 +324,8 @@ class _Reader:
                     raise self.error(
                         item, f"amsa-phys extension is not valid JSON: {exc}"
                     ) from None
+                except RecursionError:
+                    raise self.error(
+                        item, "amsa-phys extension is not valid JSON: nested too deeply"
+                    ) from None
         return out

@@ -19,6 +19,7 @@ that the message is PyYAML's, the same with or without libyaml.
 from __future__ import annotations
 
 import errno
+import json
 import os
 import stat
 import sys
@@ -268,6 +269,20 @@ def read_regular_file(path: Path, max_bytes: int, expected: str, follow: bool = 
     finally:
         os.close(fd)
     return b"".join(chunks)
+
+
+def parse_json(raw: bytes, path: Path) -> Any:
+    """The JSON value in ``raw`` (a file's bytes, :func:`read_regular_file`), or one line
+    naming ``path`` and what is wrong: the one parse of every JSON file amsa-phys reads back
+    from a directory someone may have handed over (a run's metrics, a search's records)."""
+    try:
+        return json.loads(raw)
+    except json.JSONDecodeError as exc:
+        raise ConfigError(f"invalid JSON: {exc.msg}", file=path, line=exc.lineno) from None
+    except UnicodeDecodeError:
+        raise ConfigError("invalid JSON: not UTF-8 text", file=path) from None
+    except RecursionError:
+        raise ConfigError("invalid JSON: nested too deeply", file=path) from None
 
 
 def _file_kind(mode: int) -> str:

@@ -11,7 +11,6 @@ scenario's ``duration:`` has); the file is read only if it is a regular file of 
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -19,7 +18,7 @@ from typing import Any
 from ..errors import ConfigError
 from ..model.metrics import METRICS
 from ..model.schema import MAX_DURATION_S
-from ..model.yamlio import read_regular_file
+from ..model.yamlio import parse_json, read_regular_file
 
 #: the largest metrics.json read (a run's own is kilobytes; thousands of events, megabytes)
 MAX_METRICS_BYTES = 64 << 20
@@ -29,14 +28,7 @@ def read_metrics(path: Path) -> dict[str, Any]:
     """A run's ``metrics.json``, checked for what the plots and the replay read (one line
     naming the file and the key if it is not)."""
     raw = read_regular_file(Path(path), MAX_METRICS_BYTES, "a run's metrics.json")
-    try:
-        metrics = json.loads(raw)
-    except json.JSONDecodeError as exc:
-        raise ConfigError(f"invalid JSON: {exc.msg}", file=path, line=exc.lineno) from None
-    except UnicodeDecodeError:
-        raise ConfigError("invalid JSON: not UTF-8 text", file=path) from None
-    except RecursionError:
-        raise ConfigError("invalid JSON: nested too deeply", file=path) from None
+    metrics = parse_json(raw, path)
     why = metrics_problem(metrics)
     if why is not None:
         raise ConfigError(f"not a run's metrics: {why}", file=path)

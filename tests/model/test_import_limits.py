@@ -283,3 +283,24 @@ def test_a_world_that_does_not_load_is_reported_against_the_model(
     assert "of the world w.yaml: physics.rate" in err
     assert ".tmp-" not in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.amsacore"]
+
+
+def test_a_world_extension_nested_too_deeply_is_one_line(
+    exported: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The amsa-phys extension's world is JSON inside an attribute: 100,000 nested arrays
+    (200 KB) were a RecursionError traceback; now one line naming the model's line."""
+    deep = "[" * 100_000 + "]" * 100_000
+    model = _model(
+        exported,
+        tmp_path,
+        lambda t: t.replace(
+            '<xmi:Extension extender="amsa-phys">',
+            f'<xmi:Extension extender="amsa-phys">\n    <world json="{deep}"/>',
+        ),
+    )
+    assert _import(model, exported, tmp_path / "w.yaml") == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err
+    assert "nested too deeply" in err
+    assert not (tmp_path / "w.yaml").exists()
