@@ -21,7 +21,7 @@ from ..model.adaptrules import FILE, parse_rules
 from ..model.scenario import Scenario, load_scenario
 from ..model.wording import plural
 from ..model.yamlio import parse_yaml
-from ..runs.outfile import check_output_file, refuse_input_file
+from ..runs.outfile import check_output_file
 from ..runs.suite import input_files
 from ..tune.objective import ROBUSTNESS
 
@@ -207,22 +207,22 @@ def run(args: argparse.Namespace) -> int:
         )
     if not args.margin >= 0:
         raise ConfigError(f"must be >= 0 (or inf), got {args.margin}", key="--margin")
-    if not (0 <= args.near < 1):
-        raise ConfigError(f"must be in [0, 1), got {args.near}", key="--near")
-    if not (0 <= args.cell_gain < 1):
-        raise ConfigError(f"must be in [0, 1), got {args.cell_gain}", key="--cell-gain")
-    if not (0 <= args.damp < 100):
-        raise ConfigError(f"must be in [0, 100), got {args.damp}", key="--damp")
-    if not (0 <= args.swing < 100):
-        raise ConfigError(f"must be in [0, 100), got {args.swing}", key="--swing")
+    for key, value, top in (
+        ("--near", args.near, 1),
+        ("--cell-gain", args.cell_gain, 1),
+        ("--damp", args.damp, 100),
+        ("--swing", args.swing, 100),
+        ("--min-gain", args.min_gain, 1),
+    ):
+        if not (0 <= value < top):
+            raise ConfigError(f"must be in [0, {top}), got {value}", key=key)
     if not 1 <= args.damp_steps <= 1000:
         raise ConfigError(f"must be 1..1000, got {args.damp_steps}", key="--damp-steps")
-    if not (0 <= args.min_gain < 1):
-        raise ConfigError(f"must be in [0, 1), got {args.min_gain}", key="--min-gain")
     if args.validate:
         _check_validate_args(args)
-    # the sweep's own files are inputs: replacing one would lose the sweep (even with --force)
-    inputs = [results, sweepdir / "scenario.yaml", *map(Path, filter(None, [args.scenario]))]
+    # what it reads (the sweep's files, --scenario's and its world) is never replaced
+    given = load_scenario(args.scenario) if args.scenario else None
+    inputs = [results, sweepdir / "scenario.yaml", *(input_files(given) if given else [])]
     out = check_output_file(Path(args.output), "-o", args.force, inputs)
     if args.results is not None:
         if not args.validate:
@@ -230,11 +230,7 @@ def run(args: argparse.Namespace) -> int:
         if Path(args.results).resolve() == out.resolve():
             raise ConfigError("names the rules file (-o) too; choose another", key="--results")
         check_output_file(Path(args.results), "--results", args.force, inputs)
-    scenario = load_scenario(args.scenario) if args.scenario else read_sweep_scenario(sweepdir)
-    if args.scenario:  # the world --scenario's file names is read too
-        refuse_input_file(out, input_files(scenario), "-o")
-        if args.results is not None:
-            refuse_input_file(Path(args.results), input_files(scenario), "--results")
+    scenario = given if given is not None else read_sweep_scenario(sweepdir)
     robust = _robust_option(args.robust, scenario)
     found = derive(
         results,

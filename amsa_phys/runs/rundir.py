@@ -307,6 +307,10 @@ def staged_dir(
     """
     out = _without_dotdot(out)
     check_output_dir(out, force, inputs, flag, kind)
+    try:  # ``-o a/b/pkg``: a and b made as for any output directory
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"cannot create directory: {exc.strerror}", key=flag, file=out) from None
     staged = _fresh_beside(out, "amsa-tmp", flag)
     _make_marked(staged, flag, kind)
     return staged
