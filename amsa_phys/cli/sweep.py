@@ -20,7 +20,7 @@ from ..model.scenario import load_scenario
 from ..model.wording import plural
 from ..model.yamlio import load_yaml
 from ..runs.batched import iter_batched, iter_dask_batched, plan_units
-from ..runs.rundir import default_run_dir, prepare_run_dir
+from ..runs.rundir import default_run_dir, run_dir_for
 from ..runs.suite import input_files
 from ..runs.sweep import (
     Axis,
@@ -197,7 +197,15 @@ def run(args: argparse.Namespace) -> int:
         )
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-sweep")
-    prepare_run_dir(out, args.force, inputs=plan.inputs, kind="sweep")
+    # with --force the sweep is written beside an earlier one and renamed into place when it
+    # ends (finished or interrupted): a killed sweep leaves the earlier one whole
+    with run_dir_for(out, args.force, inputs=plan.inputs, kind="sweep") as work:
+        return _sweep_into(work, out, args, plan, name)
+
+
+def _sweep_into(work: Path, out: Path, args: argparse.Namespace, plan: Any, name: str) -> int:
+    """Run the sweep, writing into ``work`` (``out`` itself, or staged beside it: the messages
+    name ``out``)."""
     # warned only once the sweep will run: a refused --out or option is the one line printed
     for warning in plan.warnings:
         print(f"warning: {warning}", file=sys.stderr)
@@ -207,12 +215,12 @@ def run(args: argparse.Namespace) -> int:
     full = float(recorded.duration)
     cut = plan.duration is not None and float(plan.duration) < full
     write_sweep_scenario(
-        out,
+        work,
         recorded,
         {"contexts": plan.contexts, "metric": plan.metric, "seeds": plan.seeds},
     )
     if args.keep_runs:
-        plan.keep_dir = str((out / "runs").resolve())
+        plan.keep_dir = str((work / "runs").resolve())
     jobs = plan.jobs()
     rows: list[dict[str, Any]] = []
     source = rows_from(jobs, args)
@@ -235,10 +243,10 @@ def run(args: argparse.Namespace) -> int:
     # results and the picture are finished first (a SIGTERM in plot_summary killed the
     # process with -15 and no summary.png)
     with interrupt.sigterm_as_ctrl_c(), interrupt.deferred():
-        write_results(rows, keys, out / "results.csv")
+        write_results(rows, keys, work / "results.csv")
         drawn = any(not r["error"] for r in rows)  # nothing to draw: no picture saying so
         if drawn:
-            _summary(rows, keys, plan, out, name, interrupted, len(jobs), full if cut else None)
+            _summary(rows, keys, plan, work, name, interrupted, len(jobs), full if cut else None)
         late = interrupt.requested()
     failed = [r for r in rows if r["error"]]
     print(

@@ -446,3 +446,33 @@ def test_batch_size_with_the_one_run_per_process_executor_is_refused(
         "error: --batch-size: sets the runs of a batch; --executor local runs one per process\n"
     )
     assert not (tmp_path / "o").exists()
+
+
+def test_force_keeps_the_earlier_sweep_whole_until_the_new_one_ends(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``sweep --force`` over an earlier sweep: while its runs run, ``--out`` still holds the
+    earlier results (the new sweep is written beside it and renamed into place at its end,
+    with its kept runs), and nothing is left beside it after."""
+    from amsa_phys.cli import sweep as cli_sweep
+
+    out = tmp_path / "s"
+    argv = ["sweep", str(SCEN), "--grid", "MyFollowerController.Kv=0.1,0.2", "--duration", "5"]
+    argv += ["-j", "1", "--keep-runs", "--out", str(out)]
+    assert main(argv) == 0
+    (out / "results.csv").write_text("the earlier sweep\n")
+    seen: list[str] = []
+    real = cli_sweep.rows_from
+
+    def watching(*args: object, **kwargs: object) -> object:
+        for row in real(*args, **kwargs):  # type: ignore[arg-type]
+            seen.append((out / "results.csv").read_text())
+            yield row
+
+    monkeypatch.setattr(cli_sweep, "rows_from", watching)
+    assert main([*argv, "--force"]) == 0
+    assert seen == ["the earlier sweep\n"] * 2
+    assert len(rows(out)) == 2
+    assert sorted(p.name for p in (out / "runs").iterdir()) == ["run-00000", "run-00001"]
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
+    capsys.readouterr()
