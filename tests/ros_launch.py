@@ -62,6 +62,11 @@ class Launch:
     """One roslaunch of the package in its own network namespace and process group."""
 
     def __init__(self, ws: Path, launch: str, *args: str) -> None:
+        if not any(a.startswith("timeout:=") for a in args):
+            # a node waits twice ``timeout:=`` (60 s by default) for its peers: on a loaded
+            # machine a peer can take longer than that to start, and the launch failed for
+            # it; a test that means a wait to run out says its own ``timeout:=``
+            args = (*args, f"timeout:={LAUNCH_TIMEOUT}")
         self.token = uuid.uuid4().hex
         script = ws / "launch.sh"
         env = {k: v for k, v in os.environ.items() if not k.startswith("ROS") and k != "PYTHONPATH"}

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import resource
@@ -31,7 +32,7 @@ from ..model.scenario import Scenario, load_scenario
 from ..model.schema import MAX_SEED
 from ..model.wording import plural
 from ..requirements.objective import requirement_of
-from ..runs.rundir import default_run_dir, prepare_run_dir
+from ..runs.rundir import default_run_dir, run_dir_for
 from ..runs.suite import input_files
 from ..runs.sweep import MAX_RUNS, timeline_overlaps, unknown_metric
 from ..stl.requirement import cut_windows
@@ -177,8 +178,33 @@ def run(args: argparse.Namespace) -> int:
             )
         if not out.is_dir():
             raise ConfigError("not a directory to resume", file=out, key="--resume")
-    else:
-        prepare_run_dir(out, args.force, inputs=input_files(scenario), kind="falsify")
+    # with --force the search is written beside an earlier one and renamed into place when it
+    # ends (finished or interrupted: --resume continues it there); a killed search leaves the
+    # earlier one whole
+    place = (
+        contextlib.nullcontext(out)
+        if args.resume
+        else run_dir_for(out, args.force, inputs=input_files(scenario), kind="falsify")
+    )
+    with place as work:
+        return _search_into(work, out, args, scenario, objective, space, name)
+
+
+def _search_into(
+    work: Path,
+    out: Path,
+    args: argparse.Namespace,
+    scenario: Scenario,
+    objective: Objective,
+    space: Space,
+    name: str,
+) -> int:
+    """The search's trials, writing into ``work`` (``out`` itself, or staged beside it: the
+    messages name ``out``)."""
+
+    def shown(path: Path) -> Path:
+        return out / path.relative_to(work)
+
     record = {
         "scenario": str(Path(args.scenario).resolve()),
         "ranges": args.ranges,
@@ -191,8 +217,10 @@ def run(args: argparse.Namespace) -> int:
         "stop_at_violation": objective.falsifies and not args.search_on,
         "duration": args.duration,
     }
-    check_same_search(out / "falsify.json", record, args.resume)
-    places = [out] if args.trials == 1 else [out / f"trial-{k + 1:03d}" for k in range(args.trials)]
+    check_same_search(work / "falsify.json", record, args.resume)
+    places = (
+        [work] if args.trials == 1 else [work / f"trial-{k + 1:03d}" for k in range(args.trials)]
+    )
     check_trial_dirs(places)  # before any trial writes: no link is ever written through
     finished = [  # every record judged before a trial runs again
         read_trial(here / "trial.json", args.seed + k, args.budget) if args.resume else None
@@ -212,7 +240,7 @@ def run(args: argparse.Namespace) -> int:
                 )
                 print(
                     one_line(
-                        f"already finished: {done.runs} runs, {found}; results in {here} "
+                        f"already finished: {done.runs} runs, {found}; results in {shown(here)} "
                         "(nothing run again)"
                     )
                 )
@@ -229,13 +257,15 @@ def run(args: argparse.Namespace) -> int:
             args.scheduler,
             stop_at_violation=objective.falsifies and not args.search_on,
         )
-        trial, found = _one_search(args, settings, objective, space, scenario, name, here, k)
+        trial, found = _one_search(
+            args, settings, objective, space, scenario, name, here, k, shown(here)
+        )
         trials.append(trial)
         violated = violated or found
     summary = summarize(trials, args.budget, objective.label)
-    write_atomic(out / "summary.json", json.dumps(summary, indent=1) + "\n")
+    write_atomic(work / "summary.json", json.dumps(summary, indent=1) + "\n")
     if args.trials > 1:
-        plot_trials(summary, out / "trials.png", one_line(name))
+        plot_trials(summary, work / "trials.png", one_line(name))
         rate = summary["falsification_rate"]
         line = f"falsified {summary['falsified']} of {len(trials)} trials ({rate:.0%})"
         if summary["mean_simulations"] is not None:
@@ -306,8 +336,10 @@ def _one_search(
     name: str,
     out: Path,
     k: int,
+    shown: Path,
 ) -> tuple[Trial, bool]:
-    """One trial: search, write its files in ``out``; (its outcome, whether it violated)."""
+    """One trial: search, write its files in ``out`` (``shown``: its name in messages, where
+    ``out`` is staged); (its outcome, whether it violated)."""
     keys = [d.key for d in space.dims]
     progress = Progress()
     if args.resume:
@@ -362,7 +394,7 @@ def _one_search(
             )
         _plot(progress, objective, name, out, interrupted, args.budget)
         late = interrupt.requested()
-    print(f"{line}; results in {out}")
+    print(f"{line}; results in {shown}")
     if progress.exhausted and len(progress.rows) < args.budget:
         print(
             one_line(
@@ -379,7 +411,7 @@ def _one_search(
         print(one_line(f"run {r['run']}: {r['error']}"), file=sys.stderr)
     if interrupted or late:
         raise Interrupted(
-            f"falsify interrupted; {len(progress.rows)} finished rows kept in {out} "
+            f"falsify interrupted; {len(progress.rows)} finished rows kept in {shown} "
             "(--resume continues)"
         )
     trial = Trial.of(settings.seed, progress, _cpu() - cpu0)

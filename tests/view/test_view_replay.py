@@ -235,7 +235,7 @@ def test_colours_follow_the_world_not_the_trace_columns(tmp_path: Path) -> None:
 
 # -- a real window: Xvfb, xdotool and ImageMagick's import ------------------------------------
 X_TOOLS = ("Xvfb", "xdotool", "import")
-X_TIMEOUT_S = 120.0  # a deadline for a failure, never a measured time: every wait polls
+X_TIMEOUT_S = 600.0  # a deadline for a failure, never a measured time: every wait polls
 
 
 def _poll(what: str, check: Callable[[], T | None], state: Callable[[], str] = str) -> T:

@@ -49,7 +49,9 @@ def main() -> None:
         link.waves = bool(rospy.get_param("~waves", True))
         if not link.speed > 0 or math.isinf(link.speed):
             raise AmsaError(f"speed:= must be a positive number, got {link.speed}")
-        ready_timeout = float(rospy.get_param("~ready_timeout", 120.0))
+        # the nodes wait twice ``timeout:=`` for their readers (amsa_leaf_node.h, leaf.py):
+        # the simulator waits as long for them to be ready
+        ready_timeout = float(rospy.get_param("~ready_timeout", 2 * cfg.timeout))
         missing = link.wait_ready(ready_timeout)
         if missing:
             raise RunFault("ROS graph", 0, f"not connected after {ready_timeout:g} s: {missing}")
