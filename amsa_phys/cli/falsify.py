@@ -10,6 +10,7 @@ import resource
 import sys
 from fractions import Fraction
 from pathlib import Path
+from typing import Any
 
 from ..atomic import write_atomic
 from ..engine import interrupt
@@ -226,9 +227,13 @@ def _search_into(
         read_trial(here / "trial.json", args.seed + k, args.budget) if args.resume else None
         for k, here in enumerate(places)
     ]
+    cached = [  # and every unfinished trial's rows: a damaged file refused before any runs
+        read_cached(here / "results.csv", args.budget) if args.resume and done is None else None
+        for here, done in zip(places, finished, strict=True)
+    ]
     trials: list[Trial] = []
     violated = False
-    for k, (here, done) in enumerate(zip(places, finished, strict=True)):
+    for k, (here, done, rows) in enumerate(zip(places, finished, cached, strict=True)):
         if done is not None:
             trials.append(done)
             violated = violated or done.falsified
@@ -258,7 +263,7 @@ def _search_into(
             stop_at_violation=objective.falsifies and not args.search_on,
         )
         trial, found = _one_search(
-            args, settings, objective, space, scenario, name, here, k, shown(here)
+            args, settings, objective, space, scenario, name, here, k, shown(here), rows
         )
         trials.append(trial)
         violated = violated or found
@@ -337,13 +342,14 @@ def _one_search(
     out: Path,
     k: int,
     shown: Path,
+    cached: dict[int, dict[str, Any]] | None,
 ) -> tuple[Trial, bool]:
     """One trial: search, write its files in ``out`` (``shown``: its name in messages, where
     ``out`` is staged); (its outcome, whether it violated)."""
     keys = [d.key for d in space.dims]
     progress = Progress()
-    if args.resume:
-        progress.cached = read_cached(out / "results.csv", args.budget)
+    if cached is not None:  # --resume: the rows read before the first trial ran
+        progress.cached = cached
     interrupted = False
     cpu0 = _cpu()
     bar = progress_bar(args.budget, "run" if args.trials == 1 else f"trial {k + 1} run")
