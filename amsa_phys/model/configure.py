@@ -183,6 +183,11 @@ def duration_option(value: float | Fraction, option: str = "--duration") -> Frac
 
 def positive_fraction(value: float, option: str) -> Fraction:
     """An option's positive finite number, exactly (``Fraction(str(value))``)."""
-    if not value > 0 or value != value or value == float("inf"):
+    if value == float("inf"):  # "inf", or digits beyond a float's range (1e400)
+        raise ConfigError(
+            "must be a positive finite number, got infinity or a number too large for a float",
+            key=option,
+        )
+    if not value > 0 or value != value:
         raise ConfigError(f"must be a positive finite number, got {value}", key=option)
     return Fraction(str(value))

@@ -159,3 +159,18 @@ def test_a_refused_option_value_of_thousands_of_characters_is_said_by_its_ends(
     assert err.count("\n") == 1
     assert len(err) < 200
     assert f"'{value[:40]}...{value[-20:]}'" in err
+
+
+@pytest.mark.parametrize("value", ["9" * 5000, "1e400", "inf"])
+def test_a_duration_beyond_a_float_says_so(
+    value: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """5,000 digits of --duration read as a float's infinity: the line said "got inf", a
+    number the user never typed."""
+    argv = ["run", str(SCENARIO), "--headless", "--out", str(tmp_path / "o")]
+    assert main([*argv, "--duration", value]) == 2
+    assert capsys.readouterr().err == (
+        "error: --duration: must be a positive finite number, got infinity or a number too "
+        "large for a float\n"
+    )
+    assert not (tmp_path / "o").exists()
