@@ -148,9 +148,47 @@ def test_sigterm_to_the_script_stops_the_launch_as_ctrl_c() -> None:
         assert proc.stdout is not None
         assert proc.stdout.readline() == "ready\n"
         proc.send_signal(signal.SIGTERM)
-        out, _ = proc.communicate(timeout=60)
+        out, _ = proc.communicate(timeout=600)  # a deadline for a failure, not a measure
     finally:  # the stand-in too, whatever happened
         with contextlib.suppress(ProcessLookupError):
             os.killpg(proc.pid, signal.SIGKILL)
     assert out == "stopped by SIGINT\nverdict 0\n"
     assert proc.returncode == 0
+
+
+def test_a_sigterm_as_roslaunch_starts_is_passed_on_too() -> None:
+    """The SIGTERM handler was set only once the output readers ran: roslaunch's first line
+    could reach the user (a CI reading it, then timing out) before it was, and a SIGTERM
+    then killed the script alone, leaving roslaunch orphaned. Here one comes as roslaunch
+    starts: the script still stops roslaunch and gives its verdict."""
+    script = (
+        "import os, signal, subprocess, sys\n"
+        "from amsa_phys.ros.runtime import launchout\n"
+        "real = subprocess.Popen\n"
+        "def popen(*args, **kwargs):\n"
+        "    child = real(*args, **kwargs)\n"
+        "    print('child', child.pid, file=sys.stderr, flush=True)\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)  # a CI's timeout, as roslaunch starts\n"
+        "    return child\n"
+        "launchout.subprocess.Popen = popen\n"
+        f"code, seen = launchout.run([sys.executable, '-c', {WAITS_FOR_CTRL_C!r}], {{}})\n"
+        "print('verdict', code, flush=True)\n"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-c", script],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        preexec_fn=sigint.at_default,
+    )
+    try:
+        out, err = proc.communicate(timeout=600)  # a deadline for a failure, not a measure
+    finally:  # the stand-in too, whatever happened
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 0, err
+    assert out.splitlines()[-1].startswith("verdict "), (out, err)
+    child = int(err.split("child ", 1)[1].split()[0])
+    with pytest.raises(ProcessLookupError):  # ended by the SIGINT, and reaped
+        os.kill(child, 0)

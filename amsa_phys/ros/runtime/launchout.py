@@ -136,6 +136,39 @@ def run(argv: list[str], env: dict[str, str]) -> tuple[int, Seen]:
     seen = Seen()
     for stream in (sys.stdout, sys.stderr):
         stream.flush()
+    # SIGTERM to this script alone (a CI's timeout) would leave roslaunch writing into a
+    # closed pipe: it is passed on as the Ctrl-C that stops a launch cleanly, and the verdict
+    # follows (130 when the simulator says "interrupted"). Taken before roslaunch starts: its
+    # first output can reach our stdout (and whoever reads it send the SIGTERM) before this
+    # thread runs again; one that comes before roslaunch exists is passed on once it does.
+    started: list[subprocess.Popen[bytes]] = []
+    asked: list[bool] = []
+
+    def on_sigterm(*_: object) -> None:
+        if started:
+            started[0].send_signal(signal.SIGINT)
+        else:
+            asked.append(True)
+
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, on_sigterm)
+    try:
+        return _launch(argv, env, seen, started, asked)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _launch(
+    argv: list[str],
+    env: dict[str, str],
+    seen: Seen,
+    started: list[subprocess.Popen[bytes]],
+    asked: list[bool],
+) -> tuple[int, Seen]:
+    """:func:`run`'s launch, its SIGTERM handler in place: roslaunch started into
+    ``started``, a SIGTERM noted in ``asked`` meanwhile passed on as SIGINT."""
     targets = (sys.stdout.fileno(), sys.stderr.fileno())
     channels = [_channel(t) for t in targets]
     try:
@@ -145,6 +178,9 @@ def run(argv: list[str], env: dict[str, str]) -> tuple[int, Seen]:
             for fd in fds:
                 os.close(fd)
         raise
+    started.append(proc)
+    if asked:
+        proc.send_signal(signal.SIGINT)
     for child_side, _ in channels:
         os.close(child_side)  # ours closed: the end of output is the child's
     readers = [
@@ -153,17 +189,7 @@ def run(argv: list[str], env: dict[str, str]) -> tuple[int, Seen]:
     ]
     for reader in readers:
         reader.start()
-    # SIGTERM to this script alone (a CI's timeout) would leave roslaunch writing into a
-    # closed pipe: it is passed on as the Ctrl-C that stops a launch cleanly, and the verdict
-    # follows (130 when the simulator says "interrupted")
-    previous = None
-    if threading.current_thread() is threading.main_thread():
-        previous = signal.signal(signal.SIGTERM, lambda *_: proc.send_signal(signal.SIGINT))
-    try:
-        code = proc.wait()
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+    code = proc.wait()
     for reader in readers:
         reader.join(DRAIN_S)
     return code, seen
