@@ -9,6 +9,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import sigint
+from deadlines import HANG_S  # bounds a hang only: a run not writing rows by then is broken
 
 FIXTURE = Path(__file__).resolve().parent / "fixtures" / "mde_short.yaml"
 
@@ -23,10 +24,6 @@ def stop_leftovers() -> None:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
-
-
-#: Bounds a hang only: a run that has not written rows by then is broken, not slow.
-HANG_S = 300.0
 
 
 def wait_until(

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 import pytest
 import sigint
+from deadlines import HANG_S
 from longrun import wait_until
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
@@ -291,7 +292,7 @@ def test_ctrl_c_leaves_a_finalised_bag(tmp_path: Path) -> None:
             proc,
         )
         proc.send_signal(signal.SIGINT)
-        _, err = proc.communicate(timeout=60)
+        _, err = proc.communicate(timeout=HANG_S)
     finally:
         if proc.poll() is None:
             proc.kill()

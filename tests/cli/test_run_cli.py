@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 
@@ -191,7 +192,7 @@ def test_sigint_finalises_outputs_and_exits_130(tmp_path: Path) -> None:
     out = tmp_path / "int"
     proc = start_long_run(out, stderr=subprocess.PIPE)
     proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=30)
+    _, err = proc.communicate(timeout=HANG_S)
     assert proc.returncode == 130
     assert "interrupted at t=" in err
     assert "Traceback" not in err
@@ -236,7 +237,7 @@ def test_sigterm_stops_on_a_whole_second_however_the_run_was_started(
     finally:
         os.close(sink)
     proc.send_signal(signal.SIGTERM)
-    _, err = proc.communicate(timeout=60)
+    _, err = proc.communicate(timeout=HANG_S)
     if stdout == "terminal":
         os.close(main_fd)
     assert proc.returncode == 130

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 import sigint
+from deadlines import HANG_S
 from longrun import start_long_run
 
 from amsa_phys.cli.main import main
@@ -127,7 +128,7 @@ def test_sigterm_finalises_like_ctrl_c(tmp_path: Path) -> None:
     out = tmp_path / "t"
     proc = start_long_run(out, stderr=subprocess.PIPE)
     proc.terminate()
-    _, err = proc.communicate(timeout=30)
+    _, err = proc.communicate(timeout=HANG_S)
     assert proc.returncode == 130
     assert "interrupted at t=" in err
     assert json.loads((out / "metrics.json").read_text())["status"] == "interrupted"
@@ -166,7 +167,7 @@ def test_sigkill_never_leaves_a_partial_file_under_a_final_name(tmp_path: Path) 
     out = tmp_path / "k"
     proc = start_long_run(out)
     proc.kill()
-    proc.wait(timeout=30)
+    proc.wait(timeout=HANG_S)
     names = sorted(p.name for p in out.iterdir())
     assert names == [".amsa-phys-run", "trace.csv.tmp"]  # no output under a final name
 

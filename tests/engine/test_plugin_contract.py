@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 import pytest
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 
@@ -96,7 +97,7 @@ def test_a_broken_return_is_a_fault_of_the_component(
 
 
 def _wait_for(what: str, found: callable) -> None:  # type: ignore[valid-type]
-    deadline = time.monotonic() + 300  # generous on a loaded machine: never the assertion
+    deadline = time.monotonic() + HANG_S  # generous on a loaded machine: never the assertion
     while not found():
         if time.monotonic() > deadline:
             pytest.fail(f"never saw {what}")
@@ -135,7 +136,7 @@ def test_one_signal_stops_a_step_that_never_returns_and_keeps_the_outputs(
     try:
         _wait_for("the component stuck", lambda: any(tmp_path.glob("stuck.*")))
         proc.send_signal(sig)  # once
-        _, err = proc.communicate(timeout=120)
+        _, err = proc.communicate(timeout=HANG_S)
     finally:
         if proc.poll() is None:
             proc.kill()

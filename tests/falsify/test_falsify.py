@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 import sigint
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 from amsa_phys.falsify.objective import build_objective
@@ -202,7 +203,7 @@ def test_a_subprocess_exit_code_and_stderr_for_a_bad_range(tmp_path: Path) -> No
     proc = subprocess.run(
         [sys.executable, "-m", "amsa_phys", "falsify", str(FIG5), "--range", "Leader.x=1:1",
          "--budget", "5", "--out", str(tmp_path / "x")],
-        capture_output=True, text=True, timeout=120,
+        capture_output=True, text=True, timeout=HANG_S,
     )  # fmt: skip
     assert proc.returncode == 2
     assert (
@@ -235,7 +236,7 @@ def test_interrupt_keeps_every_finished_row(tmp_path: Path, how: str) -> None:
             proc.terminate()
         else:
             os.killpg(proc.pid, signal.SIGINT)
-        _, err = proc.communicate(timeout=120)
+        _, err = proc.communicate(timeout=HANG_S)
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 from amsa_phys.falsify.resume import MAX_RESULTS_BYTES, results_limit
@@ -181,7 +182,7 @@ def test_a_record_that_is_a_fifo_is_refused_without_waiting(fdir: Path, name: st
     os.mkfifo(fdir / name)
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg"}
     cmd = [sys.executable, "-m", "amsa_phys", *SEARCH, "--out", str(fdir), "--resume"]
-    done = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=120)
+    done = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=HANG_S)
     assert done.returncode == 2
     err = done.stderr.strip()
     assert "\n" not in err, err

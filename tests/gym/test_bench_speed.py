@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from deadlines import HANG_S
 
 pytest.importorskip("gymnasium", reason="the gym extra is not installed")
 
@@ -67,7 +68,7 @@ def test_the_quick_run_prints_every_row_and_saves_nothing() -> None:
 def test_bad_options_stop_before_measuring() -> None:
     for argv in (["--reps", "0"], ["--only", "nothing"]):
         out = subprocess.run(
-            [sys.executable, str(BENCH), *argv], capture_output=True, text=True, timeout=120
+            [sys.executable, str(BENCH), *argv], capture_output=True, text=True, timeout=HANG_S
         )
         assert out.returncode == 2
         assert "Traceback" not in out.stderr

@@ -13,6 +13,8 @@ import pytest
 
 gymnasium = pytest.importorskip("gymnasium", reason="the gym extra is not installed")
 
+from deadlines import HANG_S  # noqa: E402
+
 from amsa_phys.errors import RunFault  # noqa: E402
 from amsa_phys.gym import FollowEnv  # noqa: E402
 
@@ -102,7 +104,7 @@ def test_an_env_left_open_at_exit_says_nothing() -> None:
         "env.step(np.array([0.5, 0.5]))\n"
     )
     done = subprocess.run(
-        [sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=HANG_S, check=False
     )
     assert (done.returncode, done.stderr) == (0, "")
 

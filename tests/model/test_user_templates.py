@@ -16,6 +16,7 @@ import uuid
 from pathlib import Path
 
 import pytest
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 
@@ -132,7 +133,7 @@ def test_sys_exit_in_a_test_suite_is_an_error_row_serial_and_parallel(
         capture_output=True,
         text=True,
         env=ENV,
-        timeout=120,
+        timeout=HANG_S,
         check=False,
     )
     assert proc.returncode == 1, proc.stderr
@@ -203,5 +204,5 @@ def test_templates_into_a_closed_pipe_exits_quietly() -> None:
     assert proc.stderr is not None
     proc.stdout.close()
     err = proc.stderr.read()
-    assert proc.wait(timeout=60) == 141  # 128 + SIGPIPE, as `yes | head -1` gives
+    assert proc.wait(timeout=HANG_S) == 141  # 128 + SIGPIPE, as `yes | head -1` gives
     assert err == b""

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 import yaml
+from deadlines import HANG_S
 
 from amsa_phys.engine.runner import Simulation
 from amsa_phys.model.scenario import load_scenario
@@ -212,7 +213,7 @@ def test_a_zone_without_area_is_refused_naming_it(tmp_path: Path) -> None:
         [sys.executable, "-m", "amsa_phys", "validate", str(path)],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=HANG_S,
     )
     assert proc.returncode == 2
     assert "Tunnel" in proc.stderr

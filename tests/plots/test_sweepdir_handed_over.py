@@ -19,6 +19,7 @@ import zlib
 from pathlib import Path
 
 import pytest
+from deadlines import HANG_S
 from refusal import assert_one_line_refusal
 
 from amsa_phys.cli.main import main
@@ -82,7 +83,7 @@ def test_plot_does_not_wait_on_a_fifo_planted_as_summary_png(tmp_path: Path) -> 
         [sys.executable, "-m", "amsa_phys", "plot", str(sweep)],
         capture_output=True,
         text=True,
-        timeout=120,  # the old reader waited for a writer forever
+        timeout=HANG_S,  # the old reader waited for a writer forever
         env=env,
     )
     assert done.returncode == 0, done.stderr

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import pytest
 import sigint
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 
@@ -62,7 +63,7 @@ def test_a_node_stopped_while_its_python_initialises_says_nothing(tmp_path: Path
         assert proc.stdout is not None
         assert proc.stdout.readline() == b"interpreter starting\n"
         proc.send_signal(signal.SIGINT)
-        out_rest, err = proc.communicate(timeout=120)
+        out_rest, err = proc.communicate(timeout=HANG_S)
     finally:
         proc.kill()
     assert err == b""

@@ -21,6 +21,7 @@ from types import SimpleNamespace
 
 import pytest
 import sigint
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 from amsa_phys.ros.runtime import startup
@@ -58,7 +59,7 @@ def test_a_node_stopped_while_it_starts_says_nothing(
         assert proc.stdout is not None
         assert proc.stdout.readline() == b"importing rospy\n"  # the node is starting
         proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=60)
+        out, err = proc.communicate(timeout=HANG_S)
     finally:
         proc.kill()
     assert err == b""

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 import sigint
+from deadlines import HANG_S
 
 TESTS = Path(__file__).resolve().parent.parent
 
@@ -38,7 +39,7 @@ def alive(pid: int) -> bool:
     return state != "Z"
 
 
-def wait_for(what: str, check: object, timeout: float = 60) -> None:
+def wait_for(what: str, check: object, timeout: float = HANG_S) -> None:
     deadline = time.monotonic() + timeout
     while not check():  # type: ignore[operator]
         assert time.monotonic() < deadline, f"timed out waiting until {what}"
@@ -94,7 +95,7 @@ def test_workers_die_with_a_sigkilled_parent(tmp_path: Path, command: str) -> No
         workers = stuck_workers(tmp_path)
         assert set(workers) <= children(proc.pid)
         proc.kill()
-        proc.communicate(timeout=60)
+        proc.communicate(timeout=HANG_S)
         wait_for("the workers are gone", lambda: not any(alive(w) for w in workers))
     finally:
         if proc.poll() is None:
@@ -122,12 +123,12 @@ def test_a_second_signal_stops_a_stuck_pool_at_once(
             proc.wait(timeout=1)
         # the second press; pressed again while it is not handled yet (two signals sent too
         # close together are delivered as one)
-        deadline = time.monotonic() + 60
+        deadline = time.monotonic() + HANG_S
         while proc.poll() is None and time.monotonic() < deadline:
             proc.send_signal(sig)
             with contextlib.suppress(subprocess.TimeoutExpired):
                 proc.wait(timeout=2)
-        _, err = proc.communicate(timeout=10)
+        _, err = proc.communicate(timeout=HANG_S)
         assert proc.returncode == 130, err
         assert err.splitlines()[-1].startswith(f"error: {command} interrupted")
         assert not any(alive(w) for w in workers)

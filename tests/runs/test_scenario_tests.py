@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 import sigint
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 
@@ -135,7 +136,7 @@ def test_ctrl_c_stops_a_parallel_suite_promptly(tmp_path: Path, how: str) -> Non
             os.killpg(proc.pid, signal.SIGINT)  # the whole group
         else:
             proc.send_signal(signal.SIGINT if how == "kill-int-parent" else signal.SIGTERM)
-        stdout, err = proc.communicate(timeout=30)
+        stdout, err = proc.communicate(timeout=HANG_S)
     finally:  # a suite that ignored Ctrl-C must not outlive the test with its workers
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)

@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 import sigint
 from daskcluster import local_cluster
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 
@@ -278,7 +279,7 @@ def test_ctrl_c_keeps_every_finished_row(tmp_path: Path, how: str) -> None:
             proc.terminate()
         else:
             os.killpg(proc.pid, signal.SIGINT)  # like a terminal's Ctrl-C: the whole group
-        proc.wait(timeout=120)  # bounds a hang only
+        proc.wait(timeout=HANG_S)  # bounds a hang only
         err = terminal.read()
     finally:  # a hung sweep must not outlive the test with its workers
         if proc.poll() is None:

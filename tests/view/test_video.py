@@ -16,6 +16,7 @@ import imageio_ffmpeg
 import numpy as np
 import pytest
 import sigint
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 
@@ -207,14 +208,14 @@ def test_ctrl_c_during_a_recording_leaves_a_playable_video(tmp_path: Path) -> No
         text=True,
     )
     tmp = video.with_name(video.name + ".tmp")
-    deadline = time.monotonic() + 60
+    deadline = time.monotonic() + HANG_S
     try:
         while not (tmp.exists() and tmp.stat().st_size > 20_000):
             assert proc.poll() is None, proc.stderr.read() if proc.stderr else ""
             assert time.monotonic() < deadline, "recording never started"
             time.sleep(0.05)
         os.killpg(proc.pid, signal.SIGINT)
-        _, err = proc.communicate(timeout=60)
+        _, err = proc.communicate(timeout=HANG_S)
     finally:  # a failed or hung run must not outlive the test (its ffmpeg follows it)
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)

@@ -15,6 +15,7 @@ from typing import TypeVar
 
 import numpy as np
 import pytest
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 from amsa_phys.cli.view import load_run
@@ -269,7 +270,7 @@ def xdisplay() -> Iterator[str]:
         yield f":{number}"
     finally:
         server.terminate()
-        server.wait(timeout=30)
+        server.wait(timeout=HANG_S)
 
 
 def _x(display: str, *argv: str) -> str:
@@ -348,7 +349,7 @@ def test_view_in_a_real_x_window_scrubs_to_an_event_and_draws_the_traced_pose(
         assert tuple(image.get_at((12, bar_y)))[:3] != INK  # the cursor left the start
     finally:
         viewer.terminate()
-        viewer.wait(timeout=30)
+        viewer.wait(timeout=HANG_S)
 
 
 def _drawn_at(
@@ -485,7 +486,7 @@ def test_a_run_quit_from_a_real_window_says_in_its_plots_where_it_was_cut(
     finally:
         if runner.poll() is None:
             runner.terminate()
-            runner.wait(timeout=30)
+            runner.wait(timeout=HANG_S)
     assert runner.returncode == 0, said()
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["status"].startswith("closed in the window at t=")

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from deadlines import HANG_S
 
 from amsa_phys.cli.main import main
 from amsa_phys.engine.runner import Simulation
@@ -185,7 +186,7 @@ def test_a_window_on_an_invisible_driver_is_refused_not_waited_on(
         text=True,
         env=env,
         check=False,
-        timeout=120,  # a hang fails here instead of holding the suite
+        timeout=HANG_S,  # a hang fails here instead of holding the suite
     )
     assert proc.returncode == 2
     assert proc.stderr == (
@@ -216,7 +217,7 @@ def test_a_window_on_an_invisible_driver_is_refused_not_waited_on(
         text=True,
         env=env,
         check=False,
-        timeout=120,
+        timeout=HANG_S,
     )
     assert proc.returncode == 2
     assert proc.stderr.startswith(f"error: view: SDL_VIDEODRIVER={driver.strip()} shows no window")
