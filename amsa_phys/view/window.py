@@ -94,16 +94,23 @@ def open_display(interactive: bool = False) -> None:
         and not env.get("WAYLAND_DISPLAY")
     ):
         raise RuntimeError("no display to open a window on (no X11 or Wayland session)")
+    named = ", ".join(f"{k}={env[k]}" for k in ("DISPLAY", "WAYLAND_DISPLAY") if env.get(k))
+    on = f" on {named}" if named and not asked else ""
     try:
         pygame.display.init()
     except pygame.error as exc:
-        raise RuntimeError(f"cannot open a window: {exc}") from None
+        raise RuntimeError(f"cannot open a window{on}: {exc}") from None
     driver = pygame.display.get_driver()
     if driver in INVISIBLE_DRIVERS and (interactive or not asked):
         pygame.display.quit()
         if asked:  # another name SDL maps to an invisible driver
             raise RuntimeError(
                 f"SDL_VIDEODRIVER={asked} opens SDL's {driver} driver, which shows no window"
+            )
+        if named:  # a session is named, but SDL could not connect to it
+            raise RuntimeError(
+                f"cannot open a window{on}: SDL could not connect to that display "
+                "(is its server running, and does it accept this user?)"
             )
         raise RuntimeError("no display to open a window on (no X11 or Wayland session)")
 

@@ -267,6 +267,12 @@ def xdisplay() -> Iterator[str]:
         with os.fdopen(read) as fh:
             number = fh.readline().strip()  # Xvfb writes it once it accepts connections
         assert number.isdigit(), "Xvfb did not start"
+        # and a client is served: a run started before that finds no display (seen once, on
+        # a loaded machine: SDL fell back to its offscreen driver and the run refused)
+        _poll(
+            "Xvfb to serve a client",
+            lambda: _x(f":{number}", "xdotool", "getdisplaygeometry") or None,
+        )
         yield f":{number}"
     finally:
         server.terminate()

@@ -167,6 +167,37 @@ def test_a_window_without_a_display_is_refused_clearly(tmp_path: Path) -> None:
     assert not (tmp_path / "w").exists()
 
 
+def test_a_display_that_refuses_the_connection_is_named(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``DISPLAY`` set, but SDL could not connect to it and fell back to its offscreen
+    driver (an X server that is not running, or refuses this user): the line said "no X11
+    or Wayland session", and a user looking at their ``DISPLAY`` could not tell why."""
+    import pygame
+
+    from amsa_phys.view import window
+
+    monkeypatch.delenv("SDL_VIDEODRIVER", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setenv("DISPLAY", ":93")
+    monkeypatch.setattr(pygame.display, "init", lambda: None)
+    monkeypatch.setattr(pygame.display, "quit", lambda: None)
+    monkeypatch.setattr(pygame.display, "get_driver", lambda: "offscreen")
+    with pytest.raises(RuntimeError) as refused:
+        window.open_display(interactive=True)
+    assert str(refused.value) == (
+        "cannot open a window on DISPLAY=:93: SDL could not connect to that display (is its "
+        "server running, and does it accept this user?)"
+    )
+
+    def no_video() -> None:
+        raise pygame.error("windows not available")
+
+    monkeypatch.setattr(pygame.display, "init", no_video)
+    with pytest.raises(RuntimeError, match=r"^cannot open a window on DISPLAY=:93: windows "):
+        window.open_display(interactive=True)
+
+
 @pytest.mark.parametrize("driver", ["dummy", "offscreen", " Dummy "])
 def test_a_window_on_an_invisible_driver_is_refused_not_waited_on(
     tmp_path: Path, driver: str
