@@ -14,6 +14,8 @@ import operator
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
+
 from ..errors import ConfigError
 from ..model.params import short_repr
 from ..model.schema import MAX_SEED
@@ -131,6 +133,13 @@ def names(value: Any, key: str) -> list[str] | None:
     if not all(isinstance(v, str) for v in value):
         raise ConfigError(f"expected names (strings), got {short_repr(value)}", key=key)
     return list(value)
+
+
+def flag(value: Any, name: str) -> bool:
+    """A switch: True or False (numpy's too). ``record_trace="no"`` was taken as True."""
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    raise ConfigError(f"expected True or False, got {short_repr(value)}", key=name)
 
 
 def component(value: Any) -> str | None:

@@ -207,6 +207,10 @@ ENV_CASES: dict[str, tuple[Callable[[], Any], str]] = {
         "set=: expected a mapping like {\"Comp.param\": value}, got list ['a=b'] "
         '(the command line\'s "Comp.param=value" is {"Comp.param": value} here)',
     ),
+    "record-trace-text": (
+        lambda: _env(record_trace="no"),
+        "record_trace: expected True or False, got 'no'",
+    ),
     "reset-seed-2**64": (lambda: _reset({}, seed=2**64), "seed: " + SEED_RANGE + str(2**64)),
     "reset-seed-2**63": (lambda: _reset({}, seed=2**63), "seed: " + SEED_RANGE + str(2**63)),
     "reset-seed-negative": (lambda: _reset({}, seed=-1), "seed: " + SEED_RANGE + "-1"),
