@@ -275,7 +275,10 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         }
 
     def close_extras(self, **kwargs: Any) -> None:
-        """Stop the episodes in progress (the batch's greenlet, or the single envs')."""
+        """Stop the episodes in progress (the batch's greenlet, or the single envs'). The env
+        then holds none: a step before the next reset says to reset (it said a run had
+        faulted)."""
         if self._episode is not None:
             self._episode.close()
+        self._episode = None
         self._guard.hold(None)

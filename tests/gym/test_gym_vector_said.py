@@ -109,3 +109,18 @@ def test_a_ctrl_c_inside_a_step_is_said_as_such_whichever_way_it_steps(
     _, reward, *_ = vec.step(np.zeros((2, 2)))
     assert np.isfinite(reward).all()
     vec.close()
+
+
+@pytest.mark.parametrize("stepping", STEPPINGS)
+def test_a_step_after_close_says_to_reset_and_a_reset_goes_on(stepping: str) -> None:
+    """A closed vector env said "a run faulted" to the next step: nothing had."""
+    vec = FollowVecEnv(2, SCENARIO1, duration=2, stepping=stepping)
+    vec.reset(seed=1)
+    vec.step(np.zeros((2, 2)))
+    vec.close()
+    with pytest.raises(gymnasium.error.ResetNeeded) as refused:
+        vec.step(np.zeros((2, 2)))
+    assert str(refused.value) == "call reset() before step()"
+    obs, _ = vec.reset(seed=1)
+    assert obs.shape == (2, 3)
+    vec.close()
