@@ -28,7 +28,7 @@ from ..falsify.search import Progress, Settings, search
 from ..falsify.space import build_space
 from ..falsify.trials import Trial, summarize
 from ..model.scenario import load_scenario
-from ..model.schema import MAX_SEED
+from .falsifyargs import check_arguments, check_metric
 
 Cost = Callable[[dict[str, Any]], float]
 
@@ -115,18 +115,17 @@ def falsify(
     """
     if sum(x is not None for x in (requirement, metric, cost)) > 1:
         raise ConfigError("give one of requirement, metric or cost", key="falsify")
-    if not 1 <= trials <= 1000:
-        raise ConfigError("must be in 1..1000", key="trials")
-    if not 0 <= seed <= MAX_SEED - (trials - 1):
-        raise ConfigError(f"must be an integer from 0 to {MAX_SEED - (trials - 1)}", key="seed")
-    if budget < 1:
-        raise ConfigError("must be at least 1", key="budget")
+    check_arguments(
+        scenario, box, budget=budget, cost=cost, seed=seed, trials=trials,
+        duration=duration, executor=executor, workers=workers,
+    )  # fmt: skip
     path = Path(scenario).resolve()
     sc = load_scenario(path)
     ranges, grids = _box(box)
     space = build_space(sc, ranges, grids)
     end = duration if duration is not None else float(sc.duration)
     n_phases = len(sc.timeline.phases_before(end))
+    check_metric(metric, n_phases)
     objective: Objective
     if cost is not None:
         objective = CostObjective(None, (), ("cost",), cost)

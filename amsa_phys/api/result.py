@@ -29,7 +29,7 @@ from ..runs.rundir import default_run_dir, run_dir_for
 from ..runs.single import Ended, execute, write_run_files
 from ..runs.suite import input_files
 from .memory import check_trace_memory
-from .source import Source, api_errors, load
+from .source import Source, api_errors, load, switch
 
 
 class Run:
@@ -144,6 +144,7 @@ def run(
     refused), finalised whatever ended the run. ``ros2`` is ``--ros2``: these Leaves are
     your ROS 2 nodes, stepped in lockstep (needs rclpy; ``docs/ros2.md``).
     """
+    progress = switch(progress, "progress")
     scenario = load(
         source,
         seed=seed,

@@ -97,8 +97,20 @@ def load(
     the CLI prints them); ``adapt=False`` is ``--no-adapt``. Raises
     :class:`~amsa_phys.errors.ConfigError`.
     """
+    adapt = switch(adapt, "adapt")
     scenario = _load(source, seed, duration, set, log_rate, trace_columns, base_dir)
     return scenario if adapt else without_adapt(scenario)
+
+
+def switch(value: Any, name: str) -> bool:
+    """A True-or-False argument (``adapt``, ``progress``): ``adapt="no"``, a true string,
+    kept the scenario's rules on. numpy's bool is taken (without importing numpy here)."""
+    if isinstance(value, bool):
+        return value
+    dtype = getattr(value, "dtype", None)
+    if getattr(dtype, "kind", None) == "b" and getattr(value, "shape", None) == ():
+        return bool(value)
+    raise ConfigError(f"expected True or False, got {short_repr(value)}", key=f"{name}=")
 
 
 def _load(

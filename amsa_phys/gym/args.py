@@ -14,6 +14,8 @@ import operator
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
+
 from ..errors import ConfigError
 from ..model.params import short_repr
 from ..model.schema import MAX_SEED
@@ -80,6 +82,23 @@ def seed(value: Any) -> int | None:
     return number
 
 
+def seeds_from(base: int | None, n: int) -> list[int | None]:
+    """A vector env's ``reset(seed=base)``: env ``i`` gets ``base + i``, so the last of ``n``
+    envs must still be a seed a scenario may hold (checked here, before any env is reset:
+    the batch took a larger one as it came, the single envs refused it midway, naming a
+    seed nobody passed)."""
+    if base is None:
+        return [None] * n
+    top = MAX_SEED - (n - 1)
+    if base > top:
+        raise ConfigError(
+            f"must be an integer from 0 to {top} (2**63 - 1 less {n - 1}: env i is seeded "
+            f"with seed + i); got {base}",
+            key="seed",
+        )
+    return [base + i for i in range(n)]
+
+
 def reset_set(options: Any) -> dict[str, Any]:
     """The ``set`` of ``reset(options=...)`` (its only option), as a dict."""
     if options is None:
@@ -114,6 +133,13 @@ def names(value: Any, key: str) -> list[str] | None:
     if not all(isinstance(v, str) for v in value):
         raise ConfigError(f"expected names (strings), got {short_repr(value)}", key=key)
     return list(value)
+
+
+def flag(value: Any, name: str) -> bool:
+    """A switch: True or False (numpy's too). ``record_trace="no"`` was taken as True."""
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    raise ConfigError(f"expected True or False, got {short_repr(value)}", key=name)
 
 
 def component(value: Any) -> str | None:

@@ -125,6 +125,7 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         controller = args.component(controller)
         actions = args.names(actions, "actions")
         size = args.render_size(render_size)
+        record_trace = args.flag(record_trace, "record_trace")
         self.action_scale = args.finite_number(action_scale, "action_scale", positive=True)
         self.collision_penalty = args.finite_number(
             collision_penalty, "collision_penalty", positive=False
@@ -276,7 +277,9 @@ class FollowEnv(gymnasium.Env[np.ndarray, np.ndarray], EzPickle):
         """
         episode = self._episode
         if episode is None or episode.done:
-            why = (episode.ended_by if episode is not None else None) or "the episode has ended"
+            if episode is None:  # never reset (an unpickled env too): no episode has ended
+                raise gymnasium.error.ResetNeeded("call reset() before step()")
+            why = episode.ended_by or "the episode has ended"
             raise gymnasium.error.ResetNeeded(f"call reset() before step(): {why}")
         if (
             type(action) is np.ndarray

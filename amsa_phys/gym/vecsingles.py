@@ -42,6 +42,8 @@ class Singles:
         self.envs = list(envs)
         self.n = len(self.envs)
         self.done = False
+        #: whether a Ctrl-C ended the episodes (the next step says so, not "a run faulted")
+        self.interrupted = False
         self._thread = threading.get_ident()
         #: no column physics, and no run ever goes alone (each already is)
         self.columns = None
@@ -51,6 +53,7 @@ class Singles:
         """New episodes, env ``i`` with scenario seed ``seeds[i]``: first observations and
         the vector env's info (``t``, ``signal``, ``collisions``, ``seed``)."""
         self.done = False
+        self.interrupted = False
         self._thread = threading.get_ident()
         try:
             results = [env.reset(seed=int(s)) for env, s in zip(self.envs, seeds, strict=True)]
@@ -84,8 +87,9 @@ class Singles:
                 t[i] = info["t"]
                 signal[i] = info["signal"]
                 collisions[i] = info["collisions"]
-        except BaseException:
+        except BaseException as exc:
             self.done = True
+            self.interrupted = isinstance(exc, KeyboardInterrupt)
             raise
         self.done = truncated
         assert obs is not None

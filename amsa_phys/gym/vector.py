@@ -161,15 +161,16 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         """New episodes; ``seed`` an int (env ``i`` gets ``seed + i``) or one seed each."""
         if options:
             raise ConfigError("the vector env takes no reset options", key="options")
-        if isinstance(seed, list | tuple):
+        one_each = isinstance(seed, np.ndarray) and seed.ndim == 1  # SyncVectorEnv takes it
+        if isinstance(seed, list | tuple) or one_each:
             if len(seed) != self.num_envs:
                 raise ConfigError(f"expected {self.num_envs} seeds, got {len(seed)}", key="seed")
             seeds = [args.seed(s) for s in seed]
             super().reset(seed=seeds[0])
         else:
             base = args.seed(seed)
+            seeds = args.seeds_from(base, self.num_envs)
             super().reset(seed=base)
-            seeds = [None if base is None else base + i for i in range(self.num_envs)]
         obs, info = self._start(seeds)
         return obs, masked(info, self.num_envs)
 
@@ -223,7 +224,7 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
             raise gymnasium.error.ResetNeeded(f"call reset() before step(): {why}")
         a = np.asarray(actions, dtype=np.float64)
         acted = self.single.acted
-        if a.size != n * len(acted) or (a.ndim == 2 and a.shape != (n, len(acted))):
+        if a.shape != (n, len(acted)) and a.shape != (n * len(acted),):
             # said as the single env says it, not as numpy's reshape would
             raise ValueError(f"expected actions of shape ({n}, {len(acted)}), got {a.shape}")
         a = a.reshape(n, len(acted))
@@ -274,7 +275,10 @@ class FollowVecEnv(gymnasium.vector.VectorEnv):
         }
 
     def close_extras(self, **kwargs: Any) -> None:
-        """Stop the episodes in progress (the batch's greenlet, or the single envs')."""
+        """Stop the episodes in progress (the batch's greenlet, or the single envs'). The env
+        then holds none: a step before the next reset says to reset (it said a run had
+        faulted)."""
         if self._episode is not None:
             self._episode.close()
+        self._episode = None
         self._guard.hold(None)

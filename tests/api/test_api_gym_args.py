@@ -79,6 +79,18 @@ API_CASES: dict[str, tuple[Callable[[], Any], str]] = {
         lambda: ap.run({"world": "w.yaml", "duration": 5, "set": {"A.b": _shared()}}),
         "<mapping>: too large: more than 500,000 values",
     ),
+    "adapt-text": (  # a true string: the rules stayed on
+        lambda: ap.run(SCENARIO, adapt="no"),
+        "adapt=: expected True or False, got 'no'",
+    ),
+    "load-adapt-text": (
+        lambda: ap.load(SCENARIO, adapt="off"),
+        "adapt=: expected True or False, got 'off'",
+    ),
+    "progress-text": (
+        lambda: ap.run(SCENARIO, progress="yes"),
+        "progress=: expected True or False, got 'yes'",
+    ),
     "seed-2**64": (lambda: ap.run(SCENARIO, seed=2**64), "seed=: " + SEED_RANGE + str(2**64)),
     "duration-nan": (
         lambda: ap.run(SCENARIO, duration=math.nan),
@@ -207,6 +219,10 @@ ENV_CASES: dict[str, tuple[Callable[[], Any], str]] = {
         "set=: expected a mapping like {\"Comp.param\": value}, got list ['a=b'] "
         '(the command line\'s "Comp.param=value" is {"Comp.param": value} here)',
     ),
+    "record-trace-text": (
+        lambda: _env(record_trace="no"),
+        "record_trace: expected True or False, got 'no'",
+    ),
     "reset-seed-2**64": (lambda: _reset({}, seed=2**64), "seed: " + SEED_RANGE + str(2**64)),
     "reset-seed-2**63": (lambda: _reset({}, seed=2**63), "seed: " + SEED_RANGE + str(2**63)),
     "reset-seed-negative": (lambda: _reset({}, seed=-1), "seed: " + SEED_RANGE + "-1"),
@@ -254,3 +270,11 @@ def test_env_keeping_a_trace_longer_than_memory_is_refused_at_reset() -> None:
         assert info["t"] == 0.0
     finally:
         env.close()
+
+
+def test_api_switches_take_true_false_and_numpys_bool() -> None:
+    import numpy as np
+
+    assert ap.load(SCENARIO, adapt=np.bool_(False)).adapt == ()
+    run = ap.run(SCENARIO, duration=1, adapt=False, progress=np.bool_(False))
+    assert run.status == "completed"

@@ -69,3 +69,44 @@ def test_a_faulted_single_episode_says_why_it_refuses_the_next_step() -> None:
     env.reset(seed=1)  # a new episode steps again
     env.step(np.zeros(2))
     env.close()
+
+
+def test_a_step_before_any_reset_says_only_to_reset() -> None:
+    """A fresh env, or one unpickled from a stepped one (its wrappers think it was reset),
+    said "the episode has ended" of an episode that never began."""
+    import pickle
+
+    env = gymnasium.make("amsa_phys/Follow-v0", scenario=SCENARIO1, duration=5)
+    env.reset(seed=1)
+    env.step(np.zeros(2))
+    copy = pickle.loads(pickle.dumps(env))
+    for fresh in (FollowEnv(SCENARIO1, duration=5), copy):
+        with pytest.raises(gymnasium.error.ResetNeeded) as caught:
+            fresh.step(np.zeros(2))
+        assert str(caught.value) == "call reset() before step()"
+        fresh.close()
+    env.close()
+
+
+def test_a_refused_first_reset_and_the_way_out_the_manual_gives() -> None:
+    """Gymnasium's passive checker breaks every step of a made env whose first reset
+    raised; the manual says so and gives the way out. When Gymnasium fixes it, the first
+    half fails: drop the manual's paragraph then."""
+    import amsa_phys as ap
+
+    env = gymnasium.make("amsa_phys/Follow-v0", scenario=SCENARIO1, duration=5)
+    with pytest.raises(ap.ConfigError):
+        env.reset(seed=-1)
+    env.reset(seed=1)
+    with pytest.raises(TypeError, match="cannot unpack non-iterable NoneType"):
+        env.step(np.zeros(2))
+    env.close()
+    kept = gymnasium.make(
+        "amsa_phys/Follow-v0", scenario=SCENARIO1, duration=5, disable_env_checker=True
+    )
+    with pytest.raises(ap.ConfigError):
+        kept.reset(seed=-1)
+    kept.reset(seed=1)
+    _, reward, *_ = kept.step(np.zeros(2))
+    assert np.isfinite(reward)
+    kept.close()
