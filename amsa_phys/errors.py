@@ -84,6 +84,8 @@ API_WORDS = {
     "--bag": "bag=",
     "--out": "out=",
     "--force": "force=True",
+    "--ros2": "ros2=",
+    "--ros2-timeout": "ros2_timeout=",
 }
 _API_FLAG = re.compile(r"(?<![\w-])(" + "|".join(map(re.escape, API_WORDS)) + r")(?![\w-])")
 

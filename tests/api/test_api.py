@@ -166,6 +166,12 @@ CLI_ERRORS = [
     (["--log-rate", "0"], {"log_rate": 0}, "log_rate="),
     (["--seed", "-1"], {"seed": -1}, "seed="),
     (["--trace-columns", "Nobody.*"], {"trace_columns": "Nobody.*"}, "trace_columns="),
+    (["--ros2", "Nobody"], {"ros2": "Nobody"}, "ros2="),
+    (
+        ["--ros2", "MyFollowerController", "--ros2-timeout", "-1.5"],
+        {"ros2": "MyFollowerController", "ros2_timeout": -1.5},
+        "ros2_timeout=",
+    ),
 ]
 
 
@@ -182,6 +188,8 @@ CLI_ERRORS = [
         "log-rate",
         "seed",
         "trace-columns",
+        "ros2",
+        "ros2-timeout",
     ],
 )
 def test_errors_are_the_cli_messages_naming_the_api_argument(
@@ -200,7 +208,7 @@ def test_errors_are_the_cli_messages_naming_the_api_argument(
         ap.run(SCENARIO2, **kwargs)  # type: ignore[arg-type]
     api = str(err.value)
     assert err.value.exit_code == 2
-    flag = argv[0] + (" " + argv[1].partition("=")[0] if argv[0] == "--set" else "")
+    flag = argv[-2] + (" " + argv[-1].partition("=")[0] if argv[-2] == "--set" else "")
     assert cli.startswith(f"error: {flag}: "), cli
     reason = cli.removeprefix(f"error: {flag}: ")
     assert api == f"{argument}: {reason}"
