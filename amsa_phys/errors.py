@@ -87,6 +87,11 @@ API_WORDS = {
     "--ros2": "ros2=",
     "--ros2-timeout": "ros2_timeout=",
 }
+#: keys only (a message's "give its values with --grid" stays as the command says it):
+#: ``amsa_phys.falsify``'s box of ranges and grids
+_API_KEYS = {**API_WORDS, "--range": "box=", "--grid": "box="}
+#: the flags whose key names a ``Comp.param`` the API passes as a mapping's key
+_API_MAPPINGS = ("--set", "--range", "--grid")
 _API_FLAG = re.compile(r"(?<![\w-])(" + "|".join(map(re.escape, API_WORDS)) + r")(?![\w-])")
 
 
@@ -95,12 +100,12 @@ def _api_key(key: str | None) -> str | None:
     if not key or not key.startswith("--"):
         return key
     flag, _, rest = key.partition(" ")
-    word = API_WORDS.get(flag)
+    word = _API_KEYS.get(flag)
     if word is None:  # an option the API does not have: as the CLI says it
         return key
     if not rest:
         return word
-    if flag == "--set":
+    if flag in _API_MAPPINGS:
         quoted = rest.replace("\\", "\\\\").replace('"', '\\"')
         return f'{word}{{"{quoted}": ...}}'  # as the user wrote it: set={"Comp.param": value}
     return f"{word} {rest}"

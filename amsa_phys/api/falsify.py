@@ -122,7 +122,10 @@ def falsify(
     path = Path(scenario).resolve()
     sc = load_scenario(path)
     ranges, grids = _box(box)
-    space = build_space(sc, ranges, grids)
+    try:
+        space = build_space(sc, ranges, grids)
+    except ConfigError as exc:  # said as the command line says it: named as passed here
+        raise exc.worded_for_api() from None
     end = duration if duration is not None else float(sc.duration)
     n_phases = len(sc.timeline.phases_before(end))
     check_metric(metric, n_phases)

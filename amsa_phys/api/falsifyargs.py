@@ -73,6 +73,12 @@ def check_arguments(
             f"got {short_repr(box)}",
             key="box=",
         )
+    if not box:
+        raise ConfigError(
+            'nothing to search: give at least one {"Comp.param": (lo, hi)} or '
+            '{"Comp.param": [a, b, ...]}',
+            key="box=",
+        )
     for key, spec in box.items():
         if isinstance(spec, tuple) and len(spec) == 2:
             for bound in spec:

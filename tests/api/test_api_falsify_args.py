@@ -41,6 +41,15 @@ CASES: dict[str, tuple[dict[str, Any], str]] = {
         {"box": {"Leader.changePeriod": ("a", "b")}},
         'box={"Leader.changePeriod": ...}: a range\'s bounds must be finite numbers',
     ),
+    "box-empty": ({"box": {}}, "box=: nothing to search: give at least one"),
+    "box-unknown-component": (
+        {"box": {"Nobody.x": (0, 1)}},
+        "box={\"Nobody.x\": ...}: unknown component 'Nobody'",
+    ),
+    "box-bounds-reversed": (
+        {"box": {"Leader.changePeriod": (40, 2)}},
+        'box={"Leader.changePeriod": ...}: the lower bound 40 must be below the upper bound 2',
+    ),
     "executor-dask": ({"executor": "dask"}, "executor=: expected one of batch, local"),
     "workers-zero": ({"workers": 0}, "workers=: must be an integer >= 1, got 0"),
     "cost-not-callable": ({"cost": 3}, "cost=: expected a function of a result row, got 3"),
