@@ -6,6 +6,7 @@ ended (``duration=1e9``), or the whole budget spent on a misspelt metric."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -90,3 +91,11 @@ def test_right_arguments_still_search(tmp_path: Path) -> None:
     found = ap.falsify(SCENARIO, BOX, budget=2, metric="phase0.rms_error", duration=4, workers=1)
     assert found.summary["objective"] == "phase0.rms_error"
     assert len(found.rows[0]) == 2
+
+
+def test_a_cost_of_nan_counts_as_the_worst_and_falsifies() -> None:
+    """As the falsification page says: a cost function that gives NaN (a metric it divides
+    by zero, say) is judged as a faulted run is, the worst there is."""
+    found = ap.falsify(SCENARIO, BOX, budget=2, duration=4, cost=lambda row: math.nan)
+    assert found.falsified
+    assert found.trials[0].simulations == 1  # stopped at the first run
