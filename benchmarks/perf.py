@@ -201,7 +201,8 @@ def startup(reps: int) -> None:
 
 
 def gym_env(reps: int) -> None:
-    """Steps a second of ``amsa_phys/Follow-v0`` (scenario1, constant action)."""
+    """Env-steps a second of ``amsa_phys/Follow-v0`` on scenario1 cut to 300 s episodes, a
+    constant half-power action, each episode run to its end."""
     import numpy as np
 
     from amsa_phys.gym import FollowEnv
