@@ -46,5 +46,5 @@ class FrameSource:
         frame = self.frame
         self.camera.update([(r.x, r.y, r.name) for r in frame.rovers], frame.t - self._last_t)
         self._last_t = frame.t
-        self.renderer.draw(self.surface, frame, self.camera, status)
+        self.renderer.draw_under_boxes(self.surface, frame, self.camera, status)
         return np.ascontiguousarray(pygame.surfarray.array3d(self.surface).transpose(1, 0, 2))

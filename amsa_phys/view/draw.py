@@ -102,6 +102,22 @@ class Renderer:
         #: the distance labels of the last frame (names are placed clear of them)
         self._distance_labels: list[pygame.Rect] = []
 
+    def draw_under_boxes(
+        self, surface: pygame.Surface, frame: Frame, camera: Camera, status: Sequence[str] = ()
+    ) -> None:
+        """:meth:`draw`, the rovers framed in the room under the HUD and status boxes, as the
+        window and ``view`` frame them: known once drawn, so when the boxes moved the
+        camera's room the frame is drawn again in it (a small frame's status box sat on
+        the leader)."""
+        points = [(r.x, r.y, r.name) for r in frame.rovers]
+        for _ in range(2):
+            room = camera.top
+            self.draw(surface, frame, camera, status)
+            camera.top = max(box.bottom for box in self.boxes.values()) + 6
+            if camera.top == room:
+                break
+            camera.update(points, 0.0)  # no glide: only keeps every rover in the new room
+
     def draw(
         self,
         surface: pygame.Surface,

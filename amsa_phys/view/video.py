@@ -83,7 +83,7 @@ class Recorder:
         surface = self.surfaces[k % 2]
         frame = self.scene.frame(t=float(t))
         self.camera.update([(r.x, r.y, r.name) for r in frame.rovers], float(self.period))
-        self.renderer.draw(surface, frame, self.camera, self._status)
+        self.renderer.draw_under_boxes(surface, frame, self.camera, self._status)
         self.encoder.submit(surface.get_view("0"))
         self.index += 1
         self.scene.expect(float(self.period * self.index))
@@ -138,7 +138,7 @@ class Snapshot:
         camera = Camera(size)
         camera.update([(r.x, r.y, r.name) for r in frame.rovers], 0.0)
         surface = new_surface(size)
-        Renderer(size).draw(surface, frame, camera)
+        Renderer(size).draw_under_boxes(surface, frame, camera)
         path = self.options.path
         png = io.BytesIO()  # encoded in memory: a full disk cannot leave half a picture
         pygame.image.save(surface, png, "png")

@@ -176,6 +176,27 @@ def test_renders_with_the_projects_renderer() -> None:
     assert FollowEnv(SCENARIO1, duration=5).render() is None  # render_mode=None
 
 
+def test_a_small_frame_shows_the_rovers_under_its_text_boxes() -> None:
+    """At 320x200 the status box (``agent: ...``) goes under the HUD, over the middle of
+    the frame, where the camera put the rovers: the leader was drawn behind it. The rovers
+    are framed in the room the boxes leave, as in the window."""
+    env = FollowEnv(render_mode="rgb_array", render_size=(320, 200))
+    env.reset(seed=1)
+    for _ in range(30):
+        env.step(np.array([0.5, 0.5]))
+    frame = env.render()
+    assert frame is not None
+    source = env.unwrapped._frames
+    below = max(box.bottom for box in source.renderer.boxes.values())
+    assert below > 200 // 3  # the boxes do reach the middle at this size
+    for rover in source.frame.rovers:
+        x, y = source.camera.to_screen(rover.x, rover.y)
+        assert below < y < 200, (rover.name, y, below)
+    colours = {tuple(c) for c in frame.reshape(-1, 3)}
+    assert (230, 120, 30) in colours  # the leader is seen
+    env.close()
+
+
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
