@@ -190,7 +190,7 @@ def test_a_small_frame_shows_the_rovers_under_its_text_boxes() -> None:
     below = max(box.bottom for box in source.renderer.boxes.values())
     assert below > 200 // 3  # the boxes do reach the middle at this size
     for rover in source.frame.rovers:
-        x, y = source.camera.to_screen(rover.x, rover.y)
+        _, y = source.camera.to_screen(rover.x, rover.y)
         assert below < y < 200, (rover.name, y, below)
     colours = {tuple(c) for c in frame.reshape(-1, 3)}
     assert (230, 120, 30) in colours  # the leader is seen
