@@ -24,6 +24,7 @@ _LAZY = {
     "TraceSizeWarning": ".api.memory",
     "OverrideWarning": ".runs.overrides",
     "ReferenceWarning": ".runs.references",
+    "SearchWarning": ".api.falsify",
     "load": ".api.source",
     "falsify": ".api.falsify",
     "validate": ".api.source",
@@ -48,6 +49,7 @@ __all__ = [  # noqa: RUF022  grouped as the README lists them
     "TraceSizeWarning",
     "OverrideWarning",
     "ReferenceWarning",
+    "SearchWarning",
     "load",
     "validate",
     "falsify",
@@ -66,7 +68,7 @@ __all__ = [  # noqa: RUF022  grouped as the README lists them
 ]
 
 if TYPE_CHECKING:  # for type checkers and editors: the same names, imported eagerly
-    from .api.falsify import falsify
+    from .api.falsify import SearchWarning, falsify
     from .api.memory import TraceSizeWarning
     from .api.result import Run, run
     from .api.source import load, validate

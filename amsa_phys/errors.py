@@ -67,7 +67,7 @@ class ConfigError(AmsaError):
             where = self.file + (f":{self.line}" if self.line is not None else "") + ": "
         key, message = self.key, self.message
         if self.front == "api":
-            key, message = _api_key(key), _API_FLAG.sub(lambda m: API_WORDS[m[0]], message)
+            key, message = _api_key(key), api_text(message)
         key = f"{key}: " if key else ""
         return one_line(f"{where}{key}{message}")
 
@@ -86,6 +86,8 @@ API_WORDS = {
     "--force": "force=True",
     "--ros2": "ros2=",
     "--ros2-timeout": "ros2_timeout=",
+    "--search-on": "search_on=True",  # ``amsa_phys.falsify``'s
+    "--requirement": "requirement=",
 }
 #: keys only (a message's "give its values with --grid" stays as the command says it):
 #: ``amsa_phys.falsify``'s box of ranges and grids
@@ -93,6 +95,12 @@ _API_KEYS = {**API_WORDS, "--range": "box=", "--grid": "box="}
 #: the flags whose key names a ``Comp.param`` the API passes as a mapping's key
 _API_MAPPINGS = ("--set", "--range", "--grid")
 _API_FLAG = re.compile(r"(?<![\w-])(" + "|".join(map(re.escape, API_WORDS)) + r")(?![\w-])")
+
+
+def api_text(text: str) -> str:
+    """``text`` (an error's or a warning's) with each CLI option the API has spelt as the
+    API's argument (``--set`` -> ``set=``)."""
+    return _API_FLAG.sub(lambda m: API_WORDS[m[0]], text)
 
 
 def _api_key(key: str | None) -> str | None:

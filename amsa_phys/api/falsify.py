@@ -11,12 +11,14 @@ from __future__ import annotations
 import math
 import os
 import time
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import ConfigError
+from ..errors import ConfigError, api_text
+from ..falsify.advice import search_warnings
 from ..falsify.objective import (
     Objective,
     Verdict,
@@ -31,6 +33,12 @@ from ..model.scenario import load_scenario
 from .falsifyargs import check_arguments, check_metric
 
 Cost = Callable[[dict[str, Any]], float]
+
+
+class SearchWarning(UserWarning):
+    """A search that will spend its budget on less than was likely meant (a requirement
+    whose windows the runs cut, ``search_on=True`` without a requirement, an axis the
+    scenario's timeline sets again): ``amsa-phys falsify``'s ``warning:`` lines."""
 
 
 @dataclass(frozen=True)
@@ -130,12 +138,15 @@ def falsify(
     n_phases = len(sc.timeline.phases_before(end))
     check_metric(metric, n_phases)
     objective: Objective
+    said: list[str] = []  # the objective's own warnings (a metric of a cut phase, ...)
     if cost is not None:
         objective = CostObjective(None, (), ("cost",), cost)
     elif requirement is not None:
         objective = requirement_objective(list(sc.expect), requirement, "requirement")
     else:
-        objective, _ = build_objective(list(sc.expect), metric, False, n_phases)
+        objective, said = build_objective(list(sc.expect), metric, False, n_phases)
+    for text in [*said, *search_warnings(sc, objective, space, end, search_on)]:
+        warnings.warn(api_text(text), SearchWarning, stacklevel=2)
     stop = objective.falsifies and not search_on
     all_rows, outcomes, worst, worst_score = [], [], None, math.inf
     for k in range(trials):

@@ -8,7 +8,6 @@ import json
 import math
 import resource
 import sys
-from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +15,7 @@ from ..atomic import write_atomic
 from ..engine import interrupt
 from ..errors import ConfigError, Interrupted, one_line
 from ..falsify import counterexample
+from ..falsify.advice import search_warnings
 from ..falsify.objective import Objective, build_objective, requirement_objective
 from ..falsify.outputs import describe_value, headline, write_results, write_worst
 from ..falsify.resume import (
@@ -35,8 +35,7 @@ from ..model.wording import plural
 from ..requirements.objective import requirement_of
 from ..runs.rundir import default_run_dir, run_dir_for
 from ..runs.suite import input_files
-from ..runs.sweep import MAX_RUNS, timeline_overlaps, unknown_metric
-from ..stl.requirement import cut_windows
+from ..runs.sweep import MAX_RUNS, unknown_metric
 from .options import add_jobs
 from .progress import bar as progress_bar
 
@@ -156,15 +155,7 @@ def run(args: argparse.Namespace) -> int:
     end = args.duration if args.duration is not None else float(scenario.duration)
     n_phases = len(scenario.timeline.phases_before(end))
     objective, warnings = _objective(args, scenario, n_phases)
-    for name, until in cut_windows(scenario.expect, end, objective.requirements):
-        warnings.append(  # a window cut by a shorter run judges fewer samples
-            f"the requirement {name} reads until t={until:g} s: runs of {end:g} s cut its "
-            "windows, so its robustness judges only what they log"
-        )
-    if args.search_on and not objective.falsifies:
-        warnings.append("--search-on only matters with --requirement: the whole budget is spent")
-    keys = [d.key for d in space.dims]
-    warnings += timeline_overlaps(keys, scenario, Fraction(str(end)))
+    warnings += search_warnings(scenario, objective, space, end, args.search_on)
     for warning in warnings:
         print(one_line(f"warning: {warning}"), file=sys.stderr)
     name = Path(args.scenario).stem

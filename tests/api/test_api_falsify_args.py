@@ -99,3 +99,13 @@ def test_a_cost_of_nan_counts_as_the_worst_and_falsifies() -> None:
     found = ap.falsify(SCENARIO, BOX, budget=2, duration=4, cost=lambda row: math.nan)
     assert found.falsified
     assert found.trials[0].simulations == 1  # stopped at the first run
+
+
+def test_the_commands_warnings_are_search_warnings_worded_for_python() -> None:
+    """The command prints them on ``warning:`` lines; ``ap.falsify`` dropped them all (a
+    cut requirement window, ``search_on`` without a requirement, a timeline axis)."""
+    with pytest.warns(ap.SearchWarning) as said:
+        ap.falsify(SCENARIO, BOX, budget=2, duration=4, search_on=True)
+    texts = [str(w.message) for w in said if issubclass(w.category, ap.SearchWarning)]
+    assert "search_on=True only matters with requirement=: the whole budget is spent" in texts
+    assert not any("--" in t for t in texts)
