@@ -10,7 +10,7 @@ and it forgets what it estimated. At exit it prints how many runs and steps it s
 ``never`` (never answers), ``late`` (answers the 20th step after 3 s), ``nan``, ``wrongtype``
 (publishes LeftPower as Float32), ``besteffort`` (publishes LeftPower BEST_EFFORT: a QoS the
 contract's RELIABLE subscription never matches), ``die`` (exits at the 20th step), ``refuse``
-(refuses Kv below 0.1).
+(refuses Kv below 0.1), ``undeclared`` (never declares Kw).
 """
 
 from __future__ import annotations
@@ -63,7 +63,8 @@ class Follower(Node):
         super().__init__("MyFollowerController")
         self.mode = mode
         for name, default in PARAMS.items():
-            self.declare_parameter(name, default)
+            if not (mode == "undeclared" and name == "Kw"):
+                self.declare_parameter(name, default)
         self.add_on_set_parameters_callback(self.on_params)
         self.fresh: dict[str, float] = {}
         self.t: Fraction | None = None

@@ -185,8 +185,7 @@ class Bridge:
             )
         for (name, value), result in zip(values.items(), future.result().results, strict=False):
             if not result.successful:
-                why = result.reason or "refused"
-                raise self._fault(leaf, f"refused parameter {name}={value!r} ({why})")
+                raise self._fault(leaf, _refusal(name, value, result.reason))
         self.counts[leaf.path]["params_set"] += len(values)
 
     def _call(self, client: Any, req: Any) -> Any:
@@ -389,6 +388,18 @@ def _param_value(value: Any) -> Any:
                 flat.append(float(v))
         return flat
     return value
+
+
+def _refusal(name: str, value: Any, reason: str) -> str:
+    """What the fault line says of a refused parameter. A parameter the node never declared
+    is refused by rclpy with a reason that names none (``Invalid access to undeclared
+    parameter(s): []``), so the line names it and says what to do."""
+    if "undeclared" in reason or "not declared" in reason:
+        return (
+            f"refused parameter {name}={value!r}: the node has not declared {name} "
+            "(declare every parameter describe --ros2 lists, with its type)"
+        )
+    return f"refused parameter {name}={value!r} ({reason or 'refused'})"
 
 
 def _parameter(name: str, value: Any) -> Any:
