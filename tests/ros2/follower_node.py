@@ -10,7 +10,8 @@ and it forgets what it estimated. At exit it prints how many runs and steps it s
 ``never`` (never answers), ``late`` (answers the 20th step after 3 s), ``nan``, ``wrongtype``
 (publishes LeftPower as Float32), ``besteffort`` (publishes LeftPower BEST_EFFORT: a QoS the
 contract's RELIABLE subscription never matches), ``die`` (exits at the 20th step), ``refuse``
-(refuses Kv below 0.1), ``undeclared`` (never declares Kw).
+(refuses Kv below 0.1), ``undeclared`` (never declares Kw), ``relative`` (publishes its outputs
+on relative names, ``LeftPower``: ``/LeftPower``, not the node's own).
 """
 
 from __future__ import annotations
@@ -80,9 +81,10 @@ class Follower(Node):
         left_qos = QOS
         if mode == "besteffort":
             left_qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
-        self.left = self.create_publisher(left_type, "/MyFollowerController/LeftPower", left_qos)
-        self.right = self.create_publisher(Float64, "/MyFollowerController/RightPower", QOS)
-        self.speed = self.create_publisher(Float64, "/MyFollowerController/leaderSpeed", QOS)
+        at = "" if mode == "relative" else "/MyFollowerController/"
+        self.left = self.create_publisher(left_type, f"{at}LeftPower", left_qos)
+        self.right = self.create_publisher(Float64, f"{at}RightPower", QOS)
+        self.speed = self.create_publisher(Float64, f"{at}leaderSpeed", QOS)
 
     def on_params(self, params: list) -> SetParametersResult:
         for p in params:

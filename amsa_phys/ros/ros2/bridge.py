@@ -40,6 +40,8 @@ from . import env, notice
 _LOOK_S = 0.2
 #: How long a service request waits for its answer before it is sent again (``_call``).
 _RESEND_S = 1.0
+#: Topics every rclpy node has of its own, left out of what a node is said to use.
+_ROS_OWN_TOPICS = frozenset({"/rosout", "/parameter_events"})
 
 
 class NodeFault(RunFault):
@@ -146,12 +148,33 @@ class Bridge:
             self._check_qos(leaf)
             self._check_watch(leaf)
             if time.monotonic() >= deadline:
-                raise self._fault(
-                    leaf,
-                    f"{missing} within {wait:g} s: is the node {leaf.node} running "
-                    f"(ROS_DOMAIN_ID, the node's name)?",
-                )
+                hint = self._where(leaf, missing)
+                raise self._fault(leaf, f"{missing} within {wait:g} s: {hint}")
             self.executor.spin_once(timeout_sec=0.05)
+
+    def _where(self, leaf: Wiring, missing: str) -> str:
+        """What to look at when the node did not connect (``missing``: what ``_missing``
+        said). A node on the graph under the Leaf's name is running: what it publishes or
+        subscribes to is then the lead (outputs on relative names, ``/LeftPower``, are a
+        common slip), not its domain or its name."""
+        ns, _, name = leaf.node.rpartition("/")
+        ns = ns or "/"
+        if not any((n, s) == (name, ns) for n, s in self.node.get_node_names_and_namespaces()):
+            return f"is the node {leaf.node} running (ROS_DOMAIN_ID, the node's name)?"
+        if missing.startswith("no publisher"):
+            what, found = "publishes", self.node.get_publisher_names_and_types_by_node(name, ns)
+        elif missing.startswith("no subscriber"):
+            what, found = (
+                "subscribes to",
+                self.node.get_subscriber_names_and_types_by_node(name, ns),
+            )
+        else:
+            return f"the node {leaf.node} is running without it"
+        own = sorted(t for t, _ in found if t not in _ROS_OWN_TOPICS)
+        return (
+            f"the node {leaf.node} is running but {what} {', '.join(own) or 'nothing'} "
+            "(describe --ros2 lists the topics to use)"
+        )
 
     def _missing(self, leaf: Wiring) -> str | None:
         if self.clock_pub.get_subscription_count() < 1:
