@@ -11,7 +11,8 @@ and it forgets what it estimated. At exit it prints how many runs and steps it s
 (publishes LeftPower as Float32), ``besteffort`` (publishes LeftPower BEST_EFFORT: a QoS the
 contract's RELIABLE subscription never matches), ``die`` (exits at the 20th step), ``refuse``
 (refuses Kv below 0.1), ``undeclared`` (never declares Kw), ``relative`` (publishes its outputs
-on relative names, ``LeftPower``: ``/LeftPower``, not the node's own).
+on relative names, ``LeftPower``: ``/LeftPower``, not the node's own), ``mute`` (its
+``set_parameters`` service never answers: the callback blocks).
 """
 
 from __future__ import annotations
@@ -87,6 +88,8 @@ class Follower(Node):
         self.speed = self.create_publisher(Float64, f"{at}leaderSpeed", QOS)
 
     def on_params(self, params: list) -> SetParametersResult:
+        while self.mode == "mute":  # the test kills the node
+            time.sleep(1.0)
         for p in params:
             if self.mode == "refuse" and p.name == "Kv" and p.value < 0.1:
                 return SetParametersResult(successful=False, reason="Kv below 0.1")

@@ -27,6 +27,7 @@ from collections.abc import Callable, Mapping, Sequence
 from fractions import Fraction
 from typing import Any
 
+from ...engine import interrupt
 from ...engine.runner import Simulation
 from ...errors import RunFault
 from ...model.scenario import Scenario
@@ -144,6 +145,10 @@ class Bridge:
             missing = self._missing(leaf)
             if missing is None:
                 return
+            # a Ctrl-C now is the user's (the node they forgot to start, say): the run only
+            # notes it (engine/interrupt.py) and nothing steps yet, so act on it here, not a
+            # minute later with the start fault
+            interrupt.check()
             self._check_types(leaf)
             self._check_qos(leaf)
             self._check_watch(leaf)
@@ -193,15 +198,18 @@ class Bridge:
         return None
 
     # -- parameters -----------------------------------------------------------------------
-    def set_params(self, leaf: Wiring, values: Mapping[str, Any]) -> None:
-        """Set the node's parameters through its service; a refusal is the run's fault."""
+    def set_params(self, leaf: Wiring, values: Mapping[str, Any], start: bool = False) -> None:
+        """Set the node's parameters through its service; a refusal is the run's fault.
+
+        ``start``: before the first step, where a Ctrl-C may end the wait at once (mid-run,
+        between the instant's other steps, the run's own grace period handles it)."""
         if not values:
             return
         from rcl_interfaces.srv import SetParameters
 
         req = SetParameters.Request()
         req.parameters = [_parameter(k, v).to_parameter_msg() for k, v in values.items()]
-        future = self._call(self.clients[leaf.path], req)
+        future = self._call(self.clients[leaf.path], req, start)
         if future is None:
             raise self._fault(
                 leaf, f"{leaf.set_parameters} did not answer within {self.timeout_s:g} s"
@@ -211,7 +219,7 @@ class Bridge:
                 raise self._fault(leaf, _refusal(name, value, result.reason))
         self.counts[leaf.path]["params_set"] += len(values)
 
-    def _call(self, client: Any, req: Any) -> Any:
+    def _call(self, client: Any, req: Any, interruptible: bool = False) -> Any:
         """The first answer to ``req``, sent again every :data:`_RESEND_S` until one comes
         (None after the timeout). A service's first answer can be lost while the discovery
         of the client's reply reader is still under way (a DDS race: the node answered, the
@@ -220,6 +228,8 @@ class Bridge:
         sent: list[Any] = []
         answered = None
         while answered is None:
+            if interruptible:  # as in connect: a node that does not answer is waited for
+                interrupt.check()
             now = time.monotonic()
             if now >= deadline:
                 break
@@ -457,7 +467,9 @@ class ExternalLeaf:
         """Wait for the node, then give it every parameter's value."""
         self._bridge.connect(self._wiring)
         self._bridge.set_params(
-            self._wiring, {p.name: getattr(self._comp.p, p.name) for p in self._wiring.params}
+            self._wiring,
+            {p.name: getattr(self._comp.p, p.name) for p in self._wiring.params},
+            start=True,
         )
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:
