@@ -10,7 +10,9 @@ and it forgets what it estimated. At exit it prints how many runs and steps it s
 ``never`` (never answers), ``late`` (answers the 20th step after 3 s), ``nan``, ``wrongtype``
 (publishes LeftPower as Float32), ``besteffort`` (publishes LeftPower BEST_EFFORT: a QoS the
 contract's RELIABLE subscription never matches), ``die`` (exits at the 20th step), ``refuse``
-(refuses Kv below 0.1).
+(refuses Kv below 0.1), ``undeclared`` (never declares Kw), ``relative`` (publishes its outputs
+on relative names, ``LeftPower``: ``/LeftPower``, not the node's own), ``mute`` (its
+``set_parameters`` service never answers: the callback blocks).
 """
 
 from __future__ import annotations
@@ -63,7 +65,8 @@ class Follower(Node):
         super().__init__("MyFollowerController")
         self.mode = mode
         for name, default in PARAMS.items():
-            self.declare_parameter(name, default)
+            if not (mode == "undeclared" and name == "Kw"):
+                self.declare_parameter(name, default)
         self.add_on_set_parameters_callback(self.on_params)
         self.fresh: dict[str, float] = {}
         self.t: Fraction | None = None
@@ -79,11 +82,14 @@ class Follower(Node):
         left_qos = QOS
         if mode == "besteffort":
             left_qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
-        self.left = self.create_publisher(left_type, "/MyFollowerController/LeftPower", left_qos)
-        self.right = self.create_publisher(Float64, "/MyFollowerController/RightPower", QOS)
-        self.speed = self.create_publisher(Float64, "/MyFollowerController/leaderSpeed", QOS)
+        at = "" if mode == "relative" else "/MyFollowerController/"
+        self.left = self.create_publisher(left_type, f"{at}LeftPower", left_qos)
+        self.right = self.create_publisher(Float64, f"{at}RightPower", QOS)
+        self.speed = self.create_publisher(Float64, f"{at}leaderSpeed", QOS)
 
     def on_params(self, params: list) -> SetParametersResult:
+        while self.mode == "mute":  # the test kills the node
+            time.sleep(1.0)
         for p in params:
             if self.mode == "refuse" and p.name == "Kv" and p.value < 0.1:
                 return SetParametersResult(successful=False, reason="Kv below 0.1")

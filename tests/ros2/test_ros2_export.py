@@ -39,8 +39,14 @@ def in_netns(tmp: Path, body: str) -> tuple[int, str, list[int]]:
     ("name", "duration"),
     # the adaptive demonstration to 360 s: its leader rule and its worn-motor rule have both
     # switched Kv by then (the suite's time; the rest of the run adds no new kind of step)
-    [("scenario1", []), ("adaptive", ["--duration", "360"])],
-    ids=["scenario1", "adaptive"],
+    # the obstacle course: a lidar's array port, and an IMU whose optional pose inputs stay
+    # unwired (its node must step without them, as the run does: a few seconds show it)
+    [
+        ("scenario1", []),
+        ("adaptive", ["--duration", "360"]),
+        ("obstacle_course", ["--duration", "5"]),
+    ],
+    ids=["scenario1", "adaptive", "obstacle_course"],
 )
 def test_lockstep_of_the_exported_package_is_the_run_byte_for_byte(
     tmp_path: Path, name: str, duration: list[str]

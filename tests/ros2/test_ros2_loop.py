@@ -102,6 +102,12 @@ FAULTS = {
     ),
     "die": ("/MyFollowerController/", True),
     "refuse": ("refused parameter Kv=0.05 (Kv below 0.1)", False),
+    # rclpy's own reason names no parameter ("undeclared parameter(s): []"): the line does
+    "undeclared": (
+        "refused parameter Kw=0.04: the node has not declared Kw (declare every parameter "
+        "describe --ros2 lists, with its type)",
+        False,
+    ),
 }
 
 

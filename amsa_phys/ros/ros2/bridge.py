@@ -27,6 +27,7 @@ from collections.abc import Callable, Mapping, Sequence
 from fractions import Fraction
 from typing import Any
 
+from ...engine import interrupt
 from ...engine.runner import Simulation
 from ...errors import RunFault
 from ...model.scenario import Scenario
@@ -40,6 +41,8 @@ from . import env, notice
 _LOOK_S = 0.2
 #: How long a service request waits for its answer before it is sent again (``_call``).
 _RESEND_S = 1.0
+#: Topics every rclpy node has of its own, left out of what a node is said to use.
+_ROS_OWN_TOPICS = frozenset({"/rosout", "/parameter_events"})
 
 
 class NodeFault(RunFault):
@@ -142,16 +145,41 @@ class Bridge:
             missing = self._missing(leaf)
             if missing is None:
                 return
+            # a Ctrl-C now is the user's (the node they forgot to start, say): the run only
+            # notes it (engine/interrupt.py) and nothing steps yet, so act on it here, not a
+            # minute later with the start fault
+            interrupt.check()
             self._check_types(leaf)
             self._check_qos(leaf)
             self._check_watch(leaf)
             if time.monotonic() >= deadline:
-                raise self._fault(
-                    leaf,
-                    f"{missing} within {wait:g} s: is the node {leaf.node} running "
-                    f"(ROS_DOMAIN_ID, the node's name)?",
-                )
+                hint = self._where(leaf, missing)
+                raise self._fault(leaf, f"{missing} within {wait:g} s: {hint}")
             self.executor.spin_once(timeout_sec=0.05)
+
+    def _where(self, leaf: Wiring, missing: str) -> str:
+        """What to look at when the node did not connect (``missing``: what ``_missing``
+        said). A node on the graph under the Leaf's name is running: what it publishes or
+        subscribes to is then the lead (outputs on relative names, ``/LeftPower``, are a
+        common slip), not its domain or its name."""
+        ns, _, name = leaf.node.rpartition("/")
+        ns = ns or "/"
+        if not any((n, s) == (name, ns) for n, s in self.node.get_node_names_and_namespaces()):
+            return f"is the node {leaf.node} running (ROS_DOMAIN_ID, the node's name)?"
+        if missing.startswith("no publisher"):
+            what, found = "publishes", self.node.get_publisher_names_and_types_by_node(name, ns)
+        elif missing.startswith("no subscriber"):
+            what, found = (
+                "subscribes to",
+                self.node.get_subscriber_names_and_types_by_node(name, ns),
+            )
+        else:
+            return f"the node {leaf.node} is running without it"
+        own = sorted(t for t, _ in found if t not in _ROS_OWN_TOPICS)
+        return (
+            f"the node {leaf.node} is running but {what} {', '.join(own) or 'nothing'} "
+            "(describe --ros2 lists the topics to use)"
+        )
 
     def _missing(self, leaf: Wiring) -> str | None:
         if self.clock_pub.get_subscription_count() < 1:
@@ -170,26 +198,28 @@ class Bridge:
         return None
 
     # -- parameters -----------------------------------------------------------------------
-    def set_params(self, leaf: Wiring, values: Mapping[str, Any]) -> None:
-        """Set the node's parameters through its service; a refusal is the run's fault."""
+    def set_params(self, leaf: Wiring, values: Mapping[str, Any], start: bool = False) -> None:
+        """Set the node's parameters through its service; a refusal is the run's fault.
+
+        ``start``: before the first step, where a Ctrl-C may end the wait at once (mid-run,
+        between the instant's other steps, the run's own grace period handles it)."""
         if not values:
             return
         from rcl_interfaces.srv import SetParameters
 
         req = SetParameters.Request()
         req.parameters = [_parameter(k, v).to_parameter_msg() for k, v in values.items()]
-        future = self._call(self.clients[leaf.path], req)
+        future = self._call(self.clients[leaf.path], req, start)
         if future is None:
             raise self._fault(
                 leaf, f"{leaf.set_parameters} did not answer within {self.timeout_s:g} s"
             )
         for (name, value), result in zip(values.items(), future.result().results, strict=False):
             if not result.successful:
-                why = result.reason or "refused"
-                raise self._fault(leaf, f"refused parameter {name}={value!r} ({why})")
+                raise self._fault(leaf, _refusal(name, value, result.reason))
         self.counts[leaf.path]["params_set"] += len(values)
 
-    def _call(self, client: Any, req: Any) -> Any:
+    def _call(self, client: Any, req: Any, interruptible: bool = False) -> Any:
         """The first answer to ``req``, sent again every :data:`_RESEND_S` until one comes
         (None after the timeout). A service's first answer can be lost while the discovery
         of the client's reply reader is still under way (a DDS race: the node answered, the
@@ -198,6 +228,8 @@ class Bridge:
         sent: list[Any] = []
         answered = None
         while answered is None:
+            if interruptible:  # as in connect: a node that does not answer is waited for
+                interrupt.check()
             now = time.monotonic()
             if now >= deadline:
                 break
@@ -391,6 +423,18 @@ def _param_value(value: Any) -> Any:
     return value
 
 
+def _refusal(name: str, value: Any, reason: str) -> str:
+    """What the fault line says of a refused parameter. A parameter the node never declared
+    is refused by rclpy with a reason that names none (``Invalid access to undeclared
+    parameter(s): []``), so the line names it and says what to do."""
+    if "undeclared" in reason or "not declared" in reason:
+        return (
+            f"refused parameter {name}={value!r}: the node has not declared {name} "
+            "(declare every parameter describe --ros2 lists, with its type)"
+        )
+    return f"refused parameter {name}={value!r} ({reason or 'refused'})"
+
+
 def _parameter(name: str, value: Any) -> Any:
     """The rclpy ``Parameter`` a node is given: a list is always a double array, as
     ``describe --ros2`` says (rclpy infers a list's type from its items, and an empty one,
@@ -423,7 +467,9 @@ class ExternalLeaf:
         """Wait for the node, then give it every parameter's value."""
         self._bridge.connect(self._wiring)
         self._bridge.set_params(
-            self._wiring, {p.name: getattr(self._comp.p, p.name) for p in self._wiring.params}
+            self._wiring,
+            {p.name: getattr(self._comp.p, p.name) for p in self._wiring.params},
+            start=True,
         )
 
     def do_step(self, t: Fraction, inp: Mapping[str, Any]) -> Mapping[str, Any]:

@@ -8,6 +8,8 @@ have the same names (``std_msgs``, ``rosgraph_msgs``) and shadow each other.
 
 from __future__ import annotations
 
+import os
+import re
 from types import ModuleType
 
 from ...errors import ConfigError
@@ -19,8 +21,33 @@ HOW = (
 )
 
 
+#: the largest domain FastDDS (the wheels' middleware, and ROS 2's default) can open: its
+#: ports for a larger one are out of range
+MAX_DOMAIN_ID = 232
+
+
+def domain_problem(value: str | None) -> str | None:
+    """What is wrong with ``value`` as ``ROS_DOMAIN_ID`` (None: unset, empty, or a domain).
+
+    Why here: rcl refuses a value that is not a number with an rclpy traceback, and FastDDS
+    ends the process for a domain over :data:`MAX_DOMAIN_ID` (its own log lines, exit 1, a
+    half-made run directory left behind); a negative one becomes a domain nobody is in."""
+    if not value:
+        return None
+    if re.fullmatch(r"[0-9]+", value) and int(value) <= MAX_DOMAIN_ID:
+        return None
+    return (
+        f"ROS_DOMAIN_ID={value!r} is not a ROS 2 domain: an integer from 0 to "
+        f"{MAX_DOMAIN_ID} (unset: 0)"
+    )
+
+
 def rclpy(key: str = "--ros2") -> ModuleType:
-    """The rclpy module, or a ConfigError naming ``key`` (what asked for ROS 2)."""
+    """The rclpy module, or a ConfigError naming ``key`` (what asked for ROS 2): rclpy is
+    missing, ROS 1's messages shadow ROS 2's, or ``ROS_DOMAIN_ID`` is no domain."""
+    problem = domain_problem(os.environ.get("ROS_DOMAIN_ID"))
+    if problem:
+        raise ConfigError(problem, key=key)
     try:
         import rclpy as mod
         from rcl_interfaces.srv import SetParameters  # noqa: F401

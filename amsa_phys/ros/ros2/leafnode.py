@@ -135,7 +135,12 @@ def main(path: str, scenario_file: str) -> None:
                 if name in values:
                     declare(self, p, _ros_value(values[name]))
             self.add_on_set_parameters_callback(self._amsa_judge)
-            self.inp: dict[str, Any] = {p.name: p.initial for p in leaf.template.inputs}
+            #: the wired inputs only, as the run's step gets them: a template tells an
+            #: optional input left unwired by its absence (the IMU's pose: without it, no
+            #: sideslip), and a default in its place changed what it computed
+            self.inp: dict[str, Any] = {
+                p.name: p.initial for p in leaf.template.inputs if p.name in leaf.inputs
+            }
             self.last_out: dict[str, Any] = {}
             for w in wiring.outputs:
                 init = (
