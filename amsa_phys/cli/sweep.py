@@ -195,6 +195,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(
             "sets the runs of a batch; --executor local runs one per process", key="--batch-size"
         )
+    if args.ros2_serial:  # before --out is made: a refused domain leaves nothing behind
+        check_ros2_lanes(min(args.jobs if args.jobs_given else 1, plan.size))
     name = Path(args.scenario).stem
     out = Path(args.out) if args.out else default_run_dir(f"{name}-sweep")
     # with --force the sweep is written beside an earlier one and renamed into place when it
@@ -294,6 +296,26 @@ def _summary(
             + (f"; interrupted: {len(rows)} of {planned} runs" if interrupted else "")
         ),
     )
+
+
+def check_ros2_lanes(lanes: int) -> None:
+    """Refuse a ``ROS_DOMAIN_ID`` the sweep's ROS 2 lanes cannot use: not a domain (int() of
+    it was a traceback), or one whose ``lanes - 1`` followers pass the last domain."""
+    if lanes <= 1:
+        return
+    from ..ros.ros2.env import MAX_DOMAIN_ID, domain_problem
+
+    value = os.environ.get("ROS_DOMAIN_ID")
+    problem = domain_problem(value)
+    if problem:
+        raise ConfigError(problem, key="sweep")
+    base = int(value or 0)
+    if base + lanes - 1 > MAX_DOMAIN_ID:
+        raise ConfigError(
+            f"-j {lanes} runs in ROS_DOMAIN_ID={base} and the {lanes - 1} after it, past "
+            f"{MAX_DOMAIN_ID}: set a lower ROS_DOMAIN_ID or fewer jobs",
+            key="sweep",
+        )
 
 
 def rows_from(jobs: list[Job], args: argparse.Namespace) -> Iterator[dict[str, Any]]:

@@ -103,7 +103,7 @@ SimulationFactory = Callable[[Scenario, TraceFn], SimDriver]
 #: Who builds the Simulation of a scenario with ``ros2:`` Leaves: the ROS 2 target, a layer
 #: above this one (it needs rclpy, imported only then), found by name as a plugin is; every
 #: command that runs scenarios (run, test, sweep, falsify) reaches it through the scenario.
-ROS2_SIMULATION = "amsa_phys.ros.ros2.bridge:ExternalSimulation"
+ROS2_SIMULATION = "amsa_phys.ros.ros2.insim:ExternalSimulation"
 
 
 def default_simulation(scenario: Scenario, trace: TraceFn) -> SimDriver:

@@ -79,3 +79,4 @@ def test_a_sweep_over_domains_refuses_an_unusable_one(
     assert rc == 2, lines
     assert lines[-1].startswith(said), lines
     assert not any(line.startswith(("Traceback", "error")) for line in lines[:-1]), lines
+    assert not (tmp_path / "sw").exists()  # refused before --out is made

@@ -26,8 +26,8 @@ from ...model.yamlio import load_yaml
 from .. import external, names
 from ..exported import KEY as CUT_KEY
 from ..exported import cut_of
-from .bridge import ExternalSimulation
 from .export import MANIFEST
+from .insim import ExternalSimulation
 
 STOP_WAIT_S = 10.0  # a node gets this long to leave after SIGINT, then it is killed
 
