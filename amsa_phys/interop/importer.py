@@ -54,6 +54,8 @@ class Imported:
     name: str
     text: str
     warnings: list[Warning_] = field(default_factory=list)
+    #: the template file read (the model's sibling unless given): an input, never an output
+    templates: Path | None = None
 
 
 def import_model(
@@ -138,7 +140,7 @@ class _Importer:
         self._check_poses(bodies)
         schedule = self._schedule(bodies)
         text = self._text(bodies, schedule)
-        return Imported(self.model.root.name, text, self.warnings)
+        return Imported(self.model.root.name, text, self.warnings, self.tpath)
 
     # -- templates -------------------------------------------------------------------------
     def _template(self, leaf: LeafNode) -> type[Template]:
