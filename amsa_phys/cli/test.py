@@ -11,8 +11,8 @@ from ..engine import interrupt
 from ..errors import ConfigError, Interrupted, one_line
 from ..model.wording import plural
 from ..runs.junit import write_junit
+from ..runs.outfile import check_output_file, junit_by_us
 from ..runs.pool import WORKER_LOST, imap_resilient
-from ..runs.rundir import check_output
 from ..runs.suite import ScenarioResult, find_scenarios, run_dir_names, run_scenario_job
 from .options import add_jobs, add_ros2
 
@@ -60,7 +60,11 @@ def run(args: argparse.Namespace) -> int:
     if args.jobs < 1:
         raise ConfigError("must be at least 1", key="--jobs")
     if args.junit:  # before the suite runs, not after (its folder is made, as pytest does)
-        check_output(Path(args.junit), "--junit", make_parent=True)
+        # a file there is replaced only if it is an earlier report; never a scenario or a
+        # world the suite reads (``--junit scenarios/a.yaml`` wrote XML over the scenario)
+        check_output_file(
+            Path(args.junit), "--junit", None, files, ours=junit_by_us, make_parent=True
+        )
     with interrupt.sigterm_as_ctrl_c():
         # a ROS 2 node answers one run at a time: the scenarios run one after another
         jobs = 1 if args.ros2 else min(args.jobs, len(files))

@@ -14,10 +14,14 @@ from pathlib import Path
 from ..atomic import write_atomic
 from .suite import ScenarioResult
 
+#: The report's root name: ``test --junit`` replaces only a file whose root says it
+#: (``runs/outfile.py``, :func:`~amsa_phys.runs.outfile.junit_by_us`)
+SUITE_NAME = "amsa-phys"
+
 
 def write_junit(results: list[ScenarioResult], path: Path) -> None:
     """Write ``path`` atomically."""
-    root = ET.Element("testsuites", name="amsa-phys")
+    root = ET.Element("testsuites", name=SUITE_NAME)
     for r in results:
         failures = sum(1 for c in r.checks if not c.passed)
         suite = ET.SubElement(

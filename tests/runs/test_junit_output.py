@@ -1,0 +1,76 @@
+"""``test --junit FILE`` loses nothing: it replaces only an earlier report of its own.
+
+``amsa-phys test s.yaml --junit s.yaml`` wrote its XML over the scenario it had just run
+(and ``--junit`` naming the world did the same to the world). The report now follows the
+output-file rule (``runs/outfile.py``): an input is refused, and an existing file is
+replaced only if it is a JUnit report amsa-phys wrote, so CI reruns need no flag.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from amsa_phys.cli.main import main
+
+WORLD = Path(__file__).resolve().parents[2] / "worlds" / "mde_challenge.yaml"
+
+
+def _scenario(folder: Path, world: Path = WORLD) -> Path:
+    path = folder / "s.yaml"
+    path.write_text(
+        f"world: {world}\nduration: 2\nseed: 1\n"
+        "quality: {signal: MyDistanceMonitor.distanceFollowerToLeader, reference: 15}\n"
+        "expect:\n  - {metric: collisions, below: 1}\n"
+    )
+    return path
+
+
+def _one_line(capsys: pytest.CaptureFixture[str]) -> str:
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1, err
+    return err
+
+
+def test_the_scenario_it_runs_is_not_the_report(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scen = _scenario(tmp_path)
+    before = scen.read_bytes()
+    assert main(["test", str(scen), "--junit", str(scen), "-j", "1"]) == 2
+    assert "--junit: is an input of this command" in _one_line(capsys)
+    assert scen.read_bytes() == before
+
+
+def test_a_file_that_is_not_a_report_is_kept(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The world the scenario reads (found by nothing but its content) and a notes file."""
+    world = tmp_path / "w.yaml"
+    world.write_bytes(WORLD.read_bytes())
+    scen = _scenario(tmp_path, world)
+    for victim in (world, tmp_path / "notes.xml"):
+        if not victim.exists():
+            victim.write_text("<notes>mine</notes>\n")
+        before = victim.read_bytes()
+        assert main(["test", str(scen), "--junit", str(victim), "-j", "1"]) == 2
+        assert "exists and was not written by amsa-phys" in _one_line(capsys)
+        assert victim.read_bytes() == before
+
+
+def test_an_earlier_report_is_replaced_and_a_link_is_not_followed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scen = _scenario(tmp_path)
+    report = tmp_path / "report.xml"
+    assert main(["test", str(scen), "--junit", str(report), "-j", "1"]) == 0
+    assert main(["test", str(scen), "--junit", str(report), "-j", "1"]) == 0
+    assert report.read_text().count("<testsuites") == 1
+    capsys.readouterr()
+    link = tmp_path / "link.xml"
+    link.symlink_to(scen)
+    before = scen.read_bytes()
+    assert main(["test", str(scen), "--junit", str(link), "-j", "1"]) == 2
+    assert "is a symbolic link" in _one_line(capsys)
+    assert scen.read_bytes() == before
