@@ -8,10 +8,13 @@ replaced only if it is a JUnit report amsa-phys wrote, so CI reruns need no flag
 
 from __future__ import annotations
 
+import os
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
 
+from amsa_phys.atomic import write_atomic
 from amsa_phys.cli.main import main
 
 WORLD = Path(__file__).resolve().parents[2] / "worlds" / "mde_challenge.yaml"
@@ -74,3 +77,24 @@ def test_an_earlier_report_is_replaced_and_a_link_is_not_followed(
     assert main(["test", str(scen), "--junit", str(link), "-j", "1"]) == 2
     assert "is a symbolic link" in _one_line(capsys)
     assert scen.read_bytes() == before
+
+
+def test_a_hostile_name_or_file_name_gives_a_report_that_parses(tmp_path: Path) -> None:
+    """A scenario named with control characters and a file name that is not UTF-8: the
+    report parses (XML 1.0 has no ``\\x01``) and shows them escaped, as the terminal does."""
+    scen = _scenario(tmp_path)
+    scen.write_text('name: "a\\x01b\\x1b[2J"\n' + scen.read_text())
+    odd = tmp_path / os.fsdecode(b"odd\xff.yaml")
+    odd.write_bytes(scen.read_bytes())
+    report = tmp_path / "r.xml"
+    assert main(["test", str(scen), str(odd), "--junit", str(report), "-j", "1"]) == 0
+    suites = ET.parse(report).getroot().findall("testsuite")
+    assert [s.get("name") for s in suites] == ["a\\x01b\\x1b[2J"] * 2
+    assert suites[1].get("file").endswith("odd\\udcff.yaml")
+    assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_text_that_cannot_be_encoded_leaves_no_temporary_file(tmp_path: Path) -> None:
+    with pytest.raises(UnicodeEncodeError):
+        write_atomic(tmp_path / "f.txt", "\udcff")
+    assert list(tmp_path.iterdir()) == []
