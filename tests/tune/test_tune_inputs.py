@@ -52,3 +52,21 @@ def test_what_no_run_could_answer_is_refused_before_any(
     assert err.startswith(said)
     assert len(err.splitlines()) == 1
     assert "worst" not in out  # nothing ran
+
+
+def test_a_search_of_more_runs_than_a_sweep_may_have_is_refused_before_any(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each bound within its own, together 10^10 runs (centuries): refused as a sweep of
+    more than 1,000,000 runs is, before the first run (which would fail this test)."""
+
+    def no_run(*_: object) -> float:
+        raise AssertionError("a run started")
+
+    monkeypatch.setattr("amsa_phys.cli.tune.evaluate", no_run)
+    assert main([*ARGS, "--budget", "10000", "--box", "1000", "--seeds", "1000"]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        "error: --budget: 10,000 evaluations x 1000 contexts x 1000 seeds is "
+        "10,000,000,000 runs; a search has at most 1,000,000, as a sweep\n"
+    )
