@@ -49,12 +49,11 @@ class Warning_:
 
 @dataclass
 class Imported:
-    """The world's text (with comments) and the warnings to print."""
+    """The world's text (with comments), warnings to print, the template file read (an input)."""
 
     name: str
     text: str
     warnings: list[Warning_] = field(default_factory=list)
-    #: the template file read (the model's sibling unless given): an input, never an output
     templates: Path | None = None
 
 
@@ -69,8 +68,7 @@ def import_model(
     """
     model = read_model(model_path)
     tpath = templates_path or _templates_file(model)
-    decls = read_templates(tpath)
-    return _Importer(model, tpath, decls, set(modules)).run()
+    return _Importer(model, tpath, read_templates(tpath), set(modules)).run()
 
 
 def _templates_file(model: Model) -> Path:
