@@ -139,9 +139,12 @@ def print_table(results: list[ScenarioResult]) -> None:
         for c in r.checks:
             value = "-" if c.value is None else c.measured
             rows.append((r.name, c.what, value, c.bound, c.verdict))
+    # cells escaped before they are measured: a name with a control character is wider shown
+    # (``a\x01b``) than its length, and the columns after it slid out of line
+    rows = [tuple(one_line(v) for v in row) for row in rows]
     widths = [max(len(row[i]) for row in rows) for i in range(5)]
     for row in rows:
-        print(one_line("  ".join(v.ljust(w) for v, w in zip(row, widths, strict=True)).rstrip()))
+        print("  ".join(v.ljust(w) for v, w in zip(row, widths, strict=True)).rstrip())
     for r in results:
         if r.error is not None:
             print(one_line(f"error: {r.name}: {r.error}"), file=sys.stderr)

@@ -98,3 +98,15 @@ def test_text_that_cannot_be_encoded_leaves_no_temporary_file(tmp_path: Path) ->
     with pytest.raises(UnicodeEncodeError):
         write_atomic(tmp_path / "f.txt", "\udcff")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_table_keeps_its_columns_for_a_hostile_name(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The scenario column is as wide as the escaped name it shows."""
+    scen = _scenario(tmp_path)
+    scen.write_text('name: "a\\x01b"\n' + scen.read_text())
+    assert main(["test", str(scen), "-j", "1"]) == 0
+    header, row = capsys.readouterr().out.splitlines()[:2]
+    assert row.startswith("a\\x01b  ")
+    assert row.index("collisions") == header.index("check")
