@@ -123,7 +123,9 @@ def _contexts(args: argparse.Namespace, scenario: Scenario) -> dict[str, dict[st
     if args.contexts:
         from ..adapt.sweepdir import read_sweep_scenario
 
-        recorded = read_sweep_scenario(Path(args.contexts))
+        recorded = read_sweep_scenario(
+            Path(args.contexts), "give the contexts in the scenario's sweep: contexts instead"
+        )
         contexts = dict(recorded.data.get("sweep", {}).get("contexts", {}))
     else:
         contexts = dict(scenario.data.get("sweep", {}).get("contexts", {}))

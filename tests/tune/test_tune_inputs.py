@@ -70,3 +70,17 @@ def test_a_search_of_more_runs_than_a_sweep_may_have_is_refused_before_any(
         "error: --budget: 10,000 evaluations x 1000 contexts x 1000 seeds is "
         "10,000,000,000 runs; a search has at most 1,000,000, as a sweep\n"
     )
+
+
+def test_contexts_that_are_not_a_sweep_offer_what_tune_takes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``tune`` has no ``--scenario``: a directory that records no sweep scenario says to
+    give the contexts in the scenario (the message was ``adapt``'s, offering the flag)."""
+    assert main([*ARGS, "--budget", "2", "--contexts", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"error: {tmp_path}: records no scenario.yaml (not a sweep directory, or made before "
+        "sweeps recorded their scenario?); give the contexts in the scenario's sweep: "
+        "contexts instead\n"
+    )
