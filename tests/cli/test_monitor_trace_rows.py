@@ -64,3 +64,13 @@ def test_a_whole_trace_is_still_judged_on_every_row(
     capsys.readouterr()
     assert main(["monitor", str(rundir), FORMULA, "--json"]) == 1
     assert '"instant": 500.5' in capsys.readouterr().out
+
+
+def test_a_column_named_twice_is_refused_not_chosen(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``t,a,a``: the formula read the second ``a`` (it passed where the first failed); no
+    run writes a column twice, so the file is not a trace."""
+    (tmp_path / "trace.csv").write_text("t,a,a\n0,-1,1\n1,-1,1\n")
+    err = _refused(tmp_path, capsys)
+    assert err == f"error: {tmp_path / 'trace.csv'}:1: not a trace: the column 'a' is named twice"
