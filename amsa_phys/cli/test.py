@@ -13,6 +13,7 @@ from ..model.wording import plural
 from ..runs.junit import write_junit
 from ..runs.outfile import check_output_file, junit_by_us
 from ..runs.pool import WORKER_LOST, imap_resilient
+from ..runs.rundir import prepare_out_root
 from ..runs.suite import ScenarioResult, find_scenarios, run_dir_names, run_scenario_job
 from .options import add_jobs, add_ros2
 
@@ -59,6 +60,8 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("no scenario with an expect: section found", key=" ".join(paths))
     if args.jobs < 1:
         raise ConfigError("must be at least 1", key="--jobs")
+    if args.out:  # its scenarios' directories are judged one by one; a bad root is one line
+        prepare_out_root(Path(args.out))
     if args.junit:  # before the suite runs, not after (its folder is made, as pytest does)
         # a file there is replaced only if it is an earlier report; never a scenario or a
         # world the suite reads (``--junit scenarios/a.yaml`` wrote XML over the scenario)
