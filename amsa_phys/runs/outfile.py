@@ -38,6 +38,7 @@ def check_output_file(
     """
     out = check_output(Path(out), flag, make_parent)
     refuse_input_file(out, inputs, flag)
+    _refuse_special(out, flag)
     if force:
         return out
     how = "use --force to replace it" if force is not None else "remove it or choose another file"
@@ -50,6 +51,26 @@ def check_output_file(
         why = "exists and was not written by amsa-phys" if ours is not None else "exists"
         raise ConfigError(f"{why} ({how})", key=flag, file=out)
     return out
+
+
+def _refuse_special(out: Path, flag: str) -> None:
+    """Refuse, even with ``--force``, an ``out`` that is a device, a FIFO or a socket.
+
+    ``--force`` replaces a file written earlier; the writer renames over whatever has the
+    name, so ``adapt -o /dev/null --force`` run as root replaced the machine's ``/dev/null``
+    by a rules file. A link is not judged here: it is replaced, never followed."""
+    try:
+        mode = os.lstat(out).st_mode
+    except OSError:
+        return
+    if stat.S_ISLNK(mode) or stat.S_ISREG(mode):
+        return
+    kind = "a FIFO" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode) else "a device"
+    raise ConfigError(
+        f"is {kind}, not a file; amsa-phys writes only files (choose a file name)",
+        key=flag,
+        file=out,
+    )
 
 
 def refuse_input_file(out: Path, inputs: Iterable[Path], flag: str) -> None:
