@@ -20,7 +20,7 @@ from typing import Any
 
 import yaml
 
-from ..errors import ConfigError
+from ..errors import ConfigError, one_line
 from ..model.dataflow import execution_order
 from ..model.template import BUILTINS, Kind, Template, TemplateNotFound, resolve_template
 from ..model.world import DEFAULT_FREQ_HZ
@@ -380,14 +380,14 @@ class _Importer:
         model = self.model
         ext_world = model.extension.get("world", {})
         lines = [
-            f"# {model.root.name}: imported by `amsa-phys import` from {model.path.name}",
-            f"# (templates: {self.tpath.name}).",
+            f"# {one_line(model.root.name)}: imported by `amsa-phys import` from",
+            f"# {one_line(model.path.name)} (templates: {one_line(self.tpath.name)}).",
         ]
         if self.warnings:
             lines.append("# Values the model leaves empty (each marked below and reported as a")
             lines.append("# warning); supply the real ones in a scenario's set:")
             for w in self.warnings:
-                lines.append(f"#   - {w.message}")
+                lines.append(f"#   - {one_line(w.message)}")
         lines.append(
             "# Parameters the AMSA templates do not declare (a rover's mass, initial pose, ...)"
         )
@@ -456,7 +456,7 @@ def _composites(node: CompositeNode) -> list[CompositeNode]:
 
 
 def _commented(line: str, note: str | None) -> str:
-    return f"{line}  # {note}" if note else line
+    return f"{line}  # {one_line(note)}" if note else line
 
 
 _PLAIN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")

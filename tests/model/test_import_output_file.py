@@ -12,6 +12,7 @@ import os
 from pathlib import Path
 
 import pytest
+import yaml
 
 from amsa_phys.cli.main import main
 
@@ -60,3 +61,22 @@ def test_the_template_file_the_model_names_is_an_input(
     assert "is an input of this command" in err
     assert err.count("\n") == 1
     assert templates.read_bytes() == before
+
+
+def test_a_model_file_name_reaches_the_world_only_as_a_comment(
+    exported: Path, tmp_path: Path
+) -> None:
+    """The model's file name is in the world's first comment: a name holding a newline and
+    ``name: pwned`` wrote YAML into the world (YAML of the file name's own)."""
+
+    model = tmp_path / "m\nname: pwned\n#\u2028x: 1\n.amsacore"
+    model.write_bytes((exported / "mdeChallenge.amsacore").read_bytes())
+    (tmp_path / "mdeChallenge.amsatemplate").write_bytes(
+        (exported / "mdeChallenge.amsatemplate").read_bytes()
+    )
+    out = tmp_path / "w.yaml"
+    assert main(["import", str(model), "-o", str(out)]) == 0
+    text = out.read_text()
+    assert yaml.safe_load(text)["name"] == "mdeChallenge"
+    assert "x" not in yaml.safe_load(text)
+    assert text.splitlines()[1].startswith("# m\\nname: pwned\\n#\\u2028x: 1\\n.amsacore")
