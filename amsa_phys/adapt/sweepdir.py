@@ -52,7 +52,9 @@ def read_sweep_scenario(sweepdir: Path, instead: str = ADAPT_INSTEAD) -> Scenari
             "(amsa-phys sweep SCENARIO --out DIR, its sweep: contexts)",
             file=sweepdir,
         )
-    if not path.is_file():
+    # one that is there but is not a file (a FIFO, a device, a link to none) is named as
+    # such by the loader below: "records none" sent the user looking for a missing file
+    if not (path.exists() or path.is_symlink()):
         raise ConfigError(
             f"records no {NAME} (not a sweep directory, or made before sweeps recorded "
             f"their scenario?); {instead}",
