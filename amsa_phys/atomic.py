@@ -125,6 +125,9 @@ class AtomicFile:
 
 def write_atomic(path: str | Path, data: str | bytes) -> Path:
     """Write a whole file (text as UTF-8) under its temporary name, then rename it."""
+    # encoded before the temporary file exists: text that cannot be encoded (a surrogate
+    # from a file name that is not UTF-8) must not leave a ``NAME.tmp`` behind
+    raw = data.encode("utf-8") if isinstance(data, str) else data
     out = AtomicFile(path)
-    out.write(data.encode("utf-8") if isinstance(data, str) else data)
+    out.write(raw)
     return out.commit()

@@ -36,19 +36,28 @@ def write_sweep_scenario(out: Path, scenario: Scenario, sweep: dict[str, Any]) -
     write_atomic(out / NAME, head + yaml.safe_dump(data, sort_keys=False, allow_unicode=False))
 
 
-def read_sweep_scenario(sweepdir: Path) -> Scenario:
-    """The scenario ``sweepdir`` records, loaded without importing any module it names."""
+#: What ``adapt`` (which takes ``--scenario``) says to do when the directory cannot answer
+ADAPT_INSTEAD = "give the scenario the sweep ran with --scenario"
+
+
+def read_sweep_scenario(sweepdir: Path, instead: str = ADAPT_INSTEAD) -> Scenario:
+    """The scenario ``sweepdir`` records, loaded without importing any module it names.
+
+    ``instead``: what the command's user can do when the directory cannot answer (``tune
+    --contexts`` has no ``--scenario``: its messages offered one)."""
     path = Path(sweepdir) / NAME
     if not path.is_file() and (Path(sweepdir) / "falsify.json").is_file():
         raise ConfigError(
-            "a falsify directory, not a sweep's: adapt derives rules from a sweep over the "
-            "contexts (amsa-phys sweep SCENARIO --out DIR, its sweep: contexts)",
+            "a falsify directory, not a sweep's: give a sweep over the contexts "
+            "(amsa-phys sweep SCENARIO --out DIR, its sweep: contexts)",
             file=sweepdir,
         )
-    if not path.is_file():
+    # one that is there but is not a file (a FIFO, a device, a link to none) is named as
+    # such by the loader below: "records none" sent the user looking for a missing file
+    if not (path.exists() or path.is_symlink()):
         raise ConfigError(
-            f"records no {NAME} (made before sweeps recorded their scenario?); give the "
-            "scenario the sweep ran with --scenario",
+            f"records no {NAME} (not a sweep directory, or made before sweeps recorded "
+            f"their scenario?); {instead}",
             file=sweepdir,
         )
     doc = load_yaml(path)
@@ -64,8 +73,7 @@ def read_sweep_scenario(sweepdir: Path) -> Scenario:
             raise doc.error(
                 (*keys, "template"),
                 f"component {one_line(name)} names template {one_line(str(template))!r}, not "
-                "built in; not imported: a sweep directory is data (give --scenario with the "
-                "scenario's own file to load it)",
+                f"built in; not imported: a sweep directory is data ({instead})",
             )
     return load_scenario(path)
 

@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
+from ..atomic import AtomicFile
 from ..errors import ConfigError
 from ..interop.importer import import_model
 from ..model.world import load_world
+from ..runs.outfile import check_output_file, refuse_input_file
+from ..runs.rundir import check_output
 
 
 def add_args(p: argparse.ArgumentParser) -> None:
@@ -37,23 +39,20 @@ def run(args: argparse.Namespace) -> int:
     model = Path(args.model)
     templates = Path(args.templates) if args.templates else None
     out = Path(args.out)
-    for given in (model, templates):
-        if given is not None and given.exists() and out.exists() and out.samefile(given):
-            raise ConfigError("is an input of the import; choose another file", key="-o", file=out)
-    if out.is_dir():
-        raise ConfigError("is a directory, expected a world file name", key="-o", file=out)
-    if (out.exists() or out.is_symlink()) and not args.force:
-        raise ConfigError("exists (use --force to replace it)", key="-o", file=out)
+    if not out.parent.exists():  # ``-o new/dir/w.yaml``: made, as for any output directory
+        check_output(out, "-o", make_parent=True)
+    inputs = [p for p in (model, templates) if p is not None]
+    out = check_output_file(out, "-o", args.force, inputs)
     imported = import_model(model, templates, args.template_module)
-    tmp = out.with_name(f".{out.name}.tmp-{os.getpid()}")
+    if imported.templates is not None:  # the sibling the model names, read too
+        refuse_input_file(out, [imported.templates], "-o")
+    # the outfile rule's writer: an exclusive temporary name that never follows a link
+    # planted there (a guessable ``.NAME.tmp-PID`` was written through to the link's target)
+    written = AtomicFile(out)
     try:
+        written.write(imported.text.encode("utf-8"))
         try:
-            out.parent.mkdir(parents=True, exist_ok=True)
-            tmp.write_text(imported.text)
-        except OSError as exc:
-            raise ConfigError(f"cannot write: {exc.strerror}", key="-o", file=out) from None
-        try:
-            world = load_world(tmp)  # the world must validate before it gets its name
+            world = load_world(written.tmp)  # the world must validate before it gets its name
         except ConfigError as exc:  # name the model, not the temporary file (removed below)
             where = f"line {exc.line} of " if exc.line else ""
             key = f"{exc.key}: " if exc.key else ""
@@ -62,9 +61,10 @@ def run(args: argparse.Namespace) -> int:
                 f"{key}{exc.message})",
                 file=model,
             ) from None
-        os.replace(tmp, out)
-    finally:
-        tmp.unlink(missing_ok=True)
+    except BaseException:
+        written.discard()
+        raise
+    written.commit()
     for warning in imported.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     print(

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, one_line
+from ..model.rates import MAX_RATE_HZ
 
 #: Spacing of logged instants may differ from the first by this much (their sum rounds).
 SPACING_TOL = 1e-9
@@ -54,6 +55,12 @@ def log_period(t: np.ndarray, path: Path) -> Fraction:
     first = float(steps[0])
     if first <= 0 or np.abs(steps - first).max() > SPACING_TOL * max(1.0, float(t[-1])):
         raise ConfigError("the trace's instants are not evenly spaced", file=path)
+    if first < (1 - SPACING_TOL) / MAX_RATE_HZ:  # its period would round to 0 (a traceback)
+        raise ConfigError(
+            f"the trace's instants are {first:g} s apart: no run logs faster than "
+            f"{MAX_RATE_HZ:,} Hz",
+            file=path,
+        )
     return Fraction(first).limit_denominator(1_000_000)
 
 

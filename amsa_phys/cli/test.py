@@ -11,8 +11,9 @@ from ..engine import interrupt
 from ..errors import ConfigError, Interrupted, one_line
 from ..model.wording import plural
 from ..runs.junit import write_junit
+from ..runs.outfile import check_output_file, junit_by_us
 from ..runs.pool import WORKER_LOST, imap_resilient
-from ..runs.rundir import check_output
+from ..runs.rundir import prepare_out_root
 from ..runs.suite import ScenarioResult, find_scenarios, run_dir_names, run_scenario_job
 from .options import add_jobs, add_ros2
 
@@ -59,8 +60,14 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError("no scenario with an expect: section found", key=" ".join(paths))
     if args.jobs < 1:
         raise ConfigError("must be at least 1", key="--jobs")
+    if args.out:  # its scenarios' directories are judged one by one; a bad root is one line
+        prepare_out_root(Path(args.out))
     if args.junit:  # before the suite runs, not after (its folder is made, as pytest does)
-        check_output(Path(args.junit), "--junit", make_parent=True)
+        # a file there is replaced only if it is an earlier report; never a scenario or a
+        # world the suite reads (``--junit scenarios/a.yaml`` wrote XML over the scenario)
+        check_output_file(
+            Path(args.junit), "--junit", None, files, ours=junit_by_us, make_parent=True
+        )
     with interrupt.sigterm_as_ctrl_c():
         # a ROS 2 node answers one run at a time: the scenarios run one after another
         jobs = 1 if args.ros2 else min(args.jobs, len(files))
@@ -135,9 +142,12 @@ def print_table(results: list[ScenarioResult]) -> None:
         for c in r.checks:
             value = "-" if c.value is None else c.measured
             rows.append((r.name, c.what, value, c.bound, c.verdict))
+    # cells escaped before they are measured: a name with a control character is wider shown
+    # (``a\x01b``) than its length, and the columns after it slid out of line
+    rows = [tuple(one_line(v) for v in row) for row in rows]
     widths = [max(len(row[i]) for row in rows) for i in range(5)]
     for row in rows:
-        print(one_line("  ".join(v.ljust(w) for v, w in zip(row, widths, strict=True)).rstrip()))
+        print("  ".join(v.ljust(w) for v, w in zip(row, widths, strict=True)).rstrip())
     for r in results:
         if r.error is not None:
             print(one_line(f"error: {r.name}: {r.error}"), file=sys.stderr)

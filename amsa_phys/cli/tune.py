@@ -12,6 +12,7 @@ from ..errors import ConfigError, one_line
 from ..model.changes import resolve_change
 from ..model.scenario import Scenario, load_scenario
 from ..model.wording import plural
+from ..runs.sweep import MAX_RUNS
 from ..tune.contexts import Sequence, box, sequences
 from ..tune.evaluate import evaluate
 from ..tune.robust import tail
@@ -122,7 +123,9 @@ def _contexts(args: argparse.Namespace, scenario: Scenario) -> dict[str, dict[st
     if args.contexts:
         from ..adapt.sweepdir import read_sweep_scenario
 
-        recorded = read_sweep_scenario(Path(args.contexts))
+        recorded = read_sweep_scenario(
+            Path(args.contexts), "give the contexts in the scenario's sweep: contexts instead"
+        )
         contexts = dict(recorded.data.get("sweep", {}).get("contexts", {}))
     else:
         contexts = dict(scenario.data.get("sweep", {}).get("contexts", {}))
@@ -159,6 +162,7 @@ def run(args: argparse.Namespace) -> int:
     if not (0 < duration <= 1_000_000 and math.isfinite(duration)):
         raise ConfigError(f"must be a positive number of seconds, got {duration}", key="--duration")
     _check_metric(args.metric, scenario, duration)
+    _check_runs(args.budget, args.box or len(contexts), args.seeds)
     if args.box:
         cases = sequences(box(scenario, contexts), args.box, duration, seed=7, segments=(1, 1))
     else:
@@ -204,6 +208,21 @@ def run(args: argparse.Namespace) -> int:
         )
     )
     return 0
+
+
+def _check_runs(budget: int, contexts: int, seeds: int) -> None:
+    """Refuse a search of more runs than a sweep may have (:data:`MAX_RUNS`), before any.
+
+    Each bound alone is modest, their product is not: ``--budget 10000 --box 1000 --seeds
+    1000`` asked for 10^10 runs (centuries), and a sweep directory's named contexts are
+    as many as its author wrote."""
+    runs = budget * contexts * seeds
+    if runs > MAX_RUNS:
+        raise ConfigError(
+            f"{budget:,} evaluations x {plural(contexts, 'context')} x {plural(seeds, 'seed')} "
+            f"is {runs:,} runs; a search has at most {MAX_RUNS:,}, as a sweep",
+            key="--budget",
+        )
 
 
 def _over(n: int, drawn: bool) -> str:

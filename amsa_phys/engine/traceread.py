@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError
+from ..errors import ConfigError, one_line
 from ..model.params import short_repr
 from ..model.schema import MAX_DURATION_S
 
@@ -50,6 +50,13 @@ def read_header(path: Path) -> list[str]:
         raise ConfigError(f"not a trace: not UTF-8 text (byte {exc.start})", file=path) from None
     if header[0] != "t":
         raise ConfigError("not a whole trace: no header line starting with t", file=path, line=1)
+    seen: set[str] = set()
+    for name in header:  # which of two ``a`` columns would a formula or a plot read?
+        if name in seen:
+            raise ConfigError(
+                f"not a trace: the column {one_line(name)!r} is named twice", file=path, line=1
+            )
+        seen.add(name)
     return header
 
 

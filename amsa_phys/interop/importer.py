@@ -20,7 +20,7 @@ from typing import Any
 
 import yaml
 
-from ..errors import ConfigError
+from ..errors import ConfigError, one_line
 from ..model.dataflow import execution_order
 from ..model.template import BUILTINS, Kind, Template, TemplateNotFound, resolve_template
 from ..model.world import DEFAULT_FREQ_HZ
@@ -49,11 +49,12 @@ class Warning_:
 
 @dataclass
 class Imported:
-    """The world's text (with comments) and the warnings to print."""
+    """The world's text (with comments), warnings to print, the template file read (an input)."""
 
     name: str
     text: str
     warnings: list[Warning_] = field(default_factory=list)
+    templates: Path | None = None
 
 
 def import_model(
@@ -67,8 +68,7 @@ def import_model(
     """
     model = read_model(model_path)
     tpath = templates_path or _templates_file(model)
-    decls = read_templates(tpath)
-    return _Importer(model, tpath, decls, set(modules)).run()
+    return _Importer(model, tpath, read_templates(tpath), set(modules)).run()
 
 
 def _templates_file(model: Model) -> Path:
@@ -138,7 +138,7 @@ class _Importer:
         self._check_poses(bodies)
         schedule = self._schedule(bodies)
         text = self._text(bodies, schedule)
-        return Imported(self.model.root.name, text, self.warnings)
+        return Imported(self.model.root.name, text, self.warnings, self.tpath)
 
     # -- templates -------------------------------------------------------------------------
     def _template(self, leaf: LeafNode) -> type[Template]:
@@ -380,14 +380,14 @@ class _Importer:
         model = self.model
         ext_world = model.extension.get("world", {})
         lines = [
-            f"# {model.root.name}: imported by `amsa-phys import` from {model.path.name}",
-            f"# (templates: {self.tpath.name}).",
+            f"# {one_line(model.root.name)}: imported by `amsa-phys import` from",
+            f"# {one_line(model.path.name)} (templates: {one_line(self.tpath.name)}).",
         ]
         if self.warnings:
             lines.append("# Values the model leaves empty (each marked below and reported as a")
             lines.append("# warning); supply the real ones in a scenario's set:")
             for w in self.warnings:
-                lines.append(f"#   - {w.message}")
+                lines.append(f"#   - {one_line(w.message)}")
         lines.append(
             "# Parameters the AMSA templates do not declare (a rover's mass, initial pose, ...)"
         )
@@ -456,7 +456,7 @@ def _composites(node: CompositeNode) -> list[CompositeNode]:
 
 
 def _commented(line: str, note: str | None) -> str:
-    return f"{line}  # {note}" if note else line
+    return f"{line}  # {one_line(note)}" if note else line
 
 
 _PLAIN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")

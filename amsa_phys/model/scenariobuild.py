@@ -182,10 +182,11 @@ def _expectations(
 ) -> list[Expectation]:
     """``expect:``: bounds on metrics (overall or of a phase) or on a trace's samples."""
     expect = []
+    names: set[str] = set()  # the requirements' names so far (a list search was quadratic)
     for i, e in enumerate(data.get("expect", [])):
         kp = ("expect", i)
         if "stl" in e:
-            expect.append(_requirement(doc, data, e, kp, world, duration, expect))
+            expect.append(_requirement(doc, data, e, kp, world, duration, names))
             continue
         if "name" in e:
             raise doc.error((*kp, "name"), "only an stl requirement takes a name")
@@ -253,7 +254,7 @@ def _requirement(
     kp: tuple[Any, ...],
     world: WorldSpec,
     duration: Fraction,
-    earlier: list[Expectation],
+    earlier: set[str],
 ) -> Expectation:
     """``{stl: FORMULA, name: NAME}``: an STL requirement, refused at load if a run could not
     judge it (``stl.requirement.check_formula``). The name is required: it is the
@@ -278,8 +279,9 @@ def _requirement(
             f"{name!r} is not a requirement name: letters, digits, _ and -, "
             "starting with a letter or _, at most 64",
         )
-    if any(x.name == name for x in earlier):
+    if name in earlier:
         raise doc.error((*kp, "name"), f"the requirement name {name!r} is used twice")
+    earlier.add(name)
     log_rate = Fraction(str(data.get("log_rate", DEFAULT_LOG_RATE_HZ)))
     try:
         check_formula(e["stl"], world.buffers, log_rate, duration, did_you_mean)

@@ -28,6 +28,7 @@ from matplotlib.path import Path as MplPath
 from matplotlib.transforms import Bbox
 
 from ..atomic import write_atomic
+from ..errors import one_line
 from ..model.wording import plural
 from ..model.world import WorldSpec
 from .graphgeom import (
@@ -192,7 +193,11 @@ def _layout(
     ax.set_ylim(y_lo, top)
     ax.set_aspect("equal")
     ax.axis("off")
-    ax.set_title(f"{world.name}: {plural(len(world.leaves), 'component')}")
+    # the world's name is the user's text: shown escaped, and never read as mathtext (a name
+    # with two ``$`` was a traceback, a control character a missing glyph)
+    ax.set_title(
+        one_line(f"{world.name}: {plural(len(world.leaves), 'component')}"), parse_math=False
+    )
     ax.apply_aspect()
     renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
     names = list(st.nodes)

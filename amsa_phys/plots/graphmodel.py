@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, replace
 
+from ..errors import one_line
 from ..model.timing import RANDOM, LeafTiming
 from ..model.world import WorldSpec
 from ..palette import rover_names
@@ -165,19 +166,28 @@ DOT_MARK = "drawn by amsa-phys graph"
 
 
 def to_dot(world: WorldSpec, collapse: bool = True) -> str:
-    """The architecture as Graphviz DOT text."""
+    """The architecture as Graphviz DOT text; every name goes through :func:`_dot`."""
     st = structure(world, collapse)
     lines = [
-        f'digraph "{world.name}" {{',
+        f'digraph "{_dot(world.name)}" {{',
         f'  comment="{DOT_MARK}";',
         "  rankdir=LR;",
         '  node [shape=box, style="rounded,filled", fontname="Helvetica"];',
     ]
     for name, node in st.nodes.items():
         copies = f", ×{node.count}" if node.count > 1 else ""
-        label = f"{name}\\n{node.template} ({node.kind}, {node.freq:g} Hz{copies})"
-        lines.append(f'  "{name}" [label="{label}", fillcolor="{KIND_COLOURS[node.kind]}"];')
+        label = f"{_dot(name)}\\n{_dot(f'{node.template} ({node.kind}, {node.freq:g} Hz{copies})')}"
+        lines.append(f'  "{_dot(name)}" [label="{label}", fillcolor="{KIND_COLOURS[node.kind]}"];')
     for a, b, label in st.links:
-        lines.append(f'  "{a}" -> "{b}" [label="{label}", fontsize=9];')
+        lines.append(f'  "{_dot(a)}" -> "{_dot(b)}" [label="{_dot(label)}", fontsize=9];')
     lines.append("}")
     return "\n".join(lines) + "\n"
+
+
+def _dot(text: str) -> str:
+    """``text`` for inside a DOT double-quoted string: one line, control characters shown
+    escaped (:func:`~amsa_phys.errors.one_line`), then ``\\`` and ``"`` escaped. A world's
+    ``name:`` may be any string: ``a"]; x [label="`` closed the quotes and wrote DOT of its
+    own (attributes that make Graphviz read a file, ``image=``), and a newline split the
+    header."""
+    return one_line(text).replace("\\", "\\\\").replace('"', '\\"')

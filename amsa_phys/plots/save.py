@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import BinaryIO
 
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 
 from ..atomic import write_atomic
 
@@ -37,6 +38,8 @@ def save_png(
     A figure made without pyplot (the run's plots: the plot child never imports it) needs no
     closing; one made with it is closed here.
     """
+    for text in fig.findobj(Text):  # see _plain
+        _plain(text)
     if margins is None:
         if fig.get_layout_engine() is None:
             # a label too wide to fit: matplotlib keeps its default layout and says "Tight
@@ -54,6 +57,14 @@ def save_png(
         sys.modules["matplotlib.pyplot"].close(fig)
     write_atomic(out, buf.getvalue())
     return out
+
+
+def _plain(text: Text) -> None:
+    """Draw ``text`` as written, never as mathtext: titles, legends and labels hold names
+    from the user's files (a scenario's or a context's name), and two ``$`` in one were
+    parsed as TeX (``$\\frac{x$`` a traceback, the run's plots lost). No amsa-phys figure
+    writes mathtext of its own."""
+    text.set_parse_math(False)
 
 
 #: The PNG signature, and the most a reader of a PNG's text takes: chunks before the image

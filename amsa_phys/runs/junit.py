@@ -12,12 +12,17 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from ..atomic import write_atomic
+from ..errors import one_line
 from .suite import ScenarioResult
+
+#: The report's root name: ``test --junit`` replaces only a file whose root says it
+#: (``runs/outfile.py``, :func:`~amsa_phys.runs.outfile.junit_by_us`)
+SUITE_NAME = "amsa-phys"
 
 
 def write_junit(results: list[ScenarioResult], path: Path) -> None:
     """Write ``path`` atomically."""
-    root = ET.Element("testsuites", name="amsa-phys")
+    root = ET.Element("testsuites", name=SUITE_NAME)
     for r in results:
         failures = sum(1 for c in r.checks if not c.passed)
         suite = ET.SubElement(
@@ -48,6 +53,17 @@ def write_junit(results: list[ScenarioResult], path: Path) -> None:
                 ET.SubElement(case, "failure", message=c.describe()).text = c.describe()
             else:  # a pass records what was measured too, not only that it passed
                 ET.SubElement(case, "system-out").text = c.describe()
+    for element in root.iter():  # names, paths and messages are the user's: see _xml_safe
+        element.attrib = {k: _xml_safe(v) for k, v in element.attrib.items()}
+        if element.text is not None:
+            element.text = _xml_safe(element.text)
     tree = ET.ElementTree(root)
     ET.indent(tree)
     write_atomic(path, ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n")
+
+
+def _xml_safe(text: str) -> str:
+    """``text`` shown as the terminal shows it (``\\x01``, ``\\udcff``): ElementTree writes
+    control characters as they are, which XML 1.0 forbids (a scenario named ``a\\x01b`` made
+    a report no CI could parse), and a file name that is not UTF-8 could not be encoded."""
+    return one_line(text)

@@ -26,25 +26,51 @@ _HEAD = 4096
 def check_output_file(
     out: Path,
     flag: str,
-    force: bool,
+    force: bool | None,
     inputs: Iterable[Path] = (),
     ours: Callable[[Path], bool] | None = None,
+    make_parent: bool = False,
 ) -> Path:
-    """``out`` checked as an output file before any work (one line naming ``flag`` if not)."""
-    out = check_output(Path(out), flag)
+    """``out`` checked as an output file before any work (one line naming ``flag`` if not).
+
+    ``force`` None: the command has no ``--force`` (``test --junit``), so a file that is
+    not ``ours`` is never replaced and the message does not offer the flag.
+    """
+    out = check_output(Path(out), flag, make_parent)
     refuse_input_file(out, inputs, flag)
+    _refuse_special(out, flag)
     if force:
         return out
+    how = "use --force to replace it" if force is not None else "remove it or choose another file"
     if out.is_symlink():
+        link = "use --force to replace the link" if force is not None else how
         raise ConfigError(
-            "is a symbolic link (use --force to replace the link; its target is not touched)",
-            key=flag,
-            file=out,
+            f"is a symbolic link ({link}; its target is not touched)", key=flag, file=out
         )
     if out.exists() and not (ours is not None and ours(out)):
         why = "exists and was not written by amsa-phys" if ours is not None else "exists"
-        raise ConfigError(f"{why} (use --force to replace it)", key=flag, file=out)
+        raise ConfigError(f"{why} ({how})", key=flag, file=out)
     return out
+
+
+def _refuse_special(out: Path, flag: str) -> None:
+    """Refuse, even with ``--force``, an ``out`` that is a device, a FIFO or a socket.
+
+    ``--force`` replaces a file written earlier; the writer renames over whatever has the
+    name, so ``adapt -o /dev/null --force`` run as root replaced the machine's ``/dev/null``
+    by a rules file. A link is not judged here: it is replaced, never followed."""
+    try:
+        mode = os.lstat(out).st_mode
+    except OSError:
+        return
+    if stat.S_ISLNK(mode) or stat.S_ISREG(mode):
+        return
+    kind = "a FIFO" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode) else "a device"
+    raise ConfigError(
+        f"is {kind}, not a file; amsa-phys writes only files (choose a file name)",
+        key=flag,
+        file=out,
+    )
 
 
 def refuse_input_file(out: Path, inputs: Iterable[Path], flag: str) -> None:
@@ -84,6 +110,14 @@ def drawn_by_us(path: Path) -> bool:
     if suffix == ".dot":
         return f'comment="{DOT_MARK}"'.encode() in head
     return False
+
+
+def junit_by_us(path: Path) -> bool:
+    """Whether ``path`` is a JUnit report ``test --junit`` wrote (its root element's name):
+    CI runs regenerate one each time, where any other file there is someone's."""
+    from .junit import SUITE_NAME
+
+    return f'<testsuites name="{SUITE_NAME}"'.encode() in _head(path)
 
 
 def _head(path: Path) -> bytes:

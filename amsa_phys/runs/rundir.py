@@ -268,6 +268,26 @@ def unwritable(directory: Path) -> str | None:
     return None
 
 
+def prepare_out_root(root: Path, flag: str = "--out") -> Path:
+    """A folder the command makes its output directories in (``test --out DIR`` puts each
+    scenario's under it), created and checked before any work.
+
+    Each directory under it is still judged by :func:`prepare_run_dir`; but a root that is
+    a file, cannot be created or takes no new file fails every one of them, so it is one
+    line (exit 2) up front, not one error per scenario after the suite has started.
+    """
+    root = _without_dotdot(Path(root))
+    if root.exists() and not root.is_dir():
+        raise ConfigError("exists and is not a directory", key=flag, file=root)
+    try:
+        root.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"cannot create directory: {exc.strerror}", key=flag, file=root) from None
+    if unwritable(root) is not None:
+        raise ConfigError("directory is not writable", key=flag, file=root)
+    return root
+
+
 def check_output(path: Path, flag: str, make_parent: bool = False) -> Path:
     """An output file's path, checked before any work (exit 2 naming ``flag``).
 

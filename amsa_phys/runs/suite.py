@@ -8,6 +8,7 @@ cannot load or faults is an error result, not a crash of the whole suite.
 from __future__ import annotations
 
 import re
+import stat
 import tempfile
 import time
 from dataclasses import dataclass, field
@@ -16,7 +17,7 @@ from pathlib import Path
 from ..errors import AmsaError
 from ..model.configure import with_ros2
 from ..model.scenario import Scenario, load_scenario
-from ..model.yamlio import load_yaml
+from ..model.yamlio import MAX_FILE_BYTES, load_yaml, read_regular_file
 from .expect import Check, check_expectations
 from .rundir import MARKER, prepare_run_dir, unique_names
 from .single import run_scenario
@@ -42,11 +43,25 @@ class ScenarioResult:
 
 def has_expectations(path: Path) -> bool:
     """Cheap test: a YAML file with a top-level ``expect:`` key (it is loaded properly later,
-    so a broken scenario surfaces as an error rather than being skipped)."""
+    so a broken scenario surfaces as an error rather than being skipped).
+
+    Read as the loader reads (``read_regular_file``): a FIFO named ``x.yaml`` in the folder
+    hung the search, a link to ``/dev/zero`` filled the memory. A file the loader refuses
+    (not a regular file, over its size) is kept, so it surfaces as that one-line error too.
+    """
     try:
-        return bool(_EXPECT.search(path.read_text(encoding="utf-8", errors="replace")))
+        st = path.stat()
     except OSError:
         return False
+    if stat.S_ISDIR(st.st_mode):
+        return False
+    if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_FILE_BYTES:
+        return True
+    try:
+        text = read_regular_file(path, MAX_FILE_BYTES, "a YAML file")
+    except AmsaError:
+        return False
+    return bool(_EXPECT.search(text.decode("utf-8", errors="replace")))
 
 
 def in_run_directory(path: Path) -> bool:

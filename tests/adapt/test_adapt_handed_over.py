@@ -63,3 +63,15 @@ def test_adapt_refuses_a_huge_results_csv_in_one_line(tmp_path: Path, capsys) ->
     argv = ["adapt", str(sweep), "--scenario", str(scenario), "-o", str(tmp_path / "r.yaml")]
     code = main(argv)
     assert_one_line_refusal(code, capsys.readouterr().err, "file too large", "error: ")
+
+
+def test_a_scenario_yaml_that_is_a_fifo_is_named_as_one(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Not "records no scenario.yaml": the file is there, and is not a file."""
+    _, sweep = _sweep(tmp_path)
+    os.mkfifo(sweep / "scenario.yaml")
+    assert main(["adapt", str(sweep), "-o", str(tmp_path / "r.yaml")]) == 2
+    assert capsys.readouterr().err == (
+        f"error: {sweep / 'scenario.yaml'}: is not a regular file (a FIFO), expected a YAML file\n"
+    )

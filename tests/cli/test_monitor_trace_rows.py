@@ -64,3 +64,32 @@ def test_a_whole_trace_is_still_judged_on_every_row(
     capsys.readouterr()
     assert main(["monitor", str(rundir), FORMULA, "--json"]) == 1
     assert '"instant": 500.5' in capsys.readouterr().out
+
+
+def test_a_column_named_twice_is_refused_not_chosen(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``t,a,a``: the formula read the second ``a`` (it passed where the first failed); no
+    run writes a column twice, so the file is not a trace."""
+    (tmp_path / "trace.csv").write_text("t,a,a\n0,-1,1\n1,-1,1\n")
+    err = _refused(tmp_path, capsys)
+    assert err == f"error: {tmp_path / 'trace.csv'}:1: not a trace: the column 'a' is named twice"
+
+
+def test_instants_closer_than_any_run_logs_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Samples 1e-300 s apart: the period rounded to 0 and dividing by it was a traceback."""
+    rundir = _trace(tmp_path, "0,1\n1e-300,1\n2e-300,1\n")
+    err = _refused(rundir, capsys)
+    assert err == (
+        f"error: {rundir / 'trace.csv'}: the trace's instants are 1e-300 s apart: no run "
+        "logs faster than 10,000 Hz"
+    )
+
+
+def test_a_trace_at_the_fastest_log_rate_is_judged(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rundir = _trace(tmp_path, "".join(f"{i / 10_000!r},1\n" for i in range(50)))
+    assert main(["monitor", str(rundir), FORMULA]) == 0

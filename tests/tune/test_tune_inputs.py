@@ -52,3 +52,35 @@ def test_what_no_run_could_answer_is_refused_before_any(
     assert err.startswith(said)
     assert len(err.splitlines()) == 1
     assert "worst" not in out  # nothing ran
+
+
+def test_a_search_of_more_runs_than_a_sweep_may_have_is_refused_before_any(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each bound within its own, together 10^10 runs (centuries): refused as a sweep of
+    more than 1,000,000 runs is, before the first run (which would fail this test)."""
+
+    def no_run(*_: object) -> float:
+        raise AssertionError("a run started")
+
+    monkeypatch.setattr("amsa_phys.cli.tune.evaluate", no_run)
+    assert main([*ARGS, "--budget", "10000", "--box", "1000", "--seeds", "1000"]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        "error: --budget: 10,000 evaluations x 1000 contexts x 1000 seeds is "
+        "10,000,000,000 runs; a search has at most 1,000,000, as a sweep\n"
+    )
+
+
+def test_contexts_that_are_not_a_sweep_offer_what_tune_takes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``tune`` has no ``--scenario``: a directory that records no sweep scenario says to
+    give the contexts in the scenario (the message was ``adapt``'s, offering the flag)."""
+    assert main([*ARGS, "--budget", "2", "--contexts", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"error: {tmp_path}: records no scenario.yaml (not a sweep directory, or made before "
+        "sweeps recorded their scenario?); give the contexts in the scenario's sweep: "
+        "contexts instead\n"
+    )
