@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 import numbers
-import operator
 import os
 from collections.abc import Mapping
 from fractions import Fraction
@@ -22,7 +21,7 @@ from typing import Any
 
 from ..errors import ConfigError
 from ..model.configure import duration_option
-from ..model.params import short_repr
+from ..model.params import exact_int, short_repr
 from ..model.schema import MAX_SEED
 from ..requirements.objective import requirement_of
 from ..runs.sweep import MAX_RUNS, unknown_metric
@@ -36,12 +35,7 @@ EXECUTORS = ("batch", "local")
 def whole(value: Any, name: str, low: int, high: int | None) -> int:
     """An integer argument from ``low`` to ``high`` (None: no upper bound); a bool or a
     float is refused, as argparse's ``type=int`` refuses ``1.5``."""
-    try:
-        if isinstance(value, bool):
-            raise TypeError
-        number = operator.index(value)
-    except TypeError:
-        number = None
+    number = exact_int(value)
     if number is None or number < low or (high is not None and number > high):
         bounds = f"from {low:,} to {high:,}" if high is not None else f">= {low:,}"
         raise ConfigError(f"must be an integer {bounds}, got {short_repr(value)}", key=f"{name}=")

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError
-from ..model.params import short_repr
+from ..model.params import exact_int, short_repr
 from ..model.schema import MAX_SEED
 
 #: The largest picture side, in pixels (8K is 7,680): a frame is width x height x 3 bytes,
@@ -67,12 +67,7 @@ def seed(value: Any) -> int | None:
     """``reset(seed=...)``: None, or an integer a scenario's ``seed:`` may hold."""
     if value is None:
         return None
-    try:
-        if isinstance(value, bool):
-            raise TypeError
-        number = operator.index(value)
-    except TypeError:
-        number = None
+    number = exact_int(value)
     if number is None or not 0 <= number <= MAX_SEED:
         raise ConfigError(
             f"must be an integer from 0 to {MAX_SEED} (2**63 - 1), like seed: in a "

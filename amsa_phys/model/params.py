@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import math
+import operator
 import re
 import reprlib
 import sys
@@ -158,6 +159,17 @@ def yaml_type(value: Any) -> str:
 _REPR = reprlib.Repr()
 _REPR.maxlevel = 3
 _REPR.maxstring = _REPR.maxother = _REPR.maxlong = 40
+
+
+def exact_int(value: Any) -> int | None:
+    """``value`` as an integer if it is one (an ``int``, a numpy integer: ``__index__``),
+    else None: a bool or a float is refused, as argparse's ``type=int`` refuses ``1.5``."""
+    if isinstance(value, bool):
+        return None
+    try:
+        return operator.index(value)
+    except TypeError:
+        return None
 
 
 def short_repr(value: Any) -> str:
