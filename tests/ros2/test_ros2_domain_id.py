@@ -24,11 +24,10 @@ ENV = {"SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg", "PATH": "/usr/bin:/bin"}
 SCENARIO = ROOT / "scenarios" / "scenario1.yaml"
 
 
-@pytest.mark.parametrize("domain", ["abc", "300", "-1"])
-def test_an_unusable_domain_id_is_one_line_before_the_run(tmp_path: Path, domain: str) -> None:
-    out, err = tmp_path / "r", tmp_path / "err"
-    argv = ["-m", "amsa_phys", "run", str(SCENARIO), "--headless", "--no-plot", "-q"]
-    argv += ["--duration", "1", "--out", str(out), "--ros2", "MyFollowerController"]
+def _in_domain(tmp_path: Path, domain: str, argv: list[str]) -> list[str]:
+    """``python ARGV`` with ``ROS_DOMAIN_ID=domain`` in a private network: its stderr lines,
+    once it exited 2 and left no process behind."""
+    err = tmp_path / "err"
     script = tmp_path / "netns.sh"
     script.write_text(
         f"ip link set lo up\nROS_DOMAIN_ID='{domain}' {PY} {' '.join(argv)} 2> {err}\n"
@@ -37,7 +36,15 @@ def test_an_unusable_domain_id_is_one_line_before_the_run(tmp_path: Path, domain
     lines = err.read_text().splitlines()
     assert left == []
     assert rc == 2, lines
-    assert lines == [
+    return lines
+
+
+@pytest.mark.parametrize("domain", ["abc", "300", "-1"])
+def test_an_unusable_domain_id_is_one_line_before_the_run(tmp_path: Path, domain: str) -> None:
+    out = tmp_path / "r"
+    argv = ["-m", "amsa_phys", "run", str(SCENARIO), "--headless", "--no-plot", "-q"]
+    argv += ["--duration", "1", "--out", str(out), "--ros2", "MyFollowerController"]
+    assert _in_domain(tmp_path, domain, argv) == [
         f"error: --ros2: ROS_DOMAIN_ID={domain!r} is not a ROS 2 domain: an integer from 0 "
         "to 232 (unset: 0)"
     ]
@@ -66,17 +73,9 @@ def test_a_sweep_over_domains_refuses_an_unusable_one(
     data["ros2"] = ["MyFollowerController"]
     scenario = tmp_path / "s.yaml"
     scenario.write_text(yaml.safe_dump(data))
-    err = tmp_path / "err"
     argv = ["-m", "amsa_phys", "sweep", str(scenario), "--duration", "1", "-j", "3"]
     argv += ["--grid", "MyFollowerController.Kv=0.1,0.2,0.3", "--out", str(tmp_path / "sw")]
-    script = tmp_path / "netns.sh"
-    script.write_text(
-        f"ip link set lo up\nROS_DOMAIN_ID='{domain}' {PY} {' '.join(argv)} 2> {err}\n"
-    )
-    rc, left = in_private_network(script, ENV, tmp_path / "log")
-    lines = err.read_text().splitlines()
-    assert left == []
-    assert rc == 2, lines
+    lines = _in_domain(tmp_path, domain, argv)
     assert lines[-1].startswith(said), lines
     assert not any(line.startswith(("Traceback", "error")) for line in lines[:-1]), lines
     assert not (tmp_path / "sw").exists()  # refused before --out is made
